@@ -1,0 +1,5 @@
+"""``python -m frustum`` runs the ``frustum`` command."""
+
+from frustum.cli import main
+
+main()

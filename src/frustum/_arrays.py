@@ -1,0 +1,135 @@
+"""The one place where shapes, dtypes and finiteness are checked at the public boundary.
+
+Every checker returns the normalized array (C-contiguous float64) or raises the given ``FrustumError``
+subclass with a message ``<where>: <name> = <value> <problem>; <what would be valid>``. Kernels and
+internal helpers never validate: they trust what these functions return.
+"""
+
+from __future__ import annotations
+
+from typing import Any, TypeAlias
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from frustum.errors import FrustumError, GeometryError, TransformError
+
+__all__ = [
+    "Matrix4",
+    "Points",
+    "Vector3",
+    "as_direction",
+    "as_homogeneous_points",
+    "as_matrix",
+    "as_points",
+    "as_scalar",
+    "as_vector3",
+    "describe",
+]
+
+Matrix4: TypeAlias = NDArray[np.float64]
+"""A (4, 4) float64 homogeneous matrix, column-vector convention: ``P' = M @ P``."""
+Points: TypeAlias = NDArray[np.float64]
+"""An (N, 3) float64 array of points or vectors, one per row (or (N, 4) homogeneous, where stated)."""
+Vector3: TypeAlias = NDArray[np.float64]
+"""A (3,) float64 vector."""
+
+ErrorType: TypeAlias = type[FrustumError]
+
+
+def describe(value: Any, *, limit: int = 80) -> str:
+    """Short, readable text of a value for an error message: floats as Python writes them, long arrays cut."""
+    if isinstance(value, np.ndarray):
+        value = value.tolist()
+    if isinstance(value, list | tuple) and all(isinstance(v, int | float | np.number) for v in value):
+        text = "(" + ", ".join(repr(float(v)) for v in value) + ("," if len(value) == 1 else "") + ")"
+    elif isinstance(value, np.number):
+        text = repr(value.item())
+    else:
+        text = repr(value)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def _as_float_array(value: ArrayLike, name: str, where: str, error: ErrorType, expected: str) -> NDArray:
+    try:
+        array = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise error(f"{where}: {name} = {describe(value)} is not numeric; expected {expected}") from None
+    return np.ascontiguousarray(array)
+
+
+def as_scalar(value: Any, name: str, *, where: str, error: ErrorType = TransformError) -> float:
+    """Return `value` as a finite Python float, or raise `error` naming it."""
+    if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
+        array = np.asarray(value) if isinstance(value, np.ndarray) else None
+        if array is None or array.shape != ():
+            raise error(f"{where}: {name} = {describe(value)} is not a number; expected a finite real number")
+        value = array.item()
+    number = float(value)
+    if not np.isfinite(number):
+        raise error(f"{where}: {name} = {number!r} is not finite; expected a finite real number")
+    return number
+
+
+def as_vector3(value: ArrayLike, name: str, *, where: str, error: ErrorType = TransformError) -> Vector3:
+    """Return `value` as a finite (3,) float64 vector, or raise `error` naming it."""
+    vector = _as_float_array(value, name, where, error, "three finite numbers (x, y, z)")
+    if vector.shape != (3,):
+        raise error(
+            f"{where}: {name} = {describe(value)} has shape {vector.shape}; expected three numbers (x, y, z)"
+        )
+    if not np.isfinite(vector).all():
+        raise error(f"{where}: {name} = {describe(vector)} is not finite; coordinates must be finite numbers")
+    return vector
+
+
+def as_direction(value: ArrayLike, name: str, *, where: str, error: ErrorType = TransformError) -> Vector3:
+    """Return `value` normalized to unit length as a (3,) float64 vector; zero length raises `error`."""
+    vector = as_vector3(value, name, where=where, error=error)
+    length = float(np.linalg.norm(vector))
+    if length == 0.0 or not np.isfinite(length):
+        raise error(f"{where}: {name} = {describe(vector)} has zero length; give a nonzero direction")
+    return vector / length
+
+
+def as_matrix(value: ArrayLike, name: str = "matrix", *, where: str, error: ErrorType = TransformError) -> Matrix4:
+    """Return `value` as a finite, C-contiguous (4, 4) float64 matrix, or raise `error` naming it."""
+    matrix = _as_float_array(value, name, where, error, "a (4, 4) matrix of finite numbers")
+    if matrix.shape != (4, 4):
+        raise error(f"{where}: {name} has shape {matrix.shape}; expected a (4, 4) homogeneous matrix")
+    if not np.isfinite(matrix).all():
+        row, column = np.argwhere(~np.isfinite(matrix))[0]
+        raise error(
+            f"{where}: {name}[{row}, {column}] = {float(matrix[row, column])!r} is not finite; "
+            "matrix entries must be finite numbers"
+        )
+    return matrix
+
+
+def _as_rows(value: ArrayLike, width: int, name: str, where: str, error: ErrorType, what: str) -> NDArray:
+    rows = _as_float_array(value, name, where, error, f"an (N, {width}) array of {what}")
+    if rows.ndim == 2 and rows.shape[0] == 0 and rows.shape[1] in (0, width):
+        return np.empty((0, width), dtype=np.float64)
+    if rows.ndim == 1 and rows.size == 0:
+        return np.empty((0, width), dtype=np.float64)
+    if rows.ndim != 2 or rows.shape[1] != width:
+        raise error(f"{where}: {name} has shape {rows.shape}; expected (N, {width}) {what}, one per row")
+    bad = np.flatnonzero(~np.isfinite(rows).all(axis=1))
+    if bad.size:
+        i = int(bad[0])
+        raise error(
+            f"{where}: {name}[{i}] = {describe(rows[i])} is not finite; coordinates must be finite numbers"
+        )
+    return rows
+
+
+def as_points(value: ArrayLike, name: str = "points", *, where: str, error: ErrorType = GeometryError) -> Points:
+    """Return `value` as a finite, C-contiguous (N, 3) float64 array; (0, 3) is valid."""
+    return _as_rows(value, 3, name, where, error, "points (x, y, z)")
+
+
+def as_homogeneous_points(
+    value: ArrayLike, name: str = "points", *, where: str, error: ErrorType = GeometryError
+) -> Points:
+    """Return `value` as a finite, C-contiguous (N, 4) float64 array of homogeneous points (x, y, z, w)."""
+    return _as_rows(value, 4, name, where, error, "homogeneous points (x, y, z, w)")

@@ -1,0 +1,39 @@
+"""Adapters to the independent oracle libraries (test-only): PyGLM, SciPy, trimesh.transformations.
+
+Each adapter returns plain float64 numpy arrays in frustum's conventions, so tests compare like with like.
+The convention traps they encode are listed in ../shared/ORACLES.md.
+"""
+
+from __future__ import annotations
+
+from pyglm import glm
+import numpy as np
+
+
+def glm_vec(v) -> glm.dvec3:
+    """A float64 PyGLM vector (dvec3), so builders return float64 dmat4 (ORACLES trap 2)."""
+    return glm.dvec3(*map(float, v))
+
+
+def glm_matrix(m) -> np.ndarray:
+    """PyGLM matrix → numpy in mathematical layout: np.array(m) needs no transpose (ORACLES trap 1)."""
+    return np.array(m, dtype=np.float64)
+
+
+def glm_wxyz(q) -> np.ndarray:
+    """PyGLM quaternion → (w, x, y, z)."""
+    return np.array([q.w, q.x, q.y, q.z], dtype=np.float64)
+
+
+def assert_close(actual, expected, tol: float = 1e-12) -> None:
+    """Equal to `tol` relative to the larger of 1 and the expected magnitude (round-off scales with size)."""
+    actual, expected = np.asarray(actual, dtype=np.float64), np.asarray(expected, dtype=np.float64)
+    assert actual.shape == expected.shape, (actual.shape, expected.shape)
+    scale = max(1.0, float(np.abs(expected).max(initial=0.0)))
+    np.testing.assert_allclose(actual, expected, rtol=0, atol=tol * scale)
+
+
+def assert_same_rotation(q, r, tol: float = 1e-12) -> None:
+    """Quaternions equal up to sign (q and −q are one rotation)."""
+    q, r = np.asarray(q, dtype=np.float64), np.asarray(r, dtype=np.float64)
+    assert min(np.abs(q - r).max(), np.abs(q + r).max()) <= tol, (q, r)

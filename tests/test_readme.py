@@ -1,0 +1,38 @@
+"""README.md stays true: it opens with exactly two commands, and its Python tour runs."""
+
+from __future__ import annotations
+
+import re
+import shlex
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+README = (Path(__file__).parents[1] / "README.md").read_text(encoding="utf-8")
+BLOCKS = re.findall(r"```(\w*)\n(.*?)```", README, flags=re.DOTALL)
+
+
+def test_readme_opens_with_exactly_two_commands():
+    before_first_block = README.split("```", 1)[0]
+    assert before_first_block.strip().startswith("# frustum")
+    assert before_first_block.strip().count("\n") == 0, "nothing but the title may precede the two commands"
+    language, body = BLOCKS[0]
+    commands = body.strip().splitlines()
+    assert language == "bash" and len(commands) == 2
+    assert "pytest" in commands[1] and "pytest" not in commands[0]
+
+
+def test_readme_main_command_runs():
+    main_call = shlex.split(BLOCKS[0][1].strip().splitlines()[0].split("&&")[-1])
+    assert Path(main_call[0]).name == "frustum"
+    result = subprocess.run(
+        [sys.executable, "-m", "frustum", *main_call[1:]], capture_output=True, text=True, timeout=120, check=False
+    )
+    assert result.returncode == 0, result.stderr
+
+
+@pytest.mark.parametrize("index", [i for i, (language, _) in enumerate(BLOCKS) if language == "python"])
+def test_readme_python_tour_runs(index, capsys):
+    exec(compile(BLOCKS[index][1], "README.md", "exec"), {})
