@@ -8,12 +8,12 @@ import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
-from oracles import assert_close, assert_same_rotation, glm_matrix, glm_vec, glm_wxyz
 from pyglm import glm
 from scipy.spatial.transform import Rotation, Slerp
-from strategies import angles, axes, point_arrays
 
 from frustum import GeometryError, Quaternion, TransformError, rotate, slerp
+from oracles import assert_close, assert_same_rotation, glm_matrix, glm_vec, glm_wxyz
+from strategies import angles, axes, point_arrays
 
 components = st.floats(min_value=-10, max_value=10, allow_nan=False, allow_infinity=False)
 
@@ -190,7 +190,7 @@ ZERO = Quaternion(0.0, 0.0, 0.0, 0.0)
         (lambda: slerp(Quaternion.identity(), Quaternion.identity(), np.nan), TransformError, r"slerp: t = .*finite"),
         (lambda: Quaternion(float("nan"), 0, 0, 0), TransformError, r"Quaternion: w = nan is not finite"),
         (lambda: Quaternion.from_axis_angle((0, 0, 0), 1.0), TransformError, r"axis = .* has zero length"),
-        (lambda: Quaternion.from_matrix(np.diag([2.0, 1, 1])), TransformError, r"from_matrix: matrix is not a rotation"),
+        (lambda: Quaternion.from_matrix(np.diag([2.0, 1, 1])), TransformError, r"from_matrix: matrix is not a rot"),
         (lambda: Quaternion.from_matrix(np.diag([-1.0, 1, 1])), TransformError, r"not a rotation .*det = -1"),
         (lambda: Quaternion.from_matrix(rotate((0, 0, 1), 1.0, (1, 0, 0))), TransformError, r"last column"),
         (lambda: Quaternion.from_matrix(np.eye(2)), TransformError, r"shape \(2, 2\)"),

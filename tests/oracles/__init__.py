@@ -6,8 +6,8 @@ The convention traps they encode are listed in ../shared/ORACLES.md.
 
 from __future__ import annotations
 
-from pyglm import glm
 import numpy as np
+from pyglm import glm
 
 
 def glm_vec(v) -> glm.dvec3:
