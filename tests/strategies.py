@@ -11,9 +11,7 @@ from hypothesis.extra.numpy import arrays
 coordinates = st.floats(min_value=-100.0, max_value=100.0, allow_nan=False, allow_infinity=False)
 angles = st.floats(min_value=-2 * np.pi, max_value=2 * np.pi, allow_nan=False, allow_infinity=False)
 # Scale factors bounded away from 0 so that inverses are well conditioned.
-scale_factors = st.one_of(
-    st.floats(min_value=0.1, max_value=10.0), st.floats(min_value=-10.0, max_value=-0.1)
-)
+scale_factors = st.one_of(st.floats(min_value=0.1, max_value=10.0), st.floats(min_value=-10.0, max_value=-0.1))
 
 
 @st.composite

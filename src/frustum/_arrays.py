@@ -19,6 +19,7 @@ __all__ = [
     "Points",
     "Vector3",
     "as_direction",
+    "as_faces",
     "as_homogeneous_points",
     "as_matrix",
     "as_points",
@@ -133,3 +134,29 @@ def as_homogeneous_points(
 ) -> Points:
     """Return `value` as a finite, C-contiguous (N, 4) float64 array of homogeneous points (x, y, z, w)."""
     return _as_rows(value, 4, name, where, error, "homogeneous points (x, y, z, w)")
+
+
+def as_faces(
+    value: ArrayLike, vertex_count: int, name: str = "faces", *, where: str, error: ErrorType = GeometryError
+) -> NDArray[np.int64]:
+    """Return `value` as a C-contiguous (M, 3) int64 array of vertex indices in [0, vertex_count); (0, 3) is valid.
+
+    Indices must already be integers (an integer dtype): a float array is refused rather than rounded.
+    """
+    try:
+        faces = np.asarray(value)
+    except ValueError:  # ragged nested sequences
+        raise error(f"{where}: {name} = {describe(value)} is not an array; expected (M, 3) vertex indices") from None
+    if faces.size == 0 and (faces.ndim == 1 or (faces.ndim == 2 and faces.shape[1] in (0, 3))):
+        return np.empty((0, 3), dtype=np.int64)
+    if faces.ndim != 2 or faces.shape[1] != 3:
+        raise error(f"{where}: {name} has shape {faces.shape}; expected (M, 3) vertex indices, one triangle per row")
+    if faces.dtype == np.bool_ or not np.issubdtype(faces.dtype, np.integer):
+        raise error(f"{where}: {name} has dtype {faces.dtype}; expected integer vertex indices")
+    if faces.shape[0] and (faces.min() < 0 or faces.max() >= vertex_count):
+        i = int(np.flatnonzero(((faces < 0) | (faces >= vertex_count)).any(axis=1))[0])
+        raise error(
+            f"{where}: {name}[{i}] = {faces[i].tolist()} indexes outside the {vertex_count} vertices; "
+            f"indices must lie in [0, {vertex_count - 1}]"
+        )
+    return np.ascontiguousarray(faces, dtype=np.int64)

@@ -1,0 +1,18 @@
+"""The Numba options of every frustum kernel, chosen once (datashader's ``ngjit`` habit).
+
+``kernel`` compiles a single-thread function; ``parallel_kernel`` is for the few drivers whose loop over
+independent items pays for ``numba.prange``. Both cache the machine code on disk (``cache=True``) and release
+the GIL (``nogil=True``). No ``fastmath``: results must be the bytes the textbook path gives. With
+``NUMBA_DISABLE_JIT=1`` both decorators return the plain Python function and ``prange`` is ``range``, so the
+test suite can run (and measure coverage of) every kernel line as Python.
+"""
+
+from __future__ import annotations
+
+import numba
+
+__all__ = ["kernel", "parallel_kernel", "prange"]
+
+kernel = numba.njit(cache=True, nogil=True)
+parallel_kernel = numba.njit(cache=True, nogil=True, parallel=True)
+prange = numba.prange
