@@ -39,8 +39,11 @@ from frustum.errors import (
     GeometryError,
     OutputError,
     SceneFileError,
+    ShadingError,
     TransformError,
 )
+from frustum.frame import Frame
+from frustum.geometry import Mesh
 from frustum.projection import (
     MULTIVIEWS,
     Axonometric,
@@ -69,6 +72,9 @@ from frustum.projection import (
     viewport,
 )
 from frustum.quaternion import Quaternion, slerp
+from frustum.render import render
+from frustum.scene import Scene, SceneItem
+from frustum.shading import DirectionalLight, Material, blinn_phong
 from frustum.transforms import (
     Step,
     apply,
@@ -89,6 +95,7 @@ from frustum.transforms import (
     to_row_major,
     translate,
 )
+from frustum.visibility import backface_mask, plane_equations, signed_window_areas, viewing_position
 
 __all__ = [
     "MAX_KERNEL_PLANES",
@@ -108,9 +115,13 @@ __all__ = [
     "ClippedSegment",
     "ClippedTriangles",
     "ClippingError",
+    "DirectionalLight",
+    "Frame",
     "Frustum",
     "FrustumError",
     "GeometryError",
+    "Material",
+    "Mesh",
     "MultiView",
     "Oblique",
     "Orthographic",
@@ -120,7 +131,10 @@ __all__ = [
     "Projection",
     "Quaternion",
     "Ray",
+    "Scene",
     "SceneFileError",
+    "SceneItem",
+    "ShadingError",
     "Step",
     "TransformError",
     "ViewFrame",
@@ -130,6 +144,8 @@ __all__ = [
     "apply_to_directions",
     "apply_to_normals",
     "axonometric_rotation",
+    "backface_mask",
+    "blinn_phong",
     "cabinet",
     "cavalier",
     "clip_line",
@@ -153,9 +169,11 @@ __all__ = [
     "orthographic",
     "perspective",
     "perspective_onto_plane",
+    "plane_equations",
     "plane_from_point_normal",
     "reflect",
     "region_code",
+    "render",
     "rotate",
     "rotate_steps",
     "rotate_x",
@@ -163,6 +181,7 @@ __all__ = [
     "rotate_z",
     "scale",
     "shear",
+    "signed_window_areas",
     "slerp",
     "swaps_handedness",
     "to_row_major",
@@ -171,5 +190,6 @@ __all__ = [
     "trimetric",
     "trivially_accepted",
     "trivially_rejected",
+    "viewing_position",
     "viewport",
 ]

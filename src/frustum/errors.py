@@ -14,6 +14,7 @@ __all__ = [
     "GeometryError",
     "OutputError",
     "SceneFileError",
+    "ShadingError",
     "TransformError",
 ]
 
@@ -32,6 +33,10 @@ class TransformError(FrustumError):
 
 class CameraError(FrustumError):
     """A degenerate camera or projection: up parallel to the view direction, near <= 0, empty viewport."""
+
+
+class ShadingError(FrustumError):
+    """A bad material or light: non-finite or out-of-range coefficients, zero-length light direction."""
 
 
 class ClippingError(FrustumError):

@@ -1,0 +1,83 @@
+"""The rendered image: an 8-bit RGBA color buffer and a float32 depth buffer, top row first."""
+
+from __future__ import annotations
+
+import io
+import os
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from frustum._arrays import describe
+from frustum.errors import OutputError
+
+__all__ = ["Frame"]
+
+
+@dataclass(frozen=True, eq=False)
+class Frame:
+    """What ``render`` returns: ``color`` (H, W, 4) uint8 RGBA and ``depth`` (H, W) float32, top row first.
+
+    Row ``r`` of both arrays is window row ``y_w = H − 1 − r`` (OpenGL's readback flipped vertically, the way
+    images are stored). ``depth`` is window depth in [0, 1], 1.0 where nothing was drawn. Color is linear RGB,
+    not sRGB-encoded. Both arrays are read-only.
+    """
+
+    color: NDArray[np.uint8]
+    depth: NDArray[np.float32]
+
+    def __post_init__(self) -> None:
+        color = np.ascontiguousarray(self.color)
+        depth = np.ascontiguousarray(self.depth)
+        if color.dtype != np.uint8 or color.ndim != 3 or color.shape[2] != 4:
+            raise OutputError(
+                f"Frame: color has dtype {color.dtype} and shape {color.shape}; expected (H, W, 4) uint8 RGBA"
+            )
+        if depth.dtype != np.float32 or depth.shape != color.shape[:2]:
+            raise OutputError(
+                f"Frame: depth has dtype {depth.dtype} and shape {depth.shape}; expected {color.shape[:2]} float32"
+            )
+        color.flags.writeable = False
+        depth.flags.writeable = False
+        object.__setattr__(self, "color", color)
+        object.__setattr__(self, "depth", depth)
+
+    @property
+    def width(self) -> int:
+        return int(self.color.shape[1])
+
+    @property
+    def height(self) -> int:
+        return int(self.color.shape[0])
+
+    def to_pil(self):  # -> PIL.Image.Image
+        """The color buffer as a Pillow RGBA image."""
+        from PIL import Image
+
+        return Image.fromarray(np.array(self.color), mode="RGBA")
+
+    def save(self, path: str | os.PathLike) -> None:
+        """Write the color buffer as a PNG file (RGBA, 8 bits per channel).
+
+        Raises
+        ------
+        OutputError
+            If the suffix is not ``.png`` or the file cannot be written.
+        """
+        suffix = os.path.splitext(os.fspath(path))[1].lower()
+        if suffix != ".png":
+            raise OutputError(f"Frame.save: path = {describe(os.fspath(path))} has suffix {suffix!r}; expected '.png'")
+        try:
+            self.to_pil().save(path, format="PNG")
+        except OSError as error:
+            raise OutputError(
+                f"Frame.save: path = {describe(os.fspath(path))} cannot be written ({error.strerror or error}); "
+                "give a path in an existing, writable folder"
+            ) from None
+
+    def _repr_png_(self) -> bytes:
+        """PNG bytes of the color buffer, for Jupyter."""
+        buffer = io.BytesIO()
+        self.to_pil().save(buffer, format="PNG")
+        return buffer.getvalue()

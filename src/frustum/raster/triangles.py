@@ -1,0 +1,236 @@
+"""Triangle kernels: setup (clip, divide, viewport, snap, cull) and the tile fill (edge functions, depth test).
+
+Fixed point. Window x and y are snapped to 1/256 pixel: ``X = floor(x_w·256 + 0.5)`` (int64), and every
+edge function is evaluated exactly in int64 at pixel centres ``(256·i + 128, 256·j + 128)``. For the edge
+a → b, ``E_ab(p) = (X_b − X_a)(Y_p − Y_a) − (Y_b − Y_a)(X_p − X_a)``: positive on its left. Front faces are
+counter-clockwise in window coordinates (y up), so inside a front face all three edge functions are
+positive and ``E_12 + E_20 + E_01 = 2·area``.
+
+Top-left rule (y up, counter-clockwise): the interior lies left of every directed edge, so a *top* edge
+(horizontal, interior below it) runs right to left (``dy = 0, dx < 0``) and a *left* edge (interior to its
+right) runs downward (``dy < 0``). A pixel centre exactly on an edge belongs to the triangle only for top and
+left edges: the test is ``E >= 0`` on those and ``E > 0`` (``E − 1 >= 0`` in integers) on the others. Two
+triangles sharing an edge traverse it in opposite directions, so exactly one of them owns the centres on it.
+
+Triangle records (one per rasterized triangle, after clipping and culling):
+``tri_int`` (T, 11) int64: ``X0, Y0, X1, Y1, X2, Y2`` snapped corners, ``code = 2·face + back``, and the
+pixel bounding box ``i_min, i_max, j_min, j_max`` (inclusive, inside the image);
+``tri_float`` (T, 3, 5) float64 per corner: window depth ``z_w``, ``1/w_clip``, and the corner's barycentric
+weights with respect to the source face (one-hot for unclipped corners).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from frustum.raster._jit import kernel, parallel_kernel, prange
+from frustum.raster.clip import clip_triangle
+
+__all__ = [
+    "INT_FIELDS",
+    "SUBPIXEL",
+    "rasterize_tiles",
+    "setup_triangles",
+]
+
+SUBPIXEL = 256
+"""Subpixel steps per pixel (8 fractional bits), as in llvmpipe."""
+HALF_SUBPIXEL = 128
+INT_FIELDS = 11
+FLOAT_FIELDS = 5
+
+
+@kernel
+def _snap(value: float) -> int:
+    """Round a window coordinate to the 1/256 pixel grid: ``floor(v·256 + 0.5)``."""
+    return np.int64(math.floor(value * 256.0 + 0.5))
+
+
+@kernel
+def _first_centre(low: int) -> int:
+    """Smallest pixel index whose centre ``256·i + 128`` is >= `low` (fixed point)."""
+    return -((HALF_SUBPIXEL - low) // SUBPIXEL)
+
+
+@kernel
+def _setup_triangle(
+    corners: np.ndarray, weights: np.ndarray, a: int, b: int, c: int, code: int, view: np.ndarray,
+    size: np.ndarray, tri_int: np.ndarray, tri_float: np.ndarray, slot: int,
+) -> int:  # fmt: skip
+    """Divide, viewport, snap and cull the triangle of polygon corners a, b, c; write its record if slot >= 0.
+
+    corners (K, 4) clip coordinates and weights (K, 3) of a clipped polygon; view = (width/2, height/2);
+    size = (width, height, cull). Returns 1 if the triangle covers at least one pixel centre's bounding box
+    and survives culling, else 0. A clockwise triangle is culled when ``cull`` is set, otherwise its corners
+    1 and 2 are swapped (so it is counter-clockwise) and its ``back`` bit set. Zero area is always dropped.
+    """
+    # perspective divide, viewport and snap
+    xa = _snap((corners[a, 0] / corners[a, 3]) * view[0] + view[0])
+    ya = _snap((corners[a, 1] / corners[a, 3]) * view[1] + view[1])
+    xb = _snap((corners[b, 0] / corners[b, 3]) * view[0] + view[0])
+    yb = _snap((corners[b, 1] / corners[b, 3]) * view[1] + view[1])
+    xc = _snap((corners[c, 0] / corners[c, 3]) * view[0] + view[0])
+    yc = _snap((corners[c, 1] / corners[c, 3]) * view[1] + view[1])
+    # back-face test by the signed area in window space (twice the area, exact)
+    area = (xb - xa) * (yc - ya) - (xc - xa) * (yb - ya)
+    if area == 0:
+        return 0
+    back = 0
+    if area < 0:
+        if size[2] != 0:
+            return 0
+        back = 1
+        b, c = c, b
+        xb, xc = xc, xb
+        yb, yc = yc, yb
+    # pixel bounding box of the centres it may cover, clamped to the image
+    i_min = max(_first_centre(min(xa, min(xb, xc))), 0)
+    i_max = min((max(xa, max(xb, xc)) - HALF_SUBPIXEL) // SUBPIXEL, size[0] - 1)
+    j_min = max(_first_centre(min(ya, min(yb, yc))), 0)
+    j_max = min((max(ya, max(yb, yc)) - HALF_SUBPIXEL) // SUBPIXEL, size[1] - 1)
+    if i_min > i_max or j_min > j_max:
+        return 0
+    if slot < 0:
+        return 1
+    tri_int[slot, 0], tri_int[slot, 1], tri_int[slot, 2] = xa, ya, xb
+    tri_int[slot, 3], tri_int[slot, 4], tri_int[slot, 5] = yb, xc, yc
+    for v in range(3):
+        p = a if v == 0 else (b if v == 1 else c)
+        w = corners[p, 3]
+        tri_float[slot, v, 0] = (corners[p, 2] / w) * 0.5 + 0.5
+        tri_float[slot, v, 1] = 1.0 / w
+        for k in range(3):
+            tri_float[slot, v, 2 + k] = weights[p, k]
+    tri_int[slot, 6] = 2 * code + back
+    tri_int[slot, 7], tri_int[slot, 8], tri_int[slot, 9], tri_int[slot, 10] = i_min, i_max, j_min, j_max
+    return 1
+
+
+@parallel_kernel
+def setup_triangles(
+    faces: np.ndarray, clip: np.ndarray, codes: np.ndarray, planes: np.ndarray, view: np.ndarray,
+    options: np.ndarray, chunk_starts: np.ndarray, tri_int: np.ndarray, tri_float: np.ndarray,
+) -> None:  # fmt: skip
+    """Per face: trivial accept / reject by region codes, clip the rest, then set up each (fan) triangle.
+
+    faces (M, 3) int64, clip (N, 4) float64, codes (N,) int64, planes (P, 4) float64, view = (width/2,
+    height/2); options = (width, height, cull, face_offset, chunk, write) int64. Faces are processed in
+    chunks of ``chunk`` (chunk c = faces [c·chunk, (c+1)·chunk)). With write = 0, ``chunk_starts[c]`` receives
+    the number of triangles chunk c produces; with write = 1, chunk c writes its records from slot
+    ``chunk_starts[c]`` on, in face order (so the output order never depends on the thread count).
+    """
+    size = options[0:3]
+    face_offset, chunk, write = options[3], options[4], options[5]
+    face_count = faces.shape[0]
+    chunk_count = (face_count + chunk - 1) // chunk
+    capacity = 3 + planes.shape[0]
+    for c in prange(chunk_count):
+        positions = np.empty((2, capacity, 4))
+        weights = np.empty((2, capacity, 3))
+        slot = chunk_starts[c] if write != 0 else -1
+        produced = 0
+        for f in range(c * chunk, min((c + 1) * chunk, face_count)):
+            i0, i1, i2 = faces[f, 0], faces[f, 1], faces[f, 2]
+            c0, c1, c2 = codes[i0], codes[i1], codes[i2]
+            if (c0 & c1 & c2) != 0:  # trivial reject: all corners outside one plane
+                continue
+            if (c0 | c1 | c2) == 0:  # trivial accept: copy the corners, one-hot weights
+                for j in range(4):
+                    positions[0, 0, j], positions[0, 1, j], positions[0, 2, j] = clip[i0, j], clip[i1, j], clip[i2, j]
+                for i in range(3):
+                    for j in range(3):
+                        weights[0, i, j] = 1.0 if i == j else 0.0
+                count = 3
+            else:  # Sutherland–Hodgman against the view volume
+                count = clip_triangle(clip[i0], clip[i1], clip[i2], planes, positions, weights)
+            for k in range(1, count - 1):  # fan (0, k, k + 1)
+                made = _setup_triangle(
+                    positions[0], weights[0], 0, k, k + 1, face_offset + f, view, size, tri_int, tri_float, slot
+                )
+                produced += made
+                if slot >= 0:
+                    slot += made
+        if write == 0:
+            chunk_starts[c] = produced
+
+
+@kernel
+def _fill_triangle(
+    t: int, tri_int: np.ndarray, tri_float: np.ndarray, tile: np.ndarray,
+    depth: np.ndarray, codes: np.ndarray, bary: np.ndarray,
+) -> None:  # fmt: skip
+    """Edge-function fill of triangle t inside one tile: top-left rule, depth test "less", deferred attributes.
+
+    tile = (i0, i1, j0, j1): the pixel columns [i0, i1) and window rows [j0, j1) this tile owns. For each
+    covered pixel whose depth ``z = (E_12·z_0 + E_20·z_1 + E_01·z_2) / (2·area)`` (affine in screen space) is
+    less than ``depth``, writes depth (float32), ``codes = tri_int[t, 6]`` and the perspective-correct
+    barycentric weights (u1, u2) of the pixel with respect to the source face (float32). Buffers are top row
+    first: window row j is array row ``H − 1 − j``.
+    """
+    height = depth.shape[0]
+    x0, y0, x1, y1, x2, y2 = tri_int[t, 0], tri_int[t, 1], tri_int[t, 2], tri_int[t, 3], tri_int[t, 4], tri_int[t, 5]
+    i_min, i_max = max(tri_int[t, 7], tile[0]), min(tri_int[t, 8], tile[1] - 1)
+    j_min, j_max = max(tri_int[t, 9], tile[2]), min(tri_int[t, 10], tile[3] - 1)
+    if i_min > i_max or j_min > j_max:
+        return
+    # edge a → b: E = dx·(Y − Ya) − dy·(X − Xa); bias 0 on top/left edges, 1 elsewhere (E − bias >= 0)
+    dx0, dy0 = x2 - x1, y2 - y1  # edge 1 → 2, opposite corner 0
+    dx1, dy1 = x0 - x2, y0 - y2  # edge 2 → 0
+    dx2, dy2 = x1 - x0, y1 - y0  # edge 0 → 1
+    bias0 = 0 if (dy0 < 0 or (dy0 == 0 and dx0 < 0)) else 1
+    bias1 = 0 if (dy1 < 0 or (dy1 == 0 and dx1 < 0)) else 1
+    bias2 = 0 if (dy2 < 0 or (dy2 == 0 and dx2 < 0)) else 1
+    area = float(dx2 * (y2 - y0) - dy2 * (x2 - x0))
+    z0, z1, z2 = tri_float[t, 0, 0], tri_float[t, 1, 0], tri_float[t, 2, 0]
+    q0, q1, q2 = tri_float[t, 0, 1], tri_float[t, 1, 1], tri_float[t, 2, 1]
+    code = tri_int[t, 6]
+    px0 = SUBPIXEL * i_min + HALF_SUBPIXEL
+    for j in range(j_min, j_max + 1):
+        py = SUBPIXEL * j + HALF_SUBPIXEL
+        e0 = dx0 * (py - y1) - dy0 * (px0 - x1)
+        e1 = dx1 * (py - y2) - dy1 * (px0 - x2)
+        e2 = dx2 * (py - y0) - dy2 * (px0 - x0)
+        row = height - 1 - j
+        for i in range(i_min, i_max + 1):
+            if e0 >= bias0 and e1 >= bias1 and e2 >= bias2:
+                f0, f1, f2 = float(e0), float(e1), float(e2)
+                z = np.float32(((f0 * z0 + f1 * z1) + f2 * z2) / area)
+                if z < depth[row, i]:
+                    depth[row, i] = z
+                    codes[row, i] = code
+                    # perspective-correct weights b_k = (E_k / w_k) / Σ E_j / w_j, then onto the source face
+                    g0, g1, g2 = f0 * q0, f1 * q1, f2 * q2
+                    total = (g0 + g1) + g2
+                    b0, b1, b2 = g0 / total, g1 / total, g2 / total
+                    for k in range(2):
+                        bary[row, i, k] = np.float32(
+                            (b0 * tri_float[t, 0, 3 + k] + b1 * tri_float[t, 1, 3 + k]) + b2 * tri_float[t, 2, 3 + k]
+                        )
+            e0 -= dy0 * SUBPIXEL
+            e1 -= dy1 * SUBPIXEL
+            e2 -= dy2 * SUBPIXEL
+
+
+@parallel_kernel
+def rasterize_tiles(
+    tri_int: np.ndarray, tri_float: np.ndarray, tile_starts: np.ndarray, tile_triangles: np.ndarray,
+    tiling: np.ndarray, depth: np.ndarray, codes: np.ndarray, bary: np.ndarray,
+) -> None:  # fmt: skip
+    """Each tile owns its pixels of ``depth``, ``codes`` and ``bary``: no write races, deterministic output.
+
+    tiling = (tile_size, tiles_x) int64; tile ``t`` covers columns ``[tx·s, tx·s + s)`` and window rows
+    ``[ty·s, ty·s + s)`` with ``tx = t % tiles_x``, ``ty = t // tiles_x``; its triangles, in drawing order, are
+    ``tile_triangles[tile_starts[t]:tile_starts[t + 1]]``.
+    """
+    size, tiles_x = tiling[0], tiling[1]
+    height, width = depth.shape[0], depth.shape[1]
+    for t in prange(tile_starts.shape[0] - 1):
+        tile = np.empty(4, dtype=np.int64)
+        tile[0] = (t % tiles_x) * size
+        tile[1] = min(tile[0] + size, width)
+        tile[2] = (t // tiles_x) * size
+        tile[3] = min(tile[2] + size, height)
+        for k in range(tile_starts[t], tile_starts[t + 1]):
+            _fill_triangle(tile_triangles[k], tri_int, tri_float, tile, depth, codes, bary)

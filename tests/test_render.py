@@ -1,0 +1,294 @@
+"""The renderer against the slow reference rasterizer; top-left rule, near plane, determinism, bad input."""
+
+from __future__ import annotations
+
+import io
+import math
+
+import numba
+import numpy as np
+import pytest
+import trimesh
+from PIL import Image
+from tests.reference_raster import reference_render
+
+from frustum import Camera, CameraError, FrustumError, GeometryError, Orthographic, Perspective, clip_triangles
+from frustum.errors import ShadingError
+from frustum.frame import Frame
+from frustum.geometry import Mesh
+from frustum.raster.vertices import transform_vertices
+from frustum.render import _item_matrices, render, setup
+from frustum.scene import Scene
+from frustum.shading import DirectionalLight, Material
+from frustum.transforms import apply_homogeneous, rotate_y, translate
+from frustum.visibility import backface_mask
+
+BACKGROUND = (26 / 255, 26 / 255, 31 / 255, 1.0)
+LIGHT = DirectionalLight(direction=(-0.4, -0.8, -0.5))
+
+
+def sphere_mesh(subdivisions: int = 1, radius: float = 1.0) -> Mesh:
+    sphere = trimesh.creation.icosphere(subdivisions=subdivisions, radius=radius)
+    return Mesh(sphere.vertices, sphere.faces, vertex_normals=sphere.vertex_normals)
+
+
+def open_cylinder() -> Mesh:
+    """An open tube (no caps): its inside shows through the ends, so back faces are visible."""
+    tube = trimesh.creation.cylinder(radius=0.6, height=1.6, sections=12)
+    keep = np.abs(tube.face_normals[:, 2]) < 0.5  # drop the caps
+    return Mesh(tube.vertices, tube.faces[keep])
+
+
+def small_scene() -> tuple[Scene, Camera]:
+    """Two items (one moved and turned), a ground quad crossing the near plane and reaching behind the eye."""
+    scene = Scene(lights=[LIGHT])
+    scene.add(sphere_mesh(1), material=Material(color=(0.8, 0.5, 0.3)))
+    scene.add(
+        open_cylinder(), material=Material(color=(0.3, 0.6, 0.9)), transform=translate(1.6, 0.2, -0.5) @ rotate_y(0.7)
+    )
+    ground = Mesh(
+        [[-20.0, -1.2, -20.0], [20.0, -1.2, -20.0], [20.0, -1.2, 20.0], [-20.0, -1.2, 20.0]], [[0, 2, 1], [0, 3, 2]]
+    )
+    scene.add(ground, material=Material(color=(0.5, 0.7, 0.4), specular=0.0))
+    camera = Camera.look_at(
+        (0.4, 0.9, 3.2), (0.3, 0.0, 0.0), (0, 1, 0), projection=Perspective(1.0, 0.3, 30.0), width=48, height=36
+    )
+    return scene, camera
+
+
+@pytest.mark.parametrize("shading", ["phong", None])
+@pytest.mark.parametrize("cull", [True, False])
+def test_render_equals_reference_byte_for_byte(shading, cull):
+    scene, camera = small_scene()
+    frame = render(scene, camera, shading=shading, background=BACKGROUND, cull_back_faces=cull)
+    color, depth = reference_render(scene, camera, shading=shading, background=BACKGROUND, cull_back_faces=cull)
+    assert frame.color.shape == (36, 48, 4) and frame.depth.dtype == np.float32
+    assert (frame.depth < 1.0).mean() > 0.5  # the scene fills most of the image: the test is not vacuous
+    np.testing.assert_array_equal(frame.depth, depth)
+    np.testing.assert_array_equal(frame.color, color)
+
+
+def test_two_sided_lighting_shows_the_inside_of_an_open_surface():
+    scene = Scene(lights=[LIGHT]).add(open_cylinder(), material=Material(color=(0.3, 0.6, 0.9)))
+    camera = Camera.look_at(
+        (0.0, 0.0, 3.0), (0, 0, 0), (0, 1, 0), projection=Perspective(0.9, 0.5, 10.0), width=40, height=40
+    )
+    culled = render(scene, camera, cull_back_faces=True)
+    both = render(scene, camera, cull_back_faces=False)
+    seen_through = (culled.depth == 1.0) & (both.depth < 1.0)
+    assert seen_through.sum() > 20  # the tube's inner wall, visible through its open end
+    color, depth = reference_render(scene, camera, cull_back_faces=False)
+    np.testing.assert_array_equal(both.color, color)
+    np.testing.assert_array_equal(both.depth, depth)
+
+
+# --- the top-left rule ---------------------------------------------------------------------------------------
+
+
+def window_camera(width: int = 48, height: int = 40) -> Camera:
+    """Orthographic camera whose world x, y are window x, y (y up): pixel centres at half-integers."""
+    eye = (width / 2, height / 2, 10.0)
+    return Camera.look_at(
+        eye,
+        (width / 2, height / 2, 0.0),
+        (0, 1, 0),
+        projection=Orthographic(height, 1.0, 20.0),
+        width=width,
+        height=height,
+    )
+
+
+def coverage(points, faces, camera) -> np.ndarray:
+    """(H, W) bool coverage of one mesh, flat shading, no culling surprises (faces are counter-clockwise)."""
+    scene = Scene().add(Mesh(points, faces))
+    return render(scene, camera, shading=None).depth < 1.0
+
+
+def test_two_triangles_sharing_an_edge_cover_every_pixel_once():
+    camera = window_camera()
+    # a quad with corners on pixel centres, so whole rows and columns of centres lie exactly on its edges
+    quad = [[8.5, 4.5, 0.0], [40.5, 4.5, 0.0], [40.5, 30.5, 0.0], [8.5, 30.5, 0.0]]
+    first = coverage(quad, [[0, 1, 2]], camera)
+    second = coverage(quad, [[0, 2, 3]], camera)
+    assert not (first & second).any()  # no double hits on the shared diagonal
+    expected = np.zeros((40, 48), dtype=bool)
+    # top-left rule: the left edge x = 8.5 and the top edge y = 30.5 are in, right and bottom edges out
+    for j in range(5, 31):
+        expected[40 - 1 - j, 8:40] = True
+    np.testing.assert_array_equal(first | second, expected)
+
+
+def test_fan_around_a_vertex_covers_every_pixel_once():
+    camera = window_camera()
+    centre = [24.5, 20.5, 0.0]
+    ring = [[24.5 + 12 * math.cos(a), 20.5 + 12 * math.sin(a), 0.0] for a in np.linspace(0, 2 * math.pi, 13)[:-1]]
+    ring += [[36.5, 20.5, 0.0], [24.5, 32.5, 0.0], [12.5, 8.5, 0.0]]  # exact centres among them
+    ring = sorted(ring, key=lambda p: math.atan2(p[1] - 20.5, p[0] - 24.5))
+    points = [centre, *ring]
+    faces = [[0, 1 + k, 1 + (k + 1) % len(ring)] for k in range(len(ring))]
+    hits = np.zeros((40, 48), dtype=np.int64)
+    for face in faces:
+        hits += coverage(points, [face], camera)
+    assert hits.max() == 1  # no pixel twice
+    np.testing.assert_array_equal(hits == 1, coverage(points, faces, camera))  # no gaps: the union is the fan
+    assert hits[40 - 1 - 20, 24] == 1  # the shared centre vertex itself is covered exactly once
+
+
+# --- near plane and behind the eye ---------------------------------------------------------------------------
+
+
+def test_ground_reaching_behind_the_eye_stays_below_the_horizon():
+    # a level camera above an infinite-looking floor: wrap-around would paint the upper half of the image
+    floor = Mesh(
+        [[-50.0, -1.0, -50.0], [50.0, -1.0, -50.0], [50.0, -1.0, 50.0], [-50.0, -1.0, 50.0]], [[0, 2, 1], [0, 3, 2]]
+    )
+    scene = Scene(lights=[LIGHT]).add(floor)
+    camera = Camera.look_at(
+        (0.0, 0.0, 0.0), (0.0, 0.0, -1.0), (0, 1, 0), projection=Perspective(1.2, 0.1, 40.0), width=40, height=30
+    )
+    frame = render(scene, camera, cull_back_faces=True)
+    covered = frame.depth < 1.0
+    assert not covered[:15].any()  # rows above the horizon (top half, top row first) see only background
+    assert covered[-1].all()  # the bottom row is floor right up to the near plane
+    assert (frame.depth[covered] >= 0.0).all()
+    color, depth = reference_render(scene, camera)
+    np.testing.assert_array_equal(frame.depth, depth)
+    np.testing.assert_array_equal(frame.color, color)
+
+
+def test_triangle_entirely_behind_the_eye_draws_nothing():
+    behind = Mesh([[-1.0, -1.0, 2.0], [1.0, -1.0, 2.0], [0.0, 1.0, 2.0]], [[0, 1, 2]])
+    scene = Scene(lights=[LIGHT]).add(behind)
+    camera = Camera.look_at((0.0, 0.0, 0.0), (0.0, 0.0, -1.0), (0, 1, 0), width=16, height=16)
+    for cull in (True, False):
+        assert (render(scene, camera, cull_back_faces=cull).depth == 1.0).all()
+
+
+# --- fast path against the textbook path ---------------------------------------------------------------------
+
+
+def test_fast_path_window_coordinates_and_culling_equal_the_textbook_path():
+    mesh = sphere_mesh(2, radius=0.8)
+    camera = Camera.look_at(
+        (0.3, 0.5, 3.0), (0, 0, 0), (0, 1, 0), projection=Perspective(0.9, 0.5, 10.0), width=64, height=48
+    )
+    item = Scene().add(mesh).items[0]
+    clip = np.empty((mesh.vertex_count, 4))
+    world, normals = np.empty((mesh.vertex_count, 3)), np.empty((mesh.vertex_count, 3))
+    codes = np.empty(mesh.vertex_count, dtype=np.int64)
+    from frustum.clipping import VIEW_VOLUME_PLANES
+
+    transform_vertices(
+        mesh.vertices,
+        mesh.vertex_normals,
+        _item_matrices(item, camera),
+        VIEW_VOLUME_PLANES,
+        clip,
+        world,
+        normals,
+        codes,
+    )
+    # clip coordinates: the textbook apply_homogeneous (round-off of a different summation order only)
+    np.testing.assert_allclose(clip, apply_homogeneous(camera.clip_from_world, mesh.vertices), rtol=0, atol=1e-12)
+    assert clip_triangles(clip, mesh.faces).faces.shape == mesh.faces.shape  # wholly inside: nothing clipped
+    tri_int, tri_float = setup(mesh.faces, clip, codes, camera, cull=True)
+    faces_drawn = tri_int[:, 6] // 2
+    # the kept faces are the front faces of the textbook back-face test, less those whose bounding box holds
+    # no pixel centre (setup drops them: they cannot cover a pixel)
+    front = np.flatnonzero(~backface_mask(mesh.vertices, mesh.faces, camera, "window"))
+    assert np.isin(faces_drawn, front).all()
+    window = camera.project(mesh.vertices)
+    dropped = window[mesh.faces[np.setdiff1d(front, faces_drawn)]]  # (D, 3, 3)
+    low, high = np.floor(dropped.min(axis=1)[:, :2] - 0.5), np.floor(dropped.max(axis=1)[:, :2] - 0.5)
+    assert len(dropped) < len(front) // 10 and (low == high).any(axis=1).all()  # no centre strictly inside
+    window = camera.project(mesh.vertices)
+    corners = window[mesh.faces[faces_drawn]]  # (T, 3, 3)
+    snapped = tri_int[:, :6].reshape(-1, 3, 2) / 256.0
+    assert np.abs(snapped - corners[:, :, :2]).max() <= 0.5 / 256 + 1e-9  # snapping moves a point <= 1/512 px
+    np.testing.assert_allclose(tri_float[:, :, 0], corners[:, :, 2], rtol=0, atol=1e-12)  # depth: round-off only
+
+
+# --- determinism ---------------------------------------------------------------------------------------------
+
+
+def test_identical_bytes_across_runs_and_thread_counts():
+    scene, camera = small_scene()
+    first = render(scene, camera, background=BACKGROUND)
+    again = render(scene, camera, background=BACKGROUND)
+    threads = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        single = render(scene, camera, background=BACKGROUND)
+    finally:
+        numba.set_num_threads(threads)
+    for other in (again, single):
+        assert first.color.tobytes() == other.color.tobytes()
+        assert first.depth.tobytes() == other.depth.tobytes()
+
+
+# --- frame and output ----------------------------------------------------------------------------------------
+
+
+def test_frame_png_round_trip(tmp_path):
+    scene, camera = small_scene()
+    frame = render(scene, camera)
+    path = tmp_path / "out.png"
+    frame.save(path)
+    np.testing.assert_array_equal(np.asarray(Image.open(path)), frame.color)
+    np.testing.assert_array_equal(np.asarray(Image.open(io.BytesIO(frame._repr_png_()))), frame.color)
+    assert not frame.color.flags.writeable and not frame.depth.flags.writeable
+
+
+def test_frame_save_rejects_other_suffixes(tmp_path):
+    frame = Frame(np.zeros((2, 3, 4), np.uint8), np.ones((2, 3), np.float32))
+    with pytest.raises(FrustumError, match=r"suffix '\.jpg'"):
+        frame.save(tmp_path / "out.jpg")
+    with pytest.raises(FrustumError, match="cannot be written"):
+        frame.save(tmp_path / "missing" / "out.png")
+
+
+# --- bad input -----------------------------------------------------------------------------------------------
+
+
+def test_empty_scene_renders_background_only():
+    camera = Camera.look_at((0, 0, 3), (0, 0, 0), (0, 1, 0), width=8, height=6)
+    frame = render(Scene(lights=[LIGHT]), camera, background=BACKGROUND)
+    assert (frame.color == [26, 26, 31, 255]).all() and (frame.depth == 1.0).all()
+    empty_mesh = Scene(lights=[LIGHT]).add(Mesh(np.empty((0, 3)), np.empty((0, 3), dtype=int)))
+    assert (render(empty_mesh, camera).depth == 1.0).all()
+
+
+def test_bad_meshes_raise_geometry_errors():
+    with pytest.raises(GeometryError, match=r"vertices\[1\] = .*nan.* not finite"):
+        Mesh([[0, 0, 0], [np.nan, 0, 0], [0, 1, 0]], [[0, 1, 2]])
+    with pytest.raises(GeometryError, match=r"faces\[0\] = \[0, 1, 3\] indexes outside the 3 vertices"):
+        Mesh([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 3]])
+
+
+def test_zero_size_image_raises_camera_error():
+    with pytest.raises(CameraError, match="width = 0"):
+        Camera.look_at((0, 0, 3), (0, 0, 0), (0, 1, 0), width=0, height=10)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "fragment"),
+    [({"ambient": float("nan")}, "ambient = nan"), ({"shininess": float("inf")}, "shininess = inf"),
+     ({"color": (1.0, np.nan, 0.0)}, "color"), ({"diffuse": -1.0}, "negative")],
+)  # fmt: skip
+def test_bad_material_values_raise(kwargs, fragment):
+    with pytest.raises(ShadingError, match=fragment):
+        Material(**kwargs)
+
+
+def test_bad_render_arguments_raise():
+    scene, camera = small_scene()
+    with pytest.raises(FrustumError, match=r"shading = 'gouraud' is unknown; expected one of 'none', 'phong'"):
+        render(scene, camera, shading="gouraud")
+    with pytest.raises(FrustumError, match="background"):
+        render(scene, camera, background=(0, 0, 2, 1))
+    with pytest.raises(FrustumError, match="needs exactly one"):
+        render(Scene().add(sphere_mesh(0)), camera)
+    with pytest.raises(ShadingError, match="zero length"):
+        DirectionalLight(direction=(0, 0, 0))
+    with pytest.raises(FrustumError, match="not a Scene"):
+        render([], camera)
