@@ -8,7 +8,9 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
+from PIL import Image
 
 README = (Path(__file__).parents[1] / "README.md").read_text(encoding="utf-8")
 BLOCKS = re.findall(r"```(\w*)\n(.*?)```", README, flags=re.DOTALL)
@@ -24,13 +26,21 @@ def test_readme_opens_with_exactly_two_commands():
     assert "pytest" in commands[1] and "pytest" not in commands[0]
 
 
-def test_readme_main_command_runs():
+def test_readme_main_command_renders_the_example_scene(tmp_path):
     main_call = shlex.split(BLOCKS[0][1].strip().splitlines()[0].split("&&")[-1])
-    assert Path(main_call[0]).name == "frustum"
+    assert main_call[:2] == [".venv/bin/python", "examples/render_example.py"]
+    out = tmp_path / "example.png"
+    script = Path(__file__).parents[1] / main_call[1]
     result = subprocess.run(
-        [sys.executable, "-m", "frustum", *main_call[1:]], capture_output=True, text=True, timeout=120, check=False
-    )
+        [sys.executable, str(script), str(out), "--width", "96", "--height", "64"],
+        capture_output=True, text=True, timeout=300, check=False,
+    )  # fmt: skip
     assert result.returncode == 0, result.stderr
+    image = np.asarray(Image.open(out))
+    assert image.shape == (64, 96, 4)
+    # the torus and the plate cover part of the image, the background the rest
+    background = np.all(image == image[0, 0], axis=2)
+    assert 0.2 < background.mean() < 0.9
 
 
 @pytest.mark.parametrize("index", [i for i, (language, _) in enumerate(BLOCKS) if language == "python"])
