@@ -400,6 +400,14 @@ def test_clip_polygon_output_is_inside_and_clipping_is_idempotent(triangle):
     assert (distance_to_boundary(twice, once) <= tolerance).all()
 
 
+def test_polygon_in_the_eye_plane_is_invisible():
+    # every vertex has w = 0: clipping collapses it onto the clip-space origin, which is no visible point
+    # (Hypothesis found this one: a subnormal x made the first pass keep origin-like vertices)
+    triangle = np.array([[2.2250738585072014e-308, 0, 0, 0], [-2.4375, 0, 0, 0], [0, 0, 0, 0.0]])
+    assert len(clip_polygon(triangle).vertices) == 0
+    assert len(clip_polygon([[1.0, 0, 0, 0], [0, 1.0, 0, 0], [0, 0, 1.0, 0]]).vertices) == 0
+
+
 def test_clip_polygon_area_never_grows_in_ndc():
     rng = np.random.default_rng(13)
     for _ in range(300):

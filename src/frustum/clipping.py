@@ -523,7 +523,9 @@ def clip_polygon(
     -------
     ClippedPolygon
         ``vertices`` (M, 4) and ``attributes`` (M, C) or None. A polygon wholly inside comes back unchanged;
-        one that keeps fewer than 3 vertices (it touches the volume at a point or an edge) comes back empty.
+        one that keeps fewer than 3 vertices (it touches the volume at a point or an edge), or whose every
+        vertex has w <= 0 (it collapsed onto the clip-space origin, e.g. a triangle lying in the eye plane),
+        comes back empty.
 
     Raises
     ------
@@ -545,7 +547,9 @@ def clip_polygon(
         if values.shape[0] == 0:
             break
         values = _clip_against_plane(values, plane)
-    if values.shape[0] < 3:  # touching a plane at a point or along an edge leaves no area
+    # touching a plane at a point or along an edge leaves no area; and a polygon with no vertex of w > 0 is
+    # collapsed onto the clip-space origin (0, 0, 0, 0), the one code-0 point that is no visible position
+    if values.shape[0] < 3 or not (values[:, 3] > 0).any():
         values = values[:0]
     if attributes is None:
         return ClippedPolygon(values[:, :4], None)

@@ -4,13 +4,17 @@ Fast path, per scene item (one compiled pass each, buffers shared between items)
 
 1. ``raster.vertices.transform_vertices``: clip = clip_from_world·world_from_model·P, world positions and
    normals, region codes (parallel over vertices).
-2. ``raster.triangles.setup_triangles``: trivial accept / reject, Sutherland–Hodgman clipping of crossing
-   triangles against the view volume, perspective divide, viewport, snap to 1/256 pixel, back-face culling
-   by signed window area, pixel bounding box (parallel over chunks of faces: count, prefix sum, write).
+2. ``raster.triangles.window_vertices`` then ``setup_triangles``: perspective divide, viewport and snap to
+   1/256 pixel once per vertex inside the view volume; per face trivial accept (those per-vertex records, no
+   clip work) / reject, Sutherland–Hodgman clipping of crossing triangles against the view volume (divide,
+   viewport, snap per clipped corner), back-face culling by signed window area, pixel bounding box (parallel
+   over chunks of faces: count, prefix sum, write).
 3. ``raster.tiles``: bin the triangles into square tiles, keeping drawing order inside each tile.
 4. ``raster.triangles.rasterize_tiles``: edge functions with the top-left rule, depth test "less" against a
-   float32 buffer cleared to 1.0, perspective-correct barycentrics stored per pixel (parallel over tiles).
-5. ``raster.shade.shade_pixels``: deferred Blinn-Phong (or flat color) once per visible pixel.
+   float32 buffer cleared to 1.0, perspective-correct barycentrics stored per pixel (parallel over tiles; the
+   first drawn mesh's pass also clears each tile's depth and face codes, so no numpy fill of the buffers).
+5. ``raster.shade.shade_pixels``: deferred Blinn-Phong (or flat color) once per visible pixel; the last
+   item's pass (rasterization complete) also paints the background pixels.
 
 The textbook path is the public stage functions (``Camera.project``, ``clip_triangles``,
 ``visibility.backface_mask``); ``tests/test_render.py`` holds both paths equal.
@@ -82,28 +86,39 @@ def render(
     mode, light = _check_arguments(scene, camera, shading, cull_back_faces, where)
     background_bytes = _background_bytes(background, where)
     height, width = camera.height, camera.width
-    depth = np.ones((height, width), dtype=np.float32)
-    codes = np.full((height, width), -1, dtype=np.int64)
-    bary = np.zeros((height, width, 2), dtype=np.float32)
+    # uninitialized: the first rasterized item clears depth and codes tile by tile, the last shading pass
+    # paints the background (both inside the parallel kernels); numpy fills only when no kernel runs
+    depth = np.empty((height, width), dtype=np.float32)
+    face_total = sum(item.mesh.face_count for item in scene.items)
+    codes = np.empty((height, width), dtype=np.int32 if 2 * face_total < 2**31 else np.int64)
+    bary = np.empty((height, width, 2), dtype=np.float32)  # read only where codes >= 0
     color = np.empty((height, width, 4), dtype=np.uint8)
-    color[:, :] = background_bytes
+    if face_total == 0:
+        depth.fill(1.0)
+        codes.fill(-1)
+    if not scene.items:
+        color[:, :] = background_bytes
     eye = _eye_position(camera)
     face_offset = 0
-    for item in scene.items:
-        world, normals = _draw_item(item, camera, bool(cull_back_faces), face_offset, depth, codes, bary)
+    clear = face_total > 0
+    for index, item in enumerate(scene.items):
+        world, normals = _draw_item(item, camera, bool(cull_back_faces), face_offset, depth, codes, bary, clear)
+        clear = clear and item.mesh.face_count == 0
         params = _shading_parameters(item, light, eye)
-        shade.shade_pixels(
-            codes, bary, item.mesh.faces, world, normals, params, np.array([face_offset, mode], dtype=np.int64), color
-        )
+        options = np.array([face_offset, mode, int(index == len(scene.items) - 1), *background_bytes], dtype=np.int64)
+        shade.shade_pixels(codes, bary, item.mesh.faces, world, normals, params, options, color)
         face_offset += item.mesh.face_count
     return Frame(color=color, depth=depth)
 
 
 def _draw_item(
     item: SceneItem, camera: Camera, cull: bool, face_offset: int,
-    depth: np.ndarray, codes: np.ndarray, bary: np.ndarray,
+    depth: np.ndarray, codes: np.ndarray, bary: np.ndarray, clear: bool,
 ) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
-    """Stages 1–4 for one placed mesh; returns its world positions and unit world normals for shading."""
+    """Stages 1–4 for one placed mesh; returns its world positions and unit world normals for shading.
+
+    With `clear`, the tile kernel first sets its tiles' depth to 1 and codes to −1 (the first drawn mesh).
+    """
     mesh = item.mesh
     vertex_count = mesh.vertex_count
     world = np.empty((vertex_count, 3))
@@ -118,6 +133,7 @@ def _draw_item(
     )  # fmt: skip
     tri_int, tri_float = setup(mesh.faces, clip, vertex_codes, camera, cull, face_offset)
     tile_starts, tile_triangles, tiling = bin_triangles(tri_int, camera.width, camera.height)
+    tiling = np.array([tiling[0], tiling[1], int(clear)], dtype=np.int64)
     triangles.rasterize_tiles(tri_int, tri_float, tile_starts, tile_triangles, tiling, depth, codes, bary)
     return world, normals
 
@@ -132,18 +148,23 @@ def setup(
     options = np.array([camera.width, camera.height, int(cull), face_offset, _SETUP_CHUNK, 0], dtype=np.int64)
     empty_int = np.empty((0, triangles.INT_FIELDS), dtype=np.int64)
     empty_float = np.empty((0, 3, 5))
+    win_int = np.empty((clip.shape[0], 2), dtype=np.int64)
+    win_float = np.empty((clip.shape[0], 2))
+    triangles.window_vertices(clip, vertex_codes, view, win_int, win_float)
     # count per chunk, exclusive prefix sum, then write
     triangles.setup_triangles(
-        faces, clip, vertex_codes, VIEW_VOLUME_PLANES, view, options, chunk_starts, empty_int, empty_float
-    )
+        faces, clip, vertex_codes, VIEW_VOLUME_PLANES, view, win_int, win_float, options, chunk_starts,
+        empty_int, empty_float,
+    )  # fmt: skip
     total = int(chunk_starts.sum())
     chunk_starts = np.concatenate([[0], np.cumsum(chunk_starts)[:-1]]).astype(np.int64)
     tri_int = np.empty((total, triangles.INT_FIELDS), dtype=np.int64)
     tri_float = np.empty((total, 3, 5))
     options[5] = 1
     triangles.setup_triangles(
-        faces, clip, vertex_codes, VIEW_VOLUME_PLANES, view, options, chunk_starts, tri_int, tri_float
-    )
+        faces, clip, vertex_codes, VIEW_VOLUME_PLANES, view, win_int, win_float, options, chunk_starts,
+        tri_int, tri_float,
+    )  # fmt: skip
     return tri_int, tri_float
 
 

@@ -32,15 +32,21 @@ def _to_byte(value: float) -> np.uint8:
 
 
 @kernel
-def _interpolate(values: np.ndarray, a: int, b: int, c: int, k: int, u0: float, u1: float, u2: float) -> float:
-    return (u0 * values[a, k] + u1 * values[b, k]) + u2 * values[c, k]
+def _interpolate(u0: float, u1: float, u2: float, va: float, vb: float, vc: float) -> float:
+    """``(u0·va + u1·vb) + u2·vc`` (scalar arguments only: per-pixel helpers take no arrays, so they inline)."""
+    return (u0 * va + u1 * vb) + u2 * vc
 
 
 @kernel
-def _phong(params: np.ndarray, px: float, py: float, pz: float, nx: float, ny: float, nz: float, channel: int) -> float:
-    """Blinn-Phong value of one color channel; params = (L, eye, color, ambient, diffuse, specular, shininess)."""
-    lx, ly, lz = params[0], params[1], params[2]
-    vx, vy, vz = params[3] - px, params[4] - py, params[5] - pz
+def _phong(
+    lx: float, ly: float, lz: float, ex: float, ey: float, ez: float, shininess: float,
+    px: float, py: float, pz: float, nx: float, ny: float, nz: float,
+) -> tuple[float, float]:  # fmt: skip
+    """Blinn-Phong terms ``(ndl, spec)`` shared by the three channels: L, eye, shininess, point P, unit normal N.
+
+    Channel k is then ``color_k·(ambient + diffuse·ndl) + specular·spec``.
+    """
+    vx, vy, vz = ex - px, ey - py, ez - pz
     length = math.sqrt((vx * vx + vy * vy) + vz * vz)
     vx, vy, vz = vx / length, vy / length, vz / length
     hx, hy, hz = lx + vx, ly + vy, lz + vz
@@ -49,8 +55,8 @@ def _phong(params: np.ndarray, px: float, py: float, pz: float, nx: float, ny: f
     ndl = max((nx * lx + ny * ly) + nz * lz, 0.0)
     spec = 0.0
     if ndl > 0.0:
-        spec = max((nx * hx + ny * hy) + nz * hz, 0.0) ** params[12]
-    return params[6 + channel] * (params[9] + params[10] * ndl) + params[11] * spec
+        spec = max((nx * hx + ny * hy) + nz * hz, 0.0) ** shininess
+    return ndl, spec
 
 
 @parallel_kernel
@@ -60,33 +66,50 @@ def shade_pixels(
 ) -> None:  # fmt: skip
     """Shade the pixels of one scene item: those whose face ``code // 2 − face_offset`` lies in [0, M).
 
-    codes (H, W) int64, bary (H, W, 2) float32, faces (M, 3) int64, world and normals (N, 3) float64 (unit
-    normals), params (13,) float64 as in ``_phong``, item = (face_offset, mode) int64; color (H, W, 4) uint8
-    is written at those pixels only (RGB, alpha 255).
+    codes (H, W) int32 or int64, bary (H, W, 2) float32, faces (M, 3) int64, world and normals (N, 3) float64
+    (unit normals), params (13,) float64 = (L, eye, color, ambient, diffuse, specular, shininess), item =
+    (face_offset, mode, paint, r, g, b, a) int64; color (H, W, 4) uint8 is written at those pixels (RGB, alpha
+    255) and, when paint != 0, at the background pixels (code < 0) with the bytes (r, g, b, a).
     """
-    face_offset, mode = item[0], item[1]
     for row in prange(codes.shape[0]):
-        for col in range(codes.shape[1]):
-            code = codes[row, col]
-            f = code // 2 - face_offset
-            if code < 0 or f < 0 or f >= faces.shape[0]:
-                continue
-            color[row, col, 3] = 255
-            if mode == SHADE_NONE:
-                for k in range(3):
-                    color[row, col, k] = _to_byte(params[6 + k])
-                continue
-            a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
-            u1, u2 = float(bary[row, col, 0]), float(bary[row, col, 1])
-            u0 = (1.0 - u1) - u2
-            px = _interpolate(world, a, b, c, 0, u0, u1, u2)
-            py = _interpolate(world, a, b, c, 1, u0, u1, u2)
-            pz = _interpolate(world, a, b, c, 2, u0, u1, u2)
-            nx = _interpolate(normals, a, b, c, 0, u0, u1, u2)
-            ny = _interpolate(normals, a, b, c, 1, u0, u1, u2)
-            nz = _interpolate(normals, a, b, c, 2, u0, u1, u2)
-            length = math.sqrt((nx * nx + ny * ny) + nz * nz)
-            sign = -1.0 if code % 2 == 1 else 1.0  # two-sided lighting: a back face's normal faces the viewer
-            nx, ny, nz = sign * nx / length, sign * ny / length, sign * nz / length
+        _shade_row(row, codes, bary, faces, world, normals, params, item, color)
+
+
+@kernel
+def _shade_row(
+    row: int, codes: np.ndarray, bary: np.ndarray, faces: np.ndarray, world: np.ndarray, normals: np.ndarray,
+    params: np.ndarray, item: np.ndarray, color: np.ndarray,
+) -> None:  # fmt: skip
+    """One image row of ``shade_pixels``."""
+    face_offset, mode, paint = item[0], item[1], item[2]
+    lx, ly, lz, ex, ey, ez = params[0], params[1], params[2], params[3], params[4], params[5]
+    ambient, diffuse, specular, shininess = params[9], params[10], params[11], params[12]
+    for col in range(codes.shape[1]):
+        code = codes[row, col]
+        if code < 0 and paint != 0:
+            for k in range(4):
+                color[row, col, k] = item[3 + k]
+            continue
+        f = code // 2 - face_offset
+        if code < 0 or f < 0 or f >= faces.shape[0]:
+            continue
+        color[row, col, 3] = 255
+        if mode == SHADE_NONE:
             for k in range(3):
-                color[row, col, k] = _to_byte(_phong(params, px, py, pz, nx, ny, nz, k))
+                color[row, col, k] = _to_byte(params[6 + k])
+            continue
+        a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
+        u1, u2 = float(bary[row, col, 0]), float(bary[row, col, 1])
+        u0 = (1.0 - u1) - u2
+        px = _interpolate(u0, u1, u2, world[a, 0], world[b, 0], world[c, 0])
+        py = _interpolate(u0, u1, u2, world[a, 1], world[b, 1], world[c, 1])
+        pz = _interpolate(u0, u1, u2, world[a, 2], world[b, 2], world[c, 2])
+        nx = _interpolate(u0, u1, u2, normals[a, 0], normals[b, 0], normals[c, 0])
+        ny = _interpolate(u0, u1, u2, normals[a, 1], normals[b, 1], normals[c, 1])
+        nz = _interpolate(u0, u1, u2, normals[a, 2], normals[b, 2], normals[c, 2])
+        length = math.sqrt((nx * nx + ny * ny) + nz * nz)
+        sign = -1.0 if code % 2 == 1 else 1.0  # two-sided lighting: a back face's normal faces the viewer
+        nx, ny, nz = sign * nx / length, sign * ny / length, sign * nz / length
+        ndl, spec = _phong(lx, ly, lz, ex, ey, ez, shininess, px, py, pz, nx, ny, nz)
+        for k in range(3):
+            color[row, col, k] = _to_byte(params[6 + k] * (ambient + diffuse * ndl) + specular * spec)

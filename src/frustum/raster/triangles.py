@@ -33,6 +33,7 @@ __all__ = [
     "SUBPIXEL",
     "rasterize_tiles",
     "setup_triangles",
+    "window_vertices",
 ]
 
 SUBPIXEL = 256
@@ -109,108 +110,202 @@ def _setup_triangle(
 
 
 @parallel_kernel
+def window_vertices(
+    clip: np.ndarray, codes: np.ndarray, view: np.ndarray, win_int: np.ndarray, win_float: np.ndarray
+) -> None:  # fmt: skip
+    """Per vertex inside the view volume (code 0): the divide, viewport and snap ``_setup_triangle`` does per corner.
+
+    win_int (N, 2) int64 receives the snapped ``X, Y``; win_float (N, 2) float64 the window depth ``z_w`` and
+    ``1/w_clip``. Rows of vertices with a nonzero code are left unwritten (their faces are clipped or rejected).
+    """
+    for i in prange(clip.shape[0]):
+        if codes[i] != 0:
+            continue
+        w = clip[i, 3]
+        win_int[i, 0] = _snap((clip[i, 0] / w) * view[0] + view[0])
+        win_int[i, 1] = _snap((clip[i, 1] / w) * view[1] + view[1])
+        win_float[i, 0] = (clip[i, 2] / w) * 0.5 + 0.5
+        win_float[i, 1] = 1.0 / w
+
+
+@kernel
+def _window_box(
+    xa: int, ya: int, xb: int, yb: int, xc: int, yc: int, width: int, height: int, cull: int
+) -> tuple[int, int, int, int, int, int]:  # fmt: skip
+    """``_setup_triangle``'s cull and bounding box on snapped corners, scalars only (so it inlines).
+
+    Returns ``(made, back, i_min, i_max, j_min, j_max)``; made = 0 for zero area, a culled clockwise triangle or
+    an empty box. For back = 1 the caller swaps corners b and c; the box does not depend on the order.
+    """
+    area = (xb - xa) * (yc - ya) - (xc - xa) * (yb - ya)
+    back = 1 if area < 0 else 0
+    i_min = max(_first_centre(min(xa, min(xb, xc))), 0)
+    i_max = min((max(xa, max(xb, xc)) - HALF_SUBPIXEL) // SUBPIXEL, width - 1)
+    j_min = max(_first_centre(min(ya, min(yb, yc))), 0)
+    j_max = min((max(ya, max(yb, yc)) - HALF_SUBPIXEL) // SUBPIXEL, height - 1)
+    made = 0 if (area == 0 or (back == 1 and cull != 0) or i_min > i_max or j_min > j_max) else 1
+    return made, back, i_min, i_max, j_min, j_max
+
+
+@parallel_kernel
 def setup_triangles(
     faces: np.ndarray, clip: np.ndarray, codes: np.ndarray, planes: np.ndarray, view: np.ndarray,
+    win_int: np.ndarray, win_float: np.ndarray,
     options: np.ndarray, chunk_starts: np.ndarray, tri_int: np.ndarray, tri_float: np.ndarray,
 ) -> None:  # fmt: skip
     """Per face: trivial accept / reject by region codes, clip the rest, then set up each (fan) triangle.
 
     faces (M, 3) int64, clip (N, 4) float64, codes (N,) int64, planes (P, 4) float64, view = (width/2,
-    height/2); options = (width, height, cull, face_offset, chunk, write) int64. Faces are processed in
+    height/2); win_int, win_float from ``window_vertices`` (read for trivially accepted faces only);
+    options = (width, height, cull, face_offset, chunk, write) int64. Faces are processed in
     chunks of ``chunk`` (chunk c = faces [c·chunk, (c+1)·chunk)). With write = 0, ``chunk_starts[c]`` receives
     the number of triangles chunk c produces; with write = 1, chunk c writes its records from slot
     ``chunk_starts[c]`` on, in face order (so the output order never depends on the thread count).
     """
-    size = options[0:3]
-    face_offset, chunk, write = options[3], options[4], options[5]
-    face_count = faces.shape[0]
-    chunk_count = (face_count + chunk - 1) // chunk
-    capacity = 3 + planes.shape[0]
+    chunk = options[4]
+    chunk_count = (faces.shape[0] + chunk - 1) // chunk
     for c in prange(chunk_count):
-        positions = np.empty((2, capacity, 4))
-        weights = np.empty((2, capacity, 3))
-        slot = chunk_starts[c] if write != 0 else -1
-        produced = 0
-        for f in range(c * chunk, min((c + 1) * chunk, face_count)):
-            i0, i1, i2 = faces[f, 0], faces[f, 1], faces[f, 2]
-            c0, c1, c2 = codes[i0], codes[i1], codes[i2]
-            if (c0 & c1 & c2) != 0:  # trivial reject: all corners outside one plane
-                continue
-            if (c0 | c1 | c2) == 0:  # trivial accept: copy the corners, one-hot weights
-                for j in range(4):
-                    positions[0, 0, j], positions[0, 1, j], positions[0, 2, j] = clip[i0, j], clip[i1, j], clip[i2, j]
-                for i in range(3):
-                    for j in range(3):
-                        weights[0, i, j] = 1.0 if i == j else 0.0
-                count = 3
-            else:  # Sutherland–Hodgman against the view volume
-                count = clip_triangle(clip[i0], clip[i1], clip[i2], planes, positions, weights)
-            for k in range(1, count - 1):  # fan (0, k, k + 1)
-                made = _setup_triangle(
-                    positions[0], weights[0], 0, k, k + 1, face_offset + f, view, size, tri_int, tri_float, slot
-                )
-                produced += made
-                if slot >= 0:
-                    slot += made
-        if write == 0:
-            chunk_starts[c] = produced
+        _setup_chunk(c, faces, clip, codes, planes, view, win_int, win_float, options, chunk_starts, tri_int, tri_float)
 
 
 @kernel
-def _fill_triangle(
-    t: int, tri_int: np.ndarray, tri_float: np.ndarray, tile: np.ndarray,
-    depth: np.ndarray, codes: np.ndarray, bary: np.ndarray,
+def _setup_chunk(
+    c: int, faces: np.ndarray, clip: np.ndarray, codes: np.ndarray, planes: np.ndarray, view: np.ndarray,
+    win_int: np.ndarray, win_float: np.ndarray,
+    options: np.ndarray, chunk_starts: np.ndarray, tri_int: np.ndarray, tri_float: np.ndarray,
 ) -> None:  # fmt: skip
-    """Edge-function fill of triangle t inside one tile: top-left rule, depth test "less", deferred attributes.
+    """Chunk c of ``setup_triangles``: trivial reject, trivial accept, or clip, per face."""
+    face_offset, chunk, write = options[3], options[4], options[5]
+    slot = chunk_starts[c] if write != 0 else -1
+    produced = 0
+    width, height, cull = options[0], options[1], options[2]
+    for f in range(c * chunk, min((c + 1) * chunk, faces.shape[0])):
+        i0, i1, i2 = faces[f, 0], faces[f, 1], faces[f, 2]
+        c0, c1, c2 = codes[i0], codes[i1], codes[i2]
+        if (c0 & c1 & c2) != 0:  # trivial reject: all corners outside one plane
+            continue
+        if (c0 | c1 | c2) != 0:  # crossing: Sutherland–Hodgman
+            made = _setup_clipped(f, faces, clip, planes, view, options, tri_int, tri_float, slot)
+            produced += made
+            if slot >= 0:
+                slot += made
+            continue
+        # trivial accept: the corners' window_vertices records, no clip work (same bytes as _setup_triangle);
+        # written inline, not by a helper taking arrays: a per-face call costs more than the face's work
+        xa, ya, xb, yb = win_int[i0, 0], win_int[i0, 1], win_int[i1, 0], win_int[i1, 1]
+        xc, yc = win_int[i2, 0], win_int[i2, 1]
+        made, back, i_min, i_max, j_min, j_max = _window_box(xa, ya, xb, yb, xc, yc, width, height, cull)
+        produced += made
+        if made == 0 or slot < 0:
+            continue
+        if back == 1:
+            i1, i2, xb, xc, yb, yc = i2, i1, xc, xb, yc, yb
+        tri_int[slot, 0], tri_int[slot, 1], tri_int[slot, 2] = xa, ya, xb
+        tri_int[slot, 3], tri_int[slot, 4], tri_int[slot, 5] = yb, xc, yc
+        tri_int[slot, 6] = 2 * (face_offset + f) + back
+        tri_int[slot, 7], tri_int[slot, 8], tri_int[slot, 9], tri_int[slot, 10] = i_min, i_max, j_min, j_max
+        for v in range(3):
+            p = i0 if v == 0 else (i1 if v == 1 else i2)
+            tri_float[slot, v, 0], tri_float[slot, v, 1] = win_float[p, 0], win_float[p, 1]
+            for k in range(3):
+                tri_float[slot, v, 2 + k] = 0.0
+        # one-hot weights of the source corners, in the (possibly swapped) drawing order
+        tri_float[slot, 0, 2], tri_float[slot, 1, 3 + back], tri_float[slot, 2, 4 - back] = 1.0, 1.0, 1.0
+        slot += 1
+    if write == 0:
+        chunk_starts[c] = produced
 
-    tile = (i0, i1, j0, j1): the pixel columns [i0, i1) and window rows [j0, j1) this tile owns. For each
-    covered pixel whose depth ``z = (E_12·z_0 + E_20·z_1 + E_01·z_2) / (2·area)`` (affine in screen space) is
-    less than ``depth``, writes depth (float32), ``codes = tri_int[t, 6]`` and the perspective-correct
-    barycentric weights (u1, u2) of the pixel with respect to the source face (float32). Buffers are top row
-    first: window row j is array row ``H − 1 − j``.
+
+@kernel
+def _setup_clipped(
+    f: int, faces: np.ndarray, clip: np.ndarray, planes: np.ndarray, view: np.ndarray, options: np.ndarray,
+    tri_int: np.ndarray, tri_float: np.ndarray, slot: int,
+) -> int:  # fmt: skip
+    """Sutherland–Hodgman clip of face f, then set up its fan (0, k, k + 1); returns the records made."""
+    capacity = 3 + planes.shape[0]
+    positions = np.empty((2, capacity, 4))
+    weights = np.empty((2, capacity, 3))
+    count = clip_triangle(clip[faces[f, 0]], clip[faces[f, 1]], clip[faces[f, 2]], planes, positions, weights)
+    size = options[0:3]
+    made = 0
+    for k in range(1, count - 1):
+        one = _setup_triangle(
+            positions[0], weights[0], 0, k, k + 1, options[3] + f, view, size, tri_int, tri_float, slot
+        )
+        made += one
+        if slot >= 0:
+            slot += one
+    return made
+
+
+@kernel
+def _fill_tile(
+    tile: int, tri_int: np.ndarray, tri_float: np.ndarray, tile_starts: np.ndarray, tile_triangles: np.ndarray,
+    tiling: np.ndarray, depth: np.ndarray, codes: np.ndarray, bary: np.ndarray,
+) -> None:  # fmt: skip
+    """Tile `tile` of ``rasterize_tiles``: clear it if asked, then edge-function fill of its triangles in order.
+
+    The tile owns the pixel columns [i0, i1) and window rows [j0, j1). Per triangle: top-left rule, depth test
+    "less"; each covered pixel whose depth ``z = (E_12·z_0 + E_20·z_1 + E_01·z_2) / (2·area)`` (affine in screen
+    space) is less than ``depth`` gets depth (float32), ``codes = tri_int[t, 6]`` (t the triangle) and the
+    perspective-correct barycentric weights (u1, u2) of the pixel with respect to the source face (float32).
+    Buffers are top row first: window row j is array row ``H − 1 − j``. The triangle loop is inline (no
+    per-triangle call taking arrays: for pixel-sized triangles the call would cost more than the fill).
     """
-    height = depth.shape[0]
-    x0, y0, x1, y1, x2, y2 = tri_int[t, 0], tri_int[t, 1], tri_int[t, 2], tri_int[t, 3], tri_int[t, 4], tri_int[t, 5]
-    i_min, i_max = max(tri_int[t, 7], tile[0]), min(tri_int[t, 8], tile[1] - 1)
-    j_min, j_max = max(tri_int[t, 9], tile[2]), min(tri_int[t, 10], tile[3] - 1)
-    if i_min > i_max or j_min > j_max:
-        return
-    # edge a → b: E = dx·(Y − Ya) − dy·(X − Xa); bias 0 on top/left edges, 1 elsewhere (E − bias >= 0)
-    dx0, dy0 = x2 - x1, y2 - y1  # edge 1 → 2, opposite corner 0
-    dx1, dy1 = x0 - x2, y0 - y2  # edge 2 → 0
-    dx2, dy2 = x1 - x0, y1 - y0  # edge 0 → 1
-    bias0 = 0 if (dy0 < 0 or (dy0 == 0 and dx0 < 0)) else 1
-    bias1 = 0 if (dy1 < 0 or (dy1 == 0 and dx1 < 0)) else 1
-    bias2 = 0 if (dy2 < 0 or (dy2 == 0 and dx2 < 0)) else 1
-    area = float(dx2 * (y2 - y0) - dy2 * (x2 - x0))
-    z0, z1, z2 = tri_float[t, 0, 0], tri_float[t, 1, 0], tri_float[t, 2, 0]
-    q0, q1, q2 = tri_float[t, 0, 1], tri_float[t, 1, 1], tri_float[t, 2, 1]
-    code = tri_int[t, 6]
-    px0 = SUBPIXEL * i_min + HALF_SUBPIXEL
-    for j in range(j_min, j_max + 1):
-        py = SUBPIXEL * j + HALF_SUBPIXEL
-        e0 = dx0 * (py - y1) - dy0 * (px0 - x1)
-        e1 = dx1 * (py - y2) - dy1 * (px0 - x2)
-        e2 = dx2 * (py - y0) - dy2 * (px0 - x0)
-        row = height - 1 - j
-        for i in range(i_min, i_max + 1):
-            if e0 >= bias0 and e1 >= bias1 and e2 >= bias2:
-                f0, f1, f2 = float(e0), float(e1), float(e2)
-                z = np.float32(((f0 * z0 + f1 * z1) + f2 * z2) / area)
-                if z < depth[row, i]:
-                    depth[row, i] = z
-                    codes[row, i] = code
-                    # perspective-correct weights b_k = (E_k / w_k) / Σ E_j / w_j, then onto the source face
-                    g0, g1, g2 = f0 * q0, f1 * q1, f2 * q2
-                    total = (g0 + g1) + g2
-                    b0, b1, b2 = g0 / total, g1 / total, g2 / total
-                    for k in range(2):
-                        bary[row, i, k] = np.float32(
-                            (b0 * tri_float[t, 0, 3 + k] + b1 * tri_float[t, 1, 3 + k]) + b2 * tri_float[t, 2, 3 + k]
-                        )
-            e0 -= dy0 * SUBPIXEL
-            e1 -= dy1 * SUBPIXEL
-            e2 -= dy2 * SUBPIXEL
+    size, tiles_x = tiling[0], tiling[1]
+    height, width = depth.shape[0], depth.shape[1]
+    i0 = (tile % tiles_x) * size
+    i1 = min(i0 + size, width)
+    j0 = (tile // tiles_x) * size
+    j1 = min(j0 + size, height)
+    if tiling[2] != 0:
+        for row in range(height - j1, height - j0):
+            for col in range(i0, i1):
+                depth[row, col] = 1.0
+                codes[row, col] = -1
+    for slot in range(tile_starts[tile], tile_starts[tile + 1]):
+        t = tile_triangles[slot]
+        x0, y0, x1, y1 = tri_int[t, 0], tri_int[t, 1], tri_int[t, 2], tri_int[t, 3]
+        x2, y2 = tri_int[t, 4], tri_int[t, 5]
+        i_min, i_max = max(tri_int[t, 7], i0), min(tri_int[t, 8], i1 - 1)
+        j_min, j_max = max(tri_int[t, 9], j0), min(tri_int[t, 10], j1 - 1)
+        if i_min > i_max or j_min > j_max:
+            continue
+        # edge a → b: E = dx·(Y − Ya) − dy·(X − Xa); bias 0 on top/left edges, 1 elsewhere (E − bias >= 0)
+        dx0, dy0 = x2 - x1, y2 - y1  # edge 1 → 2, opposite corner 0
+        dx1, dy1 = x0 - x2, y0 - y2  # edge 2 → 0
+        dx2, dy2 = x1 - x0, y1 - y0  # edge 0 → 1
+        bias0 = 0 if (dy0 < 0 or (dy0 == 0 and dx0 < 0)) else 1
+        bias1 = 0 if (dy1 < 0 or (dy1 == 0 and dx1 < 0)) else 1
+        bias2 = 0 if (dy2 < 0 or (dy2 == 0 and dx2 < 0)) else 1
+        area = float(dx2 * (y2 - y0) - dy2 * (x2 - x0))
+        z0, z1, z2 = tri_float[t, 0, 0], tri_float[t, 1, 0], tri_float[t, 2, 0]
+        q0, q1, q2 = tri_float[t, 0, 1], tri_float[t, 1, 1], tri_float[t, 2, 1]
+        code = tri_int[t, 6]
+        px0 = SUBPIXEL * i_min + HALF_SUBPIXEL
+        for j in range(j_min, j_max + 1):
+            py = SUBPIXEL * j + HALF_SUBPIXEL
+            e0 = dx0 * (py - y1) - dy0 * (px0 - x1)
+            e1 = dx1 * (py - y2) - dy1 * (px0 - x2)
+            e2 = dx2 * (py - y0) - dy2 * (px0 - x0)
+            row = height - 1 - j
+            for i in range(i_min, i_max + 1):
+                if e0 >= bias0 and e1 >= bias1 and e2 >= bias2:
+                    f0, f1, f2 = float(e0), float(e1), float(e2)
+                    z = np.float32(((f0 * z0 + f1 * z1) + f2 * z2) / area)
+                    if z < depth[row, i]:
+                        depth[row, i] = z
+                        codes[row, i] = code
+                        # perspective-correct weights b_k = (E_k / w_k) / Σ E_j / w_j, then onto the source face
+                        g0, g1, g2 = f0 * q0, f1 * q1, f2 * q2
+                        total = (g0 + g1) + g2
+                        b0, b1, b2 = g0 / total, g1 / total, g2 / total
+                        for k in range(2):
+                            w0, w1, w2 = tri_float[t, 0, 3 + k], tri_float[t, 1, 3 + k], tri_float[t, 2, 3 + k]
+                            bary[row, i, k] = np.float32((b0 * w0 + b1 * w1) + b2 * w2)
+                e0 -= dy0 * SUBPIXEL
+                e1 -= dy1 * SUBPIXEL
+                e2 -= dy2 * SUBPIXEL
 
 
 @parallel_kernel
@@ -220,17 +315,10 @@ def rasterize_tiles(
 ) -> None:  # fmt: skip
     """Each tile owns its pixels of ``depth``, ``codes`` and ``bary``: no write races, deterministic output.
 
-    tiling = (tile_size, tiles_x) int64; tile ``t`` covers columns ``[tx·s, tx·s + s)`` and window rows
+    tiling = (tile_size, tiles_x, clear) int64; with clear != 0 each tile first sets its depth to 1 and its
+    codes to −1 (the buffers may be uninitialized). Tile ``t`` covers columns ``[tx·s, tx·s + s)`` and window rows
     ``[ty·s, ty·s + s)`` with ``tx = t % tiles_x``, ``ty = t // tiles_x``; its triangles, in drawing order, are
     ``tile_triangles[tile_starts[t]:tile_starts[t + 1]]``.
     """
-    size, tiles_x = tiling[0], tiling[1]
-    height, width = depth.shape[0], depth.shape[1]
     for t in prange(tile_starts.shape[0] - 1):
-        tile = np.empty(4, dtype=np.int64)
-        tile[0] = (t % tiles_x) * size
-        tile[1] = min(tile[0] + size, width)
-        tile[2] = (t // tiles_x) * size
-        tile[3] = min(tile[2] + size, height)
-        for k in range(tile_starts[t], tile_starts[t + 1]):
-            _fill_triangle(tile_triangles[k], tri_int, tri_float, tile, depth, codes, bary)
+        _fill_tile(t, tri_int, tri_float, tile_starts, tile_triangles, tiling, depth, codes, bary)
