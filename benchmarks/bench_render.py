@@ -66,7 +66,18 @@ def _bench_modules():
 
 
 def peak_rss_mib() -> float:
-    """Peak resident set size of this process in MiB (Linux reports ``ru_maxrss`` in KiB)."""
+    """Peak resident set size of this process in MiB.
+
+    Linux: ``VmHWM`` from /proc/self/status, which starts afresh at exec. Not ``ru_maxrss``: Linux keeps that
+    across fork and exec, so a child started by a large parent reports at least the parent's peak.
+    """
+    try:
+        with open("/proc/self/status", encoding="ascii") as status:
+            for line in status:
+                if line.startswith("VmHWM:"):
+                    return int(line.split()[1]) / 1024.0
+    except OSError:
+        pass
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
 
 
