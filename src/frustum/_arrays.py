@@ -26,6 +26,7 @@ __all__ = [
     "as_scalar",
     "as_vector3",
     "describe",
+    "read_only",
 ]
 
 Matrix4: TypeAlias = NDArray[np.float64]
@@ -49,6 +50,12 @@ def describe(value: Any, *, limit: int = 80) -> str:
     else:
         text = repr(value)
     return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def read_only(array: np.ndarray) -> np.ndarray:
+    """Mark `array` read-only in place and return it: frozen frustum objects hand out arrays nobody can edit."""
+    array.flags.writeable = False
+    return array
 
 
 def _as_float_array(value: ArrayLike, name: str, where: str, error: ErrorType, expected: str) -> NDArray:

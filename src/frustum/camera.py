@@ -24,7 +24,7 @@ from typing import Literal, NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from frustum._arrays import Matrix4, Points, Vector3, as_points, as_scalar, as_vector3, describe
+from frustum._arrays import Matrix4, Points, Vector3, as_points, as_scalar, as_vector3, describe, read_only
 from frustum.errors import CameraError
 from frustum.projection import (
     Axonometric,
@@ -93,11 +93,6 @@ def _frame_axes(
     return u, v, n
 
 
-def _read_only(array: np.ndarray) -> np.ndarray:
-    array.flags.writeable = False
-    return array
-
-
 @dataclass(frozen=True, eq=False)
 class ViewFrame:
     """The uvw viewing frame at the view point `eye`: n from the view-plane normal N, u, v from the up vector V.
@@ -158,9 +153,9 @@ class ViewFrame:
         normal = None if self.normal is None else as_vector3(self.normal, "normal", where=where, error=CameraError)
         u, v, n = _frame_axes(eye, target, normal, up, where)
         for name, value in (("eye", eye), ("up", up), ("target", target), ("normal", normal)):
-            object.__setattr__(self, name, None if value is None else _read_only(value))
+            object.__setattr__(self, name, None if value is None else read_only(value))
         for name, value in (("u", u), ("v", v), ("n", n)):
-            object.__setattr__(self, name, _read_only(value))
+            object.__setattr__(self, name, read_only(value))
 
     u: Vector3 = field(init=False, repr=False, default=None)  # type: ignore[assignment]  # set in __post_init__
     v: Vector3 = field(init=False, repr=False, default=None)  # type: ignore[assignment]
@@ -177,25 +172,25 @@ class ViewFrame:
         matrix = np.eye(4)
         matrix[0, :3], matrix[1, :3] = self.u, self.v
         matrix[2, :3] = self.n if self.handedness == "right" else -self.n
-        return _read_only(matrix)
+        return read_only(matrix)
 
     @cached_property
     def steps(self) -> tuple[Step, ...]:
         """view_from_world as its two textbook steps, first-applied first: T(−P0), then R."""
         return (
-            Step("translate the view point P0 to the origin", _read_only(translate(*-self.eye))),
+            Step("translate the view point P0 to the origin", read_only(translate(*-self.eye))),
             Step("rotate u, v, n onto the x, y, z axes", self.rotation),
         )
 
     @cached_property
     def matrix(self) -> Matrix4:
         """view_from_world = R · T(−P0): rows u, v, n and last column −(u·P0, v·P0, n·P0)."""
-        return _read_only(compose(*(step.matrix for step in self.steps)))
+        return read_only(compose(*(step.matrix for step in self.steps)))
 
     @cached_property
     def world_from_view(self) -> Matrix4:
         """The inverse of ``matrix``: the camera's pose in the world (columns u, v, n and P0)."""
-        return _read_only(invert(self.matrix))
+        return read_only(invert(self.matrix))
 
 
 def look_at(eye: ArrayLike, target: ArrayLike, up: ArrayLike = (0.0, 1.0, 0.0)) -> Matrix4:
@@ -409,22 +404,22 @@ class Camera:
         clip_from_view = self.projection.matrix(self.aspect)
         if self.frame.handedness == "left":
             clip_from_view = clip_from_view @ _FLIP_Z
-        return _read_only(clip_from_view)
+        return read_only(clip_from_view)
 
     @cached_property
     def viewport_matrix(self) -> Matrix4:
         """window_from_ndc = ``viewport(0, 0, width, height)``: y up, depth in [0, 1]."""
-        return _read_only(viewport(0.0, 0.0, self.width, self.height))
+        return read_only(viewport(0.0, 0.0, self.width, self.height))
 
     @cached_property
     def clip_from_world(self) -> Matrix4:
         """clip_from_view · view_from_world."""
-        return _read_only(self.projection_matrix @ self.view_matrix)
+        return read_only(self.projection_matrix @ self.view_matrix)
 
     @cached_property
     def world_from_window(self) -> Matrix4:
         """Inverse of window_from_ndc · clip_from_world (projective; divide by w after applying it)."""
-        return _read_only(np.linalg.inv(self.viewport_matrix @ self.clip_from_world))
+        return read_only(np.linalg.inv(self.viewport_matrix @ self.clip_from_world))
 
     def steps(self) -> tuple[Step, ...]:
         """Every named matrix from world to window coordinates, first-applied first (the divide is implicit)."""

@@ -27,22 +27,17 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from frustum._arrays import Vector3, as_direction, as_scalar, as_vector3, describe
+from frustum._arrays import Vector3, as_direction, as_scalar, as_vector3, describe, read_only
 from frustum.errors import ShadingError
 
 __all__ = ["DirectionalLight", "Material", "blinn_phong"]
-
-
-def _read_only(array: np.ndarray) -> np.ndarray:
-    array.flags.writeable = False
-    return array
 
 
 def _unit_color(value: ArrayLike, name: str, where: str) -> Vector3:
     color = as_vector3(value, name, where=where, error=ShadingError)
     if (color < 0.0).any() or (color > 1.0).any():
         raise ShadingError(f"{where}: {name} = {describe(color)} is outside [0, 1]; give linear RGB in [0, 1]")
-    return _read_only(color)
+    return read_only(color)
 
 
 def _nonnegative(value: Any, name: str, where: str) -> float:
@@ -87,7 +82,7 @@ class DirectionalLight:
     def __post_init__(self) -> None:
         where = "DirectionalLight"
         object.__setattr__(
-            self, "direction", _read_only(as_direction(self.direction, "direction", where=where, error=ShadingError))
+            self, "direction", read_only(as_direction(self.direction, "direction", where=where, error=ShadingError))
         )
         object.__setattr__(self, "color", _unit_color(self.color, "color", where))
         object.__setattr__(self, "intensity", _nonnegative(self.intensity, "intensity", where))

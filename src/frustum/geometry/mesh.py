@@ -8,15 +8,10 @@ from functools import cached_property
 import numpy as np
 from numpy.typing import NDArray
 
-from frustum._arrays import Points, as_faces, as_points
+from frustum._arrays import Points, as_faces, as_points, read_only
 from frustum.errors import GeometryError
 
 __all__ = ["Mesh"]
-
-
-def _read_only(array: np.ndarray) -> np.ndarray:
-    array.flags.writeable = False
-    return array
 
 
 @dataclass(frozen=True, eq=False)
@@ -54,8 +49,8 @@ class Mesh:
         where = "Mesh"
         vertices = as_points(self.vertices, "vertices", where=where)
         faces = as_faces(self.faces, vertices.shape[0], "faces", where=where)
-        object.__setattr__(self, "vertices", _read_only(vertices))
-        object.__setattr__(self, "faces", _read_only(faces))
+        object.__setattr__(self, "vertices", read_only(vertices))
+        object.__setattr__(self, "faces", read_only(faces))
         if self.vertex_normals is None:
             normals = _area_weighted_normals(vertices, faces)
         else:
@@ -73,7 +68,7 @@ class Mesh:
                     f"{where}: vertex_normals[{i}] = {normals[i].tolist()} has zero length; normals must be nonzero"
                 )
             normals = normals / lengths[:, None]
-        object.__setattr__(self, "vertex_normals", _read_only(np.ascontiguousarray(normals)))
+        object.__setattr__(self, "vertex_normals", read_only(np.ascontiguousarray(normals)))
 
     @property
     def vertex_count(self) -> int:
@@ -92,14 +87,14 @@ class Mesh:
         lengths = np.sqrt((cross * cross).sum(axis=1))
         with np.errstate(invalid="ignore", divide="ignore"):
             normals = np.where(lengths[:, None] > 0.0, cross / lengths[:, None], 0.0)
-        return _read_only(normals)
+        return read_only(normals)
 
     @cached_property
     def bounds(self) -> Points:
         """(2, 3): the minimum and maximum corner of the axis-aligned bounding box (NaN for no vertices)."""
         if self.vertex_count == 0:
-            return _read_only(np.full((2, 3), np.nan))
-        return _read_only(np.stack([self.vertices.min(axis=0), self.vertices.max(axis=0)]))
+            return read_only(np.full((2, 3), np.nan))
+        return read_only(np.stack([self.vertices.min(axis=0), self.vertices.max(axis=0)]))
 
 
 def _face_cross_products(vertices: Points, faces: NDArray[np.int64]) -> Points:
