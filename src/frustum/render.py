@@ -16,6 +16,12 @@ Fast path, per scene item (one compiled pass each, buffers shared between items)
 5. ``raster.shade.shade_pixels``: deferred Blinn-Phong (or flat color) once per visible pixel; the last
    item's pass (rasterization complete) also paints the background pixels.
 
+``mode="wireframe"`` and ``mode="points"`` replace stages 2–5 by one serial kernel per item
+(``raster.lines``): every unique mesh edge clipped by Liang–Barsky in clip space, divided, mapped and drawn as a
+1-pixel line (DDA over pixel centres along the major axis), or every vertex inside the view volume drawn as the
+pixel containing it; depth test "less" against the same float32 buffer cleared to 1.0, the item's flat material
+color (no lighting, no culling), background bytes elsewhere.
+
 The textbook path is the public stage functions (``Camera.project``, ``clip_triangles``,
 ``visibility.backface_mask``); ``tests/test_render.py`` holds both paths equal.
 """
@@ -32,15 +38,17 @@ from frustum.camera import Camera
 from frustum.clipping import VIEW_VOLUME_PLANES
 from frustum.errors import FrustumError, ShadingError
 from frustum.frame import Frame
-from frustum.raster import shade, tiles, triangles
+from frustum.raster import lines, shade, tiles, triangles
 from frustum.raster.vertices import transform_vertices
 from frustum.scene import Scene, SceneItem
 from frustum.shading import DirectionalLight
 
-__all__ = ["SHADING_MODES", "TILE_SIZE", "render"]
+__all__ = ["RENDER_MODES", "SHADING_MODES", "TILE_SIZE", "mesh_edges", "render"]
 
 SHADING_MODES = {"phong": shade.SHADE_PHONG, "none": shade.SHADE_NONE}
 """Shading names ``render`` accepts (``None`` means ``"none"``)."""
+RENDER_MODES = ("surface", "wireframe", "points")
+"""What ``render`` draws of each mesh: filled triangles, unique edges as lines, or vertices as pixels."""
 TILE_SIZE = 32
 """Side of a square screen tile in pixels: the unit of parallel work of the rasterizer."""
 _SETUP_CHUNK = 4096
@@ -54,6 +62,7 @@ def render(
     shading: str | None = "phong",
     background: Any = (0.0, 0.0, 0.0, 1.0),
     cull_back_faces: bool = True,
+    mode: str = "surface",
 ) -> Frame:
     """Render `scene` seen by `camera` into a ``Frame`` (color (H, W, 4) uint8 and depth (H, W) float32).
 
@@ -71,19 +80,32 @@ def render(
     cull_back_faces : bool
         True: drop triangles that are clockwise (or of zero area) in window coordinates. False: draw both
         sides, lighting a back face with its normal flipped toward the viewer (two-sided lighting, for open
-        surfaces such as the teapot).
+        surfaces such as the teapot). Lines and points are never culled.
+    mode : {"surface", "wireframe", "points"}
+        ``"surface"``: filled, shaded triangles. ``"wireframe"``: every unique edge of the faces (each undirected
+        edge once), clipped in homogeneous clip space, as a 1-pixel line with window depth linear along it.
+        ``"points"``: every mesh vertex inside the view volume as the one pixel containing it. Both draw the
+        item's material color with alpha 255 (no lighting, so `shading` and the lights are not used) with the
+        depth test "less"; the pixel rules are in ``frustum.raster.lines``.
 
     Raises
     ------
     FrustumError
-        For a bad argument: unknown shading name, wrong types, background outside [0, 1], a non-white light.
+        For a bad argument: unknown shading name or mode, wrong types, background outside [0, 1], a non-white light.
 
     References
     ----------
     [HB 16] "Back-Face Detection", "Depth-Buffer Method"; [seed] "Back-face detection", "Depth-buffer method".
     """
     where = "render"
-    mode, light = _check_arguments(scene, camera, shading, cull_back_faces, where)
+    if not isinstance(mode, str) or mode not in RENDER_MODES:
+        raise FrustumError(
+            f"{where}: mode = {describe(mode)} is unknown; expected one of " + ", ".join(repr(n) for n in RENDER_MODES)
+        )
+    if mode != "surface":
+        _check_arguments(scene, camera, "none", cull_back_faces, where)
+        return _render_lines_or_points(scene, camera, _background_bytes(background, where), mode == "points")
+    shade_mode, light = _check_arguments(scene, camera, shading, cull_back_faces, where)
     background_bytes = _background_bytes(background, where)
     height, width = camera.height, camera.width
     # uninitialized: the first rasterized item clears depth and codes tile by tile, the last shading pass
@@ -105,10 +127,43 @@ def render(
         world, normals = _draw_item(item, camera, bool(cull_back_faces), face_offset, depth, codes, bary, clear)
         clear = clear and item.mesh.face_count == 0
         params = _shading_parameters(item, light, eye)
-        options = np.array([face_offset, mode, int(index == len(scene.items) - 1), *background_bytes], dtype=np.int64)
+        last = int(index == len(scene.items) - 1)
+        options = np.array([face_offset, shade_mode, last, *background_bytes], dtype=np.int64)
         shade.shade_pixels(codes, bary, item.mesh.faces, world, normals, params, options, color)
         face_offset += item.mesh.face_count
     return Frame(color=color, depth=depth)
+
+
+def _render_lines_or_points(scene: Scene, camera: Camera, background_bytes: np.ndarray, points: bool) -> Frame:
+    """``mode="wireframe"`` (or ``"points"``): each item's edges (or vertices) in scene order, one kernel each."""
+    depth = np.ones((camera.height, camera.width), dtype=np.float32)
+    color = np.empty((camera.height, camera.width, 4), dtype=np.uint8)
+    color[:, :] = background_bytes
+    view = np.array([camera.width / 2.0, camera.height / 2.0])
+    for item in scene.items:
+        mesh = item.mesh
+        rgba = np.empty(4, dtype=np.uint8)
+        rgba[:3] = np.floor(np.clip(item.material.color, 0.0, 1.0) * 255.0 + 0.5)
+        rgba[3] = 255
+        clip = np.empty((mesh.vertex_count, 4))
+        vertex_codes = np.empty(mesh.vertex_count, dtype=np.int64)
+        transform_vertices(
+            mesh.vertices, np.ones((mesh.vertex_count, 3)), _item_matrices(item, camera), VIEW_VOLUME_PLANES,
+            clip, np.empty((mesh.vertex_count, 3)), np.empty((mesh.vertex_count, 3)), vertex_codes,
+        )  # fmt: skip
+        if points:
+            lines.draw_points(clip, vertex_codes, view, rgba, depth, color)
+        else:
+            lines.draw_lines(clip, mesh_edges(mesh.faces), VIEW_VOLUME_PLANES, view, rgba, depth, color)
+    return Frame(color=color, depth=depth)
+
+
+def mesh_edges(faces: np.ndarray) -> np.ndarray:
+    """(E, 2) int64: every undirected edge of the triangles `faces` once, as ``(low, high)`` rows in sorted order."""
+    faces = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
+    pairs = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+    pairs.sort(axis=1)
+    return np.ascontiguousarray(np.unique(pairs, axis=0), dtype=np.int64).reshape(-1, 2)
 
 
 def _draw_item(
