@@ -186,41 +186,58 @@ def _draw_item(
         mesh.vertices, mesh.vertex_normals, _item_matrices(item, camera), VIEW_VOLUME_PLANES,
         clip, world, normals, vertex_codes,
     )  # fmt: skip
-    tri_int, tri_float = setup(mesh.faces, clip, vertex_codes, camera, cull, face_offset)
+    tri_int, tri_float, tri_weights = _setup_records(mesh.faces, clip, vertex_codes, camera, cull, face_offset)
     tile_starts, tile_triangles, tiling = bin_triangles(tri_int, camera.width, camera.height)
     tiling = np.array([tiling[0], tiling[1], int(clear)], dtype=np.int64)
-    triangles.rasterize_tiles(tri_int, tri_float, tile_starts, tile_triangles, tiling, depth, codes, bary)
+    triangles.rasterize_tiles(
+        tri_int, tri_float, tri_weights, tile_starts, tile_triangles, tiling, depth, codes, bary
+    )  # fmt: skip
     return world, normals
 
 
 def setup(
     faces: np.ndarray, clip: np.ndarray, vertex_codes: np.ndarray, camera: Camera, cull: bool, face_offset: int = 0
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Triangle records (``raster.triangles``) of `faces` in clip space: clipped, divided, snapped, culled."""
+    """Triangle records ``tri_int, tri_float`` (``raster.triangles``) of `faces` in clip space: clipped, divided,
+    snapped, culled (the clipped triangles' weights, ``tri_weights``, are left out: see ``_setup_records``)."""
+    tri_int, tri_float, _ = _setup_records(faces, clip, vertex_codes, camera, cull, face_offset)
+    return tri_int, tri_float
+
+
+def _setup_records(
+    faces: np.ndarray, clip: np.ndarray, vertex_codes: np.ndarray, camera: Camera, cull: bool, face_offset: int = 0
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``setup`` plus ``tri_weights``; tri_int is int32 when its coordinates and codes fit (``raster.triangles``)."""
     view = np.array([camera.width / 2.0, camera.height / 2.0])
     chunk_count = max(1, -(-faces.shape[0] // _SETUP_CHUNK))
-    chunk_starts = np.zeros(chunk_count, dtype=np.int64)
+    chunk_starts = np.zeros((chunk_count, 2), dtype=np.int64)
     options = np.array([camera.width, camera.height, int(cull), face_offset, _SETUP_CHUNK, 0], dtype=np.int64)
-    empty_int = np.empty((0, triangles.INT_FIELDS), dtype=np.int64)
-    empty_float = np.empty((0, 3, 5))
+    small = (
+        triangles.SUBPIXEL * (max(camera.width, camera.height) + 2) < 2**31
+        and 2 * (face_offset + faces.shape[0]) < 2**31
+    )
+    int_type = np.int32 if small else np.int64
+    empty_int = np.empty((0, triangles.INT_FIELDS), dtype=int_type)
+    empty_float = np.empty((0, 3, triangles.FLOAT_FIELDS))
     win_int = np.empty((clip.shape[0], 2), dtype=np.int64)
     win_float = np.empty((clip.shape[0], 2))
     triangles.window_vertices(clip, vertex_codes, view, win_int, win_float)
     # count per chunk, exclusive prefix sum, then write
     triangles.setup_triangles(
         faces, clip, vertex_codes, VIEW_VOLUME_PLANES, view, win_int, win_float, options, chunk_starts,
-        empty_int, empty_float,
+        empty_int, empty_float, empty_float,
     )  # fmt: skip
-    total = int(chunk_starts.sum())
-    chunk_starts = np.concatenate([[0], np.cumsum(chunk_starts)[:-1]]).astype(np.int64)
-    tri_int = np.empty((total, triangles.INT_FIELDS), dtype=np.int64)
-    tri_float = np.empty((total, 3, 5))
+    total, clipped = (int(n) for n in chunk_starts.sum(axis=0))
+    chunk_starts = np.concatenate([np.zeros((1, 2), dtype=np.int64), np.cumsum(chunk_starts, axis=0)[:-1]])
+    tri_int = np.empty((total, triangles.INT_FIELDS), dtype=int_type)
+    tri_float = np.empty((total, 3, triangles.FLOAT_FIELDS))
+    tri_weights = np.empty((clipped, 3, 2))
     options[5] = 1
     triangles.setup_triangles(
         faces, clip, vertex_codes, VIEW_VOLUME_PLANES, view, win_int, win_float, options, chunk_starts,
-        tri_int, tri_float,
+        tri_int, tri_float, tri_weights,
     )  # fmt: skip
-    return tri_int, tri_float
+    return tri_int, tri_float, tri_weights
 
 
 def bin_triangles(tri_int: np.ndarray, width: int, height: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -235,7 +252,7 @@ def bin_triangles(tri_int: np.ndarray, width: int, height: int) -> tuple[np.ndar
     offsets = np.empty_like(counts)
     tile_starts = np.empty(tiles_x * tiles_y + 1, dtype=np.int64)
     tiles.tile_offsets(counts, offsets, tile_starts)
-    tile_triangles = np.empty(int(tile_starts[-1]), dtype=np.int64)
+    tile_triangles = np.empty(int(tile_starts[-1]), dtype=np.int32 if tri_int.shape[0] < 2**31 else np.int64)
     tiles.fill_tile_triangles(tri_int, tiling, offsets, tile_triangles)
     return tile_starts, tile_triangles, tiling[:2].copy()
 

@@ -13,10 +13,19 @@ left edges: the test is ``E >= 0`` on those and ``E > 0`` (``E − 1 >= 0`` in i
 triangles sharing an edge traverse it in opposite directions, so exactly one of them owns the centres on it.
 
 Triangle records (one per rasterized triangle, after clipping and culling):
-``tri_int`` (T, 11) int64: ``X0, Y0, X1, Y1, X2, Y2`` snapped corners, ``code = 2·face + back``, and the
-pixel bounding box ``i_min, i_max, j_min, j_max`` (inclusive, inside the image);
-``tri_float`` (T, 3, 5) float64 per corner: window depth ``z_w``, ``1/w_clip``, and the corner's barycentric
-weights with respect to the source face (one-hot for unclipped corners).
+``tri_int`` (T, 12) int32 (int64 when a snapped coordinate or a code might not fit in int32; the caller
+chooses): ``X0, Y0, X1, Y1, X2, Y2`` snapped corners, ``code = 2·face + back``, the pixel bounding box
+``i_min, i_max, j_min, j_max`` (inclusive, inside the image), and ``weight_row``: −1 for a trivially accepted
+(unclipped) triangle, else its row in ``tri_weights``;
+``tri_float`` (T, 3, 2) float64 per corner: window depth ``z_w`` and ``1/w_clip``;
+``tri_weights`` (C, 3, 2) float64, clipped triangles only (C of them): per corner its barycentric weights
+``(u1, u2)`` with respect to the source face's corners 1 and 2 (``u0 = 1 − u1 − u2`` is never read). An
+unclipped triangle's corners are the source corners 0, 1, 2 in drawing order (1 and 2 swapped when back = 1),
+so its weights are one-hot and are not stored: the fill takes the pixel's own barycentrics instead, which is
+bit-identical to weighting by one-hot vectors (``(b0·0 + b1·1) + b2·0 = b1`` exactly for b_k >= 0).
+Snapped coordinates fit in int32 when ``256·(max(W, H) + 2) < 2^31``: every rasterized corner lies inside the
+view volume (trivially accepted vertices have region code 0, clipped corners lie on or inside every plane up
+to round-off), so its window coordinates lie in [0, W]×[0, H] up to round-off.
 """
 
 from __future__ import annotations
@@ -39,8 +48,9 @@ __all__ = [
 SUBPIXEL = 256
 """Subpixel steps per pixel (8 fractional bits), as in llvmpipe."""
 HALF_SUBPIXEL = 128
-INT_FIELDS = 11
-FLOAT_FIELDS = 5
+INT_FIELDS = 12
+FLOAT_FIELDS = 2
+WEIGHT_ROW = 11
 
 
 @kernel
@@ -58,9 +68,11 @@ def _first_centre(low: int) -> int:
 @kernel
 def _setup_triangle(
     corners: np.ndarray, weights: np.ndarray, a: int, b: int, c: int, code: int, view: np.ndarray,
-    size: np.ndarray, tri_int: np.ndarray, tri_float: np.ndarray, slot: int,
+    size: np.ndarray, tri_int: np.ndarray, tri_float: np.ndarray, tri_weights: np.ndarray, slot: int, row: int,
 ) -> int:  # fmt: skip
     """Divide, viewport, snap and cull the triangle of polygon corners a, b, c; write its record if slot >= 0.
+
+    The corners' weights go to ``tri_weights[row]`` and `row` to the record's ``weight_row``.
 
     corners (K, 4) clip coordinates and weights (K, 3) of a clipped polygon; view = (width/2, height/2);
     size = (width, height, cull). Returns 1 if the triangle covers at least one pixel centre's bounding box
@@ -102,10 +114,10 @@ def _setup_triangle(
         w = corners[p, 3]
         tri_float[slot, v, 0] = (corners[p, 2] / w) * 0.5 + 0.5
         tri_float[slot, v, 1] = 1.0 / w
-        for k in range(3):
-            tri_float[slot, v, 2 + k] = weights[p, k]
+        tri_weights[row, v, 0], tri_weights[row, v, 1] = weights[p, 1], weights[p, 2]
     tri_int[slot, 6] = 2 * code + back
     tri_int[slot, 7], tri_int[slot, 8], tri_int[slot, 9], tri_int[slot, 10] = i_min, i_max, j_min, j_max
+    tri_int[slot, WEIGHT_ROW] = row
     return 1
 
 
@@ -152,20 +164,25 @@ def setup_triangles(
     faces: np.ndarray, clip: np.ndarray, codes: np.ndarray, planes: np.ndarray, view: np.ndarray,
     win_int: np.ndarray, win_float: np.ndarray,
     options: np.ndarray, chunk_starts: np.ndarray, tri_int: np.ndarray, tri_float: np.ndarray,
+    tri_weights: np.ndarray,
 ) -> None:  # fmt: skip
     """Per face: trivial accept / reject by region codes, clip the rest, then set up each (fan) triangle.
 
     faces (M, 3) int64, clip (N, 4) float64, codes (N,) int64, planes (P, 4) float64, view = (width/2,
     height/2); win_int, win_float from ``window_vertices`` (read for trivially accepted faces only);
     options = (width, height, cull, face_offset, chunk, write) int64. Faces are processed in
-    chunks of ``chunk`` (chunk c = faces [c·chunk, (c+1)·chunk)). With write = 0, ``chunk_starts[c]`` receives
-    the number of triangles chunk c produces; with write = 1, chunk c writes its records from slot
-    ``chunk_starts[c]`` on, in face order (so the output order never depends on the thread count).
+    chunks of ``chunk`` (chunk c = faces [c·chunk, (c+1)·chunk)). chunk_starts (C, 2) int64: with write = 0,
+    ``chunk_starts[c]`` receives the number of triangles chunk c produces and how many of them are clipped; with
+    write = 1, chunk c writes its records from slot ``chunk_starts[c, 0]`` on and its clipped weights from row
+    ``chunk_starts[c, 1]`` on, in face order (so the output order never depends on the thread count).
     """
     chunk = options[4]
     chunk_count = (faces.shape[0] + chunk - 1) // chunk
     for c in prange(chunk_count):
-        _setup_chunk(c, faces, clip, codes, planes, view, win_int, win_float, options, chunk_starts, tri_int, tri_float)
+        _setup_chunk(
+            c, faces, clip, codes, planes, view, win_int, win_float, options, chunk_starts, tri_int, tri_float,
+            tri_weights,
+        )  # fmt: skip
 
 
 @kernel
@@ -173,11 +190,14 @@ def _setup_chunk(
     c: int, faces: np.ndarray, clip: np.ndarray, codes: np.ndarray, planes: np.ndarray, view: np.ndarray,
     win_int: np.ndarray, win_float: np.ndarray,
     options: np.ndarray, chunk_starts: np.ndarray, tri_int: np.ndarray, tri_float: np.ndarray,
+    tri_weights: np.ndarray,
 ) -> None:  # fmt: skip
     """Chunk c of ``setup_triangles``: trivial reject, trivial accept, or clip, per face."""
     face_offset, chunk, write = options[3], options[4], options[5]
-    slot = chunk_starts[c] if write != 0 else -1
+    slot = chunk_starts[c, 0] if write != 0 else -1
+    row = chunk_starts[c, 1] if write != 0 else -1
     produced = 0
+    clipped = 0
     width, height, cull = options[0], options[1], options[2]
     for f in range(c * chunk, min((c + 1) * chunk, faces.shape[0])):
         i0, i1, i2 = faces[f, 0], faces[f, 1], faces[f, 2]
@@ -185,10 +205,12 @@ def _setup_chunk(
         if (c0 & c1 & c2) != 0:  # trivial reject: all corners outside one plane
             continue
         if (c0 | c1 | c2) != 0:  # crossing: Sutherland–Hodgman
-            made = _setup_clipped(f, faces, clip, planes, view, options, tri_int, tri_float, slot)
+            made = _setup_clipped(f, faces, clip, planes, view, options, tri_int, tri_float, tri_weights, slot, row)
             produced += made
+            clipped += made
             if slot >= 0:
                 slot += made
+                row += made
             continue
         # trivial accept: the corners' window_vertices records, no clip work (same bytes as _setup_triangle);
         # written inline, not by a helper taking arrays: a per-face call costs more than the face's work
@@ -204,24 +226,25 @@ def _setup_chunk(
         tri_int[slot, 3], tri_int[slot, 4], tri_int[slot, 5] = yb, xc, yc
         tri_int[slot, 6] = 2 * (face_offset + f) + back
         tri_int[slot, 7], tri_int[slot, 8], tri_int[slot, 9], tri_int[slot, 10] = i_min, i_max, j_min, j_max
-        for v in range(3):
-            p = i0 if v == 0 else (i1 if v == 1 else i2)
-            tri_float[slot, v, 0], tri_float[slot, v, 1] = win_float[p, 0], win_float[p, 1]
-            for k in range(3):
-                tri_float[slot, v, 2 + k] = 0.0
-        # one-hot weights of the source corners, in the (possibly swapped) drawing order
-        tri_float[slot, 0, 2], tri_float[slot, 1, 3 + back], tri_float[slot, 2, 4 - back] = 1.0, 1.0, 1.0
+        tri_int[slot, WEIGHT_ROW] = -1  # one-hot weights of the source corners: not stored
+        tri_float[slot, 0, 0], tri_float[slot, 0, 1] = win_float[i0, 0], win_float[i0, 1]
+        tri_float[slot, 1, 0], tri_float[slot, 1, 1] = win_float[i1, 0], win_float[i1, 1]
+        tri_float[slot, 2, 0], tri_float[slot, 2, 1] = win_float[i2, 0], win_float[i2, 1]
         slot += 1
     if write == 0:
-        chunk_starts[c] = produced
+        chunk_starts[c, 0] = produced
+        chunk_starts[c, 1] = clipped
 
 
 @kernel
 def _setup_clipped(
     f: int, faces: np.ndarray, clip: np.ndarray, planes: np.ndarray, view: np.ndarray, options: np.ndarray,
-    tri_int: np.ndarray, tri_float: np.ndarray, slot: int,
+    tri_int: np.ndarray, tri_float: np.ndarray, tri_weights: np.ndarray, slot: int, row: int,
 ) -> int:  # fmt: skip
-    """Sutherland–Hodgman clip of face f, then set up its fan (0, k, k + 1); returns the records made."""
+    """Sutherland–Hodgman clip of face f, then set up its fan (0, k, k + 1); returns the records made.
+
+    Record slot + n keeps its weights in ``tri_weights`` row row + n.
+    """
     capacity = 3 + planes.shape[0]
     positions = np.empty((2, capacity, 4))
     weights = np.empty((2, capacity, 3))
@@ -230,18 +253,20 @@ def _setup_clipped(
     made = 0
     for k in range(1, count - 1):
         one = _setup_triangle(
-            positions[0], weights[0], 0, k, k + 1, options[3] + f, view, size, tri_int, tri_float, slot
-        )
+            positions[0], weights[0], 0, k, k + 1, options[3] + f, view, size, tri_int, tri_float, tri_weights,
+            slot, row,
+        )  # fmt: skip
         made += one
         if slot >= 0:
             slot += one
+            row += one
     return made
 
 
 @kernel
 def _fill_tile(
-    tile: int, tri_int: np.ndarray, tri_float: np.ndarray, tile_starts: np.ndarray, tile_triangles: np.ndarray,
-    tiling: np.ndarray, depth: np.ndarray, codes: np.ndarray, bary: np.ndarray,
+    tile: int, tri_int: np.ndarray, tri_float: np.ndarray, tri_weights: np.ndarray, tile_starts: np.ndarray,
+    tile_triangles: np.ndarray, tiling: np.ndarray, depth: np.ndarray, codes: np.ndarray, bary: np.ndarray,
 ) -> None:  # fmt: skip
     """Tile `tile` of ``rasterize_tiles``: clear it if asked, then edge-function fill of its triangles in order.
 
@@ -249,6 +274,7 @@ def _fill_tile(
     "less"; each covered pixel whose depth ``z = (E_12·z_0 + E_20·z_1 + E_01·z_2) / (2·area)`` (affine in screen
     space) is less than ``depth`` gets depth (float32), ``codes = tri_int[t, 6]`` (t the triangle) and the
     perspective-correct barycentric weights (u1, u2) of the pixel with respect to the source face (float32).
+    Record fields are read as int64 (the edge-function products need 64 bits whatever ``tri_int``'s dtype).
     Buffers are top row first: window row j is array row ``H − 1 − j``. The triangle loop is inline (no
     per-triangle call taking arrays: for pixel-sized triangles the call would cost more than the fill).
     """
@@ -265,10 +291,11 @@ def _fill_tile(
                 codes[row, col] = -1
     for slot in range(tile_starts[tile], tile_starts[tile + 1]):
         t = tile_triangles[slot]
-        x0, y0, x1, y1 = tri_int[t, 0], tri_int[t, 1], tri_int[t, 2], tri_int[t, 3]
-        x2, y2 = tri_int[t, 4], tri_int[t, 5]
-        i_min, i_max = max(tri_int[t, 7], i0), min(tri_int[t, 8], i1 - 1)
-        j_min, j_max = max(tri_int[t, 9], j0), min(tri_int[t, 10], j1 - 1)
+        x0, y0 = np.int64(tri_int[t, 0]), np.int64(tri_int[t, 1])
+        x1, y1 = np.int64(tri_int[t, 2]), np.int64(tri_int[t, 3])
+        x2, y2 = np.int64(tri_int[t, 4]), np.int64(tri_int[t, 5])
+        i_min, i_max = max(np.int64(tri_int[t, 7]), i0), min(np.int64(tri_int[t, 8]), i1 - 1)
+        j_min, j_max = max(np.int64(tri_int[t, 9]), j0), min(np.int64(tri_int[t, 10]), j1 - 1)
         if i_min > i_max or j_min > j_max:
             continue
         # edge a → b: E = dx·(Y − Ya) − dy·(X − Xa); bias 0 on top/left edges, 1 elsewhere (E − bias >= 0)
@@ -281,7 +308,9 @@ def _fill_tile(
         area = float(dx2 * (y2 - y0) - dy2 * (x2 - x0))
         z0, z1, z2 = tri_float[t, 0, 0], tri_float[t, 1, 0], tri_float[t, 2, 0]
         q0, q1, q2 = tri_float[t, 0, 1], tri_float[t, 1, 1], tri_float[t, 2, 1]
-        code = tri_int[t, 6]
+        code = np.int64(tri_int[t, 6])
+        wrow = np.int64(tri_int[t, WEIGHT_ROW])
+        swap = code % 2  # unclipped: source corner 1 is drawn as corner 1 + swap, corner 2 as 2 − swap
         px0 = SUBPIXEL * i_min + HALF_SUBPIXEL
         for j in range(j_min, j_max + 1):
             py = SUBPIXEL * j + HALF_SUBPIXEL
@@ -300,9 +329,13 @@ def _fill_tile(
                         g0, g1, g2 = f0 * q0, f1 * q1, f2 * q2
                         total = (g0 + g1) + g2
                         b0, b1, b2 = g0 / total, g1 / total, g2 / total
-                        for k in range(2):
-                            w0, w1, w2 = tri_float[t, 0, 3 + k], tri_float[t, 1, 3 + k], tri_float[t, 2, 3 + k]
-                            bary[row, i, k] = np.float32((b0 * w0 + b1 * w1) + b2 * w2)
+                        if wrow < 0:  # one-hot weights: (b0·0 + b1·1) + b2·0 is b1 exactly (b_k >= 0)
+                            bary[row, i, 0] = np.float32(b2 if swap == 1 else b1)
+                            bary[row, i, 1] = np.float32(b1 if swap == 1 else b2)
+                        else:
+                            for k in range(2):
+                                w0, w1, w2 = tri_weights[wrow, 0, k], tri_weights[wrow, 1, k], tri_weights[wrow, 2, k]
+                                bary[row, i, k] = np.float32((b0 * w0 + b1 * w1) + b2 * w2)
                 e0 -= dy0 * SUBPIXEL
                 e1 -= dy1 * SUBPIXEL
                 e2 -= dy2 * SUBPIXEL
@@ -310,8 +343,8 @@ def _fill_tile(
 
 @parallel_kernel
 def rasterize_tiles(
-    tri_int: np.ndarray, tri_float: np.ndarray, tile_starts: np.ndarray, tile_triangles: np.ndarray,
-    tiling: np.ndarray, depth: np.ndarray, codes: np.ndarray, bary: np.ndarray,
+    tri_int: np.ndarray, tri_float: np.ndarray, tri_weights: np.ndarray, tile_starts: np.ndarray,
+    tile_triangles: np.ndarray, tiling: np.ndarray, depth: np.ndarray, codes: np.ndarray, bary: np.ndarray,
 ) -> None:  # fmt: skip
     """Each tile owns its pixels of ``depth``, ``codes`` and ``bary``: no write races, deterministic output.
 
@@ -321,4 +354,4 @@ def rasterize_tiles(
     ``tile_triangles[tile_starts[t]:tile_starts[t + 1]]``.
     """
     for t in prange(tile_starts.shape[0] - 1):
-        _fill_tile(t, tri_int, tri_float, tile_starts, tile_triangles, tiling, depth, codes, bary)
+        _fill_tile(t, tri_int, tri_float, tri_weights, tile_starts, tile_triangles, tiling, depth, codes, bary)
