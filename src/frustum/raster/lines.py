@@ -29,23 +29,14 @@ rgba (4,) uint8, depth (H, W) float32 and color (H, W, 4) uint8 written in place
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from frustum.raster._jit import kernel
 from frustum.raster.clip import clip_segment
+from frustum.raster.fixed_point import HALF_SUBPIXEL, SUBPIXEL, snap
 
 __all__ = ["draw_lines", "draw_points"]
 
-SUBPIXEL = 256
-HALF_SUBPIXEL = 128
-
-
-@kernel
-def _snap(value: float) -> int:
-    """Round a window coordinate to the 1/256 pixel grid: ``floor(v·256 + 0.5)``."""
-    return np.int64(math.floor(value * 256.0 + 0.5))
 
 
 @kernel
@@ -114,8 +105,8 @@ def draw_lines(
             py = start[1] + (end[1] - start[1]) * u if moved else (start[1] if side == 0 else end[1])
             pz = start[2] + (end[2] - start[2]) * u if moved else (start[2] if side == 0 else end[2])
             pw = start[3] + (end[3] - start[3]) * u if moved else (start[3] if side == 0 else end[3])
-            x = _snap((px / pw) * view[0] + view[0])
-            y = _snap((py / pw) * view[1] + view[1])
+            x = snap((px / pw) * view[0] + view[0])
+            y = snap((py / pw) * view[1] + view[1])
             z = (pz / pw) * 0.5 + 0.5
             if side == 0:
                 xa, ya, za = x, y, z
@@ -144,8 +135,8 @@ def draw_points(
         if codes[v] != 0:
             continue
         w = clip[v, 3]
-        i = min(_snap((clip[v, 0] / w) * view[0] + view[0]) // SUBPIXEL, width - 1)
-        j = min(_snap((clip[v, 1] / w) * view[1] + view[1]) // SUBPIXEL, height - 1)
+        i = min(snap((clip[v, 0] / w) * view[0] + view[0]) // SUBPIXEL, width - 1)
+        j = min(snap((clip[v, 1] / w) * view[1] + view[1]) // SUBPIXEL, height - 1)
         if i < 0 or j < 0:
             continue
         _plot(height - 1 - j, i, (clip[v, 2] / w) * 0.5 + 0.5, rgba, depth, color)

@@ -30,12 +30,11 @@ to round-off), so its window coordinates lie in [0, W]×[0, H] up to round-off.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from frustum.raster._jit import kernel, parallel_kernel, prange
 from frustum.raster.clip import clip_triangle
+from frustum.raster.fixed_point import HALF_SUBPIXEL, SUBPIXEL, snap
 
 __all__ = [
     "INT_FIELDS",
@@ -45,18 +44,9 @@ __all__ = [
     "window_vertices",
 ]
 
-SUBPIXEL = 256
-"""Subpixel steps per pixel (8 fractional bits), as in llvmpipe."""
-HALF_SUBPIXEL = 128
 INT_FIELDS = 12
 FLOAT_FIELDS = 2
 WEIGHT_ROW = 11
-
-
-@kernel
-def _snap(value: float) -> int:
-    """Round a window coordinate to the 1/256 pixel grid: ``floor(v·256 + 0.5)``."""
-    return np.int64(math.floor(value * 256.0 + 0.5))
 
 
 @kernel
@@ -80,12 +70,12 @@ def _setup_triangle(
     1 and 2 are swapped (so it is counter-clockwise) and its ``back`` bit set. Zero area is always dropped.
     """
     # perspective divide, viewport and snap
-    xa = _snap((corners[a, 0] / corners[a, 3]) * view[0] + view[0])
-    ya = _snap((corners[a, 1] / corners[a, 3]) * view[1] + view[1])
-    xb = _snap((corners[b, 0] / corners[b, 3]) * view[0] + view[0])
-    yb = _snap((corners[b, 1] / corners[b, 3]) * view[1] + view[1])
-    xc = _snap((corners[c, 0] / corners[c, 3]) * view[0] + view[0])
-    yc = _snap((corners[c, 1] / corners[c, 3]) * view[1] + view[1])
+    xa = snap((corners[a, 0] / corners[a, 3]) * view[0] + view[0])
+    ya = snap((corners[a, 1] / corners[a, 3]) * view[1] + view[1])
+    xb = snap((corners[b, 0] / corners[b, 3]) * view[0] + view[0])
+    yb = snap((corners[b, 1] / corners[b, 3]) * view[1] + view[1])
+    xc = snap((corners[c, 0] / corners[c, 3]) * view[0] + view[0])
+    yc = snap((corners[c, 1] / corners[c, 3]) * view[1] + view[1])
     # back-face test by the signed area in window space (twice the area, exact)
     area = (xb - xa) * (yc - ya) - (xc - xa) * (yb - ya)
     if area == 0:
@@ -134,8 +124,8 @@ def window_vertices(
         if codes[i] != 0:
             continue
         w = clip[i, 3]
-        win_int[i, 0] = _snap((clip[i, 0] / w) * view[0] + view[0])
-        win_int[i, 1] = _snap((clip[i, 1] / w) * view[1] + view[1])
+        win_int[i, 0] = snap((clip[i, 0] / w) * view[0] + view[0])
+        win_int[i, 1] = snap((clip[i, 1] / w) * view[1] + view[1])
         win_float[i, 0] = (clip[i, 2] / w) * 0.5 + 0.5
         win_float[i, 1] = 1.0 / w
 
