@@ -27,6 +27,11 @@ import numpy as np
 from frustum import clip_triangles
 
 
+def placed(scene, mesh, material=None, transform=None):
+    """``scene.add(mesh, material, transform)`` and return the scene (``Scene.add`` returns the new node)."""
+    scene.add(mesh, material=material, transform=transform)
+    return scene
+
 def _rows(matrix: np.ndarray, points: np.ndarray, count: int, affine: bool) -> np.ndarray:
     x, y, z = points[:, 0], points[:, 1], points[:, 2]
     out = np.empty((points.shape[0], count))

@@ -16,6 +16,7 @@ from fractions import Fraction
 import numpy as np
 import pytest
 import trimesh
+from tests.reference_raster import placed
 
 from frustum import Camera, FrustumError, Orthographic, Perspective, clip_lines
 from frustum.clipping import VIEW_VOLUME_PLANES
@@ -152,12 +153,15 @@ def perspective_camera() -> Camera:
 
 def scenes() -> dict[str, Scene]:
     return {
-        "cube": Scene().add(cube(), material=Material(color=(0.9, 0.6, 0.2))),
-        "tetrahedron": Scene().add(tetrahedron(), material=Material(color=(0.2, 0.8, 0.4))),
-        "three items": Scene()
-        .add(cube(), material=Material(color=(0.9, 0.6, 0.2)))
-        .add(tetrahedron(), material=Material(color=(0.2, 0.8, 0.4)), transform=np.diag([1.2, 1.2, 1.2, 1.0]))
-        .add(ground(), material=Material(color=(0.5, 0.5, 1.0))),
+        "cube": placed(Scene(), cube(), material=Material(color=(0.9, 0.6, 0.2))),
+        "tetrahedron": placed(Scene(), tetrahedron(), material=Material(color=(0.2, 0.8, 0.4))),
+        "three items": placed(
+            placed(
+                placed(Scene(), cube(), material=Material(color=(0.9, 0.6, 0.2))),
+                tetrahedron(), material=Material(color=(0.2, 0.8, 0.4)), transform=np.diag([1.2, 1.2, 1.2, 1.0]),
+            ),
+            ground(), material=Material(color=(0.5, 0.5, 1.0)),
+        ),
     }
 
 
@@ -189,7 +193,9 @@ def _draw(starts_window, ends_window, z=(0.5, 0.5)) -> np.ndarray:
     depth = np.ones((HEIGHT, WIDTH), dtype=np.float32)
     color = np.zeros((HEIGHT, WIDTH, 4), dtype=np.uint8)
     red = np.array([255, 0, 0, 255], dtype=np.uint8)
-    lines.draw_lines(clip, edges, np.array(VIEW_VOLUME_PLANES), view, red, depth, color)
+    lines.draw_lines(
+        clip, np.zeros(len(clip)), edges, np.array(VIEW_VOLUME_PLANES), view, lines.line_style(red), depth, color
+    )
     return depth
 
 
@@ -229,7 +235,9 @@ def test_line_reaching_behind_the_eye_is_clipped_not_wrapped():
     )
     segment = Mesh([[0.6, -0.4, -5.0], [0.6, -0.4, 5.0], [0.6, -0.4, 5.0 + 1e-3]], [[0, 1, 2]])
     behind = Mesh([[-1.0, 0.5, 2.0], [1.0, 0.5, 3.0], [0.0, -0.5, 4.0]], [[0, 1, 2]])
-    scene = Scene().add(segment, material=Material(color=(1, 1, 1))).add(behind, material=Material(color=(1, 0, 0)))
+    scene = Scene()
+    scene.add(segment, material=Material(color=(1, 1, 1)))
+    scene.add(behind, material=Material(color=(1, 0, 0)))
     frame = render(scene, camera, mode="wireframe")
     covered = _covered(frame.depth)
     # window column of the far end (0.6, −0.4, −5): x_ndc = (0.6 / 5) / (tan(fovy/2)·aspect), x_w = 24·x_ndc + 24
@@ -267,7 +275,7 @@ def test_line_behind_a_nearer_line_is_hidden(near_first):
     lit = frame.depth < 1.0
     assert lit.sum() > 40
     assert (frame.color[lit] == [0, 255, 0, 255]).all()  # only the near (green) item shows
-    near_only = render(Scene().add(scene.items[0 if near_first else 1].mesh), camera, mode="wireframe")
+    near_only = render(placed(Scene(), scene.items[0 if near_first else 1].mesh), camera, mode="wireframe")
     np.testing.assert_array_equal(frame.depth, near_only.depth)
     color, depth = reference_lines(scene, camera, "wireframe", background=(0, 0, 0, 1))
     np.testing.assert_array_equal(frame.color, color)
@@ -300,7 +308,7 @@ def test_lines_and_points_are_deterministic(mode):
 
 def test_lines_ignore_lights_and_culling():
     scene, camera = scenes()["cube"], perspective_camera()
-    lit = Scene(lights=[DirectionalLight(direction=(0, -1, 0))]).add(cube(), material=Material(color=(0.9, 0.6, 0.2)))
+    lit = placed(Scene(lights=[DirectionalLight(direction=(0, -1, 0))]), cube(), material=Material(color=(0.9, 0.6, 0.2)))
     a = render(scene, camera, mode="wireframe")
     b = render(lit, camera, mode="wireframe", shading="phong", cull_back_faces=True)
     c = render(lit, camera, mode="wireframe", shading=None, cull_back_faces=False)

@@ -21,11 +21,15 @@ class Frame:
 
     Row ``r`` of both arrays is window row ``y_w = H − 1 − r`` (OpenGL's readback flipped vertically, the way
     images are stored). ``depth`` is window depth in [0, 1], 1.0 where nothing was drawn. Color is linear RGB,
-    not sRGB-encoded. Both arrays are read-only.
+    not sRGB-encoded unless asked for. Optional buffers (``render(..., buffers=...)``): ``normals`` (H, W, 3)
+    float32 unit world normals (0 where nothing was drawn) and ``object_id`` (H, W) int32, the index of the
+    scene item seen at each pixel (−1 for background). All arrays are read-only.
     """
 
     color: NDArray[np.uint8]
     depth: NDArray[np.float32]
+    normals: NDArray[np.float32] | None = None
+    object_id: NDArray[np.int32] | None = None
 
     def __post_init__(self) -> None:
         color = np.ascontiguousarray(self.color)
@@ -38,6 +42,17 @@ class Frame:
             raise OutputError(
                 f"Frame: depth has dtype {depth.dtype} and shape {depth.shape}; expected {color.shape[:2]} float32"
             )
+        for name, dtype, shape in (("normals", np.float32, (*depth.shape, 3)), ("object_id", np.int32, depth.shape)):
+            value = getattr(self, name)
+            if value is None:
+                continue
+            value = np.ascontiguousarray(value)
+            if value.dtype != dtype or value.shape != shape:
+                raise OutputError(
+                    f"Frame: {name} has dtype {value.dtype} and shape {value.shape}; expected {shape} {dtype.__name__}"
+                )
+            value.flags.writeable = False
+            object.__setattr__(self, name, value)
         color.flags.writeable = False
         depth.flags.writeable = False
         object.__setattr__(self, "color", color)

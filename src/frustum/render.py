@@ -13,8 +13,13 @@ Fast path, per scene item (one compiled pass each, buffers shared between items)
 4. ``raster.triangles.rasterize_tiles``: edge functions with the top-left rule, depth test "less" against a
    float32 buffer cleared to 1.0, perspective-correct barycentrics stored per pixel (parallel over tiles; the
    first drawn mesh's pass also clears each tile's depth and face codes, so no numpy fill of the buffers).
-5. ``raster.shade.shade_pixels``: deferred Blinn-Phong (or flat color) once per visible pixel; the last
-   item's pass (rasterization complete) also paints the background pixels.
+5. ``raster.shade.shade_pixels``: deferred shading once per visible pixel (``frustum.shading``'s model,
+   flat, Gouraud or Phong; per-vertex or per-face terms first by ``light_vertices`` / ``light_faces``); the
+   last item's pass (rasterization complete) also paints the background pixels.
+6. Transparent items (``Material.opacity < 1``) after all opaque ones, back to front by the view distance of
+   their centres: each rasterized alone against a copy of the opaque depth buffer (its nearest surface) and
+   blended ``α·I + (1 − α)·under``.
+7. Edges (``"surface+edges"``, ``"hidden-line"``): ``raster.lines`` against the finished depth buffer.
 
 ``mode="wireframe"`` and ``mode="points"`` replace stages 2–5 by one serial kernel per item
 (``raster.lines``): every unique mesh edge clipped by Liang–Barsky in clip space, divided, mapped and drawn as a
@@ -28,31 +33,66 @@ The textbook path is the public stage functions (``Camera.project``, ``clip_tria
 
 from __future__ import annotations
 
+import dataclasses
+import math
 from typing import Any
 
 import numba
 import numpy as np
 
-from frustum._arrays import describe
+from frustum._arrays import as_scalar, describe
 from frustum.camera import Camera
 from frustum.clipping import VIEW_VOLUME_PLANES
-from frustum.errors import FrustumError, ShadingError
+from frustum.errors import FrustumError
 from frustum.frame import Frame
 from frustum.raster import lines, shade, tiles, triangles
 from frustum.raster.vertices import transform_vertices
 from frustum.scene import Scene, SceneItem
-from frustum.shading import DirectionalLight
+from frustum.shading import SPECULAR_MODELS, DepthCue, pack_lights
+from frustum.visibility import feature_edges
 
-__all__ = ["RENDER_MODES", "SHADING_MODES", "TILE_SIZE", "mesh_edges", "render"]
+__all__ = ["HIDDEN_STYLES", "RENDER_MODES", "SHADING_MODES", "TILE_SIZE", "mesh_edges", "render"]
 
-SHADING_MODES = {"phong": shade.SHADE_PHONG, "none": shade.SHADE_NONE}
+SHADING_MODES = {
+    "phong": shade.SHADE_PHONG,
+    "gouraud": shade.SHADE_GOURAUD,
+    "flat": shade.SHADE_FLAT,
+    "normals": shade.SHADE_NORMALS,
+    "depth": shade.SHADE_DEPTH,
+    "none": shade.SHADE_NONE,
+}
 """Shading names ``render`` accepts (``None`` means ``"none"``)."""
-RENDER_MODES = ("surface", "wireframe", "points")
-"""What ``render`` draws of each mesh: filled triangles, unique edges as lines, or vertices as pixels."""
+RENDER_MODES = ("surface", "wireframe", "points", "hidden-line", "surface+edges")
+"""What ``render`` draws: filled surfaces, edges as lines, vertices as pixels, visible edges only, or both."""
+HIDDEN_STYLES = (None, "dimmed", "dashed")
+"""How ``mode="hidden-line"`` draws the hidden parts of edges: not at all, solid in `hidden_color`, or dashed."""
+EDGE_SETS = ("all", "feature")
+FILTERS = ("box", "tent")
+COLOR_SPACES = ("linear", "srgb")
+BUFFERS = ("normals", "object_id")
 TILE_SIZE = 32
 """Side of a square screen tile in pixels: the unit of parallel work of the rasterizer."""
 _SETUP_CHUNK = 4096
 _BIN_CHUNK = 16384
+_EDGE_OFFSET = 1e-5
+"""Window-depth offset of the hidden-line test (``raster.lines``), against stitching of edges into faces."""
+
+
+@dataclasses.dataclass(frozen=True)
+class _Options:
+    shade_mode: int
+    specular_model: int
+    background: np.ndarray  # (4,) uint8
+    cull: bool
+    mode: str
+    edges: str
+    crease_angle: float
+    edge_color: np.ndarray | None  # (4,) bytes as float, or None for the material color
+    hidden: str | None
+    hidden_color: np.ndarray
+    line_width: float
+    depth_cue: DepthCue | None
+    buffers: tuple[str, ...]
 
 
 def render(
@@ -60,104 +100,232 @@ def render(
     camera: Camera,
     *,
     shading: str | None = "phong",
+    specular: str = "blinn-phong",
     background: Any = (0.0, 0.0, 0.0, 1.0),
     cull_back_faces: bool = True,
     mode: str = "surface",
+    edges: str | None = None,
+    crease_angle: float = math.radians(30.0),
+    edge_color: Any = None,
+    hidden: str | None = None,
+    hidden_color: Any = (0.6, 0.6, 0.6),
+    line_width: float = 1.0,
+    depth_cue: DepthCue | None = None,
+    samples: int = 1,
+    filter: str = "box",
+    color_space: str = "linear",
+    buffers: tuple[str, ...] = (),
 ) -> Frame:
     """Render `scene` seen by `camera` into a ``Frame`` (color (H, W, 4) uint8 and depth (H, W) float32).
 
     Parameters
     ----------
     scene : Scene
-        Meshes with materials; for ``shading="phong"`` exactly one ``DirectionalLight`` (white, intensity 1).
+        Placed meshes with materials and any number of lights (``frustum.shading``).
     camera : Camera
         Its width and height are the image size.
-    shading : {"phong", "none"} or None
-        ``"phong"``: per-pixel Blinn-Phong (``frustum.shading``). ``"none"`` or None: no lighting, every
-        visible pixel gets its material's flat color (the depth buffer alone decides visibility).
+    shading : {"phong", "gouraud", "flat", "normals", "depth", "none"} or None
+        Where the illumination model is evaluated: per pixel, per vertex (interpolated), or per face
+        (``raster/shade.py``); ``"normals"`` shows ``0.5·N + 0.5`` of the world normal, ``"depth"`` the gray
+        ``(far − d)/(far − near)`` of the view distance; ``"none"`` (or None): the base color, no lighting.
+    specular : {"blinn-phong", "phong"}
+        The specular term: (N·H)^n or (R·V)^n.
     background : (4,) array_like
-        RGBA in [0, 1] for pixels no triangle covers; stored as ``round(255·value)``.
+        RGBA in [0, 1] for pixels nothing covers; stored as ``round(255·value)``.
     cull_back_faces : bool
         True: drop triangles that are clockwise (or of zero area) in window coordinates. False: draw both
         sides, lighting a back face with its normal flipped toward the viewer (two-sided lighting, for open
         surfaces such as the teapot). Lines and points are never culled.
-    mode : {"surface", "wireframe", "points"}
-        ``"surface"``: filled, shaded triangles. ``"wireframe"``: every unique edge of the faces (each undirected
-        edge once), clipped in homogeneous clip space, as a 1-pixel line with window depth linear along it.
-        ``"points"``: every mesh vertex inside the view volume as the one pixel containing it. Both draw the
-        item's material color with alpha 255 (no lighting, so `shading` and the lights are not used) with the
-        depth test "less"; the pixel rules are in ``frustum.raster.lines``.
+    mode : {"surface", "wireframe", "points", "hidden-line", "surface+edges"}
+        ``"surface"``: filled, shaded triangles. ``"wireframe"``: every unique edge, clipped in homogeneous clip
+        space, as a line with window depth linear along it. ``"points"``: every vertex inside the view volume
+        as the pixel containing it. ``"hidden-line"``: the surfaces fill the depth buffer in the background
+        color and only the visible parts of the edges are drawn (hidden parts per `hidden`).
+        ``"surface+edges"``: shaded surfaces with their visible edges on top.
+    edges : {"all", "feature"} or None
+        Which edges the line modes draw: every edge, or ``visibility.feature_edges`` (boundaries, creases
+        sharper than `crease_angle`, silhouettes). None: "all" for wireframe, "feature" for the others.
+    edge_color : (3,) or (4,) array_like or None
+        Line color in [0, 1]; None: the material color (wireframe, points) or black (the edge modes).
+    hidden : {None, "dimmed", "dashed"}
+        ``"hidden-line"`` only: draw hidden edge parts solid or dashed in `hidden_color`.
+    line_width : float
+        Line width (and point size) in pixels of the output image, >= 1.
+    depth_cue : DepthCue or None
+        Blend surfaces, lines and points toward the cue color (default the background) by view distance.
+    samples : int
+        Supersampling: 1, 4, 9, 16 (any square): render at √samples times the size and downsample with
+        `filter` ("box": the mean of each block; "tent": a separable triangle filter twice as wide). Lines
+        are drawn √samples times as wide, so they come out anti-aliased. Depth keeps each block's nearest.
+    color_space : {"linear", "srgb"}
+        Output encoding; "srgb" applies the sRGB transfer curve to the linear result.
+    buffers : tuple of {"normals", "object_id"}
+        Extra per-pixel outputs on the Frame: unit world normals (0 on background) and the index of the item
+        in ``scene.items`` (−1 on background).
 
     Raises
     ------
     FrustumError
-        For a bad argument: unknown shading name or mode, wrong types, background outside [0, 1], a non-white light.
+        For a bad argument: unknown names (the message lists the valid ones), wrong types, background outside
+        [0, 1], samples not a square.
 
     References
     ----------
-    [HB 16] "Back-Face Detection", "Depth-Buffer Method"; [seed] "Back-face detection", "Depth-buffer method".
+    [HB 16] "Back-Face Detection", "Depth-Buffer Method"; [HB 17] "Polygon Rendering Methods";
+    [seed] "Back-face detection", "Depth-buffer method", "wire-frame displays".
     """
     where = "render"
-    if not isinstance(mode, str) or mode not in RENDER_MODES:
-        raise FrustumError(
-            f"{where}: mode = {describe(mode)} is unknown; expected one of " + ", ".join(repr(n) for n in RENDER_MODES)
+    options = _check_arguments(
+        scene, camera, shading, specular, background, cull_back_faces, mode, edges, crease_angle, edge_color,
+        hidden, hidden_color, line_width, depth_cue, buffers, where,
+    )  # fmt: skip
+    factor = _supersampling(samples, where)
+    _choice(filter, FILTERS, "filter", where)
+    _choice(color_space, COLOR_SPACES, "color_space", where)
+    if factor == 1:
+        color, depth, normals, ids = _render_buffers(scene, camera, options)
+        linear = None
+    else:
+        big = dataclasses.replace(camera, width=camera.width * factor, height=camera.height * factor)
+        wide = dataclasses.replace(options, line_width=options.line_width * factor)
+        color, depth, normals, ids = _render_buffers(scene, big, wide)
+        linear = _downsample(color.astype(np.float64) / 255.0, factor, filter)
+        h, w = camera.height, camera.width
+        depth = depth.reshape(h, factor, w, factor).min(axis=(1, 3))
+        middle = factor // 2
+        normals = None if normals is None else np.ascontiguousarray(normals[middle::factor, middle::factor])
+        ids = None if ids is None else np.ascontiguousarray(ids[middle::factor, middle::factor])
+    if color_space == "srgb":
+        values = color.astype(np.float64) / 255.0 if linear is None else linear
+        values[..., :3] = np.where(
+            values[..., :3] <= 0.0031308, 12.92 * values[..., :3], 1.055 * values[..., :3] ** (1 / 2.4) - 0.055
         )
-    if mode != "surface":
-        _check_arguments(scene, camera, "none", cull_back_faces, where)
-        return _render_lines_or_points(scene, camera, _background_bytes(background, where), mode == "points")
-    shade_mode, light = _check_arguments(scene, camera, shading, cull_back_faces, where)
-    background_bytes = _background_bytes(background, where)
+        linear = values
+    if linear is not None:
+        color = np.floor(np.clip(linear, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
+    return Frame(color=color, depth=depth, normals=normals, object_id=ids)
+
+
+def _render_buffers(
+    scene: Scene, camera: Camera, options: _Options
+) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None]:
+    """Color, depth and the asked-for extra buffers at the camera's size."""
     height, width = camera.height, camera.width
+    items = scene.items
+    normal_out = np.zeros((height, width, 3), dtype=np.float32) if "normals" in options.buffers else None
+    id_out = np.full((height, width), -1, dtype=np.int32) if "object_id" in options.buffers else None
+    if options.mode in ("wireframe", "points"):
+        depth = np.ones((height, width), dtype=np.float32)
+        color = np.empty((height, width, 4), dtype=np.uint8)
+        color[:, :] = options.background
+        _draw_edges(items, camera, options, depth, color)
+        return color, depth, normal_out, id_out
+    depth, color = _draw_surfaces(scene, items, camera, options, normal_out, id_out)
+    if options.mode == "hidden-line":
+        color[:, :] = options.background
+    if options.mode in ("hidden-line", "surface+edges"):
+        _draw_edges(items, camera, options, depth, color)
+    return color, depth, normal_out, id_out
+
+
+def _draw_surfaces(
+    scene: Scene, items: list[SceneItem], camera: Camera, options: _Options,
+    normal_out: np.ndarray | None, id_out: np.ndarray | None,
+) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """Stages 1–6 for every item: the depth and color buffers."""
+    height, width = camera.height, camera.width
+    opaque = [i for i, item in enumerate(items) if item.material.opacity >= 1.0]
+    clear_items = [i for i, item in enumerate(items) if item.material.opacity < 1.0]
     # uninitialized: the first rasterized item clears depth and codes tile by tile, the last shading pass
     # paints the background (both inside the parallel kernels); numpy fills only when no kernel runs
     depth = np.empty((height, width), dtype=np.float32)
-    face_total = sum(item.mesh.face_count for item in scene.items)
-    codes = np.empty((height, width), dtype=np.int32 if 2 * face_total < 2**31 else np.int64)
+    face_total = sum(item.mesh.face_count for item in items)
+    code_type = np.int32 if 2 * face_total < 2**31 else np.int64
+    codes = np.empty((height, width), dtype=code_type)
     bary = np.empty((height, width, 2), dtype=np.float32)  # read only where codes >= 0
     color = np.empty((height, width, 4), dtype=np.uint8)
-    if face_total == 0:
+    opaque_faces = sum(items[i].mesh.face_count for i in opaque)
+    if opaque_faces == 0:
         depth.fill(1.0)
         codes.fill(-1)
-    if not scene.items:
-        color[:, :] = background_bytes
-    eye = _eye_position(camera)
+    if not opaque:
+        color[:, :] = options.background
+    ambient, lights = pack_lights(scene.world_lights())
+    extra = (
+        np.zeros((1, 1, 3), dtype=np.float32) if normal_out is None else normal_out,
+        np.zeros((1, 1), dtype=np.int32) if id_out is None else id_out,
+    )
     face_offset = 0
-    clear = face_total > 0
-    for index, item in enumerate(scene.items):
-        world, normals = _draw_item(item, camera, bool(cull_back_faces), face_offset, depth, codes, bary, clear)
+    offsets = np.cumsum([0] + [item.mesh.face_count for item in items])
+    clear = opaque_faces > 0
+    drawn = []
+    for index in opaque:
+        item = items[index]
+        face_offset = int(offsets[index])
+        world, normals = _draw_item(item, camera, options.cull, face_offset, depth, codes, bary, clear)
         clear = clear and item.mesh.face_count == 0
-        params = _shading_parameters(item, light, eye)
-        last = int(index == len(scene.items) - 1)
-        options = np.array([face_offset, shade_mode, last, *background_bytes], dtype=np.int64)
-        shade.shade_pixels(codes, bary, item.mesh.faces, world, normals, params, options, color)
-        face_offset += item.mesh.face_count
-    return Frame(color=color, depth=depth)
+        drawn.append((index, world, normals))
+    for position, (index, world, normals) in enumerate(drawn):
+        last = position == len(drawn) - 1
+        _shade_item(items[index], index, int(offsets[index]), camera, options, ambient, lights, world, normals,
+                    codes, bary, color, extra, paint=last, blend=False)  # fmt: skip
+    if clear_items:
+        axis = np.asarray(camera.frame.n, dtype=np.float64)
+        eye = np.asarray(camera.frame.eye, dtype=np.float64)
+
+        def distance(index: int) -> float:
+            item = items[index]
+            if item.mesh.vertex_count == 0:
+                return 0.0
+            centre = item.mesh.bounds.mean(axis=0)
+            centre = item.world_from_model[:3, :3] @ centre + item.world_from_model[:3, 3]
+            return float((eye - centre) @ axis)
+
+        for index in sorted(clear_items, key=distance, reverse=True):
+            item = items[index]
+            layer_depth = depth.copy()
+            layer_codes = np.full((height, width), -1, dtype=code_type)
+            world, normals = _draw_item(item, camera, options.cull, int(offsets[index]), layer_depth, layer_codes,
+                                        bary, False)  # fmt: skip
+            _shade_item(item, index, int(offsets[index]), camera, options, ambient, lights, world, normals,
+                        layer_codes, bary, color, extra, paint=False, blend=True)  # fmt: skip
+    return depth, color
 
 
-def _render_lines_or_points(scene: Scene, camera: Camera, background_bytes: np.ndarray, points: bool) -> Frame:
-    """``mode="wireframe"`` (or ``"points"``): each item's edges (or vertices) in scene order, one kernel each."""
-    depth = np.ones((camera.height, camera.width), dtype=np.float32)
-    color = np.empty((camera.height, camera.width, 4), dtype=np.uint8)
-    color[:, :] = background_bytes
-    view = np.array([camera.width / 2.0, camera.height / 2.0])
-    for item in scene.items:
-        mesh = item.mesh
-        rgba = np.empty(4, dtype=np.uint8)
-        rgba[:3] = np.floor(np.clip(item.material.color, 0.0, 1.0) * 255.0 + 0.5)
-        rgba[3] = 255
-        clip = np.empty((mesh.vertex_count, 4))
-        vertex_codes = np.empty(mesh.vertex_count, dtype=np.int64)
-        transform_vertices(
-            mesh.vertices, np.ones((mesh.vertex_count, 3)), _item_matrices(item, camera), VIEW_VOLUME_PLANES,
-            clip, np.empty((mesh.vertex_count, 3)), np.empty((mesh.vertex_count, 3)), vertex_codes,
-        )  # fmt: skip
-        if points:
-            lines.draw_points(clip, vertex_codes, view, rgba, depth, color)
-        else:
-            lines.draw_lines(clip, mesh_edges(mesh.faces), VIEW_VOLUME_PLANES, view, rgba, depth, color)
-    return Frame(color=color, depth=depth)
-
-
+def _shade_item(
+    item: SceneItem, index: int, face_offset: int, camera: Camera, options: _Options, ambient: np.ndarray,
+    lights: np.ndarray, world: np.ndarray, normals: np.ndarray, codes: np.ndarray, bary: np.ndarray,
+    color: np.ndarray, extra: tuple[np.ndarray, np.ndarray], paint: bool, blend: bool,
+) -> None:  # fmt: skip
+    mesh, material = item.mesh, item.material
+    params = _shading_parameters(item, camera, options, ambient)
+    mode = options.shade_mode
+    if mode == shade.SHADE_GOURAUD and mesh.face_count:
+        lit = np.empty((mesh.vertex_count, 6))
+        shade.light_vertices(world, normals, params, lights, options.specular_model, lit)
+    elif mode == shade.SHADE_FLAT and mesh.face_count:
+        lit = np.empty((mesh.face_count, 6))
+        shade.light_faces(world, mesh.faces, params, lights, options.specular_model, lit)
+    else:
+        lit = np.empty((0, 6))
+    vertex_colors = getattr(mesh, "vertex_colors", None)
+    vertex_colors = np.empty((0, 3)) if vertex_colors is None else np.ascontiguousarray(vertex_colors[:, :3], float)
+    uvs = getattr(mesh, "uvs", None)
+    texture = material.texture
+    if texture is None or uvs is None:
+        texture, uvs = np.empty((0, 0, 4), dtype=np.float32), np.empty((0, 2))
+    else:
+        uvs = np.ascontiguousarray(uvs, dtype=np.float64)
+    flags = np.zeros(shade.ITEM, dtype=np.int64)
+    flags[shade.I_FACE_OFFSET], flags[shade.I_MODE], flags[shade.I_PAINT] = face_offset, mode, int(paint)
+    flags[shade.I_BACKGROUND : shade.I_BACKGROUND + 4] = options.background
+    flags[shade.I_SPECULAR_MODEL], flags[shade.I_OBJECT_ID] = options.specular_model, index
+    flags[shade.I_WRITE_NORMALS] = int(extra[0].shape[0] == codes.shape[0] and extra[0].shape[1] == codes.shape[1])
+    flags[shade.I_WRITE_IDS] = int(extra[1].shape == codes.shape)
+    flags[shade.I_BLEND] = int(blend)
+    faces = mesh.faces if mesh.face_count else np.empty((0, 3), dtype=np.int64)
+    shade.shade_pixels(codes, bary, faces, world, normals, lit, vertex_colors, uvs, texture, params, lights, flags,
+                       color, extra[0], extra[1])  # fmt: skip
 def mesh_edges(faces: np.ndarray) -> np.ndarray:
     """(E, 2) int64: every undirected edge of the triangles `faces` once, as ``(low, high)`` rows in sorted order."""
     faces = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
@@ -268,24 +436,136 @@ def _item_matrices(item: SceneItem, camera: Camera) -> np.ndarray:
     return matrices
 
 
-def _eye_position(camera: Camera) -> np.ndarray:
-    """World position of the viewer, for V = normalize(eye − P): the frame's eye point."""
-    return np.asarray(camera.frame.eye, dtype=np.float64)
-
-
-def _shading_parameters(item: SceneItem, light: DirectionalLight | None, eye: np.ndarray) -> np.ndarray:
-    """(13,) float64: L (toward the light), eye, color, ambient, diffuse, specular, shininess."""
+def _shading_parameters(item: SceneItem, camera: Camera, options: _Options, ambient: np.ndarray) -> np.ndarray:
+    """(PARAMS,) float64 in the layout of ``raster.shade``: eye, material, ambient light, view axis, cueing."""
     material = item.material
-    to_light = light.to_light if light is not None else np.zeros(3)
-    return np.concatenate(
-        [to_light, eye, material.color,
-         [material.ambient, material.diffuse, material.specular, material.shininess]]
-    ).astype(np.float64)  # fmt: skip
+    params = np.zeros(shade.PARAMS)
+    params[shade.P_EYE : shade.P_EYE + 3] = camera.frame.eye
+    params[shade.P_COLOR : shade.P_COLOR + 3] = material.color
+    params[shade.P_AMBIENT], params[shade.P_DIFFUSE] = material.ambient, material.diffuse
+    params[shade.P_SPECULAR], params[shade.P_SHININESS] = material.specular, material.shininess
+    params[shade.P_EMISSIVE : shade.P_EMISSIVE + 3] = material.emissive
+    params[shade.P_LIGHT_AMBIENT : shade.P_LIGHT_AMBIENT + 3] = ambient
+    params[shade.P_VIEW_AXIS : shade.P_VIEW_AXIS + 3] = camera.frame.n
+    cue = options.depth_cue
+    if cue is not None:
+        params[shade.P_CUE_ON] = 1.0
+        params[shade.P_CUE_NEAR], params[shade.P_CUE_FAR] = cue.near, cue.far
+        params[shade.P_CUE_MIN], params[shade.P_CUE_MAX] = cue.min_intensity, cue.max_intensity
+        params[shade.P_CUE_COLOR : shade.P_CUE_COLOR + 3] = _cue_color(options)
+    params[shade.P_DEPTH_NEAR], params[shade.P_DEPTH_FAR] = camera.projection.near, camera.projection.far
+    params[shade.P_OPACITY] = material.opacity
+    return params
+
+
+def _cue_color(options: _Options) -> np.ndarray:
+    """The depth cue's color in [0, 1]: its own, or the background's."""
+    cue = options.depth_cue
+    return options.background[:3] / 255.0 if cue is None or cue.color is None else np.asarray(cue.color)
+
+
+def _draw_edges(items: list[SceneItem], camera: Camera, options: _Options, depth: np.ndarray, color: np.ndarray):
+    """Lines (or points) of every item into the buffers, serially in scene order (``raster.lines``)."""
+    view = np.array([camera.width / 2.0, camera.height / 2.0])
+    eye = np.asarray(camera.frame.eye, dtype=np.float64)
+    axis = np.asarray(camera.frame.n, dtype=np.float64)
+    edge_modes = options.mode in ("hidden-line", "surface+edges")
+    cue = None
+    if options.depth_cue is not None:
+        c = options.depth_cue
+        cue = (c.near, c.far, c.min_intensity, c.max_intensity, *(255.0 * _cue_color(options)))
+    for item in items:
+        mesh = item.mesh
+        if options.edge_color is not None:
+            rgba = options.edge_color
+        else:
+            rgba = np.append(np.floor(np.clip(item.material.color, 0.0, 1.0) * 255.0 + 0.5), 255.0)
+        style = lines.line_style(
+            rgba, width=options.line_width, write_depth=not edge_modes, hidden_line=edge_modes, offset=_EDGE_OFFSET,
+            hidden={None: 0, "dimmed": 1, "dashed": 2}[options.hidden] if options.mode == "hidden-line" else 0,
+            hidden_rgba=options.hidden_color, dash=6.0 * options.line_width, cue=cue,
+        )  # fmt: skip
+        clip = np.empty((mesh.vertex_count, 4))
+        world = np.empty((mesh.vertex_count, 3))
+        vertex_codes = np.empty(mesh.vertex_count, dtype=np.int64)
+        transform_vertices(
+            mesh.vertices, np.ones((mesh.vertex_count, 3)), _item_matrices(item, camera), VIEW_VOLUME_PLANES,
+            clip, world, np.empty((mesh.vertex_count, 3)), vertex_codes,
+        )  # fmt: skip
+        view_depth = (eye - world) @ axis
+        if options.mode == "points":
+            lines.draw_points(clip, view_depth, vertex_codes, view, style, depth, color)
+            continue
+        if options.edges == "all":
+            edges = mesh_edges(mesh.faces)
+        else:
+            edges = feature_edges(world, mesh.faces, camera, options.crease_angle)
+        lines.draw_lines(clip, view_depth, edges, VIEW_VOLUME_PLANES, view, style, depth, color)
+
+
+def _choice(value: Any, valid: tuple, name: str, where: str) -> Any:
+    if not isinstance(value, str | type(None)) or value not in valid:
+        raise FrustumError(
+            f"{where}: {name} = {describe(value)} is unknown; expected one of " + ", ".join(repr(v) for v in valid)
+        )
+    return value
+
+
+def _supersampling(samples: Any, where: str) -> int:
+    """√samples for a perfect square samples >= 1, else a FrustumError."""
+    if isinstance(samples, bool) or not isinstance(samples, int | np.integer) or samples < 1:
+        raise FrustumError(f"{where}: samples = {describe(samples)} is not a positive integer; use 1, 4, 9 or 16")
+    factor = math.isqrt(int(samples))
+    if factor * factor != samples:
+        raise FrustumError(f"{where}: samples = {samples} is not a perfect square; use 1, 4, 9 or 16")
+    return factor
+
+
+def _downsample(values: np.ndarray, factor: int, kind: str) -> np.ndarray:
+    """(H·s, W·s, C) → (H, W, C): the mean of each s×s block ("box"), or a separable tent of width 2s centred
+    on each block (weights ``s − |offset|`` for the 2s − 1 samples around it, edges clamped)."""
+    height, width = values.shape[0] // factor, values.shape[1] // factor
+    if kind == "box":
+        return values.reshape(height, factor, width, factor, -1).mean(axis=(1, 3))
+    offsets = np.arange(-(factor - 1), factor) if factor > 1 else np.array([0])
+    weights = (factor - np.abs(offsets)).astype(np.float64)
+    weights /= weights.sum()
+
+    def along(array: np.ndarray, axis: int, size: int) -> np.ndarray:
+        # output k is centred between samples k·s + (s − 1)/2: use the sample pair around the centre
+        total = np.zeros((*array.shape[:axis], size, *array.shape[axis + 1 :]))
+        for offset, weight in zip(offsets, weights, strict=True):
+            index = np.clip(np.arange(size) * factor + (factor - 1) // 2 + offset, 0, array.shape[axis] - 1)
+            if factor % 2 == 0:  # even blocks: average the two centre-adjacent alignments
+                index2 = np.clip(index + 1, 0, array.shape[axis] - 1)
+                total += 0.5 * weight * (np.take(array, index, axis=axis) + np.take(array, index2, axis=axis))
+            else:
+                total += weight * np.take(array, index, axis=axis)
+        return total
+
+    return along(along(values, 0, height), 1, width)
+
+
+def _color_bytes(value: Any, name: str, where: str) -> np.ndarray:
+    """(4,) float64 bytes of an RGB or RGBA color in [0, 1] (alpha 1 if not given)."""
+    try:
+        array = np.asarray(value, dtype=np.float64).ravel()
+    except (TypeError, ValueError):
+        array = np.array([np.nan])
+    if array.shape not in ((3,), (4,)) or not np.isfinite(array).all() or (array < 0).any() or (array > 1).any():
+        raise FrustumError(
+            f"{where}: {name} = {describe(value)} is not an RGB(A) color; expected 3 or 4 numbers in [0, 1]"
+        )
+    if array.shape == (3,):
+        array = np.append(array, 1.0)
+    return np.floor(array * 255.0 + 0.5)
 
 
 def _check_arguments(
-    scene: Any, camera: Any, shading: Any, cull_back_faces: Any, where: str
-) -> tuple[int, DirectionalLight | None]:
+    scene: Any, camera: Any, shading: Any, specular: Any, background: Any, cull_back_faces: Any, mode: Any,
+    edges: Any, crease_angle: Any, edge_color: Any, hidden: Any, hidden_color: Any, line_width: Any,
+    depth_cue: Any, buffers: Any, where: str,
+) -> _Options:  # fmt: skip
     if not isinstance(scene, Scene):
         raise FrustumError(f"{where}: scene = {describe(scene)} is not a Scene; build one with Scene(lights=[...])")
     if not isinstance(camera, Camera):
@@ -296,26 +576,51 @@ def _check_arguments(
     if not isinstance(name, str) or name not in SHADING_MODES:
         raise FrustumError(
             f"{where}: shading = {describe(shading)} is unknown; expected one of "
-            + ", ".join(repr(n) for n in sorted(SHADING_MODES))
+            + ", ".join(repr(n) for n in SHADING_MODES)
             + " or None"
         )
+    _choice(specular, SPECULAR_MODELS, "specular", where)
+    _choice(mode, RENDER_MODES, "mode", where)
     if not isinstance(cull_back_faces, bool | np.bool_):
         raise FrustumError(f"{where}: cull_back_faces = {describe(cull_back_faces)} is not a bool; give True or False")
-    mode = SHADING_MODES[name]
-    light = None
-    if mode == shade.SHADE_PHONG:
-        if len(scene.lights) != 1:
-            raise ShadingError(
-                f"{where}: scene.lights has {len(scene.lights)} lights; shading='phong' needs exactly one "
-                "DirectionalLight in this version"
-            )
-        light = scene.lights[0]
-        if (light.color != 1.0).any() or light.intensity != 1.0:
-            raise ShadingError(
-                f"{where}: light color = {describe(light.color)}, intensity = {light.intensity!r} is not white of "
-                "intensity 1; this version shades with color (1, 1, 1) and intensity 1 only"
-            )
-    return mode, light
+    if edges is None:
+        edges = "all" if mode in ("wireframe", "points") else "feature"
+    _choice(edges, EDGE_SETS, "edges", where)
+    angle = as_scalar(crease_angle, "crease_angle", where=where, error=FrustumError)
+    if not 0.0 <= angle <= math.pi:
+        raise FrustumError(f"{where}: crease_angle = {angle!r} is outside [0, pi] radians")
+    _choice(hidden, HIDDEN_STYLES, "hidden", where)
+    width = as_scalar(line_width, "line_width", where=where, error=FrustumError)
+    if width < 1.0:
+        raise FrustumError(f"{where}: line_width = {width!r} is below 1; give a width in pixels >= 1")
+    if depth_cue is not None and not isinstance(depth_cue, DepthCue):
+        raise FrustumError(
+            f"{where}: depth_cue = {describe(depth_cue)} is not a DepthCue; build one with DepthCue(near, far)"
+        )
+    if isinstance(buffers, str) or not all(isinstance(b, str) and b in BUFFERS for b in buffers):
+        raise FrustumError(
+            f"{where}: buffers = {describe(buffers)} is not a tuple of buffer names; valid names: "
+            + ", ".join(repr(b) for b in BUFFERS)
+        )
+    if edge_color is None:
+        edge = None if mode in ("wireframe", "points") else np.array([0.0, 0.0, 0.0, 255.0])
+    else:
+        edge = _color_bytes(edge_color, "edge_color", where)
+    return _Options(
+        shade_mode=SHADING_MODES[name],
+        specular_model=shade.SPECULAR_PHONG if specular == "phong" else shade.SPECULAR_BLINN,
+        background=_background_bytes(background, where),
+        cull=bool(cull_back_faces),
+        mode=mode,
+        edges=edges,
+        crease_angle=angle,
+        edge_color=edge,
+        hidden=hidden,
+        hidden_color=_color_bytes(hidden_color, "hidden_color", where),
+        line_width=width,
+        depth_cue=depth_cue,
+        buffers=tuple(buffers),
+    )
 
 
 def _background_bytes(background: Any, where: str) -> np.ndarray:

@@ -1,72 +1,418 @@
-"""The world: meshes placed by a modeling transform, each with a material, and the lights that shine on them."""
+"""The world: a hierarchy of nodes placing geometry with materials, the lights, exploded and cutaway views.
+
+A node's ``transform`` maps its own (model) coordinates into its parent's; the world transform of a node is
+the product down the parent chain, ``world_from_model = T_root · … · T_parent · T_node`` (column vectors: the
+node's own transform is applied first) [HB 9] "Composite Transformations", [HB 13] "Hierarchical modeling"
+(the seed's hierarchical polygon-mesh models). One mesh may hang on many nodes (instancing).
+"""
 
 from __future__ import annotations
 
-from collections.abc import Iterable
-from typing import NamedTuple
+from collections.abc import Iterable, Iterator
+from typing import Any, NamedTuple
 
+import numpy as np
 from numpy.typing import ArrayLike
 
-from frustum._arrays import Matrix4, as_matrix, describe
-from frustum.errors import FrustumError
+from frustum._arrays import Matrix4, as_matrix, as_scalar, as_vector3, describe
+from frustum.errors import FrustumError, GeometryError
 from frustum.geometry import Mesh
-from frustum.shading import DirectionalLight, Material
+from frustum.shading import LIGHT_TYPES, Light, Material
+from frustum.transforms import translate
 
-__all__ = ["Scene", "SceneItem"]
+__all__ = ["Node", "Placed", "Scene", "SceneItem", "cutaway", "exploded"]
+
+_IDENTITY = np.eye(4)
+_IDENTITY.flags.writeable = False
 
 
 class SceneItem(NamedTuple):
-    """One placed mesh: ``world = world_from_model · model``."""
+    """One placed mesh: ``world = world_from_model · model``, drawn with ``material``."""
 
     mesh: Mesh
     material: Material
     world_from_model: Matrix4
 
 
-class Scene:
-    """A list of placed meshes and a list of lights: ``Scene(lights=[light]); scene.add(mesh, material=m)``.
+class Placed(NamedTuple):
+    """A node and its world transform, as ``Scene.walk`` yields them (unpacks as ``node, world_from_model``)."""
 
-    Items render in the order they were added (the depth buffer makes the image independent of that order,
-    except for exactly equal depths, where the first drawn wins under the "less" test).
+    node: Node
+    world_from_model: Matrix4
+
+    @property
+    def geometry(self) -> Any:
+        return self.node.geometry
+
+    @property
+    def mesh(self) -> Any:
+        return self.node.geometry
+
+    @property
+    def material(self) -> Material | None:
+        return self.node.material
+
+
+def _modeling_transform(transform: ArrayLike | None, where: str) -> Matrix4:
+    if transform is None:
+        return _IDENTITY
+    matrix = as_matrix(transform, "transform", where=where)
+    if abs(matrix[3] - (0.0, 0.0, 0.0, 1.0)).max() != 0.0:
+        raise FrustumError(
+            f"{where}: transform bottom row = {describe(matrix[3])} makes it projective; a modeling transform "
+            "is affine (bottom row 0, 0, 0, 1)"
+        )
+    matrix.flags.writeable = False
+    return matrix
+
+
+class Node:
+    """A scene-graph node: ``Node(name, transform, geometry, material, children)``.
+
+    ``transform`` (4x4 affine, default identity) maps this node's coordinates into its parent's;
+    ``geometry`` is a ``Mesh`` (or None for a pure group); ``material`` None inherits the nearest ancestor's
+    (``Material()`` at the top); ``lights`` ride the node (they move with its world transform).
     """
 
-    def __init__(self, lights: Iterable[DirectionalLight] = ()) -> None:
-        self.lights: list[DirectionalLight] = []
-        self.items: list[SceneItem] = []
+    def __init__(
+        self,
+        name: str = "",
+        transform: ArrayLike | None = None,
+        geometry: Mesh | None = None,
+        material: Material | None = None,
+        children: Iterable[Node] = (),
+        lights: Iterable[Light] = (),
+    ) -> None:
+        where = f"Node({name!r})"
+        if not isinstance(name, str) or "/" in name:
+            raise FrustumError(f"{where}: name = {describe(name)} is not a string without '/'; '/' separates paths")
+        if geometry is not None and not isinstance(geometry, Mesh):
+            raise FrustumError(
+                f"{where}: geometry = {describe(geometry)} is not a Mesh; build one with Mesh(vertices, faces) or "
+                "a primitive, or tessellate the surface first"
+            )
+        if material is not None and not isinstance(material, Material):
+            raise FrustumError(f"{where}: material = {describe(material)} is not a Material; build one with Material()")
+        self.name = name
+        self.transform = _modeling_transform(transform, where)
+        self.geometry = geometry
+        self.material = material
+        self.children: list[Node] = []
+        self.lights: list[Light] = []
+        for child in children:
+            self.add(child)
         for light in lights:
             self.add_light(light)
 
-    def add_light(self, light: DirectionalLight) -> Scene:
-        """Append a light; returns the scene."""
-        if not isinstance(light, DirectionalLight):
+    def add(self, child: Node) -> Node:
+        """Append `child` (a Node) and return it."""
+        if not isinstance(child, Node):
+            raise FrustumError(f"Node.add: child = {describe(child)} is not a Node; build one with Node(name, ...)")
+        self.children.append(child)
+        return child
+
+    def add_light(self, light: Light) -> Node:
+        """Attach a light to this node (it moves with the node); returns the node."""
+        if not isinstance(light, LIGHT_TYPES):
             raise FrustumError(
-                f"Scene.add_light: light = {describe(light)} is not a DirectionalLight; build one with "
-                "DirectionalLight(direction=(dx, dy, dz))"
+                f"Node.add_light: light = {describe(light)} is not a light; give an AmbientLight, DirectionalLight, "
+                "PointLight or SpotLight"
             )
         self.lights.append(light)
         return self
 
-    def add(self, mesh: Mesh, material: Material | None = None, transform: ArrayLike | None = None) -> Scene:
-        """Place `mesh` with `material` (default ``Material()``) by ``world_from_model = transform``; returns self."""
-        where = "Scene.add"
-        if not isinstance(mesh, Mesh):
-            raise FrustumError(f"{where}: mesh = {describe(mesh)} is not a Mesh; build one with Mesh(vertices, faces)")
-        material = Material() if material is None else material
-        if not isinstance(material, Material):
-            raise FrustumError(f"{where}: material = {describe(material)} is not a Material; build one with Material()")
-        matrix = as_matrix(
-            [[1.0, 0, 0, 0], [0, 1.0, 0, 0], [0, 0, 1.0, 0], [0, 0, 0, 1.0]] if transform is None else transform,
-            "transform",
-            where=where,
+    def walk(self, parent_from_world: Matrix4 = _IDENTITY) -> Iterator[Placed]:
+        """Depth-first, parents before children: every node below and including this one with its world transform."""
+        world = parent_from_world @ self.transform
+        yield Placed(self, world)
+        for child in self.children:
+            yield from child.walk(world)
+
+    def find(self, path: str) -> Node:
+        """The descendant at ``"name/child/grandchild"`` (relative to this node); raises ``FrustumError`` if none."""
+        node = self
+        for part in path.strip("/").split("/"):
+            matches = [child for child in node.children if child.name == part]
+            if not matches:
+                names = ", ".join(repr(child.name) for child in node.children) or "none"
+                raise FrustumError(f"Node.find: path = {path!r} has no {part!r} under {node.name!r}; children: {names}")
+            node = matches[0]
+        return node
+
+    def copy(self) -> Node:
+        """A deep copy of the hierarchy (meshes and materials are immutable and shared)."""
+        return Node(
+            self.name, self.transform, self.geometry, self.material, [c.copy() for c in self.children], self.lights
         )
-        if abs(matrix[3] - (0.0, 0.0, 0.0, 1.0)).max() != 0.0:
-            raise FrustumError(
-                f"{where}: transform bottom row = {describe(matrix[3])} makes it projective; a modeling transform "
-                "is affine (bottom row 0, 0, 0, 1)"
-            )
-        matrix.flags.writeable = False
-        self.items.append(SceneItem(mesh, material, matrix))
+
+    def __repr__(self) -> str:
+        kind = f"{self.geometry.face_count} faces" if self.geometry is not None else "group"
+        return f"Node({self.name!r}, {kind}, {len(self.children)} children)"
+
+
+class Scene:
+    """A scene graph with a root node and lights: ``Scene(lights=[light]); node = scene.add(mesh, material=m)``.
+
+    ``scene.items`` lists the placed meshes in drawing order (depth-first). The depth buffer makes the image
+    independent of that order except for exactly equal depths (the first drawn wins under the "less" test).
+    """
+
+    def __init__(self, lights: Iterable[Light] = ()) -> None:
+        self.root = Node("")
+        for light in lights:
+            self.add_light(light)
+
+    @property
+    def lights(self) -> list[Light]:
+        """The lights attached to the root (world coordinates)."""
+        return self.root.lights
+
+    def add_light(self, light: Light, parent: Node | None = None) -> Scene:
+        """Add a light at the root, or riding `parent`; returns the scene."""
+        (self.root if parent is None else parent).add_light(light)
         return self
+
+    def add(
+        self,
+        geometry: Mesh | Node,
+        material: Material | None = None,
+        transform: ArrayLike | None = None,
+        *,
+        name: str = "",
+        parent: Node | str | None = None,
+    ) -> Node:
+        """Place `geometry` (a Mesh, or a whole Node subtree) under `parent` (default the root); returns the node.
+
+        For a Mesh, a new ``Node(name, transform, mesh, material)`` is made; for a Node, `material` and
+        `transform` must be left out (set them on the node).
+        """
+        where = "Scene.add"
+        host = self.root if parent is None else self.find(parent) if isinstance(parent, str) else parent
+        if isinstance(geometry, Node):
+            if material is not None or transform is not None:
+                raise FrustumError(f"{where}: give material and transform on the Node itself, not with a Node")
+            return host.add(geometry)
+        if not isinstance(geometry, Mesh):
+            raise FrustumError(
+                f"{where}: geometry = {describe(geometry)} is not a Mesh or Node; build one with Mesh(vertices, faces)"
+            )
+        return host.add(Node(name, transform, geometry, material))
+
+    def walk(self) -> Iterator[Placed]:
+        """Every node (root excluded) with its ``world_from_model``, depth-first, parents first."""
+        iterator = self.root.walk()
+        next(iterator)
+        yield from iterator
+
+    def find(self, path: str) -> Node:
+        """The node at ``"assembly/part"``; raises ``FrustumError`` naming the children there if there is none."""
+        return self.root.find(path)
+
+    @property
+    def items(self) -> list[SceneItem]:
+        """Placed meshes in drawing order, each with its (inherited) material and world transform."""
+        result: list[SceneItem] = []
+
+        def visit(node: Node, world: Matrix4, inherited: Material) -> None:
+            world = world @ node.transform
+            material = node.material if node.material is not None else inherited
+            if node.geometry is not None:
+                result.append(SceneItem(node.geometry, material, world))
+            for child in node.children:
+                visit(child, world, material)
+
+        visit(self.root, _IDENTITY, Material() if self.root.material is None else self.root.material)
+        return result
+
+    def world_lights(self) -> list[Light]:
+        """Every light in world coordinates (those riding nodes moved by the node's world transform)."""
+        return [light.transformed(world) for node, world in self.root.walk() for light in node.lights]
 
     def __len__(self) -> int:
         return len(self.items)
+
+    def _with_root(self, root: Node) -> Scene:
+        scene = Scene()
+        scene.root = root
+        return scene
+
+
+def _world_centroid(node: Node, world: Matrix4) -> np.ndarray | None:
+    """Area-weighted centroid of every mesh at or below `node` in world coordinates (None if no area)."""
+    total, weighted = 0.0, np.zeros(3)
+    stack = [(node, world)]
+    while stack:
+        current, m = stack.pop()
+        stack.extend((child, m @ child.transform) for child in current.children)
+        mesh = current.geometry
+        if mesh is None or mesh.face_count == 0:
+            continue
+        points = mesh.vertices @ m[:3, :3].T + m[:3, 3]
+        corners = points[mesh.faces]
+        areas = 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1)
+        total += areas.sum()
+        weighted += (areas[:, None] * corners.mean(axis=1)).sum(axis=0)
+    return weighted / total if total > 0.0 else None
+
+
+def exploded(target: Scene | Node, factor: float, center: ArrayLike | None = None) -> Scene | Node:
+    """An exploded view: each part moved away from the assembly center by ``factor·(c_part − center)``.
+
+    The parts of a node are its children; each child's world centroid ``c_part`` (area-weighted) moves by
+    ``factor·(c_part − center)`` in world space, ``center`` being the assembly's centroid unless given.
+    Hierarchy-aware: a child with children (a sub-assembly) is then exploded within itself about its own
+    centroid. Returns a new scene or node; the original is not changed. ``factor = 0`` gives the same transforms.
+    """
+    where = "exploded"
+    amount = as_scalar(factor, "factor", where=where, error=GeometryError)
+    given = None if center is None else as_vector3(center, "center", where=where, error=GeometryError)
+    if isinstance(target, Scene):
+        return target._with_root(_explode(target.root.copy(), _IDENTITY, amount, given))
+    if not isinstance(target, Node):
+        raise FrustumError(f"{where}: target = {describe(target)} is not a Scene or Node")
+    return _explode(target.copy(), _IDENTITY, amount, given)
+
+
+def _explode(node: Node, parent_world: Matrix4, factor: float, center: np.ndarray | None) -> Node:
+    world = parent_world @ node.transform
+    if center is None:
+        center = _world_centroid(node, world)
+    for child in node.children:
+        child_world = world @ child.transform
+        centroid = _world_centroid(child, child_world)
+        if center is not None and centroid is not None:
+            offset = factor * (centroid - center)
+            # a world-space shift in the parent's frame: W⁻¹·T(o)·W = T(A⁻¹·o) for the affine W = [A t]
+            local = translate(*np.linalg.solve(world[:3, :3], offset))
+            child.transform = _modeling_transform(local @ child.transform, "exploded")
+        if child.children:
+            _explode(child, world, factor, None)
+    return node
+
+
+def cutaway(
+    scene: Scene,
+    plane: tuple[ArrayLike, ArrayLike] | None = None,
+    box: tuple[ArrayLike, ArrayLike] | None = None,
+    *,
+    cap: bool = True,
+    ghost: Material | float | None = None,
+) -> Scene:
+    """A cutaway view: geometry on the side of ``plane = (point, normal)`` the normal points to, or inside the
+    axis-aligned world ``box = (min_corner, max_corner)``, is removed.
+
+    Each mesh is cut in world coordinates (the result's nodes keep the hierarchy; cut meshes are placed with
+    their node's world transform baked in). With ``cap`` a closed (watertight) mesh gets its cross-section
+    filled (section caps), so solids stay solid; open meshes are cut without caps. With ``ghost`` (an opacity
+    in (0, 1) or a Material) the removed part is kept, semi-transparent, instead of dropped. Cutting keeps
+    positions and recomputes normals; UVs and vertex colors of cut meshes are not kept.
+    """
+    where = "cutaway"
+    if (plane is None) == (box is None):
+        raise GeometryError(f"{where}: give exactly one of plane = (point, normal) or box = (min, max)")
+    if plane is not None:
+        point = as_vector3(plane[0], "plane point", where=where, error=GeometryError)
+        normal = as_vector3(plane[1], "plane normal", where=where, error=GeometryError)
+        if not np.linalg.norm(normal) > 0.0:
+            raise GeometryError(f"{where}: plane normal = {describe(normal)} has zero length; give a nonzero normal")
+        region: tuple = ("plane", point, normal / np.linalg.norm(normal))
+    else:
+        low = as_vector3(box[0], "box min", where=where, error=GeometryError)
+        high = as_vector3(box[1], "box max", where=where, error=GeometryError)
+        if not (low < high).all():
+            raise GeometryError(f"{where}: box = {describe(low)}, {describe(high)} is empty; need min < max per axis")
+        region = ("box", low, high)
+    ghost_material = None
+    if ghost is not None and not isinstance(ghost, Material):
+        opacity = as_scalar(ghost, "ghost", where=where, error=GeometryError)
+        if not 0.0 < opacity < 1.0:
+            raise GeometryError(f"{where}: ghost = {opacity!r} is not an opacity in (0, 1) or a Material")
+        ghost_material = opacity
+    elif ghost is not None:
+        ghost_material = ghost
+    result = Scene()
+    result.root.lights = list(scene.root.lights)
+    _cut_node(scene.root, result.root, _IDENTITY, Material(), region, cap, ghost_material)
+    return result
+
+
+def _cut_node(
+    source: Node, target: Node, parent_world: Matrix4, inherited: Material, region: tuple, cap: bool, ghost: Any
+) -> None:
+    world = parent_world @ source.transform
+    material = source.material if source.material is not None else inherited
+    for child in source.children:
+        copy = Node(child.name, None, None, None, lights=[light.transformed(world @ child.transform)
+                                                          for light in child.lights])  # fmt: skip
+        child_world = world @ child.transform
+        child_material = child.material if child.material is not None else material
+        if child.geometry is not None:
+            kept, removed = _cut_mesh(child.geometry, child_world, region, cap)
+            if kept is not None:
+                copy.geometry = kept
+                copy.material = child_material
+            if removed is not None and ghost is not None:
+                ghost_material = ghost if isinstance(ghost, Material) else child_material.with_(opacity=ghost)
+                copy.add(Node(child.name + ":ghost", None, removed, ghost_material))
+        target.add(copy)
+        _cut_node(child, copy, child_world, child_material, region, cap, ghost)
+        # the copy holds world-space geometry: children were cut in world space too, so no transforms remain
+
+
+def _cut_mesh(mesh: Mesh, world: Matrix4, region: tuple, cap: bool) -> tuple[Mesh | None, Mesh | None]:
+    """(kept, removed) parts of `mesh` placed by `world`, in world coordinates; None where empty."""
+    import trimesh
+
+    if mesh.face_count == 0:
+        return None, None
+    points = mesh.vertices @ world[:3, :3].T + world[:3, 3]
+    solid = trimesh.Trimesh(points, mesh.faces, process=False)
+    closed = cap and solid.is_watertight
+    if region[0] == "plane":
+        _, point, normal = region
+        kept = _slice(solid, point, -normal, closed)
+        removed = _slice(solid, point, normal, closed)
+    else:
+        _, low, high = region
+        box = trimesh.creation.box(bounds=[low, high])
+        if closed:
+            try:
+                kept = solid.difference(box, engine="manifold")
+                removed = solid.intersection(box, engine="manifold")
+            except Exception as error:  # manifold3d refuses inputs it cannot repair
+                raise GeometryError(f"cutaway: box cut of a closed mesh failed ({error}); try cap=False") from None
+        else:
+            kept, inside = _outside_box(solid, low, high)
+            removed = inside
+    return _as_mesh(kept), _as_mesh(removed)
+
+
+def _slice(solid: Any, point: np.ndarray, keep_normal: np.ndarray, cap: bool) -> Any:
+    """The part of `solid` on the side `keep_normal` points to (trimesh keeps the positive side)."""
+    if solid is None or len(solid.faces) == 0:
+        return None
+    return solid.slice_plane(point, keep_normal, cap=cap)
+
+
+def _outside_box(solid: Any, low: np.ndarray, high: np.ndarray) -> tuple[Any, Any]:
+    """Open-mesh box cut: outside = ∪_k (inside planes 0..k−1) ∩ (outside plane k); inside = the rest."""
+    import trimesh
+
+    pieces = []
+    remaining = solid
+    planes = [(low, np.array(n)) for n in np.eye(3)] + [(high, -np.array(n)) for n in np.eye(3)]
+    for point, inward in planes:
+        if remaining is None or len(remaining.faces) == 0:
+            break
+        outside = _slice(remaining, point, -inward, False)
+        if outside is not None and len(outside.faces):
+            pieces.append(outside)
+        remaining = _slice(remaining, point, inward, False)
+    kept = trimesh.util.concatenate(pieces) if pieces else None
+    return kept, remaining
+
+
+def _as_mesh(part: Any) -> Mesh | None:
+    if part is None or len(part.faces) == 0:
+        return None
+    return Mesh(np.asarray(part.vertices, dtype=np.float64), np.asarray(part.faces, dtype=np.int64))

@@ -1,36 +1,71 @@
-"""Light and material types, and the Blinn-Phong illumination model the renderer evaluates per pixel.
+"""Lights, materials, depth cueing, and the illumination model the renderer evaluates.
 
-For a surface point P with unit normal N, seen from the eye E and lit by a directional light:
+For a surface point P with unit normal N, seen from the eye E, with base color C (material color × vertex
+color × texture), the intensity of each channel is [HB 17]:
 
-    L     = −direction / |direction|          (toward the light; ``direction`` is where the light travels)
-    V     = (E − P) / |E − P|                  (toward the viewer)
-    H     = (L + V) / |L + V|                  (the halfway vector)
-    ndl   = max(N·L, 0)
-    spec  = ndl > 0 ? max(N·H, 0)^shininess : 0
-    rgb   = clamp(color · (ambient + diffuse · ndl) + specular · spec, 0, 1)
-    pixel = round(rgb · 255)                   (linear RGB, no sRGB encoding; round half up)
+    I = C·(k_a·I_a + Σ_l f_l·k_d·I_l·max(N·L_l, 0)) + Σ_l f_l·k_s·I_l·spec_l + emissive
 
-This is the formula of ``../shared/bench/README.md`` (white light of intensity 1); the light's ``color`` and
-``intensity`` fields exist for the shading issue and must be white and 1 here. The arithmetic itself runs in
-``raster/shade.py``; ``blinn_phong`` below is the readable one-point version of the same formula.
+    L_l     unit vector from P toward light l (−direction for a directional light)
+    V       = (E − P) / |E − P|, toward the viewer
+    spec_l  Blinn-Phong: max(N·H, 0)^n with H = (L + V)/|L + V|;  Phong: max(R·V, 0)^n with R = 2(N·L)N − L;
+            0 where N·L <= 0 (no highlight on the unlit side)
+    I_a     the ambient illumination: the sum of the scene's ``AmbientLight``s, or white of intensity 1 if it
+            has none (so ``k_a`` alone sets the "background illumination", as in the benchmark formula)
+    I_l     light color × intensity
+    f_l     radial attenuation 1 / (a_0 + a_1·d + a_2·d²) of point and spot lights (1 for directional
+            lights), times the spot cone factor clamp((cos α − cos θ_outer)/(cos θ_inner − cos θ_outer), 0, 1)
+
+Colors are linear RGB in [0, 1]; the result is clamped to [0, 1] and stored as ``floor(I·255 + 0.5)``.
+With one white directional light of intensity 1 and no ambient light this is exactly the formula of
+``../shared/bench/README.md``, bit for bit. ``illuminate`` below is the readable one-point version; the
+kernels are in ``raster/shade.py``.
+
+Depth cueing [HB 10] "Depth Cueing" blends each color toward a cue color by its distance d from the viewing
+plane: ``f(d) = f_min + (f_max − f_min)·(d_far − d)/(d_far − d_near)`` clamped to [f_min, f_max], then
+``color' = f·color + (1 − f)·cue_color``.
 
 References
 ----------
-[HB 17] "Basic Illumination Models": ambient, diffuse (Lambert) and specular (Phong, halfway vector H).
+[HB 17] "Basic Illumination Models" (ambient, diffuse, specular, the halfway vector, multiple light sources),
+"Light Sources" (radial intensity attenuation, directional light sources and spotlight effects).
+[HB 10] "Depth Cueing"; [seed] "we set the lighting conditions by specifying the colour and location of the
+light sources", depth cueing "by choosing a maximum and a minimum intensity value and a range of distances".
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import math
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
-from frustum._arrays import Vector3, as_direction, as_scalar, as_vector3, describe, read_only
+from frustum._arrays import Matrix4, Vector3, as_direction, as_scalar, as_vector3, describe, read_only
 from frustum.errors import ShadingError
+from frustum.transforms import apply, apply_to_directions
 
-__all__ = ["DirectionalLight", "Material", "blinn_phong"]
+__all__ = [
+    "SPECULAR_MODELS",
+    "AmbientLight",
+    "DepthCue",
+    "DirectionalLight",
+    "Light",
+    "Material",
+    "PointLight",
+    "SpotLight",
+    "blinn_phong",
+    "illuminate",
+    "pack_lights",
+]
+
+SPECULAR_MODELS = ("blinn-phong", "phong")
+"""Specular terms ``illuminate`` and ``render`` accept: Blinn-Phong (N·H)^n (default) or Phong (R·V)^n."""
+
+LIGHT_FIELDS = 16
+"""Row length of ``pack_lights``: kind, I_l (3), position (3), to-light or axis direction (3), attenuation (3),
+cos θ_inner, cos θ_outer, spare."""
+LIGHT_DIRECTIONAL, LIGHT_POINT, LIGHT_SPOT = 0, 1, 2
 
 
 def _unit_color(value: ArrayLike, name: str, where: str) -> Vector3:
@@ -47,11 +82,48 @@ def _nonnegative(value: Any, name: str, where: str) -> float:
     return number
 
 
+def _attenuation(value: ArrayLike, where: str) -> Vector3:
+    coefficients = as_vector3(value, "attenuation", where=where, error=ShadingError)
+    if (coefficients < 0.0).any() or coefficients.sum() <= 0.0:
+        raise ShadingError(
+            f"{where}: attenuation = {describe(coefficients)} is not (constant, linear, quadratic) >= 0 with a "
+            "positive sum; e.g. (1, 0, 0) for no falloff or (1, 0.09, 0.032)"
+        )
+    return read_only(coefficients)
+
+
+def _texture(value: Any, where: str) -> NDArray[np.float32] | None:
+    if value is None:
+        return None
+    array = np.asarray(value)
+    if array.ndim == 2:
+        array = np.repeat(array[:, :, None], 3, axis=2)
+    if array.ndim != 3 or array.shape[2] not in (3, 4) or array.shape[0] < 1 or array.shape[1] < 1:
+        raise ShadingError(
+            f"{where}: texture has shape {array.shape}; expected an (H, W), (H, W, 3) or (H, W, 4) image"
+        )
+    if array.dtype == np.uint8:
+        texels = array.astype(np.float32) / np.float32(255.0)
+    elif np.issubdtype(array.dtype, np.floating):
+        texels = array.astype(np.float32)
+        if not np.isfinite(texels).all() or (texels < 0).any() or (texels > 1).any():
+            raise ShadingError(f"{where}: texture has values outside [0, 1] or non-finite; give floats in [0, 1]")
+    else:
+        raise ShadingError(f"{where}: texture has dtype {array.dtype}; expected uint8 or floats in [0, 1]")
+    if texels.shape[2] == 3:
+        texels = np.concatenate([texels, np.ones((*texels.shape[:2], 1), dtype=np.float32)], axis=2)
+    return read_only(np.ascontiguousarray(texels))
+
+
 @dataclass(frozen=True, eq=False)
 class Material:
-    """Blinn-Phong surface: base ``color`` (linear RGB in [0, 1]) and the coefficients of the formula above.
+    """Surface reflectance: base ``color`` (linear RGB in [0, 1]) and the coefficients of the formula above.
 
-    Raises ``ShadingError`` for a non-finite or negative coefficient or a color outside [0, 1].
+    ``emissive`` (linear RGB added after lighting), ``opacity`` in [0, 1] (below 1 the surface is blended
+    over what lies behind it, drawn back to front after the opaque surfaces: the "ghosted" parts of a cutaway),
+    ``texture`` an (H, W[, 3|4]) image sampled bilinearly at the mesh's UV coordinates (v up: v = 0 is the
+    image's bottom row; uint8 bytes are taken as linear values / 255), multiplied into the base color.
+    Raises ``ShadingError`` for a non-finite or negative coefficient, a color outside [0, 1] or a bad texture.
     """
 
     color: Vector3 = (0.8, 0.8, 0.8)  # type: ignore[assignment]
@@ -59,21 +131,46 @@ class Material:
     diffuse: float = 0.85
     specular: float = 0.35
     shininess: float = 32.0
+    emissive: Vector3 = (0.0, 0.0, 0.0)  # type: ignore[assignment]
+    opacity: float = 1.0
+    texture: NDArray[np.float32] | None = None
 
     def __post_init__(self) -> None:
         where = "Material"
         object.__setattr__(self, "color", _unit_color(self.color, "color", where))
+        object.__setattr__(self, "emissive", _unit_color(self.emissive, "emissive", where))
         for name in ("ambient", "diffuse", "specular", "shininess"):
             object.__setattr__(self, name, _nonnegative(getattr(self, name), name, where))
+        opacity = _nonnegative(self.opacity, "opacity", where)
+        if opacity > 1.0:
+            raise ShadingError(f"{where}: opacity = {opacity!r} is above 1; expected 0 <= opacity <= 1")
+        object.__setattr__(self, "opacity", opacity)
+        object.__setattr__(self, "texture", _texture(self.texture, where))
+
+    def with_(self, **changes: Any) -> Material:
+        """A copy with some fields changed, e.g. ``material.with_(opacity=0.3)``."""
+        return replace(self, **changes)
+
+
+@dataclass(frozen=True, eq=False)
+class AmbientLight:
+    """Background illumination ``I_a = color · intensity`` reaching every surface equally (the k_a term)."""
+
+    color: Vector3 = (1.0, 1.0, 1.0)  # type: ignore[assignment]
+    intensity: float = 1.0
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "color", _unit_color(self.color, "color", "AmbientLight"))
+        object.__setattr__(self, "intensity", _nonnegative(self.intensity, "intensity", "AmbientLight"))
+
+    def transformed(self, world_from_model: Matrix4) -> AmbientLight:
+        """Ambient light has no position or direction: itself."""
+        return self
 
 
 @dataclass(frozen=True, eq=False)
 class DirectionalLight:
-    """A light at infinity whose rays travel along ``direction`` (glTF convention); ``to_light = −direction``.
-
-    ``color`` (linear RGB in [0, 1]) and ``intensity`` (>= 0) are white and 1 by default; ``render`` in this
-    version supports only that white light of intensity 1 (the benchmark formula).
-    """
+    """A light at infinity whose rays travel along ``direction`` (glTF convention); ``to_light = −direction``."""
 
     direction: Vector3
     color: Vector3 = (1.0, 1.0, 1.0)  # type: ignore[assignment]
@@ -92,23 +189,228 @@ class DirectionalLight:
         """L, the unit vector from a surface toward the light: ``−direction``."""
         return -self.direction
 
+    def transformed(self, world_from_model: Matrix4) -> DirectionalLight:
+        """The light riding a node: its direction mapped by the node's world transform."""
+        direction = apply_to_directions(world_from_model, self.direction[None, :])[0]
+        return replace(self, direction=direction)
+
+
+@dataclass(frozen=True, eq=False)
+class PointLight:
+    """A light at ``position`` shining equally in all directions, dimmed by ``1/(a0 + a1·d + a2·d²)``."""
+
+    position: Vector3
+    color: Vector3 = (1.0, 1.0, 1.0)  # type: ignore[assignment]
+    intensity: float = 1.0
+    attenuation: Vector3 = (1.0, 0.0, 0.0)  # type: ignore[assignment]
+
+    def __post_init__(self) -> None:
+        where = type(self).__name__
+        object.__setattr__(
+            self, "position", read_only(as_vector3(self.position, "position", where=where, error=ShadingError))
+        )
+        object.__setattr__(self, "color", _unit_color(self.color, "color", where))
+        object.__setattr__(self, "intensity", _nonnegative(self.intensity, "intensity", where))
+        object.__setattr__(self, "attenuation", _attenuation(self.attenuation, where))
+
+    def transformed(self, world_from_model: Matrix4) -> PointLight:
+        """The light riding a node: its position mapped by the node's world transform."""
+        return replace(self, position=apply(world_from_model, self.position[None, :])[0])
+
+
+@dataclass(frozen=True, eq=False)
+class SpotLight:
+    """A point light limited to a cone around ``direction`` (where it shines), full inside ``inner_angle``
+    and fading linearly in cos α to zero at ``outer_angle`` (half-angles in radians, 0 <= inner <= outer < π/2).
+    """
+
+    position: Vector3
+    direction: Vector3
+    color: Vector3 = (1.0, 1.0, 1.0)  # type: ignore[assignment]
+    intensity: float = 1.0
+    inner_angle: float = math.radians(20.0)
+    outer_angle: float = math.radians(30.0)
+    attenuation: Vector3 = (1.0, 0.0, 0.0)  # type: ignore[assignment]
+
+    def __post_init__(self) -> None:
+        where = "SpotLight"
+        object.__setattr__(
+            self, "position", read_only(as_vector3(self.position, "position", where=where, error=ShadingError))
+        )
+        object.__setattr__(
+            self, "direction", read_only(as_direction(self.direction, "direction", where=where, error=ShadingError))
+        )
+        object.__setattr__(self, "color", _unit_color(self.color, "color", where))
+        object.__setattr__(self, "intensity", _nonnegative(self.intensity, "intensity", where))
+        object.__setattr__(self, "attenuation", _attenuation(self.attenuation, where))
+        inner = as_scalar(self.inner_angle, "inner_angle", where=where, error=ShadingError)
+        outer = as_scalar(self.outer_angle, "outer_angle", where=where, error=ShadingError)
+        if not 0.0 <= inner <= outer < math.pi / 2:
+            raise ShadingError(
+                f"{where}: inner_angle, outer_angle = {inner!r}, {outer!r} radians; expected "
+                "0 <= inner_angle <= outer_angle < pi/2"
+            )
+        object.__setattr__(self, "inner_angle", inner)
+        object.__setattr__(self, "outer_angle", outer)
+
+    def transformed(self, world_from_model: Matrix4) -> SpotLight:
+        """The light riding a node: position and direction mapped by the node's world transform."""
+        position = apply(world_from_model, self.position[None, :])[0]
+        direction = apply_to_directions(world_from_model, self.direction[None, :])[0]
+        return replace(self, position=position, direction=direction)
+
+
+Light = AmbientLight | DirectionalLight | PointLight | SpotLight
+"""Any light a scene holds."""
+LIGHT_TYPES = (AmbientLight, DirectionalLight, PointLight, SpotLight)
+
+
+@dataclass(frozen=True, eq=False)
+class DepthCue:
+    """Depth cueing: ``f(d) = f_min + (f_max − f_min)·(far − d)/(far − near)``, clamped; ``c' = f·c + (1 − f)·cue``.
+
+    ``d`` is the distance in front of the viewing plane (−z_view); ``color=None`` cues toward the render's
+    background color. Raises ``ShadingError`` unless 0 <= near < far and 0 <= min <= max <= 1.
+    """
+
+    near: float
+    far: float
+    min_intensity: float = 0.0
+    max_intensity: float = 1.0
+    color: Vector3 | None = None
+
+    def __post_init__(self) -> None:
+        where = "DepthCue"
+        near = _nonnegative(self.near, "near", where)
+        far = as_scalar(self.far, "far", where=where, error=ShadingError)
+        if not far > near:
+            raise ShadingError(f"{where}: far = {far!r} is not beyond near = {near!r}; expected 0 <= near < far")
+        low = _nonnegative(self.min_intensity, "min_intensity", where)
+        high = _nonnegative(self.max_intensity, "max_intensity", where)
+        if not low <= high <= 1.0:
+            raise ShadingError(
+                f"{where}: min_intensity, max_intensity = {low!r}, {high!r}; expected 0 <= min <= max <= 1"
+            )
+        object.__setattr__(self, "near", near)
+        object.__setattr__(self, "far", far)
+        object.__setattr__(self, "min_intensity", low)
+        object.__setattr__(self, "max_intensity", high)
+        if self.color is not None:
+            object.__setattr__(self, "color", _unit_color(self.color, "color", where))
+
+    def factor(self, distance: ArrayLike) -> NDArray[np.float64]:
+        """f(d), the fraction of the surface's own color kept at view distance d."""
+        d = np.asarray(distance, dtype=np.float64)
+        f = self.min_intensity + (self.max_intensity - self.min_intensity) * (self.far - d) / (self.far - self.near)
+        return np.clip(f, self.min_intensity, self.max_intensity)
+
+
+def pack_lights(lights: list[Light]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Kernel form of world-space lights: the ambient I_a (3,) and an (K, 16) row per other light.
+
+    Row: kind (0 directional, 1 point, 2 spot), I_l = color·intensity (3), position (3), direction (3:
+    toward the light for a directional light, the cone axis (where it shines) for a spot), attenuation
+    (a0, a1, a2), cos θ_inner, cos θ_outer, 0.
+    """
+    ambient_lights = [light for light in lights if isinstance(light, AmbientLight)]
+    if ambient_lights:
+        ambient = np.zeros(3)
+        for light in ambient_lights:
+            ambient = ambient + light.color * light.intensity
+    else:
+        ambient = np.ones(3)
+    rows = []
+    for light in lights:
+        if isinstance(light, AmbientLight):
+            continue
+        row = np.zeros(LIGHT_FIELDS)
+        row[1:4] = light.color * light.intensity
+        if isinstance(light, DirectionalLight):
+            row[0] = LIGHT_DIRECTIONAL
+            row[7:10] = light.to_light
+            row[10] = 1.0
+        else:
+            row[0] = LIGHT_POINT if isinstance(light, PointLight) else LIGHT_SPOT
+            row[4:7] = light.position
+            row[10:13] = light.attenuation
+            if isinstance(light, SpotLight):
+                row[7:10] = light.direction
+                row[13] = math.cos(light.inner_angle)
+                row[14] = math.cos(light.outer_angle)
+        rows.append(row)
+    return ambient, np.array(rows, dtype=np.float64).reshape(-1, LIGHT_FIELDS)
+
+
+def _light_terms(light: Light, point: NDArray, normal: NDArray, view: NDArray, shininess: float, specular: str):
+    """(f·ndl, f·spec): the attenuated diffuse and specular factors of one light at one point."""
+    if isinstance(light, DirectionalLight):
+        to_light, falloff = light.to_light, 1.0
+    else:
+        offset = light.position - point
+        distance = math.sqrt(float(offset @ offset))
+        to_light = offset / distance
+        a0, a1, a2 = light.attenuation
+        falloff = 1.0 / (a0 + a1 * distance + a2 * distance * distance)
+        if isinstance(light, SpotLight):
+            cos_inner, cos_outer = math.cos(light.inner_angle), math.cos(light.outer_angle)
+            cos_alpha = float(-to_light @ light.direction)
+            if cos_inner > cos_outer:
+                falloff *= min(max((cos_alpha - cos_outer) / (cos_inner - cos_outer), 0.0), 1.0)
+            else:
+                falloff *= 1.0 if cos_alpha >= cos_outer else 0.0
+    ndl = max(float(normal @ to_light), 0.0)
+    spec = 0.0
+    if ndl > 0.0:
+        if specular == "phong":
+            reflected = 2.0 * float(normal @ to_light) * normal - to_light
+            spec = max(float(reflected @ view), 0.0) ** shininess
+        else:
+            half = to_light + view
+            half = half / math.sqrt(float(half @ half))
+            spec = max(float(normal @ half), 0.0) ** shininess
+    return falloff * ndl, falloff * spec
+
+
+def illuminate(
+    material: Material,
+    lights: list[Light],
+    point: ArrayLike,
+    normal: ArrayLike,
+    eye: ArrayLike,
+    *,
+    base_color: ArrayLike | None = None,
+    specular: str = "blinn-phong",
+) -> NDArray[np.float64]:
+    """Linear RGB (3,) in [0, 1] of one surface point by the formula of this module's docstring (slow, readable).
+
+    `normal` need not be unit length. `base_color` replaces the material color (for vertex colors or a
+    texture sample already multiplied in).
+    """
+    if specular not in SPECULAR_MODELS:
+        raise ShadingError(f"illuminate: specular = {specular!r} is unknown; expected one of {SPECULAR_MODELS}")
+    n = np.asarray(normal, dtype=np.float64)
+    n = n / math.sqrt(float(n @ n))
+    p = np.asarray(point, dtype=np.float64)
+    view = np.asarray(eye, dtype=np.float64) - p
+    view = view / math.sqrt(float(view @ view))
+    color = material.color if base_color is None else np.asarray(base_color, dtype=np.float64)
+    ambient, _ = pack_lights(lights)
+    diffuse_sum = material.ambient * ambient
+    specular_sum = np.zeros(3)
+    for light in lights:
+        if isinstance(light, AmbientLight):
+            continue
+        ndl, spec = _light_terms(light, p, n, view, material.shininess, specular)
+        intensity = light.color * light.intensity
+        diffuse_sum = diffuse_sum + material.diffuse * ndl * intensity
+        specular_sum = specular_sum + material.specular * spec * intensity
+    return np.clip(color * diffuse_sum + specular_sum + material.emissive, 0.0, 1.0)
+
 
 def blinn_phong(
     material: Material, light: DirectionalLight, normal: ArrayLike, point: ArrayLike, eye: ArrayLike
 ) -> tuple[int, int, int]:
-    """8-bit RGB of one surface point by the formula of this module's docstring (readable, slow, float64).
-
-    `normal` need not be unit length; it is normalized first.
-    """
-    n = np.asarray(normal, dtype=np.float64)
-    n = n / np.sqrt(n @ n)
-    to_light = light.to_light
-    view = np.asarray(eye, dtype=np.float64) - np.asarray(point, dtype=np.float64)
-    view = view / np.sqrt(view @ view)
-    half = to_light + view
-    half = half / np.sqrt(half @ half)
-    ndl = max(float(n @ to_light), 0.0)
-    spec = max(float(n @ half), 0.0) ** material.shininess if ndl > 0.0 else 0.0
-    rgb = np.clip(material.color * (material.ambient + material.diffuse * ndl) + material.specular * spec, 0, 1)
+    """8-bit RGB of one point lit by one directional light: ``floor(illuminate(...)·255 + 0.5)`` (the bench formula)."""
+    rgb = illuminate(material, [light], point, normal, eye)
     r, g, b = np.floor(rgb * 255.0 + 0.5).astype(int).tolist()
     return r, g, b

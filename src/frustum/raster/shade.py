@@ -1,12 +1,25 @@
-"""Deferred shading kernel: one pass over the visible pixels after the depth buffer is complete.
+"""Shading kernels: the illumination model of ``frustum.shading`` per vertex, per face or per pixel.
 
-Each pixel holds ``code = 2·face + back`` (−1: background) and the perspective-correct weights (u1, u2) of
-the surface point with respect to its face's corners (u0 = 1 − u1 − u2). ``SHADE_NONE`` writes the flat
-material color; ``SHADE_PHONG`` evaluates Blinn-Phong (``frustum.shading``) with the world-space point P and
-the normalized interpolated normal N (flipped for back faces drawn two-sided):
+Deferred: after the depth buffer is complete, each pixel holds ``code = 2·face + back`` (−1: background) and
+the perspective-correct weights (u1, u2) of its surface point with respect to the face's corners
+(u0 = 1 − u1 − u2). Every model writes, per channel,
 
-    ndl = max(N·L, 0);  spec = ndl > 0 ? max(N·H, 0)^shininess : 0
-    rgb = clamp(color·(ambient + diffuse·ndl) + specular·spec, 0, 1);  byte = floor(rgb·255 + 0.5)
+    I = base·D + S + emissive,  base = color · vertex color · texture(u, v)
+
+with D = k_a·I_a + Σ f·k_d·I_l·max(N·L, 0) (ambient + diffuse) and S = Σ f·k_s·I_l·spec (specular), where
+the models differ only in where D and S are evaluated [HB 17] "Polygon Rendering Methods":
+
+- ``SHADE_FLAT``: once per face, with the face normal at the face centroid (constant-intensity shading);
+- ``SHADE_GOURAUD``: once per vertex with the vertex normal, D and S interpolated across the face;
+- ``SHADE_PHONG``: per pixel with the interpolated, renormalized normal (normal-vector interpolation);
+- ``SHADE_NONE``: base color only; ``SHADE_NORMALS``: ``0.5·N + 0.5`` (world normal); ``SHADE_DEPTH``: gray
+  ``(far − d)/(far − near)`` of the view distance d.
+
+A back face drawn two-sided has its normal flipped toward the viewer. Depth cueing then blends
+``f·I + (1 − f)·cue``; the result is clamped to [0, 1] and stored as ``floor(I·255 + 0.5)``.
+
+Array contracts (kernels never validate): params (PARAMS,) float64 laid out by the ``P_*`` indices below,
+lights (K, 16) float64 rows of ``frustum.shading.pack_lights``, item (ITEM,) int64 laid out by ``I_*``.
 """
 
 from __future__ import annotations
@@ -17,12 +30,31 @@ import numpy as np
 
 from frustum.raster._jit import kernel, parallel_kernel, prange
 
-__all__ = ["SHADE_NONE", "SHADE_PHONG", "shade_pixels"]
+__all__ = [
+    "SHADE_DEPTH",
+    "SHADE_FLAT",
+    "SHADE_GOURAUD",
+    "SHADE_NONE",
+    "SHADE_NORMALS",
+    "SHADE_PHONG",
+    "light_faces",
+    "light_vertices",
+    "shade_pixels",
+]
 
-SHADE_NONE = 0
-"""Flat material color, no lighting (depth-only rendering)."""
-SHADE_PHONG = 1
-"""Per-pixel Blinn-Phong with one directional light."""
+SHADE_NONE, SHADE_PHONG, SHADE_FLAT, SHADE_GOURAUD, SHADE_NORMALS, SHADE_DEPTH = 0, 1, 2, 3, 4, 5
+SPECULAR_BLINN, SPECULAR_PHONG = 0, 1
+
+# params layout
+P_EYE, P_COLOR, P_AMBIENT, P_DIFFUSE, P_SPECULAR, P_SHININESS = 0, 3, 6, 7, 8, 9
+P_EMISSIVE, P_LIGHT_AMBIENT, P_VIEW_AXIS = 10, 13, 16
+P_CUE_ON, P_CUE_NEAR, P_CUE_FAR, P_CUE_MIN, P_CUE_MAX, P_CUE_COLOR = 19, 20, 21, 22, 23, 24
+P_DEPTH_NEAR, P_DEPTH_FAR, P_OPACITY = 27, 28, 29
+PARAMS = 30
+# item layout
+I_FACE_OFFSET, I_MODE, I_PAINT, I_BACKGROUND, I_SPECULAR_MODEL, I_OBJECT_ID = 0, 1, 2, 3, 7, 8
+I_WRITE_NORMALS, I_WRITE_IDS, I_BLEND = 9, 10, 11
+ITEM = 12
 
 
 @kernel
@@ -38,78 +70,260 @@ def _interpolate(u0: float, u1: float, u2: float, va: float, vb: float, vc: floa
 
 
 @kernel
-def _phong(
-    lx: float, ly: float, lz: float, ex: float, ey: float, ez: float, shininess: float,
+def _illuminate(
+    params: np.ndarray, lights: np.ndarray, specular_model: int,
     px: float, py: float, pz: float, nx: float, ny: float, nz: float,
-) -> tuple[float, float]:  # fmt: skip
-    """Blinn-Phong terms ``(ndl, spec)`` shared by the three channels: L, eye, shininess, point P, unit normal N.
-
-    Channel k is then ``color_k·(ambient + diffuse·ndl) + specular·spec``.
-    """
+) -> tuple[float, float, float, float, float, float]:  # fmt: skip
+    """(D_r, D_g, D_b, S_r, S_g, S_b) at point P with unit normal N: the module docstring's D and S."""
+    ex, ey, ez = params[P_EYE], params[P_EYE + 1], params[P_EYE + 2]
+    shininess = params[P_SHININESS]
+    kd, ks = params[P_DIFFUSE], params[P_SPECULAR]
+    ka = params[P_AMBIENT]
+    dr = ka * params[P_LIGHT_AMBIENT]
+    dg = ka * params[P_LIGHT_AMBIENT + 1]
+    db = ka * params[P_LIGHT_AMBIENT + 2]
+    sr, sg, sb = 0.0, 0.0, 0.0
     vx, vy, vz = ex - px, ey - py, ez - pz
     length = math.sqrt((vx * vx + vy * vy) + vz * vz)
     vx, vy, vz = vx / length, vy / length, vz / length
-    hx, hy, hz = lx + vx, ly + vy, lz + vz
-    length = math.sqrt((hx * hx + hy * hy) + hz * hz)
-    hx, hy, hz = hx / length, hy / length, hz / length
-    ndl = max((nx * lx + ny * ly) + nz * lz, 0.0)
-    spec = 0.0
-    if ndl > 0.0:
-        spec = max((nx * hx + ny * hy) + nz * hz, 0.0) ** shininess
-    return ndl, spec
+    for k in range(lights.shape[0]):
+        kind = lights[k, 0]
+        falloff = 1.0
+        if kind == 0.0:
+            lx, ly, lz = lights[k, 7], lights[k, 8], lights[k, 9]
+        else:
+            lx, ly, lz = lights[k, 4] - px, lights[k, 5] - py, lights[k, 6] - pz
+            distance = math.sqrt((lx * lx + ly * ly) + lz * lz)
+            lx, ly, lz = lx / distance, ly / distance, lz / distance
+            falloff = 1.0 / ((lights[k, 10] + lights[k, 11] * distance) + lights[k, 12] * distance * distance)
+            if kind == 2.0:
+                cos_alpha = -((lx * lights[k, 7] + ly * lights[k, 8]) + lz * lights[k, 9])
+                cos_inner, cos_outer = lights[k, 13], lights[k, 14]
+                if cos_inner > cos_outer:
+                    falloff *= min(max((cos_alpha - cos_outer) / (cos_inner - cos_outer), 0.0), 1.0)
+                elif cos_alpha < cos_outer:
+                    falloff = 0.0
+        ndl = (nx * lx + ny * ly) + nz * lz
+        if ndl <= 0.0 or falloff == 0.0:
+            continue
+        if specular_model == SPECULAR_PHONG:
+            rx, ry, rz = 2.0 * ndl * nx - lx, 2.0 * ndl * ny - ly, 2.0 * ndl * nz - lz
+            spec = max((rx * vx + ry * vy) + rz * vz, 0.0) ** shininess
+        else:
+            hx, hy, hz = lx + vx, ly + vy, lz + vz
+            length = math.sqrt((hx * hx + hy * hy) + hz * hz)
+            if length > 0.0:
+                hx, hy, hz = hx / length, hy / length, hz / length
+            spec = max((nx * hx + ny * hy) + nz * hz, 0.0) ** shininess
+        diffuse = kd * (falloff * ndl)
+        specular = ks * (falloff * spec)
+        dr += diffuse * lights[k, 1]
+        dg += diffuse * lights[k, 2]
+        db += diffuse * lights[k, 3]
+        sr += specular * lights[k, 1]
+        sg += specular * lights[k, 2]
+        sb += specular * lights[k, 3]
+    return dr, dg, db, sr, sg, sb
+
+
+@parallel_kernel
+def light_vertices(
+    world: np.ndarray, normals: np.ndarray, params: np.ndarray, lights: np.ndarray, specular_model: int,
+    lit: np.ndarray,
+) -> None:  # fmt: skip
+    """Gouraud: D and S at every vertex with its unit normal; lit (N, 6) float64 written."""
+    for v in prange(world.shape[0]):
+        terms = _illuminate(
+            params, lights, specular_model, world[v, 0], world[v, 1], world[v, 2],
+            normals[v, 0], normals[v, 1], normals[v, 2],
+        )  # fmt: skip
+        for k in range(6):
+            lit[v, k] = terms[k]
+
+
+@parallel_kernel
+def light_faces(
+    world: np.ndarray, faces: np.ndarray, params: np.ndarray, lights: np.ndarray, specular_model: int,
+    lit: np.ndarray,
+) -> None:  # fmt: skip
+    """Flat: D and S of every face at its centroid with the unit face normal ``(v1 − v0)×(v2 − v0)``; lit (M, 6)."""
+    for f in prange(faces.shape[0]):
+        a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
+        e1x, e1y, e1z = world[b, 0] - world[a, 0], world[b, 1] - world[a, 1], world[b, 2] - world[a, 2]
+        e2x, e2y, e2z = world[c, 0] - world[a, 0], world[c, 1] - world[a, 1], world[c, 2] - world[a, 2]
+        nx, ny, nz = e1y * e2z - e1z * e2y, e1z * e2x - e1x * e2z, e1x * e2y - e1y * e2x
+        length = math.sqrt((nx * nx + ny * ny) + nz * nz)
+        if length == 0.0:
+            nx, ny, nz, length = 0.0, 0.0, 1.0, 1.0
+        terms = _illuminate(
+            params, lights, specular_model,
+            (world[a, 0] + world[b, 0] + world[c, 0]) / 3.0,
+            (world[a, 1] + world[b, 1] + world[c, 1]) / 3.0,
+            (world[a, 2] + world[b, 2] + world[c, 2]) / 3.0,
+            nx / length, ny / length, nz / length,
+        )  # fmt: skip
+        for k in range(6):
+            lit[f, k] = terms[k]
+
+
+@kernel
+def _sample(texture: np.ndarray, u: float, v: float, channel: int) -> float:
+    """Bilinear texture lookup with repeat wrapping; v = 0 is the image's bottom row (OpenGL, OBJ)."""
+    height, width = texture.shape[0], texture.shape[1]
+    x = (u - math.floor(u)) * width - 0.5
+    y = (1.0 - (v - math.floor(v))) * height - 0.5
+    x0, y0 = math.floor(x), math.floor(y)
+    fx, fy = x - x0, y - y0
+    i0, j0 = int(x0) % width, int(y0) % height
+    i1, j1 = (i0 + 1) % width, (j0 + 1) % height
+    top = texture[j0, i0, channel] * (1.0 - fx) + texture[j0, i1, channel] * fx
+    bottom = texture[j1, i0, channel] * (1.0 - fx) + texture[j1, i1, channel] * fx
+    return top * (1.0 - fy) + bottom * fy
+
+
+@kernel
+def shade_point(
+    f: int, back: bool, u0: float, u1: float, u2: float,
+    faces: np.ndarray, world: np.ndarray, normals: np.ndarray, lit: np.ndarray,
+    vertex_colors: np.ndarray, uvs: np.ndarray, texture: np.ndarray,
+    params: np.ndarray, lights: np.ndarray, item: np.ndarray,
+) -> tuple[float, float, float, float, float, float, float]:  # fmt: skip
+    """Linear (r, g, b, alpha) of face f's point with weights (u0, u1, u2), and its unit world normal (3).
+
+    Alpha is the texture's alpha times the material opacity. Colors are not clamped yet.
+    """
+    mode = item[I_MODE]
+    a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
+    sign = -1.0 if back else 1.0  # two-sided lighting: a back face's normal faces the viewer
+    nx = _interpolate(u0, u1, u2, normals[a, 0], normals[b, 0], normals[c, 0])
+    ny = _interpolate(u0, u1, u2, normals[a, 1], normals[b, 1], normals[c, 1])
+    nz = _interpolate(u0, u1, u2, normals[a, 2], normals[b, 2], normals[c, 2])
+    length = math.sqrt((nx * nx + ny * ny) + nz * nz)
+    if length == 0.0:
+        nx, ny, nz, length = 0.0, 0.0, 1.0, 1.0
+    nx, ny, nz = sign * nx / length, sign * ny / length, sign * nz / length
+    px = _interpolate(u0, u1, u2, world[a, 0], world[b, 0], world[c, 0])
+    py = _interpolate(u0, u1, u2, world[a, 1], world[b, 1], world[c, 1])
+    pz = _interpolate(u0, u1, u2, world[a, 2], world[b, 2], world[c, 2])
+    alpha = params[P_OPACITY]
+    if mode == SHADE_NORMALS:
+        return 0.5 * nx + 0.5, 0.5 * ny + 0.5, 0.5 * nz + 0.5, alpha, nx, ny, nz
+    if mode == SHADE_DEPTH:
+        d = ((params[P_EYE] - px) * params[P_VIEW_AXIS] + (params[P_EYE + 1] - py) * params[P_VIEW_AXIS + 1]) + (
+            params[P_EYE + 2] - pz
+        ) * params[P_VIEW_AXIS + 2]
+        gray = (params[P_DEPTH_FAR] - d) / (params[P_DEPTH_FAR] - params[P_DEPTH_NEAR])
+        return gray, gray, gray, alpha, nx, ny, nz
+    base_r, base_g, base_b = params[P_COLOR], params[P_COLOR + 1], params[P_COLOR + 2]
+    if vertex_colors.shape[0] > 0:
+        base_r *= _interpolate(u0, u1, u2, vertex_colors[a, 0], vertex_colors[b, 0], vertex_colors[c, 0])
+        base_g *= _interpolate(u0, u1, u2, vertex_colors[a, 1], vertex_colors[b, 1], vertex_colors[c, 1])
+        base_b *= _interpolate(u0, u1, u2, vertex_colors[a, 2], vertex_colors[b, 2], vertex_colors[c, 2])
+    if texture.shape[0] > 0:
+        tu = _interpolate(u0, u1, u2, uvs[a, 0], uvs[b, 0], uvs[c, 0])
+        tv = _interpolate(u0, u1, u2, uvs[a, 1], uvs[b, 1], uvs[c, 1])
+        base_r *= _sample(texture, tu, tv, 0)
+        base_g *= _sample(texture, tu, tv, 1)
+        base_b *= _sample(texture, tu, tv, 2)
+        alpha *= _sample(texture, tu, tv, 3)
+    if mode == SHADE_NONE:
+        return base_r, base_g, base_b, alpha, nx, ny, nz
+    if mode == SHADE_PHONG:
+        dr, dg, db, sr, sg, sb = _illuminate(params, lights, item[I_SPECULAR_MODEL], px, py, pz, nx, ny, nz)
+    elif mode == SHADE_FLAT:
+        dr, dg, db, sr, sg, sb = lit[f, 0], lit[f, 1], lit[f, 2], lit[f, 3], lit[f, 4], lit[f, 5]
+    else:  # Gouraud
+        dr = _interpolate(u0, u1, u2, lit[a, 0], lit[b, 0], lit[c, 0])
+        dg = _interpolate(u0, u1, u2, lit[a, 1], lit[b, 1], lit[c, 1])
+        db = _interpolate(u0, u1, u2, lit[a, 2], lit[b, 2], lit[c, 2])
+        sr = _interpolate(u0, u1, u2, lit[a, 3], lit[b, 3], lit[c, 3])
+        sg = _interpolate(u0, u1, u2, lit[a, 4], lit[b, 4], lit[c, 4])
+        sb = _interpolate(u0, u1, u2, lit[a, 5], lit[b, 5], lit[c, 5])
+    r = (base_r * dr + sr) + params[P_EMISSIVE]
+    g = (base_g * dg + sg) + params[P_EMISSIVE + 1]
+    b = (base_b * db + sb) + params[P_EMISSIVE + 2]
+    return r, g, b, alpha, nx, ny, nz
+
+
+@kernel
+def _cue(params: np.ndarray, value: float, channel: int, d: float) -> float:
+    """Depth cueing ``f·I + (1 − f)·cue`` with f clamped to [f_min, f_max] (identity when cueing is off)."""
+    if params[P_CUE_ON] == 0.0:
+        return value
+    low, high = params[P_CUE_MIN], params[P_CUE_MAX]
+    f = low + (high - low) * (params[P_CUE_FAR] - d) / (params[P_CUE_FAR] - params[P_CUE_NEAR])
+    f = min(max(f, low), high)
+    return f * value + (1.0 - f) * params[P_CUE_COLOR + channel]
 
 
 @parallel_kernel
 def shade_pixels(
     codes: np.ndarray, bary: np.ndarray, faces: np.ndarray, world: np.ndarray, normals: np.ndarray,
-    params: np.ndarray, item: np.ndarray, color: np.ndarray,
+    lit: np.ndarray, vertex_colors: np.ndarray, uvs: np.ndarray, texture: np.ndarray,
+    params: np.ndarray, lights: np.ndarray, item: np.ndarray, color: np.ndarray,
+    normal_out: np.ndarray, id_out: np.ndarray,
 ) -> None:  # fmt: skip
     """Shade the pixels of one scene item: those whose face ``code // 2 − face_offset`` lies in [0, M).
 
     codes (H, W) int32 or int64, bary (H, W, 2) float32, faces (M, 3) int64, world and normals (N, 3) float64
-    (unit normals), params (13,) float64 = (L, eye, color, ambient, diffuse, specular, shininess), item =
-    (face_offset, mode, paint, r, g, b, a) int64; color (H, W, 4) uint8 is written at those pixels (RGB, alpha
-    255) and, when paint != 0, at the background pixels (code < 0) with the bytes (r, g, b, a).
+    (unit normals), lit (N or M, 6) Gouraud or flat terms (any rows otherwise), vertex_colors (N, 3) or (0, 3),
+    uvs (N, 2) and texture (Ht, Wt, 4) float32 or empty. color (H, W, 4) uint8 is written at those pixels
+    (opaque, or blended ``α·I + (1 − α)·under`` when ``item[I_BLEND]``) and, when ``item[I_PAINT]``, at the
+    background pixels (code < 0) with the background bytes. normal_out (H, W, 3) float32 and id_out (H, W)
+    int32 are written when asked for.
     """
     for row in prange(codes.shape[0]):
-        _shade_row(row, codes, bary, faces, world, normals, params, item, color)
+        _shade_row(
+            row, codes, bary, faces, world, normals, lit, vertex_colors, uvs, texture, params, lights, item,
+            color, normal_out, id_out,
+        )  # fmt: skip
 
 
 @kernel
 def _shade_row(
     row: int, codes: np.ndarray, bary: np.ndarray, faces: np.ndarray, world: np.ndarray, normals: np.ndarray,
-    params: np.ndarray, item: np.ndarray, color: np.ndarray,
+    lit: np.ndarray, vertex_colors: np.ndarray, uvs: np.ndarray, texture: np.ndarray,
+    params: np.ndarray, lights: np.ndarray, item: np.ndarray, color: np.ndarray,
+    normal_out: np.ndarray, id_out: np.ndarray,
 ) -> None:  # fmt: skip
     """One image row of ``shade_pixels``."""
-    face_offset, mode, paint = item[0], item[1], item[2]
-    lx, ly, lz, ex, ey, ez = params[0], params[1], params[2], params[3], params[4], params[5]
-    ambient, diffuse, specular, shininess = params[9], params[10], params[11], params[12]
+    face_offset, paint = item[I_FACE_OFFSET], item[I_PAINT]
     for col in range(codes.shape[1]):
         code = codes[row, col]
-        if code < 0 and paint != 0:
-            for k in range(4):
-                color[row, col, k] = item[3 + k]
+        if code < 0:
+            if paint != 0:
+                for k in range(4):
+                    color[row, col, k] = item[I_BACKGROUND + k]
             continue
         f = code // 2 - face_offset
-        if code < 0 or f < 0 or f >= faces.shape[0]:
+        if f < 0 or f >= faces.shape[0]:
             continue
-        color[row, col, 3] = 255
-        if mode == SHADE_NONE:
-            for k in range(3):
-                color[row, col, k] = _to_byte(params[6 + k])
-            continue
-        a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
         u1, u2 = float(bary[row, col, 0]), float(bary[row, col, 1])
         u0 = (1.0 - u1) - u2
-        px = _interpolate(u0, u1, u2, world[a, 0], world[b, 0], world[c, 0])
-        py = _interpolate(u0, u1, u2, world[a, 1], world[b, 1], world[c, 1])
-        pz = _interpolate(u0, u1, u2, world[a, 2], world[b, 2], world[c, 2])
-        nx = _interpolate(u0, u1, u2, normals[a, 0], normals[b, 0], normals[c, 0])
-        ny = _interpolate(u0, u1, u2, normals[a, 1], normals[b, 1], normals[c, 1])
-        nz = _interpolate(u0, u1, u2, normals[a, 2], normals[b, 2], normals[c, 2])
-        length = math.sqrt((nx * nx + ny * ny) + nz * nz)
-        sign = -1.0 if code % 2 == 1 else 1.0  # two-sided lighting: a back face's normal faces the viewer
-        nx, ny, nz = sign * nx / length, sign * ny / length, sign * nz / length
-        ndl, spec = _phong(lx, ly, lz, ex, ey, ez, shininess, px, py, pz, nx, ny, nz)
-        for k in range(3):
-            color[row, col, k] = _to_byte(params[6 + k] * (ambient + diffuse * ndl) + specular * spec)
+        r, g, b, alpha, nx, ny, nz = shade_point(
+            f, code % 2 == 1, u0, u1, u2, faces, world, normals, lit, vertex_colors, uvs, texture, params,
+            lights, item,
+        )  # fmt: skip
+        if params[P_CUE_ON] != 0.0:
+            a, bb, c = faces[f, 0], faces[f, 1], faces[f, 2]
+            d = 0.0
+            for k in range(3):
+                p = _interpolate(u0, u1, u2, world[a, k], world[bb, k], world[c, k])
+                d += (params[P_EYE + k] - p) * params[P_VIEW_AXIS + k]
+            r, g, b = _cue(params, r, 0, d), _cue(params, g, 1, d), _cue(params, b, 2, d)
+        if item[I_BLEND] != 0:
+            alpha = min(max(alpha, 0.0), 1.0)
+            r = alpha * min(max(r, 0.0), 1.0) + (1.0 - alpha) * (color[row, col, 0] / 255.0)
+            g = alpha * min(max(g, 0.0), 1.0) + (1.0 - alpha) * (color[row, col, 1] / 255.0)
+            b = alpha * min(max(b, 0.0), 1.0) + (1.0 - alpha) * (color[row, col, 2] / 255.0)
+            alpha = alpha + (1.0 - alpha) * (color[row, col, 3] / 255.0)
+        else:
+            alpha = 1.0
+        color[row, col, 0] = _to_byte(r)
+        color[row, col, 1] = _to_byte(g)
+        color[row, col, 2] = _to_byte(b)
+        color[row, col, 3] = _to_byte(alpha)
+        if item[I_WRITE_NORMALS] != 0:
+            normal_out[row, col, 0], normal_out[row, col, 1], normal_out[row, col, 2] = nx, ny, nz
+        if item[I_WRITE_IDS] != 0:
+            id_out[row, col] = item[I_OBJECT_ID]
