@@ -49,7 +49,7 @@ from frustum.raster import lines, shade, tiles, triangles
 from frustum.raster.vertices import transform_vertices
 from frustum.scene import Scene, SceneItem
 from frustum.shading import SPECULAR_MODELS, DepthCue, pack_lights
-from frustum.visibility import feature_edges
+from frustum.visibility import backface_mask, feature_edges
 
 __all__ = ["HIDDEN_STYLES", "RENDER_MODES", "SHADING_MODES", "TILE_SIZE", "mesh_edges", "render"]
 
@@ -141,12 +141,14 @@ def render(
         space, as a line with window depth linear along it. ``"points"``: every vertex inside the view volume
         as the pixel containing it. ``"hidden-line"``: the surfaces fill the depth buffer in the background
         color and only the visible parts of the edges are drawn (hidden parts per `hidden`).
-        ``"surface+edges"``: shaded surfaces with their visible edges on top.
+        ``"surface+edges"``: shaded surfaces with their visible edges on top. With `cull_back_faces`, edges of back
+        faces only (``visibility.backface_mask``) count as hidden whatever the depth buffer says.
     edges : {"all", "feature"} or None
         Which edges the line modes draw: every edge, or ``visibility.feature_edges`` (boundaries, creases
         sharper than `crease_angle`, silhouettes). None: "all" for wireframe, "feature" for the others.
     edge_color : (3,) or (4,) array_like or None
-        Line color in [0, 1]; None: the material color (wireframe, points) or black (the edge modes).
+        Line color in [0, 1]; None: the material color (wireframe, points), or for the edge modes black on a
+        light background and white on a dark one.
     hidden : {None, "dimmed", "dashed"}
         ``"hidden-line"`` only: draw hidden edge parts solid or dashed in `hidden_color`.
     line_width : float
@@ -219,12 +221,14 @@ def _render_buffers(
         color = np.empty((height, width, 4), dtype=np.uint8)
         color[:, :] = options.background
         _draw_edges(items, camera, options, depth, color)
+        _draw_polylines(scene.polylines, camera, options, depth, color)
         return color, depth, normal_out, id_out
     depth, color = _draw_surfaces(scene, items, camera, options, normal_out, id_out)
     if options.mode == "hidden-line":
         color[:, :] = options.background
     if options.mode in ("hidden-line", "surface+edges"):
         _draw_edges(items, camera, options, depth, color)
+    _draw_polylines(scene.polylines, camera, options, depth, color)
     return color, depth, normal_out, id_out
 
 
@@ -470,10 +474,7 @@ def _draw_edges(items: list[SceneItem], camera: Camera, options: _Options, depth
     eye = np.asarray(camera.frame.eye, dtype=np.float64)
     axis = np.asarray(camera.frame.n, dtype=np.float64)
     edge_modes = options.mode in ("hidden-line", "surface+edges")
-    cue = None
-    if options.depth_cue is not None:
-        c = options.depth_cue
-        cue = (c.near, c.far, c.min_intensity, c.max_intensity, *(255.0 * _cue_color(options)))
+    cue = _line_cue(options)
     for item in items:
         mesh = item.mesh
         if options.edge_color is not None:
@@ -485,13 +486,7 @@ def _draw_edges(items: list[SceneItem], camera: Camera, options: _Options, depth
             hidden={None: 0, "dimmed": 1, "dashed": 2}[options.hidden] if options.mode == "hidden-line" else 0,
             hidden_rgba=options.hidden_color, dash=6.0 * options.line_width, cue=cue,
         )  # fmt: skip
-        clip = np.empty((mesh.vertex_count, 4))
-        world = np.empty((mesh.vertex_count, 3))
-        vertex_codes = np.empty(mesh.vertex_count, dtype=np.int64)
-        transform_vertices(
-            mesh.vertices, np.ones((mesh.vertex_count, 3)), _item_matrices(item, camera), VIEW_VOLUME_PLANES,
-            clip, world, np.empty((mesh.vertex_count, 3)), vertex_codes,
-        )  # fmt: skip
+        clip, world, vertex_codes = _clip_vertices(mesh.vertices, item.world_from_model, camera)
         view_depth = (eye - world) @ axis
         if options.mode == "points":
             lines.draw_points(clip, view_depth, vertex_codes, view, style, depth, color)
@@ -500,7 +495,60 @@ def _draw_edges(items: list[SceneItem], camera: Camera, options: _Options, depth
             edges = mesh_edges(mesh.faces)
         else:
             edges = feature_edges(world, mesh.faces, camera, options.crease_angle)
+        if edge_modes and options.cull:  # edges of back faces only are hidden, whatever the depth buffer says
+            front = mesh_edges(mesh.faces[~backface_mask(world, mesh.faces, camera)])
+            size = max(mesh.vertex_count, 1)
+            in_front = np.isin(edges[:, 0] * size + edges[:, 1], front[:, 0] * size + front[:, 1])
+            if style[lines.S_HIDDEN] != 0.0:
+                always_hidden = style.copy()
+                always_hidden[lines.S_OFFSET] = -np.inf  # z − offset < depth never holds
+                lines.draw_lines(clip, view_depth, edges[~in_front], VIEW_VOLUME_PLANES, view, always_hidden, depth,
+                                 color)  # fmt: skip
+            edges = edges[in_front]
         lines.draw_lines(clip, view_depth, edges, VIEW_VOLUME_PLANES, view, style, depth, color)
+
+
+def _draw_polylines(
+    line_items: list[SceneItem], camera: Camera, options: _Options, depth: np.ndarray, color: np.ndarray
+) -> None:  # fmt: skip
+    """Every placed ``Polyline`` as depth-tested lines (or marker squares) in its material color, in order."""
+    view = np.array([camera.width / 2.0, camera.height / 2.0])
+    cue = _line_cue(options)
+    for item in line_items:
+        line = item.mesh
+        if line.vertex_count == 0:
+            continue
+        rgba = np.append(np.floor(np.clip(item.material.color, 0.0, 1.0) * 255.0 + 0.5), 255.0)
+        width = options.line_width + (2.0 if line.markers else 0.0)
+        style = lines.line_style(rgba, width=width, cue=cue)
+        clip, world, vertex_codes = _clip_vertices(line.points, item.world_from_model, camera)
+        view_depth = (np.asarray(camera.frame.eye) - world) @ np.asarray(camera.frame.n)
+        if line.markers:
+            lines.draw_points(clip, view_depth, vertex_codes, view, style, depth, color)
+        else:
+            lines.draw_lines(clip, view_depth, line.segments, VIEW_VOLUME_PLANES, view, style, depth, color)
+
+
+def _clip_vertices(points: np.ndarray, world_from_model: np.ndarray, camera: Camera):
+    """Clip coordinates, world positions and region codes of model-space points (``transform_vertices``)."""
+    count = points.shape[0]
+    clip = np.empty((count, 4))
+    world = np.empty((count, 3))
+    vertex_codes = np.empty(count, dtype=np.int64)
+    item = SceneItem(None, None, world_from_model)  # type: ignore[arg-type]
+    transform_vertices(
+        points, np.ones((count, 3)), _item_matrices(item, camera), VIEW_VOLUME_PLANES, clip, world,
+        np.empty((count, 3)), vertex_codes,
+    )  # fmt: skip
+    return clip, world, vertex_codes
+
+
+def _line_cue(options: _Options) -> tuple | None:
+    """The depth cue in ``lines.line_style`` form (color in bytes), or None."""
+    if options.depth_cue is None:
+        return None
+    c = options.depth_cue
+    return (c.near, c.far, c.min_intensity, c.max_intensity, *(255.0 * _cue_color(options)))
 
 
 def _choice(value: Any, valid: tuple, name: str, where: str) -> Any:
@@ -602,14 +650,18 @@ def _check_arguments(
             f"{where}: buffers = {describe(buffers)} is not a tuple of buffer names; valid names: "
             + ", ".join(repr(b) for b in BUFFERS)
         )
-    if edge_color is None:
-        edge = None if mode in ("wireframe", "points") else np.array([0.0, 0.0, 0.0, 255.0])
+    background_bytes = _background_bytes(background, where)
+    if edge_color is None:  # material colors for wireframes; black on light backgrounds, white on dark ones
+        light = background_bytes[:3].astype(float) @ (0.2126, 0.7152, 0.0722) > 127.5
+        edge = None if mode in ("wireframe", "points") else np.array([0.0, 0.0, 0.0, 255.0]) * light + 255.0 * (
+            not light
+        )
     else:
         edge = _color_bytes(edge_color, "edge_color", where)
     return _Options(
         shade_mode=SHADING_MODES[name],
         specular_model=shade.SPECULAR_PHONG if specular == "phong" else shade.SPECULAR_BLINN,
-        background=_background_bytes(background, where),
+        background=background_bytes,
         cull=bool(cull_back_faces),
         mode=mode,
         edges=edges,

@@ -16,7 +16,7 @@ from numpy.typing import ArrayLike
 
 from frustum._arrays import Matrix4, as_matrix, as_scalar, as_vector3, describe
 from frustum.errors import FrustumError, GeometryError
-from frustum.geometry import Mesh
+from frustum.geometry import Mesh, Polyline
 from frustum.shading import LIGHT_TYPES, Light, Material
 from frustum.transforms import translate
 
@@ -70,15 +70,15 @@ class Node:
     """A scene-graph node: ``Node(name, transform, geometry, material, children)``.
 
     ``transform`` (4x4 affine, default identity) maps this node's coordinates into its parent's;
-    ``geometry`` is a ``Mesh`` (or None for a pure group); ``material`` None inherits the nearest ancestor's
-    (``Material()`` at the top); ``lights`` ride the node (they move with its world transform).
+    ``geometry`` is a ``Mesh`` or a ``Polyline`` (or None for a pure group); ``material`` None inherits the
+    nearest ancestor's (``Material()`` at the top); ``lights`` ride the node (they move with its world transform).
     """
 
     def __init__(
         self,
         name: str = "",
         transform: ArrayLike | None = None,
-        geometry: Mesh | None = None,
+        geometry: Mesh | Polyline | None = None,
         material: Material | None = None,
         children: Iterable[Node] = (),
         lights: Iterable[Light] = (),
@@ -86,10 +86,10 @@ class Node:
         where = f"Node({name!r})"
         if not isinstance(name, str) or "/" in name:
             raise FrustumError(f"{where}: name = {describe(name)} is not a string without '/'; '/' separates paths")
-        if geometry is not None and not isinstance(geometry, Mesh):
+        if geometry is not None and not isinstance(geometry, Mesh | Polyline):
             raise FrustumError(
-                f"{where}: geometry = {describe(geometry)} is not a Mesh; build one with Mesh(vertices, faces) or "
-                "a primitive, or tessellate the surface first"
+                f"{where}: geometry = {describe(geometry)} is not a Mesh or Polyline; build one with Mesh(vertices, "
+                "faces) or a primitive, tessellate a surface, or draw a curve as Polyline(points)"
             )
         if material is not None and not isinstance(material, Material):
             raise FrustumError(f"{where}: material = {describe(material)} is not a Material; build one with Material()")
@@ -146,7 +146,10 @@ class Node:
         )
 
     def __repr__(self) -> str:
-        kind = f"{self.geometry.face_count} faces" if self.geometry is not None else "group"
+        if isinstance(self.geometry, Mesh):
+            kind = f"{self.geometry.face_count} faces"
+        else:
+            kind = "group" if self.geometry is None else f"polyline of {self.geometry.vertex_count} points"
         return f"Node({self.name!r}, {kind}, {len(self.children)} children)"
 
 
@@ -174,17 +177,18 @@ class Scene:
 
     def add(
         self,
-        geometry: Mesh | Node,
+        geometry: Mesh | Polyline | Node,
         material: Material | None = None,
         transform: ArrayLike | None = None,
         *,
         name: str = "",
         parent: Node | str | None = None,
     ) -> Node:
-        """Place `geometry` (a Mesh, or a whole Node subtree) under `parent` (default the root); returns the node.
+        """Place `geometry` (a Mesh, a Polyline, or a whole Node subtree) under `parent` (default the root);
+        returns the node.
 
-        For a Mesh, a new ``Node(name, transform, mesh, material)`` is made; for a Node, `material` and
-        `transform` must be left out (set them on the node).
+        For a Mesh or Polyline, a new ``Node(name, transform, geometry, material)`` is made; for a Node,
+        `material` and `transform` must be left out (set them on the node).
         """
         where = "Scene.add"
         host = self.root if parent is None else self.find(parent) if isinstance(parent, str) else parent
@@ -192,9 +196,10 @@ class Scene:
             if material is not None or transform is not None:
                 raise FrustumError(f"{where}: give material and transform on the Node itself, not with a Node")
             return host.add(geometry)
-        if not isinstance(geometry, Mesh):
+        if not isinstance(geometry, Mesh | Polyline):
             raise FrustumError(
-                f"{where}: geometry = {describe(geometry)} is not a Mesh or Node; build one with Mesh(vertices, faces)"
+                f"{where}: geometry = {describe(geometry)} is not a Mesh, Polyline or Node; build one with "
+                "Mesh(vertices, faces)"
             )
         return host.add(Node(name, transform, geometry, material))
 
@@ -211,12 +216,20 @@ class Scene:
     @property
     def items(self) -> list[SceneItem]:
         """Placed meshes in drawing order, each with its (inherited) material and world transform."""
+        return self._placed(Mesh)
+
+    @property
+    def polylines(self) -> list[SceneItem]:
+        """Placed polylines in drawing order (``SceneItem.mesh`` holds the Polyline)."""
+        return self._placed(Polyline)
+
+    def _placed(self, kind: type) -> list[SceneItem]:
         result: list[SceneItem] = []
 
         def visit(node: Node, world: Matrix4, inherited: Material) -> None:
             world = world @ node.transform
             material = node.material if node.material is not None else inherited
-            if node.geometry is not None:
+            if isinstance(node.geometry, kind):
                 result.append(SceneItem(node.geometry, material, world))
             for child in node.children:
                 visit(child, world, material)
@@ -245,7 +258,7 @@ def _world_centroid(node: Node, world: Matrix4) -> np.ndarray | None:
         current, m = stack.pop()
         stack.extend((child, m @ child.transform) for child in current.children)
         mesh = current.geometry
-        if mesh is None or mesh.face_count == 0:
+        if not isinstance(mesh, Mesh) or mesh.face_count == 0:
             continue
         points = mesh.vertices @ m[:3, :3].T + m[:3, 3]
         corners = points[mesh.faces]
@@ -305,7 +318,8 @@ def cutaway(
     their node's world transform baked in). With ``cap`` a closed (watertight) mesh gets its cross-section
     filled (section caps), so solids stay solid; open meshes are cut without caps. With ``ghost`` (an opacity
     in (0, 1) or a Material) the removed part is kept, semi-transparent, instead of dropped. Cutting keeps
-    positions and recomputes normals; UVs and vertex colors of cut meshes are not kept.
+    positions and recomputes normals; UVs and vertex colors of cut meshes are not kept. Polylines are kept
+    whole (not cut).
     """
     where = "cutaway"
     if (plane is None) == (box is None):
@@ -346,7 +360,12 @@ def _cut_node(
                                                           for light in child.lights])  # fmt: skip
         child_world = world @ child.transform
         child_material = child.material if child.material is not None else material
-        if child.geometry is not None:
+        if isinstance(child.geometry, Polyline):  # kept whole, baked into world coordinates like the meshes
+            line = child.geometry
+            points = line.points @ child_world[:3, :3].T + child_world[:3, 3]
+            copy.geometry = Polyline(points, line.closed, line.markers)
+            copy.material = child_material
+        elif child.geometry is not None:
             kept, removed = _cut_mesh(child.geometry, child_world, region, cap)
             if kept is not None:
                 copy.geometry = kept

@@ -1,5 +1,6 @@
-"""Modeling: things to draw, in their own (model) coordinates. This issue adds the minimal ``Mesh``."""
+"""Modeling: things to draw, in their own (model) coordinates."""
 
 from frustum.geometry.mesh import Mesh
+from frustum.geometry.polyline import Polyline
 
-__all__ = ["Mesh"]
+__all__ = ["Mesh", "Polyline"]
