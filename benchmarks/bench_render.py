@@ -84,6 +84,15 @@ def peak_rss_mib() -> float:
 # --- frustum child -------------------------------------------------------------------------------------------
 
 
+def _parse_variant(text: str | None) -> dict:
+    """``"shading=flat,samples=4"`` → ``{"shading": "flat", "samples": 4}`` (ints where they parse)."""
+    options: dict = {}
+    for pair in filter(None, (text or "").split(",")):
+        key, _, value = pair.partition("=")
+        options[key] = int(value) if value.isdigit() else value
+    return options
+
+
 def frustum_child(name: str, args: argparse.Namespace) -> dict:
     """Render one scene with frustum in this (fresh) process; save color/depth as .npy into ``args.out``."""
     t0 = time.perf_counter()
@@ -118,8 +127,11 @@ def frustum_child(name: str, args: argparse.Namespace) -> dict:
     background = tuple(float(c) for c in sc["background"])
     setup_s = time.perf_counter() - t0
 
+    options = dict(shading="phong", background=background, cull_back_faces=True)
+    options.update(_parse_variant(args.child_variant))
+
     def frame_once():
-        frame = frustum.render(scene, camera, shading="phong", background=background, cull_back_faces=True)
+        frame = frustum.render(scene, camera, **options)
         return frame.color, frame.depth
 
     t0 = time.perf_counter()
@@ -256,10 +268,11 @@ def run_llvmpipe(name: str, frames: int, args: argparse.Namespace, env: dict, wo
     return result
 
 
-def run_frustum(name: str, frames: int, args: argparse.Namespace, env: dict, work: Path) -> dict:
+def run_frustum(name: str, frames: int, args: argparse.Namespace, env: dict, work: Path, variant: str = "") -> dict:
     cmd = [
         sys.executable, os.path.abspath(__file__), "--child-frustum", name, "--frames", str(frames),
         "--warmup", str(args.warmup), "--scene-dir", str(args.scene_dir), "--child-out", str(work),
+        "--child-variant", variant,
     ]  # fmt: skip
     t0 = time.perf_counter()
     proc = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=args.timeout)
@@ -372,6 +385,11 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     parser.add_argument("--timeout", type=float, default=1800.0, help="seconds per child process")
     parser.add_argument("--child-frustum", default=None, help=argparse.SUPPRESS)
     parser.add_argument("--child-out", default=None, help=argparse.SUPPRESS)
+    parser.add_argument("--child-variant", default="", help=argparse.SUPPRESS)
+    parser.add_argument(
+        "--variants", nargs="*", default=[],
+        help="extra frustum runs per scene, e.g. shading=gouraud mode=hidden-line samples=4 (timed only)",
+    )  # fmt: skip
     return parser.parse_args(argv)
 
 
@@ -449,6 +467,16 @@ def main(argv: list[str] | None = None) -> int:
                     f"setup {f['setup_s'] * 1e3:.1f} ms  peak {f['peak_rss_mb']:6.0f} MiB",
                     flush=True,
                 )
+            for variant in args.variants if do_frustum else ():
+                try:
+                    v = run_frustum(name, frames, args, env, work, variant)
+                except (RuntimeError, subprocess.TimeoutExpired) as exc:
+                    print(f"{name}: frustum {variant} failed: {exc}", flush=True)
+                    continue
+                ratio = f" ratio {v['frame_ms'] / lp['frame_ms']:.2f}" if lp else ""
+                slower = f" ({v['frame_ms'] / f['frame_ms']:.2f}x phong)" if f else ""
+                print(f"{name:20s} {variant:24s} frame {v['frame_ms']:8.1f} ms{ratio}{slower}", flush=True)
+                row.setdefault("variants", {})[variant] = {k: v[k] for k in ("frame_ms", "peak_rss_mb")}
             if args.save:
                 for label in ("frustum", "llvmpipe"):
                     if row.get(label):

@@ -1,6 +1,146 @@
-"""Modeling: things to draw, in their own (model) coordinates."""
+"""Modeling: things to draw, in their own (model) coordinates: meshes, primitives, quadrics and superquadrics,
+curves and surfaces, fractals, mesh files and CSG."""
 
-from frustum.geometry.mesh import Mesh
-from frustum.geometry.polyline import Polyline
+from frustum.geometry.csg import (
+    difference,
+    intersection,
+    union,
+)
+from frustum.geometry.dimension import (
+    BoxCounting,
+    box_counting_dimension,
+)
+from frustum.geometry.escape_time import (
+    escape_time_colors,
+    julia,
+    mandelbrot,
+    quaternion_julia,
+    quaternion_julia_mesh,
+)
+from frustum.geometry.fractals import (
+    DEFAULT_MAX_BYTES,
+    IFS,
+    barnsley_fern,
+    cantor_set,
+    fbm_terrain,
+    fractal_coastline,
+    heightfield_mesh,
+    hilbert_curve,
+    hilbert_curve_3d,
+    koch_curve,
+    koch_snowflake,
+    menger_sponge,
+    peano_curve,
+    sierpinski_ifs,
+    sierpinski_tetrahedron,
+    sierpinski_triangle,
+    similarity_dimension,
+)
+from frustum.geometry.io import (
+    SUPPORTED_SUFFIXES,
+    MeshPart,
+    load,
+    load_parts,
+)
+from frustum.geometry.lsystem import (
+    CLASSIC_LSYSTEMS,
+    LSystem,
+    TurtlePath,
+    interpret,
+    parse_rules,
+    tube_mesh,
+)
+from frustum.geometry.mesh import (
+    Mesh,
+)
+from frustum.geometry.polyline import (
+    Polyline,
+)
+from frustum.geometry.primitives import (
+    arrow,
+    axes,
+    box,
+    cone,
+    cylinder,
+    disk,
+    grid,
+    icosphere,
+    plane,
+    torus,
+    uv_sphere,
+)
+from frustum.geometry.quadrics import (
+    ellipsoid,
+    ellipsoid_implicit,
+    sphere,
+    sphere_implicit,
+    superellipse,
+    superellipse_implicit,
+    superellipsoid,
+    superellipsoid_implicit,
+    supertoroid,
+    supertoroid_implicit,
+)
 
-__all__ = ["Mesh", "Polyline"]
+__all__ = [
+    "CLASSIC_LSYSTEMS",
+    "DEFAULT_MAX_BYTES",
+    "IFS",
+    "SUPPORTED_SUFFIXES",
+    "BoxCounting",
+    "LSystem",
+    "Mesh",
+    "MeshPart",
+    "Polyline",
+    "TurtlePath",
+    "arrow",
+    "axes",
+    "barnsley_fern",
+    "box",
+    "box_counting_dimension",
+    "cantor_set",
+    "cone",
+    "cylinder",
+    "difference",
+    "disk",
+    "ellipsoid",
+    "ellipsoid_implicit",
+    "escape_time_colors",
+    "fbm_terrain",
+    "fractal_coastline",
+    "grid",
+    "heightfield_mesh",
+    "hilbert_curve",
+    "hilbert_curve_3d",
+    "icosphere",
+    "interpret",
+    "intersection",
+    "julia",
+    "koch_curve",
+    "koch_snowflake",
+    "load",
+    "load_parts",
+    "mandelbrot",
+    "menger_sponge",
+    "parse_rules",
+    "peano_curve",
+    "plane",
+    "quaternion_julia",
+    "quaternion_julia_mesh",
+    "sierpinski_ifs",
+    "sierpinski_tetrahedron",
+    "sierpinski_triangle",
+    "similarity_dimension",
+    "sphere",
+    "sphere_implicit",
+    "superellipse",
+    "superellipse_implicit",
+    "superellipsoid",
+    "superellipsoid_implicit",
+    "supertoroid",
+    "supertoroid_implicit",
+    "torus",
+    "tube_mesh",
+    "union",
+    "uv_sphere",
+]

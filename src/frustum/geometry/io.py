@@ -1,0 +1,377 @@
+"""Mesh files: load and save OBJ, STL (ASCII and binary), PLY, OFF and glTF/GLB through trimesh.
+
+frustum writes no parser of its own: trimesh reads and writes the formats, and this module turns its objects
+into frozen ``Mesh`` objects (and back), keeping vertex normals, UVs, vertex colors and texture images where
+the format has them. Every failure (missing file, unknown suffix, truncated or corrupt data) is raised as a
+``GeometryError`` naming the path and the reason, never as an exception from inside the parser.
+
+Files are read without trimesh's "processing" (no vertex merging, no reordering), so vertex and face counts are
+those of the file, except that vertices are split where a vertex carries several UVs or normals (OBJ) and
+polygons are triangulated. Use ``Mesh.welded()`` to merge the seam copies again.
+
+References
+----------
+[seed] "Polygon Mesh Models" (object description stored as sets of surface polygons).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, NamedTuple
+
+import numpy as np
+from numpy.typing import NDArray
+
+from frustum._arrays import describe
+from frustum.errors import GeometryError
+from frustum.geometry.mesh import Mesh
+
+__all__ = ["SUPPORTED_SUFFIXES", "MeshPart", "load", "load_parts", "save"]
+
+SUPPORTED_SUFFIXES: tuple[str, ...] = (".obj", ".stl", ".ply", ".off", ".gltf", ".glb")
+"""File suffixes `load` and `save` understand (case-insensitive)."""
+
+_IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg")
+
+
+class MeshPart(NamedTuple):
+    """One object of a mesh file, as placed in the file.
+
+    Attributes
+    ----------
+    name : str
+        The node (or object) name from the file; unique within one `load_parts` result.
+    mesh : Mesh
+        The geometry in its own model coordinates.
+    world_from_model : (4, 4) float64 ndarray
+        The file's placement of the part (identity for formats without a scene graph).
+    texture : (H, W, 3 | 4) uint8 ndarray or None
+        The texture image the part's UVs index, row 0 at the top of the image (so v = 1 is row 0).
+    color : tuple of 4 floats in [0, 1] or None
+        The material's base (diffuse) RGBA color, when the file gives one.
+    """
+
+    name: str
+    mesh: Mesh
+    world_from_model: NDArray[np.float64]
+    texture: NDArray[np.uint8] | None
+    color: tuple[float, float, float, float] | None
+
+
+def load(path: str | Path, texture: str | Path | None = None) -> Mesh:
+    """Read a mesh file as one ``Mesh``; a file with several objects is joined into one, transforms baked in.
+
+    Parameters
+    ----------
+    path : str or Path
+        An OBJ, STL, PLY, OFF, glTF or GLB file (see ``SUPPORTED_SUFFIXES``).
+    texture : str or Path, optional
+        Ignored here (a ``Mesh`` carries UVs, not images); accepted so ``load`` and ``load_parts`` take the same
+        arguments. Use ``load_parts`` to get texture images.
+
+    Raises
+    ------
+    GeometryError
+        Unknown suffix (the message lists the supported ones), missing file, unreadable or corrupt data, or a
+        file without triangles.
+    """
+    parts = load_parts(path, texture=texture)
+    placed = [
+        part.mesh if _is_identity(part.world_from_model) else part.mesh.transformed(part.world_from_model)
+        for part in parts
+    ]
+    return placed[0].merged(*placed[1:])
+
+
+def load_parts(path: str | Path, texture: str | Path | None = None) -> list[MeshPart]:
+    """Read every triangle mesh of a file with its name, placement, texture image and base color.
+
+    Parts come sorted by name, so the result does not depend on the parser's internal order. Single-mesh
+    formats (OBJ without groups, STL, PLY, OFF) give one part with the identity placement.
+
+    Parameters
+    ----------
+    path : str or Path
+    texture : str or Path, optional
+        An image to use as the texture of every part with UVs, for files that do not name one (an OBJ without
+        a ``.mtl``). Without it, an OBJ/PLY whose material has no image looks next to the file for
+        ``<stem>.png``, ``<stem>_texture.png`` or ``<first word of stem>_texture.png`` (also ``.jpg``, ``.jpeg``),
+        e.g. ``spot_texture.png`` for ``spot_triangulated.obj``.
+
+    Raises
+    ------
+    GeometryError
+        As for ``load``.
+    """
+    import trimesh
+
+    file = _checked_path(path, "load")
+    explicit = None if texture is None else _read_image(Path(texture), "load")
+    if file.suffix.lower() == ".stl":
+        _check_binary_stl_size(file)
+    try:
+        scene = trimesh.load_scene(str(file), process=False)
+    except Exception as error:  # trimesh raises many types (ValueError, KeyError, struct.error, ...)
+        raise _read_error(file, error) from None
+    parts: list[MeshPart] = []
+    try:
+        nodes = sorted(scene.graph.nodes_geometry)
+        for node in nodes:
+            world_from_model, geometry_name = scene.graph[node]
+            geometry = scene.geometry.get(geometry_name)
+            if not isinstance(geometry, trimesh.Trimesh) or len(geometry.faces) == 0:
+                continue
+            mesh, image, color = _from_trimesh(geometry, file)
+            if image is None and mesh.uvs is not None:
+                image = explicit if explicit is not None else _sibling_texture(file)
+            matrix = np.array(world_from_model, dtype=np.float64)
+            parts.append(MeshPart(str(node), mesh, matrix, image, color))
+    except GeometryError as error:
+        raise GeometryError(f"load: path = {str(file)!r} holds invalid geometry ({error}); check the file") from None
+    except Exception as error:
+        raise _read_error(file, error) from None
+    if not parts:
+        raise GeometryError(
+            f"load: path = {str(file)!r} contains no triangles; give a file with at least one triangle mesh"
+        )
+    return parts
+
+
+def save(mesh: Mesh, path: str | Path, binary: bool = True, texture: Any = None) -> Path:
+    """Write `mesh` to `path`; the suffix picks the format. Returns the path written.
+
+    What each format keeps: OBJ — normals, UVs (and the `texture` image with a ``.mtl`` when given) or vertex
+    colors; PLY and glTF/GLB — normals, UVs or vertex colors; OFF — positions only; STL — positions
+    and face normals only (vertices are split per face, as the format stores them). A format can hold UVs or
+    vertex colors, not both: with a `texture` the UVs are written, otherwise vertex colors win over UVs.
+
+    Parameters
+    ----------
+    binary : bool
+        Binary STL or PLY (default) or ASCII.
+    texture : (H, W, 3 | 4) uint8 array_like, optional
+        An image to store with the UVs (OBJ: a PNG beside the file; GLB/glTF: embedded).
+
+    Raises
+    ------
+    GeometryError
+        Not a Mesh, unknown suffix, or the file cannot be written.
+    """
+    import trimesh
+
+    if not isinstance(mesh, Mesh):
+        raise GeometryError(f"save: mesh = {describe(mesh)} is not a Mesh; give a frustum Mesh")
+    file = Path(path)
+    suffix = _suffix(file, "save")
+    geometry = trimesh.Trimesh(
+        vertices=np.array(mesh.vertices),
+        faces=np.array(mesh.faces),
+        vertex_normals=np.array(mesh.vertex_normals),
+        process=False,
+    )
+    use_uvs = mesh.uvs is not None and suffix not in (".stl", ".off")
+    if use_uvs and (texture is not None or mesh.vertex_colors is None):
+        image = None
+        if texture is not None:
+            from PIL import Image
+
+            image = Image.fromarray(_as_image(texture))
+        # white diffuse, so readers that multiply the texture by the material color see the texture unchanged
+        material = trimesh.visual.material.SimpleMaterial(image=image, diffuse=(255, 255, 255, 255))
+        geometry.visual = trimesh.visual.TextureVisuals(uv=np.array(mesh.uvs), material=material)
+    elif mesh.vertex_colors is not None and suffix != ".stl":
+        colors = np.round(np.asarray(mesh.vertex_colors) * 255.0).astype(np.uint8)
+        geometry.visual = trimesh.visual.ColorVisuals(geometry, vertex_colors=colors)
+    file_type = suffix[1:]
+    options: dict[str, Any] = {}
+    if suffix == ".stl" and not binary:
+        file_type = "stl_ascii"
+    if suffix == ".ply":
+        options["encoding"] = "binary" if binary else "ascii"
+    try:
+        if suffix == ".gltf":  # one self-contained JSON file, buffers embedded as data URIs
+            from trimesh.exchange.gltf import export_gltf
+
+            data = next(iter(export_gltf(trimesh.Scene(geometry), embed_buffers=True).values()))
+        else:
+            data = geometry.export(file_type=file_type, **options)
+        if isinstance(data, str):
+            data = data.encode("utf-8")
+        if suffix == ".obj" and isinstance(data, bytes) and texture is not None:
+            data = _obj_with_texture(geometry, file)
+        file.write_bytes(data)
+    except OSError as error:
+        raise GeometryError(
+            f"save: path = {str(file)!r} cannot be written ({error.strerror}); check the folder"
+        ) from None
+    except Exception as error:
+        raise GeometryError(
+            f"save: path = {str(file)!r} could not be written as {suffix} ({type(error).__name__}: {error})"
+        ) from None
+    return file
+
+
+# --- helpers ------------------------------------------------------------------------------------------------
+
+
+def _suffix(file: Path, where: str) -> str:
+    suffix = file.suffix.lower()
+    if suffix not in SUPPORTED_SUFFIXES:
+        raise GeometryError(
+            f"{where}: path = {str(file)!r} has suffix {suffix or '(none)'!r}, which is not a mesh format; "
+            f"give one of {', '.join(SUPPORTED_SUFFIXES)}"
+        )
+    return suffix
+
+
+def _checked_path(path: Any, where: str) -> Path:
+    if not isinstance(path, str | Path):
+        raise GeometryError(f"{where}: path = {describe(path)} is not a path; give a file name")
+    file = Path(path)
+    _suffix(file, where)
+    if not file.is_file():
+        problem = "is a folder" if file.is_dir() else "does not exist"
+        raise GeometryError(f"{where}: path = {str(file)!r} {problem}; give the path of an existing mesh file")
+    if file.stat().st_size == 0:
+        raise GeometryError(f"{where}: path = {str(file)!r} is empty (0 bytes); the file is truncated or not written")
+    return file
+
+
+def _check_binary_stl_size(file: Path) -> None:
+    """A binary STL is an 80-byte header, a uint32 count n and n 50-byte records: catch truncation early."""
+    with file.open("rb") as stream:
+        head = stream.read(84)
+    if head[:5].lower() == b"solid" and b"facet" in file.read_bytes()[:1024]:
+        return  # ASCII STL
+    size = file.stat().st_size
+    if len(head) < 84:
+        raise GeometryError(
+            f"load: path = {str(file)!r} has {size} bytes, fewer than the 84-byte binary STL header; the file is "
+            "truncated or not an STL file"
+        )
+    count = int(np.frombuffer(head[80:84], dtype="<u4")[0])
+    if size < 84 + 50 * count:
+        raise GeometryError(
+            f"load: path = {str(file)!r} has {size} bytes but its header announces {count} triangles "
+            f"({84 + 50 * count} bytes); the file is truncated"
+        )
+
+
+def _read_error(file: Path, error: BaseException) -> GeometryError:
+    reason = str(error).strip().splitlines()[0] if str(error).strip() else "no details"
+    if len(reason) > 160:
+        reason = reason[:157] + "..."
+    return GeometryError(
+        f"load: path = {str(file)!r} could not be read as {file.suffix.lower()} ({type(error).__name__}: {reason}); "
+        "the file is corrupt, truncated or not in that format"
+    )
+
+
+def _from_trimesh(geometry: Any, file: Path) -> tuple[Mesh, NDArray[np.uint8] | None, tuple | None]:
+    vertices = np.asarray(geometry.vertices, dtype=np.float64)
+    faces = np.asarray(geometry.faces, dtype=np.int64)
+    normals = None
+    if "vertex_normals" in geometry._cache.cache:  # normals that came from the file, not computed by trimesh
+        candidate = np.asarray(geometry.vertex_normals, dtype=np.float64)
+        if candidate.shape == vertices.shape and np.isfinite(candidate).all() and (np.abs(candidate).sum(1) > 0).all():
+            normals = candidate
+    uvs = colors = image = base = None
+    visual = geometry.visual
+    kind = getattr(visual, "kind", None)
+    if kind == "texture":
+        uv = getattr(visual, "uv", None)
+        if uv is not None and len(uv) == len(vertices):
+            uvs = np.asarray(uv, dtype=np.float64)
+        material = getattr(visual, "material", None)
+        image = _material_image(material)
+        placeholder = image is None and getattr(material, "image", None) is not None
+        base = None if placeholder else _material_color(material)
+    elif kind == "vertex":
+        colors = np.asarray(visual.vertex_colors, dtype=np.uint8)
+        if (colors[:, 3] == 255).all():
+            colors = colors[:, :3]
+    elif kind == "face":
+        base = None  # per-face colors have no per-vertex form without splitting vertices; dropped
+    return Mesh(vertices, faces, normals, uvs, colors), image, base
+
+
+def _material_image(material: Any) -> NDArray[np.uint8] | None:
+    if material is None:
+        return None
+    image = getattr(material, "image", None)
+    if image is None:
+        image = getattr(material, "baseColorTexture", None)
+    if image is None:
+        return None
+    array = np.asarray(image.convert("RGBA" if "A" in image.mode else "RGB"), dtype=np.uint8)
+    if _is_placeholder(array):
+        return None
+    return array
+
+
+def _is_placeholder(array: NDArray[np.uint8]) -> bool:
+    # trimesh gives an OBJ with UVs but no material a uniform 2x2 placeholder image: that is no texture
+    return array.shape[:2] == (2, 2) and bool((array == array[0, 0]).all())
+
+
+def _material_color(material: Any) -> tuple[float, float, float, float] | None:
+    if material is None:
+        return None
+    color = getattr(material, "baseColorFactor", None)
+    if color is None:
+        color = getattr(material, "diffuse", None)
+    if color is None:
+        return None
+    rgba = np.asarray(color, dtype=np.float64).ravel()
+    if rgba.size == 3:
+        rgba = np.append(rgba, 255.0 if rgba.max() > 1.0 else 1.0)
+    if rgba.size != 4 or not np.isfinite(rgba).all():
+        return None
+    if rgba.max() > 1.0:
+        rgba = rgba / 255.0
+    return tuple(float(c) for c in np.clip(rgba, 0.0, 1.0))  # type: ignore[return-value]
+
+
+def _sibling_texture(file: Path) -> NDArray[np.uint8] | None:
+    stem = file.stem
+    names = [stem, f"{stem}_texture", f"{stem.split('_')[0]}_texture"]
+    for name in names:
+        for suffix in _IMAGE_SUFFIXES:
+            candidate = file.with_name(name + suffix)
+            if candidate.is_file():
+                return _read_image(candidate, "load")
+    return None
+
+
+def _read_image(file: Path, where: str) -> NDArray[np.uint8]:
+    from PIL import Image, UnidentifiedImageError
+
+    if not file.is_file():
+        raise GeometryError(f"{where}: texture = {str(file)!r} does not exist; give the path of an image file")
+    try:
+        with Image.open(file) as image:
+            return np.asarray(image.convert("RGBA" if "A" in image.mode else "RGB"), dtype=np.uint8)
+    except (OSError, UnidentifiedImageError) as error:
+        raise GeometryError(f"{where}: texture = {str(file)!r} is not a readable image ({error})") from None
+
+
+def _as_image(texture: Any) -> NDArray[np.uint8]:
+    image = np.asarray(texture)
+    if image.ndim != 3 or image.shape[2] not in (3, 4) or image.dtype != np.uint8:
+        raise GeometryError(
+            f"save: texture has shape {image.shape} and dtype {image.dtype}; expected an (H, W, 3 or 4) uint8 image"
+        )
+    return image
+
+
+def _obj_with_texture(geometry: Any, file: Path) -> bytes:
+    from trimesh.exchange.obj import export_obj
+
+    text, files = export_obj(geometry, return_texture=True, mtl_name=file.stem + ".mtl")
+    for name, data in files.items():
+        (file.parent / name).write_bytes(data)
+    return text.encode("utf-8")
+
+
+def _is_identity(matrix: NDArray[np.float64]) -> bool:
+    return bool(np.array_equal(matrix, np.eye(4)))
