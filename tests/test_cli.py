@@ -1,15 +1,21 @@
-"""The `frustum` command: output of `compose`, --version, and one-line errors with exit status 1."""
+"""The `frustum` command: compose, trace, info, turntable, --version, and one-line errors (exit 1, usage 2)."""
 
 from __future__ import annotations
 
 import subprocess
 import sys
+from pathlib import Path
 
+import imageio.v3 as iio
 import numpy as np
 import pytest
+import trimesh
 
-from frustum import __version__, compose, rotate_z, translate
-from frustum.cli import parse_step
+from frustum import Camera, Perspective, __version__, compose, rotate_z, translate
+from frustum.cli import main, parse_step
+from frustum.trace import trace
+
+BUNNY = Path("/work/shared/data/bunny")
 
 
 def run(*arguments: str) -> subprocess.CompletedProcess[str]:
@@ -47,19 +53,173 @@ def test_parse_step_builds_the_same_matrices_as_the_api():
 
 
 @pytest.mark.parametrize(
-    ("arguments", "message"),
+    ("arguments", "status", "message"),
     [
-        (("compose", "rotate_deg=0,0,0,90"), "error: rotate: axis = (0.0, 0.0, 0.0) has zero length"),
-        (("compose", "spin=1"), "error: step 'spin=1': 'spin' is not a transformation; expected one of"),
-        (("compose", "translate=1,2"), "error: step 'translate=1,2': got 2 numbers; expected 3"),
-        (("compose", "translate"), "error: step 'translate' has no '='"),
-        (("compose", "scale=a,b,c"), "is not a comma-separated list of numbers"),
-        (("compose", "scale=1", "--point", "1,2"), "got 2 numbers; expected 3"),
+        (("compose", "rotate_deg=0,0,0,90"), 1, "error: rotate: axis = (0.0, 0.0, 0.0) has zero length"),
+        (("compose", "spin=1"), 2, "error: step 'spin=1': 'spin' is not a transformation; expected one of"),
+        (("compose", "translate=1,2"), 2, "error: step 'translate=1,2': got 2 numbers; expected 3"),
+        (("compose", "translate"), 2, "error: step 'translate' has no '='"),
+        (("compose", "scale=a,b,c"), 2, "is not a comma-separated list of numbers"),
+        (("compose", "scale=1", "--point", "1,2"), 2, "got 2 numbers; expected 3"),
+        (
+            ("trace", "--point", "0,0,0", "--eye", "0,0,5", "--up", "0,0,1"),
+            1,
+            "error: ViewFrame: up = (0.0, 0.0, 1.0) is parallel",
+        ),
+        (("trace", "--point", "0,0,0", "--fovy-deg", "0"), 1, "error: perspective: fovy = 0.0"),
+        (("trace", "--point", "1,2"), 2, "error: --point = '1,2' has 2 numbers; expected 3"),
+        (("trace", "--point", "a,b,c"), 2, "error: --point = 'a,b,c' is not a comma-separated list of numbers"),
+        (("trace", "--point", "0,0,0", "--size", "64"), 2, "error: --size = '64' is not WIDTHxHEIGHT"),
+        (("trace", "--point", "0,0,0", "--markdown", "--latex"), 2, "error: --markdown and --latex were both given"),
+        (("trace",), 2, "error: Missing option '--point'"),
+        (("trace", "--point", "0,0,0", "--bogus"), 2, "error: No such option: --bogus"),
+        (("info", "/nonexistent/mesh.ply"), 1, "error: info: mesh = '/nonexistent/mesh.ply' does not exist"),
+        (("info",), 2, "error: Missing argument 'mesh'"),
+        (("turntable", "/nonexistent/mesh.ply", "-o", "x.gif"), 1, "error: turntable: mesh = '/nonexistent/mesh.ply'"),
+        (("turntable", "mesh.ply"), 2, "error: Missing option '--output'"),
     ],
 )
-def test_bad_input_prints_one_line_and_exits_1(arguments, message):
-    result = run(*arguments)
+def test_bad_input_prints_one_line_and_exits_1_or_2_for_usage(arguments, status, message, capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        main(list(arguments))
+    captured = capsys.readouterr()
+    assert exit_info.value.code == status, captured.err
+    assert captured.err.count("\n") == 1, captured.err
+    assert message in captured.err
+    assert "Traceback" not in captured.err
+
+
+def test_errors_print_no_traceback_in_a_real_process_unless_debug():
+    result = run("trace", "--point", "0,0,0", "--up", "0,0,1")
     assert result.returncode == 1
-    assert result.stderr.count("\n") == 1, result.stderr
-    assert message in result.stderr
-    assert "Traceback" not in result.stderr
+    assert result.stderr.startswith("error: ViewFrame: up = (0.0, 0.0, 1.0) is parallel")
+    assert result.stderr.count("\n") == 1 and "Traceback" not in result.stderr
+    debug = run("--debug", "trace", "--point", "0,0,0", "--up", "0,0,1")
+    assert debug.returncode == 1
+    assert "Traceback" in debug.stderr and "CameraError" in debug.stderr
+
+
+# --- trace ----------------------------------------------------------------------------------------------------
+
+
+def _trace_arguments(*extra: str) -> list[str]:
+    return ["trace", "--eye", "1,2,5", "--target", "0,0,0", "--up", "0,1,0", "--fovy-deg", "50", "--size", "64x48",
+            "--point", "0.2,0.1,-0.3", "--point", "0,0,50", *extra]  # fmt: skip
+
+
+def _camera() -> Camera:
+    return Camera.look_at((1, 2, 5), (0, 0, 0), (0, 1, 0), Perspective(np.radians(50), 0.1, 100.0), 64, 48)
+
+
+def test_trace_prints_every_stage_with_both_matrix_forms(capsys):
+    main(_trace_arguments())
+    out = capsys.readouterr().out
+    words = " ".join(out.split())  # Rich wraps long lines at the console width
+    for stage in trace([[0.2, 0.1, -0.3], [0, 0, 50]], _camera()).stages:
+        assert " ".join(stage.title.split()) in words
+    assert out.count("Mᵀ (P' = P·Mᵀ)") == 5  # world, translate, rotate, perspective, viewport
+    assert "outside:" in words  # (0, 0, 50) lies behind the eye: w < 0
+
+
+def test_trace_markdown_window_row_equals_camera_project(capsys):
+    main(_trace_arguments("--markdown"))
+    out = capsys.readouterr().out
+    assert "### 9. Viewport transformation" in out
+    viewport = out[out.index("### 9. Viewport") :]
+    row = next(line for line in viewport.splitlines() if line.startswith("| p0 |"))
+    window = [float(v) for v in row.strip("| ").split(" | ")[1:]]
+    np.testing.assert_allclose(window, _camera().project([0.2, 0.1, -0.3]), rtol=1e-5)  # printed to 6 digits
+
+
+def test_trace_latex_has_a_bmatrix_pair_per_matrix(capsys):
+    main(_trace_arguments("--latex"))
+    out = capsys.readouterr().out
+    assert out.count(r"\begin{bmatrix}") == 10  # five matrices (normalization is inside the perspective one)
+    assert out.count(r"\subsubsection*") == 9
+
+
+def test_trace_orthographic(capsys):
+    main(["trace", "--point", "0,0,0", "--ortho-height", "4", "--near", "-1", "--markdown"])
+    out = capsys.readouterr().out
+    assert "orthogonal normalization M\\_ortho,norm" in out
+
+
+# --- info -----------------------------------------------------------------------------------------------------
+
+
+def _facts(table: str) -> dict[str, str]:
+    """The rows of `frustum info`'s two-column table as a dict."""
+    facts = {}
+    for line in table.splitlines():
+        cells = [cell.strip() for cell in line.strip().strip("│").split("│")]
+        if len(cells) == 2:
+            facts[cells[0]] = cells[1]
+    return facts
+
+
+def test_info_on_the_bunny_counts_bounds_and_open_edges(capsys):
+    path = BUNNY / "bun_zipper_res4.ply"
+    reference = trimesh.load(path, process=False)
+    main(["info", str(path)])
+    facts = _facts(capsys.readouterr().out)
+    assert facts["vertices"] == str(len(reference.vertices))
+    assert facts["triangles"] == str(len(reference.faces))
+    assert facts["bounds min"] == "(" + ", ".join(f"{v:.6g}" for v in reference.vertices.min(axis=0)) + ")"
+    assert facts["bounds max"] == "(" + ", ".join(f"{v:.6g}" for v in reference.vertices.max(axis=0)) + ")"
+    assert facts["watertight"].startswith("no (")  # the scanned bunny has holes in its base
+    assert facts["vertex normals"] == "computed (area-weighted face normals)"
+
+
+def test_info_on_a_generated_closed_box(tmp_path, capsys):
+    path = tmp_path / "box.ply"
+    trimesh.creation.box(extents=(1.0, 2.0, 3.0)).export(path)
+    main(["info", str(path)])
+    facts = _facts(capsys.readouterr().out)
+    expected = {
+        "vertices": "8", "triangles": "12", "bounds min": "(-0.5, -1, -1.5)", "bounds max": "(0.5, 1, 1.5)",
+        "watertight": "yes", "winding consistent": "yes", "surface area": "22", "volume": "6",
+        "Euler characteristic": "2", "face normals": "outward", "zero-area triangles": "0",
+    }  # fmt: skip
+    assert {name: facts.get(name) for name in expected} == expected
+
+
+def test_info_reports_inward_normals_of_a_flipped_box(tmp_path, capsys):
+    box = trimesh.creation.box()
+    path = tmp_path / "inside_out.ply"
+    trimesh.Trimesh(box.vertices, box.faces[:, ::-1], process=False).export(path)
+    main(["info", str(path)])
+    assert _facts(capsys.readouterr().out)["face normals"].startswith("inward")
+
+
+def test_info_on_a_corrupt_file_is_one_line(tmp_path, capsys):
+    path = tmp_path / "broken.ply"
+    path.write_text("this is not a ply file\n")
+    with pytest.raises(SystemExit) as exit_info:
+        main(["info", str(path)])
+    err = capsys.readouterr().err
+    assert exit_info.value.code == 1 and err.count("\n") == 1 and "broken.ply" in err
+
+
+# --- turntable ------------------------------------------------------------------------------------------------
+
+
+def test_turntable_writes_the_requested_frames(tmp_path, capsys):
+    mesh_path = tmp_path / "box.ply"
+    trimesh.creation.box(extents=(1.0, 0.5, 0.3)).export(mesh_path)
+    output = tmp_path / "spin.gif"
+    main(["turntable", str(mesh_path), "-o", str(output), "--frames", "5", "--size", "32x24"])
+    captured = capsys.readouterr()
+    assert captured.err == ""  # no progress bar when stderr is not a terminal
+    assert f"wrote {output} (5 frames, 32x24)" in captured.out
+    frames = list(iio.imiter(output))
+    assert len(frames) == 5 and frames[0].shape[:2] == (24, 32)
+
+
+def test_turntable_bad_suffix_is_one_line(tmp_path, capsys):
+    mesh_path = tmp_path / "box.ply"
+    trimesh.creation.box().export(mesh_path)
+    with pytest.raises(SystemExit) as exit_info:
+        main(["turntable", str(mesh_path), "-o", str(tmp_path / "spin.avi"), "--frames", "2", "--size", "8x8"])
+    err = capsys.readouterr().err
+    assert exit_info.value.code == 1 and err.count("\n") == 1
+    assert "turntable: path = " in err and "has suffix '.avi'" in err

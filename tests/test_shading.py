@@ -407,3 +407,19 @@ def test_translate_keeps_flat_quads_unchanged():
     frame = render(scene, ortho_camera(), shading="none")
     x, y, _ = ortho_camera().project([0.5, 0.0, 0.0])
     assert frame.color[SIZE - 1 - int(y), int(x), 0] == 255
+
+
+SPOT = "/work/shared/data/spot/spot_triangulated.obj"
+
+
+@pytest.mark.skipif(not __import__("os").path.exists(SPOT), reason="shared data not present")
+def test_spot_renders_with_its_texture_black_and_white_patches():
+    from frustum.geometry import load_parts
+
+    (part,) = load_parts(SPOT)
+    scene = placed(Scene(), part.mesh, Material(color=(1, 1, 1), texture=part.texture))
+    camera = Camera.look_at((2, 1, 2.5), (0, 0.3, 0), (0, 1, 0), width=160, height=120)
+    frame = render(scene, camera, shading="none", background=(0, 0, 1, 1))
+    covered = frame.depth < 1.0
+    gray = frame.color[..., :3][covered].astype(int).mean(axis=1)
+    assert (gray < 80).mean() > 0.05 and (gray > 200).mean() > 0.3  # the dark patches of the cow on white

@@ -1,9 +1,19 @@
-"""The ``frustum`` command (Typer + Rich). Errors print as one line and exit 1, without a traceback."""
+"""The ``frustum`` command (Typer + Rich).
+
+Commands: ``compose`` (transformation steps and their composite), ``trace`` (one camera, points through every
+stage of the pipeline), ``info`` (a mesh file's counts, bounds, watertightness and normals) and ``turntable``
+(a GIF or MP4 orbiting a mesh). Errors print as one line, ``error: <message>``, without a traceback (the global
+``--debug`` option shows it): exit status 1 for a bad value or an unreadable file, 2 for a command line that
+cannot be parsed (unknown option, missing argument, malformed numbers).
+"""
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from typing import Annotated
+import math
+import sys
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Annotated, Any
 
 import numpy as np
 import typer
@@ -11,7 +21,10 @@ from rich.console import Console
 from rich.table import Table
 
 from frustum import __version__
-from frustum.errors import FrustumError
+from frustum.camera import Camera
+from frustum.errors import FrustumError, GeometryError
+from frustum.geometry import Mesh
+from frustum.projection import Orthographic, Perspective
 from frustum.quaternion import Quaternion
 from frustum.transforms import (
     Step,
@@ -40,7 +53,10 @@ error_console = Console(stderr=True, highlight=False, soft_wrap=True)
 
 
 class UsageError(FrustumError):
-    """A command-line argument that frustum cannot read."""
+    """A command-line argument that frustum cannot read (exit status 2)."""
+
+
+_STATE = {"debug": False}
 
 
 def _numbers(text: str, counts: tuple[int, ...], step: str) -> list[float]:
@@ -118,8 +134,10 @@ def _main(
     version: Annotated[
         bool, typer.Option("--version", callback=_version, is_eager=True, help="Print the version and exit.")
     ] = False,
+    debug: Annotated[bool, typer.Option("--debug", help="Show the full traceback of an error.")] = False,
 ) -> None:
     """The classical 3D graphics pipeline, inspectable at every stage."""
+    _STATE["debug"] = debug
 
 
 _STEP_HELP = "; ".join([syntax for _, _, syntax in _STEPS.values()] + ["shear=x|y|z,a,b[,ref]"])
@@ -152,10 +170,242 @@ def compose_command(
         console.print(f"M · ({', '.join(f'{v:g}' for v in p)}, 1) = ({', '.join(f'{v:.6g}' for v in moved)}, 1)")
 
 
-def main() -> None:
-    """Entry point of the ``frustum`` console script."""
+# --- trace ----------------------------------------------------------------------------------------------------
+
+
+def _vector3(text: str, option: str) -> list[float]:
+    """``x,y,z`` from the command line as three floats, or a UsageError naming the option."""
     try:
-        app()
+        values = [float(v) for v in text.split(",")]
+    except ValueError:
+        raise UsageError(f"{option} = {text!r} is not a comma-separated list of numbers; write x,y,z") from None
+    if len(values) != 3:
+        raise UsageError(f"{option} = {text!r} has {len(values)} numbers; expected 3, written x,y,z")
+    return values
+
+
+def _image_size(text: str) -> tuple[int, int]:
+    """``WxH`` (e.g. 640x480) as two positive integers, or a UsageError."""
+    width, sep, height = text.lower().partition("x")
+    try:
+        size = (int(width), int(height)) if sep else None
+    except ValueError:
+        size = None
+    if size is None or min(size) <= 0:
+        raise UsageError(f"--size = {text!r} is not WIDTHxHEIGHT; write two positive integers, e.g. 640x480")
+    return size
+
+
+@app.command("trace")
+def trace_command(
+    point: Annotated[
+        list[str], typer.Option("--point", "-p", help="A world point x,y,z to follow (repeat for more points).")
+    ],
+    eye: Annotated[str, typer.Option(help="View point P0 as x,y,z.")] = "0,0,5",
+    target: Annotated[str, typer.Option(help="Look-at point as x,y,z.")] = "0,0,0",
+    up: Annotated[str, typer.Option(help="View-up vector V as x,y,z.")] = "0,1,0",
+    fovy_deg: Annotated[float, typer.Option(help="Vertical field of view in degrees (perspective).")] = 60.0,
+    ortho_height: Annotated[
+        float | None, typer.Option(help="Use an orthographic projection with a view window this tall instead.")
+    ] = None,
+    near: Annotated[float, typer.Option(help="Near plane distance (> 0 for perspective).")] = 0.1,
+    far: Annotated[float, typer.Option(help="Far plane distance.")] = 100.0,
+    size: Annotated[str, typer.Option(help="Image size WIDTHxHEIGHT in pixels.")] = "640x480",
+    polyline: Annotated[
+        bool, typer.Option("--polyline", help="Connect the points in order and show how each segment is clipped.")
+    ] = False,
+    markdown: Annotated[bool, typer.Option("--markdown", help="Print Markdown (to paste into notes).")] = False,
+    latex: Annotated[bool, typer.Option("--latex", help="Print a LaTeX fragment (amsmath).")] = False,
+) -> None:
+    """Follow points through every stage of the viewing pipeline: each matrix (column and row form) and the
+    coordinates after it, from world to window."""
+    from frustum.trace import trace
+
+    if markdown and latex:
+        raise UsageError("--markdown and --latex were both given; choose one output format")
+    points = [_vector3(text, "--point") for text in point]
+    width, height = _image_size(size)
+    if ortho_height is None:
+        projection: Perspective | Orthographic = Perspective(math.radians(fovy_deg), near, far)
+    else:
+        projection = Orthographic(ortho_height, near, far)
+    camera = Camera.look_at(
+        _vector3(eye, "--eye"), _vector3(target, "--target"), _vector3(up, "--up"), projection, width, height
+    )
+    result = trace(points, camera, polyline=polyline)
+    if markdown or latex:
+        sys.stdout.write(result.to_markdown() if markdown else result.to_latex())
+    else:
+        console.print(result)
+
+
+# --- info -------------------------------------------------------------------------------------------------------
+
+
+def _load_mesh(path: Path, where: str) -> Mesh:
+    """A mesh file as one Mesh (``frustum.geometry.io.load``, else trimesh), errors as one-line GeometryErrors."""
+    if not path.is_file():
+        raise GeometryError(f"{where}: mesh = {str(path)!r} does not exist or is not a file; give a mesh file path")
+    try:
+        from frustum.geometry.io import load
+    except ImportError:  # pragma: no cover - the io module ships with frustum; trimesh directly otherwise
+        load = None
+    if load is not None:
+        return load(path)
+    import trimesh
+
+    try:
+        loaded = trimesh.load(path, force="mesh")
+    except Exception as error:  # trimesh raises many types for unreadable files
+        reason = (str(error).strip().splitlines() or [type(error).__name__])[0]
+        raise GeometryError(
+            f"{where}: mesh = {str(path)!r} cannot be read ({reason}); give a .ply, .obj, .stl, .off or .glb file"
+        ) from None
+    return Mesh(loaded.vertices, loaded.faces)
+
+
+def _mesh_facts(mesh: Mesh) -> list[tuple[str, str]]:
+    """(name, value) rows of ``frustum info``; topology through trimesh with coincident vertices merged."""
+    import trimesh
+
+    rows = [("vertices", f"{mesh.vertex_count}"), ("triangles", f"{mesh.face_count}")]
+    if mesh.vertex_count == 0:
+        return [*rows, ("bounds", "empty mesh")]
+    low, high = mesh.vertices.min(axis=0), mesh.vertices.max(axis=0)
+    rows += [
+        ("bounds min", _triple_text(low)),
+        ("bounds max", _triple_text(high)),
+        ("size", _triple_text(high - low)),
+        ("center", _triple_text((low + high) / 2)),
+    ]
+    if mesh.face_count == 0:
+        return [*rows, ("faces", "none (a point cloud)")]
+    solid = trimesh.Trimesh(mesh.vertices, mesh.faces, process=True)  # merges coincident vertices
+    watertight = bool(solid.is_watertight)
+    consistent = bool(solid.is_winding_consistent)
+    rows += [
+        ("watertight", "yes" if watertight else f"no ({_open_edges(solid)} boundary or non-manifold edges)"),
+        ("winding consistent", "yes" if consistent else "no"),
+        ("surface area", f"{float(solid.area):.6g}"),
+    ]
+    if watertight:
+        volume = float(solid.volume)
+        rows += [("volume", f"{volume:.6g}"), ("Euler characteristic", f"{int(solid.euler_number)}")]
+        if consistent:
+            rows.append(("face normals", "outward" if volume > 0 else "inward (faces are clockwise from outside)"))
+    cross = np.cross(
+        mesh.vertices[mesh.faces[:, 1]] - mesh.vertices[mesh.faces[:, 0]],
+        mesh.vertices[mesh.faces[:, 2]] - mesh.vertices[mesh.faces[:, 0]],
+    )
+    degenerate = int((np.linalg.norm(cross, axis=1) == 0).sum())
+    rows.append(("zero-area triangles", f"{degenerate}"))
+    computed = Mesh(mesh.vertices, mesh.faces).vertex_normals
+    given = not np.allclose(mesh.vertex_normals, computed, atol=1e-9)
+    rows.append(("vertex normals", "from the file" if given else "computed (area-weighted face normals)"))
+    unused = mesh.vertex_count - np.unique(mesh.faces).size
+    if unused:
+        rows.append(("unused vertices", f"{unused}"))
+    return rows
+
+
+def _open_edges(solid: Any) -> int:
+    edges = np.sort(solid.edges, axis=1)
+    _, counts = np.unique(edges, axis=0, return_counts=True)
+    return int((counts != 2).sum())
+
+
+def _triple_text(values: Sequence[float]) -> str:
+    return "(" + ", ".join(f"{float(v):.6g}" for v in values) + ")"
+
+
+@app.command("info")
+def info_command(mesh: Annotated[Path, typer.Argument(help="A mesh file (.ply, .obj, .stl, .off, .glb).")]) -> None:
+    """Print a mesh file's counts, bounds, watertightness and normals."""
+    loaded = _load_mesh(mesh, "info")
+    table = Table(title=str(mesh), show_header=False, title_justify="left")
+    table.add_column(style="bold")
+    table.add_column()
+    for name, value in _mesh_facts(loaded):
+        table.add_row(name, value)
+    console.print(table)
+
+
+# --- turntable --------------------------------------------------------------------------------------------------
+
+
+@app.command("turntable")
+def turntable_command(
+    mesh: Annotated[Path, typer.Argument(help="A mesh file (.ply, .obj, .stl, .off, .glb).")],
+    output: Annotated[Path, typer.Option("--output", "-o", help="The animation file, .gif or .mp4.")],
+    frames: Annotated[int, typer.Option(help="Frames in one full turn.")] = 120,
+    size: Annotated[str, typer.Option(help="Image size WIDTHxHEIGHT in pixels.")] = "480x480",
+    fps: Annotated[float, typer.Option(help="Frames per second.")] = 30.0,
+    axis: Annotated[str, typer.Option(help="Turntable axis through the mesh's center: x, y or z.")] = "y",
+    elevation_deg: Annotated[float, typer.Option(help="Camera height above the horizon in degrees.")] = 20.0,
+    mode: Annotated[str, typer.Option(help="surface, wireframe or points.")] = "surface",
+) -> None:
+    """Render a mesh from a camera orbiting it once and write the frames as a looping GIF or an MP4."""
+    from frustum.output.animation import framing_camera, turntable
+    from frustum.scene import Scene
+    from frustum.shading import DirectionalLight, Material
+
+    width, height = _image_size(size)
+    if not 0 <= abs(elevation_deg) < 90:
+        raise UsageError(f"--elevation-deg = {elevation_deg!r} is out of range; give an angle in (-90, 90)")
+    loaded = _load_mesh(mesh, "turntable")
+    scene = Scene(lights=[DirectionalLight(direction=(-0.4, -0.8, -0.5))])
+    scene.add(loaded, Material(color=(0.8, 0.8, 0.78)))
+    camera = framing_camera(scene, width, height, elevation=math.radians(elevation_deg))
+    count = turntable(
+        scene, camera, frames, axis, output, fps, progress=error_console, cull_back_faces=False, mode=mode
+    )
+    console.print(f"wrote {output} ({count} frames, {width}x{height})", markup=False, highlight=False, soft_wrap=True)
+
+
+# --- entry point ------------------------------------------------------------------------------------------------
+
+
+def _click_exception(name: str) -> type[Exception]:
+    """Click's exception class `name`, found through Typer's re-export (Typer may bundle its own copy of Click)."""
+    return next(c for c in typer.BadParameter.__mro__ if c.__name__ == name)
+
+
+_CLICK_USAGE_ERROR = _click_exception("UsageError")
+_CLICK_EXCEPTION = _click_exception("ClickException")
+
+
+def _fail(message: str, status: int) -> None:
+    error_console.print(f"error: {message}", markup=False)
+    raise SystemExit(status)
+
+
+def main(arguments: Sequence[str] | None = None) -> None:
+    """Entry point of the ``frustum`` console script: one-line errors, exit 1 (2 for usage), tracebacks on --debug."""
+    argv = list(sys.argv[1:] if arguments is None else arguments)
+    _STATE["debug"] = "--debug" in argv
+    try:
+        status = app(args=argv, prog_name="frustum", standalone_mode=False)
+    except _CLICK_USAGE_ERROR as error:
+        message = " ".join(error.format_message().split())
+        if not message:  # no command given: the help was printed instead
+            raise SystemExit(2) from None
+        _fail(message, 2)
+    except typer.Abort:
+        _fail("aborted", 1)
+    except _CLICK_EXCEPTION as error:
+        _fail(" ".join(error.format_message().split()), error.exit_code)
+    except UsageError as error:
+        if _STATE["debug"]:
+            raise
+        _fail(str(error), 2)
     except FrustumError as error:
-        error_console.print(f"error: {error}", markup=False)
-        raise SystemExit(1) from None
+        if _STATE["debug"]:
+            raise
+        _fail(str(error), 1)
+    except (OSError, ValueError, TypeError, RuntimeError, MemoryError) as error:
+        if _STATE["debug"]:
+            raise
+        text = " ".join(str(error).split()) or "no details"
+        _fail(f"{type(error).__name__}: {text}", 1)
+    if isinstance(status, int) and status:
+        raise SystemExit(status)

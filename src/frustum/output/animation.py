@@ -1,0 +1,361 @@
+"""Animations: a turntable around a scene, and any sequence of frames written as an animated GIF or an MP4.
+
+GIF frames go through Pillow with one adaptive palette per frame (median cut, at most 255 colors, no
+dithering), so the same frames give the same bytes; MP4 goes through imageio's ffmpeg plugin (install
+``imageio-ffmpeg``), H.264, yuv420p, an odd width or height padded by one repeated column or row.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Iterable, Iterator
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from frustum._arrays import as_direction, as_scalar, describe
+from frustum.camera import Camera, ViewFrame
+from frustum.errors import CameraError, OutputError
+from frustum.frame import Frame
+from frustum.projection import Perspective
+from frustum.render import render
+from frustum.scene import Node, Scene
+from frustum.transforms import apply, rotate
+
+__all__ = ["ANIMATION_FORMATS", "framing_camera", "orbit_cameras", "turntable", "write_animation"]
+
+ANIMATION_FORMATS = (".gif", ".mp4")
+"""File suffixes ``write_animation`` and ``turntable`` accept."""
+
+_AXES = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
+
+
+def _suffix(path: str | os.PathLike, where: str) -> str:
+    suffix = os.path.splitext(os.fspath(path))[1].lower()
+    if suffix not in ANIMATION_FORMATS:
+        raise OutputError(
+            f"{where}: path = {describe(os.fspath(path))} has suffix {suffix!r}; expected one of "
+            + ", ".join(repr(s) for s in ANIMATION_FORMATS)
+        )
+    return suffix
+
+
+def _rgb(frame: Frame | ArrayLike, index: int, where: str) -> NDArray[np.uint8]:
+    """(H, W, 3) uint8 of a Frame or an (H, W, 3|4) uint8 array (alpha dropped: animations are opaque)."""
+    array = frame.color if isinstance(frame, Frame) else np.asarray(frame)
+    if array.dtype != np.uint8 or array.ndim != 3 or array.shape[2] not in (3, 4) or 0 in array.shape:
+        raise OutputError(
+            f"{where}: frames[{index}] has dtype {array.dtype} and shape {array.shape}; expected a Frame or an "
+            "(H, W, 3) or (H, W, 4) uint8 image"
+        )
+    return np.ascontiguousarray(array[:, :, :3])
+
+
+def _fps(fps: Any, where: str) -> float:
+    value = as_scalar(fps, "fps", where=where, error=OutputError)
+    if not 0.0 < value <= 100.0:
+        raise OutputError(f"{where}: fps = {value!r} is out of range; give frames per second in (0, 100]")
+    return value
+
+
+def _gif_image(rgb: NDArray[np.uint8], marked: bool) -> Any:
+    """Palette image of `rgb`; palette entry k (one past the used ones) repeats pixel (0, 0)'s color.
+
+    A `marked` frame shows pixel (0, 0) through that duplicate entry: the same picture with different indices,
+    so Pillow does not merge it with an identical previous frame (it drops exact repeats, which would lose
+    frames of a symmetric turntable).
+    """
+    from PIL import Image
+
+    image = Image.fromarray(rgb, mode="RGB").quantize(colors=255, method=Image.Quantize.MEDIANCUT, dither=0)
+    palette = image.getpalette() or []
+    used = max(int(np.asarray(image).max()) + 1, 1)
+    corner = int(np.asarray(image)[0, 0])
+    palette = palette[: 3 * used] + palette[3 * corner : 3 * corner + 3]
+    image.putpalette(palette)
+    if marked:
+        image.putpixel((0, 0), used)
+    return image
+
+
+def _write_gif(frames: Iterator[NDArray[np.uint8]], path: str, fps: float, where: str) -> int:
+    images = []
+    previous: NDArray[np.uint8] | None = None
+    previous_marked = False
+    shape = None
+    for index, rgb in enumerate(frames):
+        if shape is None:
+            shape = rgb.shape
+        elif rgb.shape != shape:
+            raise OutputError(f"{where}: frames[{index}] has shape {rgb.shape}; expected {shape} like the first frame")
+        marked = previous is not None and not previous_marked and np.array_equal(rgb, previous)
+        images.append(_gif_image(rgb, marked))
+        previous, previous_marked = rgb, marked
+    if not images:
+        raise OutputError(f"{where}: frames is empty; an animation needs at least one frame")
+    duration = max(20, round(1000.0 / fps / 10) * 10)  # GIF stores centiseconds; browsers treat < 20 ms as slow
+    try:
+        images[0].save(
+            path, format="GIF", save_all=True, append_images=images[1:], duration=duration, loop=0, optimize=False
+        )
+    except OSError as error:
+        raise OutputError(
+            f"{where}: path = {describe(path)} cannot be written ({error.strerror or error}); give a path in an "
+            "existing, writable folder"
+        ) from None
+    return len(images)
+
+
+def _write_mp4(frames: Iterator[NDArray[np.uint8]], path: str, fps: float, where: str) -> int:
+    try:
+        import imageio_ffmpeg  # noqa: F401  (the plugin imageio needs for MP4)
+    except ImportError:
+        raise OutputError(
+            f"{where}: path = {describe(path)} asks for MP4, which needs the imageio-ffmpeg package; install it "
+            "(pip install imageio-ffmpeg) or write a '.gif'"
+        ) from None
+    import imageio.v2 as imageio
+
+    count = 0
+    try:
+        writer = imageio.get_writer(path, format="FFMPEG", mode="I", fps=fps, codec="libx264", macro_block_size=1)
+    except OSError as error:
+        raise OutputError(f"{where}: path = {describe(path)} cannot be written ({error})") from None
+    with writer:
+        for rgb in frames:
+            # yuv420p needs even sizes: repeat the last row / column rather than let imageio rescale
+            writer.append_data(np.pad(rgb, ((0, rgb.shape[0] % 2), (0, rgb.shape[1] % 2), (0, 0)), mode="edge"))
+            count += 1
+    if count == 0:
+        raise OutputError(f"{where}: frames is empty; an animation needs at least one frame")
+    return count
+
+
+def write_animation(frames: Iterable[Frame | ArrayLike], path: str | os.PathLike, fps: float = 30.0) -> int:
+    """Write `frames` (``Frame`` objects or (H, W, 3|4) uint8 images, all one size) as a GIF or MP4.
+
+    Each frame shows for 1/fps seconds (GIF: rounded to 10 ms, at least 20 ms; it loops forever). Alpha is
+    dropped. Frames are consumed one at a time (an MP4 never holds them all; a GIF keeps the 8-bit palette
+    images until it writes them).
+
+    Parameters
+    ----------
+    frames : iterable of Frame or (H, W, 3|4) uint8 arrays
+    path : str or PathLike
+        Ends in ``.gif`` or ``.mp4`` (MP4 needs ``imageio-ffmpeg``).
+    fps : float
+        Frames per second, in (0, 100].
+
+    Returns
+    -------
+    int
+        The number of frames written.
+
+    Raises
+    ------
+    OutputError
+        Unknown suffix, no frames, a frame of the wrong type or size, fps out of range, an unwritable path, or
+        MP4 without imageio-ffmpeg installed.
+    """
+    where = "write_animation"
+    suffix = _suffix(path, where)
+    rate = _fps(fps, where)
+    rgb_frames = (_rgb(frame, i, where) for i, frame in enumerate(frames))
+    writer = _write_gif if suffix == ".gif" else _write_mp4
+    return writer(rgb_frames, os.fspath(path), rate, where)
+
+
+def _axis(axis: Any, camera: Camera, where: str) -> NDArray[np.float64]:
+    if axis is None:
+        return as_direction(camera.frame.up, "up", where=where, error=CameraError)
+    if isinstance(axis, str):
+        if axis not in _AXES:
+            raise CameraError(
+                f"{where}: axis = {axis!r} is unknown; expected 'x', 'y', 'z', a direction (dx, dy, dz), or None "
+                "for the camera's up vector"
+            )
+        return np.array(_AXES[axis])
+    return as_direction(axis, "axis", where=where, error=CameraError)
+
+
+def orbit_cameras(camera: Camera, frames: int, axis: str | ArrayLike | None = None) -> list[Camera]:
+    """`frames` cameras spaced evenly around one turn of `camera` about the line through its target along `axis`.
+
+    Camera k has ``eye_k = target + R(axis, 2πk/frames)·(eye − target)`` and ``up_k = R·up`` (the rotation of
+    ``transforms.rotate``, counter-clockwise about `axis`), the same projection and image size; camera 0 is
+    `camera` itself and the last stops one step short of a full turn, so the animation loops seamlessly.
+
+    Parameters
+    ----------
+    camera : Camera
+        The start; built with a look-at point (``Camera.look_at`` or ``Camera.orbit``).
+    frames : int
+        Number of cameras, >= 1.
+    axis : "x", "y", "z", (3,) array_like or None
+        The turntable's axis; None (default) is the camera's view-up vector.
+
+    Raises
+    ------
+    CameraError
+        If `camera` is not a Camera or has no look-at point, frames < 1, or the axis is unknown or zero.
+    """
+    where = "orbit_cameras"
+    if not isinstance(camera, Camera):
+        raise CameraError(f"{where}: camera = {describe(camera)} is not a Camera; build one with Camera.look_at(...)")
+    if isinstance(frames, bool) or not isinstance(frames, int | np.integer) or frames < 1:
+        raise CameraError(f"{where}: frames = {describe(frames)} is not a positive integer; give at least 1 frame")
+    frame = camera.frame
+    if frame.target is None:
+        raise CameraError(
+            f"{where}: camera has no look-at point (its frame was built from a normal); build it with "
+            "Camera.look_at(eye, target, up) so the orbit has a center"
+        )
+    direction = _axis(axis, camera, where)
+    cameras = []
+    for turn in _turns(direction, frame.target, int(frames)):
+        eye = apply(turn, frame.eye[None, :])[0]
+        up = turn[:3, :3] @ frame.up
+        view = ViewFrame(eye, target=frame.target, up=up, handedness=frame.handedness)
+        cameras.append(Camera(view, camera.projection, camera.width, camera.height))
+    return cameras
+
+
+def _turns(direction: NDArray[np.float64], center: NDArray[np.float64], frames: int) -> list[NDArray[np.float64]]:
+    """R(axis, 2πk/frames) about the line through `center`, k = 0 … frames − 1."""
+    return [rotate(direction, 2.0 * math.pi * k / frames, center) for k in range(frames)]
+
+
+def _with_lights_turned(scene: Scene, turn: NDArray[np.float64]) -> Scene:
+    """`scene` with the lights attached to its root turned by `turn` (the nodes, meshes and other lights shared)."""
+    root = scene.root
+    turned_root = Node(
+        root.name, root.transform, root.geometry, root.material, root.children,
+        [light.transformed(turn) for light in root.lights],
+    )  # fmt: skip
+    turned = Scene()
+    turned.root = turned_root
+    return turned
+
+
+def framing_camera(scene: Scene, width: int = 480, height: int = 480, elevation: float = math.radians(20)) -> Camera:
+    """A perspective camera (fovy 40°) looking at the center of the scene's bounding box from the +z side, y up,
+    raised by `elevation`, far enough that the bounding sphere fits the image."""
+    where = "framing_camera"
+    corners = [apply(item.world_from_model, item.mesh.vertices) for item in scene.items if item.mesh.vertex_count]
+    if not corners:
+        raise CameraError(f"{where}: scene has no vertices; add a mesh before framing it")
+    points = np.concatenate(corners)
+    low, high = points.min(axis=0), points.max(axis=0)
+    center = (low + high) / 2
+    radius = max(float(np.linalg.norm(high - low)) / 2, 1e-9)
+    fovy = math.radians(40)
+    half_angle = min(fovy, 2 * math.atan(math.tan(fovy / 2) * width / height)) / 2
+    distance = 1.1 * radius / math.sin(half_angle)
+    projection = Perspective(fovy, max(distance - 1.5 * radius, distance * 1e-3), distance + 1.5 * radius)
+    return Camera.orbit(center, distance, 0.0, elevation, projection, width, height)
+
+
+def turntable(
+    scene: Scene,
+    camera: Camera | None = None,
+    frames: int = 120,
+    axis: str | ArrayLike | None = None,
+    path: str | os.PathLike | None = None,
+    fps: float = 30.0,
+    progress: Any = True,
+    *,
+    size: tuple[int, int] = (480, 480),
+    lights_follow: bool = True,
+    **render_options: Any,
+) -> list[Frame] | int:
+    """Render `scene` from `frames` cameras orbiting one full turn around the camera's target, as a loop.
+
+    ``eye_k = target + R(axis, 2πk/frames)·(eye − target)`` (``orbit_cameras``). With `path`, the frames are
+    written as they are rendered (``write_animation``) and the frame count is returned; without, the list of
+    ``Frame`` objects is returned.
+
+    Parameters
+    ----------
+    scene : Scene
+    camera : Camera, optional
+        The first camera. None frames the whole scene (``framing_camera``: perspective, 20° above the
+        horizon, from +z, y up) at `size`.
+    frames : int
+        Number of frames in the turn, >= 1.
+    axis : "x", "y", "z", (3,) array_like or None
+        The turntable's axis through the target; None (default) is the camera's view-up vector.
+    path : str or PathLike, optional
+        ``.gif`` or ``.mp4`` output file.
+    fps : float
+        Frames per second of the file.
+    progress : bool or rich.console.Console
+        True shows a Rich progress bar on standard error when it is a terminal (nothing otherwise, so logs and
+        pipes stay clean); a Console draws the bar there; False shows nothing.
+    size : (int, int)
+        Width and height in pixels when `camera` is None.
+    lights_follow : bool
+        True (default): the lights attached to the scene's root turn with the camera, so every side is lit the
+        same way, as on a real turntable (the object turns under fixed lights and a fixed camera). False: they
+        stay put in the world. Lights riding other nodes always stay with their nodes.
+    **render_options
+        Passed to ``render`` (``shading``, ``background``, ``cull_back_faces``, ``mode``).
+
+    Raises
+    ------
+    FrustumError
+        CameraError for a bad camera, frame count or axis; OutputError for a bad path or fps; whatever
+        ``render`` raises for bad options.
+    """
+    where = "turntable"
+    if not isinstance(scene, Scene):
+        raise OutputError(f"{where}: scene = {describe(scene)} is not a Scene; build one with Scene()")
+    if camera is None:
+        width, height = _size(size, where)
+        camera = framing_camera(scene, width, height)
+    cameras = orbit_cameras(camera, frames, axis)
+    if path is not None:
+        _suffix(path, where)
+        _fps(fps, where)
+    if lights_follow and cameras:
+        turns = _turns(_axis(axis, camera, where), camera.frame.target, len(cameras))
+        scenes = [_with_lights_turned(scene, turn) for turn in turns]
+    else:
+        scenes = [scene] * len(cameras)
+    jobs = zip(scenes, cameras, strict=True)
+    rendered = _with_progress((render(s, c, **render_options) for s, c in jobs), len(cameras), progress)
+    if path is None:
+        return list(rendered)
+    return write_animation(rendered, path, fps)
+
+
+def _size(size: Any, where: str) -> tuple[int, int]:
+    if (
+        not isinstance(size, tuple | list)
+        or len(size) != 2
+        or not all(isinstance(v, int | np.integer) and not isinstance(v, bool) and v > 0 for v in size)
+    ):
+        raise OutputError(f"{where}: size = {describe(size)} is not (width, height); give two positive integers")
+    return int(size[0]), int(size[1])
+
+
+def _with_progress(items: Iterator[Frame], total: int, progress: Any) -> Iterator[Frame]:
+    """Yield `items`, advancing a Rich progress bar on a terminal (or on the given Console)."""
+    from rich.console import Console
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+
+    if progress is False or progress is None:
+        yield from items
+        return
+    console = progress if isinstance(progress, Console) else Console(stderr=True)
+    if not console.is_terminal:
+        yield from items
+        return
+    columns = (TextColumn("turntable"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn())
+    bar = Progress(*columns, console=console, transient=False)
+    with bar:
+        task = bar.add_task("render", total=total)
+        for item in items:
+            yield item
+            bar.advance(task)
