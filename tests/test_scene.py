@@ -191,3 +191,26 @@ PROJECTIVE[3, 2] = -1.0
 def test_bad_scene_input_raises_named_errors(build, error, fragment):
     with pytest.raises(error, match=fragment):
         build()
+
+
+def test_polylines_from_curves_segments_and_control_polygons():
+    from frustum.geometry import BezierCurve, NURBSCurve
+
+    curve = BezierCurve([[0, 0], [1, 2], [3, -1], [4, 1]])  # 2D: z = 0 is added
+    line = Polyline.from_curve(curve, tolerance=1e-4)
+    assert line.points.shape[1] == 3 and (line.points[:, 2] == 0).all()
+    assert np.allclose(line.points[[0, -1], :2], [[0, 0], [4, 1]])
+    exact = curve.evaluate(np.linspace(0, 1, 50))
+    sampled = Polyline.from_curve(curve, samples=50)
+    assert np.allclose(sampled.points[:, :2], exact)
+    polygon = Polyline.control_polygon(curve)
+    assert polygon.segments.shape == (3, 2) and not polygon.markers
+    assert Polyline.control_polygon(curve, markers=True).markers
+    circle = Polyline.from_curve(NURBSCurve.circle(2.0, (0.0, 0.0)), tolerance=1e-6)
+    assert np.allclose(np.linalg.norm(circle.points[:, :2], axis=1), 2.0)
+    net = Polyline.from_segments([[[0, 0, 0], [1, 0, 0]], [[0, 1, 0], [1, 1, 0]]])
+    assert net.segments.tolist() == [[0, 1], [2, 3]]
+    with pytest.raises(GeometryError, match="pairs index"):
+        Polyline([[0, 0, 0], [1, 0, 0]], pairs=[[0, 2]])
+    with pytest.raises(GeometryError, match=r"segments has shape \(2, 3\)"):
+        Polyline.from_segments(np.zeros((2, 3)))

@@ -4,9 +4,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import cached_property
+from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from frustum._arrays import Points, as_points, read_only
 from frustum.errors import GeometryError
@@ -19,21 +20,61 @@ class Polyline:
     """Points ``P_0 … P_{N−1}`` (N, 3) joined by the segments ``P_i P_{i+1}`` (and ``P_{N−1} P_0`` when ``closed``).
 
     ``markers=True`` draws the points themselves (as squares of the line width plus two pixels) instead of the
-    segments, e.g. the control points of a curve. The renderer draws polylines as depth-tested lines in the
-    material's color in every mode. Raises ``GeometryError`` for non-finite points or wrong shapes.
+    segments, e.g. the control points of a curve. ``pairs`` (S, 2) indices replace the consecutive segments by
+    any set of segments (``from_segments``, e.g. a control net). The renderer draws polylines as depth-tested,
+    depth-cued lines in the material's color in every mode. Points may be 2D (z = 0 is added). Raises
+    ``GeometryError`` for non-finite points, wrong shapes or indices out of range.
     """
 
     points: Points
     closed: bool = False
     markers: bool = False
+    pairs: NDArray[np.int64] | None = None
 
     def __post_init__(self) -> None:
-        points = as_points(self.points, "points", where="Polyline")
+        raw = np.asarray(self.points, dtype=np.float64) if not isinstance(self.points, np.ndarray) else self.points
+        if raw.ndim == 2 and raw.shape[1] == 2:
+            raw = np.column_stack([raw, np.zeros(raw.shape[0])])
+        points = as_points(raw, "points", where="Polyline")
         if not isinstance(self.closed, bool) or not isinstance(self.markers, bool):
             raise GeometryError(
                 f"Polyline: closed = {self.closed!r}, markers = {self.markers!r}; both must be True or False"
             )
         object.__setattr__(self, "points", read_only(points))
+        if self.pairs is not None:
+            pairs = np.asarray(self.pairs)
+            if pairs.ndim != 2 or pairs.shape[1] != 2 or not np.issubdtype(pairs.dtype, np.integer):
+                raise GeometryError(f"Polyline: pairs has shape {pairs.shape}; expected (S, 2) integer indices")
+            if pairs.size and (pairs.min() < 0 or pairs.max() >= points.shape[0]):
+                raise GeometryError(
+                    f"Polyline: pairs index {int(pairs.max())} or {int(pairs.min())} is outside [0, {points.shape[0]})"
+                )
+            object.__setattr__(self, "pairs", read_only(np.ascontiguousarray(pairs, dtype=np.int64)))
+
+    @classmethod
+    def from_segments(cls, segments: ArrayLike) -> Polyline:
+        """Separate segments (S, 2, 3) (e.g. ``BezierPatchSet.control_net()``) as one drawable polyline."""
+        array = np.asarray(segments, dtype=np.float64)
+        if array.ndim != 3 or array.shape[1] != 2 or array.shape[2] not in (2, 3):
+            raise GeometryError(f"Polyline.from_segments: segments has shape {array.shape}; expected (S, 2, 3)")
+        return cls(array.reshape(-1, array.shape[2]), pairs=np.arange(2 * array.shape[0]).reshape(-1, 2))
+
+    @classmethod
+    def from_curve(cls, curve: Any, tolerance: float = 1e-3, samples: int | None = None) -> Polyline:
+        """A curve of ``frustum.geometry.curves`` as a polyline: adaptive ``curve.flatten(tolerance)`` (chord
+        within `tolerance` of the curve) or, with `samples`, that many parameter values evenly over its domain."""
+        if samples is None and hasattr(curve, "flatten"):
+            return cls(curve.flatten(tolerance))
+        if not hasattr(curve, "evaluate") or not hasattr(curve, "domain"):
+            raise GeometryError(f"Polyline.from_curve: curve = {curve!r} has no evaluate/domain; give a curve")
+        low, high = curve.domain
+        return cls(curve.evaluate(np.linspace(low, high, 200 if samples is None else int(samples))))
+
+    @classmethod
+    def control_polygon(cls, curve: Any, markers: bool = False) -> Polyline:
+        """The control polygon of a curve (its control points joined in order), or the points alone."""
+        points = np.asarray(curve.control_points, dtype=np.float64)
+        return cls(points.reshape(-1, points.shape[-1]), markers=markers)
 
     @property
     def vertex_count(self) -> int:
@@ -43,6 +84,8 @@ class Polyline:
     @cached_property
     def segments(self) -> NDArray[np.int64]:
         """(S, 2) index pairs of the drawn segments: N − 1 open, N closed (none for fewer than 2 points)."""
+        if self.pairs is not None:
+            return self.pairs
         n = self.vertex_count
         if n < 2:
             return read_only(np.empty((0, 2), dtype=np.int64))
