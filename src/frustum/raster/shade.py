@@ -28,7 +28,7 @@ import math
 
 import numpy as np
 
-from frustum.raster._jit import kernel, parallel_kernel, prange
+from frustum.raster._jit import inline_kernel, kernel, parallel_kernel, prange
 
 __all__ = [
     "SHADE_DEPTH",
@@ -57,19 +57,19 @@ I_WRITE_NORMALS, I_WRITE_IDS, I_BLEND = 9, 10, 11
 ITEM = 12
 
 
-@kernel
+@inline_kernel
 def _to_byte(value: float) -> np.uint8:
     """``floor(clamp(v, 0, 1)·255 + 0.5)``: round half up to 8 bits."""
     return np.uint8(math.floor(min(max(value, 0.0), 1.0) * 255.0 + 0.5))
 
 
-@kernel
+@inline_kernel
 def _interpolate(u0: float, u1: float, u2: float, va: float, vb: float, vc: float) -> float:
     """``(u0·va + u1·vb) + u2·vc`` (scalar arguments only: per-pixel helpers take no arrays, so they inline)."""
     return (u0 * va + u1 * vb) + u2 * vc
 
 
-@kernel
+@inline_kernel
 def _illuminate(
     params: np.ndarray, lights: np.ndarray, specular_model: int,
     px: float, py: float, pz: float, nx: float, ny: float, nz: float,
@@ -166,7 +166,7 @@ def light_faces(
             lit[f, k] = terms[k]
 
 
-@kernel
+@inline_kernel
 def _sample(texture: np.ndarray, u: float, v: float, channel: int) -> float:
     """Bilinear texture lookup with repeat wrapping; v = 0 is the image's bottom row (OpenGL, OBJ)."""
     height, width = texture.shape[0], texture.shape[1]
@@ -181,7 +181,7 @@ def _sample(texture: np.ndarray, u: float, v: float, channel: int) -> float:
     return top * (1.0 - fy) + bottom * fy
 
 
-@kernel
+@inline_kernel
 def shade_point(
     f: int, back: bool, u0: float, u1: float, u2: float,
     faces: np.ndarray, world: np.ndarray, normals: np.ndarray, lit: np.ndarray,
@@ -245,7 +245,7 @@ def shade_point(
     return r, g, b, alpha, nx, ny, nz
 
 
-@kernel
+@inline_kernel
 def _cue(params: np.ndarray, value: float, channel: int, d: float) -> float:
     """Depth cueing ``f·I + (1 − f)·cue`` with f clamped to [f_min, f_max] (identity when cueing is off)."""
     if params[P_CUE_ON] == 0.0:
