@@ -6,6 +6,11 @@ coordinates with the camera looking down −z, left-handed normalized device coo
 
 __version__ = "0.1.0"
 
+from frustum.bsp import (
+    BSPTree,
+    DepthOrder,
+    depth_sort,
+)
 from frustum.camera import (
     Camera,
     PrincipalVanishingPoints,
@@ -136,6 +141,14 @@ from frustum.output.animation import (
     turntable,
     write_animation,
 )
+from frustum.output.stereo import (
+    ANAGLYPH_METHODS,
+    STEREO_LAYOUTS,
+    anaglyph,
+    over_under,
+    render_stereo,
+    side_by_side,
+)
 from frustum.projection import (
     MULTIVIEWS,
     Axonometric,
@@ -193,6 +206,9 @@ from frustum.shading import (
     illuminate,
     pack_lights,
 )
+from frustum.stereo import (
+    StereoCamera,
+)
 from frustum.trace import (
     STAGE_NAMES,
     SegmentClipping,
@@ -231,6 +247,7 @@ from frustum.visibility import (
 )
 
 __all__ = [
+    "ANAGLYPH_METHODS",
     "CLASSIC_LSYSTEMS",
     "DEFAULT_MAX_BYTES",
     "IFS",
@@ -248,10 +265,12 @@ __all__ = [
     "SHADING_MODES",
     "SPECULAR_MODELS",
     "STAGE_NAMES",
+    "STEREO_LAYOUTS",
     "SUPPORTED_SUFFIXES",
     "VIEW_VOLUME_PLANES",
     "AmbientLight",
     "Axonometric",
+    "BSPTree",
     "BSpline",
     "BSplineSurface",
     "BezierCurve",
@@ -268,6 +287,7 @@ __all__ = [
     "Continuity",
     "CubicSpline",
     "DepthCue",
+    "DepthOrder",
     "DirectionalLight",
     "Frame",
     "Frustum",
@@ -303,6 +323,7 @@ __all__ = [
     "SpotLight",
     "Stage",
     "Step",
+    "StereoCamera",
     "Trace",
     "TracedPart",
     "TransformError",
@@ -310,6 +331,7 @@ __all__ = [
     "TurtlePath",
     "ViewFrame",
     "__version__",
+    "anaglyph",
     "apply",
     "apply_homogeneous",
     "apply_to_directions",
@@ -340,6 +362,7 @@ __all__ = [
     "cox_de_boor",
     "cutaway",
     "cylinder",
+    "depth_sort",
     "difference",
     "dimetric",
     "disk",
@@ -378,6 +401,7 @@ __all__ = [
     "oblique_normalized",
     "open_uniform_knots",
     "orthographic",
+    "over_under",
     "pack_lights",
     "parse_rules",
     "peano_curve",
@@ -391,6 +415,7 @@ __all__ = [
     "reflect",
     "region_code",
     "render",
+    "render_stereo",
     "rotate",
     "rotate_steps",
     "rotate_x",
@@ -398,6 +423,7 @@ __all__ = [
     "rotate_z",
     "scale",
     "shear",
+    "side_by_side",
     "sierpinski_ifs",
     "sierpinski_tetrahedron",
     "sierpinski_triangle",
