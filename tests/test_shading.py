@@ -423,3 +423,16 @@ def test_spot_renders_with_its_texture_black_and_white_patches():
     covered = frame.depth < 1.0
     gray = frame.color[..., :3][covered].astype(int).mean(axis=1)
     assert (gray < 80).mean() > 0.05 and (gray > 200).mean() > 0.3  # the dark patches of the cow on white
+
+
+def test_vertex_colors_interpolate_and_multiply_the_material_color():
+    v = [[-5.0, -5.0, 0.0], [5.0, -5.0, 0.0], [5.0, 5.0, 0.0], [-5.0, 5.0, 0.0]]
+    colors = np.array([[1.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, 1.0]])  # red bottom, blue top
+    mesh = Mesh(v, [[0, 1, 2], [0, 2, 3]], vertex_colors=colors)
+    frame = render(placed(Scene(), mesh, Material(color=(1.0, 1.0, 0.5))), ortho_camera(), shading="none")
+    assert (centre(frame) == to_bytes([0.5, 0.0, 0.25])).all()  # halfway up: (0.5, 0, 0.5) × (1, 1, 0.5)
+    camera = ortho_camera()
+    points = world_points(frame, camera)
+    up = (points[..., 1] + 5.0) / 10.0  # fraction of the way from the red to the blue edge
+    red = frame.color[..., 0].astype(int)
+    assert np.abs(red - to_bytes(1.0 - up)).max() <= 1
