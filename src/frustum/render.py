@@ -45,11 +45,12 @@ from frustum.camera import Camera
 from frustum.clipping import VIEW_VOLUME_PLANES
 from frustum.errors import FrustumError
 from frustum.frame import Frame
+from frustum.hidden_lines import feature_edges
 from frustum.raster import lines, shade, tiles, triangles
 from frustum.raster.vertices import transform_vertices
 from frustum.scene import Scene, SceneItem
 from frustum.shading import SPECULAR_MODELS, DepthCue, pack_lights
-from frustum.visibility import backface_mask, feature_edges
+from frustum.visibility import backface_mask
 
 __all__ = ["HIDDEN_STYLES", "RENDER_MODES", "SHADING_MODES", "TILE_SIZE", "mesh_edges", "render"]
 
@@ -144,7 +145,7 @@ def render(
         ``"surface+edges"``: shaded surfaces with their visible edges on top. With `cull_back_faces`, edges of back
         faces only (``visibility.backface_mask``) count as hidden whatever the depth buffer says.
     edges : {"all", "feature"} or None
-        Which edges the line modes draw: every edge, or ``visibility.feature_edges`` (boundaries, creases
+        Which edges the line modes draw: every edge, or ``hidden_lines.feature_edges`` (boundaries, creases
         sharper than `crease_angle`, silhouettes). None: "all" for wireframe, "feature" for the others.
     edge_color : (3,) or (4,) array_like or None
         Line color in [0, 1]; None: the material color (wireframe, points), or for the edge modes black on a
@@ -494,7 +495,8 @@ def _draw_edges(items: list[SceneItem], camera: Camera, options: _Options, depth
         if options.edges == "all":
             edges = mesh_edges(mesh.faces)
         else:
-            edges = feature_edges(world, mesh.faces, camera, options.crease_angle)
+            edges, _, kinds = feature_edges(world, mesh.faces, camera, options.crease_angle)
+            edges = np.ascontiguousarray(edges[kinds != 0])
         if edge_modes and options.cull:  # edges of back faces only are hidden, whatever the depth buffer says
             front = mesh_edges(mesh.faces[~backface_mask(world, mesh.faces, camera)])
             size = max(mesh.vertex_count, 1)

@@ -15,9 +15,6 @@ Two ways to find the back faces of a polyhedron, as the seed gives them:
 For faces in front of the eye both agree (the renderer uses the window test, on its snapped coordinates,
 after clipping); the plane test needs no projection and also works for faces behind the eye.
 
-``feature_edges`` picks the edges of a clean line drawing (boundaries, creases, silhouettes) for the
-renderer's ``"hidden-line"`` and ``"surface+edges"`` modes.
-
 References
 ----------
 [HB 16] "Back-Face Detection"; [seed] "Back-face detection".
@@ -25,17 +22,16 @@ References
 
 from __future__ import annotations
 
-import math
 from typing import Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from frustum._arrays import as_faces, as_points, as_scalar, describe
+from frustum._arrays import as_faces, as_points, describe
 from frustum.camera import Camera
 from frustum.errors import FrustumError, GeometryError
 
-__all__ = ["backface_mask", "feature_edges", "plane_equations", "signed_window_areas", "viewing_position"]
+__all__ = ["backface_mask", "plane_equations", "signed_window_areas", "viewing_position"]
 
 
 def plane_equations(vertices: ArrayLike, faces: ArrayLike) -> NDArray[np.float64]:
@@ -108,46 +104,3 @@ def backface_mask(
         return np.where(behind, by_plane, areas <= 0.0)
     raise FrustumError(f"{where}: method = {describe(method)} is unknown; expected 'plane' or 'window'")
 
-
-def feature_edges(
-    vertices: ArrayLike, faces: ArrayLike, camera: Camera | None = None, crease_angle: float = math.radians(30.0)
-) -> NDArray[np.int64]:
-    """(E, 2) the edges a clean line drawing shows, as sorted ``(low, high)`` vertex pairs, each once.
-
-    An edge is drawn when it is a *boundary* (one face), *non-manifold* (more than two faces), a *crease*
-    (the angle between its two faces' normals exceeds `crease_angle`, radians), or, given a `camera`, a
-    *silhouette*: one face front-facing and the other back-facing by the plane test
-    ``A·x + B·y + C·z + D·w > 0`` at the viewing position (``backface_mask``). Vertices are world coordinates.
-    Zero-area faces have no normal and make no creases or silhouettes.
-    """
-    points = as_points(vertices, "vertices", where="feature_edges")
-    triangles = as_faces(faces, points.shape[0], where="feature_edges")
-    angle = as_scalar(crease_angle, "crease_angle", where="feature_edges", error=GeometryError)
-    if not 0.0 <= angle <= math.pi:
-        raise GeometryError(f"feature_edges: crease_angle = {angle!r} is outside [0, pi] radians")
-    face_count = triangles.shape[0]
-    pairs = np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]])
-    pairs.sort(axis=1)
-    owners = np.tile(np.arange(face_count), 3)
-    order = np.lexsort((pairs[:, 1], pairs[:, 0]))
-    pairs, owners = pairs[order], owners[order]
-    new = np.ones(len(pairs), dtype=bool)
-    new[1:] = (pairs[1:] != pairs[:-1]).any(axis=1)
-    starts = np.flatnonzero(new)
-    counts = np.diff(np.append(starts, len(pairs)))
-    keep = counts != 2
-    two = np.flatnonzero(counts == 2)
-    if two.size:
-        planes = plane_equations(points, triangles)
-        normals = planes[:, :3]
-        lengths = np.linalg.norm(normals, axis=1)
-        f0, f1 = owners[starts[two]], owners[starts[two] + 1]
-        valid = (lengths[f0] > 0) & (lengths[f1] > 0)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            cosine = (normals[f0] * normals[f1]).sum(axis=1) / (lengths[f0] * lengths[f1])
-        crease = valid & (cosine < math.cos(angle))
-        if camera is not None:
-            front = planes @ viewing_position(camera) > 0.0
-            crease |= valid & (front[f0] != front[f1])
-        keep[two] = crease
-    return np.ascontiguousarray(pairs[starts[keep]], dtype=np.int64).reshape(-1, 2)
