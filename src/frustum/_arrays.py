@@ -18,6 +18,7 @@ __all__ = [
     "Matrix4",
     "Points",
     "Vector3",
+    "as_count",
     "as_direction",
     "as_faces",
     "as_homogeneous_points",
@@ -79,13 +80,20 @@ def as_scalar(value: Any, name: str, *, where: str, error: ErrorType = Transform
     return number
 
 
+def as_count(value: Any, name: str, minimum: int, *, where: str, error: ErrorType = GeometryError) -> int:
+    """An integer >= `minimum` (a resolution, a level, a degree); bools and floats are refused."""
+    if isinstance(value, bool) or not isinstance(value, int | np.integer):
+        raise error(f"{where}: {name} = {describe(value)} is not an integer; give an integer >= {minimum}")
+    if value < minimum:
+        raise error(f"{where}: {name} = {int(value)} is below {minimum}; give an integer >= {minimum}")
+    return int(value)
+
+
 def as_vector3(value: ArrayLike, name: str, *, where: str, error: ErrorType = TransformError) -> Vector3:
     """Return `value` as a finite (3,) float64 vector, or raise `error` naming it."""
     vector = _as_float_array(value, name, where, error, "three finite numbers (x, y, z)")
     if vector.shape != (3,):
-        raise error(
-            f"{where}: {name} = {describe(value)} has shape {vector.shape}; expected three numbers (x, y, z)"
-        )
+        raise error(f"{where}: {name} = {describe(value)} has shape {vector.shape}; expected three numbers (x, y, z)")
     if not np.isfinite(vector).all():
         raise error(f"{where}: {name} = {describe(vector)} is not finite; coordinates must be finite numbers")
     return vector
@@ -125,9 +133,7 @@ def _as_rows(value: ArrayLike, width: int, name: str, where: str, error: ErrorTy
     bad = np.flatnonzero(~np.isfinite(rows).all(axis=1))
     if bad.size:
         i = int(bad[0])
-        raise error(
-            f"{where}: {name}[{i}] = {describe(rows[i])} is not finite; coordinates must be finite numbers"
-        )
+        raise error(f"{where}: {name}[{i}] = {describe(rows[i])} is not finite; coordinates must be finite numbers")
     return rows
 
 

@@ -22,7 +22,7 @@ from typing import Any, NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from frustum._arrays import as_scalar, describe, read_only
+from frustum._arrays import as_count, as_scalar, describe, read_only
 from frustum.errors import GeometryError
 
 __all__ = [
@@ -135,14 +135,6 @@ def _as_degree(value: Any, *, where: str, name: str = "degree") -> int:
     return int(value)
 
 
-def _as_count(value: Any, name: str, minimum: int, *, where: str) -> int:
-    if isinstance(value, bool) or not isinstance(value, int | np.integer):
-        raise GeometryError(f"{where}: {name} = {describe(value)} is not an integer; give an integer >= {minimum}")
-    if value < minimum:
-        raise GeometryError(f"{where}: {name} = {int(value)} is below {minimum}; give an integer >= {minimum}")
-    return int(value)
-
-
 def _shape_result(values: FloatArray, scalar: bool) -> FloatArray:
     return values[0] if scalar else values
 
@@ -169,7 +161,7 @@ def bernstein(n: int, i: int, t: ArrayLike) -> FloatArray | float:
     [seed] "Bezier Curves & surfaces"; [HB 14] "Bézier Curve Equations".
     """
     where = "bernstein"
-    n = _as_count(n, "n", 0, where=where)
+    n = as_count(n, "n", 0, where=where)
     if isinstance(i, bool) or not isinstance(i, int | np.integer) or not 0 <= i <= n:
         raise GeometryError(f"{where}: i = {describe(i)} is not an integer in [0, {n}]; give 0 <= i <= n")
     s, scalar = _as_parameters(t, "t", 0.0, 1.0, where=where)
@@ -446,7 +438,7 @@ class BezierCurve:
             Curve points in order of t, including both ends.
         """
         where = "BezierCurve.flatten"
-        depth = _as_count(max_depth, "max_depth", 0, where=where)
+        depth = as_count(max_depth, "max_depth", 0, where=where)
         t = _flatten_pieces(self.control_points, tolerance, pixel_size, project, depth, where)
         return _de_casteljau(self.control_points, t)
 
@@ -967,7 +959,7 @@ class CubicSpline:
     def evaluate(self, s: ArrayLike, derivative: int = 0) -> FloatArray:
         """The spline (or its m-th derivative with respect to s, m <= 3) at global parameters s."""
         where = "CubicSpline.evaluate"
-        order = _as_count(derivative, "derivative", 0, where=where)
+        order = as_count(derivative, "derivative", 0, where=where)
         values, scalar = _as_parameters(s, "s", *self.domain, where=where)
         k = np.clip(np.searchsorted(self.knots, values, side="right") - 1, 0, self.coefficients.shape[0] - 1)
         h = self.knots[k + 1] - self.knots[k]
@@ -1050,7 +1042,7 @@ def open_uniform_knots(count: int, degree: int) -> FloatArray:
     """
     where = "open_uniform_knots"
     p = _as_degree(degree, where=where)
-    count = _as_count(count, "count", p + 1, where=where)
+    count = as_count(count, "count", p + 1, where=where)
     n, k = count - 1, p + 1
     i = np.arange(n + k + 1)
     return np.where(i < k, 0.0, np.where(i <= n, i - k + 1.0, n - k + 2.0))
@@ -1297,7 +1289,7 @@ class BSpline:
 
     def derivative(self, order: int = 1) -> BSpline:
         """The derivative curve: degree p − 1, ``Q_i = p·(P_{i+1} − P_i)/(t_{i+p+1} − t_{i+1})`` (0/0 = 0)."""
-        order = _as_count(order, "order", 0, where="BSpline.derivative")
+        order = as_count(order, "order", 0, where="BSpline.derivative")
         curve = self
         for _ in range(order):
             curve = curve._first_derivative()
@@ -1319,7 +1311,7 @@ class BSpline:
         """
         where = "BSpline.insert_knot"
         value = as_scalar(u, "u", where=where, error=GeometryError)
-        times = _as_count(times, "times", 1, where=where)
+        times = as_count(times, "times", 1, where=where)
         low, high = self.domain
         if not low <= value <= high:
             raise GeometryError(
@@ -1474,7 +1466,7 @@ class NURBSCurve:
         convex hull holds a rational piece with positive weights, so ``tolerance`` bounds the distance.
         """
         where = "NURBSCurve.flatten"
-        depth = _as_count(max_depth, "max_depth", 0, where=where)
+        depth = as_count(max_depth, "max_depth", 0, where=where)
         pieces, _ = self._homogeneous._bezier_segments()
         parts = []
         for k, piece in enumerate(pieces):

@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from frustum._arrays import as_scalar, as_vector3, describe
+from frustum._arrays import as_count, as_scalar, as_vector3, describe
 from frustum.errors import GeometryError
 from frustum.geometry.mesh import Mesh, _grid_faces
 from frustum.transforms import rotate, translate
@@ -103,8 +103,8 @@ def uv_sphere(radius: float = 1.0, segments: int = 32, rings: int = 16) -> Mesh:
     """
     where = "uv_sphere"
     r = _positive(radius, "radius", where)
-    n_seg = _count(segments, "segments", 3, where)
-    n_ring = _count(rings, "rings", 2, where)
+    n_seg = as_count(segments, "segments", 3, where=where)
+    n_ring = as_count(rings, "rings", 2, where=where)
     latitude = np.pi / 2 - np.pi * np.arange(n_ring + 1) / n_ring  # north (i = 0) to south
     cos_lat, sin_lat = np.cos(latitude), np.sin(latitude)
     cos_lat[[0, -1]], sin_lat[[0, -1]] = 0.0, (1.0, -1.0)
@@ -122,7 +122,7 @@ def icosphere(radius: float = 1.0, subdivisions: int = 2) -> Mesh:
     """
     where = "icosphere"
     r = _positive(radius, "radius", where)
-    k = _count(subdivisions, "subdivisions", 0, where)
+    k = as_count(subdivisions, "subdivisions", 0, where=where)
     if k > 8:
         raise GeometryError(f"{where}: subdivisions = {k} is above 8 (20·4^k triangles); give 0 … 8")
     t = (1.0 + 5.0**0.5) / 2.0
@@ -155,7 +155,7 @@ def cylinder(radius: float = 1.0, height: float = 1.0, segments: int = 32, caps:
     where = "cylinder"
     r = _positive(radius, "radius", where)
     half = 0.5 * _positive(height, "height", where)
-    n_seg = _count(segments, "segments", 3, where)
+    n_seg = as_count(segments, "segments", 3, where=where)
     side = _revolve(np.array([[r, half], [r, -half]]), np.array([[1.0, 0.0], [1.0, 0.0]]), np.array([1.0, 0.0]), n_seg)
     if not _flag(caps, "caps", where):
         return side
@@ -171,7 +171,7 @@ def cone(radius: float = 1.0, height: float = 1.0, segments: int = 32, cap: bool
     where = "cone"
     r = _positive(radius, "radius", where)
     h = _positive(height, "height", where)
-    n_seg = _count(segments, "segments", 3, where)
+    n_seg = as_count(segments, "segments", 3, where=where)
     slope = np.array([h, r]) / np.hypot(h, r)
     side = _revolve(np.array([[0.0, h / 2], [r, -h / 2]]), np.array([slope, slope]), np.array([1.0, 0.0]), n_seg)
     return side.merged(_cap(r, -h / 2, n_seg, up=False)) if _flag(cap, "cap", where) else side
@@ -192,8 +192,8 @@ def torus(
         raise GeometryError(
             f"{where}: minor_radius = {small!r} is not below major_radius = {big!r}; a ring torus needs r < R"
         )
-    n_major = _count(major_segments, "major_segments", 3, where)
-    n_minor = _count(minor_segments, "minor_segments", 3, where)
+    n_major = as_count(major_segments, "major_segments", 3, where=where)
+    n_minor = as_count(minor_segments, "minor_segments", 3, where=where)
     phi = 2 * np.pi * np.arange(n_minor) / n_minor
     cos_phi, sin_phi = np.append(np.cos(phi), 1.0), np.append(np.sin(phi), 0.0)
     # the profile circle runs downward on its outer side, so ∂P/∂i × ∂P/∂θ points out of the tube
@@ -205,7 +205,7 @@ def torus(
 def disk(radius: float = 1.0, segments: int = 32) -> Mesh:
     """A flat disk of `radius` in z = 0 facing +z: `segments` >= 3 triangles around the centre; planar UVs."""
     where = "disk"
-    return _cap(_positive(radius, "radius", where), 0.0, _count(segments, "segments", 3, where), up=True)
+    return _cap(_positive(radius, "radius", where), 0.0, as_count(segments, "segments", 3, where=where), up=True)
 
 
 def arrow(
@@ -227,7 +227,7 @@ def arrow(
     r_shaft = _positive(shaft_radius, "shaft_radius", where)
     r_head = _positive(head_radius, "head_radius", where)
     h_head = _positive(head_length, "head_length", where)
-    n_seg = _count(segments, "segments", 3, where)
+    n_seg = as_count(segments, "segments", 3, where=where)
     if h_head >= total:
         raise GeometryError(f"{where}: head_length = {h_head!r} is not below length = {total!r}; make the head shorter")
     if r_shaft >= r_head:
@@ -364,14 +364,6 @@ def _positive_vector(value: ArrayLike, name: str, where: str) -> NDArray:
     return vector
 
 
-def _count(value: Any, name: str, minimum: int, where: str) -> int:
-    if isinstance(value, bool) or not isinstance(value, int | np.integer):
-        raise GeometryError(f"{where}: {name} = {describe(value)} is not an integer; give an integer >= {minimum}")
-    if value < minimum:
-        raise GeometryError(f"{where}: {name} = {int(value)} is below {minimum}; give an integer >= {minimum}")
-    return int(value)
-
-
 def _flag(value: Any, name: str, where: str) -> bool:
     if not isinstance(value, bool | np.bool_):
         raise GeometryError(f"{where}: {name} = {describe(value)} is not a boolean; give True or False")
@@ -386,4 +378,4 @@ def _pair(value: Any, name: str, where: str, as_float: bool) -> tuple[Any, Any]:
         raise GeometryError(f"{where}: {name} = {describe(value)} is not one or two values; give (x, y)")
     if as_float:
         return tuple(as_scalar(item, f"{name}[{i}]", where=where, error=GeometryError) for i, item in enumerate(items))
-    return tuple(_count(item, f"{name}[{i}]", 1, where) for i, item in enumerate(items))
+    return tuple(as_count(item, f"{name}[{i}]", 1, where=where) for i, item in enumerate(items))

@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from frustum._arrays import Points, as_points, as_scalar, as_vector3, describe
+from frustum._arrays import Points, as_count, as_points, as_scalar, as_vector3, describe
 from frustum.errors import GeometryError
 from frustum.geometry.mesh import Mesh, _area_weighted_normals, _grid_faces
 
@@ -148,7 +148,7 @@ def superellipse(radii: ArrayLike = (1.0, 1.0), s: float = 1.0, segments: int = 
     where = "superellipse"
     r = _radii2(radii, where)
     e = _exponent(s, "s", where)
-    n = _count(segments, "segments", 3, where)
+    n = as_count(segments, "segments", 3, where=where)
     theta = 2 * np.pi * np.arange(n) / n
     return np.stack([r[0] * signed_power(np.cos(theta), e), r[1] * signed_power(np.sin(theta), e)], axis=1)
 
@@ -203,8 +203,8 @@ def supertoroid(
     where = "supertoroid"
     big, small = _torus_radii(major_radius, minor_radius, where)
     e1, e2 = _exponent(s1, "s1", where), _exponent(s2, "s2", where)
-    n_major = _count(major_segments, "major_segments", 3, where)
-    n_minor = _count(minor_segments, "minor_segments", 3, where)
+    n_major = as_count(major_segments, "major_segments", 3, where=where)
+    n_minor = as_count(minor_segments, "minor_segments", 3, where=where)
     eta = -2 * np.pi * np.arange(n_minor) / n_minor  # decreasing: the outer side runs downward (outward front)
     cos_eta, sin_eta = np.append(np.cos(eta), 1.0), np.append(np.sin(eta), 0.0)
     cos_om, sin_om = _circle(n_major)
@@ -227,8 +227,8 @@ def supertoroid(
 
 
 def _superquadric_mesh(radii: Any, e1: float, e2: float, segments: Any, rings: Any, where: str) -> Mesh:
-    n_seg = _count(segments, "segments", 3, where)
-    n_ring = _count(rings, "rings", 2, where)
+    n_seg = as_count(segments, "segments", 3, where=where)
+    n_ring = as_count(rings, "rings", 2, where=where)
     r = np.asarray(radii, dtype=np.float64)
     eta = np.pi / 2 - np.pi * np.arange(n_ring + 1) / n_ring  # north (row 0) to south
     cos_eta, sin_eta = np.cos(eta), np.sin(eta)
@@ -341,11 +341,3 @@ def _points2(value: ArrayLike, where: str) -> Points:
         i = int(bad[0])
         raise GeometryError(f"{where}: points[{i}] = {describe(p[i])} is not finite; coordinates must be finite")
     return p
-
-
-def _count(value: Any, name: str, minimum: int, where: str) -> int:
-    if isinstance(value, bool) or not isinstance(value, int | np.integer):
-        raise GeometryError(f"{where}: {name} = {describe(value)} is not an integer; give an integer >= {minimum}")
-    if value < minimum:
-        raise GeometryError(f"{where}: {name} = {int(value)} is below {minimum}; give an integer >= {minimum}")
-    return int(value)

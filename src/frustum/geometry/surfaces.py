@@ -22,12 +22,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from frustum._arrays import as_scalar, describe, read_only
+from frustum._arrays import as_count, as_scalar, describe, read_only
 from frustum.errors import GeometryError
 from frustum.geometry.curves import (
     BezierCurve,
     NURBSCurve,
-    _as_count,
     _as_degree,
     _as_parameters,
     _as_weights,
@@ -131,7 +130,7 @@ class _Surface:
     def partial(self, u: ArrayLike, v: ArrayLike, du: int = 1, dv: int = 0) -> FloatArray:
         """The partial derivative ``∂^(du+dv) S / ∂u^du ∂v^dv`` (du, dv in {0, 1}): (N, 3) or (3,)."""
         where = f"{type(self).__name__}.partial"
-        du, dv = _as_count(du, "du", 0, where=where), _as_count(dv, "dv", 0, where=where)
+        du, dv = as_count(du, "du", 0, where=where), as_count(dv, "dv", 0, where=where)
         if du > 1 or dv > 1:
             raise GeometryError(f"{where}: (du, dv) = ({du}, {dv}) is not supported; give du, dv in {{0, 1}}")
         su, sv, scalar = self._params(u, v, where)
@@ -175,7 +174,7 @@ class _Surface:
         from the normal side; triangles with two coincident corners (at collapsed edges) are dropped.
         """
         where = f"{type(self).__name__}.tessellate"
-        nu, nv = _as_count(nu, "nu", 1, where=where), _as_count(nv, "nv", 1, where=where)
+        nu, nv = as_count(nu, "nu", 1, where=where), as_count(nv, "nv", 1, where=where)
         u = np.linspace(*self.domain_u, nu + 1)
         v = np.linspace(*self.domain_v, nv + 1)
         uu, vv = (a.ravel() for a in np.meshgrid(u, v, indexing="ij"))

@@ -22,9 +22,8 @@ from importlib import resources
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from frustum._arrays import describe, read_only
+from frustum._arrays import as_count, describe, read_only
 from frustum.errors import GeometryError
-from frustum.geometry.curves import _as_count
 from frustum.geometry.mesh import Mesh
 from frustum.geometry.surfaces import BezierSurface
 
@@ -86,7 +85,7 @@ class BezierPatchSet:
         normals (limits at the lid's and bottom's collapsed edges); triangles with coincident corners are
         dropped, as three.js does.
         """
-        n = _as_count(resolution, "resolution", 1, where="BezierPatchSet.tessellate")
+        n = as_count(resolution, "resolution", 1, where="BezierPatchSet.tessellate")
         return _concatenate([patch.tessellate(n, n) for patch in self.patches])
 
     def tessellate_adaptive(self, tolerance: float) -> Mesh:
