@@ -223,3 +223,33 @@ def test_turntable_bad_suffix_is_one_line(tmp_path, capsys):
     err = capsys.readouterr().err
     assert exit_info.value.code == 1 and err.count("\n") == 1
     assert "turntable: path = " in err and "has suffix '.avi'" in err
+
+
+# --- scene-file commands --------------------------------------------------------------------------------------
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+
+
+def test_render_explain_and_view_commands(tmp_path, capsys):
+    out = tmp_path / "teapot.png"
+    main(["render", str(EXAMPLES / "teapot.toml"), "-o", str(out), "--size", "64x48"])
+    assert f"wrote {out}" in capsys.readouterr().out
+    assert iio.imread(out).shape[:2] == (48, 64)
+    main(["explain", str(EXAMPLES / "transformations.toml"), "--point", "0,0,0", "--markdown"])
+    assert "viewport" in capsys.readouterr().out.lower()
+    sheet = tmp_path / "sheet.svg"
+    main(["view", str(EXAMPLES / "exploded_assembly.toml"), "-o", str(sheet), "--views", "front,top"])
+    assert sheet.read_text().lstrip().startswith("<")
+
+
+def test_scene_file_errors_are_one_line_without_traceback(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[camera]\neye = [0, 0, 5]\nlens = 3\n")
+    result = run("render", str(bad))
+    assert result.returncode == 1, result.stderr
+    assert "Traceback" not in result.stderr and result.stderr.count("\n") == 1  # one problem, one line
+    assert "bad.toml:3: camera.lens = 3 is not a known key" in result.stderr
+    bad.write_text("[camera]\nlens = 3\n[render]\nsize = [-4, 3]\n")
+    result = run("render", str(bad))  # every problem at once, one line each
+    assert result.returncode == 1 and "Traceback" not in result.stderr
+    assert "bad.toml:1:" in result.stderr and "bad.toml:2:" in result.stderr and "bad.toml:4:" in result.stderr

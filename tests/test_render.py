@@ -290,3 +290,18 @@ def test_bad_render_arguments_raise():
         DirectionalLight(direction=(0, 0, 0))
     with pytest.raises(FrustumError, match="not a Scene"):
         render([], camera)
+
+
+@pytest.mark.parametrize("shading", ["phong", "flat", "gouraud"])
+def test_a_reflected_mesh_keeps_its_front_faces_outward(shading):
+    """det(M) < 0 turns the winding around; the renderer swaps it back, so a mirrored box is lit, not culled."""
+    from frustum import box, reflect
+
+    camera = Camera.look_at((1.5, 2.0, 5.0), (0, 0, 0), (0, 1, 0), width=64, height=48)
+    plain, mirrored = Scene(lights=[LIGHT]), Scene(lights=[LIGHT])
+    plain.add(box())
+    mirrored.add(box(), transform=reflect("xy"))  # the box is symmetric about z = 0: the same picture
+    a, b = render(plain, camera, shading=shading), render(mirrored, camera, shading=shading)
+    assert ((a.depth < 1) == (b.depth < 1)).all()  # the mirrored triangulation differs: depths to round-off
+    assert np.abs(a.depth - b.depth).max() < 1e-5
+    assert (np.abs(a.color.astype(int) - b.color.astype(int)).max(axis=2) <= 1).mean() > 0.999

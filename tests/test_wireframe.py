@@ -308,7 +308,8 @@ def test_lines_and_points_are_deterministic(mode):
 
 def test_lines_ignore_lights_and_culling():
     scene, camera = scenes()["cube"], perspective_camera()
-    lit = placed(Scene(lights=[DirectionalLight(direction=(0, -1, 0))]), cube(), material=Material(color=(0.9, 0.6, 0.2)))
+    lights = [DirectionalLight(direction=(0, -1, 0))]
+    lit = placed(Scene(lights=lights), cube(), material=Material(color=(0.9, 0.6, 0.2)))
     a = render(scene, camera, mode="wireframe")
     b = render(lit, camera, mode="wireframe", shading="phong", cull_back_faces=True)
     c = render(lit, camera, mode="wireframe", shading=None, cull_back_faces=False)

@@ -1,10 +1,12 @@
 """The ``frustum`` command (Typer + Rich).
 
-Commands: ``compose`` (transformation steps and their composite), ``trace`` (one camera, points through every
-stage of the pipeline), ``info`` (a mesh file's counts, bounds, watertightness and normals) and ``turntable``
-(a GIF or MP4 orbiting a mesh). Errors print as one line, ``error: <message>``, without a traceback (the global
-``--debug`` option shows it): exit status 1 for a bad value or an unreadable file, 2 for a command line that
-cannot be parsed (unknown option, missing argument, malformed numbers).
+Commands: ``render`` (a TOML scene file to PNG, SVG, PDF, GIF or MP4), ``explain`` (a scene file's camera and
+points through every stage, with every matrix), ``view`` (a scene as an engineering sheet of views),
+``examples`` (the gallery), ``compose`` (transformation steps and their composite), ``trace`` (one camera,
+points through every stage of the pipeline), ``info`` (a mesh file's counts, bounds, watertightness and
+normals) and ``turntable`` (a GIF or MP4 orbiting a mesh). Errors print as one line, ``error: <message>``,
+without a traceback (the global ``--debug`` option shows it): exit status 1 for a bad value or an unreadable
+file, 2 for a command line that cannot be parsed (unknown option, missing argument, malformed numbers).
 """
 
 from __future__ import annotations
@@ -360,6 +362,69 @@ def turntable_command(
         scene, camera, frames, axis, output, fps, progress=error_console, cull_back_faces=False, mode=mode
     )
     console.print(f"wrote {output} ({count} frames, {width}x{height})", markup=False, highlight=False, soft_wrap=True)
+
+
+# --- scene files ------------------------------------------------------------------------------------------------
+
+
+@app.command("render")
+def render_command(
+    scene: Annotated[Path, typer.Argument(help="A TOML scene file.")],
+    output: Annotated[
+        list[Path] | None, typer.Option("--output", "-o", help="Output file(s): .png .svg .pdf .gif .mp4.")
+    ] = None,
+    size: Annotated[str | None, typer.Option(help="Image size WIDTHxHEIGHT, overriding the file's.")] = None,
+) -> None:
+    """Render a scene file; without -o, the outputs the file names (or out/<name>.png beside it)."""
+    from frustum.scenefile import render_scene_file
+
+    written = render_scene_file(scene, output or None, size=_image_size(size) if size else None)
+    for path in written if isinstance(written, list) else [written]:
+        console.print(f"wrote {path}", markup=False, highlight=False, soft_wrap=True)
+
+
+@app.command("explain")
+def explain_command(
+    scene: Annotated[Path, typer.Argument(help="A TOML scene file.")],
+    point: Annotated[str | None, typer.Option(help="A world point x,y,z (default: the scene's vertices).")] = None,
+    markdown: Annotated[bool, typer.Option("--markdown", help="Print Markdown instead of tables.")] = False,
+    latex: Annotated[bool, typer.Option("--latex", help="Print LaTeX instead of tables.")] = False,
+) -> None:
+    """Print every stage of the pipeline (matrices in column- and row-vector form) for the scene's camera."""
+    from frustum.scenefile import explain_scene_file
+
+    trace = explain_scene_file(scene, _vector3(point, "--point") if point else None)
+    if markdown or latex:
+        console.print(trace.to_markdown() if markdown else trace.to_latex(), markup=False, highlight=False)
+    else:
+        console.print(trace)
+
+
+@app.command("view")
+def view_command(
+    scene: Annotated[Path, typer.Argument(help="A TOML scene file.")],
+    output: Annotated[Path, typer.Option("--output", "-o", help="The sheet: .svg, .pdf or .png.")],
+    views: Annotated[str, typer.Option(help="Comma-separated views: front, top, right, left, rear, bottom, iso.")] = (
+        "front,top,right,iso"
+    ),
+) -> None:
+    """Draw the scene as an engineering sheet: orthographic views with hidden lines, title block and scale bar."""
+    from frustum.scenefile import render_view_sheet
+
+    written = render_view_sheet(scene, output, tuple(v.strip() for v in views.split(",") if v.strip()))
+    console.print(f"wrote {written}", markup=False, highlight=False, soft_wrap=True)
+
+
+@app.command("examples")
+def examples_command(
+    out: Annotated[Path, typer.Option(help="Folder for the pictures.")] = Path("examples/out"),
+    size: Annotated[str, typer.Option(help="Image size WIDTHxHEIGHT.")] = "320x240",
+) -> None:
+    """Render the example gallery (examples/*.toml) into a folder."""
+    from frustum.scenefile import render_examples
+
+    for path in render_examples(out, _image_size(size)):
+        console.print(f"wrote {path}", markup=False, highlight=False, soft_wrap=True)
 
 
 # --- entry point ------------------------------------------------------------------------------------------------

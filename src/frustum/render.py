@@ -310,7 +310,7 @@ def _shade_item(
         shade.light_vertices(world, normals, params, lights, options.specular_model, lit)
     elif mode == shade.SHADE_FLAT and mesh.face_count:
         lit = np.empty((mesh.face_count, 6))
-        shade.light_faces(world, mesh.faces, params, lights, options.specular_model, lit)
+        shade.light_faces(world, _world_faces(item), params, lights, options.specular_model, lit)
     else:
         lit = np.empty((0, 6))
     vertex_colors = getattr(mesh, "vertex_colors", None)
@@ -328,9 +328,18 @@ def _shade_item(
     flags[shade.I_WRITE_NORMALS] = int(extra[0].shape[0] == codes.shape[0] and extra[0].shape[1] == codes.shape[1])
     flags[shade.I_WRITE_IDS] = int(extra[1].shape == codes.shape)
     flags[shade.I_BLEND] = int(blend)
-    faces = mesh.faces if mesh.face_count else np.empty((0, 3), dtype=np.int64)
+    faces = _world_faces(item) if mesh.face_count else np.empty((0, 3), dtype=np.int64)
     shade.shade_pixels(codes, bary, faces, world, normals, lit, vertex_colors, uvs, texture, params, lights, flags,
                        color, extra[0], extra[1])  # fmt: skip
+def _world_faces(item: SceneItem) -> np.ndarray:
+    """The item's faces, counter-clockwise seen from the front *after* its modeling transform: a transform that
+    swaps handedness (det < 0, e.g. a reflection) turns the winding around, so corners 1 and 2 are swapped."""
+    faces = item.mesh.faces
+    if np.linalg.det(np.asarray(item.world_from_model)[:3, :3]) < 0.0:
+        return np.ascontiguousarray(faces[:, [0, 2, 1]])
+    return faces
+
+
 def mesh_edges(faces: np.ndarray) -> np.ndarray:
     """(E, 2) int64: every undirected edge of the triangles `faces` once, as ``(low, high)`` rows in sorted order."""
     faces = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
@@ -359,7 +368,8 @@ def _draw_item(
         mesh.vertices, mesh.vertex_normals, _item_matrices(item, camera), VIEW_VOLUME_PLANES,
         clip, world, normals, vertex_codes,
     )  # fmt: skip
-    tri_int, tri_float, tri_weights = _setup_records(mesh.faces, clip, vertex_codes, camera, cull, face_offset)
+    faces = _world_faces(item)
+    tri_int, tri_float, tri_weights = _setup_records(faces, clip, vertex_codes, camera, cull, face_offset)
     tile_starts, tile_triangles, tiling = bin_triangles(tri_int, camera.width, camera.height)
     tiling = np.array([tiling[0], tiling[1], int(clear)], dtype=np.int64)
     triangles.rasterize_tiles(
@@ -495,10 +505,11 @@ def _draw_edges(items: list[SceneItem], camera: Camera, options: _Options, depth
         if options.edges == "all":
             edges = mesh_edges(mesh.faces)
         else:
-            edges, _, kinds = feature_edges(world, mesh.faces, camera, options.crease_angle)
+            edges, _, kinds = feature_edges(world, _world_faces(item), camera, options.crease_angle)
             edges = np.ascontiguousarray(edges[kinds != 0])
         if edge_modes and options.cull:  # edges of back faces only are hidden, whatever the depth buffer says
-            front = mesh_edges(mesh.faces[~backface_mask(world, mesh.faces, camera)])
+            faces = _world_faces(item)
+            front = mesh_edges(faces[~backface_mask(world, faces, camera)])
             size = max(mesh.vertex_count, 1)
             in_front = np.isin(edges[:, 0] * size + edges[:, 1], front[:, 0] * size + front[:, 1])
             if style[lines.S_HIDDEN] != 0.0:

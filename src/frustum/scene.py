@@ -410,7 +410,13 @@ def _slice(solid: Any, point: np.ndarray, keep_normal: np.ndarray, cap: bool) ->
     """The part of `solid` on the side `keep_normal` points to (trimesh keeps the positive side)."""
     if solid is None or len(solid.faces) == 0:
         return None
-    return solid.slice_plane(point, keep_normal, cap=cap)
+    try:
+        return solid.slice_plane(point, keep_normal, cap=cap)
+    except Exception as error:  # trimesh's capping (triangulating the section loops) can fail on odd sections
+        raise GeometryError(
+            f"cutaway: plane through {describe(point)} cuts a mesh of {len(solid.faces)} faces but the section cap "
+            f"fails ({type(error).__name__}: {error}); try cap=False"
+        ) from None
 
 
 def _outside_box(solid: Any, low: np.ndarray, high: np.ndarray) -> tuple[Any, Any]:
