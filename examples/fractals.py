@@ -104,9 +104,11 @@ def main() -> None:
             camera((1.2, -1.6, 1.0), (0, 0, 0), w, h),
         ),
     }
+    # the landscape fades into the haze with distance (the seed's depth cueing); the others render plain
+    haze = {"landscape.png": fr.DepthCue(near=1.5, far=6.0, min_intensity=0.25)}
     for name, (scene, cam) in jobs.items():
         start = time.perf_counter()
-        fr.render(scene, cam, background=background).save(out / name)
+        fr.render(scene, cam, background=background, depth_cue=haze.get(name)).save(out / name)
         print(f"wrote {out / name} in {time.perf_counter() - start:.2f} s")
     start = time.perf_counter()
     image = mandelbrot((-2.2, 0.8, -1.125, 1.125), w, h, max_iter=500)

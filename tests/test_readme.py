@@ -28,19 +28,20 @@ def test_readme_opens_with_exactly_two_commands():
 
 def test_readme_main_command_renders_the_example_scene(tmp_path):
     main_call = shlex.split(BLOCKS[0][1].strip().splitlines()[0].split("&&")[-1])
-    assert main_call[:2] == [".venv/bin/python", "examples/render_example.py"]
+    assert main_call[:3] == [".venv/bin/frustum", "render", "examples/teapot.toml"]
+    assert main_call[3:] == ["-o", "example.png"]
     out = tmp_path / "example.png"
-    script = Path(__file__).parents[1] / main_call[1]
+    scene_file = Path(__file__).parents[1] / main_call[2]
     result = subprocess.run(
-        [sys.executable, str(script), str(out), "--width", "96", "--height", "64"],
+        [sys.executable, "-m", "frustum", "render", str(scene_file), "-o", str(out), "--size", "96x64"],
         capture_output=True, text=True, timeout=300, check=False,
     )  # fmt: skip
     assert result.returncode == 0, result.stderr
     image = np.asarray(Image.open(out))
     assert image.shape == (64, 96, 4)
-    # the torus and the plate cover part of the image, the background the rest
+    # the teapot and its control net cover part of the image, the background the rest
     background = np.all(image == image[0, 0], axis=2)
-    assert 0.2 < background.mean() < 0.9
+    assert 0.2 < background.mean() < 0.95
 
 
 @pytest.mark.parametrize("index", [i for i, (language, _) in enumerate(BLOCKS) if language == "python"])
