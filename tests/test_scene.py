@@ -135,8 +135,10 @@ def test_a_cutaway_never_leaves_geometry_on_the_removed_side(offset, normal):
 def test_capped_cut_of_a_closed_box_is_a_closed_half_box():
     scene = Scene()
     scene.add(box_mesh((2.0, 2.0, 2.0)))
-    (item,) = cutaway(scene, plane=((0.0, 0.0, 0.0), (1.0, 0.0, 0.0))).items
-    half = trimesh.Trimesh(item.mesh.vertices, item.mesh.faces)
+    body, section = cutaway(scene, plane=((0.0, 0.0, 0.0), (1.0, 0.0, 0.0))).items  # the cap is its own node
+    whole = Mesh.merged(body.mesh, section.mesh)
+    half = trimesh.Trimesh(whole.vertices, whole.faces)
+    half.merge_vertices()
     assert half.is_watertight and half.volume == pytest.approx(4.0)
     (open_item,) = cutaway(scene, plane=((0.0, 0.0, 0.0), (1.0, 0.0, 0.0)), cap=False).items
     assert not trimesh.Trimesh(open_item.mesh.vertices, open_item.mesh.faces).is_watertight
@@ -147,10 +149,12 @@ def test_box_cutaway_removes_the_inside_and_ghosts_it_on_request():
     scene.add(box_mesh((2.0, 2.0, 2.0)), Material(color=(0.2, 0.4, 0.9)))
     low, high = np.array([0.0, 0.0, 0.0]), np.array([3.0, 3.0, 3.0])
     cut = cutaway(scene, box=(low, high), ghost=0.3)
-    solid, ghost = cut.items
+    solid, section, ghost = cut.items
     centroids = solid.mesh.vertices[solid.mesh.faces].mean(axis=1)
     assert not ((centroids > low + 1e-9) & (centroids < high - 1e-9)).all(axis=1).any()
-    assert trimesh.Trimesh(solid.mesh.vertices, solid.mesh.faces).volume == pytest.approx(7.0)
+    whole = Mesh.merged(solid.mesh, section.mesh)
+    assert trimesh.Trimesh(whole.vertices, whole.faces).volume == pytest.approx(7.0)
+    assert section.material.hatch == 6.0
     assert ghost.material.opacity == 0.3 and tuple(ghost.material.color) == pytest.approx((0.2, 0.4, 0.9))
     assert trimesh.Trimesh(ghost.mesh.vertices, ghost.mesh.faces).volume == pytest.approx(1.0)
     open_cut = cutaway(scene, box=(low, high), cap=False)
@@ -214,3 +218,25 @@ def test_polylines_from_curves_segments_and_control_polygons():
         Polyline([[0, 0, 0], [1, 0, 0]], pairs=[[0, 2]])
     with pytest.raises(GeometryError, match=r"segments has shape \(2, 3\)"):
         Polyline.from_segments(np.zeros((2, 3)))
+
+
+def test_section_caps_are_separate_hatched_nodes_in_the_cutting_plane():
+    from frustum import Camera, render_svg
+
+    scene = Scene()
+    scene.add(box_mesh((2.0, 2.0, 2.0)), Material(color=(0.3, 0.5, 0.9)), name="block")
+    cut = cutaway(scene, plane=((0.0, 0.0, 0.25), (0.0, 0.0, 1.0)), hatch=4.0)
+    section = cut.find("block/block:section")
+    corners = section.geometry.vertices[section.geometry.faces]
+    assert np.allclose(corners[..., 2], 0.25) and section.material.hatch == 4.0
+    area = 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1).sum()
+    assert area == pytest.approx(4.0)  # the 2 x 2 cross-section
+    normals = section.geometry.face_normals
+    assert np.allclose(normals, (0.0, 0.0, 1.0))  # facing the removed side, toward a viewer looking in
+    camera = Camera.look_at((3, 4, 5), (0, 0, 0), (0, 1, 0), width=120, height=90)
+    svg = render_svg(cut, camera, fill=True)
+    assert '<pattern id="hatch-0"' in svg and svg.count("url(#hatch-0)") == len(section.geometry.faces)
+    plain = cutaway(scene, plane=((0.0, 0.0, 0.25), (0.0, 0.0, 1.0)), hatch=None)
+    assert plain.find("block/block:section").material.hatch is None
+    with pytest.raises(GeometryError, match=r"hatch = -1\.0"):
+        cutaway(scene, plane=((0, 0, 0), (0, 0, 1)), hatch=-1)

@@ -310,6 +310,7 @@ def cutaway(
     *,
     cap: bool = True,
     ghost: Material | float | None = None,
+    hatch: float | None = 6.0,
 ) -> Scene:
     """A cutaway view: geometry on the side of ``plane = (point, normal)`` the normal points to, or inside the
     axis-aligned world ``box = (min_corner, max_corner)``, is removed.
@@ -319,7 +320,8 @@ def cutaway(
     filled (section caps), so solids stay solid; open meshes are cut without caps. With ``ghost`` (an opacity
     in (0, 1) or a Material) the removed part is kept, semi-transparent, instead of dropped. Cutting keeps
     positions and recomputes normals; UVs and vertex colors of cut meshes are not kept. Polylines are kept
-    whole (not cut).
+    whole (not cut). The section caps hang on a child node ``"<name>:section"`` whose material is the part's
+    with ``hatch`` set (45° section lines of that spacing in filled vector output; None: no hatching).
     """
     where = "cutaway"
     if (plane is None) == (box is None):
@@ -344,15 +346,20 @@ def cutaway(
         ghost_material = opacity
     elif ghost is not None:
         ghost_material = ghost
+    if hatch is not None:
+        hatch = as_scalar(hatch, "hatch", where=where, error=GeometryError)
+        if not hatch > 0.0:
+            raise GeometryError(f"{where}: hatch = {hatch!r} is not a positive spacing; give a number > 0 or None")
     result = Scene()
     result.root.lights = list(scene.root.lights)
-    _cut_node(scene.root, result.root, _IDENTITY, Material(), region, cap, ghost_material)
+    _cut_node(scene.root, result.root, _IDENTITY, Material(), region, cap, ghost_material, hatch)
     return result
 
 
 def _cut_node(
-    source: Node, target: Node, parent_world: Matrix4, inherited: Material, region: tuple, cap: bool, ghost: Any
-) -> None:
+    source: Node, target: Node, parent_world: Matrix4, inherited: Material, region: tuple, cap: bool, ghost: Any,
+    hatch: float | None,
+) -> None:  # fmt: skip
     world = parent_world @ source.transform
     material = source.material if source.material is not None else inherited
     for child in source.children:
@@ -368,13 +375,16 @@ def _cut_node(
         elif child.geometry is not None:
             kept, removed = _cut_mesh(child.geometry, child_world, region, cap)
             if kept is not None:
-                copy.geometry = kept
+                body, section = _split_section(kept, region) if cap else (kept, None)
+                copy.geometry = body
                 copy.material = child_material
+                if section is not None:
+                    copy.add(Node(child.name + ":section", None, section, child_material.with_(hatch=hatch)))
             if removed is not None and ghost is not None:
                 ghost_material = ghost if isinstance(ghost, Material) else child_material.with_(opacity=ghost)
                 copy.add(Node(child.name + ":ghost", None, removed, ghost_material))
         target.add(copy)
-        _cut_node(child, copy, child_world, child_material, region, cap, ghost)
+        _cut_node(child, copy, child_world, child_material, region, cap, ghost, hatch)
         # the copy holds world-space geometry: children were cut in world space too, so no transforms remain
 
 
@@ -386,6 +396,7 @@ def _cut_mesh(mesh: Mesh, world: Matrix4, region: tuple, cap: bool) -> tuple[Mes
         return None, None
     points = mesh.vertices @ world[:3, :3].T + world[:3, 3]
     solid = trimesh.Trimesh(points, mesh.faces, process=False)
+    solid.merge_vertices(merge_tex=True, merge_norm=True)  # meshes split vertices at UV and normal seams
     closed = cap and solid.is_watertight
     if region[0] == "plane":
         _, point, normal = region
@@ -404,6 +415,28 @@ def _cut_mesh(mesh: Mesh, world: Matrix4, region: tuple, cap: bool) -> tuple[Mes
             kept, inside = _outside_box(solid, low, high)
             removed = inside
     return _as_mesh(kept), _as_mesh(removed)
+
+
+def _split_section(mesh: Mesh, region: tuple) -> tuple[Mesh | None, Mesh | None]:
+    """(body, section caps) of a cut mesh: the caps are the faces lying in the cutting plane (or a box face)."""
+    corners = mesh.vertices[mesh.faces]  # (M, 3, 3)
+    scale = max(float(np.abs(mesh.vertices).max()), 1.0)
+    tolerance = 1e-9 * scale
+    if region[0] == "plane":
+        _, point, normal = region
+        on = (np.abs((corners - point) @ normal) <= tolerance).all(axis=1)
+    else:
+        _, low, high = region
+        inside = ((corners >= low - tolerance) & (corners <= high + tolerance)).all(axis=(1, 2))
+        on_face = np.zeros(len(corners), dtype=bool)
+        for axis in range(3):
+            for value in (low[axis], high[axis]):
+                on_face |= (np.abs(corners[:, :, axis] - value) <= tolerance).all(axis=1)
+        on = inside & on_face
+    if not on.any():
+        return mesh, None
+    body = Mesh(mesh.vertices, mesh.faces[~on]) if (~on).any() else None
+    return body, Mesh(mesh.vertices, mesh.faces[on])
 
 
 def _slice(solid: Any, point: np.ndarray, keep_normal: np.ndarray, cap: bool) -> Any:

@@ -123,6 +123,8 @@ class Material:
     over what lies behind it, drawn back to front after the opaque surfaces: the "ghosted" parts of a cutaway),
     ``texture`` an (H, W[, 3|4]) image sampled bilinearly at the mesh's UV coordinates (v up: v = 0 is the
     image's bottom row; uint8 bytes are taken as linear values / 255), multiplied into the base color.
+    ``hatch`` (vector output only): the spacing of 45° section lines drawn over the faces in filled SVG/PDF,
+    in drawing units, as engineering drawings mark cut surfaces (``cutaway`` sets it on section caps).
     Raises ``ShadingError`` for a non-finite or negative coefficient, a color outside [0, 1] or a bad texture.
     """
 
@@ -134,9 +136,15 @@ class Material:
     emissive: Vector3 = (0.0, 0.0, 0.0)  # type: ignore[assignment]
     opacity: float = 1.0
     texture: NDArray[np.float32] | None = None
+    hatch: float | None = None
 
     def __post_init__(self) -> None:
         where = "Material"
+        if self.hatch is not None:
+            spacing = as_scalar(self.hatch, "hatch", where=where, error=ShadingError)
+            if not spacing > 0.0:
+                raise ShadingError(f"{where}: hatch = {spacing!r} is not a positive spacing; give a number > 0 or None")
+            object.__setattr__(self, "hatch", spacing)
         object.__setattr__(self, "color", _unit_color(self.color, "color", where))
         object.__setattr__(self, "emissive", _unit_color(self.emissive, "emissive", where))
         for name in ("ambient", "diffuse", "specular", "shininess"):

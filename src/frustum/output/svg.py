@@ -318,7 +318,7 @@ def _fill_polygons(
     placed: Sequence[PlacedMesh], lights: Sequence[DirectionalLight], camera: Camera, order: str
 ) -> tuple[list[str], str]:
     """``<polygon>`` elements of all faces, flat-shaded, back to front; and the name of the order used."""
-    corners_parts, colors_parts = [], []
+    corners_parts, colors_parts, hatch_parts = [], [], []
     eye, direction = _centre_of_projection(camera)
     for mesh, material, world_from_model in placed:
         if not isinstance(mesh, Mesh) or mesh.face_count == 0:
@@ -342,10 +342,13 @@ def _fill_polygons(
         shade = np.clip(material.ambient + material.diffuse * lambert, 0.0, 1.0)
         corners_parts.append(corners)
         colors_parts.append(shade[:, None] * np.asarray(material.color)[None, :])
+        hatch_parts.append(np.full(corners.shape[0], 0.0 if material.hatch is None else material.hatch))
     if not corners_parts:
         return [], order
     corners = np.concatenate(corners_parts)
     colors = np.concatenate(colors_parts)
+    hatches = np.concatenate(hatch_parts)
+    patterns: dict[float, str] = {}
     fragments, used = _back_to_front(corners, eye, direction, camera, order)
     clip_from_world = np.asarray(camera.clip_from_world)
     elements = []
@@ -362,6 +365,18 @@ def _fill_polygons(
         points = " ".join(f"{_number(a)},{_number(b)}" for a, b in zip(x, y, strict=True))
         # a thin outline in the fill color closes the anti-aliasing seams between neighbouring polygons
         elements.append(f'<polygon points="{points}" fill="{color}" stroke="{color}" stroke-width="0.5"/>')
+        spacing = float(hatches[index])
+        if spacing > 0.0:  # a section cap: 45° hatching over the fill
+            name = patterns.setdefault(spacing, f"hatch-{len(patterns)}")
+            elements.append(f'<polygon points="{points}" fill="url(#{name})" stroke="none" class="section"/>')
+    if patterns:
+        definitions = "".join(
+            f'<pattern id="{name}" patternUnits="userSpaceOnUse" width="{_number(spacing)}" '
+            f'height="{_number(spacing)}" patternTransform="rotate(45)"><line x1="0" y1="0" x2="0" '
+            f'y2="{_number(spacing)}" stroke="#000000" stroke-width="{_number(spacing / 8)}"/></pattern>'
+            for spacing, name in patterns.items()
+        )
+        elements.insert(0, f"<defs>{definitions}</defs>")
     return elements, used
 
 
