@@ -357,20 +357,8 @@ def test_render_svg_rejects_bad_input(kwargs, error, match):
         render_svg(scene, camera, **arguments)
 
 
-def test_placed_meshes_reads_items_or_walks_a_scene_graph():
+def test_placed_meshes_are_the_items_then_the_polylines():
     scene = _part_scene()
+    scene.add(Polyline([[0, 0, 0], [1, 1, 1]]))
     placed = _placed_meshes(scene)
-    assert [p.mesh for p in placed] == [i.mesh for i in scene.items]
-
-    class Entry:
-        def __init__(self, geometry, material, world_from_model):
-            self.geometry, self.material, self.world_from_model = geometry, material, world_from_model
-
-    class Graph:
-        def walk(self):
-            yield Entry(None, None, np.eye(4))  # a group node
-            yield Entry(_box((1, 1, 1)), None, translate(1, 2, 3))
-
-    walked = _placed_meshes(Graph())
-    assert len(walked) == 1 and np.array_equal(walked[0].material.color, Material().color)
-    assert np.array_equal(walked[0].world_from_model, translate(1, 2, 3))
+    assert [p.mesh for p in placed] == [i.mesh for i in scene.items] + [scene.polylines[0].mesh]

@@ -18,7 +18,7 @@ Projections", "Oblique Parallel Projections" (affine maps); [HB 14] "Bézier Spl
 from __future__ import annotations
 
 import os
-from collections.abc import Iterable, Sequence
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any, NamedTuple
 from xml.sax.saxutils import escape
@@ -26,15 +26,15 @@ from xml.sax.saxutils import escape
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from frustum._arrays import Matrix4, as_scalar, describe
+from frustum._arrays import as_scalar, describe
 from frustum.bsp import BSPTree
 from frustum.camera import Camera
 from frustum.clipping import clip_polygon
 from frustum.errors import FrustumError, OutputError
-from frustum.geometry import Mesh, Polyline
+from frustum.geometry import Mesh
 from frustum.hidden_lines import DEFAULT_CREASE_ANGLE, EDGE_LINE, HiddenLines, remove_hidden_lines
-from frustum.scene import Scene
-from frustum.shading import DirectionalLight, Material
+from frustum.scene import Scene, SceneItem
+from frustum.shading import DirectionalLight
 
 __all__ = [
     "FILL_ORDERS",
@@ -57,14 +57,6 @@ _HIDDEN_GRAY = "#9a9a9a"
 # depth cueing: the nearest visible piece is drawn black at full width, the farthest at this gray and width
 _FAR_GRAY = 0.75
 _FAR_WIDTH = 0.4
-
-
-class PlacedMesh(NamedTuple):
-    """A mesh (or polyline), its material and its world_from_model, as the drawing functions read a scene."""
-
-    mesh: Mesh | Polyline
-    material: Material
-    world_from_model: Matrix4
 
 
 class _Pieces(NamedTuple):
@@ -90,36 +82,9 @@ def _split_pieces(lines: HiddenLines) -> tuple[_Pieces, dict[int, _Pieces]]:
     return edges, items
 
 
-def _placed_meshes(scene: Any) -> list[PlacedMesh]:
-    """Every placed mesh and polyline of `scene`: (geometry, material, world_from_model) in drawing order.
-
-    Reads ``scene.items`` then ``scene.polylines`` (placed meshes, then polylines, with inherited materials,
-    as ``render`` reads them) and falls back to ``scene.walk()`` (objects with ``.mesh`` or ``.geometry``,
-    ``.material`` and ``.world_from_model``; entries without geometry are groups and are skipped; a missing
-    material is ``Material()``). This is the one place that knows how a scene is stored.
-    """
-    entries: Iterable[Any]
-    items = getattr(scene, "items", None)
-    if isinstance(items, list):
-        polylines = getattr(scene, "polylines", None)
-        entries = items + (polylines if isinstance(polylines, list) else [])
-    elif callable(getattr(scene, "walk", None)):
-        entries = scene.walk()
-    else:
-        raise FrustumError(
-            f"render_svg: scene = {describe(scene)} is not a Scene; build one with Scene() and scene.add(mesh)"
-        )
-    placed = []
-    for entry in entries:
-        mesh = getattr(entry, "mesh", None)
-        if mesh is None:
-            mesh = getattr(entry, "geometry", None)
-        if not isinstance(mesh, Mesh | Polyline):
-            continue
-        material = getattr(entry, "material", None)
-        material = material if isinstance(material, Material) else Material()
-        placed.append(PlacedMesh(mesh, material, np.asarray(entry.world_from_model, dtype=np.float64)))
-    return placed
+def _placed_meshes(scene: Scene) -> list[SceneItem]:
+    """Every placed mesh, then every polyline, with inherited materials, in the order ``render`` draws them."""
+    return scene.items + scene.polylines
 
 
 def _lights(scene: Any) -> list[DirectionalLight]:
@@ -286,7 +251,7 @@ def _line_groups(
 
 
 def _drawing_groups(
-    lines: HiddenLines, placed: Sequence[PlacedMesh], transform: Any, stroke_width: float, hidden: str | None,
+    lines: HiddenLines, placed: Sequence[SceneItem], transform: Any, stroke_width: float, hidden: str | None,
     depth_cue: bool, prefix: str = "",
 ) -> list[str]:  # fmt: skip
     """Mesh edges in black (groups ``hidden``, ``visible``), then each polyline in its material color."""
@@ -315,7 +280,7 @@ def _centre_of_projection(camera: Camera) -> tuple[NDArray | None, NDArray | Non
 
 
 def _fill_polygons(
-    placed: Sequence[PlacedMesh], lights: Sequence[DirectionalLight], camera: Camera, order: str
+    placed: Sequence[SceneItem], lights: Sequence[DirectionalLight], camera: Camera, order: str
 ) -> tuple[list[str], str]:
     """``<polygon>`` elements of all faces, flat-shaded, back to front; and the name of the order used."""
     corners_parts, colors_parts, hatch_parts = [], [], []
