@@ -9,7 +9,6 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from frustum._arrays import describe
 from frustum.errors import OutputError
 
 __all__ = ["Frame"]
@@ -82,12 +81,12 @@ class Frame:
         """
         suffix = os.path.splitext(os.fspath(path))[1].lower()
         if suffix != ".png":
-            raise OutputError(f"Frame.save: path = {describe(os.fspath(path))} has suffix {suffix!r}; expected '.png'")
+            raise OutputError(f"Frame.save: path = {os.fspath(path)!r} has suffix {suffix!r}; expected '.png'")
         try:
             self.to_pil().save(path, format="PNG")
         except OSError as error:
             raise OutputError(
-                f"Frame.save: path = {describe(os.fspath(path))} cannot be written ({error.strerror or error}); "
+                f"Frame.save: path = {os.fspath(path)!r} cannot be written ({error.strerror or error}); "
                 "give a path in an existing, writable folder"
             ) from None
 

@@ -36,7 +36,7 @@ def _suffix(path: str | os.PathLike, where: str) -> str:
     suffix = os.path.splitext(os.fspath(path))[1].lower()
     if suffix not in ANIMATION_FORMATS:
         raise OutputError(
-            f"{where}: path = {describe(os.fspath(path))} has suffix {suffix!r}; expected one of "
+            f"{where}: path = {os.fspath(path)!r} has suffix {suffix!r}; expected one of "
             + ", ".join(repr(s) for s in ANIMATION_FORMATS)
         )
     return suffix
@@ -102,7 +102,7 @@ def _write_gif(frames: Iterator[NDArray[np.uint8]], path: str, fps: float, where
         )
     except OSError as error:
         raise OutputError(
-            f"{where}: path = {describe(path)} cannot be written ({error.strerror or error}); give a path in an "
+            f"{where}: path = {str(path)!r} cannot be written ({error.strerror or error}); give a path in an "
             "existing, writable folder"
         ) from None
     return len(images)
@@ -113,7 +113,7 @@ def _write_mp4(frames: Iterator[NDArray[np.uint8]], path: str, fps: float, where
         import imageio_ffmpeg  # noqa: F401  (the plugin imageio needs for MP4)
     except ImportError:
         raise OutputError(
-            f"{where}: path = {describe(path)} asks for MP4, which needs the imageio-ffmpeg package; install it "
+            f"{where}: path = {str(path)!r} asks for MP4, which needs the imageio-ffmpeg package; install it "
             "(pip install imageio-ffmpeg) or write a '.gif'"
         ) from None
     import imageio.v2 as imageio
@@ -122,7 +122,7 @@ def _write_mp4(frames: Iterator[NDArray[np.uint8]], path: str, fps: float, where
     try:
         writer = imageio.get_writer(path, format="FFMPEG", mode="I", fps=fps, codec="libx264", macro_block_size=1)
     except OSError as error:
-        raise OutputError(f"{where}: path = {describe(path)} cannot be written ({error})") from None
+        raise OutputError(f"{where}: path = {str(path)!r} cannot be written ({error})") from None
     with writer:
         for rgb in frames:
             # yuv420p needs even sizes: repeat the last row / column rather than let imageio rescale
