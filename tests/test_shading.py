@@ -437,3 +437,20 @@ def test_vertex_colors_interpolate_and_multiply_the_material_color():
     up = (points[..., 1] + 5.0) / 10.0  # fraction of the way from the red to the blue edge
     red = frame.color[..., 0].astype(int)
     assert np.abs(red - to_bytes(1.0 - up)).max() <= 1
+
+
+def test_the_directional_fast_path_equals_the_general_shading_kernel_bit_for_bit():
+    """Blinn-Phong with directional lights only runs ``shade_pixels_directional``; asking for an extra buffer
+    forces the general ``shade_pixels``: the colors must be the same bytes."""
+    sphere = trimesh.creation.icosphere(subdivisions=3)
+    lights = [
+        DirectionalLight((-0.3, -0.6, -0.7), color=(1.0, 0.8, 0.6), intensity=0.9),
+        DirectionalLight((0.5, 0.2, -0.4), color=(0.2, 0.3, 1.0)),
+        AmbientLight(intensity=0.4),
+    ]
+    scene = Scene(lights=lights)
+    scene.add(Mesh(sphere.vertices, sphere.faces), Material(color=(0.7, 0.5, 0.3), emissive=(0.02, 0.0, 0.05)))
+    camera = Camera.look_at((0.5, 0.8, 3.0), (0, 0, 0), (0, 1, 0), width=96, height=72)
+    fast = render(scene, camera)
+    general = render(scene, camera, buffers=("object_id",))
+    assert (fast.color == general.color).all() and (fast.depth == general.depth).all()

@@ -329,6 +329,14 @@ def _shade_item(
     flags[shade.I_WRITE_IDS] = int(extra[1].shape == codes.shape)
     flags[shade.I_BLEND] = int(blend)
     faces = _world_faces(item) if mesh.face_count else np.empty((0, 3), dtype=np.int64)
+    plain = (
+        mode == shade.SHADE_PHONG and options.specular_model == shade.SPECULAR_BLINN and not blend
+        and (lights[:, 0] == 0.0).all() and vertex_colors.shape[0] == 0 and texture.shape[0] == 0
+        and options.depth_cue is None and not flags[shade.I_WRITE_NORMALS] and not flags[shade.I_WRITE_IDS]
+    )  # fmt: skip
+    if plain:  # the same bytes through a kernel without the general path's branches
+        shade.shade_pixels_directional(codes, bary, faces, world, normals, params, lights, flags, color)
+        return
     shade.shade_pixels(codes, bary, faces, world, normals, lit, vertex_colors, uvs, texture, params, lights, flags,
                        color, extra[0], extra[1])  # fmt: skip
 def _world_faces(item: SceneItem) -> np.ndarray:

@@ -40,6 +40,7 @@ __all__ = [
     "light_faces",
     "light_vertices",
     "shade_pixels",
+    "shade_pixels_directional",
 ]
 
 SHADE_NONE, SHADE_PHONG, SHADE_FLAT, SHADE_GOURAUD, SHADE_NORMALS, SHADE_DEPTH = 0, 1, 2, 3, 4, 5
@@ -327,3 +328,81 @@ def _shade_row(
             normal_out[row, col, 0], normal_out[row, col, 1], normal_out[row, col, 2] = nx, ny, nz
         if item[I_WRITE_IDS] != 0:
             id_out[row, col] = item[I_OBJECT_ID]
+
+
+@parallel_kernel
+def shade_pixels_directional(
+    codes: np.ndarray, bary: np.ndarray, faces: np.ndarray, world: np.ndarray, normals: np.ndarray,
+    params: np.ndarray, lights: np.ndarray, item: np.ndarray, color: np.ndarray,
+) -> None:  # fmt: skip
+    """``shade_pixels`` for the common case, bit for bit: per-pixel Blinn-Phong with directional lights only and
+    no texture, vertex colors, depth cueing, blending or extra buffers (the benchmark scenes). The general
+    kernel's branches cost about half again per pixel; this one keeps only the arithmetic."""
+    for row in prange(codes.shape[0]):
+        _shade_row_directional(row, codes, bary, faces, world, normals, params, lights, item, color)
+
+
+@kernel
+def _shade_row_directional(
+    row: int, codes: np.ndarray, bary: np.ndarray, faces: np.ndarray, world: np.ndarray, normals: np.ndarray,
+    params: np.ndarray, lights: np.ndarray, item: np.ndarray, color: np.ndarray,
+) -> None:  # fmt: skip
+    """One image row of ``shade_pixels_directional``: the operations of ``shade_point`` and ``_illuminate`` in the
+    same order (falloff 1, so ``k_d·(1·ndl) = k_d·ndl``)."""
+    face_offset, paint = item[I_FACE_OFFSET], item[I_PAINT]
+    ex, ey, ez = params[P_EYE], params[P_EYE + 1], params[P_EYE + 2]
+    kd, ks, shininess = params[P_DIFFUSE], params[P_SPECULAR], params[P_SHININESS]
+    ka = params[P_AMBIENT]
+    for col in range(codes.shape[1]):
+        code = codes[row, col]
+        if code < 0:
+            if paint != 0:
+                for k in range(4):
+                    color[row, col, k] = item[I_BACKGROUND + k]
+            continue
+        f = code // 2 - face_offset
+        if f < 0 or f >= faces.shape[0]:
+            continue
+        u1, u2 = float(bary[row, col, 0]), float(bary[row, col, 1])
+        u0 = (1.0 - u1) - u2
+        a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
+        sign = -1.0 if code % 2 == 1 else 1.0
+        nx = _interpolate(u0, u1, u2, normals[a, 0], normals[b, 0], normals[c, 0])
+        ny = _interpolate(u0, u1, u2, normals[a, 1], normals[b, 1], normals[c, 1])
+        nz = _interpolate(u0, u1, u2, normals[a, 2], normals[b, 2], normals[c, 2])
+        length = math.sqrt((nx * nx + ny * ny) + nz * nz)
+        if length == 0.0:
+            nx, ny, nz, length = 0.0, 0.0, 1.0, 1.0
+        nx, ny, nz = sign * nx / length, sign * ny / length, sign * nz / length
+        px = _interpolate(u0, u1, u2, world[a, 0], world[b, 0], world[c, 0])
+        py = _interpolate(u0, u1, u2, world[a, 1], world[b, 1], world[c, 1])
+        pz = _interpolate(u0, u1, u2, world[a, 2], world[b, 2], world[c, 2])
+        vx, vy, vz = ex - px, ey - py, ez - pz
+        length = math.sqrt((vx * vx + vy * vy) + vz * vz)
+        vx, vy, vz = vx / length, vy / length, vz / length
+        dr = ka * params[P_LIGHT_AMBIENT]
+        dg = ka * params[P_LIGHT_AMBIENT + 1]
+        db = ka * params[P_LIGHT_AMBIENT + 2]
+        sr, sg, sb = 0.0, 0.0, 0.0
+        for k in range(lights.shape[0]):
+            lx, ly, lz = lights[k, 7], lights[k, 8], lights[k, 9]
+            ndl = (nx * lx + ny * ly) + nz * lz
+            if ndl <= 0.0:
+                continue
+            hx, hy, hz = lx + vx, ly + vy, lz + vz
+            length = math.sqrt((hx * hx + hy * hy) + hz * hz)
+            if length > 0.0:
+                hx, hy, hz = hx / length, hy / length, hz / length
+            spec = max((nx * hx + ny * hy) + nz * hz, 0.0) ** shininess
+            diffuse = kd * (1.0 * ndl)
+            specular = ks * (1.0 * spec)
+            dr += diffuse * lights[k, 1]
+            dg += diffuse * lights[k, 2]
+            db += diffuse * lights[k, 3]
+            sr += specular * lights[k, 1]
+            sg += specular * lights[k, 2]
+            sb += specular * lights[k, 3]
+        color[row, col, 0] = _to_byte((params[P_COLOR] * dr + sr) + params[P_EMISSIVE])
+        color[row, col, 1] = _to_byte((params[P_COLOR + 1] * dg + sg) + params[P_EMISSIVE + 1])
+        color[row, col, 2] = _to_byte((params[P_COLOR + 2] * db + sb) + params[P_EMISSIVE + 2])
+        color[row, col, 3] = 255
