@@ -37,7 +37,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -266,7 +266,7 @@ def feature_edges(
     """
     mesh = Mesh(points_world, faces)
     angle = _crease(crease_angle, "feature_edges")
-    facing = None if camera is None else _front_facing(camera.clip_from_world, mesh.vertices, mesh.faces)
+    facing = None if camera is None else front_facing(camera.clip_from_world, mesh.vertices, mesh.faces)
     return _edges_of(mesh.vertices, mesh.faces, facing, angle)
 
 
@@ -277,8 +277,9 @@ def _crease(value: Any, where: str) -> float:
     return angle
 
 
-def _front_facing(clip_from_world: Matrix4, points_world: NDArray, faces: NDArray) -> NDArray[np.bool_]:
-    # plane test against the centre of projection: det of the (x, y, w) clip rows of the corners
+def front_facing(clip_from_world: Matrix4, points_world: NDArray, faces: NDArray) -> NDArray[np.bool_]:
+    """(M,) True for faces whose front the camera sees: the plane test against the centre of projection, as
+    ``det[(x, y, w)_0; (x, y, w)_1; (x, y, w)_2] > 0`` of the corners' clip rows (valid behind the eye too)."""
     clip = points_world @ clip_from_world[[0, 1, 3], :3].T + clip_from_world[[0, 1, 3], 3]
     return np.linalg.det(clip[faces]) > 0.0
 
@@ -294,32 +295,64 @@ def _unit_normals(points: NDArray, faces: NDArray) -> tuple[NDArray, NDArray[np.
     return normals, degenerate
 
 
-def _edges_of(
-    points: NDArray, faces: NDArray, facing: NDArray[np.bool_] | None, crease_angle: float
-) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
+class EdgeAdjacency(NamedTuple):
+    """Every undirected edge of a triangle list once, with its faces: what ``feature_edges`` classifies.
+
+    ``edges`` (E, 2) sorted (low, high) rows in lexicographic order; ``first``/``second`` (E,) the first two
+    adjacent faces (second −1 when there is none); ``counts`` (E,) the number of adjacent faces. It depends on
+    the faces only, so callers that draw the same mesh again (the renderer) keep it.
+    """
+
+    edges: NDArray[np.int64]
+    first: NDArray[np.int64]
+    second: NDArray[np.int64]
+    counts: NDArray[np.int64]
+
+
+def edge_adjacency(faces: NDArray, vertex_count: int) -> EdgeAdjacency:
+    """The ``EdgeAdjacency`` of (M, 3) faces over `vertex_count` vertices (one sort of int64 edge keys)."""
     face_count = faces.shape[0]
     if face_count == 0:
-        return np.empty((0, 2), np.int64), np.empty((0, 2), np.int64), np.empty(0, np.int64)
+        empty = np.empty(0, np.int64)
+        return EdgeAdjacency(np.empty((0, 2), np.int64), empty, empty, empty)
     pairs = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
     pairs.sort(axis=1)
     owner = np.tile(np.arange(face_count, dtype=np.int64), 3)
-    key = pairs[:, 0] * np.int64(points.shape[0]) + pairs[:, 1]
+    key = pairs[:, 0] * np.int64(max(vertex_count, 1)) + pairs[:, 1]
     order = np.argsort(key, kind="stable")
     key, owner = key[order], owner[order]
     starts = np.flatnonzero(np.concatenate([[True], key[1:] != key[:-1]]))
     counts = np.diff(np.append(starts, key.size))
-    edges = pairs[order][starts]
+    edges = np.ascontiguousarray(pairs[order][starts])
     first = owner[starts]
     second = np.where(counts >= 2, owner[np.minimum(starts + 1, key.size - 1)], -1)
+    return EdgeAdjacency(edges, first, second, counts)
+
+
+def classify_edges(
+    adjacency: EdgeAdjacency, points: NDArray, faces: NDArray, facing: NDArray[np.bool_] | None, crease_angle: float
+) -> NDArray[np.int64]:
+    """(E,) kind bits of each edge of `adjacency` for these (world) `points` and this `facing` (or None)."""
+    first, second, counts = adjacency.first, adjacency.second, adjacency.counts
+    if first.size == 0:
+        return np.empty(0, np.int64)
     kinds = np.where(counts != 2, EDGE_BOUNDARY, 0).astype(np.int64)
     normals, degenerate = _unit_normals(points, faces)
-    both = (counts == 2) & ~degenerate[first] & ~degenerate[np.maximum(second, 0)]
-    cosine = (normals[first] * normals[np.maximum(second, 0)]).sum(axis=1)
+    other = np.maximum(second, 0)
+    both = (counts == 2) & ~degenerate[first] & ~degenerate[other]
+    cosine = (normals[first] * normals[other]).sum(axis=1)
     kinds |= np.where(both & (cosine < math.cos(crease_angle)), EDGE_CREASE, 0)
     if facing is not None:
-        kinds |= np.where(both & (facing[first] != facing[np.maximum(second, 0)]), EDGE_SILHOUETTE, 0)
-    edge_faces = np.stack([first, second], axis=1)
-    return np.ascontiguousarray(edges), edge_faces, kinds
+        kinds |= np.where(both & (facing[first] != facing[other]), EDGE_SILHOUETTE, 0)
+    return kinds
+
+
+def _edges_of(
+    points: NDArray, faces: NDArray, facing: NDArray[np.bool_] | None, crease_angle: float
+) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
+    adjacency = edge_adjacency(faces, points.shape[0])
+    kinds = classify_edges(adjacency, points, faces, facing, crease_angle)
+    return adjacency.edges, np.stack([adjacency.first, adjacency.second], axis=1), kinds
 
 
 # --- the public driver ----------------------------------------------------------------------------------
@@ -398,7 +431,7 @@ def remove_hidden_lines(
             continue
         points = mesh.vertices @ world_from_model[:3, :3].T + world_from_model[:3, 3]
         faces = np.asarray(mesh.faces, dtype=np.int64)
-        facing = _front_facing(clip_from_world, points, faces)
+        facing = front_facing(clip_from_world, points, faces)
         pairs, pair_faces, kinds = _edges_of(points, faces, facing, angle)
         chosen = np.ones(kinds.shape, bool) if mask == 0 else (kinds & mask) != 0
         points_parts.append(points)
@@ -444,7 +477,7 @@ def _window_triangles(
     _, degenerate = _unit_normals(points_world, faces)
     keep = ~degenerate
     if cull_back_faces:
-        keep &= _front_facing(np.asarray(camera.clip_from_world), points_world, faces)
+        keep &= front_facing(np.asarray(camera.clip_from_world), points_world, faces)
     source = np.flatnonzero(keep)
     clipped = clip_triangles(points_clip, faces[source])
     window = _to_window(clipped.vertices, camera)

@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import weakref
 from typing import Any
 
 import numba
@@ -45,12 +46,12 @@ from frustum.camera import Camera
 from frustum.clipping import VIEW_VOLUME_PLANES
 from frustum.errors import FrustumError
 from frustum.frame import Frame
-from frustum.hidden_lines import feature_edges
-from frustum.raster import lines, shade, tiles, triangles
+from frustum.geometry import Mesh
+from frustum.hidden_lines import EdgeAdjacency, classify_edges, edge_adjacency, front_facing
+from frustum.raster import downsample, lines, shade, tiles, triangles
 from frustum.raster.vertices import transform_vertices
 from frustum.scene import Scene, SceneItem
 from frustum.shading import SPECULAR_MODELS, DepthCue, pack_lights
-from frustum.visibility import backface_mask
 
 __all__ = ["HIDDEN_STYLES", "RENDER_MODES", "SHADING_MODES", "TILE_SIZE", "mesh_edges", "render"]
 
@@ -143,9 +144,9 @@ def render(
         as the pixel containing it. ``"hidden-line"``: the surfaces fill the depth buffer in the background
         color and only the visible parts of the edges are drawn (hidden parts per `hidden`).
         ``"surface+edges"``: shaded surfaces with their visible edges on top. With `cull_back_faces`, edges of back
-        faces only (``visibility.backface_mask``) count as hidden whatever the depth buffer says.
+        faces only (``hidden_lines.front_facing``) count as hidden whatever the depth buffer says.
     edges : {"all", "feature"} or None
-        Which edges the line modes draw: every edge, or ``hidden_lines.feature_edges`` (boundaries, creases
+        Which edges the line modes draw: every edge, or ``hidden_lines`` feature edges (boundaries, creases
         sharper than `crease_angle`, silhouettes). None: "all" for wireframe, "feature" for the others.
     edge_color : (3,) or (4,) array_like or None
         Line color in [0, 1]; None: the material color (wireframe, points), or for the edge modes black on a
@@ -192,9 +193,17 @@ def render(
         big = dataclasses.replace(camera, width=camera.width * factor, height=camera.height * factor)
         wide = dataclasses.replace(options, line_width=options.line_width * factor)
         color, depth, normals, ids = _render_buffers(scene, big, wide)
-        linear = _downsample(color.astype(np.float64) / 255.0, factor, filter)
         h, w = camera.height, camera.width
-        depth = depth.reshape(h, factor, w, factor).min(axis=(1, 3))
+        linear = None
+        if filter == "box" and color_space == "linear":  # exact in integers: floor(sum / s² + 1/2)
+            small = np.empty((h, w, 4), dtype=np.uint8)
+            downsample.resolve_color(color, factor, small)
+            color = small
+        else:
+            linear = _downsample(color.astype(np.float64) / 255.0, factor, filter)
+        nearest = np.empty((h, w), dtype=np.float32)
+        downsample.resolve_depth(depth, factor, nearest)
+        depth = nearest
         middle = factor // 2
         normals = None if normals is None else np.ascontiguousarray(normals[middle::factor, middle::factor])
         ids = None if ids is None else np.ascontiguousarray(ids[middle::factor, middle::factor])
@@ -351,9 +360,18 @@ def _world_faces(item: SceneItem) -> np.ndarray:
 def mesh_edges(faces: np.ndarray) -> np.ndarray:
     """(E, 2) int64: every undirected edge of the triangles `faces` once, as ``(low, high)`` rows in sorted order."""
     faces = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
-    pairs = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
-    pairs.sort(axis=1)
-    return np.ascontiguousarray(np.unique(pairs, axis=0), dtype=np.int64).reshape(-1, 2)
+    return edge_adjacency(faces, int(faces.max()) + 1 if faces.size else 0).edges
+
+
+_ADJACENCY: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _adjacency(mesh: Mesh) -> EdgeAdjacency:
+    """The mesh's edges and their faces, computed once per mesh (meshes are immutable)."""
+    cached = _ADJACENCY.get(mesh)
+    if cached is None:
+        cached = _ADJACENCY[mesh] = edge_adjacency(mesh.faces, mesh.vertex_count)
+    return cached
 
 
 def _draw_item(
@@ -510,22 +528,24 @@ def _draw_edges(items: list[SceneItem], camera: Camera, options: _Options, depth
         if options.mode == "points":
             lines.draw_points(clip, view_depth, vertex_codes, view, style, depth, color)
             continue
-        if options.edges == "all":
-            edges = mesh_edges(mesh.faces)
-        else:
-            edges, _, kinds = feature_edges(world, _world_faces(item), camera, options.crease_angle)
-            edges = np.ascontiguousarray(edges[kinds != 0])
-        if edge_modes and options.cull:  # edges of back faces only are hidden, whatever the depth buffer says
+        adjacency = _adjacency(mesh)
+        edges = adjacency.edges
+        if edge_modes or options.edges == "feature":
             faces = _world_faces(item)
-            front = mesh_edges(faces[~backface_mask(world, faces, camera)])
-            size = max(mesh.vertex_count, 1)
-            in_front = np.isin(edges[:, 0] * size + edges[:, 1], front[:, 0] * size + front[:, 1])
-            if style[lines.S_HIDDEN] != 0.0:
-                always_hidden = style.copy()
-                always_hidden[lines.S_OFFSET] = -np.inf  # z − offset < depth never holds
-                lines.draw_lines(clip, view_depth, edges[~in_front], VIEW_VOLUME_PLANES, view, always_hidden, depth,
-                                 color)  # fmt: skip
-            edges = edges[in_front]
+            facing = front_facing(camera.clip_from_world, world, faces)
+            if options.edges == "feature":
+                keep = classify_edges(adjacency, world, faces, facing, options.crease_angle) != 0
+            else:
+                keep = np.ones(edges.shape[0], dtype=bool)
+            if edge_modes and options.cull:  # edges of back faces only are hidden, whatever the depth buffer says
+                in_front = facing[adjacency.first] | ((adjacency.second >= 0) & facing[np.maximum(adjacency.second, 0)])
+                if style[lines.S_HIDDEN] != 0.0:
+                    always_hidden = style.copy()
+                    always_hidden[lines.S_OFFSET] = -np.inf  # z − offset < depth never holds
+                    lines.draw_lines(clip, view_depth, np.ascontiguousarray(edges[keep & ~in_front]),
+                                     VIEW_VOLUME_PLANES, view, always_hidden, depth, color)  # fmt: skip
+                keep &= in_front
+            edges = np.ascontiguousarray(edges[keep])
         lines.draw_lines(clip, view_depth, edges, VIEW_VOLUME_PLANES, view, style, depth, color)
 
 
