@@ -281,7 +281,8 @@ def front_facing(clip_from_world: Matrix4, points_world: NDArray, faces: NDArray
     """(M,) True for faces whose front the camera sees: the plane test against the centre of projection, as
     ``det[(x, y, w)_0; (x, y, w)_1; (x, y, w)_2] > 0`` of the corners' clip rows (valid behind the eye too)."""
     clip = points_world @ clip_from_world[[0, 1, 3], :3].T + clip_from_world[[0, 1, 3], 3]
-    return np.linalg.det(clip[faces]) > 0.0
+    a, b, c = clip[faces[:, 0]], clip[faces[:, 1]], clip[faces[:, 2]]
+    return np.einsum("ij,ij->i", a, np.cross(b, c)) > 0.0  # det[a; b; c] = a·(b × c)
 
 
 def _unit_normals(points: NDArray, faces: NDArray) -> tuple[NDArray, NDArray[np.bool_]]:
