@@ -183,6 +183,27 @@ def _sample(texture: np.ndarray, u: float, v: float, channel: int) -> float:
 
 
 @inline_kernel
+def _surface(
+    f: int, back: bool, u0: float, u1: float, u2: float, faces: np.ndarray, world: np.ndarray, normals: np.ndarray
+) -> tuple[float, float, float, float, float, float]:  # fmt: skip
+    """(N, P) of face f at weights (u0, u1, u2): the unit interpolated normal, flipped for a back face drawn
+    two-sided (so it faces the viewer), and the world point."""
+    a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
+    sign = -1.0 if back else 1.0
+    nx = _interpolate(u0, u1, u2, normals[a, 0], normals[b, 0], normals[c, 0])
+    ny = _interpolate(u0, u1, u2, normals[a, 1], normals[b, 1], normals[c, 1])
+    nz = _interpolate(u0, u1, u2, normals[a, 2], normals[b, 2], normals[c, 2])
+    length = math.sqrt((nx * nx + ny * ny) + nz * nz)
+    if length == 0.0:
+        nx, ny, nz, length = 0.0, 0.0, 1.0, 1.0
+    nx, ny, nz = sign * nx / length, sign * ny / length, sign * nz / length
+    px = _interpolate(u0, u1, u2, world[a, 0], world[b, 0], world[c, 0])
+    py = _interpolate(u0, u1, u2, world[a, 1], world[b, 1], world[c, 1])
+    pz = _interpolate(u0, u1, u2, world[a, 2], world[b, 2], world[c, 2])
+    return nx, ny, nz, px, py, pz
+
+
+@inline_kernel
 def shade_point(
     f: int, back: bool, u0: float, u1: float, u2: float,
     faces: np.ndarray, world: np.ndarray, normals: np.ndarray, lit: np.ndarray,
@@ -195,17 +216,7 @@ def shade_point(
     """
     mode = item[I_MODE]
     a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
-    sign = -1.0 if back else 1.0  # two-sided lighting: a back face's normal faces the viewer
-    nx = _interpolate(u0, u1, u2, normals[a, 0], normals[b, 0], normals[c, 0])
-    ny = _interpolate(u0, u1, u2, normals[a, 1], normals[b, 1], normals[c, 1])
-    nz = _interpolate(u0, u1, u2, normals[a, 2], normals[b, 2], normals[c, 2])
-    length = math.sqrt((nx * nx + ny * ny) + nz * nz)
-    if length == 0.0:
-        nx, ny, nz, length = 0.0, 0.0, 1.0, 1.0
-    nx, ny, nz = sign * nx / length, sign * ny / length, sign * nz / length
-    px = _interpolate(u0, u1, u2, world[a, 0], world[b, 0], world[c, 0])
-    py = _interpolate(u0, u1, u2, world[a, 1], world[b, 1], world[c, 1])
-    pz = _interpolate(u0, u1, u2, world[a, 2], world[b, 2], world[c, 2])
+    nx, ny, nz, px, py, pz = _surface(f, back, u0, u1, u2, faces, world, normals)
     alpha = params[P_OPACITY]
     if mode == SHADE_NORMALS:
         return 0.5 * nx + 0.5, 0.5 * ny + 0.5, 0.5 * nz + 0.5, alpha, nx, ny, nz
@@ -365,18 +376,7 @@ def _shade_row_directional(
             continue
         u1, u2 = float(bary[row, col, 0]), float(bary[row, col, 1])
         u0 = (1.0 - u1) - u2
-        a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
-        sign = -1.0 if code % 2 == 1 else 1.0
-        nx = _interpolate(u0, u1, u2, normals[a, 0], normals[b, 0], normals[c, 0])
-        ny = _interpolate(u0, u1, u2, normals[a, 1], normals[b, 1], normals[c, 1])
-        nz = _interpolate(u0, u1, u2, normals[a, 2], normals[b, 2], normals[c, 2])
-        length = math.sqrt((nx * nx + ny * ny) + nz * nz)
-        if length == 0.0:
-            nx, ny, nz, length = 0.0, 0.0, 1.0, 1.0
-        nx, ny, nz = sign * nx / length, sign * ny / length, sign * nz / length
-        px = _interpolate(u0, u1, u2, world[a, 0], world[b, 0], world[c, 0])
-        py = _interpolate(u0, u1, u2, world[a, 1], world[b, 1], world[c, 1])
-        pz = _interpolate(u0, u1, u2, world[a, 2], world[b, 2], world[c, 2])
+        nx, ny, nz, px, py, pz = _surface(f, code % 2 == 1, u0, u1, u2, faces, world, normals)
         vx, vy, vz = ex - px, ey - py, ez - pz
         length = math.sqrt((vx * vx + vy * vy) + vz * vz)
         vx, vy, vz = vx / length, vy / length, vz / length
