@@ -362,3 +362,27 @@ def test_placed_meshes_are_the_items_then_the_polylines():
     scene.add(Polyline([[0, 0, 0], [1, 1, 1]]))
     placed = _placed_meshes(scene)
     assert [p.mesh for p in placed] == [i.mesh for i in scene.items] + [scene.polylines[0].mesh]
+
+
+def test_a_visible_curve_under_a_parallel_projection_is_the_exact_bezier_path():
+    from frustum import BezierCurve, Orthographic, Perspective
+
+    curve = BezierCurve([[-1.0, -0.5, 0.0], [-0.3, 1.0, 0.2], [0.4, -1.0, -0.1], [1.0, 0.5, 0.0]])
+    scene = Scene()
+    scene.add(Polyline.from_curve(curve, tolerance=1e-3), Material(color=(1, 0, 0)))
+    camera = Camera.look_at((0.5, 0.3, 5), (0, 0, 0), (0, 1, 0), projection=Orthographic(3.0, 1, 10),
+                            width=200, height=150)  # fmt: skip
+    svg = render_svg(scene, camera)
+    (path,) = re.findall(r'class="bezier" d="([^"]+)"', svg)
+    numbers = [float(v) for v in NUMBER.findall(path)]
+    window = camera.project(curve.control_points)[:, :2]
+    expected = np.column_stack([window[:, 0], camera.height - window[:, 1]]).ravel()
+    assert path.startswith("M") and " C" in path and np.allclose(numbers, expected, atol=1e-6)
+    # hidden in part (a box in front), or seen in perspective: the flattened pieces, no Bézier path
+    blocked = Scene()
+    blocked.add(Polyline.from_curve(curve, tolerance=1e-3), Material(color=(1, 0, 0)))
+    blocked.add(_box((0.6, 0.6, 0.6), center=(0.0, 0.0, 1.0)))
+    assert 'class="bezier"' not in render_svg(blocked, camera)
+    perspective = Camera.look_at((0.5, 0.3, 5), (0, 0, 0), (0, 1, 0), projection=Perspective(0.8, 1, 10),
+                                 width=200, height=150)  # fmt: skip
+    assert 'class="bezier"' not in render_svg(scene, perspective)

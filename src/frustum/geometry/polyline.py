@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Any
 
@@ -30,6 +30,9 @@ class Polyline:
     closed: bool = False
     markers: bool = False
     pairs: NDArray[np.int64] | None = None
+    curve: Any = field(default=None, repr=False, compare=False)
+    """The curve this polyline was flattened from (``from_curve``), kept so exact outputs (SVG Bézier paths
+    under parallel projections) can use its control points."""
 
     def __post_init__(self) -> None:
         raw = np.asarray(self.points, dtype=np.float64) if not isinstance(self.points, np.ndarray) else self.points
@@ -64,11 +67,11 @@ class Polyline:
         """A curve of ``frustum.geometry.curves`` as a polyline: adaptive ``curve.flatten(tolerance)`` (chord
         within `tolerance` of the curve) or, with `samples`, that many parameter values evenly over its domain."""
         if samples is None and hasattr(curve, "flatten"):
-            return cls(curve.flatten(tolerance))
+            return cls(curve.flatten(tolerance), curve=curve)
         if not hasattr(curve, "evaluate") or not hasattr(curve, "domain"):
             raise GeometryError(f"Polyline.from_curve: curve = {curve!r} has no evaluate/domain; give a curve")
         low, high = curve.domain
-        return cls(curve.evaluate(np.linspace(low, high, 200 if samples is None else int(samples))))
+        return cls(curve.evaluate(np.linspace(low, high, 200 if samples is None else int(samples))), curve=curve)
 
     @classmethod
     def control_polygon(cls, curve: Any, markers: bool = False) -> Polyline:

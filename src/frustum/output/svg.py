@@ -32,6 +32,7 @@ from frustum.camera import Camera
 from frustum.clipping import clip_polygon
 from frustum.errors import FrustumError, OutputError
 from frustum.geometry import Mesh
+from frustum.geometry.curves import BezierCurve, PiecewiseBezier
 from frustum.hidden_lines import DEFAULT_CREASE_ANGLE, EDGE_LINE, HiddenLines, remove_hidden_lines
 from frustum.scene import Scene, SceneItem
 from frustum.shading import DirectionalLight
@@ -252,15 +253,63 @@ def _line_groups(
 
 def _drawing_groups(
     lines: HiddenLines, placed: Sequence[SceneItem], transform: Any, stroke_width: float, hidden: str | None,
-    depth_cue: bool, prefix: str = "",
+    depth_cue: bool, prefix: str = "", camera: Camera | None = None,
 ) -> list[str]:  # fmt: skip
-    """Mesh edges in black (groups ``hidden``, ``visible``), then each polyline in its material color."""
+    """Mesh edges in black (groups ``hidden``, ``visible``), then each polyline in its material color.
+
+    With a parallel-projection `camera`, a polyline flattened from a Bézier-convertible curve of degree <= 3
+    that is wholly visible is drawn as the exact SVG Bézier path of its projected control points.
+    """
     edges, items = _split_pieces(lines)
     groups = _line_groups(edges, transform, stroke_width, hidden, depth_cue, prefix=prefix)
     for item, pieces in items.items():
         color = _hex_color(np.asarray(placed[item].material.color))
+        exact = _exact_curve_path(placed[item], pieces, camera, transform) if not depth_cue else None
+        if exact is not None:
+            groups.append(
+                f'<g id="{prefix}line{item}-visible" fill="none" stroke-linecap="round" stroke-linejoin="round" '
+                f'stroke="{color}" stroke-width="{_number(stroke_width)}"><path class="bezier" d="{exact}"/></g>'
+            )
+            continue
         groups += _line_groups(pieces, transform, stroke_width, hidden, depth_cue, color, prefix=f"{prefix}line{item}-")
     return groups
+
+
+def _exact_curve_path(item: SceneItem, pieces: _Pieces, camera: Camera | None, transform: Any) -> str | None:
+    """SVG path data of the item's source curve from its projected control points, or None where that is not
+    exact: a perspective camera, no source curve, degree > 3, hidden or clipped parts."""
+    line = item.mesh
+    curve = getattr(line, "curve", None)
+    if camera is None or curve is None or not camera.projection.parallel or pieces.hidden.shape[0]:
+        return None
+    if hasattr(curve, "to_bezier") and not isinstance(curve, BezierCurve):
+        curve = curve.to_bezier()
+    if isinstance(curve, BezierCurve):
+        controls = [curve.control_points]
+    elif isinstance(curve, PiecewiseBezier):
+        controls = list(curve.control_points)
+    else:
+        return None
+    if any(c.shape[0] > 4 for c in controls):
+        return None
+    drawn = float(np.linalg.norm(pieces.visible[:, 1] - pieces.visible[:, 0], axis=1).sum())
+    window_line = camera.project(line.points @ item.world_from_model[:3, :3].T + item.world_from_model[:3, 3])
+    full = float(np.linalg.norm(np.diff(window_line[:, :2], axis=0), axis=1).sum())
+    if not full > 0.0 or abs(drawn - full) > 1e-6 * full:  # clipped by the window or split: keep the pieces
+        return None
+    parts = []
+    for points in controls:
+        world = _padded(points) @ item.world_from_model[:3, :3].T + item.world_from_model[:3, 3]
+        window = camera.project(world)[:, :2]
+        paper = transform(window)
+        parts.append(svg_path_from_bezier(paper))
+    return " ".join(parts)
+
+
+def _padded(points: NDArray) -> NDArray:
+    """2D control points get z = 0, as ``Polyline`` does for the flattened curve."""
+    points = np.asarray(points, dtype=np.float64)
+    return np.column_stack([points, np.zeros(len(points))]) if points.shape[1] == 2 else points
 
 
 def _hex_color(rgb: NDArray) -> str:
@@ -454,7 +503,7 @@ def render_svg(
     if fill:
         polygons, used = _fill_polygons(placed, _lights(scene), camera, fill_order)
         body.append(f'<g id="faces" data-order="{used}">{"".join(polygons)}</g>')
-    body += _drawing_groups(lines, placed, to_paper, width, hidden, bool(depth_cue))
+    body += _drawing_groups(lines, placed, to_paper, width, hidden, bool(depth_cue), camera=camera)
     return svg_document(camera.width, camera.height, body)
 
 
