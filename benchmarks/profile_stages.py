@@ -2,7 +2,7 @@
 
     python benchmarks/profile_stages.py bunny_like_100k_4k [--frames 5] [--scene-dir /tmp/frustum-bench/scenes]
 
-Each kernel the pipeline calls (vertex transform, window vertices, triangle setup, binning, tile rasterization,
+Each kernel the pipeline calls (vertex projection, setup and binning of the faces, clipping, tile rasterization,
 shading) is wrapped with a timer; one line per frame prints the milliseconds per kernel and the whole frame.
 Timing wrappers add a little Python overhead, so use it to compare stages, and `bench_render.py` for frame times.
 """
@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 import frustum
-from frustum.raster import shade, triangles
+from frustum.raster import shade, tiles, triangles
 
 SHARED_BENCH = Path(__file__).resolve().parents[2] / "shared" / "bench"
 
@@ -57,9 +57,11 @@ def main() -> None:
 
         setattr(module, name, wrapper)
 
-    timed(pipeline, "transform_vertices")
-    timed(pipeline, "bin_triangles")
-    for name in ("window_vertices", "setup_triangles", "rasterize_tiles"):
+    for name in ("project_vertices", "world_points", "transform_normals"):
+        timed(pipeline, name)
+    for name in ("count_tiles", "add_record_tiles", "fill_tiles"):
+        timed(tiles, name)
+    for name in ("clip_faces", "rasterize_tiles"):
         timed(triangles, name)
     for name in ("shade_pixels", "shade_pixels_directional"):
         timed(shade, name)

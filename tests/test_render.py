@@ -17,7 +17,7 @@ from frustum.errors import ShadingError
 from frustum.frame import Frame
 from frustum.geometry import Mesh
 from frustum.raster.vertices import transform_vertices
-from frustum.render import _item_matrices, render, setup
+from frustum.render import _item_matrices, bin_item, render
 from frustum.scene import Scene
 from frustum.shading import DirectionalLight, Material
 from frustum.transforms import apply_homogeneous, rotate_y, translate
@@ -191,8 +191,10 @@ def test_fast_path_window_coordinates_and_culling_equal_the_textbook_path():
     # clip coordinates: the textbook apply_homogeneous (round-off of a different summation order only)
     np.testing.assert_allclose(clip, apply_homogeneous(camera.clip_from_world, mesh.vertices), rtol=0, atol=1e-12)
     assert clip_triangles(clip, mesh.faces).faces.shape == mesh.faces.shape  # wholly inside: nothing clipped
-    tri_int, tri_float = setup(mesh.faces, clip, codes, camera, cull=True)
-    faces_drawn = tri_int[:, 6] // 2
+    binned = bin_item(item, camera, cull=True)
+    np.testing.assert_array_equal(binned.vertex_codes, codes)  # the surface path's vertex stage: same codes
+    assert binned.crossing.size == 0 and binned.tri_int.shape[0] == 0
+    faces_drawn = np.unique(binned.tile_entries)
     # the kept faces are the front faces of the textbook back-face test, less those whose bounding box holds
     # no pixel centre (setup drops them: they cannot cover a pixel)
     front = np.flatnonzero(~backface_mask(mesh.vertices, mesh.faces, camera, "window"))
@@ -201,11 +203,25 @@ def test_fast_path_window_coordinates_and_culling_equal_the_textbook_path():
     dropped = window[mesh.faces[np.setdiff1d(front, faces_drawn)]]  # (D, 3, 3)
     low, high = np.floor(dropped.min(axis=1)[:, :2] - 0.5), np.floor(dropped.max(axis=1)[:, :2] - 0.5)
     assert len(dropped) < len(front) // 10 and (low == high).any(axis=1).all()  # no centre strictly inside
-    window = camera.project(mesh.vertices)
-    corners = window[mesh.faces[faces_drawn]]  # (T, 3, 3)
-    snapped = tri_int[:, :6].reshape(-1, 3, 2) / 256.0
-    assert np.abs(snapped - corners[:, :, :2]).max() <= 0.5 / 256 + 1e-9  # snapping moves a point <= 1/512 px
-    np.testing.assert_allclose(tri_float[:, :, 0], corners[:, :, 2], rtol=0, atol=1e-12)  # depth: round-off only
+    snapped = binned.win_int / 256.0
+    assert np.abs(snapped - window[:, :2]).max() <= 0.5 / 256 + 1e-9  # snapping moves a point <= 1/512 px
+    np.testing.assert_allclose(binned.win_float[:, 0], window[:, 2], rtol=0, atol=1e-12)  # depth: round-off only
+
+
+def test_crossing_faces_are_clipped_into_records_in_drawing_order():
+    """A face crossing the view volume is listed once among the crossing faces and drawn from its clipped
+    fan's records, each placed in the tile lists where the face is."""
+    mesh = Mesh([[-3.0, -0.5, -2.0], [3.0, -0.5, -2.0], [0.0, 0.8, -2.0], [-0.2, -0.2, -1.5], [0.2, -0.2, -1.5],
+                 [0.0, 0.2, -1.5]], [[0, 1, 2], [3, 4, 5]])  # fmt: skip
+    camera = Camera.look_at((0, 0, 0), (0, 0, -1), (0, 1, 0), projection=Perspective(0.9, 0.5, 10.0), width=64,
+                            height=48)  # fmt: skip
+    binned = bin_item(placed(Scene(), mesh).items[0], camera, cull=True)
+    assert binned.crossing.tolist() == [0]
+    assert binned.tri_int.shape[0] >= 2 and (binned.tri_int[:, 6] // 2 == 0).all()
+    for t in range(binned.tile_starts.size - 1):
+        entries = binned.tile_entries[binned.tile_starts[t] : binned.tile_starts[t + 1]].tolist()
+        if 1 in entries:  # the small face (drawn second) comes after every record of the big one in its tiles
+            assert all(e < 0 for e in entries[: entries.index(1)]) and entries[entries.index(1) + 1 :] == []
 
 
 # --- determinism ---------------------------------------------------------------------------------------------

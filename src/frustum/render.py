@@ -2,14 +2,17 @@
 
 Fast path, per scene item (one compiled pass each, buffers shared between items):
 
-1. ``raster.vertices.transform_vertices``: clip = clip_from_world·world_from_model·P, world positions and
-   normals, region codes (parallel over vertices).
-2. ``raster.triangles.window_vertices`` then ``setup_triangles``: perspective divide, viewport and snap to
-   1/256 pixel once per vertex inside the view volume; per face trivial accept (those per-vertex records, no
-   clip work) / reject, Sutherland–Hodgman clipping of crossing triangles against the view volume (divide,
-   viewport, snap per clipped corner), back-face culling by signed window area, pixel bounding box (parallel
-   over chunks of faces: count, prefix sum, write).
-3. ``raster.tiles``: bin the triangles into square tiles, keeping drawing order inside each tile.
+1. ``raster.vertices.project_vertices``: clip = clip_from_world·world_from_model·P, region codes and, for the
+   vertices inside the view volume, the perspective divide, viewport and snap to 1/256 pixel, once per vertex
+   (parallel over vertices; clip coordinates are not stored).
+2. ``raster.tiles.count_tiles`` / ``fill_tiles`` (triangle setup and binning in one): per face trivial reject,
+   trivial accept (drawn straight from its vertices' records: nothing per triangle is stored but its tile list
+   entries), back-face culling by signed window area, pixel bounding box, and the tiles it touches, counted then
+   written in face order (parallel over chunks of faces). The few faces crossing the view volume are clipped by
+   Sutherland–Hodgman (``raster.triangles.clip_faces``, divide, viewport and snap per clipped corner) into
+   triangle records that take their face's place in the tile lists.
+3. World positions and unit normals for shading (``raster.vertices.world_points``, ``transform_normals``), or
+   the mesh's own arrays when the modeling transform leaves them unchanged.
 4. ``raster.triangles.rasterize_tiles``: edge functions with the top-left rule, depth test "less" against a
    float32 buffer cleared to 1.0, perspective-correct barycentrics stored per pixel (parallel over tiles; the
    first drawn mesh's pass also clears each tile's depth and face codes, so no numpy fill of the buffers).
@@ -49,7 +52,7 @@ from frustum.frame import Frame
 from frustum.geometry import Mesh
 from frustum.hidden_lines import EdgeAdjacency, classify_edges, edge_adjacency, front_facing
 from frustum.raster import downsample, lines, shade, tiles, triangles
-from frustum.raster.vertices import transform_vertices
+from frustum.raster.vertices import project_vertices, transform_normals, transform_vertices, world_points
 from frustum.scene import Scene, SceneItem
 from frustum.shading import SPECULAR_MODELS, DepthCue, pack_lights
 
@@ -72,9 +75,9 @@ EDGE_SETS = ("all", "feature")
 FILTERS = ("box", "tent")
 COLOR_SPACES = ("linear", "srgb")
 BUFFERS = ("normals", "object_id")
-TILE_SIZE = 32
-"""Side of a square screen tile in pixels: the unit of parallel work of the rasterizer."""
-_SETUP_CHUNK = 4096
+TILE_BITS = 5
+TILE_SIZE = 1 << TILE_BITS
+"""Side of a square screen tile in pixels (32): the unit of parallel work of the rasterizer."""
 _BIN_CHUNK = 16384
 _EDGE_OFFSET = 1e-5
 """Window-depth offset of the hidden-line test (``raster.lines``), against stitching of edges into faces."""
@@ -348,6 +351,8 @@ def _shade_item(
         return
     shade.shade_pixels(codes, bary, faces, world, normals, lit, vertex_colors, uvs, texture, params, lights, flags,
                        color, extra[0], extra[1])  # fmt: skip
+
+
 def _world_faces(item: SceneItem) -> np.ndarray:
     """The item's faces, counter-clockwise seen from the front *after* its modeling transform: a transform that
     swaps handedness (det < 0, e.g. a reflection) turns the winding around, so corners 1 and 2 are swapped."""
@@ -383,94 +388,116 @@ def _draw_item(
     With `clear`, the tile kernel first sets its tiles' depth to 1 and codes to −1 (the first drawn mesh).
     """
     mesh = item.mesh
-    vertex_count = mesh.vertex_count
-    world = np.empty((vertex_count, 3))
-    normals = np.empty((vertex_count, 3))
     if mesh.face_count == 0:
-        return world, normals
-    clip = np.empty((vertex_count, 4))
-    vertex_codes = np.empty(vertex_count, dtype=np.int64)
-    transform_vertices(
-        mesh.vertices, mesh.vertex_normals, _item_matrices(item, camera), VIEW_VOLUME_PLANES,
-        clip, world, normals, vertex_codes,
-    )  # fmt: skip
-    faces = _world_faces(item)
-    tri_int, tri_float, tri_weights = _setup_records(faces, clip, vertex_codes, camera, cull, face_offset)
-    tile_starts, tile_triangles, tiling = bin_triangles(tri_int, camera.width, camera.height)
-    tiling = np.array([tiling[0], tiling[1], int(clear)], dtype=np.int64)
+        return np.empty((0, 3)), np.empty((0, 3))
+    binned = bin_item(item, camera, cull, face_offset)
+    tiling = np.array([TILE_SIZE, binned.tiles_x, int(clear), face_offset], dtype=np.int64)
     triangles.rasterize_tiles(
-        tri_int, tri_float, tri_weights, tile_starts, tile_triangles, tiling, depth, codes, bary
+        binned.faces, binned.win_int, binned.win_float, binned.tri_int, binned.tri_float, binned.tri_weights,
+        binned.tile_starts, binned.tile_entries, tiling, depth, codes, bary,
     )  # fmt: skip
+    return _world_attributes(item)
+
+
+def _world_attributes(item: SceneItem) -> tuple[np.ndarray, np.ndarray]:
+    """World positions and unit world normals of the item's vertices (``raster.vertices``); the mesh's own arrays
+    where the modeling transform leaves them unchanged (identity, or a translation for the normals: the Mesh's
+    normals are unit already)."""
+    mesh = item.mesh
+    model = np.asarray(item.world_from_model, dtype=np.float64)
+    world, normals = mesh.vertices, mesh.vertex_normals
+    if not np.array_equal(model, np.eye(4)):
+        world = np.empty((mesh.vertex_count, 3))
+        world_points(mesh.vertices, model, world)
+    if not np.array_equal(model[:3, :3], np.eye(3)):
+        normals = np.empty((mesh.vertex_count, 3))
+        transform_normals(mesh.vertex_normals, _item_matrices(item, None)[2], normals)
     return world, normals
 
 
-def setup(
-    faces: np.ndarray, clip: np.ndarray, vertex_codes: np.ndarray, camera: Camera, cull: bool, face_offset: int = 0
-) -> tuple[np.ndarray, np.ndarray]:
-    """Triangle records ``tri_int, tri_float`` (``raster.triangles``) of `faces` in clip space: clipped, divided,
-    snapped, culled (the clipped triangles' weights, ``tri_weights``, are left out: see ``_setup_records``)."""
-    tri_int, tri_float, _ = _setup_records(faces, clip, vertex_codes, camera, cull, face_offset)
-    return tri_int, tri_float
+@dataclasses.dataclass(frozen=True)
+class Binned:
+    """One item after the vertex stage, triangle setup and binning: everything the tile fill reads.
+
+    ``win_int`` (N, 2) snapped window ``X, Y`` and ``win_float`` (N, 2) ``z_w, 1/w`` of the vertices inside the
+    view volume (``vertex_codes == 0``; other rows are undefined); the clipped triangles' records ``tri_int``,
+    ``tri_float``, ``tri_weights`` (``raster.triangles``) of the ``crossing`` faces; tile t's entries, in
+    drawing order, ``tile_entries[tile_starts[t]:tile_starts[t + 1]]``: a face index f >= 0 or ``−1 − r`` for
+    record r; ``tiles_x`` tiles of ``TILE_SIZE`` pixels per row.
+    """
+
+    faces: np.ndarray
+    win_int: np.ndarray
+    win_float: np.ndarray
+    vertex_codes: np.ndarray
+    crossing: np.ndarray
+    tri_int: np.ndarray
+    tri_float: np.ndarray
+    tri_weights: np.ndarray
+    tile_starts: np.ndarray
+    tile_entries: np.ndarray
+    tiles_x: int
 
 
-def _setup_records(
-    faces: np.ndarray, clip: np.ndarray, vertex_codes: np.ndarray, camera: Camera, cull: bool, face_offset: int = 0
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``setup`` plus ``tri_weights``; tri_int is int32 when its coordinates and codes fit (``raster.triangles``)."""
-    view = np.array([camera.width / 2.0, camera.height / 2.0])
-    chunk_count = max(1, -(-faces.shape[0] // _SETUP_CHUNK))
-    chunk_starts = np.zeros((chunk_count, 2), dtype=np.int64)
-    options = np.array([camera.width, camera.height, int(cull), face_offset, _SETUP_CHUNK, 0], dtype=np.int64)
-    small = (
-        triangles.SUBPIXEL * (max(camera.width, camera.height) + 2) < 2**31
-        and 2 * (face_offset + faces.shape[0]) < 2**31
-    )
-    int_type = np.int32 if small else np.int64
-    empty_int = np.empty((0, triangles.INT_FIELDS), dtype=int_type)
-    empty_float = np.empty((0, 3, triangles.FLOAT_FIELDS))
-    win_int = np.empty((clip.shape[0], 2), dtype=np.int64)
-    win_float = np.empty((clip.shape[0], 2))
-    triangles.window_vertices(clip, vertex_codes, view, win_int, win_float)
-    # count per chunk, exclusive prefix sum, then write
-    triangles.setup_triangles(
-        faces, clip, vertex_codes, VIEW_VOLUME_PLANES, view, win_int, win_float, options, chunk_starts,
-        empty_int, empty_float, empty_float,
-    )  # fmt: skip
-    total, clipped = (int(n) for n in chunk_starts.sum(axis=0))
-    chunk_starts = np.concatenate([np.zeros((1, 2), dtype=np.int64), np.cumsum(chunk_starts, axis=0)[:-1]])
-    tri_int = np.empty((total, triangles.INT_FIELDS), dtype=int_type)
-    tri_float = np.empty((total, 3, triangles.FLOAT_FIELDS))
-    tri_weights = np.empty((clipped, 3, 2))
-    options[5] = 1
-    triangles.setup_triangles(
-        faces, clip, vertex_codes, VIEW_VOLUME_PLANES, view, win_int, win_float, options, chunk_starts,
-        tri_int, tri_float, tri_weights,
-    )  # fmt: skip
-    return tri_int, tri_float, tri_weights
-
-
-def bin_triangles(tri_int: np.ndarray, width: int, height: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Tile lists: ``tile_triangles[tile_starts[t]:tile_starts[t + 1]]`` are tile t's triangles in order."""
-    tiles_x = -(-width // TILE_SIZE)
-    tiles_y = -(-height // TILE_SIZE)
-    chunk_count = min(max(1, -(-tri_int.shape[0] // _BIN_CHUNK)), 4 * numba.get_num_threads())
-    chunk = max(1, -(-tri_int.shape[0] // chunk_count))
-    tiling = np.array([TILE_SIZE, tiles_x, chunk], dtype=np.int64)
+def bin_item(item: SceneItem, camera: Camera, cull: bool, face_offset: int = 0) -> Binned:
+    """Stages 1–3 for one placed mesh with faces (module docstring): project, set up, clip, cull and bin."""
+    mesh = item.mesh
+    faces = _world_faces(item)
+    width, height = camera.width, camera.height
+    view = np.array([width / 2.0, height / 2.0])
+    clip_from_model = _item_matrices(item, camera)[0]
+    small = triangles.SUBPIXEL * (max(width, height) + 2) < 2**31
+    win_int = np.empty((mesh.vertex_count, 2), dtype=np.int32 if small else np.int64)
+    win_float = np.empty((mesh.vertex_count, 2))
+    vertex_codes = np.empty(mesh.vertex_count, dtype=np.uint8)  # 6 view-volume planes: one bit each
+    project_vertices(mesh.vertices, clip_from_model, view, win_int, win_float, vertex_codes)
+    # per face: reject / accept / crossing, cull, box, count its tiles (parallel over chunks of faces)
+    tiles_x, tiles_y = -(-width // TILE_SIZE), -(-height // TILE_SIZE)
+    chunk_count = min(max(1, -(-faces.shape[0] // _BIN_CHUNK)), 4 * numba.get_num_threads())
+    chunk = max(1, -(-faces.shape[0] // chunk_count))
+    chunk_count = -(-faces.shape[0] // chunk)
+    options = np.array([width, height, int(cull), TILE_BITS, tiles_x, chunk, face_offset], dtype=np.int64)
     counts = np.empty((chunk_count, tiles_x * tiles_y), dtype=np.int64)
-    tiles.count_tile_triangles(tri_int, tiling, counts)
+    crossing_counts = np.empty(chunk_count, dtype=np.int64)
+    listed = np.empty(faces.shape[0], dtype=np.int32 if faces.shape[0] < 2**31 else np.int64)  # pages touched as used
+    listed_counts = np.empty(chunk_count, dtype=np.int64)
+    tiles.count_tiles(faces, vertex_codes, win_int, options, counts, crossing_counts, listed, listed_counts)
+    # the crossing faces: clipped into records (count, prefix sum, write), which join their face's chunk
+    crossing_starts = np.concatenate([[0], np.cumsum(crossing_counts)])
+    crossing = np.empty(int(crossing_starts[-1]), dtype=np.int64)
+    tri_int = np.empty((0, triangles.RECORD_FIELDS), dtype=np.int64)
+    tri_float, tri_weights = np.empty((0, 3, 2)), np.empty((0, 3, 2))
+    record_starts = np.zeros(crossing.shape[0] + 1, dtype=np.int64)
+    if crossing.shape[0]:
+        triangles.list_crossing(faces, vertex_codes, chunk, listed, listed_counts, crossing_starts[:-1], crossing)
+        clip_options = np.array([width, height, int(cull), face_offset, 0], dtype=np.int64)
+        arguments = (crossing, faces, mesh.vertices, clip_from_model, VIEW_VOLUME_PLANES, view, clip_options)
+        triangles.clip_faces(*arguments, record_starts[1:], tri_int, tri_float, tri_weights)
+        record_starts = np.cumsum(record_starts)
+        total = int(record_starts[-1])
+        tri_int = np.empty((total, triangles.RECORD_FIELDS), dtype=np.int64)
+        tri_float, tri_weights = np.empty((total, 3, 2)), np.empty((total, 3, 2))
+        clip_options[4] = 1
+        triangles.clip_faces(*arguments, record_starts[:-1], tri_int, tri_float, tri_weights)
+        tiles.add_record_tiles(tri_int, options, counts)
     offsets = np.empty_like(counts)
     tile_starts = np.empty(tiles_x * tiles_y + 1, dtype=np.int64)
     tiles.tile_offsets(counts, offsets, tile_starts)
-    tile_triangles = np.empty(int(tile_starts[-1]), dtype=np.int32 if tri_int.shape[0] < 2**31 else np.int64)
-    tiles.fill_tile_triangles(tri_int, tiling, offsets, tile_triangles)
-    return tile_starts, tile_triangles, tiling[:2].copy()
+    entry_type = np.int32 if max(faces.shape[0], tri_int.shape[0] + 1) < 2**31 else np.int64
+    tile_entries = np.empty(int(tile_starts[-1]), dtype=entry_type)
+    tiles.fill_tiles(faces, vertex_codes, win_int, options, listed, listed_counts, offsets, crossing_starts[:-1],
+                     record_starts, tri_int, tile_entries)  # fmt: skip
+    return Binned(faces, win_int, win_float, vertex_codes, crossing, tri_int, tri_float, tri_weights, tile_starts,
+                  tile_entries, tiles_x)  # fmt: skip
 
 
-def _item_matrices(item: SceneItem, camera: Camera) -> np.ndarray:
-    """(3, 4, 4): clip_from_model, world_from_model, and the normal matrix (inverse transpose) in a 4x4."""
+def _item_matrices(item: SceneItem, camera: Camera | None) -> np.ndarray:
+    """(3, 4, 4): clip_from_model (zeros without a camera), world_from_model, and the normal matrix (inverse
+    transpose) in a 4x4."""
     world_from_model = np.asarray(item.world_from_model, dtype=np.float64)
     matrices = np.zeros((3, 4, 4))
-    matrices[0] = camera.clip_from_world @ world_from_model
+    if camera is not None:
+        matrices[0] = camera.clip_from_world @ world_from_model
     matrices[1] = world_from_model
     matrices[2, :3, :3] = np.linalg.inv(world_from_model[:3, :3]).T
     matrices[2, 3, 3] = 1.0
@@ -694,8 +721,8 @@ def _check_arguments(
     background_bytes = _background_bytes(background, where)
     if edge_color is None:  # material colors for wireframes; black on light backgrounds, white on dark ones
         light = background_bytes[:3].astype(float) @ (0.2126, 0.7152, 0.0722) > 127.5
-        edge = None if mode in ("wireframe", "points") else np.array([0.0, 0.0, 0.0, 255.0]) * light + 255.0 * (
-            not light
+        edge = (
+            None if mode in ("wireframe", "points") else np.array([0.0, 0.0, 0.0, 255.0]) * light + 255.0 * (not light)
         )
     else:
         edge = _color_bytes(edge_color, "edge_color", where)

@@ -11,8 +11,10 @@ import numpy as np
 
 from frustum.raster._jit import kernel
 
-__all__ = ["HALF_SUBPIXEL", "SUBPIXEL", "snap"]
+__all__ = ["HALF_SUBPIXEL", "SUBPIXEL", "SUBPIXEL_BITS", "snap"]
 
+SUBPIXEL_BITS = 8
+"""``X >> SUBPIXEL_BITS`` is ``floor(X / 256)`` for any int64 X (an arithmetic shift floors)."""
 SUBPIXEL = 256
 """Subpixel steps per pixel (8 fractional bits), as in llvmpipe."""
 HALF_SUBPIXEL = 128

@@ -1,8 +1,13 @@
-"""Binning kernels: sort triangle records into square screen tiles, keeping drawing order inside each tile.
+"""Binning kernels: sort the faces to draw into square screen tiles, keeping drawing order inside each tile.
 
-Count (parallel over chunks of triangles), prefix sum (serial, tile-major so chunk c's triangles precede
-chunk c + 1's within every tile), fill (parallel over chunks). A triangle goes to every tile its pixel
-bounding box touches. tiling = (tile_size, tiles_x, chunk) int64; tri_int as in ``triangles.py``.
+This is also the per-face half of triangle setup (``triangles.face_box``: trivial reject and accept by region
+codes, back-face cull by the signed window area, pixel bounding box), so a face's corners are read twice (count,
+then fill) and nothing per face is stored but its tile list entries. Count (parallel over chunks of faces),
+records of the clipped faces added to their face's chunk, prefix sum (serial, tile-major so chunk c's entries
+precede chunk c + 1's within every tile), fill (parallel over chunks). A face goes to every tile its pixel
+bounding box touches; a crossing face's clipped triangles (``triangles.clip_faces``) go, in fan order, where the
+face is. options = (width, height, cull, tile_bits, tiles_x, chunk, face_offset) int64: tiles are
+``2^tile_bits`` pixels square, so a pixel's tile index is a shift.
 """
 
 from __future__ import annotations
@@ -10,22 +15,57 @@ from __future__ import annotations
 import numpy as np
 
 from frustum.raster._jit import kernel, parallel_kernel, prange
+from frustum.raster.triangles import FACE_CROSSING, FACE_DRAWN, face_box
 
-__all__ = ["count_tile_triangles", "fill_tile_triangles", "tile_offsets"]
+__all__ = ["add_record_tiles", "count_tiles", "fill_tiles", "tile_offsets"]
+
+O_WIDTH, O_HEIGHT, O_CULL, O_BITS, O_TILES_X, O_CHUNK, O_FACE_OFFSET = 0, 1, 2, 3, 4, 5, 6
 
 
 @parallel_kernel
-def count_tile_triangles(tri_int: np.ndarray, tiling: np.ndarray, counts: np.ndarray) -> None:
-    """``counts[c, t]`` = how many triangles of chunk c touch tile t (counts (C, tiles) int64, written)."""
-    size, tiles_x, chunk = tiling[0], tiling[1], tiling[2]
-    total = tri_int.shape[0]
+def count_tiles(
+    faces: np.ndarray, codes: np.ndarray, win_int: np.ndarray, options: np.ndarray, counts: np.ndarray,
+    crossing: np.ndarray, listed: np.ndarray, listed_counts: np.ndarray,
+) -> None:  # fmt: skip
+    """``counts[c, t]`` = how many drawn faces of chunk c touch tile t; ``crossing[c]`` = its crossing faces.
+
+    counts (C, tiles), crossing (C,) and listed_counts (C,) int64 are written; chunk c is faces
+    [c·chunk, (c+1)·chunk). The chunk's drawn and crossing faces, in order, go to ``listed`` (M,) from
+    ``c·chunk`` on, ``listed_counts[c]`` of them: the fill visits only those (most faces of a fine mesh draw
+    nothing, being back faces or falling between pixel centres).
+    """
+    width, height, cull = options[O_WIDTH], options[O_HEIGHT], options[O_CULL]
+    bits, tiles_x, chunk = options[O_BITS], options[O_TILES_X], options[O_CHUNK]
     for c in prange(counts.shape[0]):
         for t in range(counts.shape[1]):
             counts[c, t] = 0
-        for k in range(c * chunk, min((c + 1) * chunk, total)):
-            for ty in range(tri_int[k, 9] // size, tri_int[k, 10] // size + 1):
-                for tx in range(tri_int[k, 7] // size, tri_int[k, 8] // size + 1):
-                    counts[c, ty * tiles_x + tx] += 1
+        crossed = 0
+        n = c * chunk
+        for f in range(c * chunk, min((c + 1) * chunk, faces.shape[0])):
+            state, _, i_min, i_max, j_min, j_max = face_box(faces, codes, win_int, f, width, height, cull)
+            if state == FACE_CROSSING:
+                crossed += 1
+                listed[n] = f
+                n += 1
+            elif state == FACE_DRAWN:
+                listed[n] = f
+                n += 1
+                for ty in range(j_min >> bits, (j_max >> bits) + 1):
+                    for tx in range(i_min >> bits, (i_max >> bits) + 1):
+                        counts[c, ty * tiles_x + tx] += 1
+        crossing[c] = crossed
+        listed_counts[c] = n - c * chunk
+
+
+@kernel
+def add_record_tiles(tri_int: np.ndarray, options: np.ndarray, counts: np.ndarray) -> None:
+    """Add to ``counts[c, t]`` the clipped triangle records (``triangles``) whose source face is in chunk c."""
+    bits, tiles_x, chunk = options[O_BITS], options[O_TILES_X], options[O_CHUNK]
+    for r in range(tri_int.shape[0]):
+        c = (tri_int[r, 6] // 2 - options[O_FACE_OFFSET]) // chunk
+        for ty in range(tri_int[r, 9] >> bits, (tri_int[r, 10] >> bits) + 1):
+            for tx in range(tri_int[r, 7] >> bits, (tri_int[r, 8] >> bits) + 1):
+                counts[c, ty * tiles_x + tx] += 1
 
 
 @kernel
@@ -44,16 +84,34 @@ def tile_offsets(counts: np.ndarray, offsets: np.ndarray, tile_starts: np.ndarra
 
 
 @parallel_kernel
-def fill_tile_triangles(
-    tri_int: np.ndarray, tiling: np.ndarray, offsets: np.ndarray, tile_triangles: np.ndarray
-) -> None:
-    """Write each triangle index into the lists of the tiles it touches (offsets (C, tiles) is consumed)."""
-    size, tiles_x, chunk = tiling[0], tiling[1], tiling[2]
-    total = tri_int.shape[0]
+def fill_tiles(
+    faces: np.ndarray, codes: np.ndarray, win_int: np.ndarray, options: np.ndarray, listed: np.ndarray,
+    listed_counts: np.ndarray, offsets: np.ndarray, crossing_starts: np.ndarray, record_starts: np.ndarray,
+    tri_int: np.ndarray, tile_entries: np.ndarray,
+) -> None:  # fmt: skip
+    """Write each drawn face's index (and ``−1 − r`` for each record r of a clipped face) into the lists of the
+    tiles it touches, in face order: the faces ``count_tiles`` listed. offsets (C, tiles) is consumed;
+    crossing_starts (C,) is the index of chunk c's first crossing face among all crossing faces, whose records
+    are ``record_starts[k]:record_starts[k + 1]``.
+    """
+    width, height, cull = options[O_WIDTH], options[O_HEIGHT], options[O_CULL]
+    bits, tiles_x, chunk = options[O_BITS], options[O_TILES_X], options[O_CHUNK]
     for c in prange(offsets.shape[0]):
-        for k in range(c * chunk, min((c + 1) * chunk, total)):
-            for ty in range(tri_int[k, 9] // size, tri_int[k, 10] // size + 1):
-                for tx in range(tri_int[k, 7] // size, tri_int[k, 8] // size + 1):
-                    t = ty * tiles_x + tx
-                    tile_triangles[offsets[c, t]] = k
-                    offsets[c, t] += 1
+        k = crossing_starts[c]
+        for n in range(c * chunk, c * chunk + listed_counts[c]):
+            f = listed[n]
+            state, _, i_min, i_max, j_min, j_max = face_box(faces, codes, win_int, f, width, height, cull)
+            if state == FACE_DRAWN:
+                for ty in range(j_min >> bits, (j_max >> bits) + 1):
+                    for tx in range(i_min >> bits, (i_max >> bits) + 1):
+                        t = ty * tiles_x + tx
+                        tile_entries[offsets[c, t]] = f
+                        offsets[c, t] += 1
+            elif state == FACE_CROSSING:
+                for r in range(record_starts[k], record_starts[k + 1]):
+                    for ty in range(tri_int[r, 9] >> bits, (tri_int[r, 10] >> bits) + 1):
+                        for tx in range(tri_int[r, 7] >> bits, (tri_int[r, 8] >> bits) + 1):
+                            t = ty * tiles_x + tx
+                            tile_entries[offsets[c, t]] = -1 - r
+                            offsets[c, t] += 1
+                k += 1
