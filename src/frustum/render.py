@@ -14,8 +14,8 @@ Fast path, per scene item (one compiled pass each, buffers shared between items)
 3. World positions and unit normals for shading (``raster.vertices.world_points``, ``transform_normals``), or
    the mesh's own arrays when the modeling transform leaves them unchanged.
 4. ``raster.triangles.rasterize_tiles``: edge functions with the top-left rule, depth test "less" against a
-   float32 buffer cleared to 1.0, perspective-correct barycentrics stored per pixel (parallel over tiles; the
-   first drawn mesh's pass also clears each tile's depth and face codes, so no numpy fill of the buffers).
+   float32 buffer cleared to 1.0 (``clear_buffers``, parallel over rows), perspective-correct barycentrics stored
+   per pixel (parallel over tiles).
 5. ``raster.shade.shade_pixels``: deferred shading once per visible pixel (``frustum.shading``'s model,
    flat, Gouraud or Phong; per-vertex or per-face terms first by ``light_vertices`` / ``light_faces``); the
    last item's pass (rasterization complete) also paints the background pixels.
@@ -253,18 +253,14 @@ def _draw_surfaces(
     height, width = camera.height, camera.width
     opaque = [i for i, item in enumerate(items) if item.material.opacity >= 1.0]
     clear_items = [i for i, item in enumerate(items) if item.material.opacity < 1.0]
-    # uninitialized: the first rasterized item clears depth and codes tile by tile, the last shading pass
-    # paints the background (both inside the parallel kernels); numpy fills only when no kernel runs
+    # color uninitialized: the last shading pass paints the background (numpy fills it only when none runs)
     depth = np.empty((height, width), dtype=np.float32)
     face_total = sum(item.mesh.face_count for item in items)
     code_type = np.int32 if 2 * face_total < 2**31 else np.int64
     codes = np.empty((height, width), dtype=code_type)
     bary = np.empty((height, width, 2), dtype=np.float32)  # read only where codes >= 0
     color = np.empty((height, width, 4), dtype=np.uint8)
-    opaque_faces = sum(items[i].mesh.face_count for i in opaque)
-    if opaque_faces == 0:
-        depth.fill(1.0)
-        codes.fill(-1)
+    triangles.clear_buffers(depth, codes)
     if not opaque:
         color[:, :] = options.background
     ambient, lights = pack_lights(scene.world_lights())
@@ -272,15 +268,10 @@ def _draw_surfaces(
         np.zeros((1, 1, 3), dtype=np.float32) if normal_out is None else normal_out,
         np.zeros((1, 1), dtype=np.int32) if id_out is None else id_out,
     )
-    face_offset = 0
     offsets = np.cumsum([0] + [item.mesh.face_count for item in items])
-    clear = opaque_faces > 0
     drawn = []
     for index in opaque:
-        item = items[index]
-        face_offset = int(offsets[index])
-        world, normals = _draw_item(item, camera, options.cull, face_offset, depth, codes, bary, clear)
-        clear = clear and item.mesh.face_count == 0
+        world, normals = _draw_item(items[index], camera, options.cull, int(offsets[index]), depth, codes, bary)
         drawn.append((index, world, normals))
     for position, (index, world, normals) in enumerate(drawn):
         last = position == len(drawn) - 1
@@ -302,8 +293,7 @@ def _draw_surfaces(
             item = items[index]
             layer_depth = depth.copy()
             layer_codes = np.full((height, width), -1, dtype=code_type)
-            world, normals = _draw_item(item, camera, options.cull, int(offsets[index]), layer_depth, layer_codes,
-                                        bary, False)  # fmt: skip
+            world, normals = _draw_item(item, camera, options.cull, int(offsets[index]), layer_depth, layer_codes, bary)
             _shade_item(item, index, int(offsets[index]), camera, options, ambient, lights, world, normals,
                         layer_codes, bary, color, extra, paint=False, blend=True)  # fmt: skip
     return depth, color
@@ -381,17 +371,14 @@ def _adjacency(mesh: Mesh) -> EdgeAdjacency:
 
 def _draw_item(
     item: SceneItem, camera: Camera, cull: bool, face_offset: int,
-    depth: np.ndarray, codes: np.ndarray, bary: np.ndarray, clear: bool,
+    depth: np.ndarray, codes: np.ndarray, bary: np.ndarray,
 ) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
-    """Stages 1–4 for one placed mesh; returns its world positions and unit world normals for shading.
-
-    With `clear`, the tile kernel first sets its tiles' depth to 1 and codes to −1 (the first drawn mesh).
-    """
+    """Stages 1–4 for one placed mesh into the buffers; returns its world positions and unit world normals."""
     mesh = item.mesh
     if mesh.face_count == 0:
         return np.empty((0, 3)), np.empty((0, 3))
     binned = bin_item(item, camera, cull, face_offset)
-    tiling = np.array([TILE_SIZE, binned.tiles_x, int(clear), face_offset], dtype=np.int64)
+    tiling = np.array([TILE_SIZE, binned.tiles_x, face_offset], dtype=np.int64)
     triangles.rasterize_tiles(
         binned.faces, binned.win_int, binned.win_float, binned.tri_int, binned.tri_float, binned.tri_weights,
         binned.tile_starts, binned.tile_entries, tiling, depth, codes, bary,
