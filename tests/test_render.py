@@ -242,6 +242,33 @@ def test_identical_bytes_across_runs_and_thread_counts():
         assert first.depth.tobytes() == other.depth.tobytes()
 
 
+def test_work_arrays_reused_across_calls_and_renders_in_threads_give_the_same_bytes():
+    """``Scratch`` hands the previous call's work arrays (uninitialized memory holding another frame) to the next
+    call and to repeated meshes of one call; renders in concurrent threads each take their own."""
+    import threading
+
+    scene, camera = small_scene()
+    scene.add(sphere_mesh(1), material=Material(color=(0.2, 0.9, 0.2)), transform=translate(-1.5, 0.0, -1.0))
+    expected = render(scene, camera, background=BACKGROUND)
+    other = Camera.look_at((3.0, 1.0, 1.0), (0, 0, 0), (0, 1, 0), width=48, height=36)
+    render(scene, other, background=BACKGROUND)  # leaves its arrays (same shapes) in the pool
+    results = []
+
+    def worker():
+        for _ in range(3):
+            results.append(render(scene, camera, background=BACKGROUND))
+
+    threads = [threading.Thread(target=worker) for _ in range(3)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    assert len(results) == 9
+    for frame in results:
+        assert frame.color.tobytes() == expected.color.tobytes()
+        assert frame.depth.tobytes() == expected.depth.tobytes()
+
+
 # --- frame and output ----------------------------------------------------------------------------------------
 
 

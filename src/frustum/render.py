@@ -38,8 +38,9 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import threading
 import weakref
-from typing import Any
+from typing import Any, ClassVar
 
 import numba
 import numpy as np
@@ -98,6 +99,52 @@ class _Options:
     line_width: float
     depth_cue: DepthCue | None
     buffers: tuple[str, ...]
+
+
+class Scratch:
+    """Work arrays of one ``render`` call (buffers no Frame returns: face codes, barycentrics, window records,
+    tile lists), taken from the arrays the previous call gave back when shape and dtype match.
+
+    A fresh large array costs a first-touch pass (the kernel zeroes every page) on top of its use: reusing the
+    last frame's saves that on every frame of an animation or a multi-view render of the same scene. At most one
+    call's arrays are kept (``release`` replaces them); concurrent calls each take distinct arrays (a lock
+    guards the pool), so renders in threads never share one.
+    """
+
+    _pool: ClassVar[dict[tuple, list[np.ndarray]]] = {}
+    _lock: ClassVar[threading.Lock] = threading.Lock()
+
+    def __init__(self) -> None:
+        self.taken: list[np.ndarray] = []
+        self.free: dict[tuple, list[np.ndarray]] = {}
+
+    def empty(self, shape: tuple[int, ...], dtype: Any = np.float64) -> np.ndarray:
+        """An uninitialized array like ``np.empty(shape, dtype)``: one this call recycled, or one of the pool."""
+        key = (tuple(int(n) for n in shape), np.dtype(dtype).str)
+        arrays = self.free.get(key)
+        array = arrays.pop() if arrays else None
+        if array is None:
+            with Scratch._lock:
+                arrays = Scratch._pool.get(key)
+                array = arrays.pop() if arrays else None
+        if array is None:
+            array = np.empty(key[0], dtype=dtype)
+        self.taken.append(array)
+        return array
+
+    def recycle(self, *arrays: np.ndarray) -> None:
+        """Arrays this call took and no longer reads: free for its next ``empty`` of the same shape (next item)."""
+        for array in arrays:
+            self.free.setdefault((array.shape, array.dtype.str), []).append(array)
+
+    def release(self) -> None:
+        """Give this call's arrays to the pool, in place of what it held."""
+        pool: dict[tuple, list[np.ndarray]] = {}
+        for array in {id(a): a for a in self.taken}.values():
+            pool.setdefault((array.shape, array.dtype.str), []).append(array)
+        with Scratch._lock:
+            Scratch._pool = pool
+        self.taken, self.free = [], {}
 
 
 def render(
@@ -236,7 +283,9 @@ def _render_buffers(
         _draw_edges(items, camera, options, depth, color)
         _draw_polylines(scene.polylines, camera, options, depth, color)
         return color, depth, normal_out, id_out
-    depth, color = _draw_surfaces(scene, items, camera, options, normal_out, id_out)
+    scratch = Scratch()
+    depth, color = _draw_surfaces(scene, items, camera, options, normal_out, id_out, scratch)
+    scratch.release()
     if options.mode == "hidden-line":
         color[:, :] = options.background
     if options.mode in ("hidden-line", "surface+edges"):
@@ -247,7 +296,7 @@ def _render_buffers(
 
 def _draw_surfaces(
     scene: Scene, items: list[SceneItem], camera: Camera, options: _Options,
-    normal_out: np.ndarray | None, id_out: np.ndarray | None,
+    normal_out: np.ndarray | None, id_out: np.ndarray | None, scratch: Scratch,
 ) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
     """Stages 1–6 for every item: the depth and color buffers."""
     height, width = camera.height, camera.width
@@ -257,8 +306,8 @@ def _draw_surfaces(
     depth = np.empty((height, width), dtype=np.float32)
     face_total = sum(item.mesh.face_count for item in items)
     code_type = np.int32 if 2 * face_total < 2**31 else np.int64
-    codes = np.empty((height, width), dtype=code_type)
-    bary = np.empty((height, width, 2), dtype=np.float32)  # read only where codes >= 0
+    codes = scratch.empty((height, width), code_type)
+    bary = scratch.empty((height, width, 2), np.float32)  # read only where codes >= 0
     color = np.empty((height, width, 4), dtype=np.uint8)
     triangles.clear_buffers(depth, codes)
     if not opaque:
@@ -271,7 +320,8 @@ def _draw_surfaces(
     offsets = np.cumsum([0] + [item.mesh.face_count for item in items])
     drawn = []
     for index in opaque:
-        world, normals = _draw_item(items[index], camera, options.cull, int(offsets[index]), depth, codes, bary)
+        world, normals = _draw_item(items[index], camera, options.cull, int(offsets[index]), depth, codes, bary,
+                                    scratch)  # fmt: skip
         drawn.append((index, world, normals))
     for position, (index, world, normals) in enumerate(drawn):
         last = position == len(drawn) - 1
@@ -293,7 +343,9 @@ def _draw_surfaces(
             item = items[index]
             layer_depth = depth.copy()
             layer_codes = np.full((height, width), -1, dtype=code_type)
-            world, normals = _draw_item(item, camera, options.cull, int(offsets[index]), layer_depth, layer_codes, bary)
+            world, normals = _draw_item(
+                item, camera, options.cull, int(offsets[index]), layer_depth, layer_codes, bary, scratch
+            )
             _shade_item(item, index, int(offsets[index]), camera, options, ambient, lights, world, normals,
                         layer_codes, bary, color, extra, paint=False, blend=True)  # fmt: skip
     return depth, color
@@ -371,22 +423,23 @@ def _adjacency(mesh: Mesh) -> EdgeAdjacency:
 
 def _draw_item(
     item: SceneItem, camera: Camera, cull: bool, face_offset: int,
-    depth: np.ndarray, codes: np.ndarray, bary: np.ndarray,
+    depth: np.ndarray, codes: np.ndarray, bary: np.ndarray, scratch: Scratch,
 ) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
     """Stages 1–4 for one placed mesh into the buffers; returns its world positions and unit world normals."""
     mesh = item.mesh
     if mesh.face_count == 0:
         return np.empty((0, 3)), np.empty((0, 3))
-    binned = bin_item(item, camera, cull, face_offset)
+    binned = bin_item(item, camera, cull, face_offset, scratch)
     tiling = np.array([TILE_SIZE, binned.tiles_x, face_offset], dtype=np.int64)
     triangles.rasterize_tiles(
         binned.faces, binned.win_int, binned.win_float, binned.tri_int, binned.tri_float, binned.tri_weights,
         binned.tile_starts, binned.tile_entries, tiling, depth, codes, bary,
     )  # fmt: skip
-    return _world_attributes(item)
+    scratch.recycle(binned.win_int, binned.win_float, binned.vertex_codes, binned.tile_entries)
+    return _world_attributes(item, scratch)
 
 
-def _world_attributes(item: SceneItem) -> tuple[np.ndarray, np.ndarray]:
+def _world_attributes(item: SceneItem, scratch: Scratch) -> tuple[np.ndarray, np.ndarray]:
     """World positions and unit world normals of the item's vertices (``raster.vertices``); the mesh's own arrays
     where the modeling transform leaves them unchanged (identity, or a translation for the normals: the Mesh's
     normals are unit already)."""
@@ -394,10 +447,10 @@ def _world_attributes(item: SceneItem) -> tuple[np.ndarray, np.ndarray]:
     model = np.asarray(item.world_from_model, dtype=np.float64)
     world, normals = mesh.vertices, mesh.vertex_normals
     if not np.array_equal(model, np.eye(4)):
-        world = np.empty((mesh.vertex_count, 3))
+        world = scratch.empty((mesh.vertex_count, 3))
         world_points(mesh.vertices, model, world)
     if not np.array_equal(model[:3, :3], np.eye(3)):
-        normals = np.empty((mesh.vertex_count, 3))
+        normals = scratch.empty((mesh.vertex_count, 3))
         transform_normals(mesh.vertex_normals, _item_matrices(item, None)[2], normals)
     return world, normals
 
@@ -426,17 +479,21 @@ class Binned:
     tiles_x: int
 
 
-def bin_item(item: SceneItem, camera: Camera, cull: bool, face_offset: int = 0) -> Binned:
-    """Stages 1–3 for one placed mesh with faces (module docstring): project, set up, clip, cull and bin."""
+def bin_item(
+    item: SceneItem, camera: Camera, cull: bool, face_offset: int = 0, scratch: Scratch | None = None
+) -> Binned:
+    """Stages 1–3 for one placed mesh with faces (module docstring): project, set up, clip, cull and bin (work
+    arrays from `scratch`, if given)."""
+    empty = np.empty if scratch is None else scratch.empty
     mesh = item.mesh
     faces = _world_faces(item)
     width, height = camera.width, camera.height
     view = np.array([width / 2.0, height / 2.0])
     clip_from_model = _item_matrices(item, camera)[0]
     small = triangles.SUBPIXEL * (max(width, height) + 2) < 2**31
-    win_int = np.empty((mesh.vertex_count, 2), dtype=np.int32 if small else np.int64)
-    win_float = np.empty((mesh.vertex_count, 2))
-    vertex_codes = np.empty(mesh.vertex_count, dtype=np.uint8)  # 6 view-volume planes: one bit each
+    win_int = empty((mesh.vertex_count, 2), np.int32 if small else np.int64)
+    win_float = empty((mesh.vertex_count, 2), np.float64)
+    vertex_codes = empty((mesh.vertex_count,), np.uint8)  # 6 view-volume planes: one bit each
     project_vertices(mesh.vertices, clip_from_model, view, win_int, win_float, vertex_codes)
     # per face: reject / accept / crossing, cull, box, count its tiles (parallel over chunks of faces)
     tiles_x, tiles_y = -(-width // TILE_SIZE), -(-height // TILE_SIZE)
@@ -446,7 +503,7 @@ def bin_item(item: SceneItem, camera: Camera, cull: bool, face_offset: int = 0) 
     options = np.array([width, height, int(cull), TILE_BITS, tiles_x, chunk, face_offset], dtype=np.int64)
     counts = np.empty((chunk_count, tiles_x * tiles_y), dtype=np.int64)
     crossing_counts = np.empty(chunk_count, dtype=np.int64)
-    listed = np.empty(faces.shape[0], dtype=np.int32 if faces.shape[0] < 2**31 else np.int64)  # pages touched as used
+    listed = empty((faces.shape[0],), np.int32 if faces.shape[0] < 2**31 else np.int64)
     listed_counts = np.empty(chunk_count, dtype=np.int64)
     tiles.count_tiles(faces, vertex_codes, win_int, options, counts, crossing_counts, listed, listed_counts)
     # the crossing faces: clipped into records (count, prefix sum, write), which join their face's chunk
@@ -471,9 +528,11 @@ def bin_item(item: SceneItem, camera: Camera, cull: bool, face_offset: int = 0) 
     tile_starts = np.empty(tiles_x * tiles_y + 1, dtype=np.int64)
     tiles.tile_offsets(counts, offsets, tile_starts)
     entry_type = np.int32 if max(faces.shape[0], tri_int.shape[0] + 1) < 2**31 else np.int64
-    tile_entries = np.empty(int(tile_starts[-1]), dtype=entry_type)
+    tile_entries = empty((int(tile_starts[-1]),), entry_type)
     tiles.fill_tiles(faces, vertex_codes, win_int, options, listed, listed_counts, offsets, crossing_starts[:-1],
                      record_starts, tri_int, tile_entries)  # fmt: skip
+    if scratch is not None:
+        scratch.recycle(listed)
     return Binned(faces, win_int, win_float, vertex_codes, crossing, tri_int, tri_float, tri_weights, tile_starts,
                   tile_entries, tiles_x)  # fmt: skip
 
