@@ -8,7 +8,8 @@ and shading is a Python loop over pixels. Clipping uses the public textbook func
 
 Rules, written out once more (the arithmetic order matters for byte equality):
 - clip = M·[x, y, z, 1] row by row as ((m0·x + m1·y) + m2·z) + m3; world likewise; normals by the inverse
-  transpose, ((a0·x + a1·y) + a2·z), then divided by their length sqrt((x² + y²) + z²).
+  transpose, ((a0·x + a1·y) + a2·z), then divided by their length sqrt((x² + y²) + z²); when the modeling
+  transform's 3x3 block is the identity, the Mesh's (unit) normals as stored.
 - window x = (x_c / w)·(W/2) + W/2 (y alike), snapped X = floor(x·256 + 0.5); z_w = (z_c / w)·0.5 + 0.5.
 - twice the area (X1 − X0)(Y2 − Y0) − (X2 − X0)(Y1 − Y0) in integers; 0: dropped; < 0: culled, or drawn
   with corners 1 and 2 swapped and the back flag set.
@@ -31,6 +32,7 @@ def placed(scene, mesh, material=None, transform=None):
     """``scene.add(mesh, material, transform)`` and return the scene (``Scene.add`` returns the new node)."""
     scene.add(mesh, material=material, transform=transform)
     return scene
+
 
 def _rows(matrix: np.ndarray, points: np.ndarray, count: int, affine: bool) -> np.ndarray:
     x, y, z = points[:, 0], points[:, 1], points[:, 2]
@@ -70,6 +72,8 @@ def reference_render(scene, camera, shading="phong", background=(0, 0, 0, 1), cu
             (normals[:, 0] * normals[:, 0] + normals[:, 1] * normals[:, 1]) + normals[:, 2] * normals[:, 2]
         )
         normals = normals / lengths[:, None]
+        if np.array_equal(model[:3, :3], np.eye(3)):  # the Mesh's normals are unit already: used as stored
+            normals = mesh.vertex_normals
         per_item.append((world, normals))
         if mesh.face_count == 0:
             continue
@@ -138,6 +142,19 @@ def _byte(value: float) -> int:
     return math.floor(min(max(value, 0.0), 1.0) * 255.0 + 0.5)
 
 
+def _power(x, n):
+    """x**n as the renderer takes it: integral n in [0, 1024] by repeated squaring (lowest bit first)."""
+    if n != math.floor(n) or not 0 <= n <= 1024:
+        return x**n
+    e, r = int(n), 1.0
+    while e > 0:
+        if e & 1:
+            r *= x
+        x *= x
+        e >>= 1
+    return r
+
+
 def _shade(item, scene, camera, shading, face, back, weights, world, normals):
     material = item.material
     if shading in (None, "none"):
@@ -159,7 +176,7 @@ def _shade(item, scene, camera, shading, face, back, weights, world, normals):
     length = math.sqrt((h[0] * h[0] + h[1] * h[1]) + h[2] * h[2])
     h = [x / length for x in h]
     ndl = max((n[0] * light[0] + n[1] * light[1]) + n[2] * light[2], 0.0)
-    spec = max((n[0] * h[0] + n[1] * h[1]) + n[2] * h[2], 0.0) ** material.shininess if ndl > 0.0 else 0.0
+    spec = _power(max((n[0] * h[0] + n[1] * h[1]) + n[2] * h[2], 0.0), material.shininess) if ndl > 0.0 else 0.0
     rgb = [
         float(material.color[k]) * (material.ambient + material.diffuse * ndl) + material.specular * spec
         for k in range(3)

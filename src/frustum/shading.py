@@ -43,6 +43,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from frustum._arrays import Matrix4, Vector3, as_direction, as_scalar, as_vector3, describe, read_only
 from frustum.errors import ShadingError
+from frustum.raster.shade import power
 from frustum.transforms import apply, apply_to_directions
 
 __all__ = [
@@ -371,11 +372,11 @@ def _light_terms(light: Light, point: NDArray, normal: NDArray, view: NDArray, s
     if ndl > 0.0:
         if specular == "phong":
             reflected = 2.0 * float(normal @ to_light) * normal - to_light
-            spec = max(float(reflected @ view), 0.0) ** shininess
+            spec = power(max(float(reflected @ view), 0.0), shininess)
         else:
             half = to_light + view
             half = half / math.sqrt(float(half @ half))
-            spec = max(float(normal @ half), 0.0) ** shininess
+            spec = power(max(float(normal @ half), 0.0), shininess)
     return falloff * ndl, falloff * spec
 
 

@@ -39,6 +39,7 @@ __all__ = [
     "SHADE_PHONG",
     "light_faces",
     "light_vertices",
+    "power",
     "shade_pixels",
     "shade_pixels_directional",
 ]
@@ -56,6 +57,7 @@ PARAMS = 30
 I_FACE_OFFSET, I_MODE, I_PAINT, I_BACKGROUND, I_SPECULAR_MODEL, I_OBJECT_ID = 0, 1, 2, 3, 7, 8
 I_WRITE_NORMALS, I_WRITE_IDS, I_BLEND = 9, 10, 11
 ITEM = 12
+SQUARING_MAX = 1024.0
 
 
 @inline_kernel
@@ -68,6 +70,29 @@ def _to_byte(value: float) -> np.uint8:
 def _interpolate(u0: float, u1: float, u2: float, va: float, vb: float, vc: float) -> float:
     """``(u0·va + u1·vb) + u2·vc`` (scalar arguments only: per-pixel helpers take no arrays, so they inline)."""
     return (u0 * va + u1 * vb) + u2 * vc
+
+
+@inline_kernel
+def _squarable(n: float) -> bool:
+    """Whether ``power`` takes x^n by repeated squaring: n integral in [0, SQUARING_MAX]."""
+    return n == math.floor(n) and 0.0 <= n <= SQUARING_MAX
+
+
+@inline_kernel
+def power(x: float, n: float) -> float:
+    """Textbook x^n; integral n by repeated squaring (exact same bytes in every path).
+
+    Squaring: r = 1; per bit of n from the lowest, r·x if the bit is set, then x·x. Other n: libm ``x ** n``.
+    """
+    if not _squarable(n):
+        return x**n
+    e, r = int(n), 1.0
+    while e > 0:
+        if e & 1:
+            r *= x
+        x *= x
+        e >>= 1
+    return r
 
 
 @inline_kernel
@@ -86,7 +111,8 @@ def _illuminate(
     sr, sg, sb = 0.0, 0.0, 0.0
     vx, vy, vz = ex - px, ey - py, ez - pz
     length = math.sqrt((vx * vx + vy * vy) + vz * vz)
-    vx, vy, vz = vx / length, vy / length, vz / length
+    if length > 0.0:
+        vx, vy, vz = vx / length, vy / length, vz / length
     for k in range(lights.shape[0]):
         kind = lights[k, 0]
         falloff = 1.0
@@ -109,13 +135,13 @@ def _illuminate(
             continue
         if specular_model == SPECULAR_PHONG:
             rx, ry, rz = 2.0 * ndl * nx - lx, 2.0 * ndl * ny - ly, 2.0 * ndl * nz - lz
-            spec = max((rx * vx + ry * vy) + rz * vz, 0.0) ** shininess
+            spec = power(max((rx * vx + ry * vy) + rz * vz, 0.0), shininess)
         else:
             hx, hy, hz = lx + vx, ly + vy, lz + vz
             length = math.sqrt((hx * hx + hy * hy) + hz * hz)
             if length > 0.0:
                 hx, hy, hz = hx / length, hy / length, hz / length
-            spec = max((nx * hx + ny * hy) + nz * hz, 0.0) ** shininess
+            spec = power(max((nx * hx + ny * hy) + nz * hz, 0.0), shininess)
         diffuse = kd * (falloff * ndl)
         specular = ks * (falloff * spec)
         dr += diffuse * lights[k, 1]
@@ -341,68 +367,152 @@ def _shade_row(
             id_out[row, col] = item[I_OBJECT_ID]
 
 
+# Scratch of the directional fast path: one row of _CHUNK float64 per quantity (structure of arrays), at fixed
+# offsets, so that LLVM sees the rows cannot overlap and vectorizes the branch-free passes of _shade_chunk.
+_CHUNK = 256
+_ROWS = 16  # image rows per parallel task; each allocates its scratch once
+_NX, _NY, _NZ, _SIGN, _PX, _PY, _PZ, _VX, _VY, _VZ, _X, _NDL, _POW, _DR, _DG, _DB, _SR, _SG, _SB = range(
+    0, 19 * _CHUNK, _CHUNK
+)
+_FIELDS = 19
+
+
 @parallel_kernel
 def shade_pixels_directional(
     codes: np.ndarray, bary: np.ndarray, faces: np.ndarray, world: np.ndarray, normals: np.ndarray,
     params: np.ndarray, lights: np.ndarray, item: np.ndarray, color: np.ndarray,
 ) -> None:  # fmt: skip
     """``shade_pixels`` for the common case, bit for bit: per-pixel Blinn-Phong with directional lights only and
-    no texture, vertex colors, depth cueing, blending or extra buffers (the benchmark scenes). The general
-    kernel's branches cost about half again per pixel; this one keeps only the arithmetic."""
-    for row in prange(codes.shape[0]):
-        _shade_row_directional(row, codes, bary, faces, world, normals, params, lights, item, color)
+    no texture, vertex colors, depth cueing, blending or extra buffers (the benchmark scenes).
+
+    Blocks of ``_ROWS`` image rows run in parallel; each gathers its drawn pixels into chunks of ``_CHUNK`` and
+    shades a chunk with one branch-free loop per step (vectorized: the divisions and square roots dominate).
+    color must be C-contiguous: a pixel's four bytes are written as one uint32 word.
+    """
+    height = codes.shape[0]
+    for block in prange((height + _ROWS - 1) // _ROWS):
+        start = block * _ROWS
+        _shade_rows_directional(
+            start, min(start + _ROWS, height), codes, bary, faces, world, normals, params, lights, item, color
+        )
 
 
 @kernel
-def _shade_row_directional(
-    row: int, codes: np.ndarray, bary: np.ndarray, faces: np.ndarray, world: np.ndarray, normals: np.ndarray,
-    params: np.ndarray, lights: np.ndarray, item: np.ndarray, color: np.ndarray,
+def _shade_rows_directional(
+    start: int, stop: int, codes: np.ndarray, bary: np.ndarray, faces: np.ndarray, world: np.ndarray,
+    normals: np.ndarray, params: np.ndarray, lights: np.ndarray, item: np.ndarray, color: np.ndarray,
 ) -> None:  # fmt: skip
-    """One image row of ``shade_pixels_directional``: the operations of ``shade_point`` and ``_illuminate`` in the
-    same order (falloff 1, so ``k_d·(1·ndl) = k_d·ndl``)."""
+    """Rows [start, stop) of ``shade_pixels_directional``: paint the background (one 4-byte word per pixel) and
+    gather each drawn pixel's interpolated normal ``(u0·na + u1·nb) + u2·nc``, face sign and world point into
+    the scratch, shading it whenever a chunk is full."""
+    scratch = np.empty(_FIELDS * _CHUNK)
+    where = np.empty(3 * _CHUNK, dtype=np.int64)  # row, column, then the color word of each gathered pixel
+    words = color.view(np.uint32)
+    background = item[I_BACKGROUND : I_BACKGROUND + 4].astype(np.uint8).view(np.uint32)[0]
     face_offset, paint = item[I_FACE_OFFSET], item[I_PAINT]
-    ex, ey, ez = params[P_EYE], params[P_EYE + 1], params[P_EYE + 2]
-    kd, ks, shininess = params[P_DIFFUSE], params[P_SPECULAR], params[P_SHININESS]
-    ka = params[P_AMBIENT]
-    for col in range(codes.shape[1]):
-        code = codes[row, col]
-        if code < 0:
-            if paint != 0:
-                for k in range(4):
-                    color[row, col, k] = item[I_BACKGROUND + k]
-            continue
-        f = code // 2 - face_offset
-        if f < 0 or f >= faces.shape[0]:
-            continue
-        u1, u2 = float(bary[row, col, 0]), float(bary[row, col, 1])
-        u0 = (1.0 - u1) - u2
-        nx, ny, nz, px, py, pz = _surface(f, code % 2 == 1, u0, u1, u2, faces, world, normals)
-        vx, vy, vz = ex - px, ey - py, ez - pz
-        length = math.sqrt((vx * vx + vy * vy) + vz * vz)
-        vx, vy, vz = vx / length, vy / length, vz / length
-        dr = ka * params[P_LIGHT_AMBIENT]
-        dg = ka * params[P_LIGHT_AMBIENT + 1]
-        db = ka * params[P_LIGHT_AMBIENT + 2]
-        sr, sg, sb = 0.0, 0.0, 0.0
-        for k in range(lights.shape[0]):
-            lx, ly, lz = lights[k, 7], lights[k, 8], lights[k, 9]
-            ndl = (nx * lx + ny * ly) + nz * lz
-            if ndl <= 0.0:
+    n = 0
+    for row in range(start, stop):
+        for col in range(codes.shape[1]):
+            code = codes[row, col]
+            if code < 0:
+                if paint != 0:
+                    words[row, col, 0] = background
                 continue
-            hx, hy, hz = lx + vx, ly + vy, lz + vz
+            f = code // 2 - face_offset
+            if f < 0 or f >= faces.shape[0]:
+                continue
+            u1, u2 = float(bary[row, col, 0]), float(bary[row, col, 1])
+            u0 = (1.0 - u1) - u2
+            a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
+            scratch[_NX + n] = _interpolate(u0, u1, u2, normals[a, 0], normals[b, 0], normals[c, 0])
+            scratch[_NY + n] = _interpolate(u0, u1, u2, normals[a, 1], normals[b, 1], normals[c, 1])
+            scratch[_NZ + n] = _interpolate(u0, u1, u2, normals[a, 2], normals[b, 2], normals[c, 2])
+            scratch[_SIGN + n] = -1.0 if code % 2 == 1 else 1.0
+            scratch[_PX + n] = _interpolate(u0, u1, u2, world[a, 0], world[b, 0], world[c, 0])
+            scratch[_PY + n] = _interpolate(u0, u1, u2, world[a, 1], world[b, 1], world[c, 1])
+            scratch[_PZ + n] = _interpolate(u0, u1, u2, world[a, 2], world[b, 2], world[c, 2])
+            where[n], where[_CHUNK + n] = row, col
+            n += 1
+            if n == _CHUNK:
+                _shade_chunk(n, scratch, where, params, lights, words)
+                n = 0
+    _shade_chunk(n, scratch, where, params, lights, words)
+
+
+@kernel
+def _shade_chunk(
+    n: int, s: np.ndarray, where: np.ndarray, params: np.ndarray, lights: np.ndarray, words: np.ndarray
+) -> None:  # fmt: skip
+    """Shade the first n gathered pixels: the operations of ``_surface`` and ``_illuminate`` in the same order
+    (falloff 1, so ``k_d·(1·ndl) = k_d·ndl``), as passes over the chunk with selects for branches; then store
+    each pixel's bytes (r, g, b, 255) as one little-endian word (words: color viewed as uint32)."""
+    ex, ey, ez = params[P_EYE], params[P_EYE + 1], params[P_EYE + 2]
+    ka, kd, ks, shininess = params[P_AMBIENT], params[P_DIFFUSE], params[P_SPECULAR], params[P_SHININESS]
+    ar, ag, ab = ka * params[P_LIGHT_AMBIENT], ka * params[P_LIGHT_AMBIENT + 1], ka * params[P_LIGHT_AMBIENT + 2]
+    for i in range(n):
+        nx, ny, nz = s[_NX + i], s[_NY + i], s[_NZ + i]
+        length = math.sqrt((nx * nx + ny * ny) + nz * nz)
+        zero = length == 0.0
+        nx = 0.0 if zero else nx
+        ny = 0.0 if zero else ny
+        nz = 1.0 if zero else nz
+        length = 1.0 if zero else length
+        sign = s[_SIGN + i]
+        s[_NX + i], s[_NY + i], s[_NZ + i] = sign * nx / length, sign * ny / length, sign * nz / length
+        vx, vy, vz = ex - s[_PX + i], ey - s[_PY + i], ez - s[_PZ + i]
+        length = math.sqrt((vx * vx + vy * vy) + vz * vz)
+        positive = length > 0.0  # as in _illuminate; also spares the division numba's zero check
+        s[_VX + i] = vx / length if positive else vx
+        s[_VY + i] = vy / length if positive else vy
+        s[_VZ + i] = vz / length if positive else vz
+        s[_DR + i], s[_DG + i], s[_DB + i] = ar, ag, ab
+        s[_SR + i], s[_SG + i], s[_SB + i] = 0.0, 0.0, 0.0
+    for k in range(lights.shape[0]):
+        lx, ly, lz = lights[k, 7], lights[k, 8], lights[k, 9]
+        for i in range(n):
+            nx, ny, nz = s[_NX + i], s[_NY + i], s[_NZ + i]
+            hx, hy, hz = lx + s[_VX + i], ly + s[_VY + i], lz + s[_VZ + i]
             length = math.sqrt((hx * hx + hy * hy) + hz * hz)
-            if length > 0.0:
-                hx, hy, hz = hx / length, hy / length, hz / length
-            spec = max((nx * hx + ny * hy) + nz * hz, 0.0) ** shininess
+            positive = length > 0.0
+            hx = hx / length if positive else hx
+            hy = hy / length if positive else hy
+            hz = hz / length if positive else hz
+            s[_NDL + i] = (nx * lx + ny * ly) + nz * lz
+            s[_X + i] = max((nx * hx + ny * hy) + nz * hz, 0.0)
+            s[_POW + i] = 1.0
+        if _squarable(shininess):  # power(x, shininess), one pass per step over the chunk
+            e = int(shininess)
+            while e > 0:
+                if e & 1:
+                    for i in range(n):
+                        s[_POW + i] *= s[_X + i]
+                e >>= 1
+                if e > 0:
+                    for i in range(n):
+                        s[_X + i] *= s[_X + i]
+        else:
+            for i in range(n):
+                s[_POW + i] = s[_X + i] ** shininess
+        r, g, b = lights[k, 1], lights[k, 2], lights[k, 3]
+        for i in range(n):
+            ndl = s[_NDL + i]
+            lit = not ndl <= 0.0
             diffuse = kd * (1.0 * ndl)
-            specular = ks * (1.0 * spec)
-            dr += diffuse * lights[k, 1]
-            dg += diffuse * lights[k, 2]
-            db += diffuse * lights[k, 3]
-            sr += specular * lights[k, 1]
-            sg += specular * lights[k, 2]
-            sb += specular * lights[k, 3]
-        color[row, col, 0] = _to_byte((params[P_COLOR] * dr + sr) + params[P_EMISSIVE])
-        color[row, col, 1] = _to_byte((params[P_COLOR + 1] * dg + sg) + params[P_EMISSIVE + 1])
-        color[row, col, 2] = _to_byte((params[P_COLOR + 2] * db + sb) + params[P_EMISSIVE + 2])
-        color[row, col, 3] = 255
+            specular = ks * (1.0 * s[_POW + i])
+            s[_DR + i] = s[_DR + i] + diffuse * r if lit else s[_DR + i]
+            s[_DG + i] = s[_DG + i] + diffuse * g if lit else s[_DG + i]
+            s[_DB + i] = s[_DB + i] + diffuse * b if lit else s[_DB + i]
+            s[_SR + i] = s[_SR + i] + specular * r if lit else s[_SR + i]
+            s[_SG + i] = s[_SG + i] + specular * g if lit else s[_SG + i]
+            s[_SB + i] = s[_SB + i] + specular * b if lit else s[_SB + i]
+    r, g, b = params[P_COLOR], params[P_COLOR + 1], params[P_COLOR + 2]
+    er, eg, eb = params[P_EMISSIVE], params[P_EMISSIVE + 1], params[P_EMISSIVE + 2]
+    for i in range(n):
+        where[2 * _CHUNK + i] = (
+            int(_to_byte((r * s[_DR + i] + s[_SR + i]) + er))
+            | int(_to_byte((g * s[_DG + i] + s[_SG + i]) + eg)) << 8
+            | int(_to_byte((b * s[_DB + i] + s[_SB + i]) + eb)) << 16
+            | 255 << 24
+        )
+    for i in range(n):
+        words[where[i], where[_CHUNK + i], 0] = where[2 * _CHUNK + i]
