@@ -14,11 +14,11 @@ Fast path, per scene item (one compiled pass each, buffers shared between items)
 3. World positions and unit normals for shading (``raster.vertices.world_points``, ``transform_normals``), or
    the mesh's own arrays when the modeling transform leaves them unchanged.
 4. ``raster.triangles.rasterize_tiles``: edge functions with the top-left rule, depth test "less" against a
-   float32 buffer cleared to 1.0 (``clear_buffers``, parallel over rows), perspective-correct barycentrics stored
-   per pixel (parallel over tiles).
+   float32 buffer cleared to 1.0 (``clear_buffers``, parallel over rows, which also paints the background color),
+   perspective-correct barycentrics stored per pixel (parallel over tiles).
 5. ``raster.shade.shade_pixels``: deferred shading once per visible pixel (``frustum.shading``'s model,
-   flat, Gouraud or Phong; per-vertex or per-face terms first by ``light_vertices`` / ``light_faces``); the
-   last item's pass (rasterization complete) also paints the background pixels.
+   flat, Gouraud or Phong; per-vertex or per-face terms first by ``light_vertices`` / ``light_faces``), or
+   ``shade_pixels_directional`` where it applies (per-pixel Blinn-Phong, directional lights: the same bytes).
 6. Transparent items (``Material.opacity < 1``) after all opaque ones, back to front by the view distance of
    their centres: each rasterized alone against a copy of the opaque depth buffer (its nearest surface) and
    blended ``α·I + (1 − α)·under``.
@@ -302,16 +302,13 @@ def _draw_surfaces(
     height, width = camera.height, camera.width
     opaque = [i for i, item in enumerate(items) if item.material.opacity >= 1.0]
     clear_items = [i for i, item in enumerate(items) if item.material.opacity < 1.0]
-    # color uninitialized: the last shading pass paints the background (numpy fills it only when none runs)
     depth = np.empty((height, width), dtype=np.float32)
     face_total = sum(item.mesh.face_count for item in items)
     code_type = np.int32 if 2 * face_total < 2**31 else np.int64
     codes = scratch.empty((height, width), code_type)
     bary = scratch.empty((height, width, 2), np.float32)  # read only where codes >= 0
     color = np.empty((height, width, 4), dtype=np.uint8)
-    triangles.clear_buffers(depth, codes)
-    if not opaque:
-        color[:, :] = options.background
+    triangles.clear_buffers(depth, codes, color, options.background)
     ambient, lights = pack_lights(scene.world_lights())
     extra = (
         np.zeros((1, 1, 3), dtype=np.float32) if normal_out is None else normal_out,
@@ -323,10 +320,9 @@ def _draw_surfaces(
         world, normals = _draw_item(items[index], camera, options.cull, int(offsets[index]), depth, codes, bary,
                                     scratch)  # fmt: skip
         drawn.append((index, world, normals))
-    for position, (index, world, normals) in enumerate(drawn):
-        last = position == len(drawn) - 1
+    for index, world, normals in drawn:
         _shade_item(items[index], index, int(offsets[index]), camera, options, ambient, lights, world, normals,
-                    codes, bary, color, extra, paint=last, blend=False)  # fmt: skip
+                    codes, bary, color, extra, blend=False)  # fmt: skip
     if clear_items:
         axis = np.asarray(camera.frame.n, dtype=np.float64)
         eye = np.asarray(camera.frame.eye, dtype=np.float64)
@@ -347,24 +343,56 @@ def _draw_surfaces(
                 item, camera, options.cull, int(offsets[index]), layer_depth, layer_codes, bary, scratch
             )
             _shade_item(item, index, int(offsets[index]), camera, options, ambient, lights, world, normals,
-                        layer_codes, bary, color, extra, paint=False, blend=True)  # fmt: skip
+                        layer_codes, bary, color, extra, blend=True)  # fmt: skip
     return depth, color
+
+
+def _directional(item: SceneItem, options: _Options, lights: np.ndarray, extra: tuple[np.ndarray, np.ndarray]) -> bool:
+    """Whether the item shades through ``shade.shade_pixels_directional``: per-pixel Blinn-Phong, directional
+    lights only, no vertex colors, texture, depth cue, blending or extra buffers."""
+    mesh = item.mesh
+    return (
+        item.material.opacity >= 1.0
+        and options.shade_mode == shade.SHADE_PHONG and options.specular_model == shade.SPECULAR_BLINN
+        and bool((lights[:, 0] == 0.0).all()) and getattr(mesh, "vertex_colors", None) is None
+        and (item.material.texture is None or getattr(mesh, "uvs", None) is None)
+        and options.depth_cue is None and extra[0].size <= 3 and extra[1].size <= 1
+    )  # fmt: skip
+
+
+def _item_flags(
+    index: int, face_offset: int, options: _Options, blend: bool, write_normals: bool, write_ids: bool
+) -> np.ndarray:  # fmt: skip
+    """The (ITEM,) int64 item record of ``raster.shade`` (no painting: ``clear_buffers`` paints the background)."""
+    flags = np.zeros(shade.ITEM, dtype=np.int64)
+    flags[shade.I_FACE_OFFSET], flags[shade.I_MODE] = face_offset, options.shade_mode
+    flags[shade.I_BACKGROUND : shade.I_BACKGROUND + 4] = options.background
+    flags[shade.I_SPECULAR_MODEL], flags[shade.I_OBJECT_ID] = options.specular_model, index
+    flags[shade.I_WRITE_NORMALS], flags[shade.I_WRITE_IDS] = int(write_normals), int(write_ids)
+    flags[shade.I_BLEND] = int(blend)
+    return flags
 
 
 def _shade_item(
     item: SceneItem, index: int, face_offset: int, camera: Camera, options: _Options, ambient: np.ndarray,
     lights: np.ndarray, world: np.ndarray, normals: np.ndarray, codes: np.ndarray, bary: np.ndarray,
-    color: np.ndarray, extra: tuple[np.ndarray, np.ndarray], paint: bool, blend: bool,
+    color: np.ndarray, extra: tuple[np.ndarray, np.ndarray], blend: bool,
 ) -> None:  # fmt: skip
+    """Stage 5 for one item: shade its pixels (the background is painted when the buffers are cleared)."""
     mesh, material = item.mesh, item.material
     params = _shading_parameters(item, camera, options, ambient)
     mode = options.shade_mode
+    faces = _world_faces(item) if mesh.face_count else np.empty((0, 3), dtype=np.int64)
+    if not blend and _directional(item, options, lights, extra):  # the same bytes without the general branches
+        flags = _item_flags(index, face_offset, options, blend, False, False)
+        shade.shade_pixels_directional(codes, bary, faces, world, normals, params, lights, flags, color)
+        return
     if mode == shade.SHADE_GOURAUD and mesh.face_count:
         lit = np.empty((mesh.vertex_count, 6))
         shade.light_vertices(world, normals, params, lights, options.specular_model, lit)
     elif mode == shade.SHADE_FLAT and mesh.face_count:
         lit = np.empty((mesh.face_count, 6))
-        shade.light_faces(world, _world_faces(item), params, lights, options.specular_model, lit)
+        shade.light_faces(world, faces, params, lights, options.specular_model, lit)
     else:
         lit = np.empty((0, 6))
     vertex_colors = getattr(mesh, "vertex_colors", None)
@@ -375,22 +403,8 @@ def _shade_item(
         texture, uvs = np.empty((0, 0, 4), dtype=np.float32), np.empty((0, 2))
     else:
         uvs = np.ascontiguousarray(uvs, dtype=np.float64)
-    flags = np.zeros(shade.ITEM, dtype=np.int64)
-    flags[shade.I_FACE_OFFSET], flags[shade.I_MODE], flags[shade.I_PAINT] = face_offset, mode, int(paint)
-    flags[shade.I_BACKGROUND : shade.I_BACKGROUND + 4] = options.background
-    flags[shade.I_SPECULAR_MODEL], flags[shade.I_OBJECT_ID] = options.specular_model, index
-    flags[shade.I_WRITE_NORMALS] = int(extra[0].shape[0] == codes.shape[0] and extra[0].shape[1] == codes.shape[1])
-    flags[shade.I_WRITE_IDS] = int(extra[1].shape == codes.shape)
-    flags[shade.I_BLEND] = int(blend)
-    faces = _world_faces(item) if mesh.face_count else np.empty((0, 3), dtype=np.int64)
-    plain = (
-        mode == shade.SHADE_PHONG and options.specular_model == shade.SPECULAR_BLINN and not blend
-        and (lights[:, 0] == 0.0).all() and vertex_colors.shape[0] == 0 and texture.shape[0] == 0
-        and options.depth_cue is None and not flags[shade.I_WRITE_NORMALS] and not flags[shade.I_WRITE_IDS]
-    )  # fmt: skip
-    if plain:  # the same bytes through a kernel without the general path's branches
-        shade.shade_pixels_directional(codes, bary, faces, world, normals, params, lights, flags, color)
-        return
+    write_normals = extra[0].shape[:2] == codes.shape
+    flags = _item_flags(index, face_offset, options, blend, write_normals, extra[1].shape == codes.shape)
     shade.shade_pixels(codes, bary, faces, world, normals, lit, vertex_colors, uvs, texture, params, lights, flags,
                        color, extra[0], extra[1])  # fmt: skip
 

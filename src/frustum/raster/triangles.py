@@ -195,13 +195,16 @@ def clip_faces(
 
 
 @parallel_kernel
-def clear_buffers(depth: np.ndarray, codes: np.ndarray) -> None:
-    """Depth 1.0 (far) and face code −1 (background) everywhere, row by row (parallel over rows: clearing tile by
-    tile, 128-byte pieces of rows, ran at a quarter of the memory bandwidth)."""
+def clear_buffers(depth: np.ndarray, codes: np.ndarray, color: np.ndarray, background: np.ndarray) -> None:
+    """Depth 1.0 (far), face code −1 (background) and the background color bytes (4,) everywhere, row by row
+    (parallel over rows: clearing tile by tile, 128-byte pieces of rows, ran at a quarter of the bandwidth)."""
+    words = color.view(np.uint32)
+    word = background.view(np.uint32)[0]
     for row in prange(depth.shape[0]):
         for col in range(depth.shape[1]):
             depth[row, col] = 1.0
             codes[row, col] = -1
+            words[row, col, 0] = word
 
 
 @kernel
