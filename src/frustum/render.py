@@ -518,8 +518,11 @@ def bin_item(
     counts = np.empty((chunk_count, tiles_x * tiles_y), dtype=np.int64)
     crossing_counts = np.empty(chunk_count, dtype=np.int64)
     listed = empty((faces.shape[0],), np.int32 if faces.shape[0] < 2**31 else np.int64)
+    listed_tiles = empty((faces.shape[0],), np.int32)
     listed_counts = np.empty(chunk_count, dtype=np.int64)
-    tiles.count_tiles(faces, vertex_codes, win_int, options, counts, crossing_counts, listed, listed_counts)
+    tiles.count_tiles(
+        faces, vertex_codes, win_int, options, counts, crossing_counts, listed, listed_tiles, listed_counts
+    )
     # the crossing faces: clipped into records (count, prefix sum, write), which join their face's chunk
     crossing_starts = np.concatenate([[0], np.cumsum(crossing_counts)])
     crossing = np.empty(int(crossing_starts[-1]), dtype=np.int64)
@@ -543,10 +546,12 @@ def bin_item(
     tiles.tile_offsets(counts, offsets, tile_starts)
     entry_type = np.int32 if max(faces.shape[0], tri_int.shape[0] + 1) < 2**31 else np.int64
     tile_entries = empty((int(tile_starts[-1]),), entry_type)
-    tiles.fill_tiles(faces, vertex_codes, win_int, options, listed, listed_counts, offsets, crossing_starts[:-1],
-                     record_starts, tri_int, tile_entries)  # fmt: skip
+    tiles.fill_tiles(
+        faces, vertex_codes, win_int, options, listed, listed_tiles, listed_counts, offsets, crossing_starts[:-1],
+        record_starts, tri_int, tile_entries,
+    )  # fmt: skip
     if scratch is not None:
-        scratch.recycle(listed)
+        scratch.recycle(listed, listed_tiles)
     return Binned(faces, win_int, win_float, vertex_codes, crossing, tri_int, tri_float, tri_weights, tile_starts,
                   tile_entries, tiles_x)  # fmt: skip
 

@@ -25,14 +25,16 @@ O_WIDTH, O_HEIGHT, O_CULL, O_BITS, O_TILES_X, O_CHUNK, O_FACE_OFFSET = 0, 1, 2, 
 @parallel_kernel
 def count_tiles(
     faces: np.ndarray, codes: np.ndarray, win_int: np.ndarray, options: np.ndarray, counts: np.ndarray,
-    crossing: np.ndarray, listed: np.ndarray, listed_counts: np.ndarray,
+    crossing: np.ndarray, listed: np.ndarray, listed_tiles: np.ndarray, listed_counts: np.ndarray,
 ) -> None:  # fmt: skip
     """``counts[c, t]`` = how many drawn faces of chunk c touch tile t; ``crossing[c]`` = its crossing faces.
 
     counts (C, tiles), crossing (C,) and listed_counts (C,) int64 are written; chunk c is faces
     [c·chunk, (c+1)·chunk). The chunk's drawn and crossing faces, in order, go to ``listed`` (M,) from
     ``c·chunk`` on, ``listed_counts[c]`` of them: the fill visits only those (most faces of a fine mesh draw
-    nothing, being back faces or falling between pixel centres).
+    nothing, being back faces or falling between pixel centres). ``listed_tiles`` (M,) beside each: the one
+    tile a drawn face touches, or −1 when it touches several or crosses the view volume (the fill then reads the
+    face again; small faces, the many, are filled from these two sequential arrays alone).
     """
     width, height, cull = options[O_WIDTH], options[O_HEIGHT], options[O_CULL]
     bits, tiles_x, chunk = options[O_BITS], options[O_TILES_X], options[O_CHUNK]
@@ -45,10 +47,11 @@ def count_tiles(
             state, _, i_min, i_max, j_min, j_max = face_box(faces, codes, win_int, f, width, height, cull)
             if state == FACE_CROSSING:
                 crossed += 1
-                listed[n] = f
+                listed[n], listed_tiles[n] = f, -1
                 n += 1
             elif state == FACE_DRAWN:
-                listed[n] = f
+                one = (j_min >> bits) == (j_max >> bits) and (i_min >> bits) == (i_max >> bits)
+                listed[n], listed_tiles[n] = f, ((j_min >> bits) * tiles_x + (i_min >> bits)) if one else -1
                 n += 1
                 for ty in range(j_min >> bits, (j_max >> bits) + 1):
                     for tx in range(i_min >> bits, (i_max >> bits) + 1):
@@ -86,8 +89,8 @@ def tile_offsets(counts: np.ndarray, offsets: np.ndarray, tile_starts: np.ndarra
 @parallel_kernel
 def fill_tiles(
     faces: np.ndarray, codes: np.ndarray, win_int: np.ndarray, options: np.ndarray, listed: np.ndarray,
-    listed_counts: np.ndarray, offsets: np.ndarray, crossing_starts: np.ndarray, record_starts: np.ndarray,
-    tri_int: np.ndarray, tile_entries: np.ndarray,
+    listed_tiles: np.ndarray, listed_counts: np.ndarray, offsets: np.ndarray, crossing_starts: np.ndarray,
+    record_starts: np.ndarray, tri_int: np.ndarray, tile_entries: np.ndarray,
 ) -> None:  # fmt: skip
     """Write each drawn face's index (and ``−1 − r`` for each record r of a clipped face) into the lists of the
     tiles it touches, in face order: the faces ``count_tiles`` listed. offsets (C, tiles) is consumed;
@@ -100,6 +103,11 @@ def fill_tiles(
         k = crossing_starts[c]
         for n in range(c * chunk, c * chunk + listed_counts[c]):
             f = listed[n]
+            t = listed_tiles[n]
+            if t >= 0:
+                tile_entries[offsets[c, t]] = f
+                offsets[c, t] += 1
+                continue
             state, _, i_min, i_max, j_min, j_max = face_box(faces, codes, win_int, f, width, height, cull)
             if state == FACE_DRAWN:
                 for ty in range(j_min >> bits, (j_max >> bits) + 1):
