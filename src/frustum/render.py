@@ -15,7 +15,7 @@ Fast path, per scene item (one compiled pass each, buffers shared between items)
    the mesh's own arrays when the modeling transform leaves them unchanged.
 4. ``raster.triangles.rasterize_tiles``: edge functions with the top-left rule, depth test "less" against a
    float32 buffer cleared to 1.0 (``clear_buffers``, parallel over rows, which also paints the background color),
-   perspective-correct barycentrics stored per pixel (parallel over tiles).
+   face code and perspective-correct barycentrics stored per drawn pixel (parallel over tiles).
 5. ``raster.shade.shade_pixels``: deferred shading once per visible pixel (``frustum.shading``'s model,
    flat, Gouraud or Phong; per-vertex or per-face terms first by ``light_vertices`` / ``light_faces``), or
    ``shade_pixels_directional`` where it applies (per-pixel Blinn-Phong, directional lights: the same bytes).
@@ -312,7 +312,7 @@ def _draw_surfaces(
     codes = scratch.empty((height, width), code_type)
     bary = scratch.empty((height, width, 2), np.float32)  # read only where codes >= 0
     color = np.empty((height, width, 4), dtype=np.uint8)
-    triangles.clear_buffers(depth, codes, color, options.background)
+    triangles.clear_buffers(depth, color, options.background)
     ambient, lights = pack_lights(scene.world_lights())
     extra = (
         np.zeros((1, 1, 3), dtype=np.float32) if normal_out is None else normal_out,
@@ -326,7 +326,7 @@ def _draw_surfaces(
         drawn.append((index, world, normals))
     for index, world, normals in drawn:
         _shade_item(items[index], index, int(offsets[index]), camera, options, ambient, lights, world, normals,
-                    codes, bary, color, extra, blend=False)  # fmt: skip
+                    depth, codes, bary, color, extra, blend=False)  # fmt: skip
     if clear_items:
         axis = np.asarray(camera.frame.n, dtype=np.float64)
         eye = np.asarray(camera.frame.eye, dtype=np.float64)
@@ -347,7 +347,7 @@ def _draw_surfaces(
                 item, camera, options.cull, int(offsets[index]), layer_depth, layer_codes, bary, scratch
             )
             _shade_item(item, index, int(offsets[index]), camera, options, ambient, lights, world, normals,
-                        layer_codes, bary, color, extra, blend=True)  # fmt: skip
+                        layer_depth, layer_codes, bary, color, extra, blend=True)  # fmt: skip
     return depth, color
 
 
@@ -367,10 +367,9 @@ def _directional(item: SceneItem, options: _Options, lights: np.ndarray, extra: 
 def _item_flags(
     index: int, face_offset: int, options: _Options, blend: bool, write_normals: bool, write_ids: bool
 ) -> np.ndarray:  # fmt: skip
-    """The (ITEM,) int64 item record of ``raster.shade`` (no painting: ``clear_buffers`` paints the background)."""
+    """The (ITEM,) int64 item record of ``raster.shade``."""
     flags = np.zeros(shade.ITEM, dtype=np.int64)
     flags[shade.I_FACE_OFFSET], flags[shade.I_MODE] = face_offset, options.shade_mode
-    flags[shade.I_BACKGROUND : shade.I_BACKGROUND + 4] = options.background
     flags[shade.I_SPECULAR_MODEL], flags[shade.I_OBJECT_ID] = options.specular_model, index
     flags[shade.I_WRITE_NORMALS], flags[shade.I_WRITE_IDS] = int(write_normals), int(write_ids)
     flags[shade.I_BLEND] = int(blend)
@@ -379,8 +378,8 @@ def _item_flags(
 
 def _shade_item(
     item: SceneItem, index: int, face_offset: int, camera: Camera, options: _Options, ambient: np.ndarray,
-    lights: np.ndarray, world: np.ndarray, normals: np.ndarray, codes: np.ndarray, bary: np.ndarray,
-    color: np.ndarray, extra: tuple[np.ndarray, np.ndarray], blend: bool,
+    lights: np.ndarray, world: np.ndarray, normals: np.ndarray, depth: np.ndarray, codes: np.ndarray,
+    bary: np.ndarray, color: np.ndarray, extra: tuple[np.ndarray, np.ndarray], blend: bool,
 ) -> None:  # fmt: skip
     """Stage 5 for one item: shade its pixels (the background is painted when the buffers are cleared)."""
     mesh, material = item.mesh, item.material
@@ -390,7 +389,7 @@ def _shade_item(
     if not blend and _directional(item, options, lights, extra):  # the same bytes without the general branches
         flags = _item_flags(index, face_offset, options, blend, False, False)
         with numba.parallel_chunksize(_DYNAMIC_CHUNK[0]):
-            shade.shade_pixels_directional(codes, bary, faces, world, normals, params, lights, flags, color)
+            shade.shade_pixels_directional(depth, codes, bary, faces, world, normals, params, lights, flags, color)
         return
     if mode == shade.SHADE_GOURAUD and mesh.face_count:
         lit = np.empty((mesh.vertex_count, 6))
@@ -410,8 +409,8 @@ def _shade_item(
         uvs = np.ascontiguousarray(uvs, dtype=np.float64)
     write_normals = extra[0].shape[:2] == codes.shape
     flags = _item_flags(index, face_offset, options, blend, write_normals, extra[1].shape == codes.shape)
-    shade.shade_pixels(codes, bary, faces, world, normals, lit, vertex_colors, uvs, texture, params, lights, flags,
-                       color, extra[0], extra[1])  # fmt: skip
+    shade.shade_pixels(depth, codes, bary, faces, world, normals, lit, vertex_colors, uvs, texture, params, lights,
+                       flags, color, extra[0], extra[1])  # fmt: skip
 
 
 def _world_faces(item: SceneItem) -> np.ndarray:

@@ -54,9 +54,8 @@ P_CUE_ON, P_CUE_NEAR, P_CUE_FAR, P_CUE_MIN, P_CUE_MAX, P_CUE_COLOR = 19, 20, 21,
 P_DEPTH_NEAR, P_DEPTH_FAR, P_OPACITY = 27, 28, 29
 PARAMS = 30
 # item layout
-I_FACE_OFFSET, I_MODE, I_PAINT, I_BACKGROUND, I_SPECULAR_MODEL, I_OBJECT_ID = 0, 1, 2, 3, 7, 8
-I_WRITE_NORMALS, I_WRITE_IDS, I_BLEND = 9, 10, 11
-ITEM = 12
+I_FACE_OFFSET, I_MODE, I_SPECULAR_MODEL, I_OBJECT_ID, I_WRITE_NORMALS, I_WRITE_IDS, I_BLEND = 0, 1, 2, 3, 4, 5, 6
+ITEM = 7
 SQUARING_MAX = 1024.0
 
 
@@ -296,42 +295,41 @@ def _cue(params: np.ndarray, value: float, channel: int, d: float) -> float:
 
 @parallel_kernel
 def shade_pixels(
-    codes: np.ndarray, bary: np.ndarray, faces: np.ndarray, world: np.ndarray, normals: np.ndarray,
+    depth: np.ndarray, codes: np.ndarray, bary: np.ndarray, faces: np.ndarray, world: np.ndarray, normals: np.ndarray,
     lit: np.ndarray, vertex_colors: np.ndarray, uvs: np.ndarray, texture: np.ndarray,
     params: np.ndarray, lights: np.ndarray, item: np.ndarray, color: np.ndarray,
     normal_out: np.ndarray, id_out: np.ndarray,
 ) -> None:  # fmt: skip
     """Shade the pixels of one scene item: those whose face ``code // 2 − face_offset`` lies in [0, M).
 
-    codes (H, W) int32 or int64, bary (H, W, 2) float32, faces (M, 3) int64, world and normals (N, 3) float64
-    (unit normals), lit (N or M, 6) Gouraud or flat terms (any rows otherwise), vertex_colors (N, 3) or (0, 3),
-    uvs (N, 2) and texture (Ht, Wt, 4) float32 or empty. color (H, W, 4) uint8 is written at those pixels
-    (opaque, or blended ``α·I + (1 − α)·under`` when ``item[I_BLEND]``) and, when ``item[I_PAINT]``, at the
-    background pixels (code < 0) with the background bytes. normal_out (H, W, 3) float32 and id_out (H, W)
-    int32 are written when asked for.
+    depth (H, W) float32, codes (H, W) int32 or int64, bary (H, W, 2) float32, faces (M, 3) int64, world and
+    normals (N, 3) float64 (unit normals), lit (N or M, 6) Gouraud or flat terms (any rows otherwise),
+    vertex_colors (N, 3) or (0, 3), uvs (N, 2) and texture (Ht, Wt, 4) float32 or empty. color (H, W, 4) uint8 is
+    written at those pixels (opaque, or blended ``α·I + (1 − α)·under`` when ``item[I_BLEND]``); background
+    pixels (depth 1: nothing drawn, so their codes are never read and need no clearing) and codes < 0 are left
+    alone. normal_out (H, W, 3) float32 and id_out (H, W) int32 are written when asked for.
     """
     for row in prange(codes.shape[0]):
         _shade_row(
-            row, codes, bary, faces, world, normals, lit, vertex_colors, uvs, texture, params, lights, item,
+            row, depth, codes, bary, faces, world, normals, lit, vertex_colors, uvs, texture, params, lights, item,
             color, normal_out, id_out,
         )  # fmt: skip
 
 
 @kernel
 def _shade_row(
-    row: int, codes: np.ndarray, bary: np.ndarray, faces: np.ndarray, world: np.ndarray, normals: np.ndarray,
-    lit: np.ndarray, vertex_colors: np.ndarray, uvs: np.ndarray, texture: np.ndarray,
+    row: int, depth: np.ndarray, codes: np.ndarray, bary: np.ndarray, faces: np.ndarray, world: np.ndarray,
+    normals: np.ndarray, lit: np.ndarray, vertex_colors: np.ndarray, uvs: np.ndarray, texture: np.ndarray,
     params: np.ndarray, lights: np.ndarray, item: np.ndarray, color: np.ndarray,
     normal_out: np.ndarray, id_out: np.ndarray,
 ) -> None:  # fmt: skip
     """One image row of ``shade_pixels``."""
-    face_offset, paint = item[I_FACE_OFFSET], item[I_PAINT]
+    face_offset = item[I_FACE_OFFSET]
     for col in range(codes.shape[1]):
+        if depth[row, col] >= 1.0:
+            continue
         code = codes[row, col]
         if code < 0:
-            if paint != 0:
-                for k in range(4):
-                    color[row, col, k] = item[I_BACKGROUND + k]
             continue
         f = code // 2 - face_offset
         if f < 0 or f >= faces.shape[0]:
@@ -379,8 +377,8 @@ _FIELDS = 19
 
 @parallel_kernel
 def shade_pixels_directional(
-    codes: np.ndarray, bary: np.ndarray, faces: np.ndarray, world: np.ndarray, normals: np.ndarray,
-    params: np.ndarray, lights: np.ndarray, item: np.ndarray, color: np.ndarray,
+    depth: np.ndarray, codes: np.ndarray, bary: np.ndarray, faces: np.ndarray, world: np.ndarray,
+    normals: np.ndarray, params: np.ndarray, lights: np.ndarray, item: np.ndarray, color: np.ndarray,
 ) -> None:  # fmt: skip
     """``shade_pixels`` for the common case, bit for bit: per-pixel Blinn-Phong with directional lights only and
     no texture, vertex colors, depth cueing, blending or extra buffers (the benchmark scenes).
@@ -393,30 +391,29 @@ def shade_pixels_directional(
     for block in prange((height + _ROWS - 1) // _ROWS):
         start = block * _ROWS
         _shade_rows_directional(
-            start, min(start + _ROWS, height), codes, bary, faces, world, normals, params, lights, item, color
+            start, min(start + _ROWS, height), depth, codes, bary, faces, world, normals, params, lights, item, color
         )
 
 
 @kernel
 def _shade_rows_directional(
-    start: int, stop: int, codes: np.ndarray, bary: np.ndarray, faces: np.ndarray, world: np.ndarray,
-    normals: np.ndarray, params: np.ndarray, lights: np.ndarray, item: np.ndarray, color: np.ndarray,
+    start: int, stop: int, depth: np.ndarray, codes: np.ndarray, bary: np.ndarray, faces: np.ndarray,
+    world: np.ndarray, normals: np.ndarray, params: np.ndarray, lights: np.ndarray, item: np.ndarray,
+    color: np.ndarray,
 ) -> None:  # fmt: skip
-    """Rows [start, stop) of ``shade_pixels_directional``: paint the background (one 4-byte word per pixel) and
-    gather each drawn pixel's interpolated normal ``(u0·na + u1·nb) + u2·nc``, face sign and world point into
-    the scratch, shading it whenever a chunk is full."""
+    """Rows [start, stop) of ``shade_pixels_directional``: gather each drawn pixel's interpolated normal
+    ``(u0·na + u1·nb) + u2·nc``, face sign and world point into the scratch, shading it whenever a chunk is full."""
     scratch = np.empty(_FIELDS * _CHUNK)
     where = np.empty(3 * _CHUNK, dtype=np.int64)  # row, column, then the color word of each gathered pixel
     words = color.view(np.uint32)
-    background = item[I_BACKGROUND : I_BACKGROUND + 4].astype(np.uint8).view(np.uint32)[0]
-    face_offset, paint = item[I_FACE_OFFSET], item[I_PAINT]
+    face_offset = item[I_FACE_OFFSET]
     n = 0
     for row in range(start, stop):
         for col in range(codes.shape[1]):
+            if depth[row, col] >= 1.0:
+                continue
             code = codes[row, col]
             if code < 0:
-                if paint != 0:
-                    words[row, col, 0] = background
                 continue
             f = code // 2 - face_offset
             if f < 0 or f >= faces.shape[0]:
