@@ -283,11 +283,12 @@ def _fill_tile(
                         # perspective-correct weights b_k = (E_k / w_k) / Σ E_j / w_j, then onto the source face
                         g0, g1, g2 = f0 * q0, f1 * q1, f2 * q2
                         total = (g0 + g1) + g2
-                        b0, b1, b2 = g0 / total, g1 / total, g2 / total
+                        b1, b2 = g1 / total, g2 / total
                         if record < 0:  # one-hot weights: (b0·0 + b1·1) + b2·0 is b1 exactly (b_k >= 0)
                             bary[row, i, 0] = np.float32(b2 if swap == 1 else b1)
                             bary[row, i, 1] = np.float32(b1 if swap == 1 else b2)
                         else:
+                            b0 = g0 / total
                             for k in range(2):
                                 w0, w1, w2 = (
                                     tri_weights[record, 0, k],
