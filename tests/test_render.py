@@ -269,6 +269,16 @@ def test_work_arrays_reused_across_calls_and_renders_in_threads_give_the_same_by
         assert frame.depth.tobytes() == expected.depth.tobytes()
 
 
+def test_extra_buffers_are_written_at_every_image_size_even_one_pixel():
+    """Asking for normals or object ids takes the general shading kernel whatever the image size (a 1x1 image's
+    buffers are the size of the kernels' placeholders, so the choice must not be made by size)."""
+    scene = placed(Scene(lights=[LIGHT]), sphere_mesh(2))
+    camera = Camera.look_at((0.0, 0.0, 3.0), (0, 0, 0), (0, 1, 0), width=1, height=1)
+    frame = render(scene, camera, buffers=("normals", "object_id"))
+    assert frame.object_id.tolist() == [[0]]
+    np.testing.assert_allclose(frame.normals[0, 0], [0.0, 0.0, 1.0], atol=0.05)
+
+
 # --- frame and output ----------------------------------------------------------------------------------------
 
 

@@ -310,7 +310,7 @@ def _draw_surfaces(
     face_total = sum(item.mesh.face_count for item in items)
     code_type = np.int32 if 2 * face_total < 2**31 else np.int64
     codes = scratch.empty((height, width), code_type)
-    bary = scratch.empty((height, width, 2), np.float32)  # read only where codes >= 0
+    bary = scratch.empty((height, width, 2), np.float32)  # codes and bary are read only where depth < 1
     color = np.empty((height, width, 4), dtype=np.uint8)
     triangles.clear_buffers(depth, color, options.background)
     ambient, lights = pack_lights(scene.world_lights())
@@ -351,7 +351,7 @@ def _draw_surfaces(
     return depth, color
 
 
-def _directional(item: SceneItem, options: _Options, lights: np.ndarray, extra: tuple[np.ndarray, np.ndarray]) -> bool:
+def _directional(item: SceneItem, options: _Options, lights: np.ndarray) -> bool:
     """Whether the item shades through ``shade.shade_pixels_directional``: per-pixel Blinn-Phong, directional
     lights only, no vertex colors, texture, depth cue, blending or extra buffers."""
     mesh = item.mesh
@@ -360,7 +360,7 @@ def _directional(item: SceneItem, options: _Options, lights: np.ndarray, extra: 
         and options.shade_mode == shade.SHADE_PHONG and options.specular_model == shade.SPECULAR_BLINN
         and bool((lights[:, 0] == 0.0).all()) and getattr(mesh, "vertex_colors", None) is None
         and (item.material.texture is None or getattr(mesh, "uvs", None) is None)
-        and options.depth_cue is None and extra[0].size <= 3 and extra[1].size <= 1
+        and options.depth_cue is None and not options.buffers
     )  # fmt: skip
 
 
@@ -386,7 +386,7 @@ def _shade_item(
     params = _shading_parameters(item, camera, options, ambient)
     mode = options.shade_mode
     faces = _world_faces(item) if mesh.face_count else np.empty((0, 3), dtype=np.int64)
-    if not blend and _directional(item, options, lights, extra):  # the same bytes without the general branches
+    if not blend and _directional(item, options, lights):  # the same bytes without the general branches
         flags = _item_flags(index, face_offset, options, blend, False, False)
         with numba.parallel_chunksize(_DYNAMIC_CHUNK[0]):
             shade.shade_pixels_directional(depth, codes, bary, faces, world, normals, params, lights, flags, color)

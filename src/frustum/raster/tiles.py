@@ -1,10 +1,11 @@
 """Binning kernels: sort the faces to draw into square screen tiles, keeping drawing order inside each tile.
 
 This is also the per-face half of triangle setup (``triangles.face_box``: trivial reject and accept by region
-codes, back-face cull by the signed window area, pixel bounding box), so a face's corners are read twice (count,
-then fill) and nothing per face is stored but its tile list entries. Count (parallel over chunks of faces),
-records of the clipped faces added to their face's chunk, prefix sum (serial, tile-major so chunk c's entries
-precede chunk c + 1's within every tile), fill (parallel over chunks). A face goes to every tile its pixel
+codes, back-face cull by the signed window area, pixel bounding box): nothing per face is stored but its tile
+list entries, and the count pass's list of the faces that draw anything (with the one tile of each small face),
+so the fill visits those only. Count (parallel over chunks of faces), records of the clipped faces added to
+their face's chunk, prefix sum (serial, tile-major so chunk c's entries precede chunk c + 1's within every
+tile), fill (parallel over chunks). A face goes to every tile its pixel
 bounding box touches; a crossing face's clipped triangles (``triangles.clip_faces``) go, in fan order, where the
 face is. options = (width, height, cull, tile_bits, tiles_x, chunk, face_offset) int64: tiles are
 ``2^tile_bits`` pixels square, so a pixel's tile index is a shift.
@@ -93,7 +94,8 @@ def fill_tiles(
     record_starts: np.ndarray, tri_int: np.ndarray, tile_entries: np.ndarray,
 ) -> None:  # fmt: skip
     """Write each drawn face's index (and ``−1 − r`` for each record r of a clipped face) into the lists of the
-    tiles it touches, in face order: the faces ``count_tiles`` listed. offsets (C, tiles) is consumed;
+    tiles it touches, in face order: the faces ``count_tiles`` listed, a one-tile face straight from
+    ``listed_tiles``, the others by ``face_box`` again. offsets (C, tiles) is consumed;
     crossing_starts (C,) is the index of chunk c's first crossing face among all crossing faces, whose records
     are ``record_starts[k]:record_starts[k + 1]``.
     """
