@@ -401,10 +401,11 @@ def _shade_rows_directional(
     world: np.ndarray, normals: np.ndarray, params: np.ndarray, lights: np.ndarray, item: np.ndarray,
     color: np.ndarray,
 ) -> None:  # fmt: skip
-    """Rows [start, stop) of ``shade_pixels_directional``: gather each drawn pixel's interpolated normal
-    ``(u0·na + u1·nb) + u2·nc``, face sign and world point into the scratch, shading it whenever a chunk is full."""
+    """Rows [start, stop) of ``shade_pixels_directional``: list the drawn pixels (face, weights, sign) chunk by
+    chunk, then gather and shade each full chunk (``_gather_chunk``, ``_shade_chunk``)."""
     scratch = np.empty(_FIELDS * _CHUNK)
-    where = np.empty(3 * _CHUNK, dtype=np.int64)  # row, column, then the color word of each gathered pixel
+    where = np.empty(3 * _CHUNK, dtype=np.int64)  # row, column, then the face (later the color word) of each pixel
+    corners = np.empty(3 * _CHUNK, dtype=np.int64)
     words = color.view(np.uint32)
     face_offset = item[I_FACE_OFFSET]
     n = 0
@@ -418,22 +419,39 @@ def _shade_rows_directional(
             f = code // 2 - face_offset
             if f < 0 or f >= faces.shape[0]:
                 continue
-            u1, u2 = float(bary[row, col, 0]), float(bary[row, col, 1])
-            u0 = (1.0 - u1) - u2
-            a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
-            scratch[_NX + n] = _interpolate(u0, u1, u2, normals[a, 0], normals[b, 0], normals[c, 0])
-            scratch[_NY + n] = _interpolate(u0, u1, u2, normals[a, 1], normals[b, 1], normals[c, 1])
-            scratch[_NZ + n] = _interpolate(u0, u1, u2, normals[a, 2], normals[b, 2], normals[c, 2])
+            scratch[_X + n], scratch[_NDL + n] = float(bary[row, col, 0]), float(bary[row, col, 1])
             scratch[_SIGN + n] = -1.0 if code % 2 == 1 else 1.0
-            scratch[_PX + n] = _interpolate(u0, u1, u2, world[a, 0], world[b, 0], world[c, 0])
-            scratch[_PY + n] = _interpolate(u0, u1, u2, world[a, 1], world[b, 1], world[c, 1])
-            scratch[_PZ + n] = _interpolate(u0, u1, u2, world[a, 2], world[b, 2], world[c, 2])
-            where[n], where[_CHUNK + n] = row, col
+            where[n], where[_CHUNK + n], where[2 * _CHUNK + n] = row, col, f
             n += 1
             if n == _CHUNK:
+                _gather_chunk(n, scratch, where, corners, faces, world, normals)
                 _shade_chunk(n, scratch, where, params, lights, words)
                 n = 0
+    _gather_chunk(n, scratch, where, corners, faces, world, normals)
     _shade_chunk(n, scratch, where, params, lights, words)
+
+
+@kernel
+def _gather_chunk(
+    n: int, s: np.ndarray, where: np.ndarray, corners: np.ndarray, faces: np.ndarray, world: np.ndarray,
+    normals: np.ndarray,
+) -> None:  # fmt: skip
+    """Interpolated normal ``(u0·na + u1·nb) + u2·nc`` and world point of the first n listed pixels, from their
+    weights (u1, u2 in the _X and _NDL rows). Corners first, then the vertex data, each in its own short loop:
+    the loads of many pixels are in flight at once (one long loop per pixel waited on each cache miss in turn)."""
+    for i in range(n):
+        f = where[2 * _CHUNK + i]
+        corners[i], corners[_CHUNK + i], corners[2 * _CHUNK + i] = faces[f, 0], faces[f, 1], faces[f, 2]
+    for i in range(n):
+        a, b, c = corners[i], corners[_CHUNK + i], corners[2 * _CHUNK + i]
+        u1, u2 = s[_X + i], s[_NDL + i]
+        u0 = (1.0 - u1) - u2
+        s[_NX + i] = _interpolate(u0, u1, u2, normals[a, 0], normals[b, 0], normals[c, 0])
+        s[_NY + i] = _interpolate(u0, u1, u2, normals[a, 1], normals[b, 1], normals[c, 1])
+        s[_NZ + i] = _interpolate(u0, u1, u2, normals[a, 2], normals[b, 2], normals[c, 2])
+        s[_PX + i] = _interpolate(u0, u1, u2, world[a, 0], world[b, 0], world[c, 0])
+        s[_PY + i] = _interpolate(u0, u1, u2, world[a, 1], world[b, 1], world[c, 1])
+        s[_PZ + i] = _interpolate(u0, u1, u2, world[a, 2], world[b, 2], world[c, 2])
 
 
 @kernel
