@@ -87,6 +87,8 @@ from frustum.geometry import (
     MeshPart,
     NURBSCurve,
     NURBSSurface,
+    Octree,
+    OctreeHits,
     PiecewiseBezier,
     Polyline,
     TurtlePath,
@@ -217,12 +219,14 @@ from frustum.quaternion import (
     slerp,
 )
 from frustum.render import (
+    RENDER_METHODS,
     RENDER_MODES,
     SHADING_MODES,
     render,
 )
 from frustum.scene import (
     Node,
+    Pick,
     Placed,
     Scene,
     SceneItem,
@@ -289,6 +293,9 @@ from frustum.visibility import (
     signed_window_areas,
     viewing_position,
 )
+from frustum.visibility.octree import (
+    render_octree,
+)
 
 __all__ = [
     "ANAGLYPH_METHODS",
@@ -315,6 +322,7 @@ __all__ = [
     "REGION_NEAR",
     "REGION_RIGHT",
     "REGION_TOP",
+    "RENDER_METHODS",
     "RENDER_MODES",
     "SHADING_MODES",
     "SHEET_VIEWS",
@@ -362,9 +370,12 @@ __all__ = [
     "NURBSSurface",
     "Node",
     "Oblique",
+    "Octree",
+    "OctreeHits",
     "Orthographic",
     "OutputError",
     "Perspective",
+    "Pick",
     "PiecewiseBezier",
     "Placed",
     "PointLight",
@@ -484,6 +495,7 @@ __all__ = [
     "remove_hidden_lines",
     "render",
     "render_examples",
+    "render_octree",
     "render_scene_file",
     "render_stereo",
     "render_svg",
