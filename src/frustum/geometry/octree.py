@@ -643,19 +643,36 @@ class Octree:
             boundary = _EMPTY
         return Octree(self.bounds, d, tuple(levels), boundary)
 
-    def transformed(self, matrix: ArrayLike, depth: int | None = None) -> Octree:
-        """The solid mapped by an affine `matrix` (4x4), **resampled**: ``from_function`` of the pulled-back
-        membership test on the same region (cells are re-decided from samples; not exact)."""
+    def transformed(self, matrix: ArrayLike) -> Octree:
+        """The solid mapped by an affine `matrix` (4x4) into the same region, **resampled**: a finest cell of the
+        result is full when its centre, mapped back by the inverse, lies in a full cell (not exact in general;
+        a move by whole cells gives ``shifted``'s cells). Work grows with the mapped volume in finest cells."""
         from frustum._arrays import as_matrix
 
-        m = as_matrix(matrix, where="Octree.transformed", error=GeometryError)
+        where = "Octree.transformed"
+        m = as_matrix(matrix, where=where, error=GeometryError)
+        if abs(np.linalg.det(m[:3, :3])) < 1e-12:
+            raise GeometryError(f"{where}: matrix is singular (det of its 3x3 part ~ 0); give an invertible map")
         inverse = np.linalg.inv(m)
-
-        def inside(x: NDArray, y: NDArray, z: NDArray) -> NDArray:
-            p = np.stack([x, y, z], axis=1) @ inverse[:3, :3].T + inverse[:3, 3]
-            return np.where(self.contains(p), -1.0, 1.0)
-
-        return Octree.from_function(inside, self.bounds, self.depth if depth is None else depth)
+        n, cell = 2**self.depth, self.cell_size
+        boxes = self.leaf_boxes()
+        corners = boxes[:, [0, 1]][:, np.array([[c & 1, (c >> 1) & 1, (c >> 2) & 1] for c in range(8)]), [0, 1, 2]]
+        image = corners @ m[:3, :3].T + m[:3, 3]
+        lo = np.clip(np.floor((image.min(axis=1) - self.bounds[0]) / cell - 0.5), 0, n - 1).astype(np.int64)
+        hi = np.clip(np.ceil((image.max(axis=1) - self.bounds[0]) / cell - 0.5), 0, n - 1).astype(np.int64)
+        total = float(np.prod(hi - lo + 1, axis=1).sum())
+        check_memory(total * 64.0, where=where, cause=f"depth = {self.depth} ({total:.3g} candidate cells)",
+                     error=GeometryError)  # fmt: skip
+        found = []
+        for a, b in zip(lo, hi, strict=True):
+            ijk = np.stack(np.meshgrid(*[np.arange(a[i], b[i] + 1) for i in range(3)], indexing="ij"), -1).reshape(
+                -1, 3
+            )
+            centres = self.bounds[0] + (ijk + 0.5) * cell
+            keep = self.contains(centres @ inverse[:3, :3].T + inverse[:3, 3])
+            found.append(morton_encode(ijk[keep]))
+        codes = np.unique(np.concatenate(found)) if found else _EMPTY
+        return Octree(self.bounds, self.depth, tuple([_EMPTY] * self.depth + [codes]))
 
     # --- conversions --------------------------------------------------------------------------------------
 

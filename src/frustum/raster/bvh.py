@@ -56,9 +56,10 @@ def build(triangles: np.ndarray) -> Hierarchy:
     padded[:count] = tri[order]
     index = np.full(rows, -1, dtype=np.int64)
     index[:count] = order
-    with np.errstate(invalid="ignore"):
-        tri_lo = np.where(index[:, None] >= 0, np.nanmin(padded, axis=1) if count else np.inf, np.inf)
-        tri_hi = np.where(index[:, None] >= 0, np.nanmax(padded, axis=1) if count else -np.inf, -np.inf)
+    tri_lo = np.full((rows, 3), np.inf)
+    tri_hi = np.full((rows, 3), -np.inf)
+    tri_lo[:count] = tri[order].min(axis=1)
+    tri_hi[:count] = tri[order].max(axis=1)
     node_lo = np.empty((2 * p - 1, 3))
     node_hi = np.empty((2 * p - 1, 3))
     node_lo[p - 1 :] = tri_lo.reshape(p, LEAF_SIZE, 3).min(axis=1)
