@@ -3,6 +3,7 @@ depth buffer, ray queries and Scene.pick against brute force, and bad input."""
 
 from __future__ import annotations
 
+import itertools
 import math
 from pathlib import Path
 
@@ -104,7 +105,7 @@ def test_sampled_volume_converges_inside_volume_bounds(f, exact):
         assert low <= tree.volume <= high
         errors.append(abs(tree.volume - exact))
         widths.append(high - low)
-    assert all(b < a for a, b in zip(widths, widths[1:], strict=False))  # the bracket halves with each level
+    assert all(b < a for a, b in itertools.pairwise(widths))  # the bracket halves with each level
     assert errors[-1] < 2e-3 * exact and errors[-1] < errors[0]
 
 
@@ -396,7 +397,7 @@ def test_ray_hits_equal_brute_force_ray_box_tests():
     for i in np.flatnonzero(hits.hit)[:50]:
         k = np.flatnonzero((levels == hits.level[i]) & (codes == hits.code[i]))[0]
         assert (boxes[k, 0] - 1e-9 <= hits.point[i]).all() and (hits.point[i] <= boxes[k, 1] + 1e-9).all()
-    inside = tree.ray_hits(np.zeros(3) + [0.0, 0.0, -0.6], [1.0, 0.0, 0.0])
+    inside = tree.ray_hits([0.0, 0.0, -0.6], [1.0, 0.0, 0.0])
     assert inside.hit and inside.distance == 0.0
 
 
@@ -464,8 +465,8 @@ def test_pick_agrees_with_the_rendered_object_id():
 
 
 def test_depth_over_the_memory_budget_names_estimate_budget_and_parameter():
-    with frustum.budget(bytes="64M"), pytest.raises(GeometryError, match=r"depth = 12 needs about .* over the memory "
-                                                                        r"budget of 64\.0 MiB.*set_budget"):  # fmt: skip
+    message = r"depth = 12 needs about .* over the memory budget of 64\.0 MiB.*set_budget"
+    with frustum.budget(bytes="64M"), pytest.raises(GeometryError, match=message):
         Octree.from_function(lambda x, y, z: x, CUBE, 12)
     with pytest.raises(GeometryError, match=r"depth = 16 needs about"):
         Octree.from_function(lambda x, y, z: x, CUBE, 16)
