@@ -495,7 +495,7 @@ def test_set_operations_on_different_regions_are_refused():
         (lambda: Octree.from_function(lambda x, y, z: x, CUBE, 2.5), r"depth = 2.5 is not an integer"),
         (lambda: Octree.from_function(lambda x, y, z: x, CUBE, 21), r"depth = 21 is above 20"),
         (lambda: Octree.from_function(lambda x, y, z: x[:3], CUBE, 2), r"f returned shape \(3,\)"),
-        (lambda: Octree.from_function(lambda x, y, z: x / 0.0, CUBE, 2), r"is not finite"),
+        (lambda: Octree.from_function(lambda x, y, z: np.full_like(x, np.inf), CUBE, 2), r"is not finite"),
         (lambda: Octree.from_function(3, CUBE, 2), r"f = 3 is not callable"),
         (lambda: Octree.from_mesh("mesh", 3), r"mesh = 'mesh' is not a Mesh"),
         (lambda: Octree.from_points([[0, 0, np.nan]], 3), r"points\[0\] = .* is not finite"),

@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from frustum.raster._jit import kernel
+from frustum.raster._jit import kernel, parallel_kernel, prange
 
-__all__ = ["TILE", "draw_octree"]
+__all__ = ["TILE", "draw_octree", "split_pairs"]
 
 TILE = 8
 """Side of the coverage tiles (pixels): a node whose screen box lies in completely written tiles is skipped."""
@@ -211,3 +211,62 @@ def draw_octree(full_codes, full_offsets, partial_codes, partial_offsets, params
             stack_full[top] = full
             top += 1
     return visited
+
+
+@parallel_kernel
+def split_pairs(corners, triangle_ids, parent_lo, side, reference, parity, touches, crossings):
+    """For each (cell, triangle) pair and each octant o of the cell: does the triangle touch child o, and does
+    it cross the segment from the cell's reference point to the child's (parallel over pairs).
+
+    corners (F, 3, 3) triangle corners; triangle_ids (P,) the pair's triangle; parent_lo (P, 3) the cell's min
+    corner (side 2·`side`); reference (3,) the reference point's offset from a cube's centre, in sides.
+    touches[p, o]: bounding boxes overlap and the triangle's plane meets the child cube (conservative, closed).
+    crossings[p, o] (if `parity`): Möller–Trumbore, t in [0, 1), u, v >= 0, u + v <= 1.
+    """
+    slack = 1e-12 * max(side, 1.0)
+    for p in prange(triangle_ids.shape[0]):
+        f = triangle_ids[p]
+        ax, ay, az = corners[f, 0, 0], corners[f, 0, 1], corners[f, 0, 2]
+        e1x, e1y, e1z = corners[f, 1, 0] - ax, corners[f, 1, 1] - ay, corners[f, 1, 2] - az
+        e2x, e2y, e2z = corners[f, 2, 0] - ax, corners[f, 2, 1] - ay, corners[f, 2, 2] - az
+        nx, ny, nz = e1y * e2z - e1z * e2y, e1z * e2x - e1x * e2z, e1x * e2y - e1y * e2x
+        n1 = abs(nx) + abs(ny) + abs(nz)
+        tmin_x = min(ax, min(corners[f, 1, 0], corners[f, 2, 0]))
+        tmax_x = max(ax, max(corners[f, 1, 0], corners[f, 2, 0]))
+        tmin_y = min(ay, min(corners[f, 1, 1], corners[f, 2, 1]))
+        tmax_y = max(ay, max(corners[f, 1, 1], corners[f, 2, 1]))
+        tmin_z = min(az, min(corners[f, 1, 2], corners[f, 2, 2]))
+        tmax_z = max(az, max(corners[f, 1, 2], corners[f, 2, 2]))
+        # the parent's reference point (cube of side 2·side)
+        sx0 = parent_lo[p, 0] + (0.5 + reference[0]) * 2.0 * side
+        sy0 = parent_lo[p, 1] + (0.5 + reference[1]) * 2.0 * side
+        sz0 = parent_lo[p, 2] + (0.5 + reference[2]) * 2.0 * side
+        for o in range(8):
+            lx = parent_lo[p, 0] + (o & 1) * side
+            ly = parent_lo[p, 1] + ((o >> 1) & 1) * side
+            lz = parent_lo[p, 2] + ((o >> 2) & 1) * side
+            hit = (
+                tmin_x <= lx + side + slack and tmax_x >= lx - slack and tmin_y <= ly + side + slack
+                and tmax_y >= ly - slack and tmin_z <= lz + side + slack and tmax_z >= lz - slack
+            )  # fmt: skip
+            if hit:
+                cx, cy, cz = lx + 0.5 * side, ly + 0.5 * side, lz + 0.5 * side
+                distance = nx * (cx - ax) + ny * (cy - ay) + nz * (cz - az)
+                hit = abs(distance) <= 0.5 * side * n1 * (1.0 + 1e-9) + slack * n1
+            touches[p, o] = hit
+            crossed = False
+            if parity:
+                dx = lx + (0.5 + reference[0]) * side - sx0
+                dy = ly + (0.5 + reference[1]) * side - sy0
+                dz = lz + (0.5 + reference[2]) * side - sz0
+                px, py, pz = dy * e2z - dz * e2y, dz * e2x - dx * e2z, dx * e2y - dy * e2x
+                det = e1x * px + e1y * py + e1z * pz
+                if det != 0.0:
+                    inv = 1.0 / det
+                    qx0, qy0, qz0 = sx0 - ax, sy0 - ay, sz0 - az
+                    u = (qx0 * px + qy0 * py + qz0 * pz) * inv
+                    qx, qy, qz = qy0 * e1z - qz0 * e1y, qz0 * e1x - qx0 * e1z, qx0 * e1y - qy0 * e1x
+                    v = (dx * qx + dy * qy + dz * qz) * inv
+                    t = (e2x * qx + e2y * qy + e2z * qz) * inv
+                    crossed = u >= 0.0 and v >= 0.0 and u + v <= 1.0 and t >= 0.0 and t < 1.0
+            crossings[p, o] = crossed
