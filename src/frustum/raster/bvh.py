@@ -105,72 +105,79 @@ def _box_entry(lo, hi, node, ox, oy, oz, ix, iy, iz, t_max):
     return t0
 
 
-@parallel_kernel
-def _trace(lo, hi, triangles, order, origins, directions, t_out, face_out):
-    """For each ray: nearest t >= 0 over all triangles (inf if none) and the original triangle index (−1)."""
+@kernel
+def _trace_ray(lo, hi, triangles, order, ox, oy, oz, dx, dy, dz):
+    """(t, face): nearest t >= 0 over all triangles (inf, −1 if none) of one ray."""
     leaves = (lo.shape[0] + 1) // 2
+    ix = 1.0 / dx if dx != 0.0 else np.inf
+    iy = 1.0 / dy if dy != 0.0 else np.inf
+    iz = 1.0 / dz if dz != 0.0 else np.inf
+    best = np.inf
+    best_face = -1
+    stack = np.empty(64, dtype=np.int64)
+    top = 0
+    if _box_entry(lo, hi, 0, ox, oy, oz, ix, iy, iz, best) < np.inf:
+        stack[0] = 0
+        top = 1
+    while top > 0:
+        top -= 1
+        node = stack[top]
+        if node >= leaves - 1:
+            first = (node - (leaves - 1)) * 4
+            for row in range(first, first + 4):
+                face = order[row]
+                if face < 0:
+                    continue
+                ax, ay, az = triangles[row, 0, 0], triangles[row, 0, 1], triangles[row, 0, 2]
+                e1x, e1y, e1z = triangles[row, 1, 0] - ax, triangles[row, 1, 1] - ay, triangles[row, 1, 2] - az
+                e2x, e2y, e2z = triangles[row, 2, 0] - ax, triangles[row, 2, 1] - ay, triangles[row, 2, 2] - az
+                px, py, pz = dy * e2z - dz * e2y, dz * e2x - dx * e2z, dx * e2y - dy * e2x
+                det = e1x * px + e1y * py + e1z * pz
+                if det == 0.0:
+                    continue
+                inv = 1.0 / det
+                sx, sy, sz = ox - ax, oy - ay, oz - az
+                u = (sx * px + sy * py + sz * pz) * inv
+                if u < 0.0 or u > 1.0:
+                    continue
+                qx, qy, qz = sy * e1z - sz * e1y, sz * e1x - sx * e1z, sx * e1y - sy * e1x
+                v = (dx * qx + dy * qy + dz * qz) * inv
+                if v < 0.0 or u + v > 1.0:
+                    continue
+                t = (e2x * qx + e2y * qy + e2z * qz) * inv
+                if t >= 0.0 and (t < best or (t == best and face < best_face)):
+                    best = t
+                    best_face = face
+            continue
+        left, right = 2 * node + 1, 2 * node + 2
+        t_left = _box_entry(lo, hi, left, ox, oy, oz, ix, iy, iz, best)
+        t_right = _box_entry(lo, hi, right, ox, oy, oz, ix, iy, iz, best)
+        near, far, t_near, t_far = (
+            (left, right, t_left, t_right) if t_left <= t_right else (right, left, t_right, t_left)
+        )
+        if t_far < np.inf:  # the farther child is pushed first: the nearer one is popped next
+            stack[top] = far
+            top += 1
+        if t_near < np.inf:
+            stack[top] = near
+            top += 1
+    return best, best_face
+
+
+@kernel
+def _trace(lo, hi, triangles, order, origins, directions, t_out, face_out):
+    """``_trace_ray`` for each ray, one thread (a few rays: no thread start-up)."""
+    for r in range(origins.shape[0]):
+        t_out[r], face_out[r] = _trace_ray(lo, hi, triangles, order, origins[r, 0], origins[r, 1], origins[r, 2],
+                                           directions[r, 0], directions[r, 1], directions[r, 2])  # fmt: skip
+
+
+@parallel_kernel
+def _trace_parallel(lo, hi, triangles, order, origins, directions, t_out, face_out):
+    """``_trace_ray`` for each ray, parallel over rays."""
     for r in prange(origins.shape[0]):
-        ox, oy, oz = origins[r, 0], origins[r, 1], origins[r, 2]
-        dx, dy, dz = directions[r, 0], directions[r, 1], directions[r, 2]
-        ix = 1.0 / dx if dx != 0.0 else np.inf
-        iy = 1.0 / dy if dy != 0.0 else np.inf
-        iz = 1.0 / dz if dz != 0.0 else np.inf
-        best = np.inf
-        best_face = -1
-        stack = np.empty(64, dtype=np.int64)
-        top = 0
-        if _box_entry(lo, hi, 0, ox, oy, oz, ix, iy, iz, best) < np.inf:
-            stack[0] = 0
-            top = 1
-        while top > 0:
-            top -= 1
-            node = stack[top]
-            if node >= leaves - 1:
-                first = (node - (leaves - 1)) * 4
-                for row in range(first, first + 4):
-                    face = order[row]
-                    if face < 0:
-                        continue
-                    ax, ay, az = triangles[row, 0, 0], triangles[row, 0, 1], triangles[row, 0, 2]
-                    e1x, e1y, e1z = triangles[row, 1, 0] - ax, triangles[row, 1, 1] - ay, triangles[row, 1, 2] - az
-                    e2x, e2y, e2z = triangles[row, 2, 0] - ax, triangles[row, 2, 1] - ay, triangles[row, 2, 2] - az
-                    px, py, pz = dy * e2z - dz * e2y, dz * e2x - dx * e2z, dx * e2y - dy * e2x
-                    det = e1x * px + e1y * py + e1z * pz
-                    if det == 0.0:
-                        continue
-                    inv = 1.0 / det
-                    sx, sy, sz = ox - ax, oy - ay, oz - az
-                    u = (sx * px + sy * py + sz * pz) * inv
-                    if u < 0.0 or u > 1.0:
-                        continue
-                    qx, qy, qz = sy * e1z - sz * e1y, sz * e1x - sx * e1z, sx * e1y - sy * e1x
-                    v = (dx * qx + dy * qy + dz * qz) * inv
-                    if v < 0.0 or u + v > 1.0:
-                        continue
-                    t = (e2x * qx + e2y * qy + e2z * qz) * inv
-                    if t >= 0.0 and (t < best or (t == best and face < best_face)):
-                        best = t
-                        best_face = face
-                continue
-            left, right = 2 * node + 1, 2 * node + 2
-            t_left = _box_entry(lo, hi, left, ox, oy, oz, ix, iy, iz, best)
-            t_right = _box_entry(lo, hi, right, ox, oy, oz, ix, iy, iz, best)
-            if t_left <= t_right:  # push the farther child first: the nearer one is popped next
-                if t_right < np.inf:
-                    stack[top] = right
-                    top += 1
-                if t_left < np.inf:
-                    stack[top] = left
-                    top += 1
-            else:
-                if t_left < np.inf:
-                    stack[top] = left
-                    top += 1
-                if t_right < np.inf:
-                    stack[top] = right
-                    top += 1
-        t_out[r] = best
-        face_out[r] = best_face
+        t_out[r], face_out[r] = _trace_ray(lo, hi, triangles, order, origins[r, 0], origins[r, 1], origins[r, 2],
+                                           directions[r, 0], directions[r, 1], directions[r, 2])  # fmt: skip
 
 
 def first_hits(hierarchy: Hierarchy, origins: np.ndarray, directions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -179,5 +186,6 @@ def first_hits(hierarchy: Hierarchy, origins: np.ndarray, directions: np.ndarray
     d = np.ascontiguousarray(directions, dtype=np.float64)
     t = np.empty(o.shape[0])
     face = np.empty(o.shape[0], dtype=np.int64)
-    _trace(hierarchy.lo, hierarchy.hi, hierarchy.triangles, hierarchy.order, o, d, t, face)
+    trace = _trace if o.shape[0] < 64 else _trace_parallel
+    trace(hierarchy.lo, hierarchy.hi, hierarchy.triangles, hierarchy.order, o, d, t, face)
     return t, face
