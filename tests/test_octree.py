@@ -519,3 +519,54 @@ def test_render_octree_and_pick_reject_bad_arguments():
         Scene().pick(1, 0, 0)
     with pytest.raises(FrustumError, match=r"x = nan is not finite"):
         Scene().pick(camera, float("nan"), 0)
+
+
+# --- scene files --------------------------------------------------------------------------------------------
+
+
+def test_scene_file_octree_geometry_and_method(tmp_path: Path):
+    from frustum import load_scene_file
+
+    text = """
+[render]
+size = [64, 48]
+method = "octree"
+
+[camera]
+eye = [3.0, 2.0, 3.0]
+
+[[nodes]]
+geometry = { type = "octree", depth = 4, source = { type = "box", size = [1.0, 1.0, 1.0] } }
+"""
+    path = tmp_path / "scene.toml"
+    path.write_text(text)
+    loaded = load_scene_file(path)
+    tree = loaded.scene.octrees[0].mesh
+    assert isinstance(tree, Octree) and tree.depth == 4 and tree.volume == pytest.approx(1.0)
+    assert loaded.options["method"] == "octree"
+    frame = render(loaded.scene, loaded.cameras[0], **loaded.options)
+    assert (frame.depth < 1).sum() > 100
+    # the depth buffer draws the same node as its cell faces
+    assert loaded.scene.items[0].mesh.face_count == tree.surface.face_count
+
+
+@pytest.mark.parametrize(
+    "geometry, message",
+    [
+        ('{ type = "octree", depth = 4 }', r"scene.toml:\d+: nodes\[0\].geometry.source is missing"),
+        ('{ type = "octree", depth = 40, source = { type = "box" } }', r"nodes\[0\].geometry.depth = 40"),
+        ('{ type = "octree", source = { type = "koch_snowflake", level = 1 } }', r"is not a solid"),
+        ('{ type = "octree", source = { type = "plane" } }', r"boundary edges"),
+        ('{ type = "octree", source = { type = "box" }, colour = 1 }', r"colour"),
+    ],
+)
+def test_scene_file_octree_errors_name_file_line_and_key(tmp_path: Path, geometry: str, message: str):
+    from frustum import SceneFileError, load_scene_file
+
+    path = tmp_path / "scene.toml"
+    path.write_text(f'[camera]\neye = [3.0, 2.0, 3.0]\n\n[[nodes]]\ngeometry = {geometry}\n')
+    with pytest.raises(SceneFileError, match=message):
+        load_scene_file(path)
+    path.write_text('[render]\nmethod = "ray"\n\n[camera]\neye = [3.0, 2.0, 3.0]\n')
+    with pytest.raises(SceneFileError, match=r"render.method = 'ray' is unknown|render.method = 'ray'"):
+        load_scene_file(path)

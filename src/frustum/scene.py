@@ -225,7 +225,8 @@ class Scene:
 
     @property
     def items(self) -> list[SceneItem]:
-        """Placed meshes in drawing order, each with its (inherited) material and world transform."""
+        """Placed meshes in drawing order, each with its (inherited) material and world transform; a placed
+        Octree counts as its cell faces (``Octree.surface``), as the depth buffer draws it."""
         return self._placed(Mesh)
 
     @property
@@ -285,6 +286,8 @@ class Scene:
             material = node.material if node.material is not None else inherited
             if isinstance(node.geometry, kind):
                 result.append(SceneItem(node.geometry, material, world))
+            elif kind is Mesh and isinstance(node.geometry, Octree):
+                result.append(SceneItem(node.geometry.surface, material, world))
             for child in node.children:
                 visit(child, world, material)
 

@@ -760,11 +760,16 @@ class Octree:
     # --- ray queries --------------------------------------------------------------------------------------
 
     @cached_property
+    def surface(self) -> Mesh:
+        """``to_mesh()``, computed once: the cell faces a scene draws by the depth buffer."""
+        return self.to_mesh()
+
+    @cached_property
     def _surface_index(self) -> tuple[Mesh, Any]:
         from frustum.raster import bvh
 
-        mesh = self.to_mesh()
-        return mesh, bvh.build(mesh.vertices[mesh.faces])
+        mesh = self.surface
+        return mesh, (bvh.build(mesh.vertices[mesh.faces]) if mesh.face_count else None)
 
     def ray_hits(self, origins: ArrayLike, directions: ArrayLike) -> OctreeHits:
         """First hit of each ray ``origin + t·direction`` (t >= 0) on the solid: distance, point and full leaf.
