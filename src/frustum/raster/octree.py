@@ -81,9 +81,16 @@ def _fill_face(window, corner_ids, face_rgba, color, depth, written, tile_counts
 
 
 @kernel
-def _covered(tile_counts, i0, i1, j0, j1, height, width):
-    """True if every tile under the pixel box [i0, i1] × [j0, j1] (window rows j, y up) is completely written."""
+def _covered(tile_counts, written, i0, i1, j0, j1, height, width):
+    """True if every pixel of the box [i0, i1] × [j0, j1] (window rows j, y up) is written: looked up one by one
+    for a box of at most 16 pixels, else through the tiles it touches (all completely written)."""
     r0, r1 = height - 1 - j1, height - 1 - j0
+    if (i1 - i0 + 1) * (r1 - r0 + 1) <= 16:  # a small box: look at its pixels themselves
+        for r in range(r0, r1 + 1):
+            for i in range(i0, i1 + 1):
+                if not written[r, i]:
+                    return False
+        return True
     for ty in range(r0 // 8, r1 // 8 + 1):
         rows = min(8, height - ty * 8)
         for tx in range(i0 // 8, i1 // 8 + 1):
@@ -180,7 +187,7 @@ def draw_octree(full_codes, full_offsets, partial_codes, partial_offsets, params
             j1 = min(int(np.floor(ymax - 0.5)), height - 1)
             if i0 > i1 or j0 > j1:
                 continue  # covers no pixel centre
-            if _covered(tile_counts, i0, i1, j0, j1, height, width):
+            if _covered(tile_counts, written, i0, i1, j0, j1, height, width):
                 continue  # every pixel under it is already written by nearer cells
             if full:
                 for axis in range(3):
