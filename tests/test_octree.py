@@ -136,6 +136,14 @@ def test_from_mesh_sphere_converges_to_mesh_volume():
     assert abs(tree.volume - mesh.volume) < 0.01 * mesh.volume
 
 
+def test_from_mesh_region_inside_the_solid_is_one_full_node_whatever_the_winding():
+    ball = icosphere(2.0, 2)
+    for mesh in (ball, ball.flipped()):
+        inner = Octree.from_mesh(mesh, 3, bounds=[[-0.5] * 3, [0.5] * 3])
+        assert inner.level_counts[0].tolist() == [1, 0] and inner.volume == 1.0
+        assert Octree.from_mesh(mesh, 4) == Octree.from_mesh(ball, 4)
+
+
 def _closed_bunny() -> Mesh:
     """The Stanford bunny with its 5 bottom holes closed by fans from each hole's centroid."""
     data = trimesh.load(DATA / "bunny" / "bun_zipper.ply", process=False, force="mesh")

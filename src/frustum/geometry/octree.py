@@ -466,7 +466,7 @@ class Octree:
         keep = _triangle_touches_box(corners, region[0], size)
         cell_pairs, triangle_ids = cell_pairs[keep], triangle_ids[keep]
         root_reference = region[0] + (0.5 + _REFERENCE) * size
-        root_inside = False if shell else bool(_winding_number(corners, root_reference[None])[0] > 0.5)
+        root_inside = False if shell else bool(abs(_winding_number(corners, root_reference[None])[0]) > 0.5)
         partial = np.zeros(1, dtype=np.uint64) if cell_pairs.size else _EMPTY
         partial_inside = np.array([root_inside]) if cell_pairs.size else np.zeros(0, dtype=bool)
         levels: list[NDArray[np.uint64]] = [np.zeros(1, dtype=np.uint64) if (root_inside and not cell_pairs.size)
