@@ -572,7 +572,7 @@ def test_scene_file_octree_errors_name_file_line_and_key(tmp_path: Path, geometr
     from frustum import SceneFileError, load_scene_file
 
     path = tmp_path / "scene.toml"
-    path.write_text(f'[camera]\neye = [3.0, 2.0, 3.0]\n\n[[nodes]]\ngeometry = {geometry}\n')
+    path.write_text(f"[camera]\neye = [3.0, 2.0, 3.0]\n\n[[nodes]]\ngeometry = {geometry}\n")
     with pytest.raises(SceneFileError, match=message):
         load_scene_file(path)
     path.write_text('[render]\nmethod = "ray"\n\n[camera]\neye = [3.0, 2.0, 3.0]\n')

@@ -18,16 +18,22 @@ TILE = 8
 
 
 @kernel
-def _find(codes, start, stop, code):
-    """True if `code` is in the sorted slice codes[start:stop]."""
+def _octants(codes, start, stop, parent):
+    """Bit o set for each child ``8·parent + o`` present in the sorted slice codes[start:stop] (one binary search
+    for the first child, then a scan of at most 8 entries)."""
+    first = parent << np.uint64(3)
     lo, hi = start, stop
     while lo < hi:
         mid = (lo + hi) >> 1
-        if codes[mid] < code:
+        if codes[mid] < first:
             lo = mid + 1
         else:
             hi = mid
-    return lo < stop and codes[lo] == code
+    bits = 0
+    while lo < stop and codes[lo] < first + np.uint64(8):
+        bits |= 1 << int(codes[lo] - first)
+        lo += 1
+    return bits
 
 
 @kernel
@@ -126,20 +132,17 @@ def draw_octree(full_codes, full_offsets, partial_codes, partial_offsets, params
     stack_level = np.empty(8 * (max_level + 2), dtype=np.int64)
     stack_code = np.empty(8 * (max_level + 2), dtype=np.uint64)
     stack_full = np.empty(8 * (max_level + 2), dtype=np.bool_)
-    stack_level[0], stack_code[0], stack_full[0] = 0, 0, False
-    top = 1
+    # the root: full, partial or empty (then nothing to draw)
+    stack_level[0], stack_code[0], stack_full[0] = 0, 0, full_offsets[1] > full_offsets[0]
+    top = 1 if (full_offsets[1] > full_offsets[0] or partial_offsets[1] > partial_offsets[0]) else 0
     clip = np.empty((8, 4))
     window = np.empty((8, 3))
     quad = np.empty(4, dtype=np.int64)
     visited = 0
     while top > 0 and drawn < total:
         top -= 1
-        level, code, inside_full = stack_level[top], stack_code[top], stack_full[top]
+        level, code, full = stack_level[top], stack_code[top], stack_full[top]  # full, else partial
         visited += 1
-        # state of the node: full, partial or empty
-        full = inside_full or _find(full_codes, full_offsets[level], full_offsets[level + 1], code)
-        if not full and not _find(partial_codes, partial_offsets[level], partial_offsets[level + 1], code):
-            continue
         # integer coordinates from the Morton code
         i = j = k = np.uint64(0)
         for bit in range(level):
@@ -209,13 +212,21 @@ def draw_octree(full_codes, full_offsets, partial_codes, partial_offsets, params
                 continue
         elif full and level == max_level:
             continue  # a finest cell crossing the near plane is not drawn
-        # a partial node (or a full one crossing the near plane): children front to back
+        # a partial node (or a full one crossing the near plane): its non-empty children, front to back
+        if full:
+            full_bits, partial_bits = 255, 0
+        else:
+            full_bits = _octants(full_codes, full_offsets[level + 1], full_offsets[level + 2], code)
+            partial_bits = _octants(partial_codes, partial_offsets[level + 1], partial_offsets[level + 2], code)
         cx, cy, cz = lo_x + 0.5 * s, lo_y + 0.5 * s, lo_z + 0.5 * s
         mask = (1 if ex > cx * ew else 0) | (2 if ey > cy * ew else 0) | (4 if ez > cz * ew else 0)
         for c in range(7, -1, -1):  # pushed last-first: child mask ^ 0 is popped first
+            o = mask ^ c
+            if not ((full_bits | partial_bits) >> o) & 1:
+                continue  # an empty child
             stack_level[top] = level + 1
-            stack_code[top] = (code << np.uint64(3)) | np.uint64(mask ^ c)
-            stack_full[top] = full
+            stack_code[top] = (code << np.uint64(3)) | np.uint64(o)
+            stack_full[top] = (full_bits >> o) & 1 == 1
             top += 1
     return visited
 
