@@ -33,9 +33,11 @@ from numba.core import event
 
 import frustum.raster
 
-__all__ = ["kernel", "parallel_for", "parallel_kernel", "set_threads", "threads"]
+__all__ = ["kernel", "parallel_for", "parallel_kernel", "prange", "set_threads", "threads"]
 
 kernel = numba.njit(cache=True, nogil=True)
+_parfor_kernel = numba.njit(cache=True, nogil=True, parallel=True)
+prange = numba.prange
 
 NOTICE_AFTER = 1.0
 """Seconds of kernel compilation after which ``frustum.raster.compile_notice`` is called (once per process)."""
@@ -140,7 +142,12 @@ def parallel_kernel(items: Callable[..., int], *, pieces_per_thread: int = 4) ->
 
     The returned driver takes the kernel's arguments without ``start, stop``; ``driver.kernel`` is the compiled
     single-thread kernel (call it with a slice to run part of the work on the calling thread).
+
+    Applied directly to a function that loops with ``prange`` (the older form), it compiles that function with
+    Numba's ``parallel=True`` instead; prefer the slice form for new kernels.
     """
+    if "prange" in getattr(getattr(items, "__code__", None), "co_names", ()):
+        return _parfor_kernel(items)  # type: ignore[return-value]
 
     def decorate(function: Callable[..., None]) -> Callable[..., None]:
         compiled = kernel(function)
