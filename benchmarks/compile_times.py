@@ -56,7 +56,7 @@ def measure(scene: str, cache: str, out: str) -> dict:
     if proc.returncode:
         raise SystemExit(proc.stdout + proc.stderr)
     line = next(x for x in proc.stdout.splitlines() if x.startswith("@@"))
-    return json.loads(line[2:])
+    return {**json.loads(line[2:]), "stderr": proc.stderr}
 
 
 def main() -> None:
