@@ -299,7 +299,18 @@ def test_dimension_values_are_the_model_extents_and_lines_measure_them_times_sca
     assert (
         float(diameters[0].get("data-value")) == pytest.approx(20.0) and diameters[0].find(f"{SVG}text").text == "⌀20"
     )
-    assert _group(root, "top-centre-lines") is not None and _group(root, "front-centre-lines") is None
+    # centre lines: a cross through the circle in the top view, the post's axis in the side views (30 mm tall,
+    # 2 mm past each end), vertical and on the post's axis (x = 5 in the front view, z = −4 in the right view)
+    assert _group(root, "top-centre-lines") is not None
+    for view, axis_paper_x in (("front", 5.0 - (part.bounds[0][0] + part.bounds[1][0]) / 2),
+                               ("right", 4.0 + (part.bounds[0][2] + part.bounds[1][2]) / 2)):  # fmt: skip
+        group = _group(root, f"{view}-centre-lines")
+        (x0, y0), (x1, y1) = np.array([float(v) for v in NUMBER.findall(group.find(f"{SVG}path").get("d"))]).reshape(
+            2, 2
+        )
+        centre = [float(v) for v in _group(root, f"view-{view}").get("data-centre").split()]
+        assert x0 == pytest.approx(x1, abs=1e-9) and x0 == pytest.approx(centre[0] + axis_paper_x * scale, abs=1e-9)
+        assert abs(y1 - y0) == pytest.approx(30.0 * scale + 4.0, abs=1e-9)
     arrowheads = [p for p in root.iter(f"{SVG}path") if p.get("class") == "arrowheads"]
     assert len(arrowheads) == 7 and all(p.get("d").count("Z") in (1, 2) for p in arrowheads)
 

@@ -123,6 +123,7 @@ class _View:
     lines: HiddenLines
     local: NDArray[np.float64]  # (N, 2) every model vertex in view-local model mm: x right, y down, origin = target
     circles: list[tuple[NDArray[np.float64], float, float]]  # end-on circles: local centre, radius, visible part
+    axes: list[tuple[NDArray[np.float64], NDArray[np.float64]]]  # cylinder axes seen side-on: local ends
 
 
 @dataclass
@@ -256,7 +257,8 @@ def _sheet_views(names: Sequence[str], points_world: NDArray, meshes: list, opti
         lines = remove_hidden_lines(meshes, camera, **options)
         local = _to_local(camera.project(points_world)[:, :2], mm_per_pixel)
         end_on = [] if name == "isometric" else _end_on(circles, camera, lines, mm_per_pixel)
-        views.append(_View(name, camera, mm_per_pixel, lines, local, end_on))
+        axes = [] if name == "isometric" else _side_on_axes(circles, camera, mm_per_pixel)
+        views.append(_View(name, camera, mm_per_pixel, lines, local, end_on, axes))
     return views
 
 
@@ -264,6 +266,50 @@ def _to_local(window: NDArray, factor: float) -> NDArray:
     """Window (x, y up) → view-local (x right, y down) around the window centre, times `factor`."""
     half = _PIXELS / 2.0
     return np.column_stack([(window[:, 0] - half) * factor, -(window[:, 1] - half) * factor])
+
+
+def _side_on_axes(circles: list[_Circle], camera: Camera, mm_per_pixel: float) -> list:
+    """Axes of the cylinders `camera` sees from the side, as view-local segments, collinear overlaps merged.
+
+    A cylinder (or a coaxial hole) shows as two circles of equal radius whose centres lie on their common normal;
+    its axis is drawn where it is perpendicular to the line of sight (within 1e-6 rad).
+    """
+    direction = np.asarray(camera.frame.direction)
+    found: list[tuple[NDArray, NDArray]] = []
+    for i, first in enumerate(circles):
+        if abs(float(first.normal @ direction)) > math.sin(_END_ON_ANGLE):
+            continue
+        for second in circles[i + 1 :]:
+            tolerance = _CIRCLE_TOLERANCE * first.radius
+            offset = second.centre - first.centre
+            if (
+                abs(second.radius - first.radius) > tolerance
+                or abs(abs(float(first.normal @ second.normal)) - 1.0) > _CIRCLE_TOLERANCE
+                or np.linalg.norm(np.cross(offset, first.normal)) > tolerance
+                or np.linalg.norm(offset) <= tolerance
+            ):
+                continue
+            ends = _to_local(camera.project(np.stack([first.centre, second.centre]))[:, :2], mm_per_pixel)
+            found.append((ends[0], ends[1]))
+    # merge collinear, overlapping segments (a lid on its housing): one chain line per run
+    merged: list[tuple[NDArray, NDArray]] = []
+    for a, b in sorted(found, key=lambda ends: (round(float(ends[0][0]), 9), round(float(ends[0][1]), 9))):
+        unit = (b - a) / np.linalg.norm(b - a)
+        for k, (c, d) in enumerate(merged):
+            along = (d - c) / np.linalg.norm(d - c)
+            gap = 1e-6 * max(float(np.linalg.norm(d - c)), float(np.linalg.norm(b - a)))
+            if abs(float(np.cross(unit, along))) > 1e-9 or abs(float(np.cross(a - c, along))) > gap:
+                continue
+            t = [float((p - c) @ along) for p in (a, b)]
+            span = float(np.linalg.norm(d - c))
+            if min(t) > span + gap or max(t) < -gap:
+                continue
+            low, high = min(0.0, *t), max(span, *t)
+            merged[k] = (c + low * along, c + high * along)
+            break
+        else:
+            merged.append((a, b))
+    return merged
 
 
 def _end_on(circles: list[_Circle], camera: Camera, lines: HiddenLines, mm_per_pixel: float) -> list:
@@ -310,10 +356,15 @@ def _marks(view: _View, scale: float, dimensions: bool) -> list[_Mark]:
     x0, y0 = paper.min(axis=0)
     x1, y1 = paper.max(axis=0)
     orthographic = view.name != "isometric"
-    if orthographic and view.circles:
+    if orthographic and (view.circles or view.axes):
         centres = _Mark("centre", "centre-lines")
         for centre, radius, _ in view.circles:
             _centre_lines(centres, centre * scale, radius * scale)
+        for a, b in view.axes:
+            # the axis, 2 mm past the ends of the cylinder
+            along = (b - a) / np.linalg.norm(b - a)
+            start, end = a * scale - 2.0 * along, b * scale + 2.0 * along
+            centres.lines.append((float(start[0]), float(start[1]), float(end[0]), float(end[1])))
         marks.append(centres)
     if dimensions and orthographic:
         model = view.local.max(axis=0) - view.local.min(axis=0)
