@@ -16,7 +16,7 @@ bottom                    below                        above
 right                     right of the front view      left of the front view
 left                      left                         right
 rear                      far right                    far right
-isometric                 upper right                  upper right
+isometric                 upper right (top's row)      lower right (top's row)
 ========================  ===========================  ===========================
 
 References
@@ -84,7 +84,7 @@ SHEET_VIEWS = (*MULTIVIEWS, "isometric")
 _THIRD_ANGLE = {"front": (0, 0), "top": (0, -1), "bottom": (0, 1), "right": (1, 0), "left": (-1, 0),
                 "rear": (2, 0), "isometric": (1, -1)}  # fmt: skip
 _FIRST_ANGLE = {"front": (0, 0), "top": (0, 1), "bottom": (0, -1), "right": (-1, 0), "left": (1, 0),
-                "rear": (2, 0), "isometric": (1, -1)}  # fmt: skip
+                "rear": (2, 0), "isometric": (1, 1)}  # fmt: skip
 _MARGIN = 10.0  # border to paper edge, mm
 _TITLE_HEIGHT = 36.0  # title block strip at the bottom of the frame, mm
 _TITLE_WIDTH = 170.0
@@ -555,11 +555,12 @@ def drawing_sheet(
 
     Only what a drawing shows is drawn: boundaries, creases and silhouettes of the solids (faces adjacent by
     shared vertex positions; never an edge between coplanar triangles, see ``hidden_lines.COPLANAR_ANGLE``),
-    visible solid, hidden dashed (thinner). Each orthographic view carries its overall horizontal and vertical
-    dimension (extension lines, dimension line, arrowheads, the model length in mm), centre lines through
-    the circles it sees end-on and a leader with the diameter of each visible one (``n× ⌀d`` for n equal
-    circles). Circles are closed loops of creases or boundaries with at least 10 vertices, planar and round
-    within 1e-6 of their radius.
+    visible solid, hidden dashed (thinner; the isometric view shows visible edges only). Each orthographic
+    view carries its overall horizontal and vertical dimension (extension lines, dimension line, arrowheads,
+    the model length in mm), centre lines through the circles it sees end-on and along the axes of the
+    cylinders it sees from the side, and a leader with the diameter of each visible end-on circle (``n× ⌀d``
+    for n equal circles). Circles are closed loops of creases or boundaries with at least 10 vertices, planar
+    and round within 1e-6 of their radius.
 
     Parameters
     ----------
@@ -662,7 +663,9 @@ def drawing_sheet(
     ]
     for view in sheet_views:
         centre_x, centre_y = places[view.name]
-        body.append(_view_group(view, placed, centre_x, centre_y, drawing_scale, hidden, width_line))
+        # a pictorial view shows visible edges only (hidden lines are for the orthographic views)
+        view_hidden = None if view.name == "isometric" else hidden
+        body.append(_view_group(view, placed, centre_x, centre_y, drawing_scale, view_hidden, width_line))
         body += [_mark_svg(mark, f"{view.name}-", centre_x, centre_y) for mark in marks[view.name]]
     body.append(_title_block(paper_width, paper_height, title, drawing_scale, projection_angle))
     body.append(_scale_bar(drawing_scale, paper_height))
