@@ -236,10 +236,14 @@ def test_top_view_draws_only_feature_edges_of_the_solid():
     assert all(drawn_at(point) for point in np.concatenate([*outline, rim]))
 
 
-@pytest.mark.parametrize(("paper", "orientation"), [("A3", "landscape"), ("A4", "portrait"), ("Letter", "landscape")])
-def test_views_fill_the_drawing_area_at_the_largest_standard_scale(paper, orientation):
+@pytest.mark.parametrize(
+    ("paper", "orientation", "angle"),
+    [("A3", "landscape", "third"), ("A4", "portrait", "third"), ("Letter", "landscape", "first"),
+     ("A4", "landscape", "first")],
+)  # fmt: skip
+def test_views_fill_the_drawing_area_at_the_largest_standard_scale(paper, orientation, angle):
     scene, _ = _box_with_cylinder()
-    text = drawing_sheet(scene, paper=paper, orientation=orientation)
+    text = drawing_sheet(scene, paper=paper, orientation=orientation, projection_angle=angle)
     root = ET.fromstring(text.encode())
     width, height = (float(root.get(k).removesuffix("mm")) for k in ("width", "height"))
     long, short = (
@@ -266,7 +270,7 @@ def test_views_fill_the_drawing_area_at_the_largest_standard_scale(paper, orient
     chosen = float(_group(root, "view-front").get("data-scale"))
     larger = [s for s in STANDARD_SCALES if s > chosen]
     with pytest.raises(OutputError, match="does not fit"):
-        drawing_sheet(scene, paper=paper, orientation=orientation, scale=min(larger))
+        drawing_sheet(scene, paper=paper, orientation=orientation, projection_angle=angle, scale=min(larger))
 
 
 def _dimension(root: ET.Element, group_id: str) -> tuple[float, str, np.ndarray]:
