@@ -36,6 +36,7 @@ References
 from __future__ import annotations
 
 import math
+import weakref
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from types import ModuleType
@@ -392,15 +393,35 @@ def welded_faces(points: NDArray, faces: NDArray) -> NDArray[np.int64]:
 
     Meshes often split a vertex where shading needs two normals (the rim of a cylinder's cap) or two texture
     coordinates (a seam): by index those edges have one face each and would read as boundaries. The
-    representative of each position is its lowest index, so the result still indexes `points`.
+    representative of each position is its lowest index, so the result still indexes `points`. Positions are
+    rounded to a grid of 1e-9 of the extent; two copies of a vertex that straddle a grid line (round-off of
+    about 1e-9 of the extent exactly at a cell border) stay apart.
     """
+    faces = np.asarray(faces, dtype=np.int64)
     if points.shape[0] == 0:
-        return np.asarray(faces, dtype=np.int64)
+        return faces
     low, high = points.min(axis=0), points.max(axis=0)
     step = max(float((high - low).max()), 1e-300) * _WELD_FRACTION
     keys = np.round((points - low) / step).astype(np.int64)
-    _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
-    return first[inverse.reshape(-1)][np.asarray(faces, dtype=np.int64)]
+    order = np.lexsort(keys.T[::-1])  # stable: equal positions keep index order, the lowest first
+    ordered = keys[order]
+    starts = np.concatenate([[True], (ordered[1:] != ordered[:-1]).any(axis=1)])
+    representative = np.empty(points.shape[0], dtype=np.int64)
+    representative[order] = order[np.flatnonzero(starts)][np.cumsum(starts) - 1]
+    return representative[faces]
+
+
+_WELDED: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _welded_adjacency(mesh: Mesh) -> EdgeAdjacency:
+    """The mesh's edges by shared vertex positions, computed once per mesh (welding in model space equals welding
+    after any affine modeling transform)."""
+    cached = _WELDED.get(mesh)
+    if cached is None:
+        faces = np.asarray(mesh.faces, dtype=np.int64)
+        cached = _WELDED[mesh] = edge_adjacency(welded_faces(mesh.vertices, faces), mesh.vertex_count)
+    return cached
 
 
 def _edges_of(
@@ -488,7 +509,9 @@ def remove_hidden_lines(
         points = mesh.vertices @ world_from_model[:3, :3].T + world_from_model[:3, 3]
         faces = np.asarray(mesh.faces, dtype=np.int64)
         facing = front_facing(clip_from_world, points, faces)
-        pairs, pair_faces, kinds = _edges_of(points, faces, facing, angle)
+        adjacency = _welded_adjacency(mesh)
+        kinds = classify_edges(adjacency, points, faces, facing, angle)
+        pairs, pair_faces = adjacency.edges, np.stack([adjacency.first, adjacency.second], axis=1)
         chosen = np.ones(kinds.shape, bool) if mask == 0 else (kinds & mask) != 0
         points_parts.append(points)
         faces_parts.append(faces + vertex_offset)
