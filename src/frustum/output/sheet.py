@@ -45,7 +45,8 @@ from frustum.hidden_lines import (
     EDGE_BOUNDARY,
     EDGE_CREASE,
     HiddenLines,
-    feature_edges,
+    _welded_adjacency,
+    classify_edges,
     remove_hidden_lines,
 )
 from frustum.output.svg import _check_common, _drawing_groups, _number, _placed_meshes, svg_document
@@ -209,8 +210,9 @@ def _circles(meshes: list[tuple[Mesh | Polyline, NDArray]]) -> list[_Circle]:
         if not isinstance(mesh, Mesh) or mesh.face_count == 0:
             continue
         points = mesh.vertices @ world_from_model[:3, :3].T + world_from_model[:3, 3]
-        edges, _, kinds = feature_edges(points, mesh.faces)
-        edges = edges[(kinds & (EDGE_BOUNDARY | EDGE_CREASE)) != 0]
+        adjacency = _welded_adjacency(mesh)
+        kinds = classify_edges(adjacency, points, np.asarray(mesh.faces), None, DEFAULT_CREASE_ANGLE)
+        edges = adjacency.edges[(kinds & (EDGE_BOUNDARY | EDGE_CREASE)) != 0]
         if edges.shape[0] < _CIRCLE_MIN_VERTICES:
             continue
         # connected components of the edge graph (union–find on the few feature vertices)
@@ -559,8 +561,8 @@ def drawing_sheet(
     view carries its overall horizontal and vertical dimension (extension lines, dimension line, arrowheads,
     the model length in mm), centre lines through the circles it sees end-on and along the axes of the
     cylinders it sees from the side, and a leader with the diameter of each visible end-on circle (``n× ⌀d``
-    for n equal circles). Circles are closed loops of creases or boundaries with at least 10 vertices, planar
-    and round within 1e-6 of their radius.
+    for n equal circles). Circles are closed loops of creases (over the default 30°) or boundaries with at
+    least 10 vertices, planar and round within 1e-6 of their radius.
 
     Parameters
     ----------
