@@ -91,6 +91,11 @@ def test_views_are_aligned_and_placed_by_the_projection_angle(angle):
     if angle == "first":
         assert top[:, 1].min() > front[:, 1].max() and right[:, 0].max() < front[:, 0].min()
     assert f"{angle.upper()} ANGLE PROJECTION" in ET.tostring(root, encoding="unicode")
+    # the isometric view: in the free corner of the top view's row, right of the front view's column
+    iso = _segments(root, "isometric-visible").reshape(-1, 2)
+    assert (
+        iso[:, 0].min() > front[:, 0].max() and iso[:, 1].min() < top[:, 1].max() and iso[:, 1].max() > top[:, 1].min()
+    )
 
 
 def test_title_block_labels_and_scale_bar():
