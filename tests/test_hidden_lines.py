@@ -549,3 +549,33 @@ def test_split_vertices_do_not_make_boundaries_and_edge_on_faces_hide_nothing():
         drawn = lines.visible[lines.visible_edges == edge]
         full = np.linalg.norm(camera.project(lines.edges[edge])[1, :2] - camera.project(lines.edges[edge])[0, :2])
         assert np.linalg.norm(drawn[:, 1] - drawn[:, 0], axis=1).sum() == pytest.approx(full, rel=1e-9)
+
+
+def _kind_lengths(points: np.ndarray, faces: np.ndarray, camera: Camera) -> dict[int, float]:
+    edges, _, kinds = feature_edges(points, faces, camera)
+    lengths = np.linalg.norm(points[edges[:, 1]] - points[edges[:, 0]], axis=1)
+    return {bit: float(lengths[(kinds & bit) != 0].sum()) for bit in (EDGE_BOUNDARY, EDGE_CREASE, EDGE_SILHOUETTE)}
+
+
+@settings(max_examples=25, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), azimuth=st.floats(0.0, 2 * math.pi), elevation=st.floats(-1.4, 1.4))
+def test_feature_edges_ignore_split_vertices_and_coplanar_subdivision(seed, azimuth, elevation):
+    # a random convex polyhedron (trimesh's hull of 12 points), seen from a random direction
+    hull = trimesh.convex.convex_hull(np.random.default_rng(seed).normal(size=(12, 3)))
+    eye = 6.0 * np.array(
+        [math.cos(elevation) * math.sin(azimuth), math.sin(elevation), math.cos(elevation) * math.cos(azimuth)]
+    )
+    camera = Camera(ViewFrame(eye, (0.0, 0.0, 0.0), (0.0, 1.0, 0.0) if abs(elevation) < 1.3 else (1.0, 0.0, 0.0)),
+                    Perspective(0.8, 0.1, 20.0), 200, 200)  # fmt: skip
+    reference = _kind_lengths(np.asarray(hull.vertices), np.asarray(hull.faces), camera)
+    assert reference[EDGE_BOUNDARY] == 0.0 and reference[EDGE_CREASE] > 0.0
+    # every face with its own three vertices (a flat-shaded export): the same edges of the same kinds
+    soup = np.asarray(hull.vertices)[np.asarray(hull.faces)].reshape(-1, 3)
+    split = _kind_lengths(soup, np.arange(soup.shape[0]).reshape(-1, 3), camera)
+    # every face split into four coplanar triangles: no new edges, the old ones in halves (same total length)
+    finer = hull.subdivide()
+    subdivided = _kind_lengths(np.asarray(finer.vertices), np.asarray(finer.faces), camera)
+    for bit, length in reference.items():
+        # 1e-9 relative: sums of the same lengths in another order and split in two
+        assert split[bit] == pytest.approx(length, rel=1e-9, abs=1e-12)
+        assert subdivided[bit] == pytest.approx(length, rel=1e-9, abs=1e-12)
