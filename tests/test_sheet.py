@@ -380,3 +380,15 @@ def test_pdf_and_svg_outputs_read_back_like_the_png(tmp_path):
                 pen.line([(x0 * factor, y0 * factor), (x1 * factor, y1 * factor)], fill=0, width=1)
     lines = np.asarray(drawing) < 128
     assert lines.sum() > 1000 and _near(lines, ours, 2) > 0.97
+
+
+def test_a_flat_part_seen_edge_on_gets_no_zero_dimension():
+    scene = Scene()
+    scene.add(Mesh([[0, 0, 0], [40, 0, 0], [40, 0, 20.0]], [[0, 1, 2]]))  # in the y = 0 plane
+    root = ET.fromstring(drawing_sheet(scene, views=("front", "top")).encode())
+    values = {g.get("id"): float(g.get("data-value")) for g in root.iter(f"{SVG}g") if g.get("class") == "dimension"}
+    assert values == {
+        "front-dimension-horizontal": 40.0,
+        "top-dimension-horizontal": 40.0,
+        "top-dimension-vertical": 20.0,
+    }

@@ -372,11 +372,14 @@ def _marks(view: _View, scale: float, dimensions: bool) -> list[_Mark]:
         model = view.local.max(axis=0) - view.local.min(axis=0)
         tolerance = 1e-9 * max(x1 - x0, y1 - y0, 1e-300)
         # horizontal: below the view, extension lines from the lowest point on each extreme vertical
-        feet = [float(paper[np.abs(paper[:, 0] - x) <= tolerance, 1].max()) for x in (x0, x1)]
-        marks.append(_linear("horizontal", float(model[0]), (x0, feet[0]), (x1, feet[1]), y1 + _DIMENSION_OFFSET))
+        # (a part seen edge-on, of no width or height, has nothing to dimension that way)
+        if model[0] > 1e-12 * model.max():
+            feet = [float(paper[np.abs(paper[:, 0] - x) <= tolerance, 1].max()) for x in (x0, x1)]
+            marks.append(_linear("horizontal", float(model[0]), (x0, feet[0]), (x1, feet[1]), y1 + _DIMENSION_OFFSET))
         # vertical: right of the view, extension lines from the rightmost point on each extreme horizontal
-        feet = [float(paper[np.abs(paper[:, 1] - y) <= tolerance, 0].max()) for y in (y0, y1)]
-        marks.append(_linear("vertical", float(model[1]), (feet[0], y0), (feet[1], y1), x1 + _DIMENSION_OFFSET))
+        if model[1] > 1e-12 * model.max():
+            feet = [float(paper[np.abs(paper[:, 1] - y) <= tolerance, 0].max()) for y in (y0, y1)]
+            marks.append(_linear("vertical", float(model[1]), (feet[0], y0), (feet[1], y1), x1 + _DIMENSION_OFFSET))
         marks += _diameters(view, scale, y0)
     bottom = max(float(_box(marks)[3]), y1)
     label = _Mark("label", "label")
