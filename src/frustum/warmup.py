@@ -41,7 +41,8 @@ class WarmupReport:
 def _api() -> SimpleNamespace:
     """The public names the tasks use, from their own modules (the interface layer imports downward only)."""
     names = {}
-    for module in ("camera", "clipping", "geometry", "projection", "render", "scene", "shading", "output.svg"):
+    for module in ("camera", "clipping", "geometry", "projection", "render", "scene", "shading", "transforms",
+                   "output.svg"):  # fmt: skip
         loaded = importlib.import_module(f"frustum.{module}")  # (``from frustum import render`` is the function)
         names.update({name: getattr(loaded, name) for name in loaded.__all__})
     return SimpleNamespace(**names)
