@@ -127,8 +127,8 @@ def _vector() -> None:
 def _fractals() -> None:
     fr = _api()
 
-    fr.mandelbrot(8, 8, max_iter=8)
-    fr.julia(8, 8, max_iter=8)
+    fr.mandelbrot(width=8, height=8, max_iter=8)
+    fr.julia(-0.8 + 0.156j, width=8, height=8, max_iter=8)
     fr.quaternion_julia(resolution=4, max_iter=4)
     fr.barnsley_fern().chaos_game(200, seed=0)
     fr.CLASSIC_LSYSTEMS["koch"].path(1)
