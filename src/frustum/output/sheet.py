@@ -300,7 +300,9 @@ def _side_on_axes(circles: list[_Circle], camera: Camera, mm_per_pixel: float) -
         for k, (c, d) in enumerate(merged):
             along = (d - c) / np.linalg.norm(d - c)
             gap = 1e-6 * max(float(np.linalg.norm(d - c)), float(np.linalg.norm(b - a)))
-            if abs(float(np.cross(unit, along))) > 1e-9 or abs(float(np.cross(a - c, along))) > gap:
+            offset = a - c
+            if (abs(float(unit[0] * along[1] - unit[1] * along[0])) > 1e-9  # 2D cross products: not parallel,
+                    or abs(float(offset[0] * along[1] - offset[1] * along[0])) > gap):  # or not on one line
                 continue
             t = [float((p - c) @ along) for p in (a, b)]
             span = float(np.linalg.norm(d - c))
