@@ -6,6 +6,13 @@ coordinates with the camera looking down −z, left-handed normalized device coo
 
 __version__ = "0.1.0"
 
+from frustum.batch import (
+    DatasetResult,
+    RenderJob,
+    ViewResult,
+    render_dataset,
+    render_many,
+)
 from frustum.bsp import (
     BSPTree,
     DepthOrder,
@@ -343,6 +350,7 @@ __all__ = [
     "ClippingError",
     "Continuity",
     "CubicSpline",
+    "DatasetResult",
     "DepthCue",
     "DepthOrder",
     "DirectionalLight",
@@ -373,6 +381,7 @@ __all__ = [
     "Projection",
     "Quaternion",
     "Ray",
+    "RenderJob",
     "Scene",
     "SceneFile",
     "SceneFileError",
@@ -389,6 +398,7 @@ __all__ = [
     "TriangleClipping",
     "TurtlePath",
     "ViewFrame",
+    "ViewResult",
     "__version__",
     "anaglyph",
     "apply",
@@ -483,7 +493,9 @@ __all__ = [
     "region_code",
     "remove_hidden_lines",
     "render",
+    "render_dataset",
     "render_examples",
+    "render_many",
     "render_scene_file",
     "render_stereo",
     "render_svg",
