@@ -301,7 +301,7 @@ def test_render_many_returns_metadata_in_job_order_and_reports_a_failing_view(tm
     camera = Camera.look_at((0, 0, 4), (0, 0, 0), width=24, height=16)
     jobs = [RenderJob(f"v{i}", scene, camera, {"color": tmp_path / f"v{i}.png"}) for i in range(3)]
     jobs.insert(1, RenderJob("bad", scene, camera, {"color": tmp_path / "bad.png"}, {"shading": "glossy"}))
-    results = render_many(jobs, executor="process", workers=2, progress=False)
+    results = render_many(jobs, executor="serial", progress=False)
     assert [r.key for r in results] == ["v0", "bad", "v1", "v2"]
     assert [r.ok for r in results] == [True, False, True, True]
     assert "shading" in results[1].error and "glossy" in results[1].error

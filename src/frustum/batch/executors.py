@@ -152,7 +152,9 @@ def _process(scenes: list, jobs: list[RenderJob], workers: int, on_result: Calla
     except KeyboardInterrupt:
         for future in in_flight:
             future.cancel()
-        wait(in_flight)
+        for future in wait(in_flight).done:  # views that were being drawn finish and are counted
+            if not future.cancelled() and future.exception() is None:
+                on_result(future.result())
         raise
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
@@ -193,7 +195,9 @@ def _ray(scenes: list, jobs: list[RenderJob], workers: int | None, on_result: Ca
                     if job is not None:
                         in_flight[actor.render.remote(job)] = actor
         except KeyboardInterrupt:
-            ray.wait(list(in_flight), num_returns=len(in_flight))
+            ready, _ = ray.wait(list(in_flight), num_returns=len(in_flight))
+            for result in ray.get(ready):
+                on_result(result)
             raise
         finally:
             for actor in actors:
