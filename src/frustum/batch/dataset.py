@@ -53,6 +53,10 @@ _SUFFIXES = {"color": ".png", "depth": ".npy", "normals": ".npy", "object_id": "
 _MANIFEST = "manifest.jsonl"
 _SHARED_FILES = ("cameras.json", "README.txt", "transforms.json", "sparse/0/cameras.txt", "sparse/0/images.txt",
                  "sparse/0/points3D.txt")  # fmt: skip
+_BYTES_PER_PIXEL = 64
+"""Render work per drawn sample: color 4, depth 4, normals 12, ids 4, face codes 8, barycentrics 8, slack."""
+_BYTES_PER_OUTPUT_PIXEL = 48
+"""Encoding per output pixel: metric depth in float64 and float32, ids in int64, the mask."""
 _POLE = 0.999
 """|direction · y| above which a view uses z as its up vector (y would be nearly parallel to the line of sight)."""
 
@@ -202,6 +206,18 @@ def _changes(old: dict, new: dict) -> list[str]:
 
 def _sha256(path: Path | None) -> str | None:
     return None if path is None else hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+def _check_budget(scene_file: Any, camera: Camera, executor: str, workers: int | None, where: str) -> None:
+    """Memory of the views drawn at once on this machine: frame buffers and a copy of the scene per worker."""
+    from frustum.budgets import check_memory
+
+    concurrent = 1 if executor != "process" else (workers or os.cpu_count() or 1)
+    samples = int(scene_file.options.get("samples", 1))
+    per_view = camera.width * camera.height * (_BYTES_PER_PIXEL * samples + _BYTES_PER_OUTPUT_PIXEL)
+    scene_bytes = sum(item.mesh.vertices.nbytes * 3 + item.mesh.faces.nbytes for item in scene_file.scene.items)
+    cause = f"size = {camera.width}x{camera.height}, samples = {samples}, {concurrent} views at once"
+    check_memory(concurrent * (per_view + scene_bytes), where=where, cause=cause, error=OutputError)
 
 
 def _check_folder(out: Path, where: str) -> None:
@@ -395,6 +411,7 @@ def render_dataset(
                    for item in items if item.mesh.vertex_count]  # fmt: skip
         target = np.hstack(corners).mean(axis=1) if corners else np.zeros(3)
     cameras = dataset_cameras(base, views, layout, seed=seed, target=target, cameras_file=cameras_file)
+    _check_budget(scene_file, base, executor, workers, where)
     out = Path(out)
     _check_folder(out, where)
     extra: dict[str, Any] = {}

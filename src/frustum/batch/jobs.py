@@ -45,6 +45,9 @@ OUTPUT_KINDS = {
 TEMPORARY_MARK = ".partial-"
 """Infix of temporary file names (``.<name>.partial-<pid>``): a file with it is never a finished output."""
 _MAX_UINT16 = 65535
+PNG_COMPRESS_LEVEL = 1
+"""zlib level of the PNGs: measured on the bunny at 512², level 1 encodes the color image in 15 ms against 70 ms at
+Pillow's default 6, for 13 % more bytes (88 against 77 KB): encoding, not rendering, was the larger half of a view."""
 
 
 @dataclass(frozen=True)
@@ -142,7 +145,7 @@ def _png_writer(array: np.ndarray) -> Any:
     from PIL import Image
 
     image = Image.fromarray(np.ascontiguousarray(array))
-    return lambda file: image.save(file, format="PNG")
+    return lambda file: image.save(file, format="PNG", compress_level=PNG_COMPRESS_LEVEL)
 
 
 def _npy_writer(array: np.ndarray) -> Any:
