@@ -12,7 +12,8 @@ The Stanford bunny (69,451 triangles) at ``--size``² with every buffer (color P
 - overhead per view: ``(wall × workers − Σ render − Σ write) / views``, worker time not spent on a view
   (start-up, loading the kernels, receiving the scene, passing jobs and results, idle at the end);
 - first result: seconds from the call to the first finished view (start-up cost);
-- peak resident memory per worker (psutil, sampled every 50 ms; serial: this process).
+- peak resident memory per worker (psutil, sampled every 50 ms; serial: this process);
+- the 1-minute load average after the run (the machine may be shared: read the numbers with it).
 
 The baseline is a bare loop in this process, ``render(...)`` then the same files written with the same encoders,
 after a warm-up (the first call, kernel compile or cache load, is printed separately). Output bytes per view
@@ -67,12 +68,14 @@ class PeakMemory:
         me = psutil.Process()
         if self.kind == "serial":
             return [me]
-        if self.kind == "process":
-            return [p for p in me.children(recursive=True) if "resource_tracker" not in " ".join(p.cmdline())]
         found = []
-        for process in psutil.process_iter(["cmdline"]):
-            line = " ".join(process.info["cmdline"] or [])
-            if "_RayRenderer" in line:
+        candidates = me.children(recursive=True) if self.kind == "process" else psutil.process_iter()
+        for process in candidates:
+            try:
+                line = " ".join(process.cmdline())
+            except psutil.Error:  # gone, or a zombie at the pool's shutdown
+                continue
+            if ("resource_tracker" not in line) if self.kind == "process" else ("_RayRenderer" in line):
                 found.append(process)
         return found
 
@@ -175,6 +178,7 @@ def dataset_run(scene_path: Path, out: Path, views: int, executor: str, workers:
         "first_result_s": first[0] if first else float("nan"),
         "workers_seen": len({e["worker"] for e in entries}),
         "peak_rss_mib_per_worker": [round(p / 2**20, 1) for p in peaks],
+        "load_average_1min_after": os.getloadavg()[0],
     }
 
 
@@ -202,6 +206,7 @@ def main() -> None:
           f"{os.cpu_count()} cores, python {sys.version.split()[0]}")  # fmt: skip
     report: dict = {"views": args.views, "size": args.size, "cores": os.cpu_count()}
     bare = bare_loop(scene_file, cameras, work / "bare")
+    bare["load_average_1min_after"] = os.getloadavg()[0]
     sizes = {}
     for path in (work / "bare").rglob("*"):
         if path.is_file() and "warmup" not in path.name:
@@ -209,7 +214,8 @@ def main() -> None:
     per_view = {kind: total / args.views for kind, total in sizes.items()}
     report["bare"], report["bytes_per_view"] = bare, per_view
     print(f"  bare loop        {bare['views_per_s']:6.2f} views/s   render {bare['render_ms_median']:6.1f} ms  "
-          f"write {bare['write_ms_median']:6.1f} ms (medians)   first call {bare['first_call_s']:.1f} s")  # fmt: skip
+          f"write {bare['write_ms_median']:6.1f} ms (medians)   first call {bare['first_call_s']:.1f} s   "
+          f"load {bare['load_average_1min_after']:.1f}")  # fmt: skip
     print("  output per view: " + ", ".join(f"{k} {v / 1024:.0f} KiB" for k, v in sorted(per_view.items()))
           + f"; total {sum(per_view.values()) / 2**20:.2f} MiB")  # fmt: skip
     shutil.rmtree(work / "bare")
@@ -223,7 +229,8 @@ def main() -> None:
         print(f"  {run:<16} {result['views_per_s']:6.2f} views/s   render {result['render_ms_per_view']:6.1f} ms  "
               f"write {result['write_ms_per_view']:6.1f} ms  overhead {result['overhead_ms_per_view']:6.1f} ms "
               f"(worker time per view)   first result {result['first_result_s']:.1f} s   "
-              f"peak RSS/worker {result['peak_rss_mib_per_worker']} MiB")  # fmt: skip
+              f"peak RSS/worker {result['peak_rss_mib_per_worker']} MiB   "
+              f"load {result['load_average_1min_after']:.1f}")  # fmt: skip
         shutil.rmtree(out, ignore_errors=True)
     if args.json:
         Path(args.json).write_text(json.dumps(report, indent=2) + "\n")
