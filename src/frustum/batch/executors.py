@@ -1,10 +1,11 @@
 """``render_many``: many views on one process, a local process pool, or a Ray cluster, with the same bytes.
 
 Each executor sends every distinct scene to a worker **once** (the pool's initializer; Ray's object store)
-and then only jobs (a camera, options and paths: a few hundred bytes). Workers are long-lived, so the Numba
-kernels load once per worker; each worker runs ``numba.set_num_threads(threads)`` with
-``workers × threads ≤ cores``, so the pool does not oversubscribe the machine. A view's bytes do not depend on
-the thread count (tiles own their pixels), so every executor and worker count writes the same files.
+and then only jobs (a camera, options and paths: a few hundred bytes). Workers are long-lived, so the compiled
+kernels load once per worker; each worker runs ``frustum.set_threads(threads)`` (the threads of the parallel
+kernels) with ``workers × threads ≤ cores``, so the pool does not oversubscribe the machine. A view's bytes do
+not depend on the thread count (each piece of a kernel owns its pixels), so every executor and worker count
+writes the same files.
 
 Ctrl-C: workers ignore SIGINT; the caller stops handing out jobs, lets the views in flight finish (so no file
 is left half written) and re-raises KeyboardInterrupt.
@@ -87,14 +88,14 @@ def _prepare(jobs: Sequence[RenderJob], where: str) -> tuple[list[tuple[Any, Map
 
 
 def _init_worker(scenes_blob: bytes, threads: int) -> None:
-    """Pool initializer: unpickle the scenes once, set this worker's Numba threads, ignore Ctrl-C."""
+    """Pool initializer: unpickle the scenes once, set this worker's kernel threads, ignore Ctrl-C."""
     import signal
 
-    import numba
+    from frustum.raster._jit import set_threads
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     _WORKER["scenes"] = pickle.loads(scenes_blob)
-    numba.set_num_threads(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
+    set_threads(threads)
 
 
 def _run_in_worker(job: RenderJob) -> ViewResult:
@@ -106,10 +107,10 @@ class _RayRenderer:
     """A long-lived Ray actor: the scenes from the object store once, then one view per call."""
 
     def __init__(self, scenes: list, threads: int) -> None:
-        import numba
+        from frustum.raster._jit import set_threads
 
         self.scenes = scenes
-        numba.set_num_threads(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
+        set_threads(threads)
 
     def render(self, job: RenderJob) -> ViewResult:
         scene, options = self.scenes[job.scene]
@@ -131,7 +132,7 @@ def _process(scenes: list, jobs: list[RenderJob], workers: int, on_result: Calla
 
     threads = max(1, _cpu_count() // workers)
     blob = pickle.dumps(scenes, protocol=pickle.HIGHEST_PROTOCOL)
-    # spawn, not fork: a forked child of a process whose Numba thread pool is running can deadlock
+    # spawn, not fork: a forked child of a process whose kernel threads are running can deadlock
     context = multiprocessing.get_context("spawn")
     pool = ProcessPoolExecutor(workers, mp_context=context, initializer=_init_worker, initargs=(blob, threads))
     pending = iter(jobs)
@@ -230,8 +231,8 @@ def render_many(
         One per view; keys unique.
     executor : {"serial", "process", "ray"}
         ``"serial"``: in this process. ``"process"``: a local pool of spawned processes, each given the scenes
-        once through its initializer and ``cores // workers`` Numba threads. ``"ray"``: long-lived Ray actors
-        (one CPU each, one Numba thread) on the cluster at `address`, or a local one started (and stopped)
+        once through its initializer and ``cores // workers`` kernel threads. ``"ray"``: long-lived Ray actors
+        (one CPU each, one kernel thread) on the cluster at `address`, or a local one started (and stopped)
         here unless Ray is already initialized; the files must go to a path every node can reach.
     workers : int or None
         Processes or actors; None: the number of cores (the cluster's CPUs for Ray).
