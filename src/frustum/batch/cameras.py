@@ -115,7 +115,9 @@ def colmap_pose(camera: Camera) -> tuple[tuple[float, float, float, float], tupl
     rotation = OPENCV_FROM_OPENGL[:3, :3] @ rotation_gl
     translation = -(rotation @ np.asarray(frame.eye))
     q = Quaternion.from_matrix(rotation)
-    return (float(q.w), float(q.x), float(q.y), float(q.z)), tuple(float(t) for t in translation)  # type: ignore[return-value]
+    # + 0.0 turns −0.0 into 0.0 (the same pose, written the same way)
+    quaternion = (float(q.w) + 0.0, float(q.x) + 0.0, float(q.y) + 0.0, float(q.z) + 0.0)
+    return quaternion, (float(translation[0]) + 0.0, float(translation[1]) + 0.0, float(translation[2]) + 0.0)
 
 
 def metric_depth(window_depth: NDArray[np.float32], camera: Camera) -> NDArray[np.float32]:
