@@ -20,6 +20,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 import trimesh
+from hypothesis import given
+from hypothesis import strategies as st
 from PIL import Image
 from scipy.spatial.transform import Rotation
 
@@ -128,6 +130,50 @@ def test_metric_depth_is_distance_along_the_viewing_axis(camera: Camera) -> None
     # float32 window depth: its rounding (6e-8 near 1) magnified by dz/dd = z²(far − near)/(far·near) ≤ 8e3 here
     np.testing.assert_allclose(metric_depth(window_depth[None, :], camera)[0], expected, rtol=0, atol=2e-4)
     assert metric_depth(np.ones((2, 3), np.float32), camera).tolist() == [[0.0] * 3] * 2
+
+
+@given(
+    st.integers(0, 2**32 - 1),
+    st.floats(0.2, 2.5),
+    st.integers(1, 300),
+    st.integers(1, 300),
+    st.booleans(),
+)
+def test_pixel_and_depth_conventions_hold_for_any_pinhole_camera(seed, fovy, width, height, off_centre) -> None:
+    """Property: OpenCV pixel coordinates from the written intrinsics and COLMAP pose, and metric_depth of the
+    window depth, reproduce Camera.project for any pose, field of view, image size and (off-centre) window."""
+    rng = np.random.default_rng(seed)
+    eye = rng.uniform(-10, 10, 3)
+    target = eye + rng.normal(size=3) * rng.uniform(0.5, 5.0)
+    up = rng.normal(size=3)
+    near, far = rng.uniform(0.1, 1.0), rng.uniform(20.0, 50.0)
+    if off_centre:
+        left, bottom = rng.uniform(-0.5, 0.1, 2) * near
+        projection = Frustum(left, left + rng.uniform(0.2, 1.0) * near, bottom, bottom + rng.uniform(0.2, 1.0) * near,
+                             near, far)  # fmt: skip
+    else:
+        projection = Perspective(fovy, near, far)
+    try:
+        camera = Camera.look_at(eye, target, up, projection, width, height)
+    except CameraError:  # up drawn parallel to the line of sight
+        return
+    distance = rng.uniform(2.0, 15.0, 20)
+    clip = np.column_stack([rng.uniform(-0.9, 0.9, (20, 2)), np.zeros(20), np.ones(20)])  # inside the view
+    points = camera.unproject(np.column_stack([(clip[:, 0] + 1) * width / 2, (clip[:, 1] + 1) * height / 2,
+                                               np.full(20, 0.5)]))  # fmt: skip
+    points = eye + (points - eye) * (distance / ((points - eye) @ -camera.frame.n))[:, None]  # z-depth = distance
+    window = camera.project(points)
+    k = intrinsics(camera)
+    (qw, qx, qy, qz), t = colmap_pose(camera)
+    camera_cv = points @ Rotation.from_quat([qx, qy, qz, qw]).as_matrix().T + np.asarray(t)
+    u = k["fx"] * camera_cv[:, 0] / camera_cv[:, 2] + k["cx"]
+    v = k["fy"] * camera_cv[:, 1] / camera_cv[:, 2] + k["cy"]
+    scale = 1e-9 * max(width, height, k["fx"], k["fy"])  # round-off of products of O(fx)-sized numbers
+    np.testing.assert_allclose(u, window[:, 0], atol=scale)
+    np.testing.assert_allclose(v, height - window[:, 1], atol=scale)
+    np.testing.assert_allclose(camera_cv[:, 2], distance, rtol=1e-9)
+    # float64 window depth here: the conversion itself is exact to round-off
+    np.testing.assert_allclose(metric_depth(window[None, :, 2], camera)[0], distance, rtol=1e-6)
 
 
 def test_intrinsics_refuses_parallel_projections() -> None:
