@@ -396,12 +396,14 @@ def ray_cluster():
 
 def test_ray_executor_writes_the_same_bytes(ray_cluster, scene_path, tmp_path) -> None:
     for name, executor in (("serial", "serial"), ("ray", "ray")):
+        # 5 actors asked of a 2-CPU cluster: capped at the free CPUs (more would wait for ever)
         result = render_dataset(scene_path, tmp_path / name, views=4, layout="orbit", format="nerfstudio",
-                                executor=executor, workers=2, progress=False)  # fmt: skip
+                                executor=executor, workers=5, progress=False)  # fmt: skip
         assert result.ok
     assert files_of(tmp_path / "ray") == files_of(tmp_path / "serial")
-    workers = {json.loads(line).get("worker") for line in (tmp_path / "ray/manifest.jsonl").read_text().splitlines()}
-    assert f"{os.uname().nodename}:{os.getpid()}" not in workers  # rendered in the actors, not here
+    lines = (tmp_path / "ray/manifest.jsonl").read_text().splitlines()[1:]
+    workers = {json.loads(line)["worker"] for line in lines}
+    assert 1 <= len(workers) <= 2 and f"{os.uname().nodename}:{os.getpid()}" not in workers  # in the actors
 
 
 # --- resume and safety ----------------------------------------------------------------------------------------

@@ -174,8 +174,9 @@ def _ray(scenes: list, jobs: list[RenderJob], workers: int | None, on_result: Ca
         ray.init(address=address, include_dashboard=False, log_to_driver=False, configure_logging=False)
         started = True
     try:
-        if workers is None:
-            workers = max(1, int(ray.cluster_resources().get("CPU", 1)))
+        # one CPU per actor: more actors than free CPUs would wait for ever, holding their views
+        free = max(1, int(ray.available_resources().get("CPU", 1)))
+        workers = free if workers is None else min(workers, free)
         actor_type = ray.remote(num_cpus=1)(_RayRenderer)
         scenes_ref = ray.put(scenes)  # once into the object store; each actor fetches it once
         actors = [actor_type.remote(scenes_ref, 1) for _ in range(min(workers, max(1, len(jobs))))]
@@ -235,7 +236,7 @@ def render_many(
         (one CPU each, one kernel thread) on the cluster at `address`, or a local one started (and stopped)
         here unless Ray is already initialized; the files must go to a path every node can reach.
     workers : int or None
-        Processes or actors; None: the number of cores (the cluster's CPUs for Ray).
+        Processes or actors; None: the number of cores (the cluster's free CPUs for Ray, which also caps it).
     progress : bool or ViewProgress
         Show a Rich progress bar on stderr (True), nothing (False), or count on the given bar.
     address : str or None
