@@ -397,7 +397,8 @@ def ray_cluster():
 def test_ray_executor_writes_the_same_bytes(ray_cluster, scene_path, tmp_path) -> None:
     for name, executor in (("serial", "serial"), ("ray", "ray")):
         # 5 actors asked of a 2-CPU cluster: capped at the free CPUs (more would wait for ever)
-        result = render_dataset(scene_path, tmp_path / name, views=4, layout="orbit", format="nerfstudio",
+        # 16 views on 2 actors: batches of 2 views per task
+        result = render_dataset(scene_path, tmp_path / name, views=16, layout="orbit", format="nerfstudio",
                                 executor=executor, workers=5, progress=False)  # fmt: skip
         assert result.ok
     assert files_of(tmp_path / "ray") == files_of(tmp_path / "serial")

@@ -24,10 +24,13 @@ from frustum.batch.jobs import RenderJob, ViewResult, check_job, render_view
 from frustum.batch.progress import ViewProgress
 from frustum.errors import FrustumError
 
-__all__ = ["EXECUTORS", "render_many"]
+__all__ = ["EXECUTORS", "RAY_BATCH", "render_many"]
 
 EXECUTORS = ("serial", "process", "ray")
 """Executors ``render_many`` accepts."""
+
+RAY_BATCH = 16
+"""Most views per Ray task: one task per view would make the driver's loop the limit on a large cluster."""
 
 _WORKER: dict[str, Any] = {"scenes": None}
 
@@ -104,7 +107,7 @@ def _run_in_worker(job: RenderJob) -> ViewResult:
 
 
 class _RayRenderer:
-    """A long-lived Ray actor: the scenes from the object store once, then one view per call."""
+    """A long-lived Ray actor: the scenes from the object store once, then a batch of views per call."""
 
     def __init__(self, scenes: list, threads: int) -> None:
         from frustum.raster._jit import set_threads
@@ -112,9 +115,17 @@ class _RayRenderer:
         self.scenes = scenes
         set_threads(threads)
 
-    def render(self, job: RenderJob) -> ViewResult:
-        scene, options = self.scenes[job.scene]
-        return render_view(scene, job, options)
+    def render(self, jobs: list[RenderJob]) -> list[ViewResult]:
+        results = []
+        for job in jobs:
+            scene, options = self.scenes[job.scene]
+            results.append(render_view(scene, job, options))
+        return results
+
+
+def _batch_size(views: int, workers: int) -> int:
+    """Views per Ray task: up to `RAY_BATCH`, and at least 4 tasks per actor so the work stays balanced."""
+    return max(1, min(RAY_BATCH, views // (4 * workers)))
 
 
 # --- executors ------------------------------------------------------------------------------------------------
@@ -180,26 +191,29 @@ def _ray(scenes: list, jobs: list[RenderJob], workers: int | None, on_result: Ca
         actor_type = ray.remote(num_cpus=1)(_RayRenderer)
         scenes_ref = ray.put(scenes)  # once into the object store; each actor fetches it once
         actors = [actor_type.remote(scenes_ref, 1) for _ in range(min(workers, max(1, len(jobs))))]
-        pending = iter(jobs)
+        size = _batch_size(len(jobs), len(actors))
+        batches = iter([jobs[i : i + size] for i in range(0, len(jobs), size)])
         in_flight: dict = {}
         try:
-            for actor in actors:
+            for actor in actors:  # two batches queued per actor: the next is ready when one finishes
                 for _ in range(2):
-                    job = next(pending, None)
-                    if job is not None:
-                        in_flight[actor.render.remote(job)] = actor
+                    batch = next(batches, None)
+                    if batch is not None:
+                        in_flight[actor.render.remote(batch)] = actor
             while in_flight:
                 ready, _ = ray.wait(list(in_flight), num_returns=1)
                 for ref in ready:
                     actor = in_flight.pop(ref)
-                    on_result(ray.get(ref))
-                    job = next(pending, None)
-                    if job is not None:
-                        in_flight[actor.render.remote(job)] = actor
+                    for result in ray.get(ref):
+                        on_result(result)
+                    batch = next(batches, None)
+                    if batch is not None:
+                        in_flight[actor.render.remote(batch)] = actor
         except KeyboardInterrupt:
             ready, _ = ray.wait(list(in_flight), num_returns=len(in_flight))
-            for result in ray.get(ready):
-                on_result(result)
+            for results in ray.get(ready):
+                for result in results:
+                    on_result(result)
             raise
         finally:
             for actor in actors:
@@ -233,8 +247,9 @@ def render_many(
     executor : {"serial", "process", "ray"}
         ``"serial"``: in this process. ``"process"``: a local pool of spawned processes, each given the scenes
         once through its initializer and ``cores // workers`` kernel threads. ``"ray"``: long-lived Ray actors
-        (one CPU each, one kernel thread) on the cluster at `address`, or a local one started (and stopped)
-        here unless Ray is already initialized; the files must go to a path every node can reach.
+        (one CPU each, one kernel thread, up to ``RAY_BATCH`` views per task) on the cluster at `address`, or
+        a local one started (and stopped) here unless Ray is already initialized; the files must go to a path
+        every node can reach.
     workers : int or None
         Processes or actors; None: the number of cores (the cluster's free CPUs for Ray, which also caps it).
     progress : bool or ViewProgress
