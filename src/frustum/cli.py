@@ -409,11 +409,19 @@ def view_command(
     views: Annotated[str, typer.Option(help="Comma-separated views: front, top, right, left, rear, bottom, iso.")] = (
         "front,top,right,iso"
     ),
+    paper: Annotated[str, typer.Option(help="Sheet size: A4, A3, A2, A1, A0, Letter or Tabloid.")] = "A3",
+    orientation: Annotated[str, typer.Option(help="landscape or portrait.")] = "landscape",
+    angle: Annotated[str, typer.Option(help="Projection angle: third (US, ISO E) or first (ISO, Europe).")] = "third",
+    dimensions: Annotated[bool, typer.Option(help="Draw overall dimensions and diameters.")] = True,
 ) -> None:
-    """Draw the scene as an engineering sheet: orthographic views with hidden lines, title block and scale bar."""
+    """Draw the scene as an engineering sheet: orthographic views at the largest standard scale that fits, with
+    hidden lines, dimensions, title block and scale bar."""
     from frustum.scenefile import render_view_sheet
 
-    written = render_view_sheet(scene, output, tuple(v.strip() for v in views.split(",") if v.strip()))
+    written = render_view_sheet(
+        scene, output, tuple(v.strip() for v in views.split(",") if v.strip()),
+        paper=paper, orientation=orientation, projection_angle=angle, dimensions=dimensions,
+    )  # fmt: skip
     console.print(f"wrote {written}", markup=False, highlight=False, soft_wrap=True)
 
 
