@@ -347,6 +347,20 @@ def test_octree_method_equals_depth_buffer_of_to_mesh(projection, distance):
         assert both.sum() > 2000
 
 
+def test_octree_nodes_in_a_scene_are_drawn_picked_and_cut_as_their_cell_faces():
+    from frustum import cutaway
+
+    tree = Octree.from_voxels(np.ones((4, 4, 4), bool), UNIT)
+    scene = Scene()
+    node = scene.add(tree, name="cells")
+    assert "octree of depth 2" in repr(node)
+    camera = Camera.look_at((0.5, 0.5, 3.0), (0.5, 0.5, 0.5), width=32, height=32)
+    pick = scene.pick(camera, 16.0, 16.0)
+    assert pick is not None and pick.point[2] == pytest.approx(1.0)
+    cut = cutaway(scene, plane=((0.5, 0.5, 0.5), (0.0, 0.0, 1.0)))
+    assert cut.items[0].mesh.bounds[1][2] == pytest.approx(0.5)
+
+
 def test_render_method_octree_draws_the_scene_octrees_and_keeps_the_nearest():
     tree = _csg_solid()
     scene = Scene(lights=[DirectionalLight((0.0, 0.0, -1.0))])

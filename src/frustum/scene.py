@@ -158,6 +158,8 @@ class Node:
     def __repr__(self) -> str:
         if isinstance(self.geometry, Mesh):
             kind = f"{self.geometry.face_count} faces"
+        elif isinstance(self.geometry, Octree):
+            kind = f"octree of depth {self.geometry.depth}"
         else:
             kind = "group" if self.geometry is None else f"polyline of {self.geometry.vertex_count} points"
         return f"Node({self.name!r}, {kind}, {len(self.children)} children)"
@@ -430,7 +432,8 @@ def _cut_node(
             copy.geometry = Polyline(points, line.closed, line.markers)
             copy.material = child_material
         elif child.geometry is not None:
-            kept, removed = _cut_mesh(child.geometry, child_world, region, cap)
+            mesh = child.geometry.surface if isinstance(child.geometry, Octree) else child.geometry  # its cell faces
+            kept, removed = _cut_mesh(mesh, child_world, region, cap)
             if kept is not None:
                 body, section = _split_section(kept, region) if cap else (kept, None)
                 copy.geometry = body
