@@ -360,10 +360,11 @@ class Octree:
 
         Top-down subdivision: `f` is called on whole batches of points (three (N,) float64 arrays, returning
         (N,) values) at the 3 × 3 × 3 lattice of each candidate node (corners, edge and face midpoints,
-        centre). A node whose 27 samples are all inside is full, all outside empty, otherwise it is split;
-        a mixed finest cell is full when its centre is inside and is recorded in ``boundary``. A node is taken
-        as homogeneous from its samples, so features thinner than half a node at that level can be missed
-        (exact for convex solids' insides: a cube whose corners lie in a convex set lies in it).
+        centre; a split node's 5 × 5 × 5 lattice gives its 8 children's). A node whose 27 samples are all
+        inside is full, all outside empty, otherwise it is split; a mixed finest cell is full when its centre
+        is inside and is recorded in ``boundary``. A node is taken as homogeneous from its samples, so features
+        thinner than half a node at that level can be missed (exact for convex solids' insides: a cube whose
+        corners lie in a convex set lies in it).
 
         Raises
         ------
@@ -378,24 +379,29 @@ class Octree:
         region = _cube(bounds, where, expand=True)
         _check_surface_budget(d, where)
         size = float(region[1, 0] - region[0, 0])
-        lattice = np.stack(np.meshgrid(*[np.arange(3)] * 3, indexing="ij"), axis=-1).reshape(-1, 3) * 0.5
+        fine = np.stack(np.meshgrid(*[np.arange(5)] * 3, indexing="ij"), axis=-1).reshape(-1, 3) * 0.25
+        # the 3 x 3 x 3 lattice of child o = (x, y, z) is the block [2x:2x+3, 2y:2y+3, 2z:2z+3] of its parent's 5^3
+        blocks = np.array([[((2 * (o & 1) + a) * 5 + 2 * ((o >> 1) & 1) + b) * 5 + 2 * ((o >> 2) & 1) + c
+                            for a in range(3) for b in range(3) for c in range(3)] for o in range(8)])  # fmt: skip
 
-        def sample(level: int, codes: NDArray[np.uint64]) -> NDArray[np.bool_]:
-            """(N, 27) inside flags at each node's lattice."""
-            out = np.empty((codes.size, 27), dtype=bool)
+        def children_samples(level: int, codes: NDArray[np.uint64]) -> NDArray[np.bool_]:
+            """(8N, 27) inside flags at the lattices of the children of each node, from its 5 x 5 x 5 lattice."""
+            out = np.empty((codes.size, 8, 27), dtype=bool)
             side = size / 2**level
-            for start in range(0, codes.size, _CHUNK // 27 + 1):
-                chunk = codes[start : start + _CHUNK // 27 + 1]
+            step = _CHUNK // 125 + 1
+            for start in range(0, codes.size, step):
+                chunk = codes[start : start + step]
                 lo = region[0] + morton_decode(chunk) * side
-                pts = (lo[:, None, :] + lattice[None] * side).reshape(-1, 3)
-                out[start : start + chunk.size] = _evaluate(f, pts, where).reshape(-1, 27)
-            return out
+                pts = (lo[:, None, :] + fine[None] * side).reshape(-1, 3)
+                out[start : start + chunk.size] = _evaluate(f, pts, where).reshape(-1, 125)[:, blocks]
+            return out.reshape(-1, 27)
 
         levels: list[NDArray[np.uint64]] = []
         boundary = _EMPTY
         candidates = np.zeros(1, dtype=np.uint64)
+        root = np.stack(np.meshgrid(*[np.arange(3)] * 3, indexing="ij"), axis=-1).reshape(-1, 3) * 0.5
+        inside = _evaluate(f, region[0] + root * size, where)[None]  # (1, 27) at the root's lattice
         for level in range(d + 1):
-            inside = sample(level, candidates)
             all_in, any_in = inside.all(axis=1), inside.any(axis=1)
             mixed = any_in & ~all_in
             if level == d:
@@ -403,7 +409,8 @@ class Octree:
                 levels.append(candidates[all_in | (mixed & inside[:, 13])])  # 13: the centre sample
                 break
             levels.append(candidates[all_in])
-            check_memory(mixed.sum() * 8 * 27 * 8.0, where=where, cause=f"depth = {d}", error=GeometryError)
+            check_memory(mixed.sum() * 125 * 32.0, where=where, cause=f"depth = {d}", error=GeometryError)
+            inside = children_samples(level, candidates[mixed])
             candidates = _children(candidates[mixed])
         levels += [_EMPTY] * (d + 1 - len(levels))
         return cls(region, d, tuple(levels), boundary)
