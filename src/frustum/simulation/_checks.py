@@ -54,7 +54,7 @@ def per_item(value: Any, count: int, name: str, where: str, *, positive: bool = 
         i = int(bad[0])
         problem = "is not finite" if not np.isfinite(array[i]) else "is not positive" if positive else "is negative"
         valid = "> 0" if positive else ">= 0"
-        label = name if count == 1 and np.ndim(value) == 0 else f"{name}[{i}]"
+        label = name if np.ndim(value) == 0 else f"{name}[{i}]"
         raise SimulationError(f"{where}: {label} = {float(array[i])!r} {problem}; give finite numbers {valid}")
     return np.ascontiguousarray(array)
 

@@ -5,7 +5,8 @@ Spring s joins masses i and j with stiffness k, damping c and rest length L. Wit
 
     f_i = k·(l − L)·u + c·((v_j − v_i)·u)·u,      f_j = −f_i,
 
-plus gravity ``m·g`` and air drag ``−drag·v`` on every mass. Pinned masses never move. The energy
+plus gravity ``m·g`` and air drag ``−drag·m·v`` on every mass (drag per unit mass, so a finer mesh of the
+same total mass falls the same way). Pinned masses never move. The energy
 ``E = Σ ½·m·|v|² + Σ ½·k·(l − L)² − Σ m·g·x`` is conserved without damping and drag.
 
 Integrators, for ``ẋ = v``, ``v̇ = a(x, v) = f/m`` and a step h:
@@ -74,7 +75,7 @@ class MassSpringSystem:
     integrator : str
         One of ``INTEGRATORS``.
     drag : float
-        Air drag coefficient >= 0: force ``−drag·v`` on every mass.
+        Air drag coefficient >= 0 (1/s): force ``−drag·m·v`` on every mass.
     colliders : list
         ``PlaneCollider`` / ``SphereCollider`` obstacles.
     faces : (M, 3) array_like of int, optional
@@ -206,7 +207,7 @@ class MassSpringSystem:
             total[:, c] = np.bincount(i, along[:, c], n) - np.bincount(j, along[:, c], n)
         total += self.masses[:, None] * self.gravity
         if self.drag:
-            total -= self.drag * velocities
+            total -= (self.drag * self.masses)[:, None] * velocities
         total[self.pinned] = 0.0
         return total
 
@@ -279,13 +280,13 @@ class MassSpringSystem:
         for c in range(3):
             rhs[:, c] += h * (np.bincount(i, k_v[:, c], n) - np.bincount(j, k_v[:, c], n))
         rhs *= h
-        # A = M + h·drag·I + Σ_s blocks on (ii, jj) and −blocks on (ij, ji)
+        # A = M·(1 + h·drag) + Σ_s blocks on (ii, jj) and −blocks on (ij, ji)
         a_idx = np.arange(3)
         row_i = (3 * i[:, None, None] + a_idx[None, :, None]) * np.ones((1, 1, 3), dtype=np.int64)
         col_i = (3 * i[:, None, None] + a_idx[None, None, :]) * np.ones((1, 3, 1), dtype=np.int64)
         row_j = (3 * j[:, None, None] + a_idx[None, :, None]) * np.ones((1, 1, 3), dtype=np.int64)
         col_j = (3 * j[:, None, None] + a_idx[None, None, :]) * np.ones((1, 3, 1), dtype=np.int64)
-        diagonal = np.repeat(self.masses + h * self.drag, 3)
+        diagonal = np.repeat(self.masses * (1.0 + h * self.drag), 3)
         rows = np.concatenate([row_i.ravel(), row_j.ravel(), row_i.ravel(), row_j.ravel(), np.arange(3 * n)])
         cols = np.concatenate([col_i.ravel(), col_j.ravel(), col_j.ravel(), col_i.ravel(), np.arange(3 * n)])
         values = np.concatenate([blocks.ravel(), blocks.ravel(), -blocks.ravel(), -blocks.ravel(), diagonal])
@@ -375,7 +376,7 @@ def cloth(
     stiffness: float = 500.0,
     shear_stiffness: float | None = None,
     bend_stiffness: float | None = None,
-    damping: float = 0.5,
+    damping: float = 0.02,
     **options: Any,
 ) -> MassSpringSystem:
     """A rectangular cloth of `nx` × `ny` masses with structural, shear and bend springs (Provot 1995).
@@ -437,7 +438,7 @@ def cloth(
 
 def rope(
     start: ArrayLike, end: ArrayLike, count: int, *, mass: float = 1.0, stiffness: float = 500.0,
-    bend_stiffness: float = 0.0, damping: float = 0.5, **options: Any,
+    bend_stiffness: float = 0.0, damping: float = 0.02, **options: Any,
 ) -> MassSpringSystem:  # fmt: skip
     """A rope of `count` masses evenly from `start` to `end`: springs between neighbours (`stiffness`) and, with
     `bend_stiffness` > 0, between masses two apart. `mass` is the total; other keywords go to ``MassSpringSystem``
@@ -462,7 +463,7 @@ def rope(
 
 def soft_body(
     mesh: Mesh, *, mass: float = 1.0, stiffness: float = 500.0, bend_stiffness: float | None = None,
-    damping: float = 0.5, **options: Any,
+    damping: float = 0.02, **options: Any,
 ) -> MassSpringSystem:  # fmt: skip
     """A soft body from a closed mesh: a mass at every vertex, a spring along every edge (`stiffness`) and one
     across every pair of adjacent triangles, joining the two vertices opposite their shared edge
