@@ -340,7 +340,7 @@ def _size(size: Any, where: str) -> tuple[int, int]:
     return int(size[0]), int(size[1])
 
 
-def _with_progress(items: Iterator[Frame], total: int, progress: Any) -> Iterator[Frame]:
+def _with_progress(items: Iterator[Frame], total: int, progress: Any, label: str = "turntable") -> Iterator[Frame]:
     """Yield `items`, advancing a Rich progress bar on a terminal (or on the given Console)."""
     from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
@@ -352,7 +352,7 @@ def _with_progress(items: Iterator[Frame], total: int, progress: Any) -> Iterato
     if not console.is_terminal:
         yield from items
         return
-    columns = (TextColumn("turntable"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn())
+    columns = (TextColumn(label), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn())
     bar = Progress(*columns, console=console, transient=False)
     with bar:
         task = bar.add_task("render", total=total)
