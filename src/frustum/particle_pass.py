@@ -35,82 +35,51 @@ from frustum.scene import ParticleLayer
 __all__ = ["draw_particles", "project_particles", "project_streaks"]
 
 
-def _clip(camera: Camera, points: np.ndarray) -> np.ndarray:
-    m = np.asarray(camera.clip_from_world, dtype=np.float64)
-    return points @ m[:, :3].T + m[:, 3]
+def _frame(camera: Camera, minimum: float) -> np.ndarray:
+    """(width, height, |P₁₁|·H/2, minimum radius) for ``raster.particles.project_*``."""
+    scale = abs(float(camera.projection_matrix[1, 1])) * camera.height / 2.0
+    return np.array([camera.width, camera.height, scale, minimum], dtype=np.float64)
 
 
-def _window(camera: Camera, clip: np.ndarray) -> np.ndarray:
-    """(N, 3) window coordinates (x, y, depth) of clip points with w > 0."""
-    v = np.asarray(camera.viewport_matrix, dtype=np.float64)
-    ndc = clip[:, :3] / clip[:, 3:4]
-    return ndc @ v[:3, :3].T + v[:3, 3]
-
-
-def _in_depth_range(clip: np.ndarray) -> np.ndarray:
-    w = clip[:, 3]
-    return (w > 0.0) & (clip[:, 2] >= -w) & (clip[:, 2] <= w)
+def _back_to_front(records: np.ndarray, rows: np.ndarray, depth_column: int) -> tuple[np.ndarray, np.ndarray]:
+    """Records sorted by window depth, farthest first (stable): window depth grows with clip w."""
+    order = np.argsort(-records[:, depth_column], kind="stable")
+    return np.ascontiguousarray(records[order]), np.ascontiguousarray(rows[order])
 
 
 def project_particles(system: Any, camera: Camera, style: str, blending: str) -> tuple[np.ndarray, np.ndarray]:
     """(sprites (K, 8) float64 rows x, y, z, R, r, g, b, α; rows (K, 2) int64 frame-row ranges) of the visible
     particles of `system`, in drawing order (back to front for alpha blending)."""
-    height, width = camera.height, camera.width
-    clip = _clip(camera, np.asarray(system.positions))
-    visible = np.flatnonzero(_in_depth_range(clip))
-    clip = clip[visible]
-    window = _window(camera, clip)
-    scale = abs(float(camera.projection_matrix[1, 1])) * height / 2.0
-    radius = np.asarray(system.sizes)[visible] * scale / clip[:, 3]
-    alpha = np.asarray(system.opacities)[visible].copy()
-    minimum = 1.0 if style == "sprites" else 0.5
-    small = radius < minimum
-    alpha[small] *= (radius[small] / minimum) ** 2
-    radius = np.maximum(radius, minimum)
-    x, y = window[:, 0], window[:, 1]
-    low_y = np.ceil(y - radius - 0.5)
-    high_y = np.floor(y + radius - 0.5)
-    on_screen = (high_y >= 0) & (low_y <= height - 1) & (x + radius > 0.0) & (x - radius < width) & (alpha > 0.0)
-    keep = np.flatnonzero(on_screen)
-    if blending == "alpha":
-        keep = keep[np.argsort(-clip[keep, 3], kind="stable")]
-    sprites = np.empty((keep.size, 8))
-    sprites[:, :3] = window[keep]
-    sprites[:, 3] = radius[keep]
-    sprites[:, 4:7] = np.asarray(system.colors)[visible[keep]]
-    sprites[:, 7] = alpha[keep]
-    rows = np.empty((keep.size, 2), dtype=np.int64)
-    rows[:, 0] = np.clip(height - 1 - high_y[keep], 0, height - 1)
-    rows[:, 1] = np.clip(height - 1 - low_y[keep], 0, height - 1)
-    return sprites, rows
+    from frustum.raster import particles as kernels
+
+    count = system.count
+    sprites = np.empty((count, kernels.SPRITE_FIELDS))
+    rows = np.empty((count, 2), dtype=np.int64)
+    kept = kernels.project_sprites(
+        np.ascontiguousarray(system.positions), np.ascontiguousarray(system.sizes, dtype=np.float64),
+        np.ascontiguousarray(system.colors, dtype=np.float64), np.ascontiguousarray(system.opacities, dtype=np.float64),
+        np.ascontiguousarray(camera.clip_from_world, dtype=np.float64),
+        _frame(camera, 1.0 if style == "sprites" else 0.5), sprites, rows,
+    )  # fmt: skip
+    sprites, rows = sprites[:kept], rows[:kept]
+    return _back_to_front(sprites, rows, 2) if blending == "alpha" else (sprites, rows)
 
 
 def project_streaks(system: Any, camera: Camera, blending: str) -> tuple[np.ndarray, np.ndarray]:
     """(streaks (K, 10) float64 rows x0, y0, z0, x1, y1, z1, r, g, b, α; rows (K, 2) int64) from each visible
     particle's previous position to its current one."""
-    height, width = camera.height, camera.width
-    head = _clip(camera, np.asarray(system.positions))
-    tail = _clip(camera, np.asarray(system.previous_positions))
-    visible = np.flatnonzero(_in_depth_range(head) & _in_depth_range(tail))
-    head_w, tail_w = _window(camera, head[visible]), _window(camera, tail[visible])
-    top = np.floor(np.maximum(head_w[:, 1], tail_w[:, 1]))
-    bottom = np.floor(np.minimum(head_w[:, 1], tail_w[:, 1]))
-    left = np.minimum(head_w[:, 0], tail_w[:, 0])
-    right = np.maximum(head_w[:, 0], tail_w[:, 0])
-    alpha = np.asarray(system.opacities)[visible]
-    on_screen = (top >= 0) & (bottom <= height - 1) & (right >= 0.0) & (left < width) & (alpha > 0.0)
-    keep = np.flatnonzero(on_screen)
-    if blending == "alpha":
-        keep = keep[np.argsort(-head[visible[keep], 3], kind="stable")]
-    streaks = np.empty((keep.size, 10))
-    streaks[:, 0:3] = tail_w[keep]
-    streaks[:, 3:6] = head_w[keep]
-    streaks[:, 6:9] = np.asarray(system.colors)[visible[keep]]
-    streaks[:, 9] = alpha[keep]
-    rows = np.empty((keep.size, 2), dtype=np.int64)
-    rows[:, 0] = np.clip(height - 1 - top[keep], 0, height - 1)
-    rows[:, 1] = np.clip(height - 1 - bottom[keep], 0, height - 1)
-    return streaks, rows
+    from frustum.raster import particles as kernels
+
+    count = system.count
+    streaks = np.empty((count, kernels.STREAK_FIELDS))
+    rows = np.empty((count, 2), dtype=np.int64)
+    kept = kernels.project_streaks(
+        np.ascontiguousarray(system.positions), np.ascontiguousarray(system.previous_positions),
+        np.ascontiguousarray(system.colors, dtype=np.float64), np.ascontiguousarray(system.opacities, dtype=np.float64),
+        np.ascontiguousarray(camera.clip_from_world, dtype=np.float64), _frame(camera, 0.0), streaks, rows,
+    )  # fmt: skip
+    streaks, rows = streaks[:kept], rows[:kept]
+    return _back_to_front(streaks, rows, 5) if blending == "alpha" else (streaks, rows)
 
 
 def _bands(rows: np.ndarray, height: int) -> tuple[np.ndarray, np.ndarray, int]:

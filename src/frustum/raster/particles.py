@@ -35,6 +35,8 @@ __all__ = [
     "draw_sprites",
     "draw_streaks",
     "fill_bands",
+    "project_sprites",
+    "project_streaks",
 ]
 
 SPRITE_FIELDS = 8
@@ -47,6 +49,95 @@ SHAPE_SQUARE = 1
 """A hard square of side 2R: every pixel centre in ``[x − R, x + R) × [y − R, y + R)`` at full α."""
 BAND_ROWS = 16
 """Rows per band: the unit of parallel work."""
+
+
+@kernel
+def _clip_row(m: np.ndarray, k: int, x: float, y: float, z: float) -> float:
+    """Row k of ``M·[x, y, z, 1]``."""
+    return ((m[k, 0] * x + m[k, 1] * y) + m[k, 2] * z) + m[k, 3]
+
+
+@kernel
+def project_sprites(positions: np.ndarray, sizes: np.ndarray, colors: np.ndarray, opacities: np.ndarray,
+                    clip_from_world: np.ndarray, frame: np.ndarray, sprites: np.ndarray,
+                    rows: np.ndarray) -> int:  # fmt: skip
+    """Project every particle and write the visible ones, in order, as sprite records; returns their number.
+
+    ``frame`` = (width, height, pixel scale |P₁₁|·H/2, minimum radius). A particle is kept when ``w > 0``,
+    ``−w <= z_clip <= w``, its disc of radius ``R = size·scale/w`` (at least the minimum, α scaled by
+    ``(R/minimum)²`` below it) touches the image and its α > 0. Window ``x = (x_c/w + 1)·W/2``,
+    ``y = (y_c/w + 1)·H/2``, depth ``(z_c/w + 1)/2`` (``viewport(0, 0, W, H)``).
+    """
+    width, height, scale, minimum = frame[0], frame[1], frame[2], frame[3]
+    last_row = int(height) - 1
+    count = 0
+    for k in range(positions.shape[0]):
+        x, y, z = positions[k, 0], positions[k, 1], positions[k, 2]
+        w = _clip_row(clip_from_world, 3, x, y, z)
+        zc = _clip_row(clip_from_world, 2, x, y, z)
+        if not (w > 0.0 and -w <= zc <= w):
+            continue
+        radius = sizes[k] * scale / w
+        alpha = opacities[k]
+        if radius < minimum:
+            alpha *= (radius / minimum) ** 2
+            radius = minimum
+        if not alpha > 0.0:
+            continue
+        wx = (_clip_row(clip_from_world, 0, x, y, z) / w + 1.0) * (width / 2.0)
+        wy = (_clip_row(clip_from_world, 1, x, y, z) / w + 1.0) * (height / 2.0)
+        low_y = math.ceil(wy - radius - 0.5)
+        high_y = math.floor(wy + radius - 0.5)
+        if high_y < 0 or low_y > last_row or wx + radius <= 0.0 or wx - radius >= width:
+            continue
+        sprites[count, 0], sprites[count, 1], sprites[count, 2] = wx, wy, (zc / w + 1.0) * 0.5
+        sprites[count, 3] = radius
+        sprites[count, 4], sprites[count, 5], sprites[count, 6] = colors[k, 0], colors[k, 1], colors[k, 2]
+        sprites[count, 7] = alpha
+        rows[count, 0] = max(last_row - high_y, 0)
+        rows[count, 1] = min(last_row - low_y, last_row)
+        count += 1
+    return count
+
+
+@kernel
+def project_streaks(heads: np.ndarray, tails: np.ndarray, colors: np.ndarray, opacities: np.ndarray,
+                    clip_from_world: np.ndarray, frame: np.ndarray, streaks: np.ndarray,
+                    rows: np.ndarray) -> int:  # fmt: skip
+    """Project both ends of every particle's streak (tail = previous position, head = current one) and write the
+    visible ones, in order; returns their number. Both ends must satisfy ``w > 0`` and ``−w <= z_clip <= w``."""
+    width, height = frame[0], frame[1]
+    last_row = int(height) - 1
+    count = 0
+    for k in range(heads.shape[0]):
+        if not opacities[k] > 0.0:
+            continue
+        inside = True
+        for end in range(2):
+            points = tails if end == 0 else heads
+            x, y, z = points[k, 0], points[k, 1], points[k, 2]
+            w = _clip_row(clip_from_world, 3, x, y, z)
+            zc = _clip_row(clip_from_world, 2, x, y, z)
+            if not (w > 0.0 and -w <= zc <= w):
+                inside = False
+                break
+            streaks[count, 3 * end] = (_clip_row(clip_from_world, 0, x, y, z) / w + 1.0) * (width / 2.0)
+            streaks[count, 3 * end + 1] = (_clip_row(clip_from_world, 1, x, y, z) / w + 1.0) * (height / 2.0)
+            streaks[count, 3 * end + 2] = (zc / w + 1.0) * 0.5
+        if not inside:
+            continue
+        top = math.floor(max(streaks[count, 1], streaks[count, 4]))
+        bottom = math.floor(min(streaks[count, 1], streaks[count, 4]))
+        left = min(streaks[count, 0], streaks[count, 3])
+        right = max(streaks[count, 0], streaks[count, 3])
+        if top < 0 or bottom > last_row or right < 0.0 or left >= width:
+            continue
+        streaks[count, 6], streaks[count, 7], streaks[count, 8] = colors[k, 0], colors[k, 1], colors[k, 2]
+        streaks[count, 9] = opacities[k]
+        rows[count, 0] = max(last_row - top, 0)
+        rows[count, 1] = min(last_row - bottom, last_row)
+        count += 1
+    return count
 
 
 @kernel
