@@ -401,7 +401,11 @@ def cloth(
     shear_stiffness: float | None = None,
     bend_stiffness: float | None = None,
     damping: float = 0.02,
-    **options: Any,
+    pinned: Any = (),
+    gravity: ArrayLike = (0.0, -9.81, 0.0),
+    integrator: str = "implicit-euler",
+    drag: float = 0.0,
+    colliders: Any = (),
 ) -> MassSpringSystem:
     """A rectangular cloth of `nx` × `ny` masses with structural, shear and bend springs (Provot 1995).
 
@@ -410,8 +414,9 @@ def cloth(
     or (x, y) for ``plane="xy"`` (hanging, row 0 at the bottom, faces toward +z). Springs: structural between
     4-neighbours (`stiffness`), shear along both diagonals (`shear_stiffness`, default `stiffness`), bend between
     masses two apart (`bend_stiffness`, default `stiffness`/10). `mass` is the total, shared equally. The faces
-    split every grid cell in two, counter-clockwise from the face side; uvs span [0, 1]². Other keyword
-    arguments (``pinned``, ``gravity``, ``integrator``, ``drag``, ``colliders``) go to ``MassSpringSystem``.
+    split every grid cell in two, counter-clockwise from the face side; uvs span [0, 1]². ``pinned``,
+    ``gravity`` (default Earth's, y up), ``integrator`` (default ``"implicit-euler"``, stable at frame-rate steps),
+    ``drag`` and ``colliders`` go to ``MassSpringSystem``.
     """
     where = "cloth"
     from frustum._arrays import as_scalar
@@ -455,7 +460,8 @@ def cloth(
     if total <= 0.0:
         raise SimulationError(f"{where}: mass = {total!r} is not positive; give the cloth's total mass > 0")
     system = MassSpringSystem(points, total / (nx * ny), springs, stiffness=constants, damping=damping,
-                              faces=faces, **options)  # fmt: skip
+                              faces=faces, pinned=pinned, gravity=gravity, integrator=integrator, drag=drag,
+                              colliders=colliders)  # fmt: skip
     system.uvs = np.stack([c.ravel() / (nx - 1), r.ravel() / (ny - 1)], axis=1)
     return system
 
