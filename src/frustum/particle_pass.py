@@ -20,7 +20,7 @@ channel is left as the surfaces made it.
 References
 ----------
 Reeves 1983 §2.4 (rendering particles as additive point light sources, motion-blurred streaks);
-[HB 14] "Particle Systems"; [seed] "Particle systems".
+[HB 15] "Particle Systems"; [seed] "Particle systems".
 """
 
 from __future__ import annotations

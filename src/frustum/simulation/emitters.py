@@ -7,7 +7,7 @@ model), ``speed`` varying as ``speed + speed_variance·U(−1, 1)``. Random numb
 
 References
 ----------
-[HB 14] "Particle Systems"; W. T. Reeves, "Particle Systems — a Technique for Modeling a Class of Fuzzy
+[HB 15] "Particle Systems"; W. T. Reeves, "Particle Systems — a Technique for Modeling a Class of Fuzzy
 Objects", SIGGRAPH 1983, §2.1 (generation, initial attributes); [seed] "Particle systems".
 """
 

@@ -10,7 +10,7 @@ contact). With e = 1 and μ = 0 the speed is kept.
 
 References
 ----------
-[HB 14] "Physically Based Modeling"; Reeves 1983 §2.3 (particle dynamics); A. Witkin, "Physically Based
+[HB 15] "Physically Based Modeling"; Reeves 1983 §2.3 (particle dynamics); A. Witkin, "Physically Based
 Modeling: Particle System Dynamics", SIGGRAPH course notes 2001, §§3–5 (forces, collisions).
 """
 

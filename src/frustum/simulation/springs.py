@@ -25,7 +25,7 @@ A state that stops being finite raises ``SimulationError`` naming the step.
 
 References
 ----------
-[HB 14] "Physically Based Modeling"; [seed] "Physically based modeling"; D. Baraff and A. Witkin, "Large Steps
+[HB 15] "Physically Based Modeling"; [seed] "Physically based modeling"; D. Baraff and A. Witkin, "Large Steps
 in Cloth Simulation", SIGGRAPH 1998, §§4–5; E. Hairer, C. Lubich, G. Wanner, "Geometric Numerical
 Integration", §I.1 (symplectic Euler, Störmer–Verlet); X. Provot, "Deformation Constraints in a Mass-Spring
 Model to Describe Rigid Cloth Behavior", 1995 (structural, shear and bend springs).
