@@ -311,3 +311,27 @@ def test_the_memory_budget_is_checked_before_allocating():
     system = ParticleSystem(emitter=PointEmitter((0, 0, 0)), rate=1e12, lifetime=1.0)
     with frustum.budget(bytes="1G"), pytest.raises(SimulationError, match=r"over the memory budget"):
         system.step(1.0)
+
+
+def test_no_particle_ends_a_step_inside_a_mesh_collider():
+    import trimesh
+
+    from frustum.geometry.primitives import box, icosphere
+    from frustum.simulation import MeshCollider
+
+    solid = icosphere(0.8, 2)
+    system = ParticleSystem(
+        emitter=DiskEmitter((0, 1.5, 0), radius=0.7, direction=(0, -1, 0), speed=3.0), rate=3000.0, lifetime=2.0,
+        forces=[Gravity()], colliders=[MeshCollider(solid, restitution=0.2, friction=0.1)], seed=4,
+    )  # fmt: skip
+    oracle = trimesh.Trimesh(solid.vertices, solid.faces, process=False)
+    bounced = 0
+    for _ in range(25):
+        system.step(1 / 60)
+        # trimesh's own signed distance as the oracle: positive inside; allow round-off of the closest point
+        assert trimesh.proximity.signed_distance(oracle, system.positions).max(initial=-1.0) <= 1e-9
+        bounced += int((system.velocities[:, 1] > 0).sum())
+    assert bounced > 0
+    with pytest.raises(SimulationError, match=r"mesh = .* is not a closed Mesh"):
+        MeshCollider(Mesh([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]]))  # an open triangle
+    MeshCollider(box())  # a closed box is accepted

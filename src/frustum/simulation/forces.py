@@ -30,6 +30,7 @@ __all__ = [
     "Drag",
     "Force",
     "Gravity",
+    "MeshCollider",
     "PlaneCollider",
     "SphereCollider",
     "Vortex",
@@ -189,6 +190,76 @@ class SphereCollider(_Collider):
         return offset / length[:, None]
 
 
+class MeshCollider(_Collider):
+    """A closed (watertight) mesh as a solid obstacle: particles that end a step inside it are moved to the
+    nearest surface point ``c`` plus ``e·|d|`` along its outward normal ``n = (c − x)/|c − x|`` (``d`` the
+    distance to c), and their velocities respond as for a plane with that normal.
+
+    Inside tests and closest points come from trimesh (ray parity and an R-tree of the triangles), only for the
+    particles inside the mesh's bounding box: exact, but far slower per particle than planes and spheres.
+    """
+
+    def __init__(self, mesh: Any, restitution: float = 0.5, friction: float = 0.0) -> None:
+        super().__init__(restitution, friction, "MeshCollider")
+        from frustum.geometry import Mesh
+
+        if not isinstance(mesh, Mesh) or mesh.face_count == 0 or not mesh.welded().is_watertight:
+            raise SimulationError(
+                f"MeshCollider: mesh = {describe(mesh)} is not a closed Mesh; give a watertight mesh (a solid)"
+            )
+        self.mesh = mesh
+        self._low, self._high = mesh.bounds[0], mesh.bounds[1]
+        self._solid = None
+        self._closest: NDArray[np.float64] | None = None
+
+    def _trimesh(self) -> Any:
+        if self._solid is None:
+            import trimesh
+
+            self._solid = trimesh.Trimesh(self.mesh.vertices, self.mesh.faces, process=False)
+        return self._solid
+
+    def _signed_distance(self, positions):
+        distance = np.ones(positions.shape[0])
+        near = np.flatnonzero(((positions >= self._low) & (positions <= self._high)).all(axis=1))
+        self._closest = None
+        if near.size == 0:
+            return distance
+        import trimesh
+
+        solid = self._trimesh()
+        inside = near[solid.contains(positions[near])]
+        if inside.size == 0:
+            return distance
+        closest, gap, _ = trimesh.proximity.closest_point(solid, positions[inside])
+        distance[inside] = -np.maximum(gap, 1e-300)
+        self._closest = np.empty_like(positions)
+        self._closest[inside] = closest
+        return distance
+
+    def _normals(self, positions):
+        return np.zeros_like(positions)  # unused: resolve below moves to the surface point directly
+
+    def resolve(self, positions: NDArray[np.float64], velocities: NDArray[np.float64]) -> None:
+        if positions.shape[0] == 0:
+            return
+        distance = self._signed_distance(positions)
+        inside = np.flatnonzero(distance < 0.0)
+        if inside.size == 0:
+            return
+        closest = self._closest[inside]
+        offset = closest - positions[inside]
+        depth = np.linalg.norm(offset, axis=1)
+        normals = offset / np.where(depth > 0.0, depth, 1.0)[:, None]
+        e, mu = self.restitution, self.friction
+        positions[inside] = closest + (e * depth)[:, None] * normals
+        v = velocities[inside]
+        normal_speed = (v * normals).sum(axis=1)
+        normal_part = normal_speed[:, None] * normals
+        response = (1.0 - mu) * (v - normal_part) - e * normal_part
+        velocities[inside] = np.where((normal_speed < 0.0)[:, None], response, v)
+
+
 def check_forces(forces: Any, where: str) -> tuple[Force, ...]:
     items = tuple(forces) if isinstance(forces, list | tuple) else None
     if items is None or not all(isinstance(f, Force) for f in items):
@@ -204,6 +275,6 @@ def check_colliders(colliders: Any, where: str) -> tuple[_Collider, ...]:
     if items is None or not all(isinstance(c, _Collider) for c in items):
         raise SimulationError(
             f"{where}: colliders = {describe(colliders)} is not a list of colliders; give e.g. "
-            "[PlaneCollider((0, 0, 0), (0, 1, 0))] (PlaneCollider, SphereCollider)"
+            "[PlaneCollider((0, 0, 0), (0, 1, 0))] (PlaneCollider, SphereCollider, MeshCollider)"
         )
     return items
