@@ -71,3 +71,26 @@ def test_svg_draws_particles_as_dots_and_streaks_as_segments():
     assert text.count("<circle") > 0.5 * particles.count
     assert text.count("<line") >= text.count("<circle")
     assert 'id="particles0" style="mix-blend-mode:plus-lighter"' in text and 'id="particles1">' in text
+
+
+def test_simulate_writes_an_mp4(tmp_path):
+    pytest.importorskip("imageio_ffmpeg")
+    import imageio.v2 as imageio
+
+    scene, _, _ = fountain_scene()
+    target = tmp_path / "fountain.mp4"
+    assert fr.simulate(scene, camera(), 5, fps=10, path=target, progress=False) == 5
+    reader = imageio.get_reader(target)
+    assert reader.count_frames() == 5
+    reader.close()
+
+
+def test_turntable_keeps_the_particles():
+    scene, particles, _ = fountain_scene()
+    for _ in range(10):
+        particles.step(0.05)
+    frames = fr.turntable(scene, camera(), frames=2, progress=False)
+    without = fr.Scene(lights=scene.lights)
+    without.root = scene.root
+    plain = fr.turntable(without, camera(), frames=2, progress=False)
+    assert not np.array_equal(frames[0].color, plain[0].color)

@@ -236,6 +236,7 @@ def _with_lights_turned(scene: Scene, turn: NDArray[np.float64]) -> Scene:
     )  # fmt: skip
     turned = Scene()
     turned.root = turned_root
+    turned.particle_layers = list(getattr(scene, "particle_layers", ()))  # particles turn with the camera too
     return turned
 
 
