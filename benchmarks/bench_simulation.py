@@ -3,7 +3,8 @@
     python benchmarks/bench_simulation.py [--repeat 5] [--particles 1000000] [--frames 200] [--gif-size 320x240]
 
 1. One ``ParticleSystem.step`` of 10⁶ particles with gravity, drag and a plane collision (no births or deaths:
-   the lifetime is long and the rate zero, so the step is the dynamics alone).
+   the lifetime is long and the rate zero, so the step is the dynamics alone; the fused compiled pass of
+   ``raster.particle_step``).
 2. ``render`` of 10⁶ additive soft sprites at 1920×1080 over a ground plane (the whole render, surfaces included;
    the plane alone is timed too, so the particle pass is the difference).
 3. One ``"implicit-euler"`` step of a 100×100 cloth (9,801 cells, 58,808 springs: assembly + sparse CG).
@@ -117,17 +118,23 @@ from frustum.particle_pass import draw_particles
 depth = np.ones((48, 64), np.float32); color = np.zeros((48, 64, 4), np.uint8)
 start = time.perf_counter()
 draw_particles(scene.particle_layers, camera, depth, color)
-print(f"{time.perf_counter() - start:.2f}")
+drawing = time.perf_counter() - start
+import frustum.simulation.particles as module
+module.FUSED_STEP_MINIMUM = 0
+start = time.perf_counter()
+system.step(0.01)
+print(f"{drawing:.2f} s (drawing: 7 kernels), {time.perf_counter() - start:.2f} s (fused step)")
 """
 
 
 def bench_compile() -> None:
     with tempfile.TemporaryDirectory() as cache:
         environment = {**os.environ, "NUMBA_CACHE_DIR": cache}
-        # the first draw compiles count_bands, fill_bands, draw_sprites (with _blend) and draw_streaks
+        # the first draw compiles project_sprites, project_streaks, count_bands, fill_bands, draw_sprites (with
+        # _blend) and draw_streaks; the first fused step compiles step_linear
         result = subprocess.run([sys.executable, "-c", _COMPILE], env=environment, capture_output=True, text=True,
                                 check=True)  # fmt: skip
-    print(f"particle kernels, cold compile (empty NUMBA_CACHE_DIR): {result.stdout.strip()} s")
+    print(f"particle kernels, cold compile (empty NUMBA_CACHE_DIR): {result.stdout.strip()}")
 
 
 def main() -> None:

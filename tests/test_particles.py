@@ -335,3 +335,38 @@ def test_no_particle_ends_a_step_inside_a_mesh_collider():
     with pytest.raises(SimulationError, match=r"mesh = .* is not a closed Mesh"):
         MeshCollider(Mesh([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]]))  # an open triangle
     MeshCollider(box())  # a closed box is accepted
+
+
+def test_the_fused_step_equals_the_numpy_step(monkeypatch):
+    import frustum.simulation.particles as particles_module
+
+    def run(minimum: int) -> ParticleSystem:
+        monkeypatch.setattr(particles_module, "FUSED_STEP_MINIMUM", minimum)
+        system = ParticleSystem(
+            emitter=PointEmitter((0, 0.5, 0), spread=1.2, speed=4.0, speed_variance=1.0), rate=20000.0, lifetime=0.4,
+            forces=[Gravity(), Drag(0.3), Wind((1.0, 0.0, -0.5), 0.2)], seed=8,
+            colliders=[PlaneCollider((0, 0, 0), (0, 1, 0), 0.6, 0.1), PlaneCollider((1, 0, 0), (-1, 0.2, 0), 1.0)],
+        )  # fmt: skip
+        system.emit(3000)
+        for _ in range(30):
+            system.step(1 / 50)
+        return system
+
+    fused, plain = run(0), run(10**12)
+    assert fused.count == plain.count
+    # same formulas in another order of floating-point operations: equal to round-off
+    np.testing.assert_allclose(fused.positions, plain.positions, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(fused.velocities, plain.velocities, rtol=1e-12, atol=1e-12)
+    assert fused.positions[:, 1].min() >= -1e-12
+
+
+def test_the_fused_step_names_the_step_of_a_blow_up(monkeypatch):
+    import frustum.simulation.particles as particles_module
+
+    monkeypatch.setattr(particles_module, "FUSED_STEP_MINIMUM", 0)
+    system = ParticleSystem(emitter=PointEmitter((0, 0, 0)), rate=0.0, lifetime=100.0,
+                            forces=[Gravity((0, 1e307, 0))], seed=0)  # fmt: skip
+    system.emit(4)
+    with pytest.raises(SimulationError, match=r"after step \d+"):
+        for _ in range(10):
+            system.step(100.0)

@@ -49,10 +49,13 @@ from frustum.simulation._checks import (
     state_not_finite,
 )
 from frustum.simulation.emitters import Emitter, check_emitter
-from frustum.simulation.forces import check_colliders, check_forces
+from frustum.simulation.forces import Drag, Gravity, PlaneCollider, Wind, check_colliders, check_forces
 
 __all__ = ["ParticleSystem"]
 
+FUSED_STEP_MINIMUM = 50_000
+"""From this many particles on, a step under gravity, drag, wind and planes only runs as one compiled pass
+(``raster.particle_step``); smaller systems stay whole-array numpy (no compilation for a few particles)."""
 _BYTES_PER_PARTICLE = 4 * 3 * 8 + 2 * 8
 """Positions, velocities, previous positions, a work array (3 float64 each), age and lifetime."""
 
@@ -253,12 +256,40 @@ class ParticleSystem:
                      error=SimulationError)  # fmt: skip
         return count
 
+    def _linear_forces(self) -> tuple[np.ndarray, float, np.ndarray] | None:
+        """(c, k, planes) when every force is gravity, drag or wind (``a = c − k·v``) and every collider a plane:
+        the case ``raster.particle_step.step_linear`` runs in one fused pass. None otherwise."""
+        if not all(type(f) in (Gravity, Drag, Wind) for f in self.forces):
+            return None
+        if not all(type(c) is PlaneCollider for c in self.colliders):
+            return None
+        constant, damping = np.zeros(3), 0.0
+        for force in self.forces:
+            if type(force) is Gravity:
+                constant += force.vector
+            elif type(force) is Drag:
+                damping += force.coefficient
+            else:
+                constant += force.coefficient * force.velocity
+                damping += force.coefficient
+        planes = np.array([[*c.point, *c.normal, c.restitution, c.friction] for c in self.colliders]).reshape(-1, 8)
+        return constant, damping, planes
+
     def step(self, dt: float) -> ParticleSystem:
         """Advance the system by `dt` seconds (move, collide, die, generate; see the module docstring); returns it."""
         where = "ParticleSystem.step"
         dt = as_time_step(dt, where)
         n = self._count
         x, v = self._x[:n], self._v[:n]
+        linear = self._linear_forces() if n >= FUSED_STEP_MINIMUM else None
+        if linear is not None:  # one compiled pass (same formulas, to round-off): 10x fewer passes over memory
+            from frustum.raster.particle_step import step_linear
+
+            constant, damping, planes = linear
+            with np.errstate(over="ignore", invalid="ignore"):
+                bad = step_linear(x, v, self._previous[:n], self._age[:n], constant, damping, planes, dt)
+            self._finish_step(dt, where, finite=bad == 0)
+            return self
         with np.errstate(over="ignore", invalid="ignore"):
             constant = np.zeros(3)
             varying = None
@@ -280,9 +311,16 @@ class ParticleSystem:
             self._age[:n] += dt
         for collider in self.colliders:
             collider.resolve(x, v)
+        self._finish_step(dt, where, finite=not n or bool(np.isfinite(x).all() and np.isfinite(v).all()))
+        return self
+
+    def _finish_step(self, dt: float, where: str, finite: bool) -> None:
+        """Count the step, refuse a blow-up, remove the dead, generate the newborn."""
+        n = self._count
+        x = self._x[:n]
         self.steps += 1
         self.time += dt
-        if n and not (np.isfinite(x).all() and np.isfinite(v).all()):
+        if not finite:
             raise state_not_finite(where, self.steps, self.time, dt, "symplectic-euler")
         alive = self._age[:n] < self._life[:n]
         if self.region is not None:
@@ -295,7 +333,6 @@ class ParticleSystem:
                 array[:m] = array[keep]
             self._count = m
         self._emit(self._generated(dt))
-        return self
 
     def __repr__(self) -> str:
         return (f"ParticleSystem({self.emitter!r}, rate={self.rate!r}, lifetime={self.lifetime!r}, "
