@@ -21,7 +21,7 @@ import math
 
 import numpy as np
 
-from frustum.raster._jit import kernel, parallel_kernel, prange
+from frustum.raster._jit import kernel, parallel_kernel
 
 __all__ = [
     "BAND_ROWS",
@@ -177,15 +177,15 @@ def _blend(accumulator: np.ndarray, row: int, col: int, r: float, g: float, b: f
         accumulator[row, col, 2] = alpha * 255.0 * b + keep * accumulator[row, col, 2]
 
 
-@parallel_kernel
+@parallel_kernel(lambda sprites, starts, *_: starts.size - 1)
 def draw_sprites(sprites: np.ndarray, starts: np.ndarray, entries: np.ndarray, band_rows: int, shape: int,
-                 mode: int, depth: np.ndarray, accumulator: np.ndarray) -> None:  # fmt: skip
+                 mode: int, depth: np.ndarray, accumulator: np.ndarray, start: int, stop: int) -> None:  # fmt: skip
     """Draw every sprite of every band (parallel over bands) into `accumulator`, depth-tested, depth unchanged.
 
     Pixel (row, col) has its centre at window ``(col + ½, H − 1 − row + ½)``.
     """
     height, width = depth.shape
-    for band in prange(starts.size - 1):
+    for band in range(start, stop):
         first_row = band * band_rows
         last_row = min(first_row + band_rows, height) - 1
         for e in range(starts[band], starts[band + 1]):
@@ -217,16 +217,16 @@ def draw_sprites(sprites: np.ndarray, starts: np.ndarray, entries: np.ndarray, b
                     _blend(accumulator, row, col, r, g, b, alpha * weight, mode)
 
 
-@parallel_kernel
+@parallel_kernel(lambda streaks, starts, *_: starts.size - 1)
 def draw_streaks(streaks: np.ndarray, starts: np.ndarray, entries: np.ndarray, band_rows: int, mode: int,
-                 depth: np.ndarray, accumulator: np.ndarray) -> None:  # fmt: skip
+                 depth: np.ndarray, accumulator: np.ndarray, start: int, stop: int) -> None:  # fmt: skip
     """Draw every streak (a 1-pixel DDA line from (x0, y0) to (x1, y1), depth linear along it) of every band.
 
     The line is sampled at ``n + 1`` evenly spaced points, ``n = max(⌈max(|Δx|, |Δy|)⌉, 1)``; sample t = k/n
     lands in the pixel containing it (``⌊x⌋, ⌊y⌋``) and blends with α once per sample.
     """
     height, width = depth.shape
-    for band in prange(starts.size - 1):
+    for band in range(start, stop):
         first_row = band * band_rows
         last_row = min(first_row + band_rows, height) - 1
         for e in range(starts[band], starts[band + 1]):
