@@ -13,7 +13,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from frustum.raster._jit import kernel, parallel_kernel, prange
+from frustum.raster._jit import kernel, parallel_kernel
 
 __all__ = ["LEAF_SIZE", "Hierarchy", "build", "first_hits"]
 
@@ -172,10 +172,10 @@ def _trace(lo, hi, triangles, order, origins, directions, t_out, face_out):
                                            directions[r, 0], directions[r, 1], directions[r, 2])  # fmt: skip
 
 
-@parallel_kernel
-def _trace_parallel(lo, hi, triangles, order, origins, directions, t_out, face_out):
+@parallel_kernel(lambda lo, hi, triangles, order, origins, *_: origins.shape[0])
+def _trace_parallel(lo, hi, triangles, order, origins, directions, t_out, face_out, start, stop):
     """``_trace_ray`` for each ray, parallel over rays."""
-    for r in prange(origins.shape[0]):
+    for r in range(start, stop):
         t_out[r], face_out[r] = _trace_ray(lo, hi, triangles, order, origins[r, 0], origins[r, 1], origins[r, 2],
                                            directions[r, 0], directions[r, 1], directions[r, 2])  # fmt: skip
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from frustum.raster._jit import kernel, parallel_kernel, prange
+from frustum.raster._jit import kernel, parallel_kernel
 
 __all__ = ["TILE", "draw_octree", "split_pairs"]
 
@@ -231,8 +231,8 @@ def draw_octree(full_codes, full_offsets, partial_codes, partial_offsets, params
     return visited
 
 
-@parallel_kernel
-def split_pairs(corners, triangle_ids, parent_lo, side, reference, parity, touches, crossings):
+@parallel_kernel(lambda corners, triangle_ids, *_: triangle_ids.shape[0])
+def split_pairs(corners, triangle_ids, parent_lo, side, reference, parity, touches, crossings, start, stop):
     """For each (cell, triangle) pair and each octant o of the cell: does the triangle touch child o, and does
     it cross the segment from the cell's reference point to the child's (parallel over pairs).
 
@@ -242,7 +242,7 @@ def split_pairs(corners, triangle_ids, parent_lo, side, reference, parity, touch
     crossings[p, o] (if `parity`): Möller–Trumbore, t in [0, 1), u, v >= 0, u + v <= 1.
     """
     slack = 1e-12 * max(side, 1.0)
-    for p in prange(triangle_ids.shape[0]):
+    for p in range(start, stop):
         f = triangle_ids[p]
         ax, ay, az = corners[f, 0, 0], corners[f, 0, 1], corners[f, 0, 2]
         e1x, e1y, e1z = corners[f, 1, 0] - ax, corners[f, 1, 1] - ay, corners[f, 1, 2] - az
