@@ -290,6 +290,18 @@ from frustum.visibility import (
     viewing_position,
 )
 
+
+def __getattr__(name: str) -> object:
+    """``frustum.Viewer`` is imported on first use: it needs the ``viewer`` extra (anywidget), which
+    ``import frustum`` must not load. It is left out of ``__all__`` so that ``from frustum import *`` works
+    without the extra."""
+    if name == "Viewer":
+        from frustum import viewer
+
+        return viewer.Viewer
+    raise AttributeError(f"module 'frustum' has no attribute {name!r}")
+
+
 __all__ = [
     "ANAGLYPH_METHODS",
     "CLASSIC_LSYSTEMS",
