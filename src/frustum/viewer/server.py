@@ -275,7 +275,7 @@ def serve(
     bound = sock.getsockname()
     shown = f"[{bound[0]}]" if ":" in bound[0] else bound[0]
     source.check()
-    config = uvicorn.Config(make_app(source), log_level="warning", ws="websockets", lifespan="on")
+    config = uvicorn.Config(make_app(source), log_level="warning", ws="auto", lifespan="on")
     server = uvicorn.Server(config)
     if ready is not None:
         ready(f"http://{shown}:{bound[1]}/")
