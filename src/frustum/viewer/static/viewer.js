@@ -50,9 +50,10 @@ function mountViewer(el, transport) {
   }
 
   function imagePoint(event) {
+    // image pixels (x right, y down) from the canvas's content box (inside its border)
     const box = canvas.getBoundingClientRect();
-    const sx = canvas.width / box.width, sy = canvas.height / box.height;
-    return [(event.clientX - box.left) * sx, (event.clientY - box.top) * sy];
+    const sx = canvas.width / canvas.clientWidth, sy = canvas.height / canvas.clientHeight;
+    return [(event.clientX - box.left - canvas.clientLeft) * sx, (event.clientY - box.top - canvas.clientTop) * sy];
   }
 
   canvas.addEventListener("contextmenu", (event) => event.preventDefault());
