@@ -22,6 +22,7 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
+import frustum.raster
 from frustum import __version__
 from frustum.camera import Camera
 from frustum.errors import FrustumError, GeometryError
@@ -415,6 +416,17 @@ def view_command(
     console.print(f"wrote {written}", markup=False, highlight=False, soft_wrap=True)
 
 
+@app.command("warmup")
+def warmup_command(
+    processes: Annotated[int | None, typer.Option(help="Parallel processes (default: the number of cores).")] = None,
+) -> None:
+    """Compile every kernel ahead of time into Numba's on-disk cache, so no later render waits for it."""
+    from frustum.warmup import warmup
+
+    error_console.print("compiling every kernel (once per environment) ...", markup=False)
+    console.print(str(warmup(processes)), markup=False, highlight=False)
+
+
 @app.command("examples")
 def examples_command(
     out: Annotated[Path, typer.Option(help="Folder for the pictures.")] = Path("examples/out"),
@@ -465,10 +477,17 @@ def _fail(message: str, status: int) -> None:
     raise SystemExit(status)
 
 
+def _compile_notice() -> None:
+    """Told by the kernels once they have been compiling for a second (a first run in a new environment)."""
+    error_console.print("compiling render kernels, first run only (`frustum warmup` does it ahead of time) ...",
+                        markup=False, highlight=False)  # fmt: skip
+
+
 def main(arguments: Sequence[str] | None = None) -> None:
     """Entry point of the ``frustum`` console script: one-line errors, exit 1 (2 for usage), tracebacks on --debug."""
     argv = list(sys.argv[1:] if arguments is None else arguments)
     _STATE["debug"] = "--debug" in argv
+    frustum.raster.compile_notice = _compile_notice
     try:
         status = app(args=argv, prog_name="frustum", standalone_mode=False)
     except _CLICK_USAGE_ERROR as error:
