@@ -75,16 +75,22 @@ def server(tmp_path_factory):
 
 
 @pytest.fixture(scope="module")
-def page(server):
+def browser():
     playwright_sync = pytest.importorskip("playwright.sync_api")
     with playwright_sync.sync_playwright() as playwright:
         browser = playwright.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS, headless=True)
-        page = browser.new_page(viewport={"width": 1400, "height": 900})
-        page.goto(server["url"])
-        # the first frame waits for the kernels (compiled once, cached afterwards)
-        page.wait_for_function("window.frustumViewer && window.frustumViewer.frames >= 1", timeout=300_000)
-        yield page
+        yield browser
         browser.close()
+
+
+@pytest.fixture(scope="module")
+def page(server, browser):
+    page = browser.new_page(viewport={"width": 1400, "height": 900})
+    page.goto(server["url"])
+    # the first frame waits for the kernels (compiled once, cached afterwards)
+    page.wait_for_function("window.frustumViewer && window.frustumViewer.frames >= 1", timeout=300_000)
+    yield page
+    page.close()
 
 
 def _pixels(page) -> np.ndarray:
@@ -249,3 +255,63 @@ def test_second_server_on_the_same_port_fails_clearly(server):
     )
     assert result.returncode == 1
     assert f"port = {port} on 127.0.0.1 is already in use" in result.stderr
+
+
+_FAKE_KERNEL = """async (esm) => {
+  const url = URL.createObjectURL(new Blob([esm], { type: "text/javascript" }));
+  const module = await import(url);
+  window.sent = [];
+  const listeners = [];
+  const model = {
+    send: (m) => window.sent.push(JSON.stringify(m)), on: (name, cb) => listeners.push(cb), off: () => {},
+  };
+  window.deliver = ([content, data]) => {
+    const buffers = data ? [new DataView(Uint8Array.from(atob(data), (c) => c.charCodeAt(0)).buffer)] : [];
+    for (const cb of listeners) cb(content, buffers);
+  };
+  const el = document.getElementById("widget");
+  module.default.render({ model, el });
+  window.frustumViewer = el.frustumViewer;
+}"""
+
+
+def test_widget_front_end_draws_frames_and_sends_events(browser):
+    """The anywidget ESM in a page, with a stand-in for the kernel: Python answers what the page sends."""
+    pytest.importorskip("anywidget")
+    import frustum
+
+    scene_file = frustum.load_scene_file(ROOT / "examples" / "teapot.toml")
+    camera = frustum.Camera(scene_file.camera.frame, scene_file.camera.projection, 160, 120)
+    viewer = frustum.Viewer(scene_file.scene, camera, options=scene_file.options, rest_samples=1)
+    outbox = []
+    viewer.send = lambda content, buffers=None: outbox.append((content, buffers))
+    page = browser.new_page()
+    page.set_content(f"<style>{viewer._css}</style><div id='widget'></div>")
+    page.evaluate(_FAKE_KERNEL, viewer._esm)
+
+    def pump() -> None:  # the kernel's side: handle what the page sent, deliver the replies
+        for text in page.evaluate("window.sent.splice(0)"):
+            viewer._on_message(viewer, json.loads(text), [])
+        for content, buffers in outbox:
+            data = base64.b64encode(buffers[0]).decode() if buffers else None
+            page.evaluate("(message) => window.deliver(message)", [content, data])
+        outbox.clear()
+
+    pump()  # the page said hello: state and a rest frame
+    assert page.evaluate("window.frustumViewer.frames") == 1
+    panel = _panel_matrices(page)
+    np.testing.assert_allclose(panel["view"][1], viewer.camera.view_matrix, rtol=0, atol=1e-12)
+    box = page.locator(".fv-canvas").bounding_box()
+    border = page.evaluate("document.querySelector('.fv-canvas').clientLeft")
+    x0, y0 = box["x"] + border + 40, box["y"] + border + 60
+    azimuth = viewer.session.control.azimuth
+    page.mouse.move(x0, y0)
+    page.mouse.down()
+    page.mouse.move(x0 + 30, y0)
+    pump()
+    page.mouse.up()
+    pump()
+    assert viewer.session.control.azimuth == pytest.approx(azimuth - 30 * 0.01, abs=1e-9)
+    assert page.evaluate("window.frustumViewer.quality") == "rest"
+    np.testing.assert_allclose(_panel_matrices(page)["view"][1], viewer.camera.view_matrix, rtol=0, atol=1e-12)
+    page.close()
