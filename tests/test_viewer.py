@@ -154,6 +154,7 @@ def test_control_rejects_bad_construction():
         {"type": "pointer", "action": "down", "x": float("nan"), "y": 10, "button": 0},
         {"type": "pointer", "action": "down", "x": "10", "y": 10, "button": 0},
         {"type": "pointer", "action": "down", "x": 10, "y": 10, "button": 7},
+        {"type": "pointer", "action": "down", "x": 10, "y": 10, "button": True},
         {"type": "pointer", "action": "move", "x": 10, "y": 10},  # no drag in progress
         {"type": "pointer", "action": "up"},
         {"type": "wheel", "delta": float("inf")},
@@ -352,3 +353,47 @@ def test_port_in_use_is_a_clear_error(capsys):
         taken.close()
     with pytest.raises(FrustumError, match=r"port = 70000 is not a TCP port"):
         open_socket("127.0.0.1", 70000)
+
+
+_NUMBERS = st.one_of(
+    st.floats(allow_nan=True, allow_infinity=True), st.integers(-(10**6), 10**6), st.text(max_size=3), st.none()
+)
+_EVENTS = st.one_of(
+    st.fixed_dictionaries(
+        {
+            "type": st.just("pointer"),
+            "action": st.sampled_from(["down", "move", "up", "sideways"]),
+            "x": _NUMBERS,
+            "y": _NUMBERS,
+            "button": st.one_of(st.integers(-1, 3), st.booleans()),
+            "shift": st.booleans(),
+        }
+    ),
+    st.fixed_dictionaries({"type": st.just("wheel"), "delta": _NUMBERS}),
+    st.fixed_dictionaries(
+        {"type": st.just("key"), "key": st.one_of(st.sampled_from(sorted(KEYS)), st.text(max_size=2))}
+    ),
+    st.fixed_dictionaries(
+        {
+            "type": st.just("control"),
+            "name": st.sampled_from(["projection", "shading", "mode", "depth_cue", "x"]),
+            "value": st.one_of(
+                st.sampled_from(["orthographic", "cabinet", "flat", "wireframe"]), st.booleans(), _NUMBERS
+            ),
+        }
+    ),
+)
+
+
+@given(st.lists(_EVENTS, max_size=25))
+def test_any_event_sequence_leaves_a_valid_camera(events):
+    c = control()
+    session = ViewerSession.__new__(ViewerSession)  # the protocol only, without a scene
+    session.control, session.controls = c, {"projection": c.projection, "shading": "phong", "mode": "surface",
+                                           "depth_cue": False}  # fmt: skip
+    for event in events:
+        assert session.handle(event) in (None, "", "interactive", "rest")
+    camera = c.camera()
+    assert np.isfinite(camera.view_matrix).all() and np.isfinite(camera.projection_matrix).all()
+    assert abs(c.elevation) <= math.pi / 2 and 1e-3 <= c.zoom <= 1e3
+    assert session.controls["projection"] == c.projection

@@ -181,7 +181,7 @@ class ViewerSession:
             action = message.get("action")
             if action == "down":
                 button = message.get("button", 0)
-                if button not in (0, 1, 2):
+                if isinstance(button, bool) or button not in (0, 1, 2):
                     return None
                 drag = "pan" if button != 0 or message.get("shift") is True else "orbit"
                 return "" if control.begin_drag(message.get("x"), message.get("y"), drag) else None
