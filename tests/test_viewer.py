@@ -397,3 +397,13 @@ def test_any_event_sequence_leaves_a_valid_camera(events):
     assert np.isfinite(camera.view_matrix).all() and np.isfinite(camera.projection_matrix).all()
     assert abs(c.elevation) <= math.pi / 2 and 1e-3 <= c.zoom <= 1e3
     assert session.controls["projection"] == c.projection
+
+
+def test_a_failing_render_is_reported_not_raised(teapot_session, monkeypatch):
+    def refuse(*args, **kwargs):
+        raise FrustumError("render: samples = 4 would need 9 GiB; raise the budget with frustum.budget(bytes=...)")
+
+    monkeypatch.setattr(sys.modules["frustum.render"], "render", refuse)
+    replies = teapot_session.replies([{"type": "rest"}, {"type": "pick", "x": 80, "y": 60}])
+    assert [header["type"] for header, _ in replies] == ["error", "error"]
+    assert "raise the budget" in replies[0][0]["message"]

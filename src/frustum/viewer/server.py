@@ -54,11 +54,6 @@ ws.onmessage = (event) => {
   const length = new DataView(event.data).getUint32(0);
   const header = JSON.parse(new TextDecoder().decode(new Uint8Array(event.data, 4, length)));
   const bytes = event.data.byteLength > 4 + length ? new Uint8Array(event.data, 4 + length) : null;
-  if (header.type === "error") {
-    banner.hidden = !header.message;
-    banner.textContent = header.message || "";
-    return;
-  }
   for (const h of handlers) h(header, bytes);
 };
 ws.onclose = () => { banner.hidden = false; banner.textContent = "connection to frustum serve closed"; };

@@ -148,8 +148,8 @@ class ViewerSession:
             home = CameraControl.fitting(center, radius)
         previous = getattr(self, "control", None)
         if previous is not None:
-            state = previous.state()
-            state["radius"] = home.radius
+            state = previous.state()  # keep the user's view; take the file's image size and scene radius
+            state.update(radius=home.radius, width=home.width, height=home.height)
             home_state = home.state()
             self.control = CameraControl.from_state(state)
             self.control.home = home_state
@@ -281,7 +281,8 @@ class ViewerSession:
         for it; the frame header carries the last ``seq`` seen (the page measures latency with it). A pick is
         answered where it comes. ``{"type": "hello"}`` (a page that has just opened) gets the state and a rest
         frame; if every message was ignored the answer is ``{"type": "ignored"}`` (the page then sends its next
-        pointer move).
+        pointer move). A render that fails (a ``FrustumError``, e.g. over the work budget) is answered with
+        ``{"type": "error", "message": ...}``, shown above the picture.
         """
         batch = [messages] if isinstance(messages, Mapping) or not isinstance(messages, list | tuple) else messages
         out: list[tuple[dict[str, Any], bytes | None]] = []
@@ -293,13 +294,19 @@ class ViewerSession:
             if action is None:
                 ignored = True
             elif action == "pick":
-                out.append((self.pick(message["x"], message["y"]), None))
+                try:
+                    out.append((self.pick(message["x"], message["y"]), None))
+                except FrustumError as error:
+                    out.append(({"type": "error", "message": str(error)}, None))
             elif action:
                 quality = "rest" if "rest" in (quality, action) else action
                 if isinstance(message.get("seq"), int):
                     seq = message["seq"]
         if quality is not None:
-            frame = self.render(quality)
+            try:
+                frame = self.render(quality)
+            except FrustumError as error:  # e.g. over the work budget: say so on the page, keep serving
+                return [*out, ({"type": "error", "message": str(error)}, None)]
             out += [(self.state(), None), (self.frame_header(frame, quality, seq), frame.color.tobytes())]
         elif ignored and not out:
             out.append(({"type": "ignored"}, None))

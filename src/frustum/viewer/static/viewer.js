@@ -193,6 +193,10 @@ function mountViewer(el, transport) {
     } else if (header.type === "pick") {
       api.pick = header;
       showTrace();
+    } else if (header.type === "error") {
+      errorBox.hidden = !header.message;
+      errorBox.textContent = header.message || "";
+      inFlight = false;
     } else if (header.type === "ignored") {
       inFlight = false;
       if (pendingMove) { const m = pendingMove; pendingMove = null; sendMove(m); }
