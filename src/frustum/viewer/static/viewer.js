@@ -160,6 +160,7 @@ function mountViewer(el, transport) {
     if (canvas.width !== state.camera.width || canvas.height !== state.camera.height) {
       canvas.width = state.camera.width;
       canvas.height = state.camera.height;
+      q(".fv-left").style.width = `${state.camera.width + 2}px`;  // the controls wrap under the picture
     }
     errorBox.hidden = !state.error;
     errorBox.textContent = state.error || "";
