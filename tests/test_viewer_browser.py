@@ -57,21 +57,24 @@ def server(tmp_path_factory):
     scene.write_text(_scene_text())
     env = dict(os.environ)
     env["PYTHONPATH"] = os.pathsep.join([str(ROOT / "src"), env.get("PYTHONPATH", "")])
-    process = subprocess.Popen(
-        [sys.executable, "-m", "frustum", "serve", str(scene), "--port", "0"],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        env=env,
-    )
+    log = folder / "serve.log"  # a file, not a pipe: a full pipe would block the server
+    with log.open("w") as stderr:
+        process = subprocess.Popen(
+            [sys.executable, "-m", "frustum", "serve", str(scene), "--port", "0"],
+            stdout=subprocess.PIPE,
+            stderr=stderr,
+            text=True,
+            env=env,
+        )
     line = process.stdout.readline()
     match = re.search(r"http://\S+", line)
     if match is None:
         process.kill()
-        pytest.fail(f"frustum serve printed no URL: {line!r} {process.stderr.read()!r}")
+        pytest.fail(f"frustum serve printed no URL: {line!r} {log.read_text()!r}")
     yield {"url": match.group(0), "scene": scene, "process": process, "env": env}
     process.terminate()
     process.wait(timeout=30)
+    print(f"\nfrustum serve's log:\n{log.read_text()}")
 
 
 @pytest.fixture(scope="module")
@@ -140,7 +143,11 @@ def test_drag_changes_the_picture_and_the_panel_matches_the_camera(page):
     for k in range(1, 11):
         page.mouse.move(300 + 12 * k, 300 + 3 * k)
     page.mouse.up()
-    _wait_for_rest_frame(page, frames)
+    page.wait_for_function(
+        f"window.frustumViewer.frames > {frames} && window.frustumViewer.drawn.quality === 'rest' && "
+        f"window.frustumViewer.drawn.camera.azimuth !== {azimuth!r}",
+        timeout=120_000,
+    )
     after = _pixels(page)
     assert np.mean(before != after) > 0.01
     state = page.evaluate("window.frustumViewer.state")
@@ -315,3 +322,26 @@ def test_widget_front_end_draws_frames_and_sends_events(browser):
     assert page.evaluate("window.frustumViewer.quality") == "rest"
     np.testing.assert_allclose(_panel_matrices(page)["view"][1], viewer.camera.view_matrix, rtol=0, atol=1e-12)
     page.close()
+
+
+def test_wheel_zooms_and_settles_on_a_rest_frame(page):
+    canvas = page.locator(".fv-canvas")
+    canvas.focus()
+    page.keyboard.press("0")
+    page.wait_for_function("window.frustumViewer.state.zoom === 1")
+    box = canvas.bounding_box()
+    page.mouse.move(box["x"] + 400, box["y"] + 300)
+    frames = page.evaluate("window.frustumViewer.frames")
+    for _ in range(3):
+        page.mouse.wheel(0, -100)  # three notches toward the user
+    # the wheel frames are drawn small, then (250 ms after the last turn) the full frame, always last
+    page.wait_for_function(
+        f"window.frustumViewer.frames > {frames} && window.frustumViewer.drawn.quality === 'rest' && "
+        "Math.abs(window.frustumViewer.drawn.zoom - 1.331) < 1e-9",
+        timeout=120_000,
+    )
+    frames = page.evaluate("window.frustumViewer.frames")
+    page.wait_for_timeout(500)  # nothing comes after the rest frame
+    log = "\n".join(page.evaluate("window.frustumViewer.log.slice(-20)"))
+    assert page.evaluate("window.frustumViewer.frames") == frames, log
+    assert page.evaluate("window.frustumViewer.drawn.zoom") == pytest.approx(1.1**3, rel=1e-9)

@@ -151,7 +151,7 @@ def make_app(source: SceneSource, poll_seconds: float = POLL_SECONDS) -> Any:
         try:
             while True:
                 if source.version != seen:  # a new load (or a new error): show it, keep the view
-                    seen = source.version
+                    first, seen = seen == -1, source.version
                     loaded = source.scene_file
                     if loaded is not None:
                         if session is None:
@@ -160,7 +160,7 @@ def make_app(source: SceneSource, poll_seconds: float = POLL_SECONDS) -> Any:
                             session.set_scene(loaded.scene, loaded.camera, loaded.options)
                         session.error = source.error
                     await websocket.send_bytes(_pack({"type": "error", "message": source.error}))
-                    if session is not None:
+                    if session is not None and not first:  # the first frame answers the page's hello
                         for header, data in await asyncio.to_thread(session.replies, [{"type": "rest"}]):
                             await websocket.send_bytes(_pack(header, data))
                 try:

@@ -4,7 +4,7 @@
 
 function mountViewer(el, transport) {
   const latencies = [];
-  const api = { latencies, frames: 0, state: null, pick: null, lastSeq: null };
+  const api = { latencies, frames: 0, state: null, pick: null, lastSeq: null, log: [] };
   el.classList.add("frustum-viewer");
   el.innerHTML = `
     <div class="fv-error" hidden></div>
@@ -41,12 +41,36 @@ function mountViewer(el, transport) {
   let drag = null;
   let restTimer = null;
 
-  function send(message) { transport.send(message); }
+  function note(text) { api.log.push(text); if (api.log.length > 100) api.log.shift(); }  // for debugging
+  function send(message) { note("> " + message.type + (message.action ? " " + message.action : "")); transport.send(message); }
 
+  // One interactive request in flight at a time: moves and wheel turns that come meanwhile are merged (the
+  // latest position, the summed wheel delta) and sent when the frame arrives, so Python never falls behind.
+  let pendingWheel = null;
   function sendMove(message) {
     if (inFlight) { pendingMove = message; return; }
     inFlight = true;
     send(message);
+  }
+  function sendWheel(message) {
+    if (inFlight) {
+      if (pendingWheel) message.delta = Math.max(-5000, Math.min(5000, pendingWheel.delta + message.delta));
+      pendingWheel = message;
+      return;
+    }
+    inFlight = true;
+    send(message);
+  }
+  function flushPending() {
+    const messages = [pendingWheel, pendingMove].filter((m) => m);
+    pendingWheel = pendingMove = null;
+    if (messages.length) { inFlight = true; messages.forEach(send); }
+    else if (restWanted) { restWanted = false; send({ type: "rest" }); }
+  }
+  // the full frame is asked for once the interactive ones are all answered, so it is the last one drawn
+  let restWanted = false;
+  function requestRest() {
+    if (inFlight || pendingWheel || pendingMove) restWanted = true; else send({ type: "rest" });
   }
 
   function imagePoint(event) {
@@ -90,9 +114,9 @@ function mountViewer(el, transport) {
     const delta = event.deltaMode === 1 ? event.deltaY * 33 : event.deltaMode === 2 ? event.deltaY * 400 : event.deltaY;
     seq += 1;
     sentAt.set(seq, event.timeStamp);
-    send({ type: "wheel", delta, seq });
+    sendWheel({ type: "wheel", delta: Math.max(-5000, Math.min(5000, delta)), seq });
     clearTimeout(restTimer);
-    restTimer = setTimeout(() => send({ type: "rest" }), 250);
+    restTimer = setTimeout(requestRest, 250);
   }, { passive: false });
   canvas.addEventListener("keydown", (event) => {
     send({ type: "key", key: event.key });
@@ -175,6 +199,7 @@ function mountViewer(el, transport) {
     context.drawImage(scratch, 0, 0, canvas.width, canvas.height);
     api.frames += 1;
     api.quality = header.quality;
+    api.drawn = { quality: header.quality, camera: api.state && api.state.camera, zoom: api.state && api.state.zoom };
     if (header.seq !== null && header.seq !== undefined && sentAt.has(header.seq)) {
       const start = sentAt.get(header.seq);
       latencies.push(performance.now() - start);
@@ -185,10 +210,11 @@ function mountViewer(el, transport) {
   }
 
   transport.listen((header, bytes) => {
+    note("< " + header.type + (header.quality ? " " + header.quality : ""));
     if (header.type === "frame") {
       drawFrame(header, bytes);
       inFlight = false;
-      if (pendingMove) { const m = pendingMove; pendingMove = null; sendMove(m); }
+      flushPending();
     } else if (header.type === "state") {
       showState(header);
     } else if (header.type === "pick") {
@@ -198,9 +224,10 @@ function mountViewer(el, transport) {
       errorBox.hidden = !header.message;
       errorBox.textContent = header.message || "";
       inFlight = false;
+      flushPending();
     } else if (header.type === "ignored") {
       inFlight = false;
-      if (pendingMove) { const m = pendingMove; pendingMove = null; sendMove(m); }
+      flushPending();
     }
   });
   return api;
