@@ -237,6 +237,7 @@ def test_malformed_socket_messages_are_ignored(page, server):
             json.dumps({"type": "pointer", "action": "down", "x": 1e300, "y": 5, "button": 0}),
             json.dumps({"type": "wheel", "delta": "a lot"}),
             json.dumps({"type": "key", "key": "Delete"}),
+            b"\x00\x01 binary",
         ):
             ws.send(message)
             while True:  # skip the greeting (error banner state, state, frame)
@@ -246,7 +247,7 @@ def test_malformed_socket_messages_are_ignored(page, server):
                 if header["type"] == "ignored":
                     replies.append(header)
                     break
-        assert len(replies) == 4
+        assert len(replies) == 5
     # the server is still serving the page
     assert server["process"].poll() is None
 

@@ -141,9 +141,14 @@ def make_app(source: SceneSource, poll_seconds: float = POLL_SECONDS) -> Any:
         async def read() -> None:
             try:
                 while True:
-                    await inbox.put(await websocket.receive_text())
+                    message = await websocket.receive()
+                    if message["type"] == "websocket.disconnect":
+                        break
+                    # a binary message is not a viewer message: it reaches the session as one to ignore
+                    await inbox.put(message.get("text") or "")
             except (WebSocketDisconnect, RuntimeError):
-                await inbox.put(None)
+                pass
+            await inbox.put(None)
 
         reader = asyncio.create_task(read())
         session: ViewerSession | None = None
