@@ -407,3 +407,16 @@ def test_a_failing_render_is_reported_not_raised(teapot_session, monkeypatch):
     replies = teapot_session.replies([{"type": "rest"}, {"type": "pick", "x": 80, "y": 60}])
     assert [header["type"] for header, _ in replies] == ["error", "error"]
     assert "raise the budget" in replies[0][0]["message"]
+
+
+def test_default_camera_frames_the_whole_scene():
+    scene = frustum.Scene()
+    scene.add(frustum.box((4.0, 1.0, 2.0)), transform=frustum.translate(10.0, -3.0, 5.0))
+    session = ViewerSession(scene)
+    camera = session.control.camera()
+    assert (camera.width, camera.height) == (800, 600)
+    corners = np.array([[x, y, z] for x in (8, 12) for y in (-3.5, -2.5) for z in (4, 6)], dtype=float)
+    window = camera.project(corners)
+    assert (window[:, 0] > 0).all() and (window[:, 0] < 800).all()
+    assert (window[:, 1] > 0).all() and (window[:, 1] < 600).all()
+    assert ((window[:, 2] > 0) & (window[:, 2] < 1)).all()  # between near and far
