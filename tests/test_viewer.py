@@ -194,11 +194,13 @@ def test_replies_render_low_resolution_while_dragging_and_full_at_rest(teapot_se
     s = teapot_session
     assert s.replies({"type": "pointer", "action": "down", "x": 80, "y": 60, "button": 0}) == []
     moves = [{"type": "pointer", "action": "move", "x": 80 + k, "y": 60, "seq": k} for k in (1, 2, 3)]
-    state, (header, data) = s.replies(moves)  # coalesced: one frame for three moves, with the last seq
+    ((header, data),) = s.replies(moves)  # coalesced: one frame for three moves, with the last seq
+    state = header.pop("state")
     assert header == {"type": "frame", "width": 80, "height": 60, "quality": "interactive", "seq": 3}
     assert len(data) == 80 * 60 * 4
-    assert state[0]["camera"]["azimuth"] == pytest.approx(s.control.home["azimuth"] - 3 * ORBIT_RADIANS_PER_PIXEL)
-    _, (header, data) = s.replies({"type": "pointer", "action": "up"})
+    assert state["camera"]["azimuth"] == pytest.approx(s.control.home["azimuth"] - 3 * ORBIT_RADIANS_PER_PIXEL)
+    assert state == s.state()
+    ((header, data),) = s.replies({"type": "pointer", "action": "up"})
     assert (header["width"], header["height"], header["quality"]) == (160, 120, "rest")
     assert len(data) == 160 * 120 * 4
     assert s.handle({"type": "reset"}) == "rest"
@@ -303,8 +305,9 @@ def test_widget_answers_messages_and_falls_back_to_a_png(teapot_session):
     sent = []
     viewer.send = lambda content, buffers=None: sent.append((content, buffers))
     viewer._on_message(viewer, {"type": "hello"}, [])
-    assert [content["type"] for content, _ in sent] == ["state", "frame"]
-    assert len(sent[1][1][0]) == 64 * 48 * 4
+    assert [content["type"] for content, _ in sent] == ["frame"]
+    assert len(sent[0][1][0]) == 64 * 48 * 4
+    assert sent[0][0]["state"]["camera"]["width"] == 64
     bundle = viewer._repr_mimebundle_()
     data = bundle[0] if isinstance(bundle, tuple) else bundle
     assert data["image/png"].startswith(b"\x89PNG")

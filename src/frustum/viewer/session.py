@@ -18,9 +18,10 @@ message                                                       effect
 ``{"type": "pick", "x", "y"}``                                pick the surface point under pixel (x, y)
 ============================================================  ================================================
 
-Frames go back as a header (``frame_header``) and the raw RGBA bytes of ``Frame.color`` (top row first, the
-layout of the browser's ``ImageData``): while the pointer drags, at half the width and height with one sample;
-at rest, at full size with ``rest_samples`` samples per pixel.
+Frames go back as a header (``frame_header``, with the ``state()`` of the view it shows under ``"state"``) and
+the raw RGBA bytes of ``Frame.color`` (top row first, the layout of the browser's ``ImageData``): while the
+pointer drags, at half the width and height with one sample; at rest, at full size with ``rest_samples`` samples
+per pixel.
 
 Picking reads the depth buffer of a full-size frame: pixel (column c, row r from the top) is the window point
 ``(c + 0.5, H − r − 0.5, depth[r, c])``, which ``Camera.unproject`` maps back to the world
@@ -275,7 +276,7 @@ class ViewerSession:
 
     def replies(self, messages: Any) -> list[tuple[dict[str, Any], bytes | None]]:
         """What to send back for page messages (one, or a list that arrived together): (JSON header, RGBA bytes
-        or None) pairs, in order.
+        or None) pairs, in order: picks, then at most one frame (its header holding the state).
 
         The messages are applied in order and the view is rendered once, at rest quality if any of them asks
         for it; the frame header carries the last ``seq`` seen (the page measures latency with it). A pick is
@@ -307,7 +308,9 @@ class ViewerSession:
                 frame = self.render(quality)
             except FrustumError as error:  # e.g. over the work budget: say so on the page, keep serving
                 return [*out, ({"type": "error", "message": str(error)}, None)]
-            out += [(self.state(), None), (self.frame_header(frame, quality, seq), frame.color.tobytes())]
+            header = self.frame_header(frame, quality, seq)
+            header["state"] = self.state()  # the panel's numbers travel with the picture they belong to
+            out.append((header, frame.color.tobytes()))
         elif ignored and not out:
             out.append(({"type": "ignored"}, None))
         return out

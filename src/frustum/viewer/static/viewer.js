@@ -181,17 +181,18 @@ function mountViewer(el, transport) {
       }
       if (input.type === "checkbox") input.checked = !!state.controls[name]; else input.value = state.controls[name];
     }
-    if (canvas.width !== state.camera.width || canvas.height !== state.camera.height) {
-      canvas.width = state.camera.width;
-      canvas.height = state.camera.height;
-      q(".fv-left").style.width = `${state.camera.width + 2}px`;  // the controls wrap under the picture
-    }
     errorBox.hidden = !state.error;
     errorBox.textContent = state.error || "";
     showMatrices();
   }
 
   function drawFrame(header, bytes) {
+    const camera = header.state && header.state.camera;
+    if (camera && (canvas.width !== camera.width || canvas.height !== camera.height)) {
+      canvas.width = camera.width;
+      canvas.height = camera.height;
+      q(".fv-left").style.width = `${camera.width + 2}px`;  // the controls wrap under the picture
+    }
     scratch.width = header.width;
     scratch.height = header.height;
     scratchContext.putImageData(new ImageData(new Uint8ClampedArray(bytes), header.width, header.height), 0, 0);
@@ -212,7 +213,9 @@ function mountViewer(el, transport) {
   transport.listen((header, bytes) => {
     note("< " + header.type + (header.quality ? " " + header.quality : ""));
     if (header.type === "frame") {
+      if (header.state) api.state = header.state;
       drawFrame(header, bytes);
+      if (header.state) showState(header.state);  // after the picture: the panel never delays a frame
       inFlight = false;
       flushPending();
     } else if (header.type === "state") {
