@@ -346,3 +346,27 @@ def test_wheel_zooms_and_settles_on_a_rest_frame(page):
     log = "\n".join(page.evaluate("window.frustumViewer.log.slice(-20)"))
     assert page.evaluate("window.frustumViewer.frames") == frames, log
     assert page.evaluate("window.frustumViewer.drawn.zoom") == pytest.approx(1.1**3, rel=1e-9)
+
+
+def test_controls_change_the_projection_and_the_panel_follows(page):
+    frames = page.evaluate("window.frustumViewer.frames")
+    page.select_option('select[data-control="projection"]', "orthographic")
+    page.wait_for_function(
+        f"window.frustumViewer.frames > {frames} && window.frustumViewer.drawn.quality === 'rest' && "
+        "window.frustumViewer.state.controls.projection === 'orthographic'",
+        timeout=60_000,
+    )
+    _, projection = _panel_matrices(page)["projection"]
+    np.testing.assert_array_equal(projection[3], [0.0, 0.0, 0.0, 1.0])  # parallel: no division by depth
+    frames = page.evaluate("window.frustumViewer.frames")
+    page.check('input[data-control="depth_cue"]')
+    page.select_option('select[data-control="mode"]', "hidden-line")
+    page.wait_for_function(
+        f"window.frustumViewer.frames > {frames + 1} && window.frustumViewer.state.controls.mode === 'hidden-line'"
+        " && window.frustumViewer.state.controls.depth_cue === true",
+        timeout=60_000,
+    )
+    page.click(".fv-reset")
+    page.wait_for_function("window.frustumViewer.state.controls.projection === 'perspective'", timeout=60_000)
+    page.select_option('select[data-control="mode"]', "surface")
+    page.uncheck('input[data-control="depth_cue"]')
