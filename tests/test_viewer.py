@@ -321,6 +321,8 @@ def test_viewer_rejects_a_non_scene():
         frustum.Viewer("teapot.toml")
     with pytest.raises(FrustumError, match=r"camera = .* is not a Camera"):
         ViewerSession(frustum.Scene(), camera=42)
+    with pytest.raises(FrustumError, match=r"rest_samples = 3 is not a square number of samples; expected 1, 4, 9"):
+        ViewerSession(frustum.Scene(), rest_samples=3)
 
 
 def test_scene_source_reports_file_line_errors_and_recovers(tmp_path):

@@ -115,7 +115,7 @@ class ViewerSession:
     Raises
     ------
     FrustumError
-        If `scene` is not a Scene or `camera` not a Camera.
+        If `scene` is not a Scene, `camera` not a Camera, or `rest_samples` not a square (1, 4, 9, ...).
     """
 
     def __init__(
@@ -126,6 +126,16 @@ class ViewerSession:
         *,
         rest_samples: int = 4,
     ) -> None:
+        if (
+            isinstance(rest_samples, bool)
+            or not isinstance(rest_samples, int)
+            or rest_samples < 1
+            or math.isqrt(rest_samples) ** 2 != rest_samples
+        ):
+            raise FrustumError(
+                f"Viewer: rest_samples = {describe(rest_samples)} is not a square number of samples; "
+                "expected 1, 4, 9, 16, ..."
+            )
         self.error: str | None = None
         self.control: CameraControl
         self.set_scene(scene, camera, options)
