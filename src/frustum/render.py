@@ -292,6 +292,7 @@ def _render_buffers(
         color[:, :] = options.background
         _draw_edges(items, camera, options, depth, color)
         _draw_polylines(scene.polylines, camera, options, depth, color)
+        _draw_particles(scene, camera, depth, color)
         return color, depth, normal_out, id_out
     scratch = Scratch()
     depth, color = _draw_surfaces(scene, items, camera, options, normal_out, id_out, scratch)
@@ -301,7 +302,16 @@ def _render_buffers(
     if options.mode in ("hidden-line", "surface+edges"):
         _draw_edges(items, camera, options, depth, color)
     _draw_polylines(scene.polylines, camera, options, depth, color)
+    _draw_particles(scene, camera, depth, color)
     return color, depth, normal_out, id_out
+
+
+def _draw_particles(scene: Scene, camera: Camera, depth: np.ndarray, color: np.ndarray) -> None:
+    """Particle layers over the finished surfaces: depth-tested, depth not written (``frustum.particle_pass``)."""
+    if getattr(scene, "particle_layers", None):
+        from frustum.particle_pass import draw_particles
+
+        draw_particles(scene.particle_layers, camera, depth, color)
 
 
 def _draw_surfaces(
