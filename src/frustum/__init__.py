@@ -93,6 +93,8 @@ from frustum.geometry import (
     MeshPart,
     NURBSCurve,
     NURBSSurface,
+    Octree,
+    OctreeHits,
     PiecewiseBezier,
     Polyline,
     TurtlePath,
@@ -213,6 +215,7 @@ from frustum.quaternion import (
 from frustum.scene import (
     Node,
     ParticleLayer,
+    Pick,
     Placed,
     Scene,
     SceneItem,
@@ -291,6 +294,9 @@ from frustum.visibility import (
     signed_window_areas,
     viewing_position,
 )
+from frustum.visibility.octree import (
+    render_octree,
+)
 
 # The pipeline and everything above it load Numba and compile kernels on first use, so they are imported when one
 # of their names is first used (PEP 562): ``import frustum`` stays fast and never imports Numba.
@@ -303,6 +309,7 @@ _LAZY = {
     "render_many": "frustum.batch",
     "warmup": "frustum.warmup",
     "ANAGLYPH_METHODS": "frustum.output.stereo",
+    "RENDER_METHODS": "frustum.render",
     "RENDER_MODES": "frustum.render",
     "SHADING_MODES": "frustum.render",
     "STEREO_LAYOUTS": "frustum.output.stereo",
@@ -339,7 +346,7 @@ if TYPE_CHECKING:  # pragma: no cover
         side_by_side,
     )
     from frustum.raster._jit import set_threads
-    from frustum.render import RENDER_MODES, SHADING_MODES, release_memory, render
+    from frustum.render import RENDER_METHODS, RENDER_MODES, SHADING_MODES, release_memory, render
     from frustum.scenefile import (
         SceneFile,
         explain_scene_file,
@@ -404,6 +411,7 @@ __all__ = [
     "REGION_NEAR",
     "REGION_RIGHT",
     "REGION_TOP",
+    "RENDER_METHODS",
     "RENDER_MODES",
     "SHADING_MODES",
     "SHEET_VIEWS",
@@ -460,11 +468,14 @@ __all__ = [
     "NURBSSurface",
     "Node",
     "Oblique",
+    "Octree",
+    "OctreeHits",
     "Orthographic",
     "OutputError",
     "ParticleLayer",
     "ParticleSystem",
     "Perspective",
+    "Pick",
     "PiecewiseBezier",
     "Placed",
     "PlaneCollider",
@@ -597,6 +608,7 @@ __all__ = [
     "render_dataset",
     "render_examples",
     "render_many",
+    "render_octree",
     "render_scene_file",
     "render_stereo",
     "render_svg",

@@ -57,7 +57,10 @@ from frustum.raster.vertices import project_vertices, transform_normals, transfo
 from frustum.scene import Scene, SceneItem
 from frustum.shading import SPECULAR_MODELS, DepthCue, pack_lights
 
-__all__ = ["HIDDEN_STYLES", "RENDER_MODES", "SHADING_MODES", "TILE_SIZE", "mesh_edges", "release_memory", "render"]
+__all__ = [
+    "HIDDEN_STYLES", "RENDER_METHODS", "RENDER_MODES", "SHADING_MODES", "TILE_SIZE", "mesh_edges", "release_memory",
+    "render",
+]  # fmt: skip
 
 SHADING_MODES = {
     "phong": shade.SHADE_PHONG,
@@ -181,6 +184,7 @@ def render(
     filter: str = "box",
     color_space: str = "linear",
     buffers: tuple[str, ...] = (),
+    method: str = "depth-buffer",
 ) -> Frame:
     """Render `scene` seen by `camera` into a ``Frame`` (color (H, W, 4) uint8 and depth (H, W) float32).
 
@@ -230,6 +234,11 @@ def render(
     buffers : tuple of {"normals", "object_id"}
         Extra per-pixel outputs on the Frame: unit world normals (0 on background) and the index of the item
         in ``scene.items`` (−1 on background).
+    method : {"depth-buffer", "octree"}
+        The visible-surface method (``RENDER_METHODS``). ``"depth-buffer"``: the meshes, as described above.
+        ``"octree"``: the scene's octrees (``Scene.octrees``) by ``visibility.octree.render_octree``, front to
+        back, each face orientation shaded once with the scene's lights; only `background` of the other
+        options applies, and meshes are not drawn.
 
     Raises
     ------
@@ -243,6 +252,9 @@ def render(
     [seed] "Back-face detection", "Depth-buffer method", "wire-frame displays".
     """
     where = "render"
+    _choice(method, tuple(RENDER_METHODS), "method", where)
+    if RENDER_METHODS[method] is not None:
+        return RENDER_METHODS[method](scene, camera, background=background)
     options = _check_arguments(
         scene, camera, shading, specular, background, cull_back_faces, mode, edges, crease_angle, edge_color,
         hidden, hidden_color, line_width, depth_cue, buffers, where,
@@ -276,6 +288,32 @@ def render(
     if linear is not None:
         color = np.floor(np.clip(linear, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
     return Frame(color=color, depth=depth, normals=normals, object_id=ids)
+
+
+def _render_octrees(scene: Scene, camera: Camera, *, background: Any) -> Frame:
+    """``method="octree"``: every placed octree by the octree method, nearest surface kept between octrees."""
+    from frustum.visibility.octree import draw_octree_into, octree_face_colors
+
+    if not isinstance(scene, Scene) or not isinstance(camera, Camera):
+        _check_arguments(scene, camera, "phong", "blinn-phong", background, True, "surface", None, 0.0, None, None,
+                         (0.6, 0.6, 0.6), 1.0, None, (), "render")  # fmt: skip
+    rgba = _background_bytes(background, "render")
+    color = np.empty((camera.height, camera.width, 4), dtype=np.uint8)
+    color[:, :] = rgba
+    depth = np.ones((camera.height, camera.width), dtype=np.float32)
+    lights = scene.world_lights()
+    for item in scene.octrees:
+        item_color, item_depth = color.copy(), np.ones_like(depth)
+        written = np.zeros(depth.shape, dtype=bool)
+        faces = octree_face_colors(item.mesh, item.material, lights, item.world_from_model, camera.frame.eye)
+        draw_octree_into(item.mesh, camera, item.world_from_model, faces, item_color, item_depth, written)
+        nearer = written & (item_depth < depth)
+        color[nearer], depth[nearer] = item_color[nearer], item_depth[nearer]
+    return Frame(color=color, depth=depth)
+
+
+RENDER_METHODS = {"depth-buffer": None, "octree": _render_octrees}
+"""Visible-surface methods of ``render(..., method=...)``: None is the built-in depth-buffer pipeline."""
 
 
 def _render_buffers(

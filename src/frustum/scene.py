@@ -12,11 +12,11 @@ from collections.abc import Iterable, Iterator
 from typing import Any, NamedTuple
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from frustum._arrays import Matrix4, as_matrix, as_scalar, as_vector3, describe
 from frustum.errors import FrustumError, GeometryError
-from frustum.geometry import Mesh, Polyline
+from frustum.geometry import Mesh, Octree, Polyline
 from frustum.shading import LIGHT_TYPES, Light, Material
 from frustum.simulation import MassSpringSystem, ParticleSystem
 from frustum.transforms import translate
@@ -26,6 +26,7 @@ __all__ = [
     "PARTICLE_STYLES",
     "Node",
     "ParticleLayer",
+    "Pick",
     "Placed",
     "Scene",
     "SceneItem",
@@ -48,6 +49,16 @@ class SceneItem(NamedTuple):
     mesh: Mesh
     material: Material
     world_from_model: Matrix4
+
+
+class Pick(NamedTuple):
+    """What ``Scene.pick`` finds: the placed item, the face index in its mesh, the world point and the distance
+    from the ray's origin on the near plane."""
+
+    item: SceneItem
+    face: int
+    point: NDArray[np.float64]
+    distance: float
 
 
 class ParticleLayer(NamedTuple):
@@ -110,7 +121,7 @@ class Node:
         where = f"Node({name!r})"
         if not isinstance(name, str) or "/" in name:
             raise FrustumError(f"{where}: name = {describe(name)} is not a string without '/'; '/' separates paths")
-        if geometry is not None and not isinstance(geometry, Mesh | Polyline):
+        if geometry is not None and not isinstance(geometry, Mesh | Polyline | Octree):
             raise FrustumError(
                 f"{where}: geometry = {describe(geometry)} is not a Mesh or Polyline; build one with Mesh(vertices, "
                 "faces) or a primitive, tessellate a surface, or draw a curve as Polyline(points)"
@@ -172,6 +183,8 @@ class Node:
     def __repr__(self) -> str:
         if isinstance(self.geometry, Mesh):
             kind = f"{self.geometry.face_count} faces"
+        elif isinstance(self.geometry, Octree):
+            kind = f"octree of depth {self.geometry.depth}"
         else:
             kind = "group" if self.geometry is None else f"polyline of {self.geometry.vertex_count} points"
         return f"Node({self.name!r}, {kind}, {len(self.children)} children)"
@@ -203,7 +216,7 @@ class Scene:
 
     def add(
         self,
-        geometry: Mesh | Polyline | Node,
+        geometry: Mesh | Polyline | Octree | Node,
         material: Material | None = None,
         transform: ArrayLike | None = None,
         *,
@@ -222,7 +235,7 @@ class Scene:
             if material is not None or transform is not None:
                 raise FrustumError(f"{where}: give material and transform on the Node itself, not with a Node")
             return host.add(geometry)
-        if not isinstance(geometry, Mesh | Polyline):
+        if not isinstance(geometry, Mesh | Polyline | Octree):
             raise FrustumError(
                 f"{where}: geometry = {describe(geometry)} is not a Mesh, Polyline or Node; build one with "
                 "Mesh(vertices, faces)"
@@ -269,13 +282,58 @@ class Scene:
 
     @property
     def items(self) -> list[SceneItem]:
-        """Placed meshes in drawing order, each with its (inherited) material and world transform."""
+        """Placed meshes in drawing order, each with its (inherited) material and world transform; a placed
+        Octree counts as its cell faces (``Octree.surface``), as the depth buffer draws it."""
         return self._placed(Mesh)
 
     @property
     def polylines(self) -> list[SceneItem]:
         """Placed polylines in drawing order (``SceneItem.mesh`` holds the Polyline)."""
         return self._placed(Polyline)
+
+    @property
+    def octrees(self) -> list[SceneItem]:
+        """Placed octrees in drawing order (``SceneItem.mesh`` holds the Octree; ``render(..., method="octree")``)."""
+        return self._placed(Octree)
+
+    def pick(self, camera: Any, x: float, y: float) -> Pick | None:
+        """The surface seen at window position (x, y) (``Camera.ray``'s convention: y up, pixel centres at
+        half-integers): the item, the face index in its mesh, the world point and the distance along the ray;
+        None where the ray meets no mesh.
+
+        All placed meshes are put in world coordinates into one triangle index (a bounding-volume hierarchy,
+        ``raster.bvh``, built once and kept until the scene's meshes or transforms change); the first hit of
+        the ray from the near plane is the nearest triangle with t >= 0.
+        """
+        from frustum.camera import Camera
+        from frustum.raster import bvh
+
+        where = "Scene.pick"
+        if not isinstance(camera, Camera):
+            raise FrustumError(f"{where}: camera = {describe(camera)} is not a Camera; build one with Camera.look_at")
+        px = as_scalar(x, "x", where=where, error=FrustumError)
+        py = as_scalar(y, "y", where=where, error=FrustumError)
+        items = [item for item in self.items if item.mesh.face_count]
+        if not items:
+            return None
+        key = tuple((id(item.mesh), item.world_from_model.tobytes()) for item in items)
+        cached = getattr(self, "_pick_index", None)
+        if cached is None or cached[0] != key:
+            corners = [
+                item.mesh.vertices[item.mesh.faces] @ item.world_from_model[:3, :3].T + item.world_from_model[:3, 3]
+                for item in items
+            ]
+            starts = np.cumsum([0] + [c.shape[0] for c in corners])
+            cached = (key, bvh.build(np.concatenate(corners)), starts, [item.mesh for item in items])
+            self._pick_index = cached
+        _, index, starts, _ = cached
+        ray = camera.ray((px, py))
+        t, face = bvh.first_hits(index, ray.origin[None], ray.direction[None])
+        if face[0] < 0:
+            return None
+        item_index = int(np.searchsorted(starts, face[0], side="right") - 1)
+        point = ray.origin + t[0] * ray.direction
+        return Pick(items[item_index], int(face[0] - starts[item_index]), point, float(t[0]))
 
     def _placed(self, kind: type) -> list[SceneItem]:
         result: list[SceneItem] = []
@@ -285,6 +343,8 @@ class Scene:
             material = node.material if node.material is not None else inherited
             if isinstance(node.geometry, kind):
                 result.append(SceneItem(node.geometry, material, world))
+            elif kind is Mesh and isinstance(node.geometry, Octree):
+                result.append(SceneItem(node.geometry.surface, material, world))
             for child in node.children:
                 visit(child, world, material)
 
@@ -428,7 +488,8 @@ def _cut_node(
             copy.geometry = Polyline(points, line.closed, line.markers)
             copy.material = child_material
         elif child.geometry is not None:
-            kept, removed = _cut_mesh(child.geometry, child_world, region, cap)
+            mesh = child.geometry.surface if isinstance(child.geometry, Octree) else child.geometry  # its cell faces
+            kept, removed = _cut_mesh(mesh, child_world, region, cap)
             if kept is not None:
                 body, section = _split_section(kept, region) if cap else (kept, None)
                 copy.geometry = body

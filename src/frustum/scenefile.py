@@ -49,7 +49,7 @@ from frustum.frame import Frame
 from frustum.geometry import Mesh
 from frustum.projection import MULTIVIEWS, Axonometric, Frustum, Oblique, Orthographic, Perspective
 from frustum.quaternion import Quaternion
-from frustum.render import RENDER_MODES, SHADING_MODES, render
+from frustum.render import RENDER_METHODS, RENDER_MODES, SHADING_MODES, render
 from frustum.scene import Node, Scene, cutaway, exploded
 from frustum.shading import AmbientLight, DepthCue, DirectionalLight, Material, PointLight, SpotLight
 from frustum.transforms import compose, reflect, rotate, rotate_x, rotate_y, rotate_z, scale, shear, translate
@@ -116,7 +116,7 @@ _CAMERA_KEYS = (
 _STEREO_KEYS = ("eye_separation", "convergence_distance", "layout", "anaglyph_method", "cross_eyed")
 _RENDER_KEYS = (
     "size", "shading", "specular", "background", "cull_back_faces", "mode", "edges", "crease_angle_deg", "edge_color",
-    "hidden", "hidden_color", "line_width", "depth_cue", "samples", "filter", "color_space", "columns",
+    "hidden", "hidden_color", "line_width", "depth_cue", "samples", "filter", "color_space", "columns", "method",
 )  # fmt: skip
 _DEPTH_CUE_KEYS = ("near", "far", "min_intensity", "max_intensity", "color")
 _LIGHT_TYPES = {"ambient": AmbientLight, "directional": DirectionalLight, "point": PointLight, "spot": SpotLight}
@@ -178,6 +178,8 @@ GEOMETRY_TYPES: dict[str, tuple[str, str, str]] = {
     "union": ("csg", "frustum.geometry.csg", "union"),
     "difference": ("csg", "frustum.geometry.csg", "difference"),
     "intersection": ("csg", "frustum.geometry.csg", "intersection"),
+    # a solid as an octree of the cells of another geometry table (drawn by [render] method = "octree")
+    "octree": ("octree", "frustum.geometry.octree", "Octree"),
 }
 """``geometry.type`` values: (kind, module, attribute) of the function or class that builds each one."""
 
@@ -910,6 +912,8 @@ def _geometry(report: _Report, path: tuple, value: Any, base: Path, materials: d
         return _csg(report, path, params, builder, base, materials), []
     if kind == "lsystem":
         return _lsystem(report, path, params, builder), []
+    if kind == "octree":
+        return _octree(report, path, params, builder, base, materials), []
     # curves and point fractals: sampled into a polyline, drawn as a tube or line
     options = _curve_options(report, path, params)
     rest = {k: v for k, v in params.items() if k not in _CURVE_KEYS}
@@ -995,6 +999,39 @@ def _csg(report: _Report, path: tuple, params: dict, boolean: Callable, base: Pa
         return boolean(*meshes, sharp_angle=angle)
     except (FrustumError, ValueError, RuntimeError) as error:
         report.refused(path, {"operands": "..."}, error)
+        return _BAD
+
+
+def _octree(report: _Report, path: tuple, params: dict, octree: Any, base: Path, materials: dict) -> Any:
+    """``Octree.from_mesh`` of the closed mesh the ``source`` geometry table builds (a mesh file, a primitive or a
+    CSG expression, with its own ``transform`` list), down to ``depth`` levels (``shell`` for a surface)."""
+    keys = ("source", "depth", "shell")
+    _unknown_keys(report, path, params, keys)
+    if "source" not in params:
+        report.missing((*path, "source"), "give the solid as a geometry table, e.g. source = { type = 'sphere' }")
+        return _BAD
+    depth = _number(report, (*path, "depth"), params.get("depth", 6), low=0, high=12, integer=True)
+    shell = _boolean(report, (*path, "shell"), params.get("shell", False))
+    table = _table(report, (*path, "source"), params["source"])
+    mesh = _BAD
+    if table is not _BAD:
+        table = dict(table)
+        steps = table.pop("transform", None)
+        mesh, _ = _geometry(report, (*path, "source"), table, base, materials)
+        if mesh is not _BAD and not isinstance(mesh, Mesh):
+            report.add((*path, "source", "type"), table.get("type"), "is not a solid", "give a closed mesh geometry")
+            mesh = _BAD
+        matrix = None if steps is None else _transform(report, (*path, "source", "transform"), steps)
+        if matrix is _BAD:
+            mesh = _BAD
+        elif mesh is not _BAD and matrix is not None:
+            mesh = mesh.transformed(matrix)
+    if _bad(depth, shell, mesh) or any(key not in keys for key in params):
+        return _BAD
+    try:
+        return octree.from_mesh(mesh, int(depth), shell=bool(shell))
+    except FrustumError as error:
+        report.refused(path, {"source": "...", "depth": depth}, error)
         return _BAD
 
 
@@ -1385,6 +1422,7 @@ def _render_options(report: _Report, path: tuple, value: Any) -> tuple[dict, tup
         "samples": lambda p, v: _number(report, p, v, low=1, high=64, integer=True),
         "filter": lambda p, v: _choice(report, p, v, ("box", "tent")),
         "color_space": lambda p, v: _choice(report, p, v, ("linear", "srgb")),
+        "method": lambda p, v: _choice(report, p, v, tuple(RENDER_METHODS)),
     }
     for key, check in simple.items():
         if key in params:
