@@ -492,6 +492,27 @@ def dataset_command(
         raise typer.Exit(3)
 
 
+@app.command("serve")
+def serve_command(
+    scene: Annotated[Path, typer.Argument(help="A TOML scene file (reloaded whenever it is saved).")],
+    host: Annotated[
+        str, typer.Option(help="Interface to listen on; 127.0.0.1 is this machine only, 0.0.0.0 every interface.")
+    ] = "127.0.0.1",
+    port: Annotated[int, typer.Option(help="TCP port; 0 picks a free one.")] = 8000,
+) -> None:
+    """Open an interactive viewer of a scene file in the browser (orbit, pan, zoom, the pipeline beside it)."""
+    from frustum.viewer.server import serve
+
+    def ready(url: str) -> None:
+        console.print(f"frustum serve: {scene} at {url}", markup=False, highlight=False, soft_wrap=True)
+        if host in ("127.0.0.1", "localhost", "::1"):
+            console.print("listening on this machine only; --host 0.0.0.0 serves other machines too; Ctrl-C stops",
+                          markup=False, highlight=False, soft_wrap=True)  # fmt: skip
+        console.file.flush()
+
+    serve(scene, host, port, ready=ready)
+
+
 # --- entry point ------------------------------------------------------------------------------------------------
 
 
