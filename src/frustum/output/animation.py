@@ -7,8 +7,10 @@ dithering), so the same frames give the same bytes; MP4 goes through imageio's f
 
 from __future__ import annotations
 
+import io
 import math
 import os
+import struct
 from collections.abc import Iterable, Iterator
 from typing import Any
 
@@ -16,6 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from frustum._arrays import as_direction, as_scalar, describe
+from frustum._files import atomic_path, os_reason
 from frustum.camera import Camera, ViewFrame
 from frustum.errors import CameraError, OutputError
 from frustum.frame import Frame
@@ -80,32 +83,71 @@ def _gif_image(rgb: NDArray[np.uint8], marked: bool) -> Any:
     return image
 
 
+def _gif_frame_block(rgb: NDArray[np.uint8], marked: bool, duration_cs: int) -> bytes:
+    """One GIF frame (graphic control extension, image descriptor, local color table, LZW data) for streaming.
+
+    Pillow encodes the frame as a one-image GIF; its global color table becomes the frame's local table, so
+    every frame is written the moment it is rendered and none is kept ([GIF89a] sections 20, 21, 23).
+    """
+    buffer = io.BytesIO()
+    _gif_image(rgb, marked).save(buffer, format="GIF", optimize=False)
+    data = buffer.getvalue()
+    packed = data[10]
+    position, table, size_bits = 13, b"", 0
+    if packed & 0x80:
+        size_bits = packed & 0x07
+        length = 3 * (2 << size_bits)
+        table, position = data[13 : 13 + length], 13 + length
+    while data[position] == 0x21:  # extensions Pillow may add before the image: skip their sub-blocks
+        position += 2
+        while data[position]:
+            position += data[position] + 1
+        position += 1
+    if data[position] != 0x2C or data[-1] != 0x3B:  # pragma: no cover - Pillow always writes one image
+        raise OutputError("write_animation: Pillow wrote an unexpected GIF layout; cannot stream the frame")
+    descriptor = bytearray(data[position : position + 10])
+    body = data[position + 10 : -1]
+    if not descriptor[9] & 0x80:
+        descriptor[9] = (descriptor[9] & 0x40) | 0x80 | size_bits  # the global table becomes the local one
+        body = table + body
+    control = b"\x21\xf9\x04\x04" + struct.pack("<H", duration_cs) + b"\x00\x00"  # disposal: keep; no transparency
+    return control + bytes(descriptor) + body
+
+
 def _write_gif(frames: Iterator[NDArray[np.uint8]], path: str, fps: float, where: str) -> int:
-    images = []
-    previous: NDArray[np.uint8] | None = None
-    previous_marked = False
-    shape = None
-    for index, rgb in enumerate(frames):
-        if shape is None:
-            shape = rgb.shape
-        elif rgb.shape != shape:
-            raise OutputError(f"{where}: frames[{index}] has shape {rgb.shape}; expected {shape} like the first frame")
-        marked = previous is not None and not previous_marked and np.array_equal(rgb, previous)
-        images.append(_gif_image(rgb, marked))
-        previous, previous_marked = rgb, marked
-    if not images:
-        raise OutputError(f"{where}: frames is empty; an animation needs at least one frame")
     duration = max(20, round(1000.0 / fps / 10) * 10)  # GIF stores centiseconds; browsers treat < 20 ms as slow
-    try:
-        images[0].save(
-            path, format="GIF", save_all=True, append_images=images[1:], duration=duration, loop=0, optimize=False
-        )
-    except OSError as error:
-        raise OutputError(
-            f"{where}: path = {str(path)!r} cannot be written ({error.strerror or error}); give a path in an "
-            "existing, writable folder"
-        ) from None
-    return len(images)
+    count = 0
+    with atomic_path(path, where=where) as temporary:
+        try:
+            with open(temporary, "wb") as file:
+                previous: NDArray[np.uint8] | None = None
+                previous_marked = False
+                for index, rgb in enumerate(frames):
+                    if previous is None:
+                        height, width = rgb.shape[:2]
+                        if max(width, height) > 65535:
+                            raise OutputError(f"{where}: frames[0] is {width}x{height}; GIF allows at most 65535 "
+                                              "pixels a side")  # fmt: skip
+                        file.write(b"GIF89a" + struct.pack("<HHBBB", width, height, 0x70, 0, 0))
+                        file.write(b"\x21\xff\x0bNETSCAPE2.0\x03\x01\x00\x00\x00")  # loop forever
+                    elif rgb.shape != previous.shape:
+                        raise OutputError(f"{where}: frames[{index}] has shape {rgb.shape}; expected "
+                                          f"{previous.shape} like the first frame")  # fmt: skip
+                    # a frame equal to the one before is marked (same picture, other indices) so players and
+                    # Pillow keep it as its own frame
+                    marked = previous is not None and not previous_marked and np.array_equal(rgb, previous)
+                    file.write(_gif_frame_block(rgb, marked, duration // 10))
+                    previous, previous_marked = rgb, marked
+                    count += 1
+                if count == 0:
+                    raise OutputError(f"{where}: frames is empty; an animation needs at least one frame")
+                file.write(b"\x3b")
+        except OSError as error:
+            raise OutputError(
+                f"{where}: path = {str(path)!r} cannot be written ({os_reason(error)}); give a path in an "
+                "existing, writable folder with free space"
+            ) from None
+    return count
 
 
 def _write_mp4(frames: Iterator[NDArray[np.uint8]], path: str, fps: float, where: str) -> int:
@@ -119,17 +161,23 @@ def _write_mp4(frames: Iterator[NDArray[np.uint8]], path: str, fps: float, where
     import imageio.v2 as imageio
 
     count = 0
-    try:
-        writer = imageio.get_writer(path, format="FFMPEG", mode="I", fps=fps, codec="libx264", macro_block_size=1)
-    except OSError as error:
-        raise OutputError(f"{where}: path = {str(path)!r} cannot be written ({error})") from None
-    with writer:
-        for rgb in frames:
-            # yuv420p needs even sizes: repeat the last row / column rather than let imageio rescale
-            writer.append_data(np.pad(rgb, ((0, rgb.shape[0] % 2), (0, rgb.shape[1] % 2), (0, 0)), mode="edge"))
-            count += 1
-    if count == 0:
-        raise OutputError(f"{where}: frames is empty; an animation needs at least one frame")
+    with atomic_path(path, where=where) as temporary:
+        try:
+            writer = imageio.get_writer(str(temporary), format="FFMPEG", mode="I", fps=fps, codec="libx264",
+                                        macro_block_size=1, ffmpeg_log_level="error")  # fmt: skip
+            with writer:
+                for rgb in frames:
+                    # yuv420p needs even sizes: repeat the last row / column rather than let imageio rescale
+                    writer.append_data(np.pad(rgb, ((0, rgb.shape[0] % 2), (0, rgb.shape[1] % 2), (0, 0)),
+                                              mode="edge"))  # fmt: skip
+                    count += 1
+        except (OSError, RuntimeError, BrokenPipeError) as error:  # ffmpeg's failures carry its whole command line
+            raise OutputError(
+                f"{where}: path = {str(path)!r} cannot be written ({os_reason(error)}); give a path in an "
+                "existing, writable folder with free space"
+            ) from None
+        if count == 0:
+            raise OutputError(f"{where}: frames is empty; an animation needs at least one frame")
     return count
 
 
@@ -137,8 +185,8 @@ def write_animation(frames: Iterable[Frame | ArrayLike], path: str | os.PathLike
     """Write `frames` (``Frame`` objects or (H, W, 3|4) uint8 images, all one size) as a GIF or MP4.
 
     Each frame shows for 1/fps seconds (GIF: rounded to 10 ms, at least 20 ms; it loops forever). Alpha is
-    dropped. Frames are consumed one at a time (an MP4 never holds them all; a GIF keeps the 8-bit palette
-    images until it writes them).
+    dropped. Frames are consumed one at a time and written as they come (neither format holds them all);
+    the file appears under `path` only when complete (an existing one survives a failure or Ctrl-C).
 
     Parameters
     ----------
