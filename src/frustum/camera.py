@@ -255,6 +255,10 @@ def _as_window_points(value: ArrayLike, name: str, where: str, width: int) -> tu
     return single, np.ascontiguousarray(rows)
 
 
+MAX_IMAGE_SIZE = 32768
+"""Largest image width or height a Camera accepts (a supersampled 8192-pixel image, ×4, still fits)."""
+
+
 @dataclass(frozen=True, eq=False)
 class Camera:
     """A viewing frame, a projection and an image size: everything that maps world points to pixels.
@@ -268,12 +272,12 @@ class Camera:
     frame : ViewFrame
     projection : Perspective, Frustum, Orthographic, Oblique or Axonometric
     width, height : int
-        Image size in pixels, > 0.
+        Image size in pixels, in [1, MAX_IMAGE_SIZE] (32768).
 
     Raises
     ------
     CameraError
-        If the frame or projection has the wrong type, or the image size is not a positive integer.
+        If the frame or projection has the wrong type, or the image size is not an integer in [1, 32768].
 
     References
     ----------
@@ -301,6 +305,12 @@ class Camera:
                 raise CameraError(
                     f"{where}: {name} = {describe(value)} is not a positive integer; an image needs at least "
                     "one pixel in each direction"
+                )
+            if value > MAX_IMAGE_SIZE:
+                raise CameraError(
+                    f"{where}: {name} = {int(value)} is above the limit of {MAX_IMAGE_SIZE} pixels a side; give "
+                    f"width and height in [1, {MAX_IMAGE_SIZE}] (render's work budget, frustum.set_budget, bounds "
+                    "the whole image)"
                 )
             object.__setattr__(self, name, int(value))
 
