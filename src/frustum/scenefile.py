@@ -17,7 +17,12 @@ Conventions of the format (``docs/topics.md`` has a tour, ``scene.schema.json`` 
   z]`` and ``matrix`` (4x4 rows).
 - Geometry parameters are checked against the building function's own signature (``inspect.signature``), so a
   keyword argument that a geometry function gains later works in scene files at once.
-- Paths (mesh files, outputs) are relative to the scene file's folder.
+- Paths (mesh files, outputs) are relative to the scene file's folder. Output files named in ``[output]
+  files`` must stay inside that folder (no ``..`` escape, no absolute path, no symlink pointing out): rendering
+  an untrusted scene file cannot write anywhere else. The command line's ``-o`` goes wherever the user says.
+- Hostile input is refused early, with ``file:line``: files over ``MAX_SCENE_FILE_BYTES`` (16 MiB), arrays or
+  tables nested deeper than ``_MAX_NESTING`` (64), dotted keys of more than 64 parts; keys and values are quoted
+  in messages with control characters escaped.
 
 References
 ----------
@@ -41,7 +46,7 @@ from typing import Any
 
 import numpy as np
 
-from frustum._arrays import describe
+from frustum._arrays import describe, escape_control
 from frustum.camera import Camera
 from frustum.errors import FrustumError, OutputError, SceneFileError
 from frustum.frame import Frame
@@ -90,6 +95,10 @@ TRANSFORM_STEPS = (
 """The named steps a node's ``transform`` list may hold (each step is a table with one of these keys)."""
 
 _MAX_PIXELS = 8192
+MAX_SCENE_FILE_BYTES = 16 * 2**20
+"""Largest scene file read (16 MiB): ``frustum render /dev/zero`` stops there instead of reading gigabytes."""
+_MAX_NESTING = 64
+"""Deepest nesting of arrays / inline tables, and most parts of a dotted key, a scene file may use."""
 """Largest image width or height a scene file may ask for."""
 _MAX_INTEGER_PARAMETER = 100_000
 """Largest integer geometry parameter (segments, resolution, ...): guards against runaway tessellation."""
@@ -365,13 +374,13 @@ def _path_text(path: Sequence) -> str:
             text += f"[{part}]"
         else:
             bare = part.replace("_", "").replace("-", "").isalnum()
-            shown = part if bare else f'"{part}"'
+            shown = part if bare else f'"{escape_control(part)}"'
             text += ("." if text else "") + shown
     return text or "(file)"
 
 
 def _problem_text(error: Exception) -> str:
-    return str(error).splitlines()[0] if str(error) else type(error).__name__
+    return escape_control(str(error).splitlines()[0]) if str(error) else type(error).__name__
 
 
 class _Report:
@@ -394,7 +403,8 @@ class _Report:
 
     def _where(self, path: Sequence) -> str:
         line = self.line(path)
-        return f"{self.source}:{line}" if line is not None else self.source
+        source = escape_control(self.source)
+        return f"{source}:{line}" if line is not None else source
 
     def add(self, path: Sequence, value: Any, problem: str, valid: str) -> None:
         """``key = value problem; valid``."""
@@ -1479,6 +1489,19 @@ def _cut(report: _Report, path: tuple, params: dict, scene: Scene) -> Scene:
         return scene
 
 
+def _inside(base: Path, name: str) -> bool:
+    """Whether output `name` of a scene file in folder `base` resolves inside `base` (symlinks followed)."""
+    relative = Path(name)
+    if relative.is_absolute() or relative.drive or ".." in relative.parts or "\0" in name:
+        return False
+    try:
+        folder = base.resolve()
+        target = (folder / relative).resolve()
+    except (OSError, RuntimeError, ValueError):  # a symlink loop
+        return False
+    return target != folder and target.is_relative_to(folder)
+
+
 def _outputs(report: _Report, data: dict, base: Path) -> tuple[tuple[Path, ...], dict, dict]:
     outputs: list[Path] = []
     if "output" in data:
@@ -1493,6 +1516,11 @@ def _outputs(report: _Report, data: dict, base: Path) -> tuple[tuple[Path, ...],
                     if Path(name).suffix.lower() not in OUTPUT_SUFFIXES:
                         report.add(("output", "files", i), name, "has an unknown suffix",
                                    f"expected one of {', '.join(OUTPUT_SUFFIXES)}")  # fmt: skip
+                    elif not _inside(base, name):
+                        report.add(("output", "files", i), name, "is outside the scene file's folder",
+                                   "outputs named in a scene file must stay in its folder (no '..', no absolute "
+                                   "path, no symlink pointing out); give a relative path, or use -o on the "
+                                   "command line")  # fmt: skip
                     else:
                         outputs.append(base / name)
     animation: dict[str, Any] = {}
@@ -1652,12 +1680,18 @@ def load_scene(data: Mapping[str, Any] | str, *, source: str = "<scene>", base_d
     """
     lines: dict[tuple, int] | None = None
     if isinstance(data, str):
+        _check_shape(data, source)
         try:
             parsed = tomllib.loads(data)
         except tomllib.TOMLDecodeError as error:
             found = re.search(r"at line (\d+), column (\d+)", str(error))
-            at = f"{source}:{found.group(1)}" if found else source
-            raise SceneFileError(f"{at}: the text is not valid TOML: {error}; fix the syntax there") from None
+            at = f"{escape_control(source)}:{found.group(1)}" if found else escape_control(source)
+            raise SceneFileError(
+                f"{at}: the text is not valid TOML: {escape_control(str(error))}; fix the syntax there"
+            ) from None
+        except RecursionError:
+            raise SceneFileError(f"{escape_control(source)}: the text nests too deeply to parse; "
+                                 f"nest arrays and tables at most {_MAX_NESTING} deep") from None  # fmt: skip
         lines = _key_lines(data)
     elif isinstance(data, Mapping):
         parsed = dict(data)
@@ -1668,6 +1702,43 @@ def load_scene(data: Mapping[str, Any] | str, *, source: str = "<scene>", base_d
     report.raise_if_any()
     assert scene_file is not None
     return dataclasses.replace(scene_file, path=None)
+
+
+_TOKENS = re.compile(r'"""|\'\'\'|"(?:\\.|[^"\\\n])*"|\'[^\'\n]*\'|#[^\n]*|[\[\]{}]|\n')
+_DOTTED = re.compile(r"(?:(?:[A-Za-z0-9_-]+|\"[^\"\n]*\"|'[^'\n]*')[ \t]*\.[ \t]*){" + str(_MAX_NESTING) + "}")
+
+
+def _check_shape(text: str, source: str) -> None:
+    """Refuse text the TOML parser and the key-line scanner would take very long (or recurse too deep) on.
+
+    One linear pass: the depth of ``[`` / ``{`` outside strings and comments, and dotted keys of more than
+    `_MAX_NESTING` parts; the ``SceneFileError`` names the line.
+    """
+    where = escape_control(source)
+    dotted = _DOTTED.search(text)
+    if dotted:
+        line = text.count("\n", 0, dotted.start()) + 1
+        raise SceneFileError(f"{where}:{line}: a dotted key has more than {_MAX_NESTING} parts; write at most "
+                             f"{_MAX_NESTING} levels of tables")  # fmt: skip
+    depth, line, multiline = 0, 1, None
+    for token in _TOKENS.finditer(text):
+        value = token.group()
+        if value == "\n":
+            line += 1
+        elif multiline is not None:  # inside a multi-line string: only its closing quotes matter
+            if value == multiline:
+                multiline = None
+        elif value in ('"""', "\'\'\'"):
+            multiline = value
+        elif value in "[{":
+            depth += 1
+            if depth > _MAX_NESTING:
+                raise SceneFileError(f"{where}:{line}: arrays or tables nest more than {_MAX_NESTING} deep here; "
+                                     f"nest them at most {_MAX_NESTING} deep")  # fmt: skip
+        elif value in "]}":
+            depth = max(depth - 1, 0)
+        elif value[0] in "\"'" and "\n" in value:  # pragma: no cover - the pattern stops strings at a newline
+            line += value.count("\n")
 
 
 def _build(report: _Report, data: dict, base: Path) -> SceneFile | None:
@@ -1732,11 +1803,17 @@ def load_scene_file(path: str | Path) -> SceneFile:
         problem as ``file:line: key = value problem; what is valid``.
     """
     file = Path(path)
+    shown = escape_control(str(file))
     try:
-        text = file.read_text(encoding="utf-8")
+        with open(file, "rb") as handle:
+            raw = handle.read(MAX_SCENE_FILE_BYTES + 1)  # /dev/zero or a huge file: stop at the cap
+        if len(raw) > MAX_SCENE_FILE_BYTES:
+            raise SceneFileError(f"{shown}: is larger than {MAX_SCENE_FILE_BYTES // 2**20} MiB; a scene file "
+                                 "describes a scene (put large data in mesh files it names)")  # fmt: skip
+        text = raw.decode("utf-8")
     except (OSError, UnicodeDecodeError) as error:
         reason = getattr(error, "strerror", None) or str(error)
-        raise SceneFileError(f"{file}: cannot be read ({reason}); give an existing UTF-8 TOML scene file") from None
+        raise SceneFileError(f"{shown}: cannot be read ({reason}); give an existing UTF-8 TOML scene file") from None
     scene_file = load_scene(text, source=str(file), base_dir=file.parent)
     return dataclasses.replace(scene_file, path=file)
 
