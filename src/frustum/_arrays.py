@@ -90,11 +90,12 @@ def _as_float_array(value: ArrayLike, name: str, where: str, error: ErrorType, e
     """A C-contiguous float64 array that never is (or views) the caller's own array; complex input is refused."""
     try:
         raw = np.asarray(value)
-        if raw.dtype.kind == "c":
-            raise error(f"{where}: {name} = {describe(value)} is complex; expected {expected} (real numbers)")
-        array = np.asarray(raw, dtype=np.float64)
+        complex_input = raw.dtype.kind == "c"
+        array = None if complex_input else np.asarray(raw, dtype=np.float64)
     except (TypeError, ValueError):
         raise error(f"{where}: {name} = {describe(value)} is not numeric; expected {expected}") from None
+    if array is None:
+        raise error(f"{where}: {name} = {describe(value)} is complex; expected {expected} (real numbers)")
     array = np.ascontiguousarray(array)
     if isinstance(value, np.ndarray) and np.may_share_memory(array, value):
         array = array.copy()  # the checked array is ours: later read-only flags must not reach the caller's

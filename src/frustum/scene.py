@@ -62,6 +62,14 @@ def _modeling_transform(transform: ArrayLike | None, where: str) -> Matrix4:
             f"{where}: transform bottom row = {describe(matrix[3])} makes it projective; a modeling transform "
             "is affine (bottom row 0, 0, 0, 1)"
         )
+    block = matrix[:3, :3]
+    scale = float(np.abs(block).max())
+    if scale == 0.0 or abs(float(np.linalg.det(block))) <= 1e-12 * scale**3:
+        raise FrustumError(
+            f"{where}: transform upper 3x3 = {describe(block)} is singular (determinant 0): it flattens the model "
+            "onto a plane, a line or a point, where normals are undefined; give an invertible transform "
+            "(no scale factor of 0)"
+        )
     matrix.flags.writeable = False
     return matrix
 
