@@ -247,7 +247,12 @@ class Scene:
 
     def world_lights(self) -> list[Light]:
         """Every light in world coordinates (those riding nodes moved by the node's world transform)."""
-        return [light.transformed(world) for node, world in self.root.walk() for light in node.lights]
+        lights: list[Light] = []
+        for node, world in self.root.walk():
+            if node.lights:  # lights at the identity (the root's, usually all of them) need no copy
+                identity = world is _IDENTITY or np.array_equal(world, _IDENTITY)
+                lights.extend(node.lights if identity else [light.transformed(world) for light in node.lights])
+        return lights
 
     def __len__(self) -> int:
         return len(self.items)

@@ -193,6 +193,13 @@ GEOMETRY_TYPES: dict[str, tuple[str, str, str]] = {
 # --- key lines: where each key path is written in the TOML text --------------------------------------------
 
 
+_SPACES = re.compile(r"[ \t\r]*")
+_BARE_KEY = re.compile(r"[\w-]*")  # letters, digits, "_" and "-"
+_BARE_VALUE = re.compile(r"[^,\]}\n#]*")
+_BASIC_STRING = re.compile(r'"((?:[^"\\\n]|\\.)*)"')
+_LITERAL_STRING = re.compile(r"'([^'\n]*)'")
+
+
 class _Scanner:
     """Map every key path (and array element) of valid TOML text to its 1-based line number."""
 
@@ -209,8 +216,7 @@ class _Scanner:
         self.pos += count
 
     def _skip_spaces(self) -> None:
-        while self._char() in (" ", "\t", "\r") and self._char():
-            self.pos += 1
+        self.pos = _SPACES.match(self.text, self.pos).end()  # type: ignore[union-attr]
 
     def _skip_blank(self) -> None:
         """Spaces, newlines and comments (inside arrays)."""
@@ -230,6 +236,12 @@ class _Scanner:
     def _string(self) -> str:
         quote = self._char()
         triple = self.text.startswith(quote * 3, self.pos)
+        if not triple:  # one-line strings (nearly all of them) in one regular-expression step
+            found = (_BASIC_STRING if quote == '"' else _LITERAL_STRING).match(self.text, self.pos)
+            if found:
+                self.pos = found.end()
+                body = found.group(1)
+                return _unescape(body) if quote == '"' and "\\" in body else body
         start = self.pos + (3 if triple else 1)
         self._advance(start - self.pos)
         chars = []
@@ -259,8 +271,7 @@ class _Scanner:
                 parts.append(self._string())
             else:
                 start = self.pos
-                while self._char() and (self._char().isalnum() or self._char() in "_-"):
-                    self.pos += 1
+                self.pos = _BARE_KEY.match(self.text, self.pos).end()  # type: ignore[union-attr]
                 parts.append(self.text[start : self.pos])
             self._skip_spaces()
             if self._char() != ".":
@@ -299,8 +310,7 @@ class _Scanner:
         if char in ('"', "'"):
             self._string()
             return
-        while self._char() and self._char() not in ",]}\n#":
-            self.pos += 1
+        self.pos = _BARE_VALUE.match(self.text, self.pos).end()  # type: ignore[union-attr]
 
     def _pair(self, table: tuple) -> None:
         keys = self._key()
@@ -386,10 +396,17 @@ def _problem_text(error: Exception) -> str:
 class _Report:
     """Collects every problem as ``file:line: key = value problem; what is valid``."""
 
-    def __init__(self, source: str, lines: dict[tuple, int] | None) -> None:
+    def __init__(self, source: str, lines: dict[tuple, int] | str | None) -> None:
         self.source = source
-        self.lines = lines
+        self._lines = lines  # TOML text: scanned for key lines only when a problem needs one
         self.problems: list[str] = []
+        self.built: dict[tuple, Any] = {}  # (builder, arguments) -> result, for deterministic builders
+
+    @property
+    def lines(self) -> dict[tuple, int] | None:
+        if isinstance(self._lines, str):
+            self._lines = _key_lines(self._lines)
+        return self._lines
 
     def line(self, path: Sequence) -> int | None:
         if self.lines is None:
@@ -569,6 +586,23 @@ def _check_plain_value(report: _Report, path: tuple, value: Any) -> bool:
     return True
 
 
+_SIGNATURES: dict[Any, inspect.Signature | None] = {}
+
+
+def _signature(function: Callable) -> inspect.Signature | None:
+    """``inspect.signature``, cached (it is slow, and a large scene file calls the same builders 10⁴ times)."""
+    key = getattr(function, "__func__", function)  # bound methods: one entry per function
+    if key not in _SIGNATURES:
+        try:
+            _SIGNATURES[key] = inspect.signature(key)
+        except (TypeError, ValueError):  # pragma: no cover - builtins without signatures
+            _SIGNATURES[key] = None
+    signature = _SIGNATURES[key]
+    if signature is not None and key is not function:  # a bound method: drop `self`
+        signature = signature.replace(parameters=list(signature.parameters.values())[1:])
+    return signature
+
+
 def _call(
     report: _Report,
     path: tuple,
@@ -579,10 +613,7 @@ def _call(
     skip: Sequence[str] = (),
 ) -> Any:
     """``function(**params)`` with keys checked against its signature; `_deg` keys converted to radians."""
-    try:
-        signature = inspect.signature(function)
-    except (TypeError, ValueError):  # pragma: no cover - builtins without signatures
-        signature = None
+    signature = _signature(function)
     accepted = {
         name: p
         for name, p in (signature.parameters.items() if signature else ())
@@ -633,6 +664,10 @@ def _call(
             missing = True
     if missing:
         return _BAD
+    cacheable = ok and getattr(function, "__module__", "") in _DETERMINISTIC_MODULES
+    key = (function, repr(sorted(kwargs.items()))) if cacheable else None
+    if key is not None and key in report.built:  # the same primitive again: share the immutable result
+        return report.built[key]
     try:  # even after a bad key: the function's own checks may find more problems in the other values
         built = function(**kwargs)
     except FrustumError as error:
@@ -641,7 +676,14 @@ def _call(
     except (TypeError, ValueError, ArithmeticError, IndexError, MemoryError) as error:
         report.refused(path, dict(params), error)
         return _BAD
+    if key is not None:
+        report.built[key] = built
     return built if ok else _BAD
+
+
+_DETERMINISTIC_MODULES = frozenset({"frustum.geometry.primitives", "frustum.geometry.quadrics", "frustum.shading"})
+"""Builders whose results depend only on their arguments and are immutable: a scene file of 10⁴ equal spheres
+builds one Mesh and shares it (``_call``)."""
 
 
 def _resolve(report: _Report, path: tuple, kind: str, module: str, attribute: str) -> Any:
@@ -1678,7 +1720,7 @@ def load_scene(data: Mapping[str, Any] | str, *, source: str = "<scene>", base_d
     SceneFileError
         Malformed TOML (tomllib's own line and column), or any invalid key or value.
     """
-    lines: dict[tuple, int] | None = None
+    lines: dict[tuple, int] | str | None = None
     if isinstance(data, str):
         _check_shape(data, source)
         try:
@@ -1692,7 +1734,7 @@ def load_scene(data: Mapping[str, Any] | str, *, source: str = "<scene>", base_d
         except RecursionError:
             raise SceneFileError(f"{escape_control(source)}: the text nests too deeply to parse; "
                                  f"nest arrays and tables at most {_MAX_NESTING} deep") from None  # fmt: skip
-        lines = _key_lines(data)
+        lines = data  # the key-line scan (linear, but slow in Python) runs only if a problem is reported
     elif isinstance(data, Mapping):
         parsed = dict(data)
     else:
