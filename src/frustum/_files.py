@@ -18,13 +18,15 @@ import tempfile
 import threading
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 from frustum.errors import FrustumError, OutputError
 
-__all__ = ["atomic_path", "os_reason", "remove_partial_files"]
+__all__ = ["atomic_path", "os_reason", "remove_partial_files", "track_process"]
 
 _lock = threading.Lock()
 _open: set[str] = set()
+_processes: set[Any] = set()
 _closed = False
 _umask: int | None = None
 
@@ -42,9 +44,11 @@ def _file_mode() -> int:
 def os_reason(error: BaseException) -> str:
     """The short reason of an OS error ("No space left on device"), never a command line or a bare number."""
     strerror = getattr(error, "strerror", None)
-    if strerror:
-        return str(strerror)
+    if isinstance(strerror, str) and strerror:
+        return strerror
     text = " ".join(str(error).split())
+    if "CAIRO_STATUS_WRITE_ERROR" in text:  # cairo's OSError(message, 11): its status, not an errno
+        return "cairo could not write it: the disk is full or the file cannot be written"
     for known in ("No space left on device", "Permission denied", "Disk quota exceeded", "Read-only file system",
                   "File too large"):  # fmt: skip
         if known.lower() in text.lower():
@@ -92,11 +96,38 @@ def atomic_path(target: str | os.PathLike, *, where: str, error: type[FrustumErr
             _open.discard(name)
 
 
+@contextlib.contextmanager
+def track_process(process: Any) -> Iterator[Any]:
+    """Kill `process` (an encoder writing a temporary file) if the block fails, and let
+    :func:`remove_partial_files` kill it on Ctrl-C, before the temporary is removed (it could recreate it)."""
+    with _lock:
+        _processes.add(process)
+    try:
+        yield process
+    except BaseException:
+        _stop(process)
+        raise
+    finally:
+        with _lock:
+            _processes.discard(process)
+
+
+def _stop(process: Any) -> None:
+    if process.poll() is None:
+        with contextlib.suppress(OSError):
+            process.kill()
+        with contextlib.suppress(Exception):
+            process.wait(timeout=2.0)
+
+
 def remove_partial_files() -> list[str]:
-    """Remove every temporary file still being written and refuse new ones (the CLI calls it on Ctrl-C)."""
+    """Stop the encoders, remove every temporary file still being written and refuse new ones (the CLI calls
+    it on Ctrl-C)."""
     global _closed
     with _lock:
         _closed = True
+        for process in list(_processes):
+            _stop(process)
         names = sorted(_open)
         for name in names:
             with contextlib.suppress(OSError):

@@ -255,8 +255,8 @@ def _as_window_points(value: ArrayLike, name: str, where: str, width: int) -> tu
     return single, np.ascontiguousarray(rows)
 
 
-MAX_IMAGE_SIZE = 32768
-"""Largest image width or height a Camera accepts (a supersampled 8192-pixel image, ×4, still fits)."""
+MAX_IMAGE_SIZE = 65536
+"""Largest image width or height a Camera accepts (an 8192-pixel image supersampled 64 times, ×8 a side, fits)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -272,12 +272,12 @@ class Camera:
     frame : ViewFrame
     projection : Perspective, Frustum, Orthographic, Oblique or Axonometric
     width, height : int
-        Image size in pixels, in [1, MAX_IMAGE_SIZE] (32768).
+        Image size in pixels, in [1, MAX_IMAGE_SIZE] (65536).
 
     Raises
     ------
     CameraError
-        If the frame or projection has the wrong type, or the image size is not an integer in [1, 32768].
+        If the frame or projection has the wrong type, or the image size is not an integer in [1, 65536].
 
     References
     ----------

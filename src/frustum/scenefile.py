@@ -47,6 +47,7 @@ from typing import Any
 import numpy as np
 
 from frustum._arrays import describe, escape_control
+from frustum.budgets import check_memory
 from frustum.camera import Camera
 from frustum.errors import FrustumError, OutputError, SceneFileError
 from frustum.frame import Frame
@@ -1463,6 +1464,26 @@ def _render_options(report: _Report, path: tuple, value: Any) -> tuple[dict, tup
     return options, size, columns
 
 
+def _check_image_memory(report: _Report, options: dict, size: tuple[int, int], cameras: int) -> None:
+    """The image budget (``render.check_image_budget``'s estimate) at load time, so the error has file:line:
+    one camera's supersampled buffers (12 bytes a rendered pixel, more for extra buffers and filters) plus
+    every camera's finished 8-byte pixels (a contact sheet keeps them all)."""
+    width, height = size
+    samples = int(options.get("samples", 1))
+    buffers = options.get("buffers", ())
+    per_pixel = 12 + 12 * ("normals" in buffers) + 4 * ("object_id" in buffers)
+    if options.get("filter", "box") != "box" or options.get("color_space", "linear") != "linear":
+        per_pixel += 64
+    needed = width * height * (samples * per_pixel + 8 * cameras)
+    key = "samples" if "samples" in options else "size"
+    try:
+        check_memory(needed, where="render", cause=f"{width} x {height} pixels x samples = {samples} x {cameras} "
+                     f"camera{'s' if cameras > 1 else ''}", error=SceneFileError)  # fmt: skip
+    except SceneFileError as error:
+        report.add(("render", key), options.get(key, list(size)), "is over the memory budget",
+                   str(error).split(": ", 1)[1])  # fmt: skip
+
+
 def _explode_and_cut(report: _Report, data: dict, scene: Scene) -> Scene:
     if "exploded" in data:
         path = ("exploded",)
@@ -1828,6 +1849,7 @@ def _build(report: _Report, data: dict, base: Path) -> SceneFile | None:
     else:
         report.missing(("camera",), "add a [camera] table with eye and target (or [[cameras]])")
     outputs, animation, svg = _outputs(report, data, base)
+    _check_image_memory(report, options, size, max(len(cameras), 1))
     if report.problems:
         return None
     title = data.get("title", "")

@@ -25,6 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from frustum._arrays import describe
+from frustum._files import atomic_path, os_reason
 from frustum.budgets import check_memory, format_bytes
 from frustum.errors import GeometryError
 from frustum.geometry.mesh import Mesh
@@ -214,11 +215,13 @@ def save(mesh: Mesh, path: str | Path, binary: bool = True, texture: Any = None)
             data = data.encode("utf-8")
         if suffix == ".obj" and isinstance(data, bytes) and texture is not None:
             data = _obj_with_texture(geometry, file)
-        file.write_bytes(data)
+        _write_atomically(file, data)
     except OSError as error:
         raise GeometryError(
-            f"save: path = {str(file)!r} cannot be written ({error.strerror}); check the folder"
+            f"save: path = {str(file)!r} cannot be written ({os_reason(error)}); check the folder"
         ) from None
+    except GeometryError:
+        raise
     except Exception as error:
         raise GeometryError(
             f"save: path = {str(file)!r} could not be written as {suffix} ({type(error).__name__}: {error})"
@@ -422,8 +425,14 @@ def _obj_with_texture(geometry: Any, file: Path) -> bytes:
 
     text, files = export_obj(geometry, return_texture=True, mtl_name=file.stem + ".mtl")
     for name, data in files.items():
-        (file.parent / name).write_bytes(data)
+        _write_atomically(file.parent / name, data)
     return text.encode("utf-8")
+
+
+def _write_atomically(file: Path, data: bytes) -> None:
+    """Write `data` to a temporary beside `file` and rename it: an existing file survives a failed write."""
+    with atomic_path(file, where="save", error=GeometryError) as temporary:
+        temporary.write_bytes(data)
 
 
 def _is_identity(matrix: NDArray[np.float64]) -> bool:

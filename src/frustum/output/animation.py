@@ -7,10 +7,12 @@ dithering), so the same frames give the same bytes; MP4 goes through imageio's f
 
 from __future__ import annotations
 
+import contextlib
 import io
 import math
 import os
 import struct
+import tempfile
 from collections.abc import Iterable, Iterator
 from typing import Any
 
@@ -18,7 +20,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from frustum._arrays import as_direction, as_scalar, describe
-from frustum._files import atomic_path, os_reason
+from frustum._files import atomic_path, os_reason, track_process
 from frustum.camera import Camera, ViewFrame
 from frustum.errors import CameraError, OutputError
 from frustum.frame import Frame
@@ -151,34 +153,102 @@ def _write_gif(frames: Iterator[NDArray[np.uint8]], path: str, fps: float, where
 
 
 def _write_mp4(frames: Iterator[NDArray[np.uint8]], path: str, fps: float, where: str) -> int:
+    """Pipe raw RGB frames to ffmpeg (from imageio-ffmpeg) as they come: H.264, yuv420p, crf 25 (imageio's
+    quality 5). frustum owns the process: its exit status reports a failed write, and a failure or Ctrl-C
+    kills it before the temporary file is removed."""
     try:
-        import imageio_ffmpeg  # noqa: F401  (the plugin imageio needs for MP4)
+        import imageio_ffmpeg
     except ImportError:
         raise OutputError(
             f"{where}: path = {str(path)!r} asks for MP4, which needs the imageio-ffmpeg package; install it "
             "(pip install imageio-ffmpeg) or write a '.gif'"
         ) from None
-    import imageio.v2 as imageio
+    import subprocess
+    from fractions import Fraction
 
     count = 0
     with atomic_path(path, where=where) as temporary:
+        process: subprocess.Popen | None = None
         try:
-            writer = imageio.get_writer(str(temporary), format="FFMPEG", mode="I", fps=fps, codec="libx264",
-                                        macro_block_size=1, ffmpeg_log_level="error")  # fmt: skip
-            with writer:
+            with contextlib.ExitStack() as stack:
                 for rgb in frames:
-                    # yuv420p needs even sizes: repeat the last row / column rather than let imageio rescale
-                    writer.append_data(np.pad(rgb, ((0, rgb.shape[0] % 2), (0, rgb.shape[1] % 2), (0, 0)),
-                                              mode="edge"))  # fmt: skip
+                    # yuv420p needs even sizes: repeat the last row / column rather than let ffmpeg rescale
+                    even = np.pad(rgb, ((0, rgb.shape[0] % 2), (0, rgb.shape[1] % 2), (0, 0)), mode="edge")
+                    if process is None:
+                        height, width = even.shape[:2]
+                        command = [imageio_ffmpeg.get_ffmpeg_exe(), "-y", "-v", "error", "-f", "rawvideo",
+                                   "-vcodec", "rawvideo", "-s", f"{width}x{height}", "-pix_fmt", "rgb24", "-r",
+                                   str(Fraction(fps).limit_denominator()), "-i", "-", "-an", "-vcodec", "libx264",
+                                   "-pix_fmt", "yuv420p", "-crf", "25", "-f", "mp4", str(temporary)]  # fmt: skip
+                        log = stack.enter_context(tempfile.TemporaryFile())
+                        # its own session: a terminal's Ctrl-C reaches frustum, which stops it
+                        process = subprocess.Popen(command, stdin=subprocess.PIPE, stdout=subprocess.DEVNULL,
+                                                   stderr=log, start_new_session=True)  # fmt: skip
+                        stack.enter_context(track_process(process))
+                    elif even.shape[:2] != (height, width):
+                        raise OutputError(f"{where}: frames[{count}] has shape {rgb.shape}; expected the first "
+                                          "frame's size")  # fmt: skip
+                    try:
+                        process.stdin.write(np.ascontiguousarray(even).tobytes())  # type: ignore[union-attr]
+                    except BrokenPipeError:  # ffmpeg stopped: say why (a full disk), not "broken pipe"
+                        process.wait()
+                        log.seek(0)
+                        reason = " ".join(log.read().decode("utf-8", "replace").split())
+                        raise OutputError(
+                            f"{where}: path = {str(path)!r} cannot be written (the encoder stopped: "
+                            f"{_ffmpeg_reason(reason)}); free space or choose another folder"
+                        ) from None
                     count += 1
-        except (OSError, RuntimeError, BrokenPipeError) as error:  # ffmpeg's failures carry its whole command line
+                if process is None:
+                    raise OutputError(f"{where}: frames is empty; an animation needs at least one frame")
+                process.stdin.close()  # type: ignore[union-attr]
+                status = process.wait()
+                log.seek(0)
+                reason = " ".join(log.read().decode("utf-8", "replace").split())
+            if status != 0 or not _complete_mp4(temporary):
+                raise OutputError(
+                    f"{where}: path = {str(path)!r} cannot be written (the encoder could not finish the file: "
+                    f"{_ffmpeg_reason(reason)}); free space or choose another folder"
+                )
+        except (OSError, ValueError) as error:  # a broken pipe: ffmpeg stopped (a full disk, a bad folder)
+            if isinstance(error, OutputError):
+                raise
             raise OutputError(
                 f"{where}: path = {str(path)!r} cannot be written ({os_reason(error)}); give a path in an "
                 "existing, writable folder with free space"
             ) from None
-        if count == 0:
-            raise OutputError(f"{where}: frames is empty; an animation needs at least one frame")
     return count
+
+
+def _ffmpeg_reason(log: str) -> str:
+    """The cause in ffmpeg's error output (never its command line)."""
+    for known in ("No space left on device", "File too large", "Permission denied", "Disk quota exceeded"):
+        if known.lower() in log.lower():
+            return known
+    return "the disk is full or the file too large"
+
+
+def _complete_mp4(path: Any) -> bool:
+    """Whether the file is a whole MP4: top-level boxes (32-bit size, type) tile it exactly and one is ``moov``
+    (ffmpeg writes it last, so a truncated file lacks it) [ISO/IEC 14496-12 §4.2]."""
+    size = os.path.getsize(path)
+    position, found = 0, False
+    with open(path, "rb") as file:
+        while position < size:
+            file.seek(position)
+            header = file.read(16)
+            if len(header) < 8:
+                return False
+            length, kind = struct.unpack(">I4s", header[:8])
+            if length == 1 and len(header) == 16:  # 64-bit size
+                length = struct.unpack(">Q", header[8:16])[0]
+            elif length == 0:  # the box runs to the end of the file
+                length = size - position
+            if length < 8 or position + length > size:
+                return False
+            found = found or kind == b"moov"
+            position += length
+    return found
 
 
 def write_animation(frames: Iterable[Frame | ArrayLike], path: str | os.PathLike, fps: float = 30.0) -> int:
