@@ -6,7 +6,9 @@ points through every stage, with every matrix), ``view`` (a scene as an engineer
 points through every stage of the pipeline), ``info`` (a mesh file's counts, bounds, watertightness and
 normals) and ``turntable`` (a GIF or MP4 orbiting a mesh). Errors print as one line, ``error: <message>``,
 without a traceback (the global ``--debug`` option shows it): exit status 1 for a bad value or an unreadable
-file, 2 for a command line that cannot be parsed (unknown option, missing argument, malformed numbers).
+file, 2 for a command line that cannot be parsed (unknown option, missing argument, malformed numbers), 130
+after Ctrl-C (honoured at once: the work runs on a worker thread; no partial output file is left). The global
+options ``--max-bytes`` and ``--max-operations`` set the work budget (``frustum.set_budget``).
 """
 
 from __future__ import annotations
