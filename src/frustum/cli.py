@@ -26,6 +26,7 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
+import frustum.raster
 from frustum import __version__
 from frustum._arrays import escape_control
 from frustum.camera import Camera
@@ -447,6 +448,17 @@ def view_command(
     console.print(f"wrote {written}", markup=False, highlight=False, soft_wrap=True)
 
 
+@app.command("warmup")
+def warmup_command(
+    processes: Annotated[int | None, typer.Option(help="Parallel processes (default: the number of cores).")] = None,
+) -> None:
+    """Compile every kernel ahead of time into Numba's on-disk cache, so no later render waits for it."""
+    from frustum.warmup import warmup
+
+    error_console.print("compiling every kernel (once per environment) ...", markup=False)
+    console.print(str(warmup(processes)), markup=False, highlight=False)
+
+
 @app.command("examples")
 def examples_command(
     out: Annotated[Path, typer.Option(help="Folder for the pictures.")] = Path("examples/out"),
@@ -514,6 +526,12 @@ def _run_interruptible(work: Callable[[], Any]) -> Any:
     return outcome.get("value")
 
 
+def _compile_notice() -> None:
+    """Told by the kernels once they have been compiling for a second (a first run in a new environment)."""
+    error_console.print("compiling render kernels, first run only (`frustum warmup` does it ahead of time) ...",
+                        markup=False, highlight=False)  # fmt: skip
+
+
 def main(arguments: Sequence[str] | None = None) -> None:
     """Entry point of the ``frustum`` console script: one-line errors, exit 1 (2 for usage), tracebacks on --debug.
 
@@ -522,6 +540,7 @@ def main(arguments: Sequence[str] | None = None) -> None:
     """
     argv = list(sys.argv[1:] if arguments is None else arguments)
     _STATE["debug"] = "--debug" in argv
+    frustum.raster.compile_notice = _compile_notice
     try:
         status = _run_interruptible(lambda: app(args=argv, prog_name="frustum", standalone_mode=False))
     except _CLICK_USAGE_ERROR as error:
