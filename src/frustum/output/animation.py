@@ -331,18 +331,21 @@ def orbit_cameras(camera: Camera, frames: int, axis: str | ArrayLike | None = No
             "Camera.look_at(eye, target, up) so the orbit has a center"
         )
     direction = _axis(axis, camera, where)
-    cameras = []
-    for turn in _turns(direction, frame.target, int(frames)):
-        eye = apply(turn, frame.eye[None, :])[0]
-        up = turn[:3, :3] @ frame.up
-        view = ViewFrame(eye, target=frame.target, up=up, handedness=frame.handedness)
-        cameras.append(Camera(view, camera.projection, camera.width, camera.height))
-    return cameras
+    return [_orbit_camera(camera, turn) for turn in _turns(direction, frame.target, int(frames))]
 
 
-def _turns(direction: NDArray[np.float64], center: NDArray[np.float64], frames: int) -> list[NDArray[np.float64]]:
-    """R(axis, 2πk/frames) about the line through `center`, k = 0 … frames − 1."""
-    return [rotate(direction, 2.0 * math.pi * k / frames, center) for k in range(frames)]
+def _orbit_camera(camera: Camera, turn: NDArray[np.float64]) -> Camera:
+    """`camera` with its eye and up turned by `turn` about its target."""
+    frame = camera.frame
+    eye = apply(turn, frame.eye[None, :])[0]
+    up = turn[:3, :3] @ frame.up
+    view = ViewFrame(eye, target=frame.target, up=up, handedness=frame.handedness)
+    return Camera(view, camera.projection, camera.width, camera.height)
+
+
+def _turns(direction: NDArray[np.float64], center: NDArray[np.float64], frames: int) -> Iterator[NDArray[np.float64]]:
+    """R(axis, 2πk/frames) about the line through `center`, k = 0 … frames − 1, one at a time."""
+    return (rotate(direction, 2.0 * math.pi * k / frames, center) for k in range(frames))
 
 
 def _with_lights_turned(scene: Scene, turn: NDArray[np.float64]) -> Scene:
@@ -432,17 +435,20 @@ def turntable(
     if camera is None:
         width, height = _size(size, where)
         camera = framing_camera(scene, width, height)
-    cameras = orbit_cameras(camera, frames, axis)
+    if isinstance(frames, bool) or not isinstance(frames, int | np.integer) or frames < 1:
+        orbit_cameras(camera, frames, axis)  # raises orbit_cameras' error for the frame count
+    orbit_cameras(camera, 1, axis)  # checks camera and axis (a one-frame orbit is the camera itself)
     if path is not None:
         _suffix(path, where)
         _fps(fps, where)
-    if lights_follow and cameras:
-        turns = _turns(_axis(axis, camera, where), camera.frame.target, len(cameras))
-        scenes = [_with_lights_turned(scene, turn) for turn in turns]
-    else:
-        scenes = [scene] * len(cameras)
-    jobs = zip(scenes, cameras, strict=True)
-    rendered = _with_progress((render(s, c, **render_options) for s, c in jobs), len(cameras), progress)
+    count = int(frames)
+    turns = _turns(_axis(axis, camera, where), camera.frame.target, count)
+
+    def jobs() -> Iterator[tuple[Scene, Camera]]:  # one frame's scene and camera at a time: none are kept
+        for turn in turns:
+            yield (_with_lights_turned(scene, turn) if lights_follow else scene), _orbit_camera(camera, turn)
+
+    rendered = _with_progress((render(s, c, **render_options) for s, c in jobs()), count, progress)
     if path is None:
         return list(rendered)
     return write_animation(rendered, path, fps)
