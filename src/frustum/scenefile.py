@@ -1774,34 +1774,47 @@ _DOTTED = re.compile(r"(?:(?:[A-Za-z0-9_-]+|\"[^\"\n]*\"|'[^'\n]*')[ \t]*\.[ \t]
 def _check_shape(text: str, source: str) -> None:
     """Refuse text the TOML parser and the key-line scanner would take very long (or recurse too deep) on.
 
-    One linear pass: the depth of ``[`` / ``{`` outside strings and comments, and dotted keys of more than
-    `_MAX_NESTING` parts; the ``SceneFileError`` names the line.
+    One linear pass over the tokens outside strings and comments: the depth of ``[`` / ``{``, then dotted
+    keys of more than `_MAX_NESTING` parts in the text with its strings blanked; the ``SceneFileError`` names
+    the line.
     """
     where = escape_control(source)
-    dotted = _DOTTED.search(text)
-    if dotted:
-        line = text.count("\n", 0, dotted.start()) + 1
-        raise SceneFileError(f"{where}:{line}: a dotted key has more than {_MAX_NESTING} parts; write at most "
-                             f"{_MAX_NESTING} levels of tables")  # fmt: skip
     depth, line, multiline = 0, 1, None
+    code: list[str] = []  # the text with strings emptied and comments dropped (newlines kept)
+    last = 0
     for token in _TOKENS.finditer(text):
         value = token.group()
+        if multiline is None:
+            code.append(text[last : token.start()])
+        last = token.end()
         if value == "\n":
             line += 1
+            code.append("\n")
         elif multiline is not None:  # inside a multi-line string: only its closing quotes matter
             if value == multiline:
                 multiline = None
+                code.append('""')
         elif value in ('"""', "\'\'\'"):
             multiline = value
         elif value in "[{":
+            code.append(value)
             depth += 1
             if depth > _MAX_NESTING:
                 raise SceneFileError(f"{where}:{line}: arrays or tables nest more than {_MAX_NESTING} deep here; "
                                      f"nest them at most {_MAX_NESTING} deep")  # fmt: skip
         elif value in "]}":
+            code.append(value)
             depth = max(depth - 1, 0)
-        elif value[0] in "\"'" and "\n" in value:  # pragma: no cover - the pattern stops strings at a newline
-            line += value.count("\n")
+        elif value[0] in "\"'":
+            code.append('""')
+    if multiline is None:
+        code.append(text[last:])
+    stripped = "".join(code)
+    dotted = _DOTTED.search(stripped)
+    if dotted:
+        line = stripped.count("\n", 0, dotted.start()) + 1
+        raise SceneFileError(f"{where}:{line}: a dotted key has more than {_MAX_NESTING} parts; write at most "
+                             f"{_MAX_NESTING} levels of tables")  # fmt: skip
 
 
 def _build(report: _Report, data: dict, base: Path) -> SceneFile | None:

@@ -332,3 +332,33 @@ def test_gif_frames_are_streamed_to_the_file(tmp_path):
 
     with Image.open(target) as image:
         assert image.n_frames == 6
+
+
+def test_many_large_cameras_count_in_the_image_budget(tmp_path):
+    cameras = "".join(f"[[cameras]]\neye = [0, 0, {5 + k}]\ntarget = [0, 0, 0]\n\n" for k in range(64))
+    scene = tmp_path / "wall.toml"
+    scene.write_text('[render]\nsize = [8192, 8192]\n\n' + cameras + '[[nodes]]\ngeometry = { type = "uv_sphere" }\n')
+    result = run_cli("render", str(scene), cwd=tmp_path)
+    assert result.returncode == 1
+    expected = ("wall.toml:2: render.size = (8192.0, 8192.0) is over the memory budget; 8192 x 8192 pixels x "
+                "samples = 1 x 64 cameras needs about 32.8 GiB")
+    assert expected in result.stderr, result.stderr
+
+
+def test_brackets_and_dots_inside_strings_are_not_nesting():
+    from frustum.scenefile import load_scene
+
+    text = ('title = "' + "[" * 200 + "a.b." * 100 + '"\n'
+            "description = '''\n" + "{" * 200 + "\n'''\n"
+            '[camera]\neye = [0, 0, 5]\ntarget = [0, 0, 0]\n'
+            '[[nodes]]\ngeometry = { type = "uv_sphere" }\n')  # fmt: skip
+    assert load_scene(text).title.startswith("[[[")
+
+
+def test_escape_control_covers_c0_c1_and_bidi_overrides():
+    from frustum._arrays import describe, escape_control
+
+    assert escape_control("a\nb\x1b[31m\x7f\x85\u202e\u2066c") == "a\\nb\\x1b[31m\\x7f\\u0085\\u202e\\u2066c"
+    assert escape_control("a\nb\tc", keep_newlines=True) == "a\nb\\tc"
+    assert "\x1b" not in describe(["\x1b[2J"]) and "\n" not in describe({"k\n": 1})
+    assert describe(list(range(1000))) == "<list of 1000 items>"
