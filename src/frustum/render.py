@@ -251,7 +251,7 @@ def render(
     factor = _supersampling(samples, where)
     _choice(filter, FILTERS, "filter", where)
     _choice(color_space, COLOR_SPACES, "color_space", where)
-    check_image_budget(camera, factor, options.buffers, filter, color_space, where)
+    _check_image_budget(camera, factor, options.buffers, filter, color_space, where)
     if factor == 1:
         color, depth, normals, ids = _render_buffers(scene, camera, options)
         linear = None
@@ -778,7 +778,7 @@ def _color_bytes(value: Any, name: str, where: str) -> np.ndarray:
     return np.floor(array * 255.0 + 0.5)
 
 
-def check_image_budget(camera: Camera, factor: int, buffers: tuple[str, ...], filter: str, color_space: str,
+def _check_image_budget(camera: Camera, factor: int, buffers: tuple[str, ...], filter: str, color_space: str,
                        where: str) -> None:  # fmt: skip
     """Refuse, before any buffer is allocated, an image whose buffers exceed the memory budget (``frustum.budgets``).
 
