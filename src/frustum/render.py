@@ -51,7 +51,7 @@ from frustum.clipping import VIEW_VOLUME_PLANES
 from frustum.errors import FrustumError
 from frustum.frame import Frame
 from frustum.geometry import Mesh
-from frustum.hidden_lines import EdgeAdjacency, classify_edges, edge_adjacency, front_facing
+from frustum.hidden_lines import EdgeAdjacency, classify_edges, edge_adjacency, front_facing, welded_adjacency
 from frustum.raster import lines, shade, tiles, triangles
 from frustum.raster._jit import threads
 from frustum.raster.vertices import project_vertices, transform_normals, transform_vertices, world_points
@@ -294,6 +294,7 @@ def _render_buffers(
         color[:, :] = options.background
         _draw_edges(items, camera, options, depth, color)
         _draw_polylines(scene.polylines, camera, options, depth, color)
+        _draw_particles(scene, camera, depth, color)
         return color, depth, normal_out, id_out
     scratch = Scratch()
     depth, color = _draw_surfaces(scene, items, camera, options, normal_out, id_out, scratch)
@@ -303,7 +304,16 @@ def _render_buffers(
     if options.mode in ("hidden-line", "surface+edges"):
         _draw_edges(items, camera, options, depth, color)
     _draw_polylines(scene.polylines, camera, options, depth, color)
+    _draw_particles(scene, camera, depth, color)
     return color, depth, normal_out, id_out
+
+
+def _draw_particles(scene: Scene, camera: Camera, depth: np.ndarray, color: np.ndarray) -> None:
+    """Particle layers over the finished surfaces: depth-tested, depth not written (``frustum.particle_pass``)."""
+    if getattr(scene, "particle_layers", None):
+        from frustum.particle_pass import draw_particles
+
+        draw_particles(scene.particle_layers, camera, depth, color)
 
 
 def _draw_surfaces(
@@ -647,7 +657,8 @@ def _draw_edges(items: list[SceneItem], camera: Camera, options: _Options, depth
         if options.mode == "points":
             lines.draw_points(clip, view_depth, vertex_codes, view, style, depth, color)
             continue
-        adjacency = _adjacency(mesh)
+        # feature edges by shared positions: a cap's rim or a seam split for normals or UVs is not a boundary
+        adjacency = welded_adjacency(mesh) if options.edges == "feature" else _adjacency(mesh)
         edges = adjacency.edges
         if edge_modes or options.edges == "feature":
             faces = _world_faces(item)

@@ -18,9 +18,25 @@ from frustum._arrays import Matrix4, as_matrix, as_scalar, as_vector3, describe
 from frustum.errors import FrustumError, GeometryError
 from frustum.geometry import Mesh, Polyline
 from frustum.shading import LIGHT_TYPES, Light, Material
+from frustum.simulation import MassSpringSystem, ParticleSystem
 from frustum.transforms import translate
 
-__all__ = ["Node", "Placed", "Scene", "SceneItem", "cutaway", "exploded"]
+__all__ = [
+    "PARTICLE_BLENDING",
+    "PARTICLE_STYLES",
+    "Node",
+    "ParticleLayer",
+    "Placed",
+    "Scene",
+    "SceneItem",
+    "cutaway",
+    "exploded",
+]
+
+PARTICLE_STYLES = ("sprites", "points", "streaks")
+"""How ``Scene.add_particles`` draws particles: soft round sprites, hard squares, or motion streaks."""
+PARTICLE_BLENDING = ("additive", "alpha")
+"""How particles combine with what is under them: ``C + α·c`` (fire, sparks) or ``α·c + (1 − α)·C`` (smoke)."""
 
 _IDENTITY = np.eye(4)
 _IDENTITY.flags.writeable = False
@@ -32,6 +48,14 @@ class SceneItem(NamedTuple):
     mesh: Mesh
     material: Material
     world_from_model: Matrix4
+
+
+class ParticleLayer(NamedTuple):
+    """A particle system drawn over the surfaces (``Scene.add_particles``); particles are in world coordinates."""
+
+    system: ParticleSystem
+    style: str
+    blending: str
 
 
 class Placed(NamedTuple):
@@ -170,6 +194,8 @@ class Scene:
 
     def __init__(self, lights: Iterable[Light] = ()) -> None:
         self.root = Node("")
+        self.particle_layers: list[ParticleLayer] = []
+        self.mass_springs: list[tuple[Node, MassSpringSystem]] = []
         for light in lights:
             self.add_light(light)
 
@@ -210,6 +236,34 @@ class Scene:
                 "Mesh(vertices, faces)"
             )
         return host.add(Node(name, transform, geometry, material))
+
+    def add_particles(self, system: ParticleSystem, *, style: str = "sprites",
+                      blending: str = "additive") -> ParticleLayer:  # fmt: skip
+        """Draw `system` (a ``ParticleSystem``, world coordinates) as `style` with `blending`; returns its layer.
+
+        Particles are drawn after the opaque surfaces, depth-tested against them without writing depth
+        (``frustum.particle_pass``); ``frustum.simulate`` steps the system between frames.
+        """
+        where = "Scene.add_particles"
+        if not isinstance(system, ParticleSystem):
+            raise FrustumError(f"{where}: system = {describe(system)} is not a ParticleSystem")
+        for name, value, valid in (("style", style, PARTICLE_STYLES), ("blending", blending, PARTICLE_BLENDING)):
+            if not isinstance(value, str) or value not in valid:
+                raise FrustumError(f"{where}: {name} = {describe(value)} is unknown; expected one of "
+                                   + ", ".join(repr(v) for v in valid))  # fmt: skip
+        layer = ParticleLayer(system, style, blending)
+        self.particle_layers.append(layer)
+        return layer
+
+    def add_mass_spring(self, system: MassSpringSystem, material: Material | None = None, *, name: str = "",
+                        parent: Node | str | None = None) -> Node:  # fmt: skip
+        """Place `system`'s current ``mesh`` (cloth, soft body) as a node; ``frustum.simulate`` replaces the
+        node's geometry by the new mesh after every frame's steps. Returns the node."""
+        if not isinstance(system, MassSpringSystem):
+            raise FrustumError(f"Scene.add_mass_spring: system = {describe(system)} is not a MassSpringSystem")
+        node = self.add(system.mesh, material, name=name, parent=parent)
+        self.mass_springs.append((node, system))
+        return node
 
     def walk(self) -> Iterator[Placed]:
         """Every node (root excluded) with its ``world_from_model``, depth-first, parents first."""
@@ -260,6 +314,7 @@ class Scene:
     def _with_root(self, root: Node) -> Scene:
         scene = Scene()
         scene.root = root
+        scene.particle_layers = list(self.particle_layers)
         return scene
 
 

@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import dataclasses
 import difflib
+import functools
 import importlib
 import inspect
 import math
@@ -105,7 +106,7 @@ _MAX_INTEGER_PARAMETER = 100_000
 """Largest integer geometry parameter (segments, resolution, ...): guards against runaway tessellation."""
 _ANGLE_PARAMETERS = frozenset(
     {"angle", "fovy", "alpha", "phi", "rotation_x", "rotation_y", "crease_angle", "inner_angle", "outer_angle",
-     "azimuth", "elevation", "start", "end"}
+     "azimuth", "elevation", "start", "end", "spread"}
 )  # fmt: skip
 """Radian parameters of the Python API: scene files must give them in degrees, as ``<name>_deg``."""
 _DEGREE_PARAMETERS = frozenset({"LSystem.angle", "union.sharp_angle", "difference.sharp_angle",
@@ -114,7 +115,7 @@ _DEGREE_PARAMETERS = frozenset({"LSystem.angle", "union.sharp_angle", "differenc
 
 _TOP_LEVEL = (
     "title", "description", "camera", "cameras", "lights", "materials", "nodes", "render", "exploded", "cutaway",
-    "output", "animation", "svg",
+    "output", "animation", "svg", "particles", "cloth",
 )  # fmt: skip
 _NODE_KEYS = ("name", "geometry", "material", "transform", "children", "lights")
 _CAMERA_KEYS = (
@@ -593,6 +594,11 @@ _SIGNATURES: dict[Any, inspect.Signature | None] = {}
 def _signature(function: Callable) -> inspect.Signature | None:
     """``inspect.signature``, cached (it is slow, and a large scene file calls the same builders 10⁴ times)."""
     key = getattr(function, "__func__", function)  # bound methods: one entry per function
+    if isinstance(key, functools.partial):  # made per call: not worth a cache entry
+        try:
+            return inspect.signature(key)
+        except (TypeError, ValueError):  # pragma: no cover
+            return None
     if key not in _SIGNATURES:
         try:
             _SIGNATURES[key] = inspect.signature(key)
@@ -1565,6 +1571,87 @@ def _inside(base: Path, name: str) -> bool:
     return target != folder and target.is_relative_to(folder)
 
 
+# --- simulations: [[particles]] and [[cloth]] ---------------------------------------------------------------
+
+_EMITTERS = {"point": "PointEmitter", "line": "LineEmitter", "disk": "DiskEmitter", "sphere": "SphereEmitter"}
+_FORCES = {"gravity": "Gravity", "drag": "Drag", "wind": "Wind", "vortex": "Vortex", "attractor": "Attractor"}
+_COLLIDERS = {"plane": "PlaneCollider", "sphere": "SphereCollider"}
+_PARTICLE_KEYS = ("emitter", "forces", "colliders", "style", "blending")
+_CLOTH_KEYS = ("material", "colliders", "name")
+
+
+def _typed(report: _Report, path: tuple, value: Any, kinds: dict[str, str]) -> Any:
+    """``{ type = "...", ... }`` → the simulation class of that type built from the other keys."""
+    params = _table(report, path, value)
+    if params is _BAD:
+        return _BAD
+    kind = params.pop("type", None)
+    if kind not in kinds:
+        report.add((*path, "type"), kind, "is unknown" if kind is not None else "is missing",
+                   f"expected one of {', '.join(repr(k) for k in kinds)}")  # fmt: skip
+        return _BAD
+    simulation = importlib.import_module("frustum.simulation")
+    return _call(report, path, getattr(simulation, kinds[kind]), params, label=kinds[kind])
+
+
+def _typed_list(report: _Report, path: tuple, value: Any, kinds: dict[str, str]) -> Any:
+    if not isinstance(value, list):
+        report.add(path, value, "is not a list of tables", "write e.g. [{ type = ... }, ...]")
+        return _BAD
+    built = [_typed(report, (*path, i), item, kinds) for i, item in enumerate(value)]
+    return _BAD if any(item is _BAD for item in built) else built
+
+
+def _simulations(report: _Report, data: dict, scene: Scene, materials: dict) -> None:
+    """``[[particles]]`` (a ParticleSystem with its emitter, forces, colliders, style, blending) and ``[[cloth]]``
+    (``frustum.cloth`` with its material and colliders) added to `scene`; ``[animation].warmup`` steps them."""
+    simulation = importlib.import_module("frustum.simulation")
+    for i, entry in enumerate(_table_list(report, ("particles",), data.get("particles", []))):
+        path, params = ("particles", i), dict(entry)
+        if "emitter" not in params:
+            report.missing((*path, "emitter"), "give an emitter = { type = 'point', position = [x, y, z] }")
+            continue
+        emitter = _typed(report, (*path, "emitter"), params["emitter"], _EMITTERS)
+        forces = _typed_list(report, (*path, "forces"), params.get("forces", []), _FORCES)
+        colliders = _typed_list(report, (*path, "colliders"), params.get("colliders", []), _COLLIDERS)
+        style = _choice(report, (*path, "style"), params.get("style", "sprites"), ("sprites", "points", "streaks"))
+        blending = _choice(report, (*path, "blending"), params.get("blending", "additive"), ("additive", "alpha"))
+        if _bad(emitter, forces, colliders, style, blending):
+            continue
+        build = functools.partial(simulation.ParticleSystem, emitter=emitter, forces=forces, colliders=colliders)
+        system = _call(report, path, build, params, label="ParticleSystem", skip=_PARTICLE_KEYS)
+        if system is not _BAD:
+            scene.add_particles(system, style=style, blending=blending)
+    for i, entry in enumerate(_table_list(report, ("cloth",), data.get("cloth", []))):
+        path, params = ("cloth", i), dict(entry)
+        material = _material_reference(report, (*path, "material"), params["material"], materials) \
+            if "material" in params else None  # fmt: skip
+        colliders = _typed_list(report, (*path, "colliders"), params.get("colliders", []), _COLLIDERS)
+        name = params.get("name", "")
+        if not isinstance(name, str):
+            report.add((*path, "name"), name, "is not a string", "give a node name in quotes")
+            continue
+        if _bad(material, colliders):
+            continue
+        build = functools.partial(simulation.cloth, colliders=colliders)
+        system = _call(report, path, build, params, label="cloth", skip=_CLOTH_KEYS)
+        if system is not _BAD:
+            scene.add_mass_spring(system, material, name=name)
+
+
+def _warm_up(report: _Report, scene: Scene, animation: dict) -> None:
+    """Step the simulations ``[animation].warmup`` seconds (in steps of ``1/(fps·substeps)``) before any frame."""
+    warmup = animation.get("warmup", 0.0)
+    if not warmup or not (scene.particle_layers or scene.mass_springs):
+        return
+    step_scene = importlib.import_module("frustum.output.simulate").step_scene
+    dt = 1.0 / (animation.get("fps", 12.0) * animation.get("substeps", 1))
+    try:
+        step_scene(scene, dt, round(warmup / dt))
+    except FrustumError as error:
+        report.refused(("animation", "warmup"), warmup, error)
+
+
 def _outputs(report: _Report, data: dict, base: Path) -> tuple[tuple[Path, ...], dict, dict]:
     outputs: list[Path] = []
     if "output" in data:
@@ -1591,7 +1678,12 @@ def _outputs(report: _Report, data: dict, base: Path) -> tuple[tuple[Path, ...],
         path = ("animation",)
         params = _table(report, path, data["animation"])
         if params is not _BAD:
-            _unknown_keys(report, path, params, ("frames", "fps", "axis"))
+            _unknown_keys(report, path, params, ("frames", "fps", "axis", "substeps", "warmup"))
+            if "substeps" in params:
+                animation["substeps"] = _number(report, (*path, "substeps"), params["substeps"], low=1, high=1000,
+                                                integer=True)  # fmt: skip
+            if "warmup" in params:
+                animation["warmup"] = _number(report, (*path, "warmup"), params["warmup"], low=0.0, high=3600.0)
             if "frames" in params:
                 animation["frames"] = _number(report, (*path, "frames"), params["frames"], low=1, high=3600,
                                               integer=True)  # fmt: skip
@@ -1837,6 +1929,7 @@ def _build(report: _Report, data: dict, base: Path) -> SceneFile | None:
         if node is not _BAD:
             scene.add(node)
     scene = _explode_and_cut(report, data, scene)
+    _simulations(report, data, scene, materials)
     cameras: list[Camera] = []
     stereo = None
     if "camera" in data and "cameras" in data:
@@ -1863,6 +1956,8 @@ def _build(report: _Report, data: dict, base: Path) -> SceneFile | None:
         report.missing(("camera",), "add a [camera] table with eye and target (or [[cameras]])")
     outputs, animation, svg = _outputs(report, data, base)
     _check_image_memory(report, options, size, max(len(cameras), 1))
+    if not report.problems:
+        _warm_up(report, scene, animation)
     if report.problems:
         return None
     title = data.get("title", "")
@@ -1927,6 +2022,12 @@ def _write(scene_file: SceneFile, target: Path) -> Path:
     except ImportError:
         raise OutputError("render_scene_file: GIF/MP4 output is not available in this version") from None
     settings = {"frames": 36, "fps": 12.0, **scene_file.animation}
+    if scene_file.scene.particle_layers or scene_file.scene.mass_springs:  # [[particles]] / [[cloth]]: simulate
+        simulate = importlib.import_module("frustum.output.simulate").simulate
+        simulate(scene_file.scene, camera, int(settings["frames"]), fps=settings["fps"],
+                 substeps=int(settings.get("substeps", 1)), path=target, progress=False,
+                 **scene_file.options)  # fmt: skip
+        return target
     animation.turntable(scene_file.scene, camera, settings["frames"], settings.get("axis"), target,
                         settings["fps"], progress=False, **scene_file.options)  # fmt: skip
     return target
