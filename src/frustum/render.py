@@ -377,12 +377,12 @@ def _draw_surfaces(
     offsets = np.cumsum([0] + [item.mesh.face_count for item in items])
     drawn = []
     for index in opaque:
-        world, normals = _draw_item(items[index], camera, options.cull, int(offsets[index]), depth, codes, bary,
-                                    scratch)  # fmt: skip
-        drawn.append((index, world, normals))
-    for index, world, normals in drawn:
+        world, normals, rows = _draw_item(items[index], camera, options.cull, int(offsets[index]), depth, codes,
+                                          bary, scratch)  # fmt: skip
+        drawn.append((index, world, normals, rows))
+    for index, world, normals, rows in drawn:
         _shade_item(items[index], index, int(offsets[index]), camera, options, ambient, lights, world, normals,
-                    depth, codes, bary, color, extra, blend=False)  # fmt: skip
+                    depth, codes, bary, color, extra, rows, blend=False)  # fmt: skip
     if clear_items:
         axis = np.asarray(camera.frame.n, dtype=np.float64)
         eye = np.asarray(camera.frame.eye, dtype=np.float64)
@@ -399,11 +399,11 @@ def _draw_surfaces(
             item = items[index]
             layer_depth = depth.copy()
             layer_codes = np.full((height, width), -1, dtype=code_type)
-            world, normals = _draw_item(
+            world, normals, rows = _draw_item(
                 item, camera, options.cull, int(offsets[index]), layer_depth, layer_codes, bary, scratch
             )
             _shade_item(item, index, int(offsets[index]), camera, options, ambient, lights, world, normals,
-                        layer_depth, layer_codes, bary, color, extra, blend=True)  # fmt: skip
+                        layer_depth, layer_codes, bary, color, extra, rows, blend=True)  # fmt: skip
     return depth, color
 
 
@@ -435,10 +435,16 @@ def _item_flags(
 def _shade_item(
     item: SceneItem, index: int, face_offset: int, camera: Camera, options: _Options, ambient: np.ndarray,
     lights: np.ndarray, world: np.ndarray, normals: np.ndarray, depth: np.ndarray, codes: np.ndarray,
-    bary: np.ndarray, color: np.ndarray, extra: tuple[np.ndarray, np.ndarray], blend: bool,
+    bary: np.ndarray, color: np.ndarray, extra: tuple[np.ndarray, np.ndarray], rows: tuple[int, int], blend: bool,
 ) -> None:  # fmt: skip
-    """Stage 5 for one item: shade its pixels (the background is painted when the buffers are cleared)."""
+    """Stage 5 for one item: shade its pixels (the background is painted when the buffers are cleared), scanning
+    only the image rows [rows[0], rows[1]) its tiles cover (a scene of many small meshes shades each in its band)."""
     mesh, material = item.mesh, item.material
+    write_normals = extra[0].shape[:2] == codes.shape
+    write_ids = extra[1].shape == codes.shape
+    band = slice(*rows)
+    depth, codes, bary, color = depth[band], codes[band], bary[band], color[band]
+    extra = (extra[0][band] if write_normals else extra[0], extra[1][band] if write_ids else extra[1])
     params = _shading_parameters(item, camera, options, ambient)
     mode = options.shade_mode
     faces = _world_faces(item) if mesh.face_count else np.empty((0, 3), dtype=np.int64)
@@ -462,8 +468,7 @@ def _shade_item(
         texture, uvs = np.empty((0, 0, 4), dtype=np.float32), np.empty((0, 2))
     else:
         uvs = np.ascontiguousarray(uvs, dtype=np.float64)
-    write_normals = extra[0].shape[:2] == codes.shape
-    flags = _item_flags(index, face_offset, options, blend, write_normals, extra[1].shape == codes.shape)
+    flags = _item_flags(index, face_offset, options, blend, write_normals, write_ids)
     shade.shade_pixels(depth, codes, bary, faces, world, normals, lit, vertex_colors, uvs, texture, params, lights,
                        flags, color, extra[0], extra[1])  # fmt: skip
 
@@ -472,7 +477,8 @@ def _world_faces(item: SceneItem) -> np.ndarray:
     """The item's faces, counter-clockwise seen from the front *after* its modeling transform: a transform that
     swaps handedness (det < 0, e.g. a reflection) turns the winding around, so corners 1 and 2 are swapped."""
     faces = item.mesh.faces
-    if np.linalg.det(np.asarray(item.world_from_model)[:3, :3]) < 0.0:
+    (a, b, c), (d, e, f), (g, h, i) = np.asarray(item.world_from_model)[:3, :3].tolist()
+    if a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g) < 0.0:  # det < 0
         return np.ascontiguousarray(faces[:, [0, 2, 1]])
     return faces
 
@@ -513,19 +519,24 @@ def _page_aligned(shape: tuple[int, ...], dtype: Any) -> np.ndarray:
 def _draw_item(
     item: SceneItem, camera: Camera, cull: bool, face_offset: int,
     depth: np.ndarray, codes: np.ndarray, bary: np.ndarray, scratch: Scratch,
-) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
-    """Stages 1–4 for one placed mesh into the buffers; returns its world positions and unit world normals."""
+) -> tuple[np.ndarray, np.ndarray, tuple[int, int]]:  # fmt: skip
+    """Stages 1–4 for one placed mesh into the buffers; returns its world positions, unit world normals and the
+    image rows [first, last) of the tiles it touches."""
     mesh = item.mesh
     if mesh.face_count == 0:
-        return np.empty((0, 3)), np.empty((0, 3))
+        return np.empty((0, 3)), np.empty((0, 3)), (0, 0)
     binned = bin_item(item, camera, cull, face_offset, scratch)
+    used = np.flatnonzero(np.diff(binned.tile_starts)) // binned.tiles_x  # tile rows, window y up
+    height = depth.shape[0]
+    rows = (0, 0) if used.size == 0 else (max(height - (int(used[-1]) + 1) * TILE_SIZE, 0),
+                                          min(height - int(used[0]) * TILE_SIZE, height))  # fmt: skip
     tiling = np.array([TILE_SIZE, binned.tiles_x, face_offset], dtype=np.int64)
     triangles.rasterize_tiles(
         binned.faces, binned.win_int, binned.win_float, binned.tri_int, binned.tri_float, binned.tri_weights,
         binned.tile_starts, binned.tile_entries, tiling, depth, codes, bary,
     )  # fmt: skip
     scratch.recycle(binned.win_int, binned.win_float, binned.vertex_codes, binned.tile_entries)
-    return _world_attributes(item, scratch)
+    return (*_world_attributes(item, scratch), rows)
 
 
 def _world_attributes(item: SceneItem, scratch: Scratch) -> tuple[np.ndarray, np.ndarray]:

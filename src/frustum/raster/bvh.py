@@ -172,7 +172,7 @@ def _trace(lo, hi, triangles, order, origins, directions, t_out, face_out):
                                            directions[r, 0], directions[r, 1], directions[r, 2])  # fmt: skip
 
 
-@parallel_kernel(lambda lo, hi, triangles, order, origins, *_: origins.shape[0])
+@parallel_kernel(lambda lo, hi, triangles, order, origins, *_: origins.shape[0], grain=256)
 def _trace_parallel(lo, hi, triangles, order, origins, directions, t_out, face_out, start, stop):
     """``_trace_ray`` for each ray, parallel over rays."""
     for r in range(start, stop):
