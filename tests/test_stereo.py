@@ -15,7 +15,9 @@ from frustum.output.stereo import anaglyph, over_under, render_stereo, side_by_s
 from frustum.stereo import StereoCamera
 from oracles import assert_close, glm_matrix, glm_vec
 
-GLM_FLOAT32 = {"rtol": 1e-6, "atol": 1e-6}  # glm.frustumRH_NO builds float32 matrices (ORACLES trap 2)
+# glm.frustumRH_NO builds float32 matrices (ORACLES trap 2): each entry is a few float32 roundings (eps 1.2e-7)
+# away from the float64 one, e.g. 2n/(r - l) with an off-centre window differs by 1.3e-6 relative.
+GLM_FLOAT32 = {"rtol": 4e-6, "atol": 1e-6}
 
 fovys = st.floats(min_value=0.2, max_value=2.5)
 sizes = st.integers(min_value=16, max_value=1920)
