@@ -56,6 +56,7 @@ from frustum.raster import downsample, lines, shade, tiles, triangles
 from frustum.raster.vertices import project_vertices, transform_normals, transform_vertices, world_points
 from frustum.scene import Scene, SceneItem
 from frustum.shading import SPECULAR_MODELS, DepthCue, pack_lights
+from frustum.volume_pass import draw_volumes
 
 __all__ = ["HIDDEN_STYLES", "RENDER_MODES", "SHADING_MODES", "TILE_SIZE", "mesh_edges", "render"]
 
@@ -328,6 +329,7 @@ def _draw_surfaces(
     for index, world, normals in drawn:
         _shade_item(items[index], index, int(offsets[index]), camera, options, ambient, lights, world, normals,
                     depth, codes, bary, color, extra, blend=False)  # fmt: skip
+    draw_volumes(scene, camera, depth, color)  # rays stop at the opaque depth; before transparent items
     if clear_items:
         axis = np.asarray(camera.frame.n, dtype=np.float64)
         eye = np.asarray(camera.frame.eye, dtype=np.float64)
