@@ -252,7 +252,8 @@ class Scene:
             transfer_function = TransferFunction.preset("grayscale", (low, high) if low < high else (low, low + 1.0))
         elif not isinstance(transfer_function, TransferFunction):
             raise GeometryError(f"{where}: transfer_function = {describe(transfer_function)} is not a "
-                                "TransferFunction; build one with TransferFunction(values, colors, opacities)")  # fmt: skip
+                                "TransferFunction; build one with TransferFunction(values, colors, opacities)"
+                                )  # fmt: skip
         if not isinstance(mode, str) or mode not in VOLUME_MODES:
             raise GeometryError(f"{where}: mode = {describe(mode)} is unknown; expected one of "
                                 + ", ".join(repr(m) for m in VOLUME_MODES))  # fmt: skip
@@ -270,7 +271,9 @@ class Scene:
             try:
                 point, normal = plane
             except (TypeError, ValueError):
-                raise GeometryError(f"{where}: clip_planes[{index}] = {describe(plane)} is not (point, normal)") from None
+                raise GeometryError(
+                    f"{where}: clip_planes[{index}] = {describe(plane)} is not (point, normal)"
+                ) from None
             point = as_vector3(point, f"clip_planes[{index}] point", where=where, error=GeometryError)
             normal = as_vector3(normal, f"clip_planes[{index}] normal", where=where, error=GeometryError)
             if not np.linalg.norm(normal) > 0.0:

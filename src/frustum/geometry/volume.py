@@ -116,24 +116,26 @@ class TransferFunction:
             bad = np.argwhere(~np.isfinite(array))
             if bad.size:
                 index = tuple(int(i) for i in bad[0])
-                raise GeometryError(f"{where}: {name}[{', '.join(map(str, index))}] = {array[index]!r} is not "
+                raise GeometryError(f"{where}: {name}[{', '.join(map(str, index))}] = {float(array[index])!r} is not "
                                     "finite; expected finite numbers")  # fmt: skip
         steps = np.flatnonzero(np.diff(v) <= 0.0)
         if steps.size:
             i = int(steps[0])
-            raise GeometryError(f"{where}: values[{i + 1}] = {v[i + 1]!r} is not above values[{i}] = {v[i]!r}; "
+            after, before = float(v[i + 1]), float(v[i])
+            raise GeometryError(f"{where}: values[{i + 1}] = {after!r} is not above values[{i}] = {before!r}; "
                                 "control values must be sorted, strictly increasing")  # fmt: skip
         for name, array in (("colors", c), ("opacities", a)):
             bad = np.argwhere((array < 0.0) | (array > 1.0))
             if bad.size:
                 index = tuple(int(i) for i in bad[0])
-                raise GeometryError(f"{where}: {name}[{', '.join(map(str, index))}] = {array[index]!r} is outside "
+                label = ", ".join(map(str, index))
+                raise GeometryError(f"{where}: {name}[{label}] = {float(array[index])!r} is outside "
                                     "[0, 1]; colors and opacities are fractions in [0, 1]")  # fmt: skip
         low, high = (float(v[0]), float(v[-1])) if range is None else _range(range, where)
         outside = np.flatnonzero((v < low) | (v > high))
         if outside.size:
             i = int(outside[0])
-            raise GeometryError(f"{where}: values[{i}] = {v[i]!r} is outside range = ({low!r}, {high!r}); "
+            raise GeometryError(f"{where}: values[{i}] = {float(v[i])!r} is outside range = ({low!r}, {high!r}); "
                                 "control values must lie in the range")  # fmt: skip
         self.values, self.colors, self.opacities = read_only(v), read_only(c), read_only(a)
         self.range = (low, high)
@@ -185,7 +187,8 @@ class TransferFunction:
             import matplotlib
         except ImportError:
             raise GeometryError(f"{where}: name = {name!r} needs Matplotlib, which is not installed; "
-                                "pip install 'frustum[colormaps]', or use TransferFunction.preset") from None  # fmt: skip
+                                "pip install 'frustum[colormaps]', or use TransferFunction.preset"
+                                ) from None  # fmt: skip
         try:
             cmap = matplotlib.colormaps[name]
         except (KeyError, TypeError):
@@ -302,7 +305,8 @@ class Volume:
         self.data = array
 
     def __repr__(self) -> str:
-        return f"Volume(shape={self.shape}, spacing={tuple(self.spacing.tolist())}, origin={tuple(self.origin.tolist())})"
+        spacing, origin = tuple(self.spacing.tolist()), tuple(self.origin.tolist())
+        return f"Volume(shape={self.shape}, spacing={spacing}, origin={origin})"
 
     @property
     def shape(self) -> tuple[int, int, int]:
@@ -509,8 +513,9 @@ class Volume:
         if not data.flags.writeable:
             data = data.copy()
         check_memory(data.size * 40.0, where=where, cause=f"a grid of {data.shape}", error=GeometryError)
+        gradient = "descent" if inside == "above" else "ascent"
         verts, faces, _, _ = marching_cubes(data, value, spacing=tuple(stride * self.spacing),
-                                            gradient_direction="descent" if inside == "above" else "ascent")  # fmt: skip
+                                            gradient_direction=gradient)  # fmt: skip
         points = verts.astype(np.float64) @ self.direction.T + self.origin
         faces = faces.astype(np.int64)
         # skimage winds the faces clockwise seen from the side its gradient direction calls outside; the
@@ -627,7 +632,7 @@ def fbm_cloud(shape: Any = 64, *, octaves: int = 5, hurst: float = 0.5, frequenc
     axes = [np.linspace(0.0, 1.0, n) for n in counts]
     field = np.zeros(counts)
     for octave in range(count):
-        cells = int(round(base * 2**octave))
+        cells = round(base * 2**octave)
         lattice = rng.random((cells, cells, cells))
         coords = [a * cells for a in axes]
         index = [np.floor(c).astype(np.int64) for c in coords]

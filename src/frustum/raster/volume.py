@@ -60,12 +60,13 @@ M_GRID_FROM_WINDOW, M_MODEL_FROM_GRID, M_WINDOW_FROM_GRID, M_WORLD_FROM_GRID, M_
 B_MIN, B_MAX, B_EMPTY = 0, 1, 2
 
 
-@parallel_kernel
+@kernel
 def block_ranges(data, blocks):  # pragma: no cover - compiled
-    """Min and max of the (BLOCK + 1)³ grid points each block's cells touch, into ``blocks[..., :2]``."""
+    """Min and max of the (BLOCK + 1)³ grid points each block's cells touch, into ``blocks[..., :2]`` (serial:
+    one pass over the data, once per volume)."""
     nx, ny, nz = data.shape
     bx, by, bz = blocks.shape[0], blocks.shape[1], blocks.shape[2]
-    for b in prange(bx):
+    for b in range(bx):
         i0, i1 = b * BLOCK, min(b * BLOCK + BLOCK, nx - 1)
         for c in range(by):
             j0, j1 = c * BLOCK, min(c * BLOCK + BLOCK, ny - 1)
@@ -217,7 +218,7 @@ def _position(s0, ds, count, last, k):  # pragma: no cover - compiled
 def _composite(data, blocks, table, matrices, params, lights, origin, direction, s0, s1, ds, model_length,
                view_dir, out):  # pragma: no cover - compiled  # fmt: skip
     """Front-to-back compositing along one ray; (r, g, b, A) into `out`."""
-    count = int(math.ceil((s1 - s0) / ds))
+    count = math.ceil((s1 - s0) / ds)
     last = (s1 - s0) - (count - 1) * ds
     unit = params[P_UNIT]
     threshold = params[P_TERMINATE]
@@ -233,7 +234,7 @@ def _composite(data, blocks, table, matrices, params, lights, origin, direction,
         bi, bj, bk = _block_of(blocks, data, u[0], u[1], u[2])
         if blocks[bi, bj, bk, B_EMPTY] != 0.0:  # jump to the first sample at or past the block's exit
             exit_s = _block_exit(origin, direction, bi, bj, bk, data.shape)
-            k = max(k + 1, int(math.ceil((exit_s - s0) / ds - 0.5)))
+            k = max(k + 1, math.ceil((exit_s - s0) / ds - 0.5))
             continue
         value = _sample(data, u[0], u[1], u[2])
         alpha = _lookup(table, params, value, 3)
@@ -261,20 +262,20 @@ def _composite(data, blocks, table, matrices, params, lights, origin, direction,
 @kernel
 def _extreme(data, blocks, origin, direction, s0, s1, ds, sign):  # pragma: no cover - compiled
     """sign = +1: the largest sample along the ray (MIP); −1: the smallest (MinIP)."""
-    count = int(math.ceil((s1 - s0) / ds))
+    count = math.ceil((s1 - s0) / ds)
     last = (s1 - s0) - (count - 1) * ds
     best = -np.inf
     bound = B_MAX if sign > 0.0 else B_MIN
     k = 0
     while k < count:
-        s, seg = _position(s0, ds, count, last, k)
+        s = _position(s0, ds, count, last, k)[0]
         u0 = origin[0] + s * direction[0]
         u1 = origin[1] + s * direction[1]
         u2 = origin[2] + s * direction[2]
         bi, bj, bk = _block_of(blocks, data, u0, u1, u2)
         if sign * blocks[bi, bj, bk, bound] <= best:  # nothing in this block can beat the current extreme
             exit_s = _block_exit(origin, direction, bi, bj, bk, data.shape)
-            k = max(k + 1, int(math.ceil((exit_s - s0) / ds - 0.5)))
+            k = max(k + 1, math.ceil((exit_s - s0) / ds - 0.5))
             continue
         best = max(best, sign * _sample(data, u0, u1, u2))
         k += 1
@@ -284,7 +285,7 @@ def _extreme(data, blocks, origin, direction, s0, s1, ds, sign):  # pragma: no c
 @kernel
 def _average(data, origin, direction, s0, s1, ds):  # pragma: no cover - compiled
     """Length-weighted mean of the samples along the ray."""
-    count = int(math.ceil((s1 - s0) / ds))
+    count = math.ceil((s1 - s0) / ds)
     last = (s1 - s0) - (count - 1) * ds
     total, length = 0.0, 0.0
     for k in range(count):
@@ -298,27 +299,23 @@ def _average(data, origin, direction, s0, s1, ds):  # pragma: no cover - compile
 @kernel
 def _first_crossing(data, blocks, origin, direction, s0, s1, ds, level, bisections):  # pragma: no cover - compiled
     """Ray parameter of the first crossing of `level` (bisection between the samples around it), or −1."""
-    count = int(math.ceil((s1 - s0) / ds))
+    count = math.ceil((s1 - s0) / ds)
     last = (s1 - s0) - (count - 1) * ds
     previous_s, previous = s0, _sample(data, origin[0] + s0 * direction[0], origin[1] + s0 * direction[1],
                                        origin[2] + s0 * direction[2]) - level  # fmt: skip
     k = 0
     while k < count + 1:
-        if k < count:
-            s, seg = _position(s0, ds, count, last, k)
-        else:
-            s = s1
+        s = _position(s0, ds, count, last, k)[0] if k < count else s1
         u0, u1, u2 = origin[0] + s * direction[0], origin[1] + s * direction[1], origin[2] + s * direction[2]
         if k < count:
             bi, bj, bk = _block_of(blocks, data, u0, u1, u2)
             low, high = blocks[bi, bj, bk, B_MIN] - level, blocks[bi, bj, bk, B_MAX] - level
             if (previous < 0.0 and high < 0.0) or (previous > 0.0 and low > 0.0):  # the block stays on one side
                 exit_s = _block_exit(origin, direction, bi, bj, bk, data.shape)
-                k_next = int(math.ceil((exit_s - s0) / ds - 0.5))
+                k_next = math.ceil((exit_s - s0) / ds - 0.5)
                 if k_next > k + 1:
                     k = min(k_next, count) - 1  # keep the sample before the next block as `previous`
-                    s, seg = _position(s0, ds, count, last, k)
-                    previous_s = s
+                    previous_s = _position(s0, ds, count, last, k)[0]
                     k += 1
                     continue
         value = _sample(data, u0, u1, u2) - level
@@ -392,63 +389,70 @@ def cast_rays(mode, data, blocks, table, matrices, planes, params, lights, depth
     ``value = low + t / scale``; `matrices` (5, 4, 4) as the ``M_*`` constants; `planes` (P, 4) clip planes in
     grid coordinates; `params` (PARAMS,) as the ``P_*`` constants; `lights` (K, 16) from
     ``shading.pack_lights``; `depth` (H, W) float32 window depth (read; the isosurface mode writes its hits).
-    Rows of the buffers are stored top row first (row r is window y = H − 1 − r).
+    Rows of the buffers are stored top row first (row r is window y = H − 1 − r). Each row is one task; the
+    work of a row is ``_cast_row`` (compiled once, outside the parallel loop: short compile).
     """
+    for row in prange(depth.shape[0]):
+        _cast_row(mode, data, blocks, table, matrices, planes, params, lights, depth, color, row)
+
+
+@kernel
+def _cast_row(mode, data, blocks, table, matrices, planes, params, lights, depth, color, row):  # pragma: no cover
+    """Every pixel of image row `row` (see ``cast_rays``)."""
     height, width = depth.shape
     shape = np.array(data.shape, dtype=np.float64)
     model = matrices[M_MODEL_FROM_GRID]
     level = params[P_LEVEL]
-    for row in prange(height):
-        origin = np.empty(3)
-        direction = np.empty(3)
-        out = np.empty(4)
-        view_dir = np.empty(3)
-        y = height - 1 - row + 0.5
-        for column in range(width):
-            x = column + 0.5
-            s0, s1 = _ray(matrices, planes, shape, x, y, depth[row, column], origin, direction)
-            if not s0 < s1:
+    origin = np.empty(3)
+    direction = np.empty(3)
+    out = np.empty(4)
+    view_dir = np.empty(3)
+    u = np.empty(3)
+    y = height - 1 - row + 0.5
+    for column in range(width):
+        x = column + 0.5
+        s0, s1 = _ray(matrices, planes, shape, x, y, depth[row, column], origin, direction)
+        if not s0 < s1:
+            continue
+        d0 = model[0, 0] * direction[0] + model[0, 1] * direction[1] + model[0, 2] * direction[2]
+        d1 = model[1, 0] * direction[0] + model[1, 1] * direction[1] + model[1, 2] * direction[2]
+        d2 = model[2, 0] * direction[0] + model[2, 1] * direction[1] + model[2, 2] * direction[2]
+        model_length = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)  # model units per unit of s
+        ds = params[P_STEP] / model_length
+        world = matrices[M_WORLD_FROM_GRID]
+        for a in range(3):  # toward the eye: minus the ray direction, in world coordinates
+            view_dir[a] = -(world[a, 0] * direction[0] + world[a, 1] * direction[1] + world[a, 2] * direction[2])
+        vl = math.sqrt(view_dir[0] ** 2 + view_dir[1] ** 2 + view_dir[2] ** 2)
+        for a in range(3):
+            view_dir[a] /= vl
+        if mode == MODE_COMPOSITE:
+            _composite(data, blocks, table, matrices, params, lights, origin, direction, s0, s1, ds,
+                       model_length, view_dir, out)  # fmt: skip
+        elif mode == MODE_ISOSURFACE:
+            hit = _first_crossing(data, blocks, origin, direction, s0, s1, ds, level, int(params[P_BISECTIONS]))
+            if hit < 0.0:
                 continue
-            d0 = model[0, 0] * direction[0] + model[0, 1] * direction[1] + model[0, 2] * direction[2]
-            d1 = model[1, 0] * direction[0] + model[1, 1] * direction[1] + model[1, 2] * direction[2]
-            d2 = model[2, 0] * direction[0] + model[2, 1] * direction[1] + model[2, 2] * direction[2]
-            model_length = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)  # model units per unit of s
-            ds = params[P_STEP] / model_length
-            world = matrices[M_WORLD_FROM_GRID]
-            for a in range(3):  # toward the eye: minus the ray direction, in world coordinates
-                view_dir[a] = -(world[a, 0] * direction[0] + world[a, 1] * direction[1] + world[a, 2] * direction[2])
-            vl = math.sqrt(view_dir[0] ** 2 + view_dir[1] ** 2 + view_dir[2] ** 2)
             for a in range(3):
-                view_dir[a] /= vl
-            if mode == MODE_COMPOSITE:
-                _composite(data, blocks, table, matrices, params, lights, origin, direction, s0, s1, ds,
-                           model_length, view_dir, out)  # fmt: skip
-            elif mode == MODE_ISOSURFACE:
-                hit = _first_crossing(data, blocks, origin, direction, s0, s1, ds, level, int(params[P_BISECTIONS]))
-                if hit < 0.0:
-                    continue
-                u = np.empty(3)
-                for a in range(3):
-                    u[a] = origin[a] + hit * direction[a]
-                r = _lookup(table, params, level, 0)
-                g = _lookup(table, params, level, 1)
-                b = _lookup(table, params, level, 2)
-                out[0], out[1], out[2] = _shade(data, matrices, params, lights, u, view_dir, r, g, b)
-                out[3] = 1.0
-                wm = matrices[M_WINDOW_FROM_GRID]
-                zw = wm[2, 0] * u[0] + wm[2, 1] * u[1] + wm[2, 2] * u[2] + wm[2, 3]
-                ww = wm[3, 0] * u[0] + wm[3, 1] * u[1] + wm[3, 2] * u[2] + wm[3, 3]
-                depth[row, column] = min(depth[row, column], zw / ww)
+                u[a] = origin[a] + hit * direction[a]
+            r = _lookup(table, params, level, 0)
+            g = _lookup(table, params, level, 1)
+            b = _lookup(table, params, level, 2)
+            out[0], out[1], out[2] = _shade(data, matrices, params, lights, u, view_dir, r, g, b)
+            out[3] = 1.0
+            wm = matrices[M_WINDOW_FROM_GRID]
+            zw = wm[2, 0] * u[0] + wm[2, 1] * u[1] + wm[2, 2] * u[2] + wm[2, 3]
+            ww = wm[3, 0] * u[0] + wm[3, 1] * u[1] + wm[3, 2] * u[2] + wm[3, 3]
+            depth[row, column] = min(depth[row, column], zw / ww)
+        else:
+            if mode == MODE_AVERAGE:
+                value = _average(data, origin, direction, s0, s1, ds)
             else:
-                if mode == MODE_AVERAGE:
-                    value = _average(data, origin, direction, s0, s1, ds)
-                else:
-                    value = _extreme(data, blocks, origin, direction, s0, s1, ds, 1.0 if mode == MODE_MIP else -1.0)
-                alpha = _lookup(table, params, value, 3)
-                for c in range(3):
-                    out[c] = alpha * _lookup(table, params, value, c)
-                out[3] = alpha
-            under = 1.0 - out[3]
-            for c in range(4):
-                v = out[c] + under * (color[row, column, c] / 255.0)
-                color[row, column, c] = np.uint8(math.floor(min(max(v, 0.0), 1.0) * 255.0 + 0.5))
+                value = _extreme(data, blocks, origin, direction, s0, s1, ds, 1.0 if mode == MODE_MIP else -1.0)
+            alpha = _lookup(table, params, value, 3)
+            for c in range(3):
+                out[c] = alpha * _lookup(table, params, value, c)
+            out[3] = alpha
+        under = 1.0 - out[3]
+        for c in range(4):
+            v = out[c] + under * (color[row, column, c] / 255.0)
+            color[row, column, c] = np.uint8(math.floor(min(max(v, 0.0), 1.0) * 255.0 + 0.5))
