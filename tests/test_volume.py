@@ -462,3 +462,58 @@ def test_a_step_too_small_for_the_work_budget_raises_with_the_estimate():
 
 def test_termination_threshold_leaves_under_half_a_level():
     assert (1.0 - TERMINATE) * 255.0 < 0.5
+
+
+# --- scene files -------------------------------------------------------------------------------------------
+
+_VOLUME_SCENE = """
+[camera]
+eye = [0.0, 0.0, 4.0]
+target = [0.0, 0.0, 0.0]
+[[volumes]]
+source = { type = "blobby", centers = [[0.0, 0.0, 0.0]], radii = 0.5, shape = 24 }
+transfer_function = { preset = "fire", range = [0.0, 1.0], opacity = 0.5 }
+mode = "mip"
+step = 0.05
+transform = [{ translate = [0.5, 0.0, 0.0] }]
+clip_planes = [{ point = [0.0, 0.0, 0.0], normal = [0.0, 1.0, 0.0] }]
+"""
+
+
+def test_scene_file_volumes_place_a_volume_like_add_volume(tmp_path):
+    from frustum.scenefile import load_scene_file
+
+    (tmp_path / "scene.toml").write_text(_VOLUME_SCENE, encoding="utf-8")
+    loaded = load_scene_file(tmp_path / "scene.toml")
+    (item,) = loaded.scene.volumes
+    assert item.mode == "mip" and item.step == 0.05 and item.transfer_function.range == (0.0, 1.0)
+    np.testing.assert_allclose(item.world_from_model[:3, 3], [0.5, 0.0, 0.0])
+    np.testing.assert_allclose(item.clip_planes, [[[0, 0, 0], [0, 1, 0]]])
+    scene = f.Scene()
+    tf = TransferFunction.preset("fire", (0, 1), opacity=0.5)
+    scene.add_volume(blobby_volume([[0.0, 0.0, 0.0]], 0.5, 24), tf, mode="mip", step=0.05,
+                     transform=f.translate(0.5, 0, 0), clip_planes=[((0, 0, 0), (0, 1, 0))])  # fmt: skip
+    np.testing.assert_array_equal(f.render(loaded.scene, loaded.camera).color, f.render(scene, loaded.camera).color)
+
+
+@pytest.mark.parametrize(
+    ("replace", "line", "fragment"),
+    [
+        ('mode = "mip"', 8, "volumes[0].mode = 'xray' is unknown"),
+        ('type = "blobby"', 6, "volumes[0].source.type = 'cloud' is unknown"),
+        ('preset = "fire"', 7, "volumes[0].transfer_function.preset = 'lava' is not accepted"),
+        ("step = 0.05", 9, "volumes[0].step = -1 is out of range"),
+        ("radii = 0.5", 6, "volumes[0].source.radii = -0.5 is not accepted"),
+    ],
+)
+def test_scene_file_volume_errors_name_file_line_and_key(tmp_path, replace, line, fragment):
+    from frustum.errors import SceneFileError
+    from frustum.scenefile import load_scene_file
+
+    bad = {'mode = "mip"': 'mode = "xray"', 'type = "blobby"': 'type = "cloud"', 'preset = "fire"': 'preset = "lava"',
+           "step = 0.05": "step = -1", "radii = 0.5": "radii = -0.5"}[replace]  # fmt: skip
+    (tmp_path / "scene.toml").write_text(_VOLUME_SCENE.replace(replace, bad), encoding="utf-8")
+    with pytest.raises(SceneFileError) as caught:
+        load_scene_file(tmp_path / "scene.toml")
+    problems = getattr(caught.value, "problems", [str(caught.value)])
+    assert any(p.startswith(f"{tmp_path / 'scene.toml'}:{line}: ") and fragment in p for p in problems), problems

@@ -118,6 +118,7 @@ from frustum.geometry.volume import (
     Volume,
     blobby_volume,
     fbm_cloud,
+    head_phantom,
     quaternion_julia_volume,
 )
 
@@ -173,6 +174,7 @@ __all__ = [
     "fbm_terrain",
     "fractal_coastline",
     "grid",
+    "head_phantom",
     "heightfield_mesh",
     "hermite_blending",
     "hilbert_curve",

@@ -102,6 +102,39 @@ def _sample(data, u0, u1, u2):  # pragma: no cover - compiled
 
 
 @kernel
+def _cell(data, u0, u1, u2):  # pragma: no cover - compiled
+    """The cell (i, j, k) holding grid position u (clamped into the box) and the fractions (fx, fy, fz) in it."""
+    nx, ny, nz = data.shape
+    u0 = min(max(u0, 0.0), nx - 1.0)
+    u1 = min(max(u1, 0.0), ny - 1.0)
+    u2 = min(max(u2, 0.0), nz - 1.0)
+    i, j, k = min(int(u0), nx - 2), min(int(u1), ny - 2), min(int(u2), nz - 2)
+    return i, j, k, u0 - i, u1 - j, u2 - k
+
+
+@kernel
+def _trilinear(data, i, j, k, fx, fy, fz):  # pragma: no cover - compiled
+    """Trilinear interpolation inside cell (i, j, k) at fractions (fx, fy, fz)."""
+    c00 = data[i, j, k] * (1.0 - fz) + data[i, j, k + 1] * fz
+    c01 = data[i, j + 1, k] * (1.0 - fz) + data[i, j + 1, k + 1] * fz
+    c10 = data[i + 1, j, k] * (1.0 - fz) + data[i + 1, j, k + 1] * fz
+    c11 = data[i + 1, j + 1, k] * (1.0 - fz) + data[i + 1, j + 1, k + 1] * fz
+    c0 = c00 * (1.0 - fy) + c01 * fy
+    c1 = c10 * (1.0 - fy) + c11 * fy
+    return c0 * (1.0 - fx) + c1 * fx
+
+
+@kernel
+def _table_index(table, params, value):  # pragma: no cover - compiled
+    """Entry i and fraction t of `value` in the transfer-function table (clamped at the ends)."""
+    size = table.shape[0]
+    f = (value - params[P_TABLE_LOW]) * params[P_TABLE_SCALE]
+    f = min(max(f, 0.0), size - 1.0)
+    i = min(int(f), size - 2)
+    return i, f - i
+
+
+@kernel
 def _lookup(table, params, value, channel):  # pragma: no cover - compiled
     """One channel of the transfer-function table at `value` (linear between entries, clamped at the ends)."""
     size = table.shape[0]
@@ -227,25 +260,27 @@ def _composite(data, blocks, table, matrices, params, lights, origin, direction,
     u = np.empty(3)
     k = 0
     while k < count:
-        s, seg = _position(s0, ds, count, last, k)
+        s = s0 + (k + 0.5) * ds if k < count - 1 else s0 + (count - 1) * ds + 0.5 * last
         u[0] = origin[0] + s * direction[0]
         u[1] = origin[1] + s * direction[1]
         u[2] = origin[2] + s * direction[2]
-        bi, bj, bk = _block_of(blocks, data, u[0], u[1], u[2])
+        i, j, kk, fx, fy, fz = _cell(data, u[0], u[1], u[2])
+        bi, bj, bk = i // BLOCK, j // BLOCK, kk // BLOCK
         if blocks[bi, bj, bk, B_EMPTY] != 0.0:  # jump to the first sample at or past the block's exit
             exit_s = _block_exit(origin, direction, bi, bj, bk, data.shape)
             k = max(k + 1, math.ceil((exit_s - s0) / ds - 0.5))
             continue
-        value = _sample(data, u[0], u[1], u[2])
-        alpha = _lookup(table, params, value, 3)
+        value = _trilinear(data, i, j, kk, fx, fy, fz)
+        t_index, t = _table_index(table, params, value)
+        alpha = table[t_index, 3] * (1.0 - t) + table[t_index + 1, 3] * t
         if alpha > 0.0:
-            if k < count - 1:
-                alpha = _lookup(table, params, value, 4)  # corrected for Δ in the table
+            if k < count - 1:  # corrected for Δ in the table
+                alpha = table[t_index, 4] * (1.0 - t) + table[t_index + 1, 4] * t
             else:
-                alpha = 1.0 - (1.0 - alpha) ** (seg * model_length / unit)
-            r = _lookup(table, params, value, 0)
-            g = _lookup(table, params, value, 1)
-            b = _lookup(table, params, value, 2)
+                alpha = 1.0 - (1.0 - alpha) ** (last * model_length / unit)
+            r = table[t_index, 0] * (1.0 - t) + table[t_index + 1, 0] * t
+            g = table[t_index, 1] * (1.0 - t) + table[t_index + 1, 1] * t
+            b = table[t_index, 2] * (1.0 - t) + table[t_index + 1, 2] * t
             if shade:
                 r, g, b = _shade(data, matrices, params, lights, u, view_dir, r, g, b)
             weight = (1.0 - acc) * alpha
@@ -268,16 +303,15 @@ def _extreme(data, blocks, origin, direction, s0, s1, ds, sign):  # pragma: no c
     bound = B_MAX if sign > 0.0 else B_MIN
     k = 0
     while k < count:
-        s = _position(s0, ds, count, last, k)[0]
-        u0 = origin[0] + s * direction[0]
-        u1 = origin[1] + s * direction[1]
-        u2 = origin[2] + s * direction[2]
-        bi, bj, bk = _block_of(blocks, data, u0, u1, u2)
+        s = s0 + (k + 0.5) * ds if k < count - 1 else s0 + (count - 1) * ds + 0.5 * last
+        i, j, kk, fx, fy, fz = _cell(data, origin[0] + s * direction[0], origin[1] + s * direction[1],
+                                     origin[2] + s * direction[2])  # fmt: skip
+        bi, bj, bk = i // BLOCK, j // BLOCK, kk // BLOCK
         if sign * blocks[bi, bj, bk, bound] <= best:  # nothing in this block can beat the current extreme
             exit_s = _block_exit(origin, direction, bi, bj, bk, data.shape)
             k = max(k + 1, math.ceil((exit_s - s0) / ds - 0.5))
             continue
-        best = max(best, sign * _sample(data, u0, u1, u2))
+        best = max(best, sign * _trilinear(data, i, j, kk, fx, fy, fz))
         k += 1
     return sign * best
 
