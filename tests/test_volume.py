@@ -182,6 +182,15 @@ def test_shaded_composite_through_a_parallel_camera_and_a_transform_equals_refer
     _assert_close(frame.color, expected)
 
 
+def test_a_volume_seen_from_inside_equals_reference():
+    volume = _phantom(20)
+    camera = f.Camera.look_at((0.3, 0.2, 0.6), (-0.5, 0.0, -1.0), width=20, height=16)  # the eye is in the box
+    frame = _render(volume, camera, "composite", step=0.05)
+    expected = _reference(volume, _TF, "composite", camera, step=0.05)
+    _assert_close(frame.color, expected)
+    assert (frame.color[..., :3] > 0).all()  # every ray starts inside the volume
+
+
 def test_clip_plane_and_cutaway_cut_the_volume_as_the_reference_does():
     volume = _phantom(20)
     camera = f.Camera.look_at((0.5, 1.5, 3.0), (0.0, 0.0, 0.0), width=20, height=16)

@@ -12,13 +12,13 @@ per axis (no half-voxel border). Sources: arrays, ``.npy`` and NIfTI files (``Vo
 ``quadrics.sphere_implicit``), blobby objects (``blobby_volume``), fBm clouds (``fbm_cloud``) and the
 quaternion Julia set (``quaternion_julia_volume``).
 
-A ``TransferFunction`` maps a scalar s to color and opacity, both piecewise linear in s [HB 21]
-"Volume Visualization": ``(r, g, b, α)(s)`` interpolates the control rows around s and is constant past the
+A ``TransferFunction`` maps a scalar s to color and opacity, both piecewise linear in s [HB 15]
+"Visual Representations for Scalar Fields": ``(r, g, b, α)(s)`` interpolates the control rows around s and is constant past the
 first and last control value. The renderer samples it into a lookup table (``TransferFunction.table``).
 
 References
 ----------
-[HB 21] "Visualization of Scalar Fields" (volume visualization, isosurfaces); [HB 8] "Blobby Objects";
+[HB 15] "Visualization of Data Sets" (scalar fields: isosurfaces, volume rendering); [HB 13] "Blobby Objects";
 [HB 15] "Fractal-Geometry Methods"; [seed] "other modeling techniques" (volume rendering), fractal clouds.
 """
 
@@ -99,7 +99,7 @@ class TransferFunction:
 
     References
     ----------
-    [HB 21] "Volume Visualization" (assigning color and opacity to scalar values).
+    [HB 15] "Visual Representations for Scalar Fields" (color and opacity assigned to scalar values).
     """
 
     def __init__(self, values: ArrayLike, colors: ArrayLike, opacities: ArrayLike, range: Any = None) -> None:
@@ -271,7 +271,7 @@ class Volume:
 
     References
     ----------
-    [HB 21] "Visualization of Scalar Fields"; ITK "Image" (origin, spacing, direction).
+    [HB 15] "Visualization of Data Sets"; ITK "Image" (origin, spacing, direction).
     """
 
     def __init__(self, data: ArrayLike, spacing: ArrayLike = (1.0, 1.0, 1.0), origin: ArrayLike = (0.0, 0.0, 0.0),
@@ -494,7 +494,7 @@ class Volume:
 
         References
         ----------
-        [HB 21] "Isosurfaces"; Lorensen & Cline, "Marching cubes", SIGGRAPH 1987 (scikit-image implements
+        [HB 15] "Visual Representations for Scalar Fields" (isosurfaces); Lorensen & Cline, "Marching cubes", SIGGRAPH 1987 (scikit-image implements
         Lewiner et al. 2003).
         """
         from skimage.measure import marching_cubes
@@ -571,7 +571,7 @@ def _grid_points(low: NDArray, high: NDArray, counts: tuple[int, int, int]) -> N
 
 def blobby_volume(centers: ArrayLike, radii: ArrayLike, shape: Any = 64, *, strengths: ArrayLike | None = None,
                   bounds: ArrayLike | None = None) -> Volume:  # fmt: skip
-    """Blobby objects (metaballs): ``f(P) = Σ_k b_k · exp(−a_k·r_k²)`` with ``a_k = 1/R_k²`` [HB 8].
+    """Blobby objects (metaballs): ``f(P) = Σ_k b_k · exp(−a_k·r_k²)`` with ``a_k = 1/R_k²`` [HB 13] "Blobby Objects".
 
     `centers` (K, 3), `radii` (K,) R_k > 0, `strengths` (K,) b_k (default 1). The field is sampled on `shape`
     grid points over `bounds` (default the centres' box grown by 2·R). A blobby surface is its isosurface
@@ -698,15 +698,17 @@ def head_phantom(shape: Any = 64) -> Volume:
     """
     where = "head_phantom"
     low, high, counts = _grid(((-1, -1, -1), (1, 1, 1)), shape, where)
-    points = _grid_points(low, high, counts)
-    field = np.zeros(points.shape[0])
+    axes = [np.linspace(low[a], high[a], counts[a]) for a in range(3)]
+    y, z = np.meshgrid(axes[1], axes[2], indexing="ij")  # one x-slice at a time: memory of a few slices
+    field = np.zeros(counts, dtype=np.float32)
     voxel = 2.0 / (min(counts) - 1)
-    for x0, y0, z0, a, b, c, degrees, density in _HEAD_ELLIPSOIDS:
-        angle = math.radians(degrees)
-        d = points - (x0, y0, z0)
-        u = d[:, 0] * math.cos(angle) + d[:, 1] * math.sin(angle)
-        v = -d[:, 0] * math.sin(angle) + d[:, 1] * math.cos(angle)
-        radius = np.sqrt((u / a) ** 2 + (v / b) ** 2 + (d[:, 2] / c) ** 2)
-        # edges ramp over one voxel (distance ≈ (1 − radius)·smallest semi-axis): no staircase in the gradient
-        field += density * np.clip(0.5 + (1.0 - radius) * min(a, b, c) / voxel, 0.0, 1.0)
-    return Volume(np.clip(field, 0.0, 1.0).reshape(counts), (high - low) / (np.array(counts) - 1.0), low)
+    for i, x in enumerate(axes[0]):
+        for x0, y0, z0, a, b, c, degrees, density in _HEAD_ELLIPSOIDS:
+            angle = math.radians(degrees)
+            dx, dy, dz = x - x0, y - y0, z - z0
+            u = dx * math.cos(angle) + dy * math.sin(angle)
+            v = -dx * math.sin(angle) + dy * math.cos(angle)
+            radius = np.sqrt((u / a) ** 2 + (v / b) ** 2 + (dz / c) ** 2)
+            # edges ramp over one voxel (distance ≈ (1 − radius)·smallest semi-axis): no staircase in the gradient
+            field[i] += density * np.clip(0.5 + (1.0 - radius) * min(a, b, c) / voxel, 0.0, 1.0)
+    return Volume(np.clip(field, 0.0, 1.0), (high - low) / (np.array(counts) - 1.0), low)

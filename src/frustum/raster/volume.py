@@ -1,4 +1,5 @@
-"""Volume ray casting: one ray per pixel through a scalar grid, composited into a framebuffer [HB 21].
+"""Volume ray casting: one ray per pixel through a scalar grid, composited into a framebuffer [HB 15] "Visual
+Representations for Scalar Fields" (volume rendering); Levoy, "Display of surfaces from volume data", 1988.
 
 Per pixel (window centre (x + ½, y + ½), y up), in grid-index coordinates u (voxel (i, j, k) at u = (i, j, k)):
 
@@ -272,15 +273,16 @@ def _composite(data, blocks, table, matrices, params, lights, origin, direction,
             continue
         value = _trilinear(data, i, j, kk, fx, fy, fz)
         t_index, t = _table_index(table, params, value)
-        alpha = table[t_index, 3] * (1.0 - t) + table[t_index + 1, 3] * t
+        low, high = table[t_index], table[t_index + 1]
+        if k < count - 1:  # opacity corrected for Δ in the table (0 exactly where the raw opacity is 0)
+            alpha = low[4] * (1.0 - t) + high[4] * t
+        else:
+            alpha = low[3] * (1.0 - t) + high[3] * t
+            alpha = 1.0 - (1.0 - alpha) ** (last * model_length / unit) if alpha > 0.0 else 0.0
         if alpha > 0.0:
-            if k < count - 1:  # corrected for Δ in the table
-                alpha = table[t_index, 4] * (1.0 - t) + table[t_index + 1, 4] * t
-            else:
-                alpha = 1.0 - (1.0 - alpha) ** (last * model_length / unit)
-            r = table[t_index, 0] * (1.0 - t) + table[t_index + 1, 0] * t
-            g = table[t_index, 1] * (1.0 - t) + table[t_index + 1, 1] * t
-            b = table[t_index, 2] * (1.0 - t) + table[t_index + 1, 2] * t
+            r = low[0] * (1.0 - t) + high[0] * t
+            g = low[1] * (1.0 - t) + high[1] * t
+            b = low[2] * (1.0 - t) + high[2] * t
             if shade:
                 r, g, b = _shade(data, matrices, params, lights, u, view_dir, r, g, b)
             weight = (1.0 - acc) * alpha
