@@ -12,9 +12,9 @@ per axis (no half-voxel border). Sources: arrays, ``.npy`` and NIfTI files (``Vo
 ``quadrics.sphere_implicit``), blobby objects (``blobby_volume``), fBm clouds (``fbm_cloud``) and the
 quaternion Julia set (``quaternion_julia_volume``).
 
-A ``TransferFunction`` maps a scalar s to color and opacity, both piecewise linear in s [HB 15]
-"Visual Representations for Scalar Fields": ``(r, g, b, α)(s)`` interpolates the control rows around s and is constant past the
-first and last control value. The renderer samples it into a lookup table (``TransferFunction.table``).
+A ``TransferFunction`` maps a scalar s to color and opacity, both piecewise linear in s [HB 15] "Visual
+Representations for Scalar Fields": ``(r, g, b, α)(s)`` interpolates the control rows around s and is constant
+past the first and last control value. The renderer samples it into a lookup table (``TransferFunction.table``).
 
 References
 ----------
@@ -494,8 +494,8 @@ class Volume:
 
         References
         ----------
-        [HB 15] "Visual Representations for Scalar Fields" (isosurfaces); Lorensen & Cline, "Marching cubes", SIGGRAPH 1987 (scikit-image implements
-        Lewiner et al. 2003).
+        [HB 15] "Visual Representations for Scalar Fields" (isosurfaces); Lorensen & Cline, "Marching cubes",
+        SIGGRAPH 1987 (scikit-image implements Lewiner et al. 2003).
         """
         from skimage.measure import marching_cubes
 
