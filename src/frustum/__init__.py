@@ -6,6 +6,11 @@ coordinates with the camera looking down −z, left-handed normalized device coo
 
 __version__ = "0.1.0"
 
+import importlib
+import sys
+import types
+from typing import TYPE_CHECKING, Any
+
 from frustum.bsp import (
     BSPTree,
     DepthOrder,
@@ -165,24 +170,12 @@ from frustum.hidden_lines import (
     feature_edges,
     remove_hidden_lines,
 )
-from frustum.output.animation import (
-    turntable,
-    write_animation,
-)
 from frustum.output.sheet import (
     PAPER_SIZES,
     SHEET_VIEWS,
     STANDARD_SCALES,
     drawing_sheet,
     scale_label,
-)
-from frustum.output.stereo import (
-    ANAGLYPH_METHODS,
-    STEREO_LAYOUTS,
-    anaglyph,
-    over_under,
-    render_stereo,
-    side_by_side,
 )
 from frustum.output.svg import (
     FILL_ORDERS,
@@ -224,11 +217,6 @@ from frustum.quaternion import (
     Quaternion,
     slerp,
 )
-from frustum.render import (
-    RENDER_MODES,
-    SHADING_MODES,
-    render,
-)
 from frustum.scene import (
     Node,
     Placed,
@@ -236,15 +224,6 @@ from frustum.scene import (
     SceneItem,
     cutaway,
     exploded,
-)
-from frustum.scenefile import (
-    SceneFile,
-    explain_scene_file,
-    load_scene,
-    load_scene_file,
-    render_examples,
-    render_scene_file,
-    render_view_sheet,
 )
 from frustum.shading import (
     SPECULAR_MODELS,
@@ -297,6 +276,82 @@ from frustum.visibility import (
     signed_window_areas,
     viewing_position,
 )
+
+# The pipeline and everything above it load Numba and compile kernels on first use, so they are imported when one
+# of their names is first used (PEP 562): ``import frustum`` stays fast and never imports Numba.
+_LAZY = {
+    "set_threads": "frustum.raster._jit",
+    "warmup": "frustum.warmup",
+    "ANAGLYPH_METHODS": "frustum.output.stereo",
+    "RENDER_MODES": "frustum.render",
+    "SHADING_MODES": "frustum.render",
+    "STEREO_LAYOUTS": "frustum.output.stereo",
+    "SceneFile": "frustum.scenefile",
+    "anaglyph": "frustum.output.stereo",
+    "explain_scene_file": "frustum.scenefile",
+    "load_scene": "frustum.scenefile",
+    "load_scene_file": "frustum.scenefile",
+    "over_under": "frustum.output.stereo",
+    "release_memory": "frustum.render",
+    "render": "frustum.render",
+    "render_examples": "frustum.scenefile",
+    "render_scene_file": "frustum.scenefile",
+    "render_stereo": "frustum.output.stereo",
+    "render_view_sheet": "frustum.scenefile",
+    "side_by_side": "frustum.output.stereo",
+    "turntable": "frustum.output.animation",
+    "write_animation": "frustum.output.animation",
+}
+
+if TYPE_CHECKING:  # pragma: no cover
+    from frustum.output.animation import turntable, write_animation
+    from frustum.output.stereo import (
+        ANAGLYPH_METHODS,
+        STEREO_LAYOUTS,
+        anaglyph,
+        over_under,
+        render_stereo,
+        side_by_side,
+    )
+    from frustum.raster._jit import set_threads
+    from frustum.render import RENDER_MODES, SHADING_MODES, release_memory, render
+    from frustum.scenefile import (
+        SceneFile,
+        explain_scene_file,
+        load_scene,
+        load_scene_file,
+        render_examples,
+        render_scene_file,
+        render_view_sheet,
+    )
+    from frustum.warmup import warmup
+
+
+def __getattr__(name: str) -> Any:
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'frustum' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY))
+
+
+class _Package(types.ModuleType):
+    """``frustum`` itself: importing the submodule ``frustum.render`` must not replace the function ``render``
+    (the import system sets a package attribute for every submodule it loads)."""
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        if name in _LAZY and isinstance(value, types.ModuleType):
+            return
+        super().__setattr__(name, value)
+
+
+sys.modules[__name__].__class__ = _Package
+
 
 __all__ = [
     "ANAGLYPH_METHODS",
@@ -497,6 +552,7 @@ __all__ = [
     "quaternion_julia_volume",
     "reflect",
     "region_code",
+    "release_memory",
     "remove_hidden_lines",
     "render",
     "render_examples",
@@ -513,6 +569,7 @@ __all__ = [
     "scale",
     "scale_label",
     "set_budget",
+    "set_threads",
     "shear",
     "side_by_side",
     "sierpinski_ifs",
@@ -546,5 +603,6 @@ __all__ = [
     "uv_sphere",
     "viewing_position",
     "viewport",
+    "warmup",
     "write_animation",
 ]

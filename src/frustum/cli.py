@@ -22,6 +22,7 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
+import frustum.raster
 from frustum import __version__
 from frustum.camera import Camera
 from frustum.errors import FrustumError, GeometryError
@@ -407,12 +408,31 @@ def view_command(
     views: Annotated[str, typer.Option(help="Comma-separated views: front, top, right, left, rear, bottom, iso.")] = (
         "front,top,right,iso"
     ),
+    paper: Annotated[str, typer.Option(help="Sheet size: A4, A3, A2, A1, A0, Letter or Tabloid.")] = "A3",
+    orientation: Annotated[str, typer.Option(help="landscape or portrait.")] = "landscape",
+    angle: Annotated[str, typer.Option(help="Projection angle: third (US, ISO E) or first (ISO, Europe).")] = "third",
+    dimensions: Annotated[bool, typer.Option(help="Draw overall dimensions and diameters.")] = True,
 ) -> None:
-    """Draw the scene as an engineering sheet: orthographic views with hidden lines, title block and scale bar."""
+    """Draw the scene as an engineering sheet: orthographic views at the largest standard scale that fits, with
+    hidden lines, dimensions, title block and scale bar."""
     from frustum.scenefile import render_view_sheet
 
-    written = render_view_sheet(scene, output, tuple(v.strip() for v in views.split(",") if v.strip()))
+    written = render_view_sheet(
+        scene, output, tuple(v.strip() for v in views.split(",") if v.strip()),
+        paper=paper, orientation=orientation, projection_angle=angle, dimensions=dimensions,
+    )  # fmt: skip
     console.print(f"wrote {written}", markup=False, highlight=False, soft_wrap=True)
+
+
+@app.command("warmup")
+def warmup_command(
+    processes: Annotated[int | None, typer.Option(help="Parallel processes (default: the number of cores).")] = None,
+) -> None:
+    """Compile every kernel ahead of time into Numba's on-disk cache, so no later render waits for it."""
+    from frustum.warmup import warmup
+
+    error_console.print("compiling every kernel (once per environment) ...", markup=False)
+    console.print(str(warmup(processes)), markup=False, highlight=False)
 
 
 @app.command("examples")
@@ -444,10 +464,17 @@ def _fail(message: str, status: int) -> None:
     raise SystemExit(status)
 
 
+def _compile_notice() -> None:
+    """Told by the kernels once they have been compiling for a second (a first run in a new environment)."""
+    error_console.print("compiling render kernels, first run only (`frustum warmup` does it ahead of time) ...",
+                        markup=False, highlight=False)  # fmt: skip
+
+
 def main(arguments: Sequence[str] | None = None) -> None:
     """Entry point of the ``frustum`` console script: one-line errors, exit 1 (2 for usage), tracebacks on --debug."""
     argv = list(sys.argv[1:] if arguments is None else arguments)
     _STATE["debug"] = "--debug" in argv
+    frustum.raster.compile_notice = _compile_notice
     try:
         status = app(args=argv, prog_name="frustum", standalone_mode=False)
     except _CLICK_USAGE_ERROR as error:

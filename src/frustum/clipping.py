@@ -42,6 +42,7 @@ Viewing", which holds 3D clipping; [seed] is the lecture notes.
 
 from __future__ import annotations
 
+from types import ModuleType
 from typing import NamedTuple
 
 import numpy as np
@@ -49,7 +50,6 @@ from numpy.typing import ArrayLike, NDArray
 
 from frustum._arrays import Points, as_faces, as_homogeneous_points, as_matrix, as_points, describe
 from frustum.errors import ClippingError
-from frustum.raster import clip as _kernels
 
 __all__ = [
     "MAX_KERNEL_PLANES",
@@ -76,6 +76,14 @@ __all__ = [
     "trivially_accepted",
     "trivially_rejected",
 ]
+
+
+def _kernels() -> ModuleType:
+    """The compiled clipping kernels (``raster/clip.py``), imported on first use: ``import frustum`` never loads
+    Numba."""
+    from frustum.raster import clip
+
+    return clip
 
 REGION_LEFT = 1
 """Region-code bit 1: ``w + x < 0`` (x < −w)."""
@@ -350,7 +358,7 @@ def clip_line(
         return _cohen_sutherland(start, end, all_planes)
     if method == "cyrus-beck":
         return _cyrus_beck(start, end, all_planes)
-    u0, u1 = _kernels.clip_segment(start, end, all_planes)
+    u0, u1 = _kernels().clip_segment(start, end, all_planes)
     return _segment(start, end, u0, u1)
 
 
@@ -388,7 +396,7 @@ def clip_lines(p0s: ArrayLike, p1s: ArrayLike, planes: ArrayLike | None = None) 
     all_planes = _kernel_planes(planes, "clip_lines")
     clipped_starts, clipped_ends = np.empty_like(starts), np.empty_like(ends)
     parameters = np.empty((starts.shape[0], 2))
-    _kernels.clip_segments(starts, ends, all_planes, clipped_starts, clipped_ends, parameters)
+    _kernels().clip_segments(starts, ends, all_planes, clipped_starts, clipped_ends, parameters)
     return ClippedLines(clipped_starts, clipped_ends, parameters, parameters[:, 0] <= parameters[:, 1])
 
 
@@ -673,14 +681,14 @@ def clip_triangles(vertices_h: ArrayLike, faces: ArrayLike, planes: ArrayLike | 
     all_planes = _kernel_planes(planes, "clip_triangles")
     # trivial accept / reject from the vertices' region codes
     status = np.empty(triangles.shape[0], dtype=np.int8)
-    _kernels.classify_triangles(triangles, _kernel_codes(vertices, all_planes), status)
-    crossing = np.flatnonzero(status == _kernels.TRIANGLE_CROSSING)
+    _kernels().classify_triangles(triangles, _kernel_codes(vertices, all_planes), status)
+    crossing = np.flatnonzero(status == _kernels().TRIANGLE_CROSSING)
     # Sutherland–Hodgman on the rest
     capacity = 3 + all_planes.shape[0]
     positions = np.empty((crossing.size, capacity, 4))
     weights = np.empty((crossing.size, capacity, 3))
     counts = np.empty(crossing.size, dtype=np.int64)
-    _kernels.clip_crossing_triangles(vertices, triangles, crossing, all_planes, positions, weights, counts)
+    _kernels().clip_crossing_triangles(vertices, triangles, crossing, all_planes, positions, weights, counts)
     counts[counts < 3] = 0  # points and slivers have no area
     return _assemble(vertices, triangles, status, crossing, positions, weights, counts)
 
@@ -702,10 +710,10 @@ def _assemble(
     new_rows, new_slots = np.nonzero(new)
     index[new_rows, new_slots] = vertices.shape[0] + np.arange(new_rows.size)
     # fan (0, i, i + 1) of each polygon, placed where its source triangle was
-    face_count = int(np.count_nonzero(status == _kernels.TRIANGLE_INSIDE) + np.maximum(counts - 2, 0).sum())
+    face_count = int(np.count_nonzero(status == _kernels().TRIANGLE_INSIDE) + np.maximum(counts - 2, 0).sum())
     out_faces = np.empty((face_count, 3), dtype=np.int64)
     face_sources = np.empty(face_count, dtype=np.int64)
-    _kernels.assemble_faces(triangles, status, index, counts, out_faces, face_sources)
+    _kernels().assemble_faces(triangles, status, index, counts, out_faces, face_sources)
     return ClippedTriangles(
         vertices=np.concatenate([vertices, positions[new_rows, new_slots]]),
         faces=out_faces,
@@ -720,7 +728,7 @@ def _assemble(
 
 def _kernel_codes(points: NDArray, planes: NDArray) -> NDArray[np.int64]:
     codes = np.empty(points.shape[0], dtype=np.int64)
-    _kernels.region_codes(points, planes, codes)
+    _kernels().region_codes(points, planes, codes)
     return codes
 
 

@@ -3,9 +3,10 @@
 The seed's object-space methods compare objects with each other "to float data precision", independent of any
 pixel grid. For line drawings that means: for every drawn edge, find the parts that other faces hide.
 
-1. **Edges to draw.** From each placed mesh: *boundary* edges (one adjacent face), *creases* (the angle between
-   the two adjacent unit world normals exceeds ``crease_angle``), *silhouettes* (one adjacent face front-facing,
-   the other not, by the plane test against the centre of projection) or *all* edges; and the segments of
+1. **Edges to draw.** From each placed mesh, faces adjacent by shared vertex positions: *boundary* edges (one
+   adjacent face), *creases* (the angle between the two adjacent unit world normals exceeds ``crease_angle``),
+   *silhouettes* (one adjacent face front-facing, the other not, by the plane test against the centre of
+   projection) — never between coplanar neighbours (``COPLANAR_ANGLE``) — or *all* edges; and the segments of
    every ``Polyline`` (curves, control polygons), which faces hide but which hide nothing.
 2. **Clip.** Edges (Liang–Barsky) and occluding triangles (Sutherland–Hodgman) are clipped in homogeneous clip
    space against the view volume, so edges that cross the near plane or pass behind the eye keep only their
@@ -35,8 +36,10 @@ References
 from __future__ import annotations
 
 import math
+import weakref
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
+from types import ModuleType
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -47,9 +50,9 @@ from frustum.camera import Camera
 from frustum.clipping import clip_lines, clip_triangles
 from frustum.errors import FrustumError, GeometryError
 from frustum.geometry import Mesh, Polyline
-from frustum.raster._jit import kernel, parallel_kernel, prange
 
 __all__ = [
+    "COPLANAR_ANGLE",
     "EDGE_BOUNDARY",
     "EDGE_CREASE",
     "EDGE_KINDS",
@@ -59,6 +62,14 @@ __all__ = [
     "feature_edges",
     "remove_hidden_lines",
 ]
+
+
+def _kernels() -> ModuleType:
+    """The compiled kernels of this module (``raster/hidden_lines.py``), imported on first use: ``import frustum``
+    never loads Numba."""
+    from frustum.raster import hidden_lines
+
+    return hidden_lines
 
 EDGE_BOUNDARY = 1
 """Edge-kind bit: the edge has one adjacent face (or more than two: a non-manifold edge)."""
@@ -92,6 +103,21 @@ _GAP_FRACTION = 1e-7
 _POINT_FRACTION = 1e-12
 # A face whose |(P1 − P0) × (P2 − P0)| is below this fraction of its longest squared edge has no normal.
 _DEGENERATE_FRACTION = 1e-12
+# Two neighbouring faces whose unit normals differ by at most this angle (radians) are coplanar: their shared
+# edge is never a crease or a silhouette, whatever crease_angle says, so a flat face split into triangles draws
+# no inner lines. 1e-4 rad covers float32 vertices (relative error 6e-8) on slivers up to ~1000:1, and is far
+# below the facet angle of any tessellated curved surface (2π/60000 for a 60000-segment circle).
+COPLANAR_ANGLE = 1e-4
+# A projected triangle whose doubled area is below this fraction of its longest squared window edge is seen
+# edge-on (height <= 1e-9 of its length): it hides nothing.
+_SLIVER_FRACTION = 1e-9
+# A face whose plane test det[a; b; c] is within this fraction of |a|·|b − a|·|c − a| is seen edge-on.
+_EDGE_ON_FRACTION = 1e-9
+# Round-off of a dihedral angle computed from float64 unit normals, radians.
+_ANGLE_ROUNDOFF = 1e-9
+# Vertices closer than this fraction of the mesh's extent are one vertex for the edge adjacency (meshes with
+# split vertices for flat normals or texture seams): positions are rounded to this grid before matching.
+_WELD_FRACTION = 1e-9
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -235,12 +261,15 @@ def feature_edges(
 ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
     """Every undirected edge of a triangle mesh with its adjacent faces and kind bits.
 
-    An edge is a *boundary* with one adjacent face (or more than two), a *crease* when its two unit face
-    normals n1, n2 satisfy ``n1·n2 < cos(crease_angle)``, a *silhouette* when exactly one of the two faces is
-    front-facing for `camera`. Front-facing is the plane test against the centre of projection, computed in
-    clip space as ``det[(x, y, w)_0; (x, y, w)_1; (x, y, w)_2] > 0`` (the signed window area times
-    ``w0·w1·w2``, valid also for corners behind the eye). Faces of zero area have no normal: their edges are
-    neither creases nor silhouettes.
+    Faces are adjacent when they share two vertex *positions* (``welded_faces``: split vertices at shading
+    seams do not make boundaries). An edge is a *boundary* with one adjacent face (or more than two), a
+    *crease* when the angle between its two unit face normals, ``atan2(|n1 × n2|, n1·n2)``, exceeds
+    `crease_angle`, a *silhouette* when exactly one of the two faces is front-facing for `camera`. Neighbours
+    within ``COPLANAR_ANGLE`` (1e-4 rad) of each other are coplanar: their edge is neither, so the triangles of
+    a flat face never draw lines between them. Front-facing is the plane test against the centre of
+    projection, computed in clip space as ``det[(x, y, w)_0; (x, y, w)_1; (x, y, w)_2] > 0`` (the signed
+    window area times ``w0·w1·w2``, valid also for corners behind the eye). Faces of zero area have no
+    normal: their edges are neither creases nor silhouettes.
 
     Parameters
     ----------
@@ -279,10 +308,17 @@ def _crease(value: Any, where: str) -> float:
 
 def front_facing(clip_from_world: Matrix4, points_world: NDArray, faces: NDArray) -> NDArray[np.bool_]:
     """(M,) True for faces whose front the camera sees: the plane test against the centre of projection, as
-    ``det[(x, y, w)_0; (x, y, w)_1; (x, y, w)_2] > 0`` of the corners' clip rows (valid behind the eye too)."""
+    ``det[(x, y, w)_0; (x, y, w)_1; (x, y, w)_2] > 0`` of the corners' clip rows (valid behind the eye too).
+
+    A face seen edge-on (``det = a·((b − a) × (c − a))`` within 1e-9 of ``|a|·|b − a|·|c − a|``, about 1e-9
+    rad) counts as not front-facing, whatever the round-off sign: the silhouette is then the boundary of the
+    front-facing region, the nearest of the edges that project onto the edge-on face's line.
+    """
     clip = points_world @ clip_from_world[[0, 1, 3], :3].T + clip_from_world[[0, 1, 3], 3]
     a, b, c = clip[faces[:, 0]], clip[faces[:, 1]], clip[faces[:, 2]]
-    return np.einsum("ij,ij->i", a, np.cross(b, c)) > 0.0  # det[a; b; c] = a·(b × c)
+    determinant = np.einsum("ij,ij->i", a, np.cross(b, c))  # det[a; b; c] = a·(b × c)
+    size = np.linalg.norm(a, axis=1) * np.linalg.norm(b - a, axis=1) * np.linalg.norm(c - a, axis=1)
+    return determinant > _EDGE_ON_FRACTION * size
 
 
 def _unit_normals(points: NDArray, faces: NDArray) -> tuple[NDArray, NDArray[np.bool_]]:
@@ -340,18 +376,58 @@ def classify_edges(
     kinds = np.where(counts != 2, EDGE_BOUNDARY, 0).astype(np.int64)
     normals, degenerate = _unit_normals(points, faces)
     other = np.maximum(second, 0)
-    both = (counts == 2) & ~degenerate[first] & ~degenerate[other]
-    cosine = (normals[first] * normals[other]).sum(axis=1)
-    kinds |= np.where(both & (cosine < math.cos(crease_angle)), EDGE_CREASE, 0)
+    # the dihedral angle from atan2(|n1 × n2|, n1 · n2): accurate near 0 and pi, where acos(n1 · n2) is not
+    n1, n2 = normals[first], normals[other]
+    angle = np.arctan2(np.linalg.norm(np.cross(n1, n2), axis=1), (n1 * n2).sum(axis=1))
+    # coplanar neighbours (within COPLANAR_ANGLE) share no drawn edge: neither crease nor silhouette
+    both = (counts == 2) & ~degenerate[first] & ~degenerate[other] & (angle > COPLANAR_ANGLE)
+    # "exceeds": by more than the normals' round-off, so a regular 12-gon prism (exactly 30°) has no creases
+    kinds |= np.where(both & (angle > crease_angle + _ANGLE_ROUNDOFF), EDGE_CREASE, 0)
     if facing is not None:
         kinds |= np.where(both & (facing[first] != facing[other]), EDGE_SILHOUETTE, 0)
     return kinds
 
 
+def welded_faces(points: NDArray, faces: NDArray) -> NDArray[np.int64]:
+    """(M, 3) faces re-indexed so that vertices at the same position (within 1e-9 of the extent) are one vertex.
+
+    Meshes often split a vertex where shading needs two normals (the rim of a cylinder's cap) or two texture
+    coordinates (a seam): by index those edges have one face each and would read as boundaries. The
+    representative of each position is its lowest index, so the result still indexes `points`. Positions are
+    rounded to a grid of 1e-9 of the extent; two copies of a vertex that straddle a grid line (round-off of
+    about 1e-9 of the extent exactly at a cell border) stay apart.
+    """
+    faces = np.asarray(faces, dtype=np.int64)
+    if points.shape[0] == 0:
+        return faces
+    low, high = points.min(axis=0), points.max(axis=0)
+    step = max(float((high - low).max()), 1e-300) * _WELD_FRACTION
+    keys = np.round((points - low) / step).astype(np.int64)
+    order = np.lexsort(keys.T[::-1])  # stable: equal positions keep index order, the lowest first
+    ordered = keys[order]
+    starts = np.concatenate([[True], (ordered[1:] != ordered[:-1]).any(axis=1)])
+    representative = np.empty(points.shape[0], dtype=np.int64)
+    representative[order] = order[np.flatnonzero(starts)][np.cumsum(starts) - 1]
+    return representative[faces]
+
+
+_WELDED: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _welded_adjacency(mesh: Mesh) -> EdgeAdjacency:
+    """The mesh's edges by shared vertex positions, computed once per mesh (welding in model space equals welding
+    after any affine modeling transform)."""
+    cached = _WELDED.get(mesh)
+    if cached is None:
+        faces = np.asarray(mesh.faces, dtype=np.int64)
+        cached = _WELDED[mesh] = edge_adjacency(welded_faces(mesh.vertices, faces), mesh.vertex_count)
+    return cached
+
+
 def _edges_of(
     points: NDArray, faces: NDArray, facing: NDArray[np.bool_] | None, crease_angle: float
 ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
-    adjacency = edge_adjacency(faces, points.shape[0])
+    adjacency = edge_adjacency(welded_faces(points, faces), points.shape[0])
     kinds = classify_edges(adjacency, points, faces, facing, crease_angle)
     return adjacency.edges, np.stack([adjacency.first, adjacency.second], axis=1), kinds
 
@@ -433,7 +509,9 @@ def remove_hidden_lines(
         points = mesh.vertices @ world_from_model[:3, :3].T + world_from_model[:3, 3]
         faces = np.asarray(mesh.faces, dtype=np.int64)
         facing = front_facing(clip_from_world, points, faces)
-        pairs, pair_faces, kinds = _edges_of(points, faces, facing, angle)
+        adjacency = _welded_adjacency(mesh)
+        kinds = classify_edges(adjacency, points, faces, facing, angle)
+        pairs, pair_faces = adjacency.edges, np.stack([adjacency.first, adjacency.second], axis=1)
         chosen = np.ones(kinds.shape, bool) if mask == 0 else (kinds & mask) != 0
         points_parts.append(points)
         faces_parts.append(faces + vertex_offset)
@@ -481,8 +559,13 @@ def _window_triangles(
         keep &= front_facing(np.asarray(camera.clip_from_world), points_world, faces)
     source = np.flatnonzero(keep)
     clipped = clip_triangles(points_clip, faces[source])
-    window = _to_window(clipped.vertices, camera)
-    return np.ascontiguousarray(window[clipped.faces]), source[clipped.face_sources]
+    window = _to_window(clipped.vertices, camera)[clipped.faces]
+    # a face seen edge-on projects to a sliver that covers nothing, but its plane's depth, interpolated over a
+    # round-off area, is noise that would hide the edges lying along it (a tessellated cylinder's silhouette)
+    sides = window[:, [1, 2, 0], :2] - window[:, :, :2]
+    area = np.abs(sides[:, 0, 0] * sides[:, 2, 1] - sides[:, 0, 1] * sides[:, 2, 0])
+    covers = area > _SLIVER_FRACTION * (sides**2).sum(axis=2).max(axis=1)
+    return np.ascontiguousarray(window[covers]), source[clipped.face_sources][covers]
 
 
 def _window_segments(
@@ -527,17 +610,17 @@ def _grid(occluders: NDArray, camera: Camera) -> tuple[NDArray[np.int64], NDArra
         columns = max(1, math.ceil(width / cell))
         rows = max(1, math.ceil(height / cell))
         grid = np.array([0.0, 0.0, cell, columns, rows])
-        _cell_range(low, high, grid, boxes)
+        _kernels()._cell_range(low, high, grid, boxes)
         entries = int(((boxes[:, 2] - boxes[:, 0] + 1) * (boxes[:, 3] - boxes[:, 1] + 1)).sum())
         if entries <= max(16 * count, 1 << 20) or columns * rows == 1:
             break
         cell *= 2.0
     counts = np.zeros(columns * rows + 1, dtype=np.int64)
-    _count_cells(boxes, columns, counts)
+    _kernels()._count_cells(boxes, columns, counts)
     cell_starts = np.zeros(columns * rows + 1, dtype=np.int64)
     np.cumsum(counts[:-1], out=cell_starts[1:])
     cell_triangles = np.empty(int(cell_starts[-1]), dtype=np.int64)
-    _fill_cells(boxes, columns, cell_starts.copy(), cell_triangles)
+    _kernels()._fill_cells(boxes, columns, cell_starts.copy(), cell_triangles)
     return cell_starts, cell_triangles, grid
 
 
@@ -552,9 +635,9 @@ def _hidden_intervals(
     low = segments[:, :, :2].min(axis=1)
     high = segments[:, :, :2].max(axis=1)
     boxes = np.empty((count, 4), dtype=np.int64)
-    _cell_range(low, high, grid, boxes)
+    _kernels()._cell_range(low, high, grid, boxes)
     tri_boxes = np.empty((occluders.shape[0], 4), dtype=np.int64)
-    _cell_range(occluders[:, :, :2].min(axis=1), occluders[:, :, :2].max(axis=1), grid, tri_boxes)
+    _kernels()._cell_range(occluders[:, :, :2].min(axis=1), occluders[:, :, :2].max(axis=1), grid, tri_boxes)
     lengths = np.hypot(segments[:, 1, 0] - segments[:, 0, 0], segments[:, 1, 1] - segments[:, 0, 1])
     seg = np.ascontiguousarray(segments[:, :, :3])
     tolerances = np.array([_DEPTH_TOLERANCE, _GAP_FRACTION * max(camera.width, camera.height)])
@@ -563,10 +646,10 @@ def _hidden_intervals(
     out = np.empty((0, 2))
     args = (seg, lengths, boxes, np.ascontiguousarray(edge_faces), occluders, occluder_faces, tri_boxes,
             cell_starts, cell_triangles, grid, tolerances)  # fmt: skip
-    _segment_intervals(*args, counts, offsets, out, 0)
+    _kernels()._segment_intervals(*args, counts, offsets, out, 0)
     np.cumsum(counts, out=offsets[1:])
     out = np.empty((int(offsets[-1]), 2))
-    _segment_intervals(*args, counts, offsets, out, 1)
+    _kernels()._segment_intervals(*args, counts, offsets, out, 1)
     return offsets, out
 
 
@@ -579,9 +662,9 @@ def _assemble(
     # visible = complement of the merged hidden intervals in [0, 1]
     per_edge = np.diff(offsets)
     visible_counts = np.zeros(count, dtype=np.int64)
-    _complement(offsets, hidden, visible_counts, np.empty((0, 2)), 0)
+    _kernels()._complement(offsets, hidden, visible_counts, np.empty((0, 2)), 0)
     visible_t = np.empty((int(visible_counts.sum()), 2))
-    _complement(offsets, hidden, visible_counts, visible_t, 1)
+    _kernels()._complement(offsets, hidden, visible_counts, visible_t, 1)
     visible_owner = np.repeat(np.arange(count), visible_counts)
     # drop visible slivers no longer than the gap
     lengths = np.hypot(segments[:, 1, 0] - segments[:, 0, 0], segments[:, 1, 1] - segments[:, 0, 1])
@@ -609,219 +692,3 @@ def _assemble(
 
 # --- kernels --------------------------------------------------------------------------------------------
 
-
-@kernel
-def _cell_range(low, high, grid, boxes):  # pragma: no cover - compiled
-    """Cell index ranges (column0, row0, column1, row1) of boxes [low, high], clamped to the grid."""
-    cell, columns, rows = grid[2], int(grid[3]), int(grid[4])
-    for i in range(low.shape[0]):
-        boxes[i, 0] = min(max(math.floor((low[i, 0] - grid[0]) / cell), 0), columns - 1)
-        boxes[i, 1] = min(max(math.floor((low[i, 1] - grid[1]) / cell), 0), rows - 1)
-        boxes[i, 2] = min(max(math.floor((high[i, 0] - grid[0]) / cell), 0), columns - 1)
-        boxes[i, 3] = min(max(math.floor((high[i, 1] - grid[1]) / cell), 0), rows - 1)
-
-
-@kernel
-def _count_cells(boxes, columns, counts):  # pragma: no cover - compiled
-    """Number of triangles per cell (each triangle counted in every cell of its box)."""
-    for i in range(boxes.shape[0]):
-        for row in range(boxes[i, 1], boxes[i, 3] + 1):
-            for column in range(boxes[i, 0], boxes[i, 2] + 1):
-                counts[row * columns + column] += 1
-
-
-@kernel
-def _fill_cells(boxes, columns, cursor, cell_triangles):  # pragma: no cover - compiled
-    """Triangle indices per cell, in triangle order (deterministic)."""
-    for i in range(boxes.shape[0]):
-        for row in range(boxes[i, 1], boxes[i, 3] + 1):
-            for column in range(boxes[i, 0], boxes[i, 2] + 1):
-                cell = row * columns + column
-                cell_triangles[cursor[cell]] = i
-                cursor[cell] += 1
-
-
-@kernel
-def _triangle_interval(a, b, tri, depth_tolerance):  # pragma: no cover - compiled
-    """(t0, t1) of segment a→b (window x, y, z) hidden by window triangle `tri`; t0 >= t1 when none.
-
-    Liang–Barsky on four linear inequalities in t: three edge functions ``σ·E_k(t) >= 0`` (inside the closed
-    projected triangle, σ its orientation) and ``z_a + t(z_b − z_a) − z_T(t) > 0`` (behind its plane), kept
-    only where the depth gap exceeds ε at one of its ends.
-    """
-    x0, y0, z0 = tri[0, 0], tri[0, 1], tri[0, 2]
-    x1, y1, z1 = tri[1, 0], tri[1, 1], tri[1, 2]
-    x2, y2, z2 = tri[2, 0], tri[2, 1], tri[2, 2]
-    area = (x1 - x0) * (y2 - y0) - (x2 - x0) * (y1 - y0)
-    if area == 0.0:
-        return 1.0, 0.0
-    sigma = 1.0 if area > 0.0 else -1.0
-    lo, hi = 0.0, 1.0
-    # barycentric numerators at both ends: E_12, E_20, E_01
-    e_a = np.empty(3)
-    e_b = np.empty(3)
-    for k in range(3):
-        i = (k + 1) % 3
-        j = (k + 2) % 3
-        xi, yi, xj, yj = tri[i, 0], tri[i, 1], tri[j, 0], tri[j, 1]
-        e_a[k] = (xj - xi) * (a[1] - yi) - (yj - yi) * (a[0] - xi)
-        e_b[k] = (xj - xi) * (b[1] - yi) - (yj - yi) * (b[0] - xi)
-    for k in range(3):
-        c0 = sigma * e_a[k]
-        c = sigma * (e_b[k] - e_a[k])
-        if c == 0.0:
-            if c0 < 0.0:
-                return 1.0, 0.0
-        elif c > 0.0:
-            lo = max(lo, -c0 / c)
-        else:
-            hi = min(hi, -c0 / c)
-        if lo >= hi:
-            return 1.0, 0.0
-    # depth of the plane at both ends (barycentric interpolation), then z_edge − z_plane > 0; the interval
-    # ends exactly where the edge pierces the plane, and counts only if somewhere in it the triangle lies
-    # more than the tolerance in front (an edge in the triangle's plane is never hidden by round-off)
-    za = (e_a[0] * z0 + e_a[1] * z1 + e_a[2] * z2) / area
-    zb = (e_b[0] * z0 + e_b[1] * z1 + e_b[2] * z2) / area
-    g0 = a[2] - za
-    g = (b[2] - zb) - g0
-    if g == 0.0:
-        if g0 <= 0.0:
-            return 1.0, 0.0
-    elif g > 0.0:
-        lo = max(lo, -g0 / g)
-    else:
-        hi = min(hi, -g0 / g)
-    if lo >= hi or max(g0 + lo * g, g0 + hi * g) <= depth_tolerance:
-        return 1.0, 0.0
-    return lo, hi
-
-
-@kernel
-def _row_span(a, b, grid, row, box):  # pragma: no cover - compiled
-    """First and last column of the cells in grid row `row` that the window segment a→b passes through.
-
-    The segment's part inside the row's band of y (the whole segment below the first / above the last row
-    of its box, which the box clamps to the grid) spans x from xa to xb; a slack of 1e-9 cells keeps a
-    crossing exactly on a cell border in both cells. Clamped to the segment's box columns.
-    """
-    cell = grid[2]
-    ax, ay = (a[0] - grid[0]) / cell, (a[1] - grid[1]) / cell
-    bx, by = (b[0] - grid[0]) / cell, (b[1] - grid[1]) / cell
-    band_lo = min(ay, by) if row == box[1] else max(float(row), min(ay, by))
-    band_hi = max(ay, by) if row == box[3] else min(float(row + 1), max(ay, by))
-    if by != ay:
-        xa = ax + (band_lo - ay) / (by - ay) * (bx - ax)
-        xb = ax + (band_hi - ay) / (by - ay) * (bx - ax)
-    else:
-        xa, xb = ax, bx
-    slack = 1e-9 * (abs(ax) + abs(bx) + 1.0)
-    first = math.floor(min(xa, xb) - slack)
-    last = math.floor(max(xa, xb) + slack)
-    return max(first, box[0]), min(last, box[2])
-
-
-@parallel_kernel
-def _segment_intervals(
-    seg, lengths, boxes, edge_faces, occluders, occluder_faces, tri_boxes, cell_starts, cell_triangles,
-    grid, tolerances, counts, offsets, out, write,
-):  # pragma: no cover - compiled  # fmt: skip
-    """Merged hidden intervals of every segment: counts them (write = 0) or writes them at offsets (write = 1).
-
-    Only the cells the segment passes through are visited (row by row, ``_row_span``), and each (segment,
-    triangle) pair once: in the first of those cells that the triangle's bounding box covers.
-    """
-    columns = int(grid[3])
-    depth_tolerance, gap_pixels = tolerances[0], tolerances[1]
-    for e in prange(seg.shape[0]):
-        r0, r1 = boxes[e, 1], boxes[e, 3]
-        capacity = 0
-        for row in range(r0, r1 + 1):
-            first, last = _row_span(seg[e, 0], seg[e, 1], grid, row, boxes[e])
-            for column in range(first, last + 1):
-                cell = row * columns + column
-                capacity += cell_starts[cell + 1] - cell_starts[cell]
-        starts = np.empty(capacity)
-        ends = np.empty(capacity)
-        n = 0
-        zmax = max(seg[e, 0, 2], seg[e, 1, 2])
-        xlo, xhi = min(seg[e, 0, 0], seg[e, 1, 0]), max(seg[e, 0, 0], seg[e, 1, 0])
-        ylo, yhi = min(seg[e, 0, 1], seg[e, 1, 1]), max(seg[e, 0, 1], seg[e, 1, 1])
-        before_first, before_last = 0, -1
-        for row in range(r0, r1 + 1):
-            first, last = _row_span(seg[e, 0], seg[e, 1], grid, row, boxes[e])
-            for column in range(first, last + 1):
-                cell = row * columns + column
-                for slot in range(cell_starts[cell], cell_starts[cell + 1]):
-                    t = cell_triangles[slot]
-                    # visit the pair only in the first cell on the segment's path inside the triangle's box:
-                    # not if an earlier cell of this row, or a cell of the row before, lies in the box
-                    if column > max(first, tri_boxes[t, 0]):
-                        continue
-                    if row > max(r0, tri_boxes[t, 1]) and max(before_first, tri_boxes[t, 0]) <= min(
-                        before_last, tri_boxes[t, 2]
-                    ):
-                        continue
-                    face = occluder_faces[t]
-                    if face == edge_faces[e, 0] or face == edge_faces[e, 1]:
-                        continue
-                    tri = occluders[t]
-                    if min(tri[0, 2], tri[1, 2], tri[2, 2]) >= zmax:
-                        continue  # wholly behind the edge
-                    if max(tri[0, 0], tri[1, 0], tri[2, 0]) < xlo or min(tri[0, 0], tri[1, 0], tri[2, 0]) > xhi:
-                        continue
-                    if max(tri[0, 1], tri[1, 1], tri[2, 1]) < ylo or min(tri[0, 1], tri[1, 1], tri[2, 1]) > yhi:
-                        continue
-                    lo, hi = _triangle_interval(seg[e, 0], seg[e, 1], tri, depth_tolerance)
-                    if hi > lo:
-                        starts[n] = lo
-                        ends[n] = hi
-                        n += 1
-            before_first, before_last = first, last
-        # union of the intervals: sort by start, merge overlaps and gaps below gap_pixels
-        order = np.argsort(starts[:n], kind="mergesort")
-        gap = gap_pixels / lengths[e]
-        merged_lo = np.empty(n)
-        merged_hi = np.empty(n)
-        merged = 0
-        for k in range(n):
-            lo = starts[order[k]]
-            hi = ends[order[k]]
-            if merged > 0 and lo <= merged_hi[merged - 1] + gap:
-                merged_hi[merged - 1] = max(merged_hi[merged - 1], hi)
-            else:
-                merged_lo[merged] = lo
-                merged_hi[merged] = hi
-                merged += 1
-        # snap ends within the gap of 0 and 1; drop hidden pieces no longer than the gap
-        kept = 0
-        for k in range(merged):
-            lo = merged_lo[k] if merged_lo[k] > gap else 0.0
-            hi = merged_hi[k] if merged_hi[k] < 1.0 - gap else 1.0
-            if hi - lo <= gap:
-                continue
-            if write == 1:
-                out[offsets[e] + kept, 0] = lo
-                out[offsets[e] + kept, 1] = hi
-            kept += 1
-        counts[e] = kept
-
-
-@kernel
-def _complement(offsets, hidden, counts, out, write):  # pragma: no cover - compiled
-    """Visible intervals of each segment: [0, 1] minus its sorted, disjoint hidden intervals (count or write)."""
-    cursor = 0
-    for e in range(offsets.shape[0] - 1):
-        lo = 0.0
-        count = 0
-        for k in range(offsets[e], offsets[e + 1] + 1):
-            hi = hidden[k, 0] if k < offsets[e + 1] else 1.0
-            if hi > lo:
-                if write == 1:
-                    out[cursor, 0] = lo
-                    out[cursor, 1] = hi
-                cursor += 1
-                count += 1
-            if k < offsets[e + 1]:
-                lo = hidden[k, 1]
-        counts[e] = count

@@ -42,7 +42,6 @@ import threading
 import weakref
 from typing import Any, ClassVar
 
-import numba
 import numpy as np
 
 from frustum._arrays import as_scalar, describe
@@ -52,13 +51,14 @@ from frustum.errors import FrustumError
 from frustum.frame import Frame
 from frustum.geometry import Mesh
 from frustum.hidden_lines import EdgeAdjacency, classify_edges, edge_adjacency, front_facing
-from frustum.raster import downsample, lines, shade, tiles, triangles
+from frustum.raster import lines, shade, tiles, triangles
+from frustum.raster._jit import threads
 from frustum.raster.vertices import project_vertices, transform_normals, transform_vertices, world_points
 from frustum.scene import Scene, SceneItem
 from frustum.shading import SPECULAR_MODELS, DepthCue, pack_lights
 from frustum.volume_pass import draw_volumes
 
-__all__ = ["HIDDEN_STYLES", "RENDER_MODES", "SHADING_MODES", "TILE_SIZE", "mesh_edges", "render"]
+__all__ = ["HIDDEN_STYLES", "RENDER_MODES", "SHADING_MODES", "TILE_SIZE", "mesh_edges", "release_memory", "render"]
 
 SHADING_MODES = {
     "phong": shade.SHADE_PHONG,
@@ -82,10 +82,6 @@ TILE_SIZE = 1 << TILE_BITS
 """Side of a square screen tile in pixels (32): the unit of parallel work of the rasterizer."""
 _BIN_CHUNK = 16384
 _HUGE_PAGE = 1 << 21
-_DYNAMIC_CHUNK = (2, 16)
-"""Dynamic scheduling (``numba.parallel_chunksize``) of the shading row blocks and of the tiles: threads take the
-next 2 blocks (16 tiles) when done, so a picture whose surfaces crowd one part of the image keeps every thread
-busy (static halves left one idle: 4-8 % of the frame on two threads)."""
 _EDGE_OFFSET = 1e-5
 """Window-depth offset of the hidden-line test (``raster.lines``), against stitching of edges into faces."""
 
@@ -151,6 +147,19 @@ class Scratch:
         with Scratch._lock:
             Scratch._pool = pool
         self.taken, self.free = [], {}
+
+
+def release_memory() -> int:
+    """Free the work arrays ``render`` keeps between calls (face codes, barycentrics, window records, tile lists
+    of the last frame: about 200 MiB after a 4096² frame); return how many bytes were released.
+
+    The next ``render`` allocates (and first-touches) them anew. Call it when a program that rendered large
+    frames goes on to other work.
+    """
+    with Scratch._lock:
+        released = sum(a.nbytes for arrays in Scratch._pool.values() for a in arrays)
+        Scratch._pool = {}
+    return released
 
 
 def render(
@@ -251,15 +260,11 @@ def render(
         color, depth, normals, ids = _render_buffers(scene, big, wide)
         h, w = camera.height, camera.width
         linear = None
-        if filter == "box" and color_space == "linear":  # exact in integers: floor(sum / s² + 1/2)
-            small = np.empty((h, w, 4), dtype=np.uint8)
-            downsample.resolve_color(color, factor, small)
-            color = small
+        if filter == "box" and color_space == "linear":
+            color = resolve_color(color, factor)
         else:
             linear = _downsample(color.astype(np.float64) / 255.0, factor, filter)
-        nearest = np.empty((h, w), dtype=np.float32)
-        downsample.resolve_depth(depth, factor, nearest)
-        depth = nearest
+        depth = depth.reshape(h, factor, w, factor).min(axis=(1, 3))
         middle = factor // 2
         normals = None if normals is None else np.ascontiguousarray(normals[middle::factor, middle::factor])
         ids = None if ids is None else np.ascontiguousarray(ids[middle::factor, middle::factor])
@@ -391,8 +396,7 @@ def _shade_item(
     faces = _world_faces(item) if mesh.face_count else np.empty((0, 3), dtype=np.int64)
     if not blend and _directional(item, options, lights):  # the same bytes without the general branches
         flags = _item_flags(index, face_offset, options, blend, False, False)
-        with numba.parallel_chunksize(_DYNAMIC_CHUNK[0]):
-            shade.shade_pixels_directional(depth, codes, bary, faces, world, normals, params, lights, flags, color)
+        shade.shade_pixels_directional(depth, codes, bary, faces, world, normals, params, lights, flags, color)
         return
     if mode == shade.SHADE_GOURAUD and mesh.face_count:
         lit = np.empty((mesh.vertex_count, 6))
@@ -468,11 +472,10 @@ def _draw_item(
         return np.empty((0, 3)), np.empty((0, 3))
     binned = bin_item(item, camera, cull, face_offset, scratch)
     tiling = np.array([TILE_SIZE, binned.tiles_x, face_offset], dtype=np.int64)
-    with numba.parallel_chunksize(_DYNAMIC_CHUNK[1]):
-        triangles.rasterize_tiles(
-            binned.faces, binned.win_int, binned.win_float, binned.tri_int, binned.tri_float, binned.tri_weights,
-            binned.tile_starts, binned.tile_entries, tiling, depth, codes, bary,
-        )  # fmt: skip
+    triangles.rasterize_tiles(
+        binned.faces, binned.win_int, binned.win_float, binned.tri_int, binned.tri_float, binned.tri_weights,
+        binned.tile_starts, binned.tile_entries, tiling, depth, codes, bary,
+    )  # fmt: skip
     scratch.recycle(binned.win_int, binned.win_float, binned.vertex_codes, binned.tile_entries)
     return _world_attributes(item, scratch)
 
@@ -535,7 +538,7 @@ def bin_item(
     project_vertices(mesh.vertices, clip_from_model, view, win_int, win_float, vertex_codes)
     # per face: reject / accept / crossing, cull, box, count its tiles (parallel over chunks of faces)
     tiles_x, tiles_y = -(-width // TILE_SIZE), -(-height // TILE_SIZE)
-    chunk_count = min(max(1, -(-faces.shape[0] // _BIN_CHUNK)), 4 * numba.get_num_threads())
+    chunk_count = min(max(1, -(-faces.shape[0] // _BIN_CHUNK)), 4 * threads())
     chunk = max(1, -(-faces.shape[0] // chunk_count))
     chunk_count = -(-faces.shape[0] // chunk)
     options = np.array([width, height, int(cull), TILE_BITS, tiles_x, chunk, face_offset], dtype=np.int64)
@@ -724,6 +727,15 @@ def _supersampling(samples: Any, where: str) -> int:
     if factor * factor != samples:
         raise FrustumError(f"{where}: samples = {samples} is not a perfect square; use 1, 4, 9 or 16")
     return factor
+
+
+def resolve_color(big: np.ndarray, factor: int) -> np.ndarray:
+    """Box-filter resolve in integers: (H·s, W·s, 4) uint8 → (H, W, 4) uint8, each channel the rounded mean of
+    its s×s block, ``floor(Σ/s² + 1/2) = (2·Σ + s²) // (2·s²)`` (exactly the rounded mean)."""
+    height, width = big.shape[0] // factor, big.shape[1] // factor
+    area = factor * factor
+    total = big.reshape(height, factor, width, factor, 4).sum(axis=(1, 3), dtype=np.uint32)
+    return ((2 * total + area) // (2 * area)).astype(np.uint8)
 
 
 def _downsample(values: np.ndarray, factor: int, kind: str) -> np.ndarray:

@@ -43,7 +43,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from frustum._arrays import Matrix4, Vector3, as_direction, as_scalar, as_vector3, describe, read_only
 from frustum.errors import ShadingError
-from frustum.raster.shade import power
+from frustum.raster.power import textbook_power as power
 from frustum.transforms import apply, apply_to_directions
 
 __all__ = [

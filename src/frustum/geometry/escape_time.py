@@ -18,6 +18,7 @@ References
 from __future__ import annotations
 
 import math
+from types import ModuleType
 from typing import Any
 
 import numpy as np
@@ -27,58 +28,16 @@ from frustum._arrays import as_scalar, describe
 from frustum.errors import GeometryError
 from frustum.geometry.fractals import DEFAULT_MAX_BYTES, _budget, _check_memory
 from frustum.geometry.mesh import Mesh
-from frustum.raster._jit import kernel, parallel_kernel, prange
 
 __all__ = ["escape_time_colors", "julia", "mandelbrot", "quaternion_julia", "quaternion_julia_mesh"]
 
 
-@kernel
-def _escape(zx, zy, cx, cy, max_iter, radius2, log_radius, smooth):  # pragma: no cover - compiled
-    """Iterate z ← z² + c from z; return the (smooth) escape time or inf."""
-    for n in range(max_iter):
-        x2 = zx * zx
-        y2 = zy * zy
-        if x2 + y2 > radius2:
-            if smooth:
-                return n + 1.0 - math.log2(0.5 * math.log(x2 + y2) / log_radius)
-            return float(n)
-        zy = 2.0 * zx * zy + cy
-        zx = x2 - y2 + cx
-    x2 = zx * zx
-    y2 = zy * zy
-    if x2 + y2 > radius2:
-        if smooth:
-            return max_iter + 1.0 - math.log2(0.5 * math.log(x2 + y2) / log_radius)
-        return float(max_iter)
-    return np.inf
+def _kernels() -> ModuleType:
+    """The compiled kernels of this module (``raster/escape_time.py``), imported on first use: ``import frustum``
+    never loads Numba."""
+    from frustum.raster import escape_time
 
-
-@kernel
-def _in_cardioid_or_bulb(x, y):  # pragma: no cover - compiled
-    """c in the main cardioid, q(q + x − ¼) <= y²/4 with q = (x − ¼)² + y², or the period-2 disc |c + 1| <= ¼.
-
-    Their orbits converge (to an attracting fixed point or 2-cycle), so they never escape: skipping them saves
-    max_iter iterations per interior pixel and changes no value.
-    """
-    xq = x - 0.25
-    q = xq * xq + y * y
-    if q * (q + xq) <= 0.25 * y * y:
-        return True
-    return (x + 1.0) * (x + 1.0) + y * y <= 0.0625
-
-
-@parallel_kernel
-def _escape_image(xs, ys, julia_mode, cx, cy, max_iter, radius2, smooth, out):  # pragma: no cover - compiled
-    """out[i, j] for the pixel at (xs[j], ys[i]); Mandelbrot (z₀ = 0, c = pixel) or Julia (z₀ = pixel)."""
-    log_radius = 0.5 * math.log(radius2)
-    for i in prange(ys.shape[0]):
-        for j in range(xs.shape[0]):
-            if julia_mode:
-                out[i, j] = _escape(xs[j], ys[i], cx, cy, max_iter, radius2, log_radius, smooth)
-            elif _in_cardioid_or_bulb(xs[j], ys[i]):
-                out[i, j] = np.inf
-            else:
-                out[i, j] = _escape(0.0, 0.0, xs[j], ys[i], max_iter, radius2, log_radius, smooth)
+    return escape_time
 
 
 def _window(value: Any, where: str) -> tuple[float, float, float, float]:
@@ -116,7 +75,7 @@ def _image(where: str, window: Any, width: Any, height: Any, max_iter: Any, esca
     ys = y1 - (np.arange(h) + 0.5) * ((y1 - y0) / h)
     out = np.empty((h, w))
     c = 0j if julia_c is None else julia_c
-    _escape_image(xs, ys, julia_c is not None, c.real, c.imag, iters, radius * radius, bool(smooth), out)
+    _kernels()._escape_image(xs, ys, julia_c is not None, c.real, c.imag, iters, radius * radius, bool(smooth), out)
     return out
 
 
@@ -194,29 +153,6 @@ def escape_time_colors(image: ArrayLike, *, period: float = 32.0, inside: ArrayL
 # ------------------------------------------------------------------------------------- quaternion Julia
 
 
-@parallel_kernel
-def _quaternion_field(xs, ys, zs, w, c, max_iter, radius2, out):  # pragma: no cover - compiled
-    """Smooth escape time of q ← q² + c from q₀ = (x, y, z, w) (components 1, i, j, k); max_iter inside."""
-    log_radius = 0.5 * math.log(radius2)
-    for a in prange(xs.shape[0]):
-        for b in range(ys.shape[0]):
-            for d in range(zs.shape[0]):
-                q0, q1, q2, q3 = xs[a], ys[b], zs[d], w
-                value = float(max_iter)
-                for n in range(max_iter):
-                    norm2 = q0 * q0 + q1 * q1 + q2 * q2 + q3 * q3
-                    if norm2 > radius2:
-                        value = min(n + 1.0 - math.log2(0.5 * math.log(norm2) / log_radius), float(max_iter))
-                        break
-                    # (s, v)² = (s² − v·v, 2 s v)
-                    s = q0
-                    q0 = s * s - q1 * q1 - q2 * q2 - q3 * q3 + c[0]
-                    q1 = 2.0 * s * q1 + c[1]
-                    q2 = 2.0 * s * q2 + c[2]
-                    q3 = 2.0 * s * q3 + c[3]
-                out[a, b, d] = value
-
-
 def quaternion_julia(c: ArrayLike = (-0.2, 0.6, 0.2, 0.0), *, resolution: int = 64, bound: float = 1.5,
                      slice_w: float = 0.0, max_iter: int = 12, escape_radius: float = 4.0,
                      max_bytes: int = DEFAULT_MAX_BYTES) -> NDArray[np.float64]:  # fmt: skip
@@ -254,7 +190,7 @@ def quaternion_julia(c: ArrayLike = (-0.2, 0.6, 0.2, 0.0), *, resolution: int = 
     _check_memory(n**3 * 8 * 4, _budget(max_bytes, where), where=where, name="resolution", value=n)
     axis = np.linspace(-b, b, n)
     out = np.empty((n, n, n))
-    _quaternion_field(axis, axis, axis, w, np.ascontiguousarray(cq), iters, radius * radius, out)
+    _kernels()._quaternion_field(axis, axis, axis, w, np.ascontiguousarray(cq), iters, radius * radius, out)
     return out
 
 

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from types import ModuleType
 from typing import Any
 
 import numpy as np
@@ -26,7 +27,6 @@ from numpy.typing import ArrayLike, NDArray
 from frustum._arrays import Points, as_points, as_scalar, describe, read_only
 from frustum.errors import GeometryError
 from frustum.geometry.mesh import Mesh
-from frustum.raster._jit import kernel
 
 __all__ = [
     "DEFAULT_MAX_BYTES",
@@ -47,6 +47,14 @@ __all__ = [
     "sierpinski_triangle",
     "similarity_dimension",
 ]
+
+
+def _kernels() -> ModuleType:
+    """The compiled kernels of this module (``raster/fractals.py``), imported on first use: ``import frustum``
+    never loads Numba."""
+    from frustum.raster import fractals
+
+    return fractals
 
 DEFAULT_MAX_BYTES = 2**30
 """Default memory budget (1 GiB) of one generator's output; raise it per call with ``max_bytes=``."""
@@ -537,22 +545,6 @@ def peano_curve(level: int, *, max_bytes: int = DEFAULT_MAX_BYTES) -> Points:
 # ----------------------------------------------------------------------------- iterated function systems
 
 
-@kernel
-def _chaos_game_kernel(linear, offset, choices, start, skip, out):  # pragma: no cover - compiled
-    """x ← A_k x + b_k for k = choices[t]; rows t >= skip are written to out. Arrays contiguous."""
-    x0, x1, x2 = start[0], start[1], start[2]
-    for t in range(choices.shape[0]):
-        k = choices[t]
-        y0 = linear[k, 0, 0] * x0 + linear[k, 0, 1] * x1 + linear[k, 0, 2] * x2 + offset[k, 0]
-        y1 = linear[k, 1, 0] * x0 + linear[k, 1, 1] * x1 + linear[k, 1, 2] * x2 + offset[k, 1]
-        y2 = linear[k, 2, 0] * x0 + linear[k, 2, 1] * x1 + linear[k, 2, 2] * x2 + offset[k, 2]
-        x0, x1, x2 = y0, y1, y2
-        if t >= skip:
-            out[t - skip, 0] = x0
-            out[t - skip, 1] = x1
-            out[t - skip, 2] = x2
-
-
 @dataclass(frozen=True, eq=False)
 class IFS:
     """An iterated function system: contractive affine maps wᵢ(P) = Aᵢ·P + bᵢ chosen with probabilities pᵢ.
@@ -699,7 +691,7 @@ class IFS:
         choices = np.searchsorted(cumulative, rng.random(count + skip), side="right").astype(np.int64)
         choices = np.minimum(choices, self.map_count - 1)
         out = np.empty((count, 3))
-        _chaos_game_kernel(np.ascontiguousarray(self.linear), np.ascontiguousarray(self.offset), choices,
+        _kernels()._chaos_game_kernel(np.ascontiguousarray(self.linear), np.ascontiguousarray(self.offset), choices,
                            self.fixed_point(0), skip, out)  # fmt: skip
         return out
 

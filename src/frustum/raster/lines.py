@@ -173,7 +173,8 @@ def draw_lines(
         u0, u1 = clip_segment(start, end, planes)
         if u0 > u1:
             continue
-        xa, ya, za, xb, yb, zb = 0, 0, 0.0, 0, 0, 0.0
+        xa, ya, xb, yb = np.int64(0), np.int64(0), np.int64(0), np.int64(0)
+        za, zb = 0.0, 0.0
         da, wa, db, wb = 0.0, 1.0, 0.0, 1.0
         for side in range(2):
             u = u0 if side == 0 else u1
@@ -192,15 +193,12 @@ def draw_lines(
                 xb, yb, zb, db, wb = x, y, z, d, pw
         if xa == xb and ya == yb:
             continue
-        if abs(xb - xa) >= abs(yb - ya):
-            if xa < xb:
-                _draw_segment(xa, ya, za, da, wa, xb, yb, zb, db, wb, True, style, depth, color)
-            else:
-                _draw_segment(xb, yb, zb, db, wb, xa, ya, za, da, wa, True, style, depth, color)
-        elif ya < yb:
-            _draw_segment(ya, xa, za, da, wa, yb, xb, zb, db, wb, False, style, depth, color)
-        else:
-            _draw_segment(yb, xb, zb, db, wb, ya, xa, za, da, wa, False, style, depth, color)
+        x_major = abs(xb - xa) >= abs(yb - ya)
+        if not x_major:  # draw along y: y as "x" (``_draw_segment`` swaps them back)
+            xa, ya, xb, yb = ya, xa, yb, xb
+        if xa > xb:  # from the lower major end
+            xa, ya, za, da, wa, xb, yb, zb, db, wb = xb, yb, zb, db, wb, xa, ya, za, da, wa
+        _draw_segment(xa, ya, za, da, wa, xb, yb, zb, db, wb, x_major, style, depth, color)
 
 
 @kernel

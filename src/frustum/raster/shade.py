@@ -28,7 +28,8 @@ import math
 
 import numpy as np
 
-from frustum.raster._jit import inline_kernel, kernel, parallel_kernel, prange
+from frustum.raster._jit import kernel, parallel_kernel
+from frustum.raster.power import SQUARING_MAX, textbook_power
 
 __all__ = [
     "SHADE_DEPTH",
@@ -56,45 +57,32 @@ PARAMS = 30
 # item layout
 I_FACE_OFFSET, I_MODE, I_SPECULAR_MODEL, I_OBJECT_ID, I_WRITE_NORMALS, I_WRITE_IDS, I_BLEND = 0, 1, 2, 3, 4, 5, 6
 ITEM = 7
-SQUARING_MAX = 1024.0
 
 
-@inline_kernel
+@kernel
 def _to_byte(value: float) -> np.uint8:
     """``floor(clamp(v, 0, 1)·255 + 0.5)``: round half up to 8 bits."""
     return np.uint8(math.floor(min(max(value, 0.0), 1.0) * 255.0 + 0.5))
 
 
-@inline_kernel
+@kernel
 def _interpolate(u0: float, u1: float, u2: float, va: float, vb: float, vc: float) -> float:
     """``(u0·va + u1·vb) + u2·vc`` (scalar arguments only: per-pixel helpers take no arrays, so they inline)."""
     return (u0 * va + u1 * vb) + u2 * vc
 
 
-@inline_kernel
+@kernel
 def _squarable(n: float) -> bool:
     """Whether ``power`` takes x^n by repeated squaring: n integral in [0, SQUARING_MAX]."""
     return n == math.floor(n) and 0.0 <= n <= SQUARING_MAX
 
 
-@inline_kernel
-def power(x: float, n: float) -> float:
-    """Textbook x^n; integral n by repeated squaring (exact same bytes in every path).
-
-    Squaring: r = 1; per bit of n from the lowest, r·x if the bit is set, then x·x. Other n: libm ``x ** n``.
-    """
-    if not _squarable(n):
-        return x**n
-    e, r = int(n), 1.0
-    while e > 0:
-        if e & 1:
-            r *= x
-        x *= x
-        e >>= 1
-    return r
+power = kernel(textbook_power)
+"""``textbook_power`` compiled, for the shading kernels (``shading.illuminate`` calls the plain function: the
+same operations, so the same bytes)."""
 
 
-@inline_kernel
+@kernel
 def _illuminate(
     params: np.ndarray, lights: np.ndarray, specular_model: int,
     px: float, py: float, pz: float, nx: float, ny: float, nz: float,
@@ -152,13 +140,14 @@ def _illuminate(
     return dr, dg, db, sr, sg, sb
 
 
-@parallel_kernel
+@parallel_kernel(lambda world, *_: world.shape[0])
 def light_vertices(
     world: np.ndarray, normals: np.ndarray, params: np.ndarray, lights: np.ndarray, specular_model: int,
     lit: np.ndarray,
+    start: int, stop: int,
 ) -> None:  # fmt: skip
     """Gouraud: D and S at every vertex with its unit normal; lit (N, 6) float64 written."""
-    for v in prange(world.shape[0]):
+    for v in range(start, stop):
         terms = _illuminate(
             params, lights, specular_model, world[v, 0], world[v, 1], world[v, 2],
             normals[v, 0], normals[v, 1], normals[v, 2],
@@ -167,13 +156,14 @@ def light_vertices(
             lit[v, k] = terms[k]
 
 
-@parallel_kernel
+@parallel_kernel(lambda world, faces, *_: faces.shape[0])
 def light_faces(
     world: np.ndarray, faces: np.ndarray, params: np.ndarray, lights: np.ndarray, specular_model: int,
     lit: np.ndarray,
+    start: int, stop: int,
 ) -> None:  # fmt: skip
     """Flat: D and S of every face at its centroid with the unit face normal ``(v1 − v0)×(v2 − v0)``; lit (M, 6)."""
-    for f in prange(faces.shape[0]):
+    for f in range(start, stop):
         a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
         e1x, e1y, e1z = world[b, 0] - world[a, 0], world[b, 1] - world[a, 1], world[b, 2] - world[a, 2]
         e2x, e2y, e2z = world[c, 0] - world[a, 0], world[c, 1] - world[a, 1], world[c, 2] - world[a, 2]
@@ -192,9 +182,9 @@ def light_faces(
             lit[f, k] = terms[k]
 
 
-@inline_kernel
-def _sample(texture: np.ndarray, u: float, v: float, channel: int) -> float:
-    """Bilinear texture lookup with repeat wrapping; v = 0 is the image's bottom row (OpenGL, OBJ)."""
+@kernel
+def _sample(texture: np.ndarray, u: float, v: float) -> tuple[float, float, float, float]:
+    """Bilinear texture lookup (r, g, b, a) with repeat wrapping; v = 0 is the image's bottom row (OpenGL, OBJ)."""
     height, width = texture.shape[0], texture.shape[1]
     x = (u - math.floor(u)) * width - 0.5
     y = (1.0 - (v - math.floor(v))) * height - 0.5
@@ -202,12 +192,19 @@ def _sample(texture: np.ndarray, u: float, v: float, channel: int) -> float:
     fx, fy = x - x0, y - y0
     i0, j0 = int(x0) % width, int(y0) % height
     i1, j1 = (i0 + 1) % width, (j0 + 1) % height
-    top = texture[j0, i0, channel] * (1.0 - fx) + texture[j0, i1, channel] * fx
-    bottom = texture[j1, i0, channel] * (1.0 - fx) + texture[j1, i1, channel] * fx
-    return top * (1.0 - fy) + bottom * fy
+    gx, gy = 1.0 - fx, 1.0 - fy
+    r0 = texture[j0, i0, 0] * gx + texture[j0, i1, 0] * fx
+    r1 = texture[j1, i0, 0] * gx + texture[j1, i1, 0] * fx
+    g0 = texture[j0, i0, 1] * gx + texture[j0, i1, 1] * fx
+    g1 = texture[j1, i0, 1] * gx + texture[j1, i1, 1] * fx
+    b0 = texture[j0, i0, 2] * gx + texture[j0, i1, 2] * fx
+    b1 = texture[j1, i0, 2] * gx + texture[j1, i1, 2] * fx
+    a0 = texture[j0, i0, 3] * gx + texture[j0, i1, 3] * fx
+    a1 = texture[j1, i0, 3] * gx + texture[j1, i1, 3] * fx
+    return r0 * gy + r1 * fy, g0 * gy + g1 * fy, b0 * gy + b1 * fy, a0 * gy + a1 * fy
 
 
-@inline_kernel
+@kernel
 def _surface(
     f: int, back: bool, u0: float, u1: float, u2: float, faces: np.ndarray, world: np.ndarray, normals: np.ndarray
 ) -> tuple[float, float, float, float, float, float]:  # fmt: skip
@@ -228,7 +225,7 @@ def _surface(
     return nx, ny, nz, px, py, pz
 
 
-@inline_kernel
+@kernel
 def shade_point(
     f: int, back: bool, u0: float, u1: float, u2: float,
     faces: np.ndarray, world: np.ndarray, normals: np.ndarray, lit: np.ndarray,
@@ -259,10 +256,11 @@ def shade_point(
     if texture.shape[0] > 0:
         tu = _interpolate(u0, u1, u2, uvs[a, 0], uvs[b, 0], uvs[c, 0])
         tv = _interpolate(u0, u1, u2, uvs[a, 1], uvs[b, 1], uvs[c, 1])
-        base_r *= _sample(texture, tu, tv, 0)
-        base_g *= _sample(texture, tu, tv, 1)
-        base_b *= _sample(texture, tu, tv, 2)
-        alpha *= _sample(texture, tu, tv, 3)
+        texel_r, texel_g, texel_b, texel_a = _sample(texture, tu, tv)
+        base_r *= texel_r
+        base_g *= texel_g
+        base_b *= texel_b
+        alpha *= texel_a
     if mode == SHADE_NONE:
         return base_r, base_g, base_b, alpha, nx, ny, nz
     if mode == SHADE_PHONG:
@@ -282,23 +280,23 @@ def shade_point(
     return r, g, b, alpha, nx, ny, nz
 
 
-@inline_kernel
-def _cue(params: np.ndarray, value: float, channel: int, d: float) -> float:
-    """Depth cueing ``f·I + (1 − f)·cue`` with f clamped to [f_min, f_max] (identity when cueing is off)."""
-    if params[P_CUE_ON] == 0.0:
-        return value
+@kernel
+def _cue(params: np.ndarray, r: float, g: float, b: float, d: float) -> tuple[float, float, float]:
+    """Depth cueing ``f·I + (1 − f)·cue`` per channel, f clamped to [f_min, f_max], at view distance d."""
     low, high = params[P_CUE_MIN], params[P_CUE_MAX]
     f = low + (high - low) * (params[P_CUE_FAR] - d) / (params[P_CUE_FAR] - params[P_CUE_NEAR])
     f = min(max(f, low), high)
-    return f * value + (1.0 - f) * params[P_CUE_COLOR + channel]
+    cue = params[P_CUE_COLOR : P_CUE_COLOR + 3]
+    return f * r + (1.0 - f) * cue[0], f * g + (1.0 - f) * cue[1], f * b + (1.0 - f) * cue[2]
 
 
-@parallel_kernel
+@parallel_kernel(lambda depth, codes, *_: codes.shape[0])
 def shade_pixels(
     depth: np.ndarray, codes: np.ndarray, bary: np.ndarray, faces: np.ndarray, world: np.ndarray, normals: np.ndarray,
     lit: np.ndarray, vertex_colors: np.ndarray, uvs: np.ndarray, texture: np.ndarray,
     params: np.ndarray, lights: np.ndarray, item: np.ndarray, color: np.ndarray,
     normal_out: np.ndarray, id_out: np.ndarray,
+    start: int, stop: int,
 ) -> None:  # fmt: skip
     """Shade the pixels of one scene item: those whose face ``code // 2 − face_offset`` lies in [0, M).
 
@@ -309,7 +307,7 @@ def shade_pixels(
     pixels (depth 1: nothing drawn, so their codes are never read and need no clearing) and codes < 0 are left
     alone. normal_out (H, W, 3) float32 and id_out (H, W) int32 are written when asked for.
     """
-    for row in prange(codes.shape[0]):
+    for row in range(start, stop):
         _shade_row(
             row, depth, codes, bary, faces, world, normals, lit, vertex_colors, uvs, texture, params, lights, item,
             color, normal_out, id_out,
@@ -346,7 +344,7 @@ def _shade_row(
             for k in range(3):
                 p = _interpolate(u0, u1, u2, world[a, k], world[bb, k], world[c, k])
                 d += (params[P_EYE + k] - p) * params[P_VIEW_AXIS + k]
-            r, g, b = _cue(params, r, 0, d), _cue(params, g, 1, d), _cue(params, b, 2, d)
+            r, g, b = _cue(params, r, g, b, d)
         if item[I_BLEND] != 0:
             alpha = min(max(alpha, 0.0), 1.0)
             r = alpha * min(max(r, 0.0), 1.0) + (1.0 - alpha) * (color[row, col, 0] / 255.0)
@@ -375,10 +373,11 @@ _NX, _NY, _NZ, _SIGN, _PX, _PY, _PZ, _VX, _VY, _VZ, _X, _NDL, _POW, _DR, _DG, _D
 _FIELDS = 19
 
 
-@parallel_kernel
+@parallel_kernel(lambda depth, codes, *_: (codes.shape[0] + _ROWS - 1) // _ROWS)
 def shade_pixels_directional(
     depth: np.ndarray, codes: np.ndarray, bary: np.ndarray, faces: np.ndarray, world: np.ndarray,
     normals: np.ndarray, params: np.ndarray, lights: np.ndarray, item: np.ndarray, color: np.ndarray,
+    start: int, stop: int,
 ) -> None:  # fmt: skip
     """``shade_pixels`` for the common case, bit for bit: per-pixel Blinn-Phong with directional lights only and
     no texture, vertex colors, depth cueing, blending or extra buffers (the benchmark scenes).
@@ -388,7 +387,7 @@ def shade_pixels_directional(
     color must be C-contiguous: a pixel's four bytes are written as one uint32 word.
     """
     height = codes.shape[0]
-    for block in prange((height + _ROWS - 1) // _ROWS):
+    for block in range(start, stop):
         start = block * _ROWS
         _shade_rows_directional(
             start, min(start + _ROWS, height), depth, codes, bary, faces, world, normals, params, lights, item, color

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from frustum.raster._jit import kernel, parallel_kernel, prange
+from frustum.raster._jit import kernel, parallel_kernel
 from frustum.raster.triangles import FACE_CROSSING, FACE_DRAWN, face_box
 
 __all__ = ["add_record_tiles", "count_tiles", "fill_tiles", "tile_offsets"]
@@ -23,10 +23,11 @@ __all__ = ["add_record_tiles", "count_tiles", "fill_tiles", "tile_offsets"]
 O_WIDTH, O_HEIGHT, O_CULL, O_BITS, O_TILES_X, O_CHUNK, O_FACE_OFFSET = 0, 1, 2, 3, 4, 5, 6
 
 
-@parallel_kernel
+@parallel_kernel(lambda *args: args[4].shape[0])  # counts: one row per chunk of faces
 def count_tiles(
     faces: np.ndarray, codes: np.ndarray, win_int: np.ndarray, options: np.ndarray, counts: np.ndarray,
     crossing: np.ndarray, listed: np.ndarray, listed_tiles: np.ndarray, listed_counts: np.ndarray,
+    start: int, stop: int,
 ) -> None:  # fmt: skip
     """``counts[c, t]`` = how many drawn faces of chunk c touch tile t; ``crossing[c]`` = its crossing faces.
 
@@ -39,7 +40,7 @@ def count_tiles(
     """
     width, height, cull = options[O_WIDTH], options[O_HEIGHT], options[O_CULL]
     bits, tiles_x, chunk = options[O_BITS], options[O_TILES_X], options[O_CHUNK]
-    for c in prange(counts.shape[0]):
+    for c in range(start, stop):
         for t in range(counts.shape[1]):
             counts[c, t] = 0
         crossed = 0
@@ -87,11 +88,12 @@ def tile_offsets(counts: np.ndarray, offsets: np.ndarray, tile_starts: np.ndarra
     tile_starts[counts.shape[1]] = running
 
 
-@parallel_kernel
+@parallel_kernel(lambda *args: args[7].shape[0])  # offsets: one row per chunk of faces
 def fill_tiles(
     faces: np.ndarray, codes: np.ndarray, win_int: np.ndarray, options: np.ndarray, listed: np.ndarray,
     listed_tiles: np.ndarray, listed_counts: np.ndarray, offsets: np.ndarray, crossing_starts: np.ndarray,
     record_starts: np.ndarray, tri_int: np.ndarray, tile_entries: np.ndarray,
+    start: int, stop: int,
 ) -> None:  # fmt: skip
     """Write each drawn face's index (and ``−1 − r`` for each record r of a clipped face) into the lists of the
     tiles it touches, in face order: the faces ``count_tiles`` listed, a one-tile face straight from
@@ -101,7 +103,7 @@ def fill_tiles(
     """
     width, height, cull = options[O_WIDTH], options[O_HEIGHT], options[O_CULL]
     bits, tiles_x, chunk = options[O_BITS], options[O_TILES_X], options[O_CHUNK]
-    for c in prange(offsets.shape[0]):
+    for c in range(start, stop):
         k = crossing_starts[c]
         for n in range(c * chunk, c * chunk + listed_counts[c]):
             f = listed[n]

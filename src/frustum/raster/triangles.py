@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from frustum.raster._jit import inline_kernel, kernel, parallel_kernel, prange
+from frustum.raster._jit import kernel, parallel_kernel
 from frustum.raster.clip import clip_triangle
 from frustum.raster.fixed_point import HALF_SUBPIXEL, SUBPIXEL, SUBPIXEL_BITS, snap
 from frustum.raster.vertices import clip_vertex
@@ -85,7 +85,7 @@ def _window_box(
     return made, back, i_min, i_max, j_min, j_max
 
 
-@inline_kernel
+@kernel
 def face_box(
     faces: np.ndarray, codes: np.ndarray, win_int: np.ndarray, f: int, width: int, height: int, cull: int
 ) -> tuple[int, int, int, int, int, int]:  # fmt: skip
@@ -104,15 +104,16 @@ def face_box(
     return (FACE_DRAWN if made != 0 else FACE_NONE), back, i_min, i_max, j_min, j_max
 
 
-@parallel_kernel
+@parallel_kernel(lambda faces, codes, chunk, listed, listed_counts, crossing_starts, *_: crossing_starts.shape[0])
 def list_crossing(
     faces: np.ndarray, codes: np.ndarray, chunk: int, listed: np.ndarray, listed_counts: np.ndarray,
     crossing_starts: np.ndarray, crossing: np.ndarray,
+    start: int, stop: int,
 ) -> None:  # fmt: skip
     """The faces crossing the view volume, in order, picked from the faces ``tiles.count_tiles`` listed: chunk c
     (``listed[c·chunk : c·chunk + listed_counts[c]]``) writes its crossing faces' indices into ``crossing`` from
     ``crossing_starts[c]`` on."""
-    for c in prange(crossing_starts.shape[0]):
+    for c in range(start, stop):
         k = crossing_starts[c]
         for n in range(c * chunk, c * chunk + listed_counts[c]):
             f = listed[n]
@@ -156,11 +157,12 @@ def _setup_triangle(
     return 1
 
 
-@parallel_kernel
+@parallel_kernel(lambda crossing, *_: crossing.shape[0])
 def clip_faces(
     crossing: np.ndarray, faces: np.ndarray, vertices: np.ndarray, clip_from_model: np.ndarray,
     planes: np.ndarray, view: np.ndarray, options: np.ndarray, record_starts: np.ndarray,
     tri_int: np.ndarray, tri_float: np.ndarray, tri_weights: np.ndarray,
+    start: int, stop: int,
 ) -> None:  # fmt: skip
     """Sutherland–Hodgman clip of each crossing face, then set up its fan (0, k, k + 1) as records.
 
@@ -172,7 +174,7 @@ def clip_faces(
     write = options[4]
     size = options[0:3]
     capacity = 3 + planes.shape[0]
-    for k in prange(crossing.shape[0]):
+    for k in range(start, stop):
         f = crossing[k]
         corners = np.empty((3, 4))
         for v in range(3):
@@ -194,14 +196,14 @@ def clip_faces(
             record_starts[k] = made
 
 
-@parallel_kernel
-def clear_buffers(depth: np.ndarray, color: np.ndarray, background: np.ndarray) -> None:
+@parallel_kernel(lambda depth, *_: depth.shape[0])
+def clear_buffers(depth: np.ndarray, color: np.ndarray, background: np.ndarray, start: int, stop: int) -> None:
     """Depth 1.0 (far) and the background color bytes (4,) everywhere, row by row (parallel over rows: clearing
     tile by tile, 128-byte pieces of rows, ran at a quarter of the bandwidth). Face codes need no clearing: a
     pixel is drawn exactly where its depth is below 1, and only there are codes and barycentrics read."""
     words = color.view(np.uint32)
     word = background.view(np.uint32)[0]
-    for row in prange(depth.shape[0]):
+    for row in range(start, stop):
         for col in range(depth.shape[1]):
             depth[row, col] = 1.0
             words[row, col, 0] = word
@@ -301,11 +303,12 @@ def _fill_tile(
                 e2 -= dy2 * SUBPIXEL
 
 
-@parallel_kernel
+@parallel_kernel(lambda *args: args[6].shape[0] - 1)  # tile_starts: tiles + 1
 def rasterize_tiles(
     faces: np.ndarray, win_int: np.ndarray, win_float: np.ndarray, tri_int: np.ndarray, tri_float: np.ndarray,
     tri_weights: np.ndarray, tile_starts: np.ndarray, tile_entries: np.ndarray, tiling: np.ndarray,
     depth: np.ndarray, codes: np.ndarray, bary: np.ndarray,
+    start: int, stop: int,
 ) -> None:  # fmt: skip
     """Each tile owns its pixels of ``depth``, ``codes`` and ``bary``: no write races, deterministic output.
 
@@ -315,7 +318,7 @@ def rasterize_tiles(
     order, are ``tile_entries[tile_starts[t]:tile_starts[t + 1]]`` (``raster.tiles``): a face index f >= 0 (drawn
     from ``win_int``/``win_float`` of its vertices) or ``−1 − r`` for clipped record r.
     """
-    for t in prange(tile_starts.shape[0] - 1):
+    for t in range(start, stop):
         _fill_tile(
             t, faces, win_int, win_float, tri_int, tri_float, tri_weights, tile_starts, tile_entries, tiling,
             depth, codes, bary,

@@ -19,7 +19,7 @@ import math
 
 import numpy as np
 
-from frustum.raster._jit import kernel, parallel_kernel, prange
+from frustum.raster._jit import kernel, parallel_kernel
 from frustum.raster.fixed_point import snap
 
 __all__ = [
@@ -77,10 +77,11 @@ def view_volume_code(cx: float, cy: float, cz: float, cw: float) -> int:
     return code
 
 
-@parallel_kernel
+@parallel_kernel(lambda vertices, *_: vertices.shape[0])
 def project_vertices(
     vertices: np.ndarray, clip_from_model: np.ndarray, view: np.ndarray,
     win_int: np.ndarray, win_float: np.ndarray, codes: np.ndarray,
+    start: int, stop: int,
 ) -> None:  # fmt: skip
     """View-volume region code of ``clip = clip_from_model·P``; inside (code 0) also the window coordinates.
 
@@ -90,7 +91,7 @@ def project_vertices(
     unwritten: their faces are clipped (from ``clip_vertex``) or rejected.
     """
     m = clip_from_model
-    for i in prange(vertices.shape[0]):
+    for i in range(start, stop):
         x, y, z = vertices[i, 0], vertices[i, 1], vertices[i, 2]
         cx, cy = _affine_row(m, 0, x, y, z), _affine_row(m, 1, x, y, z)
         cz, cw = _affine_row(m, 2, x, y, z), _affine_row(m, 3, x, y, z)
@@ -104,19 +105,19 @@ def project_vertices(
         win_float[i, 1] = 1.0 / cw
 
 
-@parallel_kernel
-def world_points(vertices: np.ndarray, world_from_model: np.ndarray, world: np.ndarray) -> None:
+@parallel_kernel(lambda vertices, *_: vertices.shape[0])
+def world_points(vertices: np.ndarray, world_from_model: np.ndarray, world: np.ndarray, start: int, stop: int) -> None:
     """``world = world_from_model·P`` per vertex (world (N, 3) float64, written)."""
-    for i in prange(vertices.shape[0]):
+    for i in range(start, stop):
         x, y, z = vertices[i, 0], vertices[i, 1], vertices[i, 2]
         for k in range(3):
             world[i, k] = _affine_row(world_from_model, k, x, y, z)
 
 
-@parallel_kernel
-def transform_normals(normals: np.ndarray, normal_matrix: np.ndarray, out: np.ndarray) -> None:
+@parallel_kernel(lambda normals, *_: normals.shape[0])
+def transform_normals(normals: np.ndarray, normal_matrix: np.ndarray, out: np.ndarray, start: int, stop: int) -> None:
     """``n' = N·n / |N·n|`` per vertex, N the 3x3 block of normal_matrix (out (N, 3) float64, written)."""
-    for i in prange(normals.shape[0]):
+    for i in range(start, stop):
         nx = _linear_row(normal_matrix, 0, normals[i, 0], normals[i, 1], normals[i, 2])
         ny = _linear_row(normal_matrix, 1, normals[i, 0], normals[i, 1], normals[i, 2])
         nz = _linear_row(normal_matrix, 2, normals[i, 0], normals[i, 1], normals[i, 2])
@@ -124,17 +125,18 @@ def transform_normals(normals: np.ndarray, normal_matrix: np.ndarray, out: np.nd
         out[i, 0], out[i, 1], out[i, 2] = nx / length, ny / length, nz / length
 
 
-@parallel_kernel
+@parallel_kernel(lambda vertices, *_: vertices.shape[0])
 def transform_vertices(
     vertices: np.ndarray, normals: np.ndarray, matrices: np.ndarray, planes: np.ndarray,
     clip: np.ndarray, world: np.ndarray, world_normals: np.ndarray, codes: np.ndarray,
+    start: int, stop: int,
 ) -> None:  # fmt: skip
     """``clip = clip_from_model·P``, ``world = world_from_model·P``, ``n' = normalize(N·n)``, region code of clip.
 
     Written: clip (N, 4), world (N, 3), world_normals (N, 3) float64, codes (N,) int64. The region code has bit k
     set when the clip-space point is outside plane k (``planes[k]·clip < 0``).
     """
-    for i in prange(vertices.shape[0]):
+    for i in range(start, stop):
         x, y, z = vertices[i, 0], vertices[i, 1], vertices[i, 2]
         for k in range(4):
             clip[i, k] = _affine_row(matrices[0], k, x, y, z)

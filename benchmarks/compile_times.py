@@ -1,0 +1,88 @@
+"""Cold-start cost of the README's main job: per-kernel Numba compile seconds with an empty cache.
+
+    python benchmarks/compile_times.py [scene.toml] [--json]
+
+Runs the scene file's render in a fresh subprocess with ``NUMBA_CACHE_DIR`` set to an empty temporary directory
+(so nothing is loaded from a previous run's cache), records Numba's ``numba:compile`` events, and prints the
+compile seconds (CPU time of the compiling thread, steadier than wall time on a busy
+machine) of every kernel (outermost compilations only: a kernel's callees compiled on its behalf are counted
+inside it), the total, and the wall time of the whole render. A second run in a new
+process with the same cache directory gives the warm time.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+_CHILD = r"""
+import json, sys, time
+start = time.perf_counter()
+from numba.core import event
+records = []
+stack = []
+
+class Listener(event.Listener):
+    def on_start(self, ev):
+        stack.append((ev.data["dispatcher"].py_func.__module__ + "." + ev.data["dispatcher"].py_func.__qualname__,
+                      time.process_time()))
+    def on_end(self, ev):
+        name, t0 = stack.pop()
+        records.append({"kernel": name, "seconds": time.process_time() - t0, "depth": len(stack),
+                        "signature": str(ev.data["args"])[:200]})
+
+event.register("numba:compile", Listener())
+from frustum.cli import main
+try:
+    main(sys.argv[1:])
+except SystemExit as stop:
+    if stop.code:
+        raise
+print("@@" + json.dumps({"records": records, "wall": time.perf_counter() - start, "cpu": time.process_time()}))
+"""
+
+
+def measure(scene: str, cache: str, out: str) -> dict:
+    env = dict(os.environ, NUMBA_CACHE_DIR=cache)
+    proc = subprocess.run([sys.executable, "-c", _CHILD, "render", scene, "-o", out], env=env, capture_output=True,
+                          text=True, cwd=ROOT)  # fmt: skip
+    if proc.returncode:
+        raise SystemExit(proc.stdout + proc.stderr)
+    line = next(x for x in proc.stdout.splitlines() if x.startswith("@@"))
+    return {**json.loads(line[2:]), "stderr": proc.stderr}
+
+
+def main() -> None:
+    args = [a for a in sys.argv[1:] if not a.startswith("--")]
+    scene = args[0] if args else "examples/teapot.toml"
+    with tempfile.TemporaryDirectory() as cache:
+        out = os.path.join(cache, "out.png")
+        t0 = time.perf_counter()
+        cold = measure(scene, cache, out)
+        cold_wall = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        warm = measure(scene, cache, out)
+        warm_wall = time.perf_counter() - t0
+    if "--json" in sys.argv:
+        print(json.dumps({"cold": cold, "warm": warm, "cold_process": cold_wall, "warm_process": warm_wall}))
+        return
+    top = sorted((r for r in cold["records"] if r["depth"] == 0), key=lambda r: -r["seconds"])
+    print(f"{'kernel':60s} {'compile s':>9s}  (CPU)")
+    for r in top:
+        print(f"{r['kernel']:60s} {r['seconds']:9.2f}")
+    total = sum(r["seconds"] for r in top)
+    print(f"{'total (outermost compilations)':60s} {total:9.2f}")
+    print(f"cold process {cold_wall:.2f} s (render {cold['wall']:.2f} s, process CPU {cold['cpu']:.2f} s)")
+    print(f"warm process {warm_wall:.2f} s (render {warm['wall']:.2f} s, process CPU {warm['cpu']:.2f} s, "
+          f"{len(warm['records'])} compilations)")
+
+
+if __name__ == "__main__":
+    main()

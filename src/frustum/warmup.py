@@ -1,0 +1,178 @@
+"""Compile every kernel ahead of time: ``frustum warmup`` (or ``frustum.warmup()``).
+
+Numba compiles each kernel the first time it runs and keeps the machine code in its on-disk cache, so only the
+first render in a new environment pays for compilation (about 8 s of CPU for the README example, more for the
+modes it does not use). ``warmup`` runs one small task per family of kernels — the surface paths (the fast
+directional shader, the general shader with textures, vertex colors, point and spot lights, depth cueing,
+transparency and extra buffers, Gouraud and flat), the line and point modes, clipping of faces that cross the view
+volume, exact hidden lines, and the fractal generators — in parallel processes, each filling the shared cache.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import importlib
+import multiprocessing
+import os
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from types import SimpleNamespace
+
+import numpy as np
+
+__all__ = ["WarmupReport", "warmup"]
+
+
+@dataclass(frozen=True)
+class WarmupReport:
+    """What ``warmup`` did: kernels compiled (0 when the cache already held them all), processes, seconds."""
+
+    kernels: int
+    processes: int
+    seconds: float
+
+    def __str__(self) -> str:
+        if self.kernels == 0:
+            return f"all kernels were already compiled ({self.seconds:.1f} s to check, {self.processes} processes)"
+        return f"compiled {self.kernels} kernels in {self.seconds:.1f} s ({self.processes} processes)"
+
+
+def _api() -> SimpleNamespace:
+    """The public names the tasks use, from their own modules (the interface layer imports downward only)."""
+    names = {}
+    for module in ("camera", "clipping", "geometry", "projection", "render", "scene", "shading", "transforms",
+                   "output.svg"):  # fmt: skip
+        loaded = importlib.import_module(f"frustum.{module}")  # (``from frustum import render`` is the function)
+        names.update({name: getattr(loaded, name) for name in loaded.__all__})
+    return SimpleNamespace(**names)
+
+
+def _scene(light: str = "directional", **mesh_options: object):  # type: ignore[no-untyped-def]
+    fr = _api()
+
+    lights = {
+        "directional": [fr.DirectionalLight(direction=(-0.3, -0.6, -1.0))],
+        "all": [fr.AmbientLight(intensity=0.3), fr.DirectionalLight(direction=(0, -1, -1)),
+                fr.PointLight((2, 3, 4)), fr.SpotLight((0, 3, 3), (0, -1, -1))],
+    }[light]
+    scene = fr.Scene(lights=lights)
+    sphere = fr.uv_sphere(1.0, 16, 8)
+    if mesh_options:
+        sphere = fr.Mesh(sphere.vertices, sphere.faces, sphere.vertex_normals, **mesh_options)
+    scene.add(sphere, fr.Material(color=(0.8, 0.5, 0.2)), fr.rotate_y(0.3))
+    return scene
+
+
+def _camera(eye: tuple[float, float, float] = (0.0, 1.0, 4.0)):  # type: ignore[no-untyped-def]
+    fr = _api()
+
+    return fr.Camera.look_at(eye, (0, 0, 0), (0, 1, 0), projection=fr.Perspective(fovy=0.8, near=0.1, far=20),
+                             width=48, height=32)  # fmt: skip
+
+
+def _surfaces_fast() -> None:
+    fr = _api()
+
+    scene = fr.Scene(lights=[fr.DirectionalLight(direction=(0, -1, -1))])
+    scene.add(fr.uv_sphere(1.0, 16, 8), fr.Material(color=(0.8, 0.5, 0.2)))
+    fr.render(scene, _camera())
+    fr.render(scene, _camera(), samples=4, cull_back_faces=False)
+    fr.render(scene, _camera((0.0, 0.0, 0.5)))  # the eye inside the sphere: faces crossing the view volume
+
+
+def _surfaces_general() -> None:
+    fr = _api()
+
+    scene = _scene("all")
+    camera = _camera()
+    fr.render(scene, camera, cull_back_faces=False)
+    fr.render(scene, camera, depth_cue=fr.DepthCue(near=2, far=6), buffers=("normals", "object_id"))
+    texture = np.linspace(0, 1, 4 * 4 * 4, dtype=np.float32).reshape(4, 4, 4)
+    textured = fr.Scene(lights=[fr.PointLight((2, 3, 4))])
+    sphere = fr.uv_sphere(1.0, 16, 8)
+    colors = np.abs(sphere.vertex_normals)
+    textured.add(fr.Mesh(sphere.vertices, sphere.faces, uvs=sphere.uvs, vertex_colors=colors),
+                 fr.Material(texture=texture, opacity=0.5))  # fmt: skip
+    fr.render(textured, camera)
+
+
+def _surfaces_interpolated() -> None:
+    fr = _api()
+
+    scene, camera = _scene("all"), _camera()
+    for shading in ("gouraud", "flat", "normals", "depth", "none"):
+        fr.render(scene, camera, shading=shading)
+
+
+def _lines() -> None:
+    fr = _api()
+
+    scene, camera = _scene(), _camera()
+    scene.add(fr.Polyline([[0, 0, 0], [1, 1, 0], [1, 2, 1]]), fr.Material(color=(1, 1, 0)))
+    for mode in ("wireframe", "points", "hidden-line", "surface+edges"):
+        fr.render(scene, camera, mode=mode, depth_cue=fr.DepthCue(near=2, far=6) if mode == "wireframe" else None)
+    fr.render(scene, camera, mode="hidden-line", hidden="dashed")
+
+
+def _vector() -> None:
+    fr = _api()
+
+    scene, camera = _scene(), _camera()
+    fr.render_svg(scene, camera, hidden="dashed")
+    fr.clip_polygon([[0, 0, 0, 1], [2, 0, 0, 1], [0, 2, 0, 1]])
+    fr.clip_line([-2, 0, 0, 1], [2, 0.5, 0, 1])
+
+
+def _fractals() -> None:
+    fr = _api()
+
+    fr.mandelbrot(width=8, height=8, max_iter=8)
+    fr.julia(-0.8 + 0.156j, width=8, height=8, max_iter=8)
+    fr.quaternion_julia(resolution=4, max_iter=4)
+    fr.barnsley_fern().chaos_game(200, seed=0)
+    fr.CLASSIC_LSYSTEMS["koch"].path(1)
+
+
+TASKS: dict[str, Callable[[], None]] = {
+    "surfaces (general shader)": _surfaces_general,
+    "surfaces (fast path, supersampling, clipping)": _surfaces_fast,
+    "surfaces (Gouraud, flat, inspection modes)": _surfaces_interpolated,
+    "lines and points": _lines,
+    "hidden lines and clipping": _vector,
+    "fractals": _fractals,
+}
+"""The families of kernels ``warmup`` compiles, each by running small examples of what uses them."""
+
+
+def _run(name: str) -> int:
+    """Run one task in this process; return how many kernels it compiled (outermost compilations)."""
+    from numba.core import event
+
+    compiled = []
+
+    class Count(event.Listener):
+        def __init__(self) -> None:
+            self.depth = 0
+
+        def on_start(self, ev: event.Event) -> None:
+            self.depth += 1
+
+        def on_end(self, ev: event.Event) -> None:
+            self.depth -= 1
+            if self.depth == 0:
+                compiled.append(1)
+
+    with event.install_listener("numba:compile", Count()):
+        TASKS[name]()
+    return len(compiled)
+
+
+def warmup(processes: int | None = None) -> WarmupReport:
+    """Compile every kernel frustum has into Numba's on-disk cache, `processes` at a time (default: the cores)."""
+    processes = max(1, min(processes or os.cpu_count() or 1, len(TASKS)))
+    start = time.perf_counter()
+    context = multiprocessing.get_context("spawn")  # fresh interpreters: no threads or half-loaded state copied
+    with concurrent.futures.ProcessPoolExecutor(processes, mp_context=context) as pool:
+        counts = list(pool.map(_run, TASKS))
+    return WarmupReport(sum(counts), processes, time.perf_counter() - start)
