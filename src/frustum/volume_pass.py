@@ -32,9 +32,6 @@ TERMINATE = 1.0 - 1.0 / 512.0
 """Early ray termination: a composite ray stops once its accumulated opacity reaches this (what is left behind
 could change a pixel by under half a level)."""
 BISECTIONS = 16
-ROW_CHUNK = 4
-"""Rows a thread takes at a time (``numba.parallel_chunksize``): the work per row varies with the volume's
-outline, so threads take the next rows when done instead of one fixed half each."""
 _block_cache: weakref.WeakKeyDictionary[Volume, np.ndarray] = weakref.WeakKeyDictionary()
 
 
@@ -114,8 +111,6 @@ def draw_volumes(scene: Scene, camera: Camera, depth: np.ndarray, color: np.ndar
     """
     if not scene.volumes:
         return
-    import numba
-
     from frustum.raster import volume as kernels
 
     packed = pack_lights(scene.world_lights())
@@ -128,6 +123,5 @@ def draw_volumes(scene: Scene, camera: Camera, depth: np.ndarray, color: np.ndar
 
     for item in sorted(scene.volumes, key=distance, reverse=True):
         arguments = volume_arrays(item, camera, packed)
-        with numba.parallel_chunksize(ROW_CHUNK):  # dynamic: rows off the volume cost nothing, others much
-            kernels.cast_rays(*arguments, depth, color)
+        kernels.cast_rays(*arguments, depth, color)
 

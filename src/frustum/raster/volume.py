@@ -30,7 +30,7 @@ import math
 
 import numpy as np
 
-from frustum.raster._jit import kernel, parallel_kernel, prange
+from frustum.raster._jit import kernel, parallel_kernel
 
 __all__ = [
     "BLOCK",
@@ -416,19 +416,22 @@ def _ray(matrices, planes, shape, x, y, window_depth, origin, direction):  # pra
     return s0, s1
 
 
-@parallel_kernel
-def cast_rays(mode, data, blocks, table, matrices, planes, params, lights, depth, color):  # pragma: no cover
-    """Cast one ray per pixel (parallel over rows) and blend the result over ``color`` (H, W, 4) uint8.
+@parallel_kernel(lambda mode, data, blocks, table, matrices, planes, params, lights, depth, color: depth.shape[0],
+                 pieces_per_thread=16)  # fmt: skip
+def cast_rays(mode, data, blocks, table, matrices, planes, params, lights, depth, color, start,
+              stop):  # pragma: no cover  # fmt: skip
+    """Cast one ray per pixel of image rows [start, stop) and blend the result over ``color`` (H, W, 4) uint8.
 
     `data` (nx, ny, nz) float32; `blocks` (bx, by, bz, 3) float32 from ``block_ranges`` plus the empty flags;
     `table` (T, 5) float64 rows (r, g, b, α, α corrected for the step Δ) over the scalar range
     ``value = low + t / scale``; `matrices` (5, 4, 4) as the ``M_*`` constants; `planes` (P, 4) clip planes in
     grid coordinates; `params` (PARAMS,) as the ``P_*`` constants; `lights` (K, 16) from
     ``shading.pack_lights``; `depth` (H, W) float32 window depth (read; the isosurface mode writes its hits).
-    Rows of the buffers are stored top row first (row r is window y = H − 1 − r). Each row is one task; the
-    work of a row is ``_cast_row`` (compiled once, outside the parallel loop: short compile).
+    Rows of the buffers are stored top row first (row r is window y = H − 1 − r). The driver (``_jit``) splits
+    the rows into pieces taken by a pool of threads as they finish (rows off the volume cost nothing); each
+    piece owns its rows, so the bytes do not depend on the thread count.
     """
-    for row in prange(depth.shape[0]):
+    for row in range(start, stop):
         _cast_row(mode, data, blocks, table, matrices, planes, params, lights, depth, color, row)
 
 
