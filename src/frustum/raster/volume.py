@@ -262,10 +262,8 @@ def _composite(data, blocks, table, matrices, params, lights, origin, direction,
     k = 0
     while k < count:
         s = s0 + (k + 0.5) * ds if k < count - 1 else s0 + (count - 1) * ds + 0.5 * last
-        u[0] = origin[0] + s * direction[0]
-        u[1] = origin[1] + s * direction[1]
-        u[2] = origin[2] + s * direction[2]
-        i, j, kk, fx, fy, fz = _cell(data, u[0], u[1], u[2])
+        u0, u1, u2 = origin[0] + s * direction[0], origin[1] + s * direction[1], origin[2] + s * direction[2]
+        i, j, kk, fx, fy, fz = _cell(data, u0, u1, u2)
         bi, bj, bk = i // BLOCK, j // BLOCK, kk // BLOCK
         if blocks[bi, bj, bk, B_EMPTY] != 0.0:  # jump to the first sample at or past the block's exit
             exit_s = _block_exit(origin, direction, bi, bj, bk, data.shape)
@@ -273,17 +271,17 @@ def _composite(data, blocks, table, matrices, params, lights, origin, direction,
             continue
         value = _trilinear(data, i, j, kk, fx, fy, fz)
         t_index, t = _table_index(table, params, value)
-        low, high = table[t_index], table[t_index + 1]
         if k < count - 1:  # opacity corrected for Δ in the table (0 exactly where the raw opacity is 0)
-            alpha = low[4] * (1.0 - t) + high[4] * t
+            alpha = table[t_index, 4] * (1.0 - t) + table[t_index + 1, 4] * t
         else:
-            alpha = low[3] * (1.0 - t) + high[3] * t
+            alpha = table[t_index, 3] * (1.0 - t) + table[t_index + 1, 3] * t
             alpha = 1.0 - (1.0 - alpha) ** (last * model_length / unit) if alpha > 0.0 else 0.0
         if alpha > 0.0:
-            r = low[0] * (1.0 - t) + high[0] * t
-            g = low[1] * (1.0 - t) + high[1] * t
-            b = low[2] * (1.0 - t) + high[2] * t
+            r = table[t_index, 0] * (1.0 - t) + table[t_index + 1, 0] * t
+            g = table[t_index, 1] * (1.0 - t) + table[t_index + 1, 1] * t
+            b = table[t_index, 2] * (1.0 - t) + table[t_index + 1, 2] * t
             if shade:
+                u[0], u[1], u[2] = u0, u1, u2
                 r, g, b = _shade(data, matrices, params, lights, u, view_dir, r, g, b)
             weight = (1.0 - acc) * alpha
             cr += weight * r
