@@ -41,6 +41,9 @@ __all__ = [
     "MODE_MIP",
     "PARAMS",
     "block_ranges",
+    "cast_composite",
+    "cast_isosurface",
+    "cast_projection",
     "cast_rays",
 ]
 
@@ -414,73 +417,60 @@ def _ray(matrices, planes, shape, x, y, window_depth, origin, direction):  # pra
     return s0, s1
 
 
-@parallel_kernel(lambda mode, data, blocks, table, matrices, planes, params, lights, depth, color: depth.shape[0],
-                 pieces_per_thread=16)  # fmt: skip
-def cast_rays(mode, data, blocks, table, matrices, planes, params, lights, depth, color, start,
-              stop):  # pragma: no cover  # fmt: skip
-    """Cast one ray per pixel of image rows [start, stop) and blend the result over ``color`` (H, W, 4) uint8.
+def cast_rays(mode, data, blocks, table, matrices, planes, params, lights, depth, color):
+    """Cast one ray per pixel and blend the result over ``color`` (H, W, 4) uint8 (a driver: the compiled
+    kernel of `mode` runs over pieces of the rows on a pool of threads; only that mode's kernel is compiled).
 
     `data` (nx, ny, nz) float32; `blocks` (bx, by, bz, 3) float32 from ``block_ranges`` plus the empty flags;
     `table` (T, 5) float64 rows (r, g, b, α, α corrected for the step Δ) over the scalar range
     ``value = low + t / scale``; `matrices` (5, 4, 4) as the ``M_*`` constants; `planes` (P, 4) clip planes in
     grid coordinates; `params` (PARAMS,) as the ``P_*`` constants; `lights` (K, 16) from
     ``shading.pack_lights``; `depth` (H, W) float32 window depth (read; the isosurface mode writes its hits).
-    Rows of the buffers are stored top row first (row r is window y = H − 1 − r). The driver (``_jit``) splits
-    the rows into pieces taken by a pool of threads as they finish (rows off the volume cost nothing); each
-    piece owns its rows, so the bytes do not depend on the thread count.
+    Rows of the buffers are stored top row first (row r is window y = H − 1 − r). Pieces of rows are taken by
+    the threads as they finish (rows off the volume cost nothing); each piece owns its rows, so the bytes do not
+    depend on the thread count.
     """
-    for row in range(start, stop):
-        _cast_row(mode, data, blocks, table, matrices, planes, params, lights, depth, color, row)
+    if mode == MODE_COMPOSITE:
+        cast_composite(data, blocks, table, matrices, planes, params, lights, depth, color)
+    elif mode == MODE_ISOSURFACE:
+        cast_isosurface(data, blocks, table, matrices, planes, params, lights, depth, color)
+    else:
+        cast_projection(mode, data, blocks, table, matrices, planes, params, depth, color)
 
 
-@kernel
-def _cast_row(mode, data, blocks, table, matrices, planes, params, lights, depth, color, row):  # pragma: no cover
-    """Every pixel of image row `row` (see ``cast_rays``)."""
+@parallel_kernel(lambda *arguments: arguments[-2].shape[0], pieces_per_thread=16)
+def cast_composite(data, blocks, table, matrices, planes, params, lights, depth, color, start,
+                   stop):  # pragma: no cover  # fmt: skip
+    """``MODE_COMPOSITE`` over image rows [start, stop) (see ``cast_rays``)."""
     height, width = depth.shape
     shape = np.array(data.shape, dtype=np.float64)
-    model = matrices[M_MODEL_FROM_GRID]
-    level = params[P_LEVEL]
-    origin = np.empty(3)
-    direction = np.empty(3)
-    out = np.empty(4)
-    view_dir = np.empty(3)
-    u = np.empty(3)
-    y = height - 1 - row + 0.5
-    for column in range(width):
-        x = column + 0.5
-        s0, s1 = _ray(matrices, planes, shape, x, y, depth[row, column], origin, direction)
-        if not s0 < s1:
-            continue
-        d0 = model[0, 0] * direction[0] + model[0, 1] * direction[1] + model[0, 2] * direction[2]
-        d1 = model[1, 0] * direction[0] + model[1, 1] * direction[1] + model[1, 2] * direction[2]
-        d2 = model[2, 0] * direction[0] + model[2, 1] * direction[1] + model[2, 2] * direction[2]
-        model_length = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)  # model units per unit of s
-        ds = params[P_STEP] / model_length
-        world = matrices[M_WORLD_FROM_GRID]
-        for a in range(3):  # toward the eye: minus the ray direction, in world coordinates
-            view_dir[a] = -(world[a, 0] * direction[0] + world[a, 1] * direction[1] + world[a, 2] * direction[2])
-        vl = math.sqrt(view_dir[0] ** 2 + view_dir[1] ** 2 + view_dir[2] ** 2)
-        for a in range(3):
-            view_dir[a] /= vl
-        if mode == MODE_COMPOSITE:
-            _composite(data, blocks, table, matrices, params, lights, origin, direction, s0, s1, ds,
-                       model_length, view_dir, out)  # fmt: skip
-        elif mode == MODE_ISOSURFACE:
-            hit = _first_crossing(data, blocks, origin, direction, s0, s1, ds, level, int(params[P_BISECTIONS]))
-            if hit < 0.0:
+    origin, direction, view_dir, out = np.empty(3), np.empty(3), np.empty(3), np.empty(4)
+    for row in range(start, stop):
+        y = height - 1 - row + 0.5
+        for column in range(width):
+            s0, s1, ds, model_length = _pixel_ray(matrices, planes, shape, params, column + 0.5, y,
+                                                  depth[row, column], origin, direction, view_dir)  # fmt: skip
+            if s0 < s1:
+                _composite(data, blocks, table, matrices, params, lights, origin, direction, s0, s1, ds,
+                           model_length, view_dir, out)  # fmt: skip
+                _blend(color, row, column, out)
+
+
+@parallel_kernel(lambda *arguments: arguments[-2].shape[0], pieces_per_thread=16)
+def cast_projection(mode, data, blocks, table, matrices, planes, params, depth, color, start,
+                    stop):  # pragma: no cover  # fmt: skip
+    """``MODE_MIP``, ``MODE_MINIP`` or ``MODE_AVERAGE`` over image rows [start, stop): one value per ray,
+    classified by the table (no opacity correction) and blended over the buffer."""
+    height, width = depth.shape
+    shape = np.array(data.shape, dtype=np.float64)
+    origin, direction, view_dir, out = np.empty(3), np.empty(3), np.empty(3), np.empty(4)
+    for row in range(start, stop):
+        y = height - 1 - row + 0.5
+        for column in range(width):
+            s0, s1, ds, _ = _pixel_ray(matrices, planes, shape, params, column + 0.5, y,
+                                                  depth[row, column], origin, direction, view_dir)  # fmt: skip
+            if not s0 < s1:
                 continue
-            for a in range(3):
-                u[a] = origin[a] + hit * direction[a]
-            r = _lookup(table, params, level, 0)
-            g = _lookup(table, params, level, 1)
-            b = _lookup(table, params, level, 2)
-            out[0], out[1], out[2] = _shade(data, matrices, params, lights, u, view_dir, r, g, b)
-            out[3] = 1.0
-            wm = matrices[M_WINDOW_FROM_GRID]
-            zw = wm[2, 0] * u[0] + wm[2, 1] * u[1] + wm[2, 2] * u[2] + wm[2, 3]
-            ww = wm[3, 0] * u[0] + wm[3, 1] * u[1] + wm[3, 2] * u[2] + wm[3, 3]
-            depth[row, column] = min(depth[row, column], zw / ww)
-        else:
             if mode == MODE_AVERAGE:
                 value = _average(data, origin, direction, s0, s1, ds)
             else:
@@ -489,7 +479,68 @@ def _cast_row(mode, data, blocks, table, matrices, planes, params, lights, depth
             for c in range(3):
                 out[c] = alpha * _lookup(table, params, value, c)
             out[3] = alpha
-        under = 1.0 - out[3]
-        for c in range(4):
-            v = out[c] + under * (color[row, column, c] / 255.0)
-            color[row, column, c] = np.uint8(math.floor(min(max(v, 0.0), 1.0) * 255.0 + 0.5))
+            _blend(color, row, column, out)
+
+
+@parallel_kernel(lambda *arguments: arguments[-2].shape[0], pieces_per_thread=16)
+def cast_isosurface(data, blocks, table, matrices, planes, params, lights, depth, color, start,
+                    stop):  # pragma: no cover  # fmt: skip
+    """``MODE_ISOSURFACE`` over image rows [start, stop): the first crossing of the level, shaded with the table's
+    color at the level, opaque; its window depth goes into `depth`."""
+    height, width = depth.shape
+    shape = np.array(data.shape, dtype=np.float64)
+    origin, direction, view_dir, out, u = np.empty(3), np.empty(3), np.empty(3), np.empty(4), np.empty(3)
+    level = params[P_LEVEL]
+    r = _lookup(table, params, level, 0)
+    g = _lookup(table, params, level, 1)
+    b = _lookup(table, params, level, 2)
+    wm = matrices[M_WINDOW_FROM_GRID]
+    for row in range(start, stop):
+        y = height - 1 - row + 0.5
+        for column in range(width):
+            s0, s1, ds, _ = _pixel_ray(matrices, planes, shape, params, column + 0.5, y,
+                                                  depth[row, column], origin, direction, view_dir)  # fmt: skip
+            if not s0 < s1:
+                continue
+            hit = _first_crossing(data, blocks, origin, direction, s0, s1, ds, level, int(params[P_BISECTIONS]))
+            if hit < 0.0:
+                continue
+            for a in range(3):
+                u[a] = origin[a] + hit * direction[a]
+            out[0], out[1], out[2] = _shade(data, matrices, params, lights, u, view_dir, r, g, b)
+            out[3] = 1.0
+            zw = wm[2, 0] * u[0] + wm[2, 1] * u[1] + wm[2, 2] * u[2] + wm[2, 3]
+            ww = wm[3, 0] * u[0] + wm[3, 1] * u[1] + wm[3, 2] * u[2] + wm[3, 3]
+            depth[row, column] = min(depth[row, column], zw / ww)
+            _blend(color, row, column, out)
+
+
+@kernel
+def _pixel_ray(matrices, planes, shape, params, x, y, window_depth, origin, direction,
+               view_dir):  # pragma: no cover - compiled  # fmt: skip
+    """The ray of window point (x, y) in grid coordinates (origin, direction, and the unit world vector toward the
+    eye in view_dir); returns (s0, s1, ds, model_length), empty when s0 >= s1."""
+    s0, s1 = _ray(matrices, planes, shape, x, y, window_depth, origin, direction)
+    if not s0 < s1:
+        return s0, s1, 0.0, 0.0
+    model = matrices[M_MODEL_FROM_GRID]
+    d0 = model[0, 0] * direction[0] + model[0, 1] * direction[1] + model[0, 2] * direction[2]
+    d1 = model[1, 0] * direction[0] + model[1, 1] * direction[1] + model[1, 2] * direction[2]
+    d2 = model[2, 0] * direction[0] + model[2, 1] * direction[1] + model[2, 2] * direction[2]
+    model_length = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)  # model units per unit of s
+    world = matrices[M_WORLD_FROM_GRID]
+    for a in range(3):  # toward the eye: minus the ray direction, in world coordinates
+        view_dir[a] = -(world[a, 0] * direction[0] + world[a, 1] * direction[1] + world[a, 2] * direction[2])
+    length = math.sqrt(view_dir[0] ** 2 + view_dir[1] ** 2 + view_dir[2] ** 2)
+    for a in range(3):
+        view_dir[a] /= length
+    return s0, s1, params[P_STEP] / model_length, model_length
+
+
+@kernel
+def _blend(color, row, column, out):  # pragma: no cover - compiled
+    """``out + (1 − out_α)·under`` into the pixel's bytes, ``floor(255·v + 0.5)``."""
+    under = 1.0 - out[3]
+    for c in range(4):
+        v = out[c] + under * (color[row, column, c] / 255.0)
+        color[row, column, c] = np.uint8(math.floor(min(max(v, 0.0), 1.0) * 255.0 + 0.5))
