@@ -414,7 +414,7 @@ def welded_faces(points: NDArray, faces: NDArray) -> NDArray[np.int64]:
 _WELDED: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
-def _welded_adjacency(mesh: Mesh) -> EdgeAdjacency:
+def welded_adjacency(mesh: Mesh) -> EdgeAdjacency:
     """The mesh's edges by shared vertex positions, computed once per mesh (welding in model space equals welding
     after any affine modeling transform)."""
     cached = _WELDED.get(mesh)
@@ -509,7 +509,7 @@ def remove_hidden_lines(
         points = mesh.vertices @ world_from_model[:3, :3].T + world_from_model[:3, 3]
         faces = np.asarray(mesh.faces, dtype=np.int64)
         facing = front_facing(clip_from_world, points, faces)
-        adjacency = _welded_adjacency(mesh)
+        adjacency = welded_adjacency(mesh)
         kinds = classify_edges(adjacency, points, faces, facing, angle)
         pairs, pair_faces = adjacency.edges, np.stack([adjacency.first, adjacency.second], axis=1)
         chosen = np.ones(kinds.shape, bool) if mask == 0 else (kinds & mask) != 0

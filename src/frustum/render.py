@@ -50,15 +50,17 @@ from frustum.clipping import VIEW_VOLUME_PLANES
 from frustum.errors import FrustumError
 from frustum.frame import Frame
 from frustum.geometry import Mesh
-from frustum.hidden_lines import EdgeAdjacency, classify_edges, edge_adjacency, front_facing
+from frustum.hidden_lines import EdgeAdjacency, classify_edges, edge_adjacency, front_facing, welded_adjacency
 from frustum.raster import lines, shade, tiles, triangles
 from frustum.raster._jit import threads
 from frustum.raster.vertices import project_vertices, transform_normals, transform_vertices, world_points
 from frustum.scene import Scene, SceneItem
 from frustum.shading import SPECULAR_MODELS, DepthCue, pack_lights
-from frustum.volume_pass import draw_volumes
 
-__all__ = ["HIDDEN_STYLES", "RENDER_MODES", "SHADING_MODES", "TILE_SIZE", "mesh_edges", "release_memory", "render"]
+__all__ = [
+    "HIDDEN_STYLES", "RENDER_METHODS", "RENDER_MODES", "SHADING_MODES", "TILE_SIZE", "mesh_edges", "release_memory",
+    "render",
+]  # fmt: skip
 
 SHADING_MODES = {
     "phong": shade.SHADE_PHONG,
@@ -182,6 +184,7 @@ def render(
     filter: str = "box",
     color_space: str = "linear",
     buffers: tuple[str, ...] = (),
+    method: str = "depth-buffer",
 ) -> Frame:
     """Render `scene` seen by `camera` into a ``Frame`` (color (H, W, 4) uint8 and depth (H, W) float32).
 
@@ -231,6 +234,11 @@ def render(
     buffers : tuple of {"normals", "object_id"}
         Extra per-pixel outputs on the Frame: unit world normals (0 on background) and the index of the item
         in ``scene.items`` (−1 on background).
+    method : {"depth-buffer", "octree"}
+        The visible-surface method (``RENDER_METHODS``). ``"depth-buffer"``: the meshes, as described above.
+        ``"octree"``: the scene's octrees (``Scene.octrees``) by ``visibility.octree.render_octree``, front to
+        back, each face orientation shaded once with the scene's lights; only `background` of the other
+        options applies, and meshes are not drawn.
 
     Raises
     ------
@@ -244,6 +252,9 @@ def render(
     [seed] "Back-face detection", "Depth-buffer method", "wire-frame displays".
     """
     where = "render"
+    _choice(method, tuple(RENDER_METHODS), "method", where)
+    if RENDER_METHODS[method] is not None:
+        return RENDER_METHODS[method](scene, camera, background=background)
     options = _check_arguments(
         scene, camera, shading, specular, background, cull_back_faces, mode, edges, crease_angle, edge_color,
         hidden, hidden_color, line_width, depth_cue, buffers, where,
@@ -279,6 +290,32 @@ def render(
     return Frame(color=color, depth=depth, normals=normals, object_id=ids)
 
 
+def _render_octrees(scene: Scene, camera: Camera, *, background: Any) -> Frame:
+    """``method="octree"``: every placed octree by the octree method, nearest surface kept between octrees."""
+    from frustum.visibility.octree import draw_octree_into, octree_face_colors
+
+    if not isinstance(scene, Scene) or not isinstance(camera, Camera):
+        _check_arguments(scene, camera, "phong", "blinn-phong", background, True, "surface", None, 0.0, None, None,
+                         (0.6, 0.6, 0.6), 1.0, None, (), "render")  # fmt: skip
+    rgba = _background_bytes(background, "render")
+    color = np.empty((camera.height, camera.width, 4), dtype=np.uint8)
+    color[:, :] = rgba
+    depth = np.ones((camera.height, camera.width), dtype=np.float32)
+    lights = scene.world_lights()
+    for item in scene.octrees:
+        item_color, item_depth = color.copy(), np.ones_like(depth)
+        written = np.zeros(depth.shape, dtype=bool)
+        faces = octree_face_colors(item.mesh, item.material, lights, item.world_from_model, camera.frame.eye)
+        draw_octree_into(item.mesh, camera, item.world_from_model, faces, item_color, item_depth, written)
+        nearer = written & (item_depth < depth)
+        color[nearer], depth[nearer] = item_color[nearer], item_depth[nearer]
+    return Frame(color=color, depth=depth)
+
+
+RENDER_METHODS = {"depth-buffer": None, "octree": _render_octrees}
+"""Visible-surface methods of ``render(..., method=...)``: None is the built-in depth-buffer pipeline."""
+
+
 def _render_buffers(
     scene: Scene, camera: Camera, options: _Options
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None]:
@@ -293,6 +330,7 @@ def _render_buffers(
         color[:, :] = options.background
         _draw_edges(items, camera, options, depth, color)
         _draw_polylines(scene.polylines, camera, options, depth, color)
+        _draw_particles(scene, camera, depth, color)
         return color, depth, normal_out, id_out
     scratch = Scratch()
     depth, color = _draw_surfaces(scene, items, camera, options, normal_out, id_out, scratch)
@@ -302,7 +340,16 @@ def _render_buffers(
     if options.mode in ("hidden-line", "surface+edges"):
         _draw_edges(items, camera, options, depth, color)
     _draw_polylines(scene.polylines, camera, options, depth, color)
+    _draw_particles(scene, camera, depth, color)
     return color, depth, normal_out, id_out
+
+
+def _draw_particles(scene: Scene, camera: Camera, depth: np.ndarray, color: np.ndarray) -> None:
+    """Particle layers over the finished surfaces: depth-tested, depth not written (``frustum.particle_pass``)."""
+    if getattr(scene, "particle_layers", None):
+        from frustum.particle_pass import draw_particles
+
+        draw_particles(scene.particle_layers, camera, depth, color)
 
 
 def _draw_surfaces(
@@ -334,7 +381,10 @@ def _draw_surfaces(
     for index, world, normals in drawn:
         _shade_item(items[index], index, int(offsets[index]), camera, options, ambient, lights, world, normals,
                     depth, codes, bary, color, extra, blend=False)  # fmt: skip
-    draw_volumes(scene, camera, depth, color)  # rays stop at the opaque depth; before transparent items
+    if scene.volumes:  # ray cast after the opaque surfaces (rays stop at their depth), before transparent items
+        from frustum.volume_pass import draw_volumes
+
+        draw_volumes(scene, camera, depth, color)
     if clear_items:
         axis = np.asarray(camera.frame.n, dtype=np.float64)
         eye = np.asarray(camera.frame.eye, dtype=np.float64)
@@ -647,7 +697,8 @@ def _draw_edges(items: list[SceneItem], camera: Camera, options: _Options, depth
         if options.mode == "points":
             lines.draw_points(clip, view_depth, vertex_codes, view, style, depth, color)
             continue
-        adjacency = _adjacency(mesh)
+        # feature edges by shared positions: a cap's rim or a seam split for normals or UVs is not a boundary
+        adjacency = welded_adjacency(mesh) if options.edges == "feature" else _adjacency(mesh)
         edges = adjacency.edges
         if edge_modes or options.edges == "feature":
             faces = _world_faces(item)

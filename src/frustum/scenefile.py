@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import dataclasses
 import difflib
+import functools
 import importlib
 import inspect
 import math
@@ -48,7 +49,7 @@ from frustum.frame import Frame
 from frustum.geometry import Mesh
 from frustum.projection import MULTIVIEWS, Axonometric, Frustum, Oblique, Orthographic, Perspective
 from frustum.quaternion import Quaternion
-from frustum.render import RENDER_MODES, SHADING_MODES, render
+from frustum.render import RENDER_METHODS, RENDER_MODES, SHADING_MODES, render
 from frustum.scene import Node, Scene, cutaway, exploded
 from frustum.shading import AmbientLight, DepthCue, DirectionalLight, Material, PointLight, SpotLight
 from frustum.transforms import compose, reflect, rotate, rotate_x, rotate_y, rotate_z, scale, shear, translate
@@ -95,7 +96,7 @@ _MAX_INTEGER_PARAMETER = 100_000
 """Largest integer geometry parameter (segments, resolution, ...): guards against runaway tessellation."""
 _ANGLE_PARAMETERS = frozenset(
     {"angle", "fovy", "alpha", "phi", "rotation_x", "rotation_y", "crease_angle", "inner_angle", "outer_angle",
-     "azimuth", "elevation", "start", "end"}
+     "azimuth", "elevation", "start", "end", "spread"}
 )  # fmt: skip
 """Radian parameters of the Python API: scene files must give them in degrees, as ``<name>_deg``."""
 _DEGREE_PARAMETERS = frozenset({"LSystem.angle", "union.sharp_angle", "difference.sharp_angle",
@@ -104,7 +105,7 @@ _DEGREE_PARAMETERS = frozenset({"LSystem.angle", "union.sharp_angle", "differenc
 
 _TOP_LEVEL = (
     "title", "description", "camera", "cameras", "lights", "materials", "nodes", "render", "exploded", "cutaway",
-    "output", "animation", "svg", "volumes",
+    "output", "animation", "svg", "particles", "cloth", "volumes",
 )  # fmt: skip
 _NODE_KEYS = ("name", "geometry", "material", "transform", "children", "lights")
 _CAMERA_KEYS = (
@@ -115,7 +116,7 @@ _CAMERA_KEYS = (
 _STEREO_KEYS = ("eye_separation", "convergence_distance", "layout", "anaglyph_method", "cross_eyed")
 _RENDER_KEYS = (
     "size", "shading", "specular", "background", "cull_back_faces", "mode", "edges", "crease_angle_deg", "edge_color",
-    "hidden", "hidden_color", "line_width", "depth_cue", "samples", "filter", "color_space", "columns",
+    "hidden", "hidden_color", "line_width", "depth_cue", "samples", "filter", "color_space", "columns", "method",
 )  # fmt: skip
 _DEPTH_CUE_KEYS = ("near", "far", "min_intensity", "max_intensity", "color")
 _LIGHT_TYPES = {"ambient": AmbientLight, "directional": DirectionalLight, "point": PointLight, "spot": SpotLight}
@@ -177,6 +178,8 @@ GEOMETRY_TYPES: dict[str, tuple[str, str, str]] = {
     "union": ("csg", "frustum.geometry.csg", "union"),
     "difference": ("csg", "frustum.geometry.csg", "difference"),
     "intersection": ("csg", "frustum.geometry.csg", "intersection"),
+    # a solid as an octree of the cells of another geometry table (drawn by [render] method = "octree")
+    "octree": ("octree", "frustum.geometry.octree", "Octree"),
 }
 """``geometry.type`` values: (kind, module, attribute) of the function or class that builds each one."""
 
@@ -909,6 +912,8 @@ def _geometry(report: _Report, path: tuple, value: Any, base: Path, materials: d
         return _csg(report, path, params, builder, base, materials), []
     if kind == "lsystem":
         return _lsystem(report, path, params, builder), []
+    if kind == "octree":
+        return _octree(report, path, params, builder, base, materials), []
     # curves and point fractals: sampled into a polyline, drawn as a tube or line
     options = _curve_options(report, path, params)
     rest = {k: v for k, v in params.items() if k not in _CURVE_KEYS}
@@ -994,6 +999,39 @@ def _csg(report: _Report, path: tuple, params: dict, boolean: Callable, base: Pa
         return boolean(*meshes, sharp_angle=angle)
     except (FrustumError, ValueError, RuntimeError) as error:
         report.refused(path, {"operands": "..."}, error)
+        return _BAD
+
+
+def _octree(report: _Report, path: tuple, params: dict, octree: Any, base: Path, materials: dict) -> Any:
+    """``Octree.from_mesh`` of the closed mesh the ``source`` geometry table builds (a mesh file, a primitive or a
+    CSG expression, with its own ``transform`` list), down to ``depth`` levels (``shell`` for a surface)."""
+    keys = ("source", "depth", "shell")
+    _unknown_keys(report, path, params, keys)
+    if "source" not in params:
+        report.missing((*path, "source"), "give the solid as a geometry table, e.g. source = { type = 'sphere' }")
+        return _BAD
+    depth = _number(report, (*path, "depth"), params.get("depth", 6), low=0, high=12, integer=True)
+    shell = _boolean(report, (*path, "shell"), params.get("shell", False))
+    table = _table(report, (*path, "source"), params["source"])
+    mesh = _BAD
+    if table is not _BAD:
+        table = dict(table)
+        steps = table.pop("transform", None)
+        mesh, _ = _geometry(report, (*path, "source"), table, base, materials)
+        if mesh is not _BAD and not isinstance(mesh, Mesh):
+            report.add((*path, "source", "type"), table.get("type"), "is not a solid", "give a closed mesh geometry")
+            mesh = _BAD
+        matrix = None if steps is None else _transform(report, (*path, "source", "transform"), steps)
+        if matrix is _BAD:
+            mesh = _BAD
+        elif mesh is not _BAD and matrix is not None:
+            mesh = mesh.transformed(matrix)
+    if _bad(depth, shell, mesh) or any(key not in keys for key in params):
+        return _BAD
+    try:
+        return octree.from_mesh(mesh, int(depth), shell=bool(shell))
+    except FrustumError as error:
+        report.refused(path, {"source": "...", "depth": depth}, error)
         return _BAD
 
 
@@ -1384,6 +1422,7 @@ def _render_options(report: _Report, path: tuple, value: Any) -> tuple[dict, tup
         "samples": lambda p, v: _number(report, p, v, low=1, high=64, integer=True),
         "filter": lambda p, v: _choice(report, p, v, ("box", "tent")),
         "color_space": lambda p, v: _choice(report, p, v, ("linear", "srgb")),
+        "method": lambda p, v: _choice(report, p, v, tuple(RENDER_METHODS)),
     }
     for key, check in simple.items():
         if key in params:
@@ -1574,6 +1613,87 @@ def _cut(report: _Report, path: tuple, params: dict, scene: Scene) -> Scene:
         return scene
 
 
+# --- simulations: [[particles]] and [[cloth]] ---------------------------------------------------------------
+
+_EMITTERS = {"point": "PointEmitter", "line": "LineEmitter", "disk": "DiskEmitter", "sphere": "SphereEmitter"}
+_FORCES = {"gravity": "Gravity", "drag": "Drag", "wind": "Wind", "vortex": "Vortex", "attractor": "Attractor"}
+_COLLIDERS = {"plane": "PlaneCollider", "sphere": "SphereCollider"}
+_PARTICLE_KEYS = ("emitter", "forces", "colliders", "style", "blending")
+_CLOTH_KEYS = ("material", "colliders", "name")
+
+
+def _typed(report: _Report, path: tuple, value: Any, kinds: dict[str, str]) -> Any:
+    """``{ type = "...", ... }`` → the simulation class of that type built from the other keys."""
+    params = _table(report, path, value)
+    if params is _BAD:
+        return _BAD
+    kind = params.pop("type", None)
+    if kind not in kinds:
+        report.add((*path, "type"), kind, "is unknown" if kind is not None else "is missing",
+                   f"expected one of {', '.join(repr(k) for k in kinds)}")  # fmt: skip
+        return _BAD
+    simulation = importlib.import_module("frustum.simulation")
+    return _call(report, path, getattr(simulation, kinds[kind]), params, label=kinds[kind])
+
+
+def _typed_list(report: _Report, path: tuple, value: Any, kinds: dict[str, str]) -> Any:
+    if not isinstance(value, list):
+        report.add(path, value, "is not a list of tables", "write e.g. [{ type = ... }, ...]")
+        return _BAD
+    built = [_typed(report, (*path, i), item, kinds) for i, item in enumerate(value)]
+    return _BAD if any(item is _BAD for item in built) else built
+
+
+def _simulations(report: _Report, data: dict, scene: Scene, materials: dict) -> None:
+    """``[[particles]]`` (a ParticleSystem with its emitter, forces, colliders, style, blending) and ``[[cloth]]``
+    (``frustum.cloth`` with its material and colliders) added to `scene`; ``[animation].warmup`` steps them."""
+    simulation = importlib.import_module("frustum.simulation")
+    for i, entry in enumerate(_table_list(report, ("particles",), data.get("particles", []))):
+        path, params = ("particles", i), dict(entry)
+        if "emitter" not in params:
+            report.missing((*path, "emitter"), "give an emitter = { type = 'point', position = [x, y, z] }")
+            continue
+        emitter = _typed(report, (*path, "emitter"), params["emitter"], _EMITTERS)
+        forces = _typed_list(report, (*path, "forces"), params.get("forces", []), _FORCES)
+        colliders = _typed_list(report, (*path, "colliders"), params.get("colliders", []), _COLLIDERS)
+        style = _choice(report, (*path, "style"), params.get("style", "sprites"), ("sprites", "points", "streaks"))
+        blending = _choice(report, (*path, "blending"), params.get("blending", "additive"), ("additive", "alpha"))
+        if _bad(emitter, forces, colliders, style, blending):
+            continue
+        build = functools.partial(simulation.ParticleSystem, emitter=emitter, forces=forces, colliders=colliders)
+        system = _call(report, path, build, params, label="ParticleSystem", skip=_PARTICLE_KEYS)
+        if system is not _BAD:
+            scene.add_particles(system, style=style, blending=blending)
+    for i, entry in enumerate(_table_list(report, ("cloth",), data.get("cloth", []))):
+        path, params = ("cloth", i), dict(entry)
+        material = _material_reference(report, (*path, "material"), params["material"], materials) \
+            if "material" in params else None  # fmt: skip
+        colliders = _typed_list(report, (*path, "colliders"), params.get("colliders", []), _COLLIDERS)
+        name = params.get("name", "")
+        if not isinstance(name, str):
+            report.add((*path, "name"), name, "is not a string", "give a node name in quotes")
+            continue
+        if _bad(material, colliders):
+            continue
+        build = functools.partial(simulation.cloth, colliders=colliders)
+        system = _call(report, path, build, params, label="cloth", skip=_CLOTH_KEYS)
+        if system is not _BAD:
+            scene.add_mass_spring(system, material, name=name)
+
+
+def _warm_up(report: _Report, scene: Scene, animation: dict) -> None:
+    """Step the simulations ``[animation].warmup`` seconds (in steps of ``1/(fps·substeps)``) before any frame."""
+    warmup = animation.get("warmup", 0.0)
+    if not warmup or not (scene.particle_layers or scene.mass_springs):
+        return
+    step_scene = importlib.import_module("frustum.output.simulate").step_scene
+    dt = 1.0 / (animation.get("fps", 12.0) * animation.get("substeps", 1))
+    try:
+        step_scene(scene, dt, round(warmup / dt))
+    except FrustumError as error:
+        report.refused(("animation", "warmup"), warmup, error)
+
+
 def _outputs(report: _Report, data: dict, base: Path) -> tuple[tuple[Path, ...], dict, dict]:
     outputs: list[Path] = []
     if "output" in data:
@@ -1595,7 +1715,12 @@ def _outputs(report: _Report, data: dict, base: Path) -> tuple[tuple[Path, ...],
         path = ("animation",)
         params = _table(report, path, data["animation"])
         if params is not _BAD:
-            _unknown_keys(report, path, params, ("frames", "fps", "axis"))
+            _unknown_keys(report, path, params, ("frames", "fps", "axis", "substeps", "warmup"))
+            if "substeps" in params:
+                animation["substeps"] = _number(report, (*path, "substeps"), params["substeps"], low=1, high=1000,
+                                                integer=True)  # fmt: skip
+            if "warmup" in params:
+                animation["warmup"] = _number(report, (*path, "warmup"), params["warmup"], low=0.0, high=3600.0)
             if "frames" in params:
                 animation["frames"] = _number(report, (*path, "frames"), params["frames"], low=1, high=3600,
                                               integer=True)  # fmt: skip
@@ -1787,6 +1912,7 @@ def _build(report: _Report, data: dict, base: Path) -> SceneFile | None:
     for i, value in enumerate(_table_list(report, ("volumes",), data.get("volumes", []))):
         _volume(report, ("volumes", i), dict(value), base, materials, scene)
     scene = _explode_and_cut(report, data, scene)
+    _simulations(report, data, scene, materials)
     cameras: list[Camera] = []
     stereo = None
     if "camera" in data and "cameras" in data:
@@ -1812,6 +1938,8 @@ def _build(report: _Report, data: dict, base: Path) -> SceneFile | None:
     else:
         report.missing(("camera",), "add a [camera] table with eye and target (or [[cameras]])")
     outputs, animation, svg = _outputs(report, data, base)
+    if not report.problems:
+        _warm_up(report, scene, animation)
     if report.problems:
         return None
     title = data.get("title", "")
@@ -1870,6 +1998,12 @@ def _write(scene_file: SceneFile, target: Path) -> Path:
     except ImportError:
         raise OutputError("render_scene_file: GIF/MP4 output is not available in this version") from None
     settings = {"frames": 36, "fps": 12.0, **scene_file.animation}
+    if scene_file.scene.particle_layers or scene_file.scene.mass_springs:  # [[particles]] / [[cloth]]: simulate
+        simulate = importlib.import_module("frustum.output.simulate").simulate
+        simulate(scene_file.scene, camera, int(settings["frames"]), fps=settings["fps"],
+                 substeps=int(settings.get("substeps", 1)), path=target, progress=False,
+                 **scene_file.options)  # fmt: skip
+        return target
     animation.turntable(scene_file.scene, camera, settings["frames"], settings.get("axis"), target,
                         settings["fps"], progress=False, **scene_file.options)  # fmt: skip
     return target

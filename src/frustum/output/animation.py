@@ -236,6 +236,7 @@ def _with_lights_turned(scene: Scene, turn: NDArray[np.float64]) -> Scene:
     )  # fmt: skip
     turned = Scene()
     turned.root = turned_root
+    turned.particle_layers = list(getattr(scene, "particle_layers", ()))  # particles turn with the camera too
     return turned
 
 
@@ -340,7 +341,7 @@ def _size(size: Any, where: str) -> tuple[int, int]:
     return int(size[0]), int(size[1])
 
 
-def _with_progress(items: Iterator[Frame], total: int, progress: Any) -> Iterator[Frame]:
+def _with_progress(items: Iterator[Frame], total: int, progress: Any, label: str = "turntable") -> Iterator[Frame]:
     """Yield `items`, advancing a Rich progress bar on a terminal (or on the given Console)."""
     from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
@@ -352,7 +353,7 @@ def _with_progress(items: Iterator[Frame], total: int, progress: Any) -> Iterato
     if not console.is_terminal:
         yield from items
         return
-    columns = (TextColumn("turntable"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn())
+    columns = (TextColumn(label), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn())
     bar = Progress(*columns, console=console, transient=False)
     with bar:
         task = bar.add_task("render", total=total)

@@ -45,9 +45,9 @@ from frustum.hidden_lines import (
     EDGE_BOUNDARY,
     EDGE_CREASE,
     HiddenLines,
-    _welded_adjacency,
     classify_edges,
     remove_hidden_lines,
+    welded_adjacency,
 )
 from frustum.output.svg import _check_common, _drawing_groups, _number, _placed_meshes, svg_document
 from frustum.projection import ISOMETRIC_ROTATION_X, MULTIVIEWS, Axonometric, Orthographic, multiview
@@ -210,7 +210,7 @@ def _circles(meshes: list[tuple[Mesh | Polyline, NDArray]]) -> list[_Circle]:
         if not isinstance(mesh, Mesh) or mesh.face_count == 0:
             continue
         points = mesh.vertices @ world_from_model[:3, :3].T + world_from_model[:3, 3]
-        adjacency = _welded_adjacency(mesh)
+        adjacency = welded_adjacency(mesh)
         kinds = classify_edges(adjacency, points, np.asarray(mesh.faces), None, DEFAULT_CREASE_ANGLE)
         edges = adjacency.edges[(kinds & (EDGE_BOUNDARY | EDGE_CREASE)) != 0]
         if edges.shape[0] < _CIRCLE_MIN_VERTICES:
@@ -300,7 +300,9 @@ def _side_on_axes(circles: list[_Circle], camera: Camera, mm_per_pixel: float) -
         for k, (c, d) in enumerate(merged):
             along = (d - c) / np.linalg.norm(d - c)
             gap = 1e-6 * max(float(np.linalg.norm(d - c)), float(np.linalg.norm(b - a)))
-            if abs(float(np.cross(unit, along))) > 1e-9 or abs(float(np.cross(a - c, along))) > gap:
+            offset = a - c
+            if (abs(float(unit[0] * along[1] - unit[1] * along[0])) > 1e-9  # 2D cross products: not parallel,
+                    or abs(float(offset[0] * along[1] - offset[1] * along[0])) > gap):  # or not on one line
                 continue
             t = [float((p - c) @ along) for p in (a, b)]
             span = float(np.linalg.norm(d - c))

@@ -504,6 +504,10 @@ def render_svg(
         polygons, used = _fill_polygons(placed, _lights(scene), camera, fill_order)
         body.append(f'<g id="faces" data-order="{used}">{"".join(polygons)}</g>')
     body += _drawing_groups(lines, placed, to_paper, width, hidden, bool(depth_cue), camera=camera)
+    if getattr(scene, "particle_layers", None):  # dots and segments over the drawing (output/svg_particles.py)
+        from frustum.output.svg_particles import particle_elements
+
+        body += particle_elements(scene, camera)
     return svg_document(camera.width, camera.height, body)
 
 
