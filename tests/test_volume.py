@@ -315,6 +315,15 @@ def test_isosurface_step_and_dense_inside_keep_outward_winding():
         assert trimesh.Trimesh(mesh.vertices, mesh.faces, process=False).volume > 0
 
 
+@pytest.mark.parametrize("direction", [np.eye(3), np.diag([-1.0, 1.0, 1.0]), [[0, 1, 0], [1, 0, 0], [0, 0, 1]]])
+def test_isosurface_winding_stays_outward_when_the_direction_flips_handedness(direction):
+    import trimesh
+
+    base = Volume.from_function(lambda p: sphere_implicit(p, 0.8), ((-1, -1, -1), (1, 1, 1)), 31)
+    mesh = Volume(base.data, base.spacing, base.origin, direction=direction).isosurface(1.0, inside="below")
+    assert trimesh.Trimesh(mesh.vertices, mesh.faces, process=False).volume > 2.0  # 4/3·π·0.8³ = 2.14
+
+
 # --- the volume itself -------------------------------------------------------------------------------------
 
 
