@@ -337,6 +337,8 @@ _LAZY = {
     "simulate": "frustum.output.simulate",
     "turntable": "frustum.output.animation",
     "write_animation": "frustum.output.animation",
+    # needs the viewer extra (anywidget); left out of __all__ so that `from frustum import *` works without it
+    "Viewer": "frustum.viewer",
 }
 
 if TYPE_CHECKING:  # pragma: no cover

@@ -45,6 +45,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from frustum._arrays import as_scalar, describe
+from frustum.budgets import check_memory
 from frustum.camera import Camera
 from frustum.clipping import VIEW_VOLUME_PLANES
 from frustum.errors import FrustumError
@@ -262,6 +263,7 @@ def render(
     factor = _supersampling(samples, where)
     _choice(filter, FILTERS, "filter", where)
     _choice(color_space, COLOR_SPACES, "color_space", where)
+    _check_image_budget(camera, factor, options.buffers, filter, color_space, where)
     if factor == 1:
         color, depth, normals, ids = _render_buffers(scene, camera, options)
         linear = None
@@ -829,6 +831,26 @@ def _color_bytes(value: Any, name: str, where: str) -> np.ndarray:
     return np.floor(array * 255.0 + 0.5)
 
 
+def _check_image_budget(camera: Camera, factor: int, buffers: tuple[str, ...], filter: str, color_space: str,
+                       where: str) -> None:  # fmt: skip
+    """Refuse, before any buffer is allocated, an image whose buffers exceed the memory budget (``frustum.budgets``).
+
+    Per rendered pixel (``width·height·samples`` of them): color 4 + depth 4 bytes, about 4 bytes of the
+    renderer's work arrays (measured with tracemalloc: 12 bytes a pixel at 1024², surface mode), 12 for a
+    ``normals`` buffer and 4 for ``object_id``; a float64 copy for the tent filter or sRGB (2 × 32 bytes).
+    """
+    pixels = camera.width * camera.height * factor * factor
+    per_pixel = 12 + 12 * ("normals" in buffers) + 4 * ("object_id" in buffers)
+    if filter != "box" or color_space != "linear":
+        per_pixel += 64
+    cause = f"a {camera.width} x {camera.height} image x samples = {factor * factor}"
+    check_memory(pixels * per_pixel, where=where, cause=cause, error=FrustumError)
+
+
+_MAX_LINE_WIDTH = 256.0
+"""Widest line (and largest point) ``render`` draws, in output pixels."""
+
+
 def _check_arguments(
     scene: Any, camera: Any, shading: Any, specular: Any, background: Any, cull_back_faces: Any, mode: Any,
     edges: Any, crease_angle: Any, edge_color: Any, hidden: Any, hidden_color: Any, line_width: Any,
@@ -861,6 +883,11 @@ def _check_arguments(
     width = as_scalar(line_width, "line_width", where=where, error=FrustumError)
     if width < 1.0:
         raise FrustumError(f"{where}: line_width = {width!r} is below 1; give a width in pixels >= 1")
+    if width > _MAX_LINE_WIDTH:
+        raise FrustumError(
+            f"{where}: line_width = {width!r} is above {_MAX_LINE_WIDTH:g}; give a width in pixels in [1, "
+            f"{_MAX_LINE_WIDTH:g}]"
+        )
     if depth_cue is not None and not isinstance(depth_cue, DepthCue):
         raise FrustumError(
             f"{where}: depth_cue = {describe(depth_cue)} is not a DepthCue; build one with DepthCue(near, far)"

@@ -118,6 +118,14 @@ def _modeling_transform(transform: ArrayLike | None, where: str) -> Matrix4:
             f"{where}: transform bottom row = {describe(matrix[3])} makes it projective; a modeling transform "
             "is affine (bottom row 0, 0, 0, 1)"
         )
+    block = matrix[:3, :3]
+    scale = float(np.abs(block).max())
+    if scale == 0.0 or abs(float(np.linalg.det(block))) <= 1e-12 * scale**3:
+        raise FrustumError(
+            f"{where}: transform upper 3x3 = {describe(block)} is singular (determinant 0): it flattens the model "
+            "onto a plane, a line or a point, where normals are undefined; give an invertible transform "
+            "(no scale factor of 0)"
+        )
     matrix.flags.writeable = False
     return matrix
 
@@ -437,7 +445,12 @@ class Scene:
 
     def world_lights(self) -> list[Light]:
         """Every light in world coordinates (those riding nodes moved by the node's world transform)."""
-        return [light.transformed(world) for node, world in self.root.walk() for light in node.lights]
+        lights: list[Light] = []
+        for node, world in self.root.walk():
+            if node.lights:  # lights at the identity (the root's, usually all of them) need no copy
+                identity = world is _IDENTITY or np.array_equal(world, _IDENTITY)
+                lights.extend(node.lights if identity else [light.transformed(world) for light in node.lights])
+        return lights
 
     def __len__(self) -> int:
         return len(self.items)
