@@ -383,6 +383,10 @@ def _draw_surfaces(
     for index, world, normals, rows in drawn:
         _shade_item(items[index], index, int(offsets[index]), camera, options, ambient, lights, world, normals,
                     depth, codes, bary, color, extra, rows, blend=False)  # fmt: skip
+    if scene.volumes:  # ray cast after the opaque surfaces (rays stop at their depth), before transparent items
+        from frustum.volume_pass import draw_volumes
+
+        draw_volumes(scene, camera, depth, color)
     if clear_items:
         axis = np.asarray(camera.frame.n, dtype=np.float64)
         eye = np.asarray(camera.frame.eye, dtype=np.float64)

@@ -17,6 +17,7 @@ from numpy.typing import ArrayLike, NDArray
 from frustum._arrays import Matrix4, as_matrix, as_scalar, as_vector3, describe
 from frustum.errors import FrustumError, GeometryError
 from frustum.geometry import Mesh, Octree, Polyline
+from frustum.geometry.volume import VOLUME_MODES, TransferFunction, Volume
 from frustum.shading import LIGHT_TYPES, Light, Material
 from frustum.simulation import MassSpringSystem, ParticleSystem
 from frustum.transforms import translate
@@ -30,6 +31,7 @@ __all__ = [
     "Placed",
     "Scene",
     "SceneItem",
+    "VolumeItem",
     "cutaway",
     "exploded",
 ]
@@ -49,6 +51,25 @@ class SceneItem(NamedTuple):
     mesh: Mesh
     material: Material
     world_from_model: Matrix4
+
+
+class VolumeItem(NamedTuple):
+    """One placed volume (``Scene.add_volume``): drawn by ray casting after the opaque meshes.
+
+    ``clip_planes`` (P, 2, 3) world (point, normal) rows: the side each normal points to is cut away, as
+    ``cutaway`` cuts meshes. ``step`` is the sample distance Δ in model units; ``shade`` gradient shading with
+    the scene's lights and ``material``'s coefficients (base color from the transfer function).
+    """
+
+    volume: Volume
+    transfer_function: TransferFunction
+    mode: str
+    world_from_model: Matrix4
+    step: float
+    level: float
+    shade: bool
+    material: Material
+    clip_planes: np.ndarray
 
 
 class Pick(NamedTuple):
@@ -209,6 +230,7 @@ class Scene:
         self.root = Node("")
         self.particle_layers: list[ParticleLayer] = []
         self.mass_springs: list[tuple[Node, MassSpringSystem]] = []
+        self.volumes: list[VolumeItem] = []
         for light in lights:
             self.add_light(light)
 
@@ -249,6 +271,68 @@ class Scene:
                 "Mesh(vertices, faces)"
             )
         return host.add(Node(name, transform, geometry, material))
+
+    def add_volume(
+        self,
+        volume: Volume,
+        transfer_function: TransferFunction | None = None,
+        mode: str = "composite",
+        transform: ArrayLike | None = None,
+        *,
+        step: float | None = None,
+        level: float | None = None,
+        shade: bool | None = None,
+        material: Material | None = None,
+        clip_planes: Iterable[tuple[ArrayLike, ArrayLike]] = (),
+    ) -> VolumeItem:
+        """Place a ``Volume`` (``world = transform · model``) to be ray cast by ``render``; returns its record.
+
+        `transfer_function` defaults to the grayscale preset over the data's range; `mode` is one of
+        ``VOLUME_MODES``; `step` the sample distance in model units (default half the smallest spacing);
+        `level` the isosurface value (default the middle of the data's range); `shade` gradient shading
+        (default on for "isosurface" only); `clip_planes` world (point, normal) pairs whose normal side is cut.
+        """
+        where = "Scene.add_volume"
+        if not isinstance(volume, Volume):
+            raise GeometryError(f"{where}: volume = {describe(volume)} is not a Volume; build one with Volume(data)")
+        low, high = volume.value_range
+        if transfer_function is None:
+            transfer_function = TransferFunction.preset("grayscale", (low, high) if low < high else (low, low + 1.0))
+        elif not isinstance(transfer_function, TransferFunction):
+            raise GeometryError(f"{where}: transfer_function = {describe(transfer_function)} is not a "
+                                "TransferFunction; build one with TransferFunction(values, colors, opacities)"
+                                )  # fmt: skip
+        if not isinstance(mode, str) or mode not in VOLUME_MODES:
+            raise GeometryError(f"{where}: mode = {describe(mode)} is unknown; expected one of "
+                                + ", ".join(repr(m) for m in VOLUME_MODES))  # fmt: skip
+        delta = 0.5 * volume.unit_distance if step is None else as_scalar(step, "step", where=where,
+                                                                           error=GeometryError)  # fmt: skip
+        if not delta > 0.0:
+            raise GeometryError(f"{where}: step = {delta!r} is not positive; give a sample distance > 0 (model units)")
+        value = 0.5 * (low + high) if level is None else as_scalar(level, "level", where=where, error=GeometryError)
+        if shade is not None and not isinstance(shade, bool | np.bool_):
+            raise GeometryError(f"{where}: shade = {describe(shade)} is not a bool; give True or False")
+        if material is not None and not isinstance(material, Material):
+            raise GeometryError(f"{where}: material = {describe(material)} is not a Material")
+        planes = []
+        for index, plane in enumerate(clip_planes):
+            try:
+                point, normal = plane
+            except (TypeError, ValueError):
+                raise GeometryError(
+                    f"{where}: clip_planes[{index}] = {describe(plane)} is not (point, normal)"
+                ) from None
+            point = as_vector3(point, f"clip_planes[{index}] point", where=where, error=GeometryError)
+            normal = as_vector3(normal, f"clip_planes[{index}] normal", where=where, error=GeometryError)
+            if not np.linalg.norm(normal) > 0.0:
+                raise GeometryError(f"{where}: clip_planes[{index}] normal = {describe(normal)} has zero length")
+            planes.append((point, normal / np.linalg.norm(normal)))
+        item = VolumeItem(volume, transfer_function, mode, _modeling_transform(transform, where), float(delta), value,
+                          mode == "isosurface" if shade is None else bool(shade),
+                          Material() if material is None else material,
+                          np.array(planes, dtype=np.float64).reshape(-1, 2, 3))  # fmt: skip
+        self.volumes.append(item)
+        return item
 
     def add_particles(self, system: ParticleSystem, *, style: str = "sprites",
                       blending: str = "additive") -> ParticleLayer:  # fmt: skip
@@ -375,6 +459,7 @@ class Scene:
         scene = Scene()
         scene.root = root
         scene.particle_layers = list(self.particle_layers)
+        scene.volumes = list(self.volumes)
         return scene
 
 
@@ -450,6 +535,7 @@ def cutaway(
     positions and recomputes normals; UVs and vertex colors of cut meshes are not kept. Polylines are kept
     whole (not cut). The section caps hang on a child node ``"<name>:section"`` whose material is the part's
     with ``hatch`` set (45° section lines of that spacing in filled vector output; None: no hatching).
+    Placed volumes (``Scene.add_volume``) get a plane cut as a clip plane; a box cut leaves them whole.
     """
     where = "cutaway"
     if (plane is None) == (box is None):
@@ -480,8 +566,18 @@ def cutaway(
             raise GeometryError(f"{where}: hatch = {hatch!r} is not a positive spacing; give a number > 0 or None")
     result = Scene()
     result.root.lights = list(scene.root.lights)
+    result.volumes = [_cut_volume(item, region) for item in scene.volumes]
     _cut_node(scene.root, result.root, _IDENTITY, Material(), region, cap, ghost_material, hatch)
     return result
+
+
+def _cut_volume(item: VolumeItem, region: tuple) -> VolumeItem:
+    """The volume with a plane cut added to its clip planes (the ray caster clips to half-spaces; what a box cut
+    keeps is not convex, so volumes stay whole under a box cut)."""
+    if region[0] != "plane":
+        return item
+    planes = np.concatenate([item.clip_planes, np.array([[region[1], region[2]]])])
+    return item._replace(clip_planes=planes)
 
 
 def _cut_node(

@@ -1,0 +1,546 @@
+"""Volume ray casting: one ray per pixel through a scalar grid, composited into a framebuffer [HB 15] "Visual
+Representations for Scalar Fields" (volume rendering); Levoy, "Display of surfaces from volume data", 1988.
+
+Per pixel (window centre (x + ½, y + ½), y up), in grid-index coordinates u (voxel (i, j, k) at u = (i, j, k)):
+
+1. Ray: ``A = grid_from_window·(x, y, 0, 1)``, ``B = grid_from_window·(x, y, 1, 1)`` (divided by w), the points
+   on the near and far planes; ``u(s) = A + s·(B − A)``, s ∈ [0, 1]. This is every projection's ray: through the
+   eye for a perspective camera, along the projection direction for a parallel one.
+2. Entry and exit: s clipped by the box ``0 <= u <= n − 1`` (slabs), by each clip plane ``a·u + d >= 0``, and by
+   the opaque depth buffer: a pixel whose window depth is ``z < 1`` ends the ray at its point's s.
+3. Samples at the middles of segments of model length Δ (the last one shorter), trilinear; a segment of
+   model length δ uses the opacity ``α' = 1 − (1 − α)^(δ/Δ₀)``.
+4. Modes: composite front to back ``C += (1 − A)·α'·c``, ``A += (1 − A)·α'``, stopped once A reaches the
+   termination threshold (early ray termination); ``mip`` / ``minip`` the largest / smallest sample; ``average``
+   the length-weighted mean; ``isosurface`` the first sign change of ``value − level`` between two samples,
+   refined by bisection. The last three classify their value through the table and blend it over the buffer.
+5. Empty-space skipping: blocks of ``BLOCK`` cells carry (min, max, empty); a composite ray jumps over a block
+   whose value range the transfer function maps to opacity 0, a MIP ray over a block whose max cannot beat its
+   current maximum; the samples kept are exactly the ones a ray without skipping would use.
+
+Gradient shading uses ``frustum.shading``'s model with the base color of the transfer function and the normal
+``−∇f/|∇f|`` (central differences of the trilinear field, one voxel apart) turned toward the viewer.
+
+Kernels take plain arrays only; ``frustum.volume_pass`` builds them.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from frustum.raster._jit import kernel, parallel_kernel
+
+__all__ = [
+    "BLOCK",
+    "MODE_AVERAGE",
+    "MODE_COMPOSITE",
+    "MODE_ISOSURFACE",
+    "MODE_MINIP",
+    "MODE_MIP",
+    "PARAMS",
+    "block_ranges",
+    "cast_composite",
+    "cast_isosurface",
+    "cast_projection",
+    "cast_rays",
+]
+
+MODE_COMPOSITE, MODE_MIP, MODE_MINIP, MODE_AVERAGE, MODE_ISOSURFACE = 0, 1, 2, 3, 4
+BLOCK = 8
+"""Cells per side of an empty-space-skipping block."""
+
+# params layout (float64)
+P_STEP, P_UNIT, P_LEVEL, P_SHADE = 0, 1, 2, 3
+P_KA, P_KD, P_KS, P_SHININESS = 4, 5, 6, 7
+P_AMBIENT = 8  # 3 values
+P_EYE = 11  # 3 values
+P_SPECULAR_PHONG, P_TABLE_LOW, P_TABLE_SCALE, P_TERMINATE, P_BISECTIONS = 14, 15, 16, 17, 18
+PARAMS = 19
+# matrices (5, 4, 4)
+M_GRID_FROM_WINDOW, M_MODEL_FROM_GRID, M_WINDOW_FROM_GRID, M_WORLD_FROM_GRID, M_NORMAL_FROM_GRID = 0, 1, 2, 3, 4
+# blocks (bx, by, bz, 3) float32: min, max, empty (1.0: opacity 0 over the block's range)
+B_MIN, B_MAX, B_EMPTY = 0, 1, 2
+
+
+@kernel
+def block_ranges(data, blocks):  # pragma: no cover - compiled
+    """Min and max of the (BLOCK + 1)³ grid points each block's cells touch, into ``blocks[..., :2]`` (serial:
+    one pass over the data, once per volume)."""
+    nx, ny, nz = data.shape
+    bx, by, bz = blocks.shape[0], blocks.shape[1], blocks.shape[2]
+    for b in range(bx):
+        i0, i1 = b * BLOCK, min(b * BLOCK + BLOCK, nx - 1)
+        for c in range(by):
+            j0, j1 = c * BLOCK, min(c * BLOCK + BLOCK, ny - 1)
+            for d in range(bz):
+                k0, k1 = d * BLOCK, min(d * BLOCK + BLOCK, nz - 1)
+                low, high = np.inf, -np.inf
+                for i in range(i0, i1 + 1):
+                    for j in range(j0, j1 + 1):
+                        for k in range(k0, k1 + 1):
+                            v = data[i, j, k]
+                            low = min(low, v)
+                            high = max(high, v)
+                blocks[b, c, d, B_MIN] = low
+                blocks[b, c, d, B_MAX] = high
+
+
+@kernel
+def _sample(data, u0, u1, u2):  # pragma: no cover - compiled
+    """Trilinear value at grid position (u0, u1, u2), clamped into the box."""
+    nx, ny, nz = data.shape
+    u0 = min(max(u0, 0.0), nx - 1.0)
+    u1 = min(max(u1, 0.0), ny - 1.0)
+    u2 = min(max(u2, 0.0), nz - 1.0)
+    i, j, k = min(int(u0), nx - 2), min(int(u1), ny - 2), min(int(u2), nz - 2)
+    fx, fy, fz = u0 - i, u1 - j, u2 - k
+    c00 = data[i, j, k] * (1.0 - fz) + data[i, j, k + 1] * fz
+    c01 = data[i, j + 1, k] * (1.0 - fz) + data[i, j + 1, k + 1] * fz
+    c10 = data[i + 1, j, k] * (1.0 - fz) + data[i + 1, j, k + 1] * fz
+    c11 = data[i + 1, j + 1, k] * (1.0 - fz) + data[i + 1, j + 1, k + 1] * fz
+    c0 = c00 * (1.0 - fy) + c01 * fy
+    c1 = c10 * (1.0 - fy) + c11 * fy
+    return c0 * (1.0 - fx) + c1 * fx
+
+
+@kernel
+def _cell(data, u0, u1, u2):  # pragma: no cover - compiled
+    """The cell (i, j, k) holding grid position u (clamped into the box) and the fractions (fx, fy, fz) in it."""
+    nx, ny, nz = data.shape
+    u0 = min(max(u0, 0.0), nx - 1.0)
+    u1 = min(max(u1, 0.0), ny - 1.0)
+    u2 = min(max(u2, 0.0), nz - 1.0)
+    i, j, k = min(int(u0), nx - 2), min(int(u1), ny - 2), min(int(u2), nz - 2)
+    return i, j, k, u0 - i, u1 - j, u2 - k
+
+
+@kernel
+def _trilinear(data, i, j, k, fx, fy, fz):  # pragma: no cover - compiled
+    """Trilinear interpolation inside cell (i, j, k) at fractions (fx, fy, fz)."""
+    c00 = data[i, j, k] * (1.0 - fz) + data[i, j, k + 1] * fz
+    c01 = data[i, j + 1, k] * (1.0 - fz) + data[i, j + 1, k + 1] * fz
+    c10 = data[i + 1, j, k] * (1.0 - fz) + data[i + 1, j, k + 1] * fz
+    c11 = data[i + 1, j + 1, k] * (1.0 - fz) + data[i + 1, j + 1, k + 1] * fz
+    c0 = c00 * (1.0 - fy) + c01 * fy
+    c1 = c10 * (1.0 - fy) + c11 * fy
+    return c0 * (1.0 - fx) + c1 * fx
+
+
+@kernel
+def _table_index(table, params, value):  # pragma: no cover - compiled
+    """Entry i and fraction t of `value` in the transfer-function table (clamped at the ends)."""
+    size = table.shape[0]
+    f = (value - params[P_TABLE_LOW]) * params[P_TABLE_SCALE]
+    f = min(max(f, 0.0), size - 1.0)
+    i = min(int(f), size - 2)
+    return i, f - i
+
+
+@kernel
+def _lookup(table, params, value, channel):  # pragma: no cover - compiled
+    """One channel of the transfer-function table at `value` (linear between entries, clamped at the ends)."""
+    size = table.shape[0]
+    f = (value - params[P_TABLE_LOW]) * params[P_TABLE_SCALE]
+    f = min(max(f, 0.0), size - 1.0)
+    i = min(int(f), size - 2)
+    t = f - i
+    return table[i, channel] * (1.0 - t) + table[i + 1, channel] * t
+
+
+@kernel
+def _block_of(blocks, data, u0, u1, u2):  # pragma: no cover - compiled
+    """(bx, by, bz) of the block holding the cell of grid position u."""
+    nx, ny, nz = data.shape
+    i = min(max(int(u0), 0), nx - 2) // BLOCK
+    j = min(max(int(u1), 0), ny - 2) // BLOCK
+    k = min(max(int(u2), 0), nz - 2) // BLOCK
+    return i, j, k
+
+
+@kernel
+def _block_exit(origin, direction, bi, bj, bk, shape):  # pragma: no cover - compiled
+    """The ray parameter where u = origin + s·direction leaves block (bi, bj, bk)'s cell box."""
+    exit_s = np.inf
+    index = (bi, bj, bk)
+    for a in range(3):
+        d = direction[a]
+        if d == 0.0:
+            continue
+        low = index[a] * BLOCK
+        high = min(low + BLOCK, shape[a] - 1)
+        bound = high if d > 0.0 else low
+        exit_s = min(exit_s, (bound - origin[a]) / d)
+    return exit_s
+
+
+@kernel
+def _shade(data, matrices, params, lights, u, view_dir, r, g, b):  # pragma: no cover - compiled
+    """``frustum.shading``'s illumination of base color (r, g, b) at grid position u with the gradient normal.
+
+    ``view_dir`` is the unit vector toward the eye (world). Returns (r, g, b) clamped to [0, 1]; a zero
+    gradient leaves the base color unlit.
+    """
+    h = 1.0
+    g0 = _sample(data, u[0] + h, u[1], u[2]) - _sample(data, u[0] - h, u[1], u[2])
+    g1 = _sample(data, u[0], u[1] + h, u[2]) - _sample(data, u[0], u[1] - h, u[2])
+    g2 = _sample(data, u[0], u[1], u[2] + h) - _sample(data, u[0], u[1], u[2] - h)
+    m = matrices[M_NORMAL_FROM_GRID]
+    n0 = -(m[0, 0] * g0 + m[0, 1] * g1 + m[0, 2] * g2)
+    n1 = -(m[1, 0] * g0 + m[1, 1] * g1 + m[1, 2] * g2)
+    n2 = -(m[2, 0] * g0 + m[2, 1] * g1 + m[2, 2] * g2)
+    length = math.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
+    if not length > 1e-12:
+        return r, g, b
+    n0, n1, n2 = n0 / length, n1 / length, n2 / length
+    if n0 * view_dir[0] + n1 * view_dir[1] + n2 * view_dir[2] < 0.0:  # two-sided: face the viewer
+        n0, n1, n2 = -n0, -n1, -n2
+    w = matrices[M_WORLD_FROM_GRID]
+    p0 = w[0, 0] * u[0] + w[0, 1] * u[1] + w[0, 2] * u[2] + w[0, 3]
+    p1 = w[1, 0] * u[0] + w[1, 1] * u[1] + w[1, 2] * u[2] + w[1, 3]
+    p2 = w[2, 0] * u[0] + w[2, 1] * u[1] + w[2, 2] * u[2] + w[2, 3]
+    ka, kd, ks, shininess = params[P_KA], params[P_KD], params[P_KS], params[P_SHININESS]
+    dr, dg, db = ka * params[P_AMBIENT], ka * params[P_AMBIENT + 1], ka * params[P_AMBIENT + 2]
+    sr, sg, sb = 0.0, 0.0, 0.0
+    e0, e1, e2 = params[P_EYE] - p0, params[P_EYE + 1] - p1, params[P_EYE + 2] - p2
+    el = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+    if el > 0.0:
+        e0, e1, e2 = e0 / el, e1 / el, e2 / el
+    for light in range(lights.shape[0]):
+        row = lights[light]
+        if row[0] == 0.0:
+            l0, l1, l2, falloff = row[7], row[8], row[9], 1.0
+        else:
+            l0, l1, l2 = row[4] - p0, row[5] - p1, row[6] - p2
+            distance = math.sqrt(l0 * l0 + l1 * l1 + l2 * l2)
+            l0, l1, l2 = l0 / distance, l1 / distance, l2 / distance
+            falloff = 1.0 / (row[10] + row[11] * distance + row[12] * distance * distance)
+            if row[0] == 2.0:
+                cos_alpha = -(l0 * row[7] + l1 * row[8] + l2 * row[9])
+                if row[13] > row[14]:
+                    falloff *= min(max((cos_alpha - row[14]) / (row[13] - row[14]), 0.0), 1.0)
+                elif cos_alpha < row[14]:
+                    falloff = 0.0
+        ndl = n0 * l0 + n1 * l1 + n2 * l2
+        if ndl <= 0.0:
+            continue
+        if params[P_SPECULAR_PHONG] != 0.0:
+            q0, q1, q2 = 2.0 * ndl * n0 - l0, 2.0 * ndl * n1 - l1, 2.0 * ndl * n2 - l2
+            cosine = max(q0 * e0 + q1 * e1 + q2 * e2, 0.0)
+        else:
+            q0, q1, q2 = l0 + e0, l1 + e1, l2 + e2
+            ql = math.sqrt(q0 * q0 + q1 * q1 + q2 * q2)
+            cosine = max((n0 * q0 + n1 * q1 + n2 * q2) / ql, 0.0) if ql > 0.0 else 0.0
+        spec = falloff * cosine**shininess
+        diffuse = falloff * kd * ndl
+        dr += diffuse * row[1]
+        dg += diffuse * row[2]
+        db += diffuse * row[3]
+        sr += ks * spec * row[1]
+        sg += ks * spec * row[2]
+        sb += ks * spec * row[3]
+    return (min(max(r * dr + sr, 0.0), 1.0), min(max(g * dg + sg, 0.0), 1.0), min(max(b * db + sb, 0.0), 1.0))
+
+
+@kernel
+def _position(s0, ds, count, last, k):  # pragma: no cover - compiled
+    """Ray parameter of sample k and its segment length in s: middles of segments ds, the last one `last` long."""
+    if k < count - 1:
+        return s0 + (k + 0.5) * ds, ds
+    return s0 + (count - 1) * ds + 0.5 * last, last
+
+
+@kernel
+def _composite(data, blocks, table, matrices, params, lights, origin, direction, s0, s1, ds, model_length,
+               view_dir, out):  # pragma: no cover - compiled  # fmt: skip
+    """Front-to-back compositing along one ray; (r, g, b, A) into `out`."""
+    count = math.ceil((s1 - s0) / ds)
+    last = (s1 - s0) - (count - 1) * ds
+    unit = params[P_UNIT]
+    threshold = params[P_TERMINATE]
+    shade = params[P_SHADE] != 0.0
+    cr, cg, cb, acc = 0.0, 0.0, 0.0, 0.0
+    u = np.empty(3)
+    k = 0
+    while k < count:
+        s = s0 + (k + 0.5) * ds if k < count - 1 else s0 + (count - 1) * ds + 0.5 * last
+        u0, u1, u2 = origin[0] + s * direction[0], origin[1] + s * direction[1], origin[2] + s * direction[2]
+        i, j, kk, fx, fy, fz = _cell(data, u0, u1, u2)
+        bi, bj, bk = i // BLOCK, j // BLOCK, kk // BLOCK
+        if blocks[bi, bj, bk, B_EMPTY] != 0.0:  # jump to the first sample at or past the block's exit
+            exit_s = _block_exit(origin, direction, bi, bj, bk, data.shape)
+            k = max(k + 1, math.ceil((exit_s - s0) / ds - 0.5))
+            continue
+        value = _trilinear(data, i, j, kk, fx, fy, fz)
+        t_index, t = _table_index(table, params, value)
+        if k < count - 1:  # opacity corrected for Δ in the table (0 exactly where the raw opacity is 0)
+            alpha = table[t_index, 4] * (1.0 - t) + table[t_index + 1, 4] * t
+        else:
+            alpha = table[t_index, 3] * (1.0 - t) + table[t_index + 1, 3] * t
+            alpha = 1.0 - (1.0 - alpha) ** (last * model_length / unit) if alpha > 0.0 else 0.0
+        if alpha > 0.0:
+            r = table[t_index, 0] * (1.0 - t) + table[t_index + 1, 0] * t
+            g = table[t_index, 1] * (1.0 - t) + table[t_index + 1, 1] * t
+            b = table[t_index, 2] * (1.0 - t) + table[t_index + 1, 2] * t
+            if shade:
+                u[0], u[1], u[2] = u0, u1, u2
+                r, g, b = _shade(data, matrices, params, lights, u, view_dir, r, g, b)
+            weight = (1.0 - acc) * alpha
+            cr += weight * r
+            cg += weight * g
+            cb += weight * b
+            acc += weight
+            if acc >= threshold:
+                break
+        k += 1
+    out[0], out[1], out[2], out[3] = cr, cg, cb, acc
+
+
+@kernel
+def _extreme(data, blocks, origin, direction, s0, s1, ds, sign):  # pragma: no cover - compiled
+    """sign = +1: the largest sample along the ray (MIP); −1: the smallest (MinIP)."""
+    count = math.ceil((s1 - s0) / ds)
+    last = (s1 - s0) - (count - 1) * ds
+    best = -np.inf
+    bound = B_MAX if sign > 0.0 else B_MIN
+    k = 0
+    while k < count:
+        s = s0 + (k + 0.5) * ds if k < count - 1 else s0 + (count - 1) * ds + 0.5 * last
+        i, j, kk, fx, fy, fz = _cell(data, origin[0] + s * direction[0], origin[1] + s * direction[1],
+                                     origin[2] + s * direction[2])  # fmt: skip
+        bi, bj, bk = i // BLOCK, j // BLOCK, kk // BLOCK
+        if sign * blocks[bi, bj, bk, bound] <= best:  # nothing in this block can beat the current extreme
+            exit_s = _block_exit(origin, direction, bi, bj, bk, data.shape)
+            k = max(k + 1, math.ceil((exit_s - s0) / ds - 0.5))
+            continue
+        best = max(best, sign * _trilinear(data, i, j, kk, fx, fy, fz))
+        k += 1
+    return sign * best
+
+
+@kernel
+def _average(data, origin, direction, s0, s1, ds):  # pragma: no cover - compiled
+    """Length-weighted mean of the samples along the ray."""
+    count = math.ceil((s1 - s0) / ds)
+    last = (s1 - s0) - (count - 1) * ds
+    total, length = 0.0, 0.0
+    for k in range(count):
+        s, seg = _position(s0, ds, count, last, k)
+        total += seg * _sample(data, origin[0] + s * direction[0], origin[1] + s * direction[1],
+                               origin[2] + s * direction[2])  # fmt: skip
+        length += seg
+    return total / length
+
+
+@kernel
+def _first_crossing(data, blocks, origin, direction, s0, s1, ds, level, bisections):  # pragma: no cover - compiled
+    """Ray parameter of the first crossing of `level` (bisection between the samples around it), or −1."""
+    count = math.ceil((s1 - s0) / ds)
+    last = (s1 - s0) - (count - 1) * ds
+    previous_s, previous = s0, _sample(data, origin[0] + s0 * direction[0], origin[1] + s0 * direction[1],
+                                       origin[2] + s0 * direction[2]) - level  # fmt: skip
+    k = 0
+    while k < count + 1:
+        s = _position(s0, ds, count, last, k)[0] if k < count else s1
+        u0, u1, u2 = origin[0] + s * direction[0], origin[1] + s * direction[1], origin[2] + s * direction[2]
+        if k < count:
+            bi, bj, bk = _block_of(blocks, data, u0, u1, u2)
+            low, high = blocks[bi, bj, bk, B_MIN] - level, blocks[bi, bj, bk, B_MAX] - level
+            if (previous < 0.0 and high < 0.0) or (previous > 0.0 and low > 0.0):  # the block stays on one side
+                exit_s = _block_exit(origin, direction, bi, bj, bk, data.shape)
+                k_next = math.ceil((exit_s - s0) / ds - 0.5)
+                if k_next > k + 1:
+                    k = min(k_next, count) - 1  # keep the sample before the next block as `previous`
+                    previous_s = _position(s0, ds, count, last, k)[0]
+                    k += 1
+                    continue
+        value = _sample(data, u0, u1, u2) - level
+        if value == 0.0 or (value > 0.0) != (previous > 0.0):
+            if value == 0.0:
+                return s
+            a, b, fa = previous_s, s, previous
+            for _ in range(bisections):
+                m = 0.5 * (a + b)
+                fm = _sample(data, origin[0] + m * direction[0], origin[1] + m * direction[1],
+                             origin[2] + m * direction[2]) - level  # fmt: skip
+                if (fm > 0.0) == (fa > 0.0) and fm != 0.0:
+                    a, fa = m, fm
+                else:
+                    b = m
+            return 0.5 * (a + b)
+        previous_s, previous = s, value
+        k += 1
+    return -1.0
+
+
+@kernel
+def _ray(matrices, planes, shape, x, y, window_depth, origin, direction):  # pragma: no cover - compiled
+    """Ray of window point (x, y) in grid coordinates into origin/direction; returns (s0, s1) (empty: s0 >= s1)."""
+    m = matrices[M_GRID_FROM_WINDOW]
+    for z, target in ((0.0, origin), (1.0, direction)):
+        w = m[3, 0] * x + m[3, 1] * y + m[3, 2] * z + m[3, 3]
+        for a in range(3):
+            target[a] = (m[a, 0] * x + m[a, 1] * y + m[a, 2] * z + m[a, 3]) / w
+    for a in range(3):
+        direction[a] -= origin[a]
+    s0, s1 = 0.0, 1.0
+    for a in range(3):  # slabs 0 <= u_a <= n_a − 1
+        d = direction[a]
+        high = shape[a] - 1.0
+        if d == 0.0:
+            if origin[a] < 0.0 or origin[a] > high:
+                return 1.0, 0.0
+            continue
+        t0, t1 = (0.0 - origin[a]) / d, (high - origin[a]) / d
+        if t0 > t1:
+            t0, t1 = t1, t0
+        s0, s1 = max(s0, t0), min(s1, t1)
+    for p in range(planes.shape[0]):  # half-spaces a·u + d >= 0
+        start = planes[p, 0] * origin[0] + planes[p, 1] * origin[1] + planes[p, 2] * origin[2] + planes[p, 3]
+        rate = planes[p, 0] * direction[0] + planes[p, 1] * direction[1] + planes[p, 2] * direction[2]
+        if rate == 0.0:
+            if start < 0.0:
+                return 1.0, 0.0
+        elif rate > 0.0:
+            s0 = max(s0, -start / rate)
+        else:
+            s1 = min(s1, -start / rate)
+    if window_depth < 1.0 and s0 < s1:  # the opaque surface's point on this ray ends it
+        w = m[3, 0] * x + m[3, 1] * y + m[3, 2] * window_depth + m[3, 3]
+        along, norm2 = 0.0, 0.0
+        for a in range(3):
+            q = (m[a, 0] * x + m[a, 1] * y + m[a, 2] * window_depth + m[a, 3]) / w - origin[a]
+            along += q * direction[a]
+            norm2 += direction[a] * direction[a]
+        s1 = min(s1, along / norm2)
+    return s0, s1
+
+
+def cast_rays(mode, data, blocks, table, matrices, planes, params, lights, depth, color):
+    """Cast one ray per pixel and blend the result over ``color`` (H, W, 4) uint8 (a driver: the compiled
+    kernel of `mode` runs over pieces of the rows on a pool of threads; only that mode's kernel is compiled).
+
+    `data` (nx, ny, nz) float32; `blocks` (bx, by, bz, 3) float32 from ``block_ranges`` plus the empty flags;
+    `table` (T, 5) float64 rows (r, g, b, α, α corrected for the step Δ) over the scalar range
+    ``value = low + t / scale``; `matrices` (5, 4, 4) as the ``M_*`` constants; `planes` (P, 4) clip planes in
+    grid coordinates; `params` (PARAMS,) as the ``P_*`` constants; `lights` (K, 16) from
+    ``shading.pack_lights``; `depth` (H, W) float32 window depth (read; the isosurface mode writes its hits).
+    Rows of the buffers are stored top row first (row r is window y = H − 1 − r). Pieces of rows are taken by
+    the threads as they finish (rows off the volume cost nothing); each piece owns its rows, so the bytes do not
+    depend on the thread count.
+    """
+    if mode == MODE_COMPOSITE:
+        cast_composite(data, blocks, table, matrices, planes, params, lights, depth, color)
+    elif mode == MODE_ISOSURFACE:
+        cast_isosurface(data, blocks, table, matrices, planes, params, lights, depth, color)
+    else:
+        cast_projection(mode, data, blocks, table, matrices, planes, params, depth, color)
+
+
+@parallel_kernel(lambda *arguments: arguments[-2].shape[0], pieces_per_thread=16)
+def cast_composite(data, blocks, table, matrices, planes, params, lights, depth, color, start,
+                   stop):  # pragma: no cover  # fmt: skip
+    """``MODE_COMPOSITE`` over image rows [start, stop) (see ``cast_rays``)."""
+    height, width = depth.shape
+    shape = np.array(data.shape, dtype=np.float64)
+    origin, direction, view_dir, out = np.empty(3), np.empty(3), np.empty(3), np.empty(4)
+    for row in range(start, stop):
+        y = height - 1 - row + 0.5
+        for column in range(width):
+            s0, s1, ds, model_length = _pixel_ray(matrices, planes, shape, params, column + 0.5, y,
+                                                  depth[row, column], origin, direction, view_dir)  # fmt: skip
+            if s0 < s1:
+                _composite(data, blocks, table, matrices, params, lights, origin, direction, s0, s1, ds,
+                           model_length, view_dir, out)  # fmt: skip
+                _blend(color, row, column, out)
+
+
+@parallel_kernel(lambda *arguments: arguments[-2].shape[0], pieces_per_thread=16)
+def cast_projection(mode, data, blocks, table, matrices, planes, params, depth, color, start,
+                    stop):  # pragma: no cover  # fmt: skip
+    """``MODE_MIP``, ``MODE_MINIP`` or ``MODE_AVERAGE`` over image rows [start, stop): one value per ray,
+    classified by the table (no opacity correction) and blended over the buffer."""
+    height, width = depth.shape
+    shape = np.array(data.shape, dtype=np.float64)
+    origin, direction, view_dir, out = np.empty(3), np.empty(3), np.empty(3), np.empty(4)
+    for row in range(start, stop):
+        y = height - 1 - row + 0.5
+        for column in range(width):
+            s0, s1, ds, _ = _pixel_ray(matrices, planes, shape, params, column + 0.5, y,
+                                                  depth[row, column], origin, direction, view_dir)  # fmt: skip
+            if not s0 < s1:
+                continue
+            if mode == MODE_AVERAGE:
+                value = _average(data, origin, direction, s0, s1, ds)
+            else:
+                value = _extreme(data, blocks, origin, direction, s0, s1, ds, 1.0 if mode == MODE_MIP else -1.0)
+            alpha = _lookup(table, params, value, 3)
+            for c in range(3):
+                out[c] = alpha * _lookup(table, params, value, c)
+            out[3] = alpha
+            _blend(color, row, column, out)
+
+
+@parallel_kernel(lambda *arguments: arguments[-2].shape[0], pieces_per_thread=16)
+def cast_isosurface(data, blocks, table, matrices, planes, params, lights, depth, color, start,
+                    stop):  # pragma: no cover  # fmt: skip
+    """``MODE_ISOSURFACE`` over image rows [start, stop): the first crossing of the level, shaded with the table's
+    color at the level, opaque; its window depth goes into `depth`."""
+    height, width = depth.shape
+    shape = np.array(data.shape, dtype=np.float64)
+    origin, direction, view_dir, out, u = np.empty(3), np.empty(3), np.empty(3), np.empty(4), np.empty(3)
+    level = params[P_LEVEL]
+    r = _lookup(table, params, level, 0)
+    g = _lookup(table, params, level, 1)
+    b = _lookup(table, params, level, 2)
+    wm = matrices[M_WINDOW_FROM_GRID]
+    for row in range(start, stop):
+        y = height - 1 - row + 0.5
+        for column in range(width):
+            s0, s1, ds, _ = _pixel_ray(matrices, planes, shape, params, column + 0.5, y,
+                                                  depth[row, column], origin, direction, view_dir)  # fmt: skip
+            if not s0 < s1:
+                continue
+            hit = _first_crossing(data, blocks, origin, direction, s0, s1, ds, level, int(params[P_BISECTIONS]))
+            if hit < 0.0:
+                continue
+            for a in range(3):
+                u[a] = origin[a] + hit * direction[a]
+            out[0], out[1], out[2] = _shade(data, matrices, params, lights, u, view_dir, r, g, b)
+            out[3] = 1.0
+            zw = wm[2, 0] * u[0] + wm[2, 1] * u[1] + wm[2, 2] * u[2] + wm[2, 3]
+            ww = wm[3, 0] * u[0] + wm[3, 1] * u[1] + wm[3, 2] * u[2] + wm[3, 3]
+            depth[row, column] = min(depth[row, column], zw / ww)
+            _blend(color, row, column, out)
+
+
+@kernel
+def _pixel_ray(matrices, planes, shape, params, x, y, window_depth, origin, direction,
+               view_dir):  # pragma: no cover - compiled  # fmt: skip
+    """The ray of window point (x, y) in grid coordinates (origin, direction, and the unit world vector toward the
+    eye in view_dir); returns (s0, s1, ds, model_length), empty when s0 >= s1."""
+    s0, s1 = _ray(matrices, planes, shape, x, y, window_depth, origin, direction)
+    if not s0 < s1:
+        return s0, s1, 0.0, 0.0
+    model = matrices[M_MODEL_FROM_GRID]
+    d0 = model[0, 0] * direction[0] + model[0, 1] * direction[1] + model[0, 2] * direction[2]
+    d1 = model[1, 0] * direction[0] + model[1, 1] * direction[1] + model[1, 2] * direction[2]
+    d2 = model[2, 0] * direction[0] + model[2, 1] * direction[1] + model[2, 2] * direction[2]
+    model_length = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)  # model units per unit of s
+    world = matrices[M_WORLD_FROM_GRID]
+    for a in range(3):  # toward the eye: minus the ray direction, in world coordinates
+        view_dir[a] = -(world[a, 0] * direction[0] + world[a, 1] * direction[1] + world[a, 2] * direction[2])
+    length = math.sqrt(view_dir[0] ** 2 + view_dir[1] ** 2 + view_dir[2] ** 2)
+    for a in range(3):
+        view_dir[a] /= length
+    return s0, s1, params[P_STEP] / model_length, model_length
+
+
+@kernel
+def _blend(color, row, column, out):  # pragma: no cover - compiled
+    """``out + (1 − out_α)·under`` into the pixel's bytes, ``floor(255·v + 0.5)``."""
+    under = 1.0 - out[3]
+    for c in range(4):
+        v = out[c] + under * (color[row, column, c] / 255.0)
+        color[row, column, c] = np.uint8(math.floor(min(max(v, 0.0), 1.0) * 255.0 + 0.5))
