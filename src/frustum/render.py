@@ -100,6 +100,9 @@ class _Options:
     line_width: float
     depth_cue: DepthCue | None
     buffers: tuple[str, ...]
+    method: str = "depth-buffer"
+    transparency: str = "sort"
+    counts: dict | None = None  # the method's counts (Frame.stats), filled while drawing
 
 
 class Scratch:
@@ -181,6 +184,9 @@ def render(
     filter: str = "box",
     color_space: str = "linear",
     buffers: tuple[str, ...] = (),
+    method: str = "depth-buffer",
+    transparency: str = "sort",
+    stats: bool = False,
 ) -> Frame:
     """Render `scene` seen by `camera` into a ``Frame`` (color (H, W, 4) uint8 and depth (H, W) float32).
 
@@ -230,6 +236,18 @@ def render(
     buffers : tuple of {"normals", "object_id"}
         Extra per-pixel outputs on the Frame: unit world normals (0 on background) and the index of the item
         in ``scene.items`` (−1 on background).
+    method : str
+        The visible-surface method (``VISIBILITY_METHODS``, docs/visibility.md): ``"depth-buffer"`` (the
+        default), ``"scan-line"``, ``"area-subdivision"`` (Warnock), ``"depth-sort"``, ``"bsp"`` or
+        ``"a-buffer"`` (anti-aliased edges, exact transparency). All shade with the same model, so where they
+        find the same surface they give the same bytes. Surface modes only; each returns its counts in
+        ``Frame.stats``.
+    transparency : {"sort", "a-buffer"}
+        How transparent items are composited: whole items back to front by the view distance of their centres
+        (fast; right for transparent objects that do not cut through or overlap each other cyclically), or
+        per subsample through an A-buffer (exact whatever the order, anti-aliased edges; costs fragment memory).
+    stats : bool
+        ``method="depth-buffer"`` only: also count its depth tests (an extra counting pass) into ``Frame.stats``.
 
     Raises
     ------
@@ -248,6 +266,7 @@ def render(
         hidden, hidden_color, line_width, depth_cue, buffers, where,
     )  # fmt: skip
     factor = _supersampling(samples, where)
+    options = _method_options(options, method, transparency, stats, where)
     _choice(filter, FILTERS, "filter", where)
     _choice(color_space, COLOR_SPACES, "color_space", where)
     if factor == 1:
@@ -275,7 +294,7 @@ def render(
         linear = values
     if linear is not None:
         color = np.floor(np.clip(linear, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
-    return Frame(color=color, depth=depth, normals=normals, object_id=ids)
+    return Frame(color=color, depth=depth, normals=normals, object_id=ids, stats=options.counts)
 
 
 def _render_buffers(
@@ -294,7 +313,12 @@ def _render_buffers(
         _draw_polylines(scene.polylines, camera, options, depth, color)
         return color, depth, normal_out, id_out
     scratch = Scratch()
-    depth, color = _draw_surfaces(scene, items, camera, options, normal_out, id_out, scratch)
+    if options.method == "depth-buffer" and options.transparency == "sort":
+        depth, color = _draw_surfaces(scene, items, camera, options, normal_out, id_out, scratch)
+        if options.counts is not None:
+            _count_depth_tests(items, camera, options)
+    else:
+        depth, color = _draw_surfaces_by_method(scene, items, camera, options, normal_out, id_out, scratch)
     scratch.release()
     if options.mode == "hidden-line":
         color[:, :] = options.background
@@ -858,3 +882,168 @@ def _background_bytes(background: Any, where: str) -> np.ndarray:
             f"{where}: background = {describe(background)} is not an RGBA color; expected four finite numbers in [0, 1]"
         )
     return np.floor(values * 255.0 + 0.5).astype(np.uint8)
+
+
+# --- visible-surface methods (render(..., method=...), docs/visibility.md) -----------------------------------
+
+VISIBILITY_METHODS = {
+    "depth-buffer": None,
+    "scan-line": "frustum.visibility.scanline:scan_line",
+    "area-subdivision": "frustum.visibility.warnock:area_subdivision",
+    "depth-sort": "frustum.visibility.painter:depth_sort",
+    "bsp": "frustum.visibility.painter:bsp_tree",
+    "a-buffer": "frustum.visibility.abuffer",
+}
+"""``render(..., method=...)``: name → the visibility function that fills depth, codes and barycentrics (the
+depth buffer is the renderer's own path; the A-buffer resolves fragments instead)."""
+PLANNED_METHODS = {
+    "octree": "octree solids (the octree method of frustum.visibility.octree)",
+    "ray-casting": "a ray per pixel through the scene's spatial index (the BVH of Scene.pick)",
+}
+"""Methods of the visible-surface chapter that this version does not draw yet."""
+TRANSPARENCY_MODES = ("sort", "a-buffer")
+
+
+def _method_options(options: _Options, method: Any, transparency: Any, stats: Any, where: str) -> _Options:
+    """Check `method`, `transparency` and `stats`; the options with them (and a counts dict where counted)."""
+    valid = ", ".join(repr(name) for name in VISIBILITY_METHODS)
+    if isinstance(method, str) and method in PLANNED_METHODS:
+        raise FrustumError(
+            f"{where}: method = {method!r} is not available yet ({PLANNED_METHODS[method]}); available: {valid}"
+        )
+    if not isinstance(method, str) or method not in VISIBILITY_METHODS:
+        raise FrustumError(f"{where}: method = {describe(method)} is unknown; expected one of {valid}")
+    _choice(transparency, TRANSPARENCY_MODES, "transparency", where)
+    if not isinstance(stats, bool | np.bool_):
+        raise FrustumError(f"{where}: stats = {describe(stats)} is not a bool; give True or False")
+    if (method != "depth-buffer" or transparency != "sort") and options.mode in ("wireframe", "points"):
+        raise FrustumError(
+            f"{where}: method = {method!r} with transparency = {transparency!r} draws surfaces; mode = "
+            f"{options.mode!r} draws lines or points with the depth buffer: use mode 'surface', 'hidden-line' or "
+            "'surface+edges', or method 'depth-buffer'"
+        )
+    if method == "a-buffer" and options.buffers:
+        raise FrustumError(
+            f"{where}: buffers = {describe(options.buffers)} are not available with method 'a-buffer' (a pixel "
+            "holds several surfaces); use another method for per-pixel normals or object ids"
+        )
+    counted = method != "depth-buffer" or transparency != "sort" or bool(stats)
+    counts = {"method": method} if counted else None
+    return dataclasses.replace(options, method=method, transparency=transparency, counts=counts)
+
+
+def _face_offsets(items: list[SceneItem]) -> list[int]:
+    return [int(n) for n in np.cumsum([0] + [item.mesh.face_count for item in items])[:-1]]
+
+
+def _count_depth_tests(items: list[SceneItem], camera: Camera, options: _Options) -> None:
+    """The depth buffer's counts: depth tests (pixel centres covered, summed over the drawn triangles)."""
+    from frustum.raster import window
+    from frustum.visibility.window import window_triangles
+
+    tris = window_triangles(items, list(range(len(items))), _face_offsets(items), camera, options.cull)
+    covered = np.empty(tris.count, dtype=np.int64)
+    window.count_covered(tris.xy, tris.box, covered)
+    assert options.counts is not None
+    options.counts.update(depth_tests=int(covered.sum()), triangles=tris.count)
+
+
+def _draw_surfaces_by_method(
+    scene: Scene, items: list[SceneItem], camera: Camera, options: _Options,
+    normal_out: np.ndarray | None, id_out: np.ndarray | None, scratch: Scratch,
+) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """Stages 1–6 by another visible-surface method, or with A-buffer transparency: the depth and color buffers.
+
+    The method writes the depth-buffer's depth, face code and barycentrics of the surface it finds at each pixel
+    (``visibility.window``); ``_shade_item`` shades them as for the depth buffer. The A-buffer shades one sample
+    per fragment (a column image through the same kernel) and composites.
+    """
+    import importlib
+
+    from frustum.visibility.window import window_triangles
+
+    height, width = camera.height, camera.width
+    counts = options.counts if options.counts is not None else {}
+    offsets = _face_offsets(items)
+    opaque = [i for i, item in enumerate(items) if item.material.opacity >= 1.0]
+    clear_items = [i for i, item in enumerate(items) if item.material.opacity < 1.0]
+    depth = np.empty((height, width), dtype=np.float32)
+    color = np.empty((height, width, 4), dtype=np.uint8)
+    triangles.clear_buffers(depth, color, options.background)
+    ambient, lights = pack_lights(scene.world_lights())
+    extra = (
+        np.zeros((1, 1, 3), dtype=np.float32) if normal_out is None else normal_out,
+        np.zeros((1, 1), dtype=np.int32) if id_out is None else id_out,
+    )
+    if options.method == "a-buffer":
+        tris = window_triangles(items, list(range(len(items))), offsets, camera, options.cull)
+        counts.update(_composite(tris, items, offsets, camera, options, ambient, lights, color, depth, scratch))
+        counts["triangles"] = tris.count
+        return depth, color
+    codes = np.zeros((height, width), dtype=np.int64)
+    bary = np.zeros((height, width, 2), dtype=np.float32)
+    if options.method == "depth-buffer":
+        hidden = [
+            item if item.material.opacity >= 1.0 else item._replace(mesh=Mesh(np.empty((0, 3)), np.empty((0, 3), int)))
+            for item in items
+        ]  # fmt: skip
+        depth, color = _draw_surfaces(scene, hidden, camera, options, normal_out, id_out, scratch)
+    else:
+        module, name = VISIBILITY_METHODS[options.method].split(":")  # type: ignore[union-attr]
+        draw = getattr(importlib.import_module(module), name)
+        tris = window_triangles(items, opaque, offsets, camera, options.cull)
+        counts.update(draw(tris, depth, codes, bary))
+        for index in opaque:
+            world, normals = _world_attributes(items[index], scratch)
+            _shade_item(items[index], index, offsets[index], camera, options, ambient, lights, world, normals,
+                        depth, codes, bary, color, extra, blend=False)  # fmt: skip
+    if not clear_items:
+        return depth, color
+    if options.transparency == "a-buffer":
+        tris = window_triangles(items, clear_items, offsets, camera, options.cull)
+        found = _composite(tris, items, offsets, camera, options, ambient, lights, color, depth.copy(), scratch,
+                           under_depth=depth)  # fmt: skip
+        counts.update({f"transparent_{key}": value for key, value in found.items()})
+        return depth, color
+    axis = np.asarray(camera.frame.n, dtype=np.float64)
+    eye = np.asarray(camera.frame.eye, dtype=np.float64)
+
+    def distance(index: int) -> float:
+        item = items[index]
+        if item.mesh.vertex_count == 0:
+            return 0.0
+        centre = item.mesh.bounds.mean(axis=0)
+        centre = item.world_from_model[:3, :3] @ centre + item.world_from_model[:3, 3]
+        return float((eye - centre) @ axis)
+
+    for index in sorted(clear_items, key=distance, reverse=True):  # per-object sort, as the depth buffer does
+        item = items[index]
+        layer_depth = depth.copy()
+        layer_codes = np.full((height, width), -1, dtype=np.int64)
+        world, normals = _draw_item(item, camera, options.cull, offsets[index], layer_depth, layer_codes, bary, scratch)
+        _shade_item(item, index, offsets[index], camera, options, ambient, lights, world, normals, layer_depth,
+                    layer_codes, bary, color, extra, blend=True)  # fmt: skip
+    return depth, color
+
+
+def _composite(
+    tris: Any, items: list[SceneItem], offsets: list[int], camera: Camera, options: _Options, ambient: np.ndarray,
+    lights: np.ndarray, color: np.ndarray, depth: np.ndarray, scratch: Scratch, under_depth: np.ndarray | None = None,
+) -> dict:  # fmt: skip
+    """A-buffer: fragments of `tris`, each shaded once (blended over transparent black: premultiplied bytes),
+    composited per subsample over `color` (behind `under_depth`, default the far plane) into `color`; the
+    nearest opaque fragment's depth at each pixel centre into `depth`."""
+    from frustum.visibility import abuffer
+
+    fragments = abuffer.build_fragments(tris)
+    premultiplied = np.zeros((fragments.count, 1, 4), dtype=np.uint8)
+    dummy = (np.zeros((1, 1, 3), dtype=np.float32), np.zeros((1, 1), dtype=np.int32))
+    for index in sorted(set(tris.item.tolist())):
+        world, normals = _world_attributes(items[index], scratch)
+        _shade_item(items[index], index, offsets[index], camera, options, ambient, lights, world, normals,
+                    fragments.depth, fragments.code, fragments.bary, premultiplied, dummy, blend=True)  # fmt: skip
+    if under_depth is None:
+        under_depth = np.ones(depth.shape, dtype=np.float32)
+    return abuffer.resolve_fragments(
+        fragments, premultiplied.reshape(-1, 4), tris, color, under_depth, color, depth
+    )
