@@ -43,7 +43,7 @@ def _sample_box(xy: np.ndarray, t: int, width: int, height: int) -> tuple[int, i
 @kernel
 def _mask(xy: np.ndarray, t: int, i: int, j: int) -> tuple[int, int, int]:
     """Coverage mask of triangle t in pixel (i, j), and the sums of the covered subsamples' X and Y."""
-    dx0, dy0, dx1, dy1, dx2, dy2, bias0, bias1, bias2, area = edge_setup(xy, t)
+    dx0, dy0, dx1, dy1, dx2, dy2, bias0, bias1, bias2, _area = edge_setup(xy, t)
     mask, sum_x, sum_y = 0, 0, 0
     for b in range(4):
         py = SUBPIXEL * j + _FIRST + _STEP * b
@@ -68,7 +68,7 @@ def count_fragments(xy: np.ndarray, counts: np.ndarray) -> None:
         i_min, i_max, j_min, j_max = _sample_box(xy, t, width, height)
         for j in range(j_min, j_max + 1):
             for i in range(i_min, i_max + 1):
-                mask, sum_x, sum_y = _mask(xy, t, i, j)
+                mask, _sum_x, _sum_y = _mask(xy, t, i, j)
                 if mask != 0:
                     counts[height - 1 - j, i] += 1
 
@@ -84,7 +84,7 @@ def write_fragments(
     height, width = cursor.shape[0], cursor.shape[1]
     for t in range(xy.shape[0]):
         i_min, i_max, j_min, j_max = _sample_box(xy, t, width, height)
-        dx0, dy0, dx1, dy1, dx2, dy2, bias0, bias1, bias2, area = edge_setup(xy, t)
+        dx0, dy0, dx1, dy1, dx2, dy2, _bias0, _bias1, _bias2, area = edge_setup(xy, t)
         for j in range(j_min, j_max + 1):
             for i in range(i_min, i_max + 1):
                 mask, sum_x, sum_y = _mask(xy, t, i, j)
@@ -108,8 +108,12 @@ def write_fragments(
                 masks[slot] = mask
                 frag_depth[slot, 0] = np.float32(min(max(z, 0.0), 0.99999994))
                 frag_code[slot, 0] = code[t]
-                frag_bary[slot, 0, 0] = np.float32((b0 * weights[t, 0, 0] + b1 * weights[t, 1, 0]) + b2 * weights[t, 2, 0])
-                frag_bary[slot, 0, 1] = np.float32((b0 * weights[t, 0, 1] + b1 * weights[t, 1, 1]) + b2 * weights[t, 2, 1])
+                frag_bary[slot, 0, 0] = np.float32(
+                    (b0 * weights[t, 0, 0] + b1 * weights[t, 1, 0]) + b2 * weights[t, 2, 0]
+                )
+                frag_bary[slot, 0, 1] = np.float32(
+                    (b0 * weights[t, 0, 1] + b1 * weights[t, 1, 1]) + b2 * weights[t, 2, 1]
+                )
 
 
 @parallel_kernel(lambda starts, *_: starts.shape[0] - 1)

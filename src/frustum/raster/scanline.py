@@ -54,7 +54,7 @@ def _nearest(
     px = SUBPIXEL * i + HALF_SUBPIXEL
     for n in range(count):
         t = current[n]
-        dx0, dy0, dx1, dy1, dx2, dy2, bias0, bias1, bias2, area = edge_setup(xy, t)
+        dx0, dy0, dx1, dy1, dx2, dy2, _bias0, _bias1, _bias2, area = edge_setup(xy, t)
         x0, y0, x1, y1, x2, y2 = xy[t, 0], xy[t, 1], xy[t, 2], xy[t, 3], xy[t, 4], xy[t, 5]
         e0 = dx0 * (py - y1) - dy0 * (px - x1)
         e1 = dx1 * (py - y2) - dy1 * (px - x2)
@@ -71,7 +71,7 @@ def _fill(
     depth: np.ndarray, codes: np.ndarray, bary: np.ndarray,
 ) -> None:  # fmt: skip
     """Triangle t on row j over columns [i0, i1): edge functions stepped per pixel, the depth buffer's values."""
-    dx0, dy0, dx1, dy1, dx2, dy2, bias0, bias1, bias2, area = edge_setup(xy, t)
+    dx0, dy0, dx1, dy1, dx2, dy2, _bias0, _bias1, _bias2, area = edge_setup(xy, t)
     x0, y0, x1, y1, x2, y2 = xy[t, 0], xy[t, 1], xy[t, 2], xy[t, 3], xy[t, 4], xy[t, 5]
     py = SUBPIXEL * j + HALF_SUBPIXEL
     px = SUBPIXEL * i0 + HALF_SUBPIXEL
@@ -118,10 +118,7 @@ def scan_lines(
             count += 1
     for j in range(start, stop):
         py = SUBPIXEL * j + HALF_SUBPIXEL
-        for n in range(bucket[j], bucket[j + 1]):
-            active[count] = order[n]
-            count += 1
-        # drop finished triangles, (re)compute the row constants of new ones, step the others
+        # drop the triangles that ended on the row below, then add those that begin on this one
         kept = 0
         updates = 0
         for n in range(count):
@@ -131,9 +128,12 @@ def scan_lines(
             active[kept] = t
             kept += 1
         count = kept
+        for n in range(bucket[j], bucket[j + 1]):
+            active[count] = order[n]
+            count += 1
         for n in range(count):
             t = active[n]
-            dx0, dy0, dx1, dy1, dx2, dy2, bias0, bias1, bias2, area = edge_setup(xy, t)
+            _dx0, _dy0, _dx1, _dy1, _dx2, _dy2, _bias0, _bias1, _bias2, _area = edge_setup(xy, t)
             lo, hi = 0, width - 1
             for k in range(3):
                 a = (k + 1) % 3  # edge k runs from corner k + 1 to corner k + 2

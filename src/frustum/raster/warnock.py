@@ -45,7 +45,7 @@ def _relation(xy: np.ndarray, box: np.ndarray, t: int, i0: int, j0: int, i1: int
     """Relation of triangle t to the area [i0, i1) × [j0, j1)."""
     if box[t, 1] < i0 or box[t, 0] >= i1 or box[t, 3] < j0 or box[t, 2] >= j1:
         return OUTSIDE
-    dx0, dy0, dx1, dy1, dx2, dy2, bias0, bias1, bias2, area = edge_setup(xy, t)
+    _dx0, _dy0, _dx1, _dy1, _dx2, _dy2, bias0, bias1, bias2, _area = edge_setup(xy, t)
     xa, xb = SUBPIXEL * i0 + HALF_SUBPIXEL, SUBPIXEL * (i1 - 1) + HALF_SUBPIXEL
     ya, yb = SUBPIXEL * j0 + HALF_SUBPIXEL, SUBPIXEL * (j1 - 1) + HALF_SUBPIXEL
     every = True
@@ -73,7 +73,7 @@ def _relation(xy: np.ndarray, box: np.ndarray, t: int, i0: int, j0: int, i1: int
 @kernel
 def _plane_range(xy: np.ndarray, zq: np.ndarray, t: int, i0: int, j0: int, i1: int, j1: int) -> tuple[float, float]:
     """Least and greatest depth of triangle t's plane over the corner pixel centres of the area."""
-    dx0, dy0, dx1, dy1, dx2, dy2, bias0, bias1, bias2, area = edge_setup(xy, t)
+    dx0, dy0, dx1, dy1, dx2, dy2, _bias0, _bias1, _bias2, area = edge_setup(xy, t)
     low, high = np.inf, -np.inf
     for corner in range(4):
         px = SUBPIXEL * (i0 if corner % 2 == 0 else i1 - 1) + HALF_SUBPIXEL
@@ -183,7 +183,7 @@ def subdivide(
                 e2 = dx2 * (py - xy[t, 1]) - dy2 * (px - xy[t, 0])
                 if e0 >= bias0 and e1 >= bias1 and e2 >= bias2:
                     stats[s + 8] += 1
-                    z, u1, u2 = pixel_values(zq, weights, t, e0, e1, e2, area)
+                    z, _u1, _u2 = pixel_values(zq, weights, t, e0, e1, e2, area)
                     if z < chosen_z:
                         chosen, chosen_z = t, z
             if chosen >= 0:

@@ -24,7 +24,16 @@ from frustum.raster._jit import kernel, parallel_kernel
 from frustum.raster.fixed_point import HALF_SUBPIXEL, SUBPIXEL
 from frustum.raster.triangles import FACE_DRAWN, face_box
 
-__all__ = ["count_covered", "covers", "depth_at", "edge_setup", "edges_at", "gather_faces", "pixel_values", "write_pixel"]
+__all__ = [
+    "count_covered",
+    "covers",
+    "depth_at",
+    "edge_setup",
+    "edges_at",
+    "gather_faces",
+    "pixel_values",
+    "write_pixel",
+]
 
 
 @parallel_kernel(lambda faces, *_: faces.shape[0])
@@ -90,14 +99,14 @@ def edges_at(xy: np.ndarray, t: int, px: int, py: int) -> tuple[int, int, int]:
 @kernel
 def covers(xy: np.ndarray, t: int, px: int, py: int) -> bool:
     """Whether the fixed-point point (px, py) is inside triangle t by the top-left rule."""
-    dx0, dy0, dx1, dy1, dx2, dy2, bias0, bias1, bias2, area = edge_setup(xy, t)
+    _dx0, _dy0, _dx1, _dy1, _dx2, _dy2, bias0, bias1, bias2, _area = edge_setup(xy, t)
     e0, e1, e2 = edges_at(xy, t, px, py)
     return e0 >= bias0 and e1 >= bias1 and e2 >= bias2
 
 
 @kernel
 def depth_at(xy: np.ndarray, zq: np.ndarray, t: int, px: float, py: float) -> float:
-    """Window depth of triangle t's plane at (px, py) (fixed point, float): ``(E_0 z_0 + E_1 z_1 + E_2 z_2)/(2·area)``."""
+    """Window depth of triangle t's plane at (px, py) (fixed point): ``(E_0 z_0 + E_1 z_1 + E_2 z_2)/(2·area)``."""
     x0, y0, x1, y1, x2, y2 = float(xy[t, 0]), float(xy[t, 1]), float(xy[t, 2]), float(xy[t, 3]), float(xy[t, 4]), \
         float(xy[t, 5])  # fmt: skip
     f0 = (x2 - x1) * (py - y1) - (y2 - y1) * (px - x1)
@@ -129,7 +138,7 @@ def write_pixel(
 ) -> None:  # fmt: skip
     """Write triangle t's depth, code and barycentrics at pixel column i, window row j (no depth test; a depth
     of 1 or more, which the depth buffer's test "less" against its clear value never draws, is not written)."""
-    dx0, dy0, dx1, dy1, dx2, dy2, bias0, bias1, bias2, area = edge_setup(xy, t)
+    _dx0, _dy0, _dx1, _dy1, _dx2, _dy2, _bias0, _bias1, _bias2, area = edge_setup(xy, t)
     e0, e1, e2 = edges_at(xy, t, SUBPIXEL * i + HALF_SUBPIXEL, SUBPIXEL * j + HALF_SUBPIXEL)
     z, u1, u2 = pixel_values(zq, weights, t, e0, e1, e2, area)
     if not z < 1.0:
@@ -144,7 +153,7 @@ def write_pixel(
 def count_covered(xy: np.ndarray, box: np.ndarray, covered: np.ndarray, start: int, stop: int) -> None:
     """covered (T,) int64: the pixel centres each triangle covers (the depth buffer's depth tests)."""
     for t in range(start, stop):
-        dx0, dy0, dx1, dy1, dx2, dy2, bias0, bias1, bias2, area = edge_setup(xy, t)
+        _dx0, dy0, _dx1, dy1, _dx2, dy2, bias0, bias1, bias2, _area = edge_setup(xy, t)
         n = 0
         for j in range(box[t, 2], box[t, 3] + 1):
             py = SUBPIXEL * j + HALF_SUBPIXEL
