@@ -321,3 +321,39 @@ def test_methods_draw_edges_and_transparent_items_like_the_depth_buffer() -> Non
     for method in ["scan-line", "area-subdivision"]:
         assert_same_picture(render(scene, camera, mode="surface+edges", method=method), reference, 0.995)
     assert math.isfinite(render(scene, camera, method="scan-line", samples=4).stats["spans"])
+
+
+# --- frustum explain --method ----------------------------------------------------------------------------------
+
+SCENE_FILE = """
+[camera]
+eye = [0.5, 0.8, 4.0]
+target = [0.0, 0.0, 0.0]
+
+[render]
+size = [48, 32]
+
+[[lights]]
+type = "directional"
+direction = [-0.3, -1.0, -0.5]
+
+[[nodes]]
+geometry = { type = "torus", major_radius = 1.0, minor_radius = 0.3, major_segments = 12, minor_segments = 6 }
+"""
+
+
+def test_explain_method_prints_the_counts(tmp_path, capsys) -> None:
+    from frustum.cli import main
+
+    path = tmp_path / "ball.toml"
+    path.write_text(SCENE_FILE)
+    main(["explain", str(path), "--method", "scan-line"])
+    lines = dict(line.split(None, 1) for line in capsys.readouterr().out.splitlines() if line.strip())
+    assert lines["method"] == "scan-line" and int(lines["spans"]) > 0 and int(lines["edge_updates"]) > 0
+    main(["explain", str(path), "--method", "area-subdivision"])
+    lines = dict(line.split(None, 1) for line in capsys.readouterr().out.splitlines() if line.strip())
+    assert lines["areas_per_level"].startswith("[1, 4,")
+    with pytest.raises(SystemExit) as exit_info:
+        main(["explain", str(path), "--method", "z-buffer"])
+    err = capsys.readouterr().err
+    assert exit_info.value.code == 1 and "expected one of 'depth-buffer', 'scan-line'" in err

@@ -1044,6 +1044,4 @@ def _composite(
                     fragments.depth, fragments.code, fragments.bary, premultiplied, dummy, blend=True)  # fmt: skip
     if under_depth is None:
         under_depth = np.ones(depth.shape, dtype=np.float32)
-    return abuffer.resolve_fragments(
-        fragments, premultiplied.reshape(-1, 4), tris, color, under_depth, color, depth
-    )
+    return abuffer.resolve_fragments(fragments, premultiplied.reshape(-1, 4), tris, color, under_depth, color, depth)
