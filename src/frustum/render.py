@@ -1036,12 +1036,28 @@ def _composite(
     from frustum.visibility import abuffer
 
     fragments = abuffer.build_fragments(tris)
-    premultiplied = np.zeros((fragments.count, 1, 4), dtype=np.uint8)
+    premultiplied = np.zeros((fragments.count, 4), dtype=np.uint8)
     dummy = (np.zeros((1, 1, 3), dtype=np.float32), np.zeros((1, 1), dtype=np.int32))
+    owner = tris.item[fragments.triangle]
+    columns = 256
     for index in sorted(set(tris.item.tolist())):
+        # the item's fragments as a (rows, 256) image, padded with depth 1 (nothing drawn), shaded by the one kernel:
+        # opaque items as the depth buffer shades them, transparent ones blended over transparent black
+        chosen = np.flatnonzero(owner == index)
+        rows = -(-chosen.shape[0] // columns)
+        depth_image = np.ones(rows * columns, dtype=np.float32)
+        code_image = np.zeros(rows * columns, dtype=np.int64)
+        bary_image = np.zeros((rows * columns, 2), dtype=np.float32)
+        depth_image[: chosen.shape[0]] = fragments.depth[chosen, 0]
+        code_image[: chosen.shape[0]] = fragments.code[chosen, 0]
+        bary_image[: chosen.shape[0]] = fragments.bary[chosen, 0]
+        color_image = np.zeros((rows, columns, 4), dtype=np.uint8)
         world, normals = _world_attributes(items[index], scratch)
         _shade_item(items[index], index, offsets[index], camera, options, ambient, lights, world, normals,
-                    fragments.depth, fragments.code, fragments.bary, premultiplied, dummy, blend=True)  # fmt: skip
+                    depth_image.reshape(rows, columns), code_image.reshape(rows, columns),
+                    bary_image.reshape(rows, columns, 2), color_image, dummy,
+                    blend=items[index].material.opacity < 1.0)  # fmt: skip
+        premultiplied[chosen] = color_image.reshape(-1, 4)[: chosen.shape[0]]
     if under_depth is None:
         under_depth = np.ones(depth.shape, dtype=np.float32)
-    return abuffer.resolve_fragments(fragments, premultiplied.reshape(-1, 4), tris, color, under_depth, color, depth)
+    return abuffer.resolve_fragments(fragments, premultiplied, tris, color, under_depth, color, depth)
