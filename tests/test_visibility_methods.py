@@ -8,6 +8,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from frustum import Camera, FrustumError, GeometryError, Orthographic, Perspective
 from frustum.budgets import budget
@@ -57,6 +59,22 @@ def test_triangle_soup_matches_depth_buffer(method: str, seed: int) -> None:
     frame = render(scene, camera, cull_back_faces=False, method=method)
     assert_same_picture(frame, reference)
     assert frame.stats["method"] == method and frame.stats["triangles"] == reference.stats["triangles"] >= 60
+
+
+@settings(max_examples=12, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), count=st.integers(1, 24), two_sided=st.booleans())
+def test_image_space_methods_find_the_depth_buffers_surface(seed: int, count: int, two_sided: bool) -> None:
+    """Property: on any soup, scan-line and area subdivision pick, pixel by pixel, the depth buffer's surface."""
+    scene = Scene(lights=[LIGHT])
+    scene.add(soup(seed, count), material=Material(color=(0.8, 0.5, 0.3)))
+    camera = Camera.look_at((0.3, 0.4, 4.0), (0.0, 0.0, 0.0), projection=Perspective(0.9, 0.5, 20.0), width=24,
+                            height=20)  # fmt: skip
+    reference = render(scene, camera, cull_back_faces=not two_sided)
+    for method in ("scan-line", "area-subdivision"):
+        frame = render(scene, camera, cull_back_faces=not two_sided, method=method)
+        assert ((frame.depth < 1.0) == (reference.depth < 1.0)).mean() >= 0.99
+        close = np.abs(frame.color.astype(int) - reference.color.astype(int)).max(axis=2) <= 1
+        assert close.mean() >= 0.99
 
 
 @pytest.fixture(scope="module")
