@@ -932,6 +932,11 @@ def _method_options(options: _Options, method: Any, transparency: Any, stats: An
     return dataclasses.replace(options, method=method, transparency=transparency, counts=counts)
 
 
+def _code_type(items: list[SceneItem]) -> type:
+    """The dtype of the face-code buffer, as ``_draw_surfaces`` chooses it."""
+    return np.int32 if 2 * sum(item.mesh.face_count for item in items) < 2**31 else np.int64
+
+
 def _face_offsets(items: list[SceneItem]) -> list[int]:
     return [int(n) for n in np.cumsum([0] + [item.mesh.face_count for item in items])[:-1]]
 
@@ -980,7 +985,8 @@ def _draw_surfaces_by_method(
         counts.update(_composite(tris, items, offsets, camera, options, ambient, lights, color, depth, scratch))
         counts["triangles"] = tris.count
         return depth, color
-    codes = np.zeros((height, width), dtype=np.int64)
+    code_type = _code_type(items)  # the depth buffer's: the shading kernels are compiled for it already
+    codes = np.zeros((height, width), dtype=code_type)
     bary = np.zeros((height, width, 2), dtype=np.float32)
     if options.method == "depth-buffer":
         hidden = [
@@ -1019,7 +1025,7 @@ def _draw_surfaces_by_method(
     for index in sorted(clear_items, key=distance, reverse=True):  # per-object sort, as the depth buffer does
         item = items[index]
         layer_depth = depth.copy()
-        layer_codes = np.full((height, width), -1, dtype=np.int64)
+        layer_codes = np.full((height, width), -1, dtype=code_type)
         world, normals = _draw_item(item, camera, options.cull, offsets[index], layer_depth, layer_codes, bary, scratch)
         _shade_item(item, index, offsets[index], camera, options, ambient, lights, world, normals, layer_depth,
                     layer_codes, bary, color, extra, blend=True)  # fmt: skip
@@ -1046,7 +1052,7 @@ def _composite(
         chosen = np.flatnonzero(owner == index)
         rows = -(-chosen.shape[0] // columns)
         depth_image = np.ones(rows * columns, dtype=np.float32)
-        code_image = np.zeros(rows * columns, dtype=np.int64)
+        code_image = np.zeros(rows * columns, dtype=_code_type(items))
         bary_image = np.zeros((rows * columns, 2), dtype=np.float32)
         depth_image[: chosen.shape[0]] = fragments.depth[chosen, 0]
         code_image[: chosen.shape[0]] = fragments.code[chosen, 0]

@@ -30,7 +30,7 @@ def scan_line(triangles: WindowTriangles, depth: np.ndarray, codes: np.ndarray, 
     triangles : WindowTriangles
     depth : (H, W) float32
         Cleared to 1.0 (far); written where a surface is visible.
-    codes : (H, W) int64
+    codes : (H, W) int32 or int64
     bary : (H, W, 2) float32
 
     Returns

@@ -95,7 +95,8 @@ def window_triangles(
             continue
         faces = _faces(item)
         clip_from_model = camera.clip_from_world @ np.asarray(item.world_from_model, dtype=np.float64)
-        win_int = np.empty((mesh.vertex_count, 2), dtype=np.int64)
+        small = triangles.SUBPIXEL * (max(width, height) + 2) < 2**31  # as render.bin_item: one compiled version
+        win_int = np.empty((mesh.vertex_count, 2), dtype=np.int32 if small else np.int64)
         win_float = np.empty((mesh.vertex_count, 2))
         vertex_codes = np.zeros(mesh.vertex_count, dtype=np.uint8)
         project_vertices(mesh.vertices, clip_from_model, view, win_int, win_float, vertex_codes)
