@@ -103,6 +103,17 @@ def test_view_frame_from_normal_equals_frame_from_target():
     assert_close(from_normal.matrix, ViewFrame(eye, target=target).matrix)
 
 
+def test_view_frame_takes_eye_target_up_positionally_like_look_at():
+    eye, target, up = (3.0, 1.0, 2.0), (-1.0, 0.5, 0.0), (0.2, 1.0, 0.1)
+    frame = ViewFrame(eye, target, up)
+    assert_close(frame.matrix, look_at(eye, target, up))
+    assert_close(frame.matrix, Camera.look_at(eye, target, up, PERSPECTIVE, 320, 200).view_matrix)
+    assert_close(frame.up, up) and frame.normal is None
+    # normal is keyword-only: a fourth positional argument is refused by Python itself
+    with pytest.raises(TypeError, match=r"positional"):
+        ViewFrame(eye, target, up, (0.0, 0.0, 1.0))  # type: ignore[misc]
+
+
 def test_left_handed_frame_points_z_view_along_the_line_of_sight():
     eye, target = np.array([1.0, 2.0, 5.0]), np.array([0.0, 0.0, 0.0])
     right = ViewFrame(eye, target=target)

@@ -242,6 +242,20 @@ def test_render_explain_and_view_commands(tmp_path, capsys):
     assert sheet.read_text().lstrip().startswith("<")
 
 
+def test_view_command_sheet_options(tmp_path, capsys):
+    sheet = tmp_path / "sheet.svg"
+    arguments = ["view", str(EXAMPLES / "exploded_assembly.toml"), "-o", str(sheet), "--views", "front,top"]
+    main([*arguments, "--paper", "a4", "--orientation", "portrait", "--angle", "first", "--no-dimensions"])
+    text = sheet.read_text()
+    assert 'width="210mm" height="297mm"' in text and "FIRST ANGLE PROJECTION" in text
+    assert 'class="dimension"' not in text
+    main([*arguments, "--paper", "Tabloid"])
+    text = sheet.read_text()
+    assert 'width="431.8mm"' in text and 'class="dimension"' in text
+    result = run(*arguments, "--orientation", "sideways")
+    assert result.returncode == 1 and "orientation = 'sideways' is unknown" in result.stderr
+
+
 def test_scene_file_errors_are_one_line_without_traceback(tmp_path):
     bad = tmp_path / "bad.toml"
     bad.write_text("[camera]\neye = [0, 0, 5]\nlens = 3\n")

@@ -29,7 +29,10 @@ def test_readme_example_compiles_within_budget_in_a_fresh_cache():
     result = json.loads(proc.stdout)
     kernels = sorted((r for r in result["cold"]["records"] if r["depth"] == 0), key=lambda r: -r["seconds"])
     table = "\n".join(f"{r['kernel']:60s} {r['seconds']:6.2f} s" for r in kernels)
-    assert result["cold_process"] <= COMPILE_BUDGET_S, f"cold start {result['cold_process']:.1f} s:\n{table}"
+    # CPU seconds of the child: the compile work itself, steady when other processes share the cores (wall time
+    # is what a user waits on a quiet machine, about the same; both are printed on failure)
+    cold = result["cold"]
+    assert cold["cpu"] <= COMPILE_BUDGET_S, f"cold start {cold['cpu']:.1f} s CPU ({cold['wall']:.1f} s wall):\n{table}"
     assert "compiling render kernels, first run only" in result["cold"]["stderr"]
     assert result["warm"]["records"] == [], "the second run must load every kernel from the cache"
     assert "compiling" not in result["warm"]["stderr"]

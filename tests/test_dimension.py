@@ -103,3 +103,45 @@ def test_bad_input():
         box_counting_dimension([[1.0, 1.0], [1.0, 1.0]])
     with pytest.raises(GeometryError, match=r"mesh has no faces"):
         box_counting_dimension(Mesh([[0, 0, 0], [1, 1, 1]], np.empty((0, 3), dtype=np.int64)), [1.0, 0.5, 0.25])
+
+
+def _square_grid(count: int) -> np.ndarray:
+    side = np.linspace(0.0, 2.0, count)  # to the square's edges
+    return np.stack(np.meshgrid(side, side), -1).reshape(-1, 2)
+
+
+def _line(count: int) -> np.ndarray:
+    return np.linspace(0.0, 1.0, count)[:, None] * np.array([[3.0, 1.0]]) + np.array([[2.0, -1.0]])
+
+
+@pytest.mark.parametrize(
+    ("name", "data", "expected"),
+    [
+        ("Koch curve, level-7 vertices", lambda: koch_curve(7), KOCH),
+        ("Koch curve, level-8 vertices (x, y)", lambda: koch_curve(8)[:, :2], KOCH),
+        ("Sierpinski triangle mesh, level 8", lambda: sierpinski_triangle(8), SIERPINSKI),
+        ("Cantor set, level-10 interval ends", lambda: cantor_set(10).reshape(-1, 1), CANTOR),
+        ("Cantor set, level-10 interval centres", lambda: cantor_set(10).mean(axis=1)[:, None], CANTOR),
+        ("Menger sponge mesh, level 3", lambda: menger_sponge(3), MENGER),
+        ("straight line, 10001 points off the axes", lambda: _line(10001), 1.0),
+        ("filled square, 300 x 300 grid", lambda: _square_grid(300), 2.0),
+        ("filled square, 60000 random points", lambda: np.random.default_rng(0).random((60000, 2)), 2.0),
+    ],
+)  # fmt: skip
+def test_default_sizes_give_the_documented_dimensions_within_002(name, data, expected):
+    result = box_counting_dimension(data())  # no sizes: the defaults alone
+    assert abs(result.dimension - expected) < 0.02, (name, result.dimension, result.sizes, result.counts)
+    assert result.sizes.size >= 3 and np.all(np.diff(result.sizes) < 0)
+
+
+def test_default_sizes_are_the_finest_three_octaves_of_well_filled_tiling_boxes():
+    points = koch_curve(7)
+    result = box_counting_dimension(points)
+    # boxes of side extent/m (whole m) over the bounding box; the finest still holds >= 4 points on average
+    m = 1.0 / result.sizes  # the Koch curve's extent is 1
+    np.testing.assert_allclose(m, np.round(m), atol=1e-9)
+    assert result.counts[-1] <= points.shape[0] / 4 and result.sizes[0] / result.sizes[-1] <= 8.0 * (1 + 1e-9)
+    # exact counts on a line sampled to its ends: m boxes for every m (the last box of the tiling is closed)
+    line = box_counting_dimension(_line(4001))
+    np.testing.assert_array_equal(line.counts, np.round(3.0 / line.sizes).astype(np.int64))
+    assert line.dimension == pytest.approx(1.0, abs=1e-12)

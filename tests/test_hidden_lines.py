@@ -483,3 +483,99 @@ def test_results_are_read_only_and_deterministic():
         assert np.array_equal(getattr(first, name), getattr(second, name))
         with pytest.raises(ValueError, match="read-only"):
             getattr(first, name)[...] = 0
+
+
+# --- flat faces split into triangles, split vertices, faces seen edge-on ---------------------------------------
+
+
+def _plate_and_post() -> tuple[list, trimesh.Trimesh]:
+    """A plate whose faces are split into many coplanar triangles and a frustum cylinder (cap rims and the seam
+    split into separate vertices), as placed meshes and as one trimesh."""
+    from frustum.geometry import cylinder
+    from frustum.transforms import rotate_x
+
+    plate = trimesh.creation.box(extents=(60.0, 10.0, 40.0)).subdivide().subdivide()
+    post = cylinder(radius=10.0, height=30.0, segments=48)
+    place = translate(5.0, 20.0, -4.0) @ rotate_x(-math.pi / 2)
+    post_world = trimesh.Trimesh(post.vertices, post.faces).apply_transform(place)
+    return [Mesh(plate.vertices, plate.faces), (post, place)], trimesh.util.concatenate([plate, post_world])
+
+
+def _on_sharp_edge(edges: np.ndarray, part: trimesh.Trimesh) -> np.ndarray:
+    """(E,) True where both ends of a world edge lie on one edge between faces more than 1e-3 rad apart (trimesh,
+    vertices merged by position): the oracle for "a feature edge of the solid"."""
+    merged = part.copy()
+    merged.merge_vertices(digits_vertex=9)
+    sharp = merged.vertices[merged.face_adjacency_edges[merged.face_adjacency_angles > 1e-3]]
+    a, direction = sharp[:, 0], sharp[:, 1] - sharp[:, 0]
+    length2 = (direction**2).sum(axis=1)
+
+    def distance(p: np.ndarray) -> np.ndarray:
+        t = np.clip(((p - a) * direction).sum(axis=1) / length2, 0.0, 1.0)
+        return np.linalg.norm(a + t[:, None] * direction - p, axis=1)
+
+    return np.array([((distance(e[0]) < 1e-9) & (distance(e[1]) < 1e-9)).any() for e in edges])
+
+
+@pytest.mark.parametrize("view", ["top", "front", "right"])
+def test_feature_edges_are_edges_of_the_solid_never_between_coplanar_faces(view):
+    meshes, part = _plate_and_post()
+    centre = part.bounds.mean(axis=0)
+    camera = Camera.multiview(view, Orthographic(100.0, 50.0, 250.0), centre, 150.0, 400, 400)
+    lines = remove_hidden_lines(meshes, camera)
+    assert lines.edges.shape[0] > 0 and _on_sharp_edge(lines.edges, part).all()
+    # a flat face split into triangles, seen face-on or edge-on, has no kind bits on its inner edges
+    plate = meshes[0]
+    edges, _, kinds = feature_edges(plate.vertices, plate.faces, camera)
+    assert _on_sharp_edge(plate.vertices[edges[kinds != 0]], part).all()
+    assert (kinds != 0).sum() == 12 * 4  # the box's 12 edges, each split in 4 by two subdivisions
+
+
+def test_split_vertices_do_not_make_boundaries_and_edge_on_faces_hide_nothing():
+    from frustum.geometry import cylinder
+
+    post = cylinder(radius=0.08, height=0.6, segments=12)  # a 12-gon: facets exactly 30 degrees apart
+    _, _, kinds = feature_edges(post.vertices, post.faces)
+    assert not (kinds & EDGE_BOUNDARY).any()  # closed, though rims and seam are split vertices
+    assert (kinds == EDGE_CREASE).sum() == 24  # the two rims; 30 degrees does not exceed crease_angle = 30
+    # an isometric view sees two side facets exactly edge-on: both silhouettes are drawn, whole and visible
+    frame = ViewFrame((0.0, 0.0, 2.0), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0))
+    camera = Camera(frame, Axonometric(-math.pi / 4, math.asin(math.tan(math.pi / 6)), 1.0, 1.0, 3.0), 500, 500)
+    turned = (post, np.array([[1.0, 0, 0, 0], [0, 0, 1.0, 0], [0, -1.0, 0, 0], [0, 0, 0, 1.0]]))  # axis along y
+    lines = remove_hidden_lines([turned], camera)
+    silhouettes = np.flatnonzero(lines.edge_kinds == EDGE_SILHOUETTE)
+    assert silhouettes.size == 2 and not np.isin(silhouettes, lines.hidden_edges).any()
+    for edge in silhouettes:
+        drawn = lines.visible[lines.visible_edges == edge]
+        full = np.linalg.norm(camera.project(lines.edges[edge])[1, :2] - camera.project(lines.edges[edge])[0, :2])
+        assert np.linalg.norm(drawn[:, 1] - drawn[:, 0], axis=1).sum() == pytest.approx(full, rel=1e-9)
+
+
+def _kind_lengths(points: np.ndarray, faces: np.ndarray, camera: Camera) -> dict[int, float]:
+    edges, _, kinds = feature_edges(points, faces, camera)
+    lengths = np.linalg.norm(points[edges[:, 1]] - points[edges[:, 0]], axis=1)
+    return {bit: float(lengths[(kinds & bit) != 0].sum()) for bit in (EDGE_BOUNDARY, EDGE_CREASE, EDGE_SILHOUETTE)}
+
+
+@settings(max_examples=25, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), azimuth=st.floats(0.0, 2 * math.pi), elevation=st.floats(-1.4, 1.4))
+def test_feature_edges_ignore_split_vertices_and_coplanar_subdivision(seed, azimuth, elevation):
+    # a random convex polyhedron (trimesh's hull of 12 points), seen from a random direction
+    hull = trimesh.convex.convex_hull(np.random.default_rng(seed).normal(size=(12, 3)))
+    eye = 6.0 * np.array(
+        [math.cos(elevation) * math.sin(azimuth), math.sin(elevation), math.cos(elevation) * math.cos(azimuth)]
+    )
+    camera = Camera(ViewFrame(eye, (0.0, 0.0, 0.0), (0.0, 1.0, 0.0) if abs(elevation) < 1.3 else (1.0, 0.0, 0.0)),
+                    Perspective(0.8, 0.1, 20.0), 200, 200)  # fmt: skip
+    reference = _kind_lengths(np.asarray(hull.vertices), np.asarray(hull.faces), camera)
+    assert reference[EDGE_BOUNDARY] == 0.0 and reference[EDGE_CREASE] > 0.0
+    # every face with its own three vertices (a flat-shaded export): the same edges of the same kinds
+    soup = np.asarray(hull.vertices)[np.asarray(hull.faces)].reshape(-1, 3)
+    split = _kind_lengths(soup, np.arange(soup.shape[0]).reshape(-1, 3), camera)
+    # every face split into four coplanar triangles: no new edges, the old ones in halves (same total length)
+    finer = hull.subdivide()
+    subdivided = _kind_lengths(np.asarray(finer.vertices), np.asarray(finer.faces), camera)
+    for bit, length in reference.items():
+        # 1e-9 relative: sums of the same lengths in another order and split in two
+        assert split[bit] == pytest.approx(length, rel=1e-9, abs=1e-12)
+        assert subdivided[bit] == pytest.approx(length, rel=1e-9, abs=1e-12)

@@ -9,17 +9,20 @@ from __future__ import annotations
 import io
 import math
 import re
+import shutil
+import subprocess
 import xml.etree.ElementTree as ET
 
 import cairosvg
 import numpy as np
 import pytest
 import trimesh
-from PIL import Image
+from PIL import Image, ImageDraw
 
-from frustum import FrustumError, OutputError, Scene, rotate_z, translate
-from frustum.geometry import Mesh
-from frustum.output.sheet import PAPER_SIZES, STANDARD_SCALES, drawing_sheet, scale_label
+from frustum import FrustumError, OutputError, Scene, rotate_x, rotate_z, translate
+from frustum.geometry import Mesh, cylinder
+from frustum.output.sheet import PAPER_SIZES, STANDARD_SCALES, dimension_text, drawing_sheet, scale_label
+from frustum.output.svg import save_svg
 
 SVG = "{http://www.w3.org/2000/svg}"
 NUMBER = re.compile(r"-?\d+(?:\.\d+)?(?:e-?\d+)?")
@@ -88,6 +91,11 @@ def test_views_are_aligned_and_placed_by_the_projection_angle(angle):
     if angle == "first":
         assert top[:, 1].min() > front[:, 1].max() and right[:, 0].max() < front[:, 0].min()
     assert f"{angle.upper()} ANGLE PROJECTION" in ET.tostring(root, encoding="unicode")
+    # the isometric view: in the free corner of the top view's row, right of the front view's column
+    iso = _segments(root, "isometric-visible").reshape(-1, 2)
+    assert (
+        iso[:, 0].min() > front[:, 0].max() and iso[:, 1].min() < top[:, 1].max() and iso[:, 1].max() > top[:, 1].min()
+    )
 
 
 def test_title_block_labels_and_scale_bar():
@@ -141,7 +149,13 @@ def test_scale_labels():
         ({"views": ()}, OutputError, r"views = \(\) is empty"),
         ({"scale": 0.0}, OutputError, r"scale = 0.0 must be > 0"),
         ({"scale": float("nan")}, OutputError, r"scale = nan is not finite"),
-        ({"scale": 50.0}, OutputError, r"scale = 50.0 does not fit 4 views on A3 \(at most"),
+        (
+            {"scale": 50.0},
+            OutputError,
+            r"scale = 50.0 does not fit 4 views on A3 \(the largest standard scale that fits is 2:1\)",
+        ),
+        ({"orientation": "sideways"}, OutputError, r"orientation = 'sideways' is unknown; expected 'landscape'"),
+        ({"dimensions": "yes"}, OutputError, r"dimensions = 'yes' is not a bool"),
         ({"paper": "B5"}, OutputError, r"paper = 'B5' is unknown"),
         ({"paper": (50, 40)}, OutputError, r"paper = \(50.0, 40.0\) is not a paper name"),
         ({"projection_angle": "second"}, OutputError, r"projection_angle = 'second' is unknown"),
@@ -153,3 +167,228 @@ def test_drawing_sheet_rejects_bad_input(kwargs, error, match):
     scene = arguments.pop("scene")
     with pytest.raises(error, match=match):
         drawing_sheet(scene, **arguments)
+
+
+# --- a part a drafter would draw: a box with a cylinder standing on it ----------------------------------------
+
+
+def _box_with_cylinder() -> tuple[Scene, trimesh.Trimesh]:
+    """A 60 x 10 x 40 mm plate (each face split into many coplanar triangles) with a ⌀20 x 30 mm cylinder on top
+    (frustum's primitive: cap and seam vertices split from the side's), and the same part as one trimesh."""
+    plate = trimesh.creation.box(extents=(60.0, 10.0, 40.0)).subdivide().subdivide()
+    post = cylinder(radius=10.0, height=30.0, segments=48)
+    place = translate(5.0, 20.0, -4.0) @ rotate_x(-math.pi / 2)  # axis along y, standing on the plate's top
+    scene = Scene()
+    scene.add(Mesh(plate.vertices, plate.faces))
+    scene.add(post, transform=place)
+    post_world = trimesh.Trimesh(post.vertices, post.faces).apply_transform(place)
+    return scene, trimesh.util.concatenate([plate, post_world])
+
+
+def _group(root: ET.Element, group_id: str) -> ET.Element | None:
+    return next((g for g in root.iter(f"{SVG}g") if g.get("id") == group_id), None)
+
+
+def _oracle_feature_edges(part: trimesh.Trimesh) -> np.ndarray:
+    """(E, 2, 3) edges between faces more than 1e-3 rad apart, by trimesh (vertices merged by position)."""
+    merged = part.copy()
+    merged.merge_vertices(digits_vertex=9)
+    sharp = merged.face_adjacency_angles > 1e-3
+    return merged.vertices[merged.face_adjacency_edges[sharp]]
+
+
+def test_top_view_draws_only_feature_edges_of_the_solid():
+    scene, part = _box_with_cylinder()
+    text = drawing_sheet(scene, views=("front", "top", "right"), paper="A3")
+    root = ET.fromstring(text.encode())
+    view = _group(root, "view-top")
+    scale = float(view.get("data-scale"))
+    centre = np.array([float(v) for v in view.get("data-centre").split()])
+    drawn = np.concatenate([_segments(root, "top-visible"), _segments(root, "top-hidden")])
+    assert drawn.shape[0] > 0
+    # the top view: paper x = x, paper y = z (the front toward the bottom), around the part's box centre
+    low, high = part.bounds
+    middle = (low + high) / 2.0
+    oracle = _oracle_feature_edges(part)[:, :, [0, 2]]
+    oracle = centre + scale * (oracle - middle[[0, 2]])
+    oracle = oracle[np.linalg.norm(oracle[:, 1] - oracle[:, 0], axis=1) > 1e-9]  # edges seen end-on are points
+    a, b = oracle[:, 0], oracle[:, 1]
+    direction = b - a
+    length2 = (direction**2).sum(axis=1)
+
+    def distance(p: np.ndarray) -> np.ndarray:  # from point p to every oracle segment
+        t = np.clip(((p - a) * direction).sum(axis=1) / length2, 0.0, 1.0)
+        return np.linalg.norm(a + t[:, None] * direction - p, axis=1)
+
+    for start, end in drawn:
+        # both ends (and the middle) on one projected feature edge; 1e-6 mm is round-off of the paper mapping
+        on = (distance(start) < 1e-6) & (distance(end) < 1e-6) & (distance((start + end) / 2.0) < 1e-6)
+        assert on.any(), f"segment {start} -> {end} is not on a feature edge of the part"
+    # and the outline is complete: points along the plate's rectangle and the post's circle are all drawn
+    visible = _segments(root, "top-visible")
+    p, q = visible[:, 0], visible[:, 1]
+
+    def drawn_at(point: np.ndarray) -> bool:
+        t = np.clip(((point - p) * (q - p)).sum(axis=1) / ((q - p) ** 2).sum(axis=1), 0.0, 1.0)
+        return bool((np.linalg.norm(p + t[:, None] * (q - p) - point, axis=1) < 1e-6).any())
+
+    corners = centre + scale * np.array([[-30.0, -20.0], [30.0, -20.0], [30.0, 20.0], [-30.0, 20.0]])
+    along = np.linspace(0.0, 1.0, 25)[:, None]
+    outline = [corners[k] + along * (corners[(k + 1) % 4] - corners[k]) for k in range(4)]
+    angles = 2 * math.pi * np.arange(48) / 48
+    axis = centre + scale * (np.array([5.0, -4.0]) - middle[[0, 2]])
+    rim = axis + scale * 10.0 * np.column_stack([np.cos(angles), np.sin(angles)])
+    assert all(drawn_at(point) for point in np.concatenate([*outline, rim]))
+
+
+@pytest.mark.parametrize(
+    ("paper", "orientation", "angle"),
+    [("A3", "landscape", "third"), ("A4", "portrait", "third"), ("Letter", "landscape", "first"),
+     ("A4", "landscape", "first")],
+)  # fmt: skip
+def test_views_fill_the_drawing_area_at_the_largest_standard_scale(paper, orientation, angle):
+    scene, _ = _box_with_cylinder()
+    text = drawing_sheet(scene, paper=paper, orientation=orientation, projection_angle=angle)
+    root = ET.fromstring(text.encode())
+    width, height = (float(root.get(k).removesuffix("mm")) for k in ("width", "height"))
+    long, short = (
+        max(PAPER_SIZES[paper.upper() if paper.startswith("A") else paper.lower()]),
+        min(PAPER_SIZES[paper.upper() if paper.startswith("A") else paper.lower()]),
+    )
+    assert (width, height) == ((long, short) if orientation == "landscape" else (short, long))
+    # every view as drawn (its lines, dimensions and diameter leaders) together: a bounding box over >= 60 % of
+    # the drawing area's width or height (the 1, 2, 5 scale series can leave the geometry alone at 40 %)
+    views = ("front", "top", "right", "isometric")
+    points = np.array(
+        [
+            float(v)
+            for g in root.iter(f"{SVG}g")
+            if g.get("id", "").startswith(tuple(f"{view}-" for view in views))
+            for path in g.iter(f"{SVG}path")
+            for v in NUMBER.findall(path.get("d"))
+        ]
+    ).reshape(-1, 2)
+    area_width, area_height = width - 20.0, height - 20.0 - 36.0
+    used = points.max(axis=0) - points.min(axis=0)
+    assert max(used[0] / area_width, used[1] / area_height) >= 0.6
+    # and the next larger standard scale does not fit
+    chosen = float(_group(root, "view-front").get("data-scale"))
+    larger = [s for s in STANDARD_SCALES if s > chosen]
+    with pytest.raises(OutputError, match="does not fit"):
+        drawing_sheet(scene, paper=paper, orientation=orientation, projection_angle=angle, scale=min(larger))
+
+
+def _dimension(root: ET.Element, group_id: str) -> tuple[float, str, np.ndarray]:
+    group = _group(root, group_id)
+    assert group is not None and group.get("class") == "dimension", group_id
+    lines = np.array([float(v) for v in NUMBER.findall(group.find(f"{SVG}path").get("d"))]).reshape(-1, 2, 2)
+    return float(group.get("data-value")), group.find(f"{SVG}text").text, lines
+
+
+@pytest.mark.parametrize("scale", [1.0, 2.0])
+def test_dimension_values_are_the_model_extents_and_lines_measure_them_times_scale(scale):
+    scene, part = _box_with_cylinder()
+    root = ET.fromstring(drawing_sheet(scene, views=("front", "top", "right"), scale=scale).encode())
+    extent = part.bounds[1] - part.bounds[0]  # (60, 40, 40): x, y, z
+    # (horizontal, vertical) model axes of each view
+    axes = {"front": (0, 1), "top": (0, 2), "right": (2, 1)}
+    for view, (across, up) in axes.items():
+        geometry = np.concatenate([_segments(root, f"{view}-visible"), _segments(root, f"{view}-hidden")])
+        size = geometry.reshape(-1, 2).max(axis=0) - geometry.reshape(-1, 2).min(axis=0)
+        for name, axis, paper_axis in (("horizontal", across, 0), ("vertical", up, 1)):
+            value, label, lines = _dimension(root, f"{view}-dimension-{name}")
+            assert value == pytest.approx(extent[axis], abs=1e-9) and label == dimension_text(extent[axis])
+            # the dimension line (the one along the measured direction) spans extent × scale, as does the view
+            along = np.abs(lines[:, 1, paper_axis] - lines[:, 0, paper_axis])
+            assert along.max() == pytest.approx(extent[axis] * scale, abs=1e-9)
+            assert size[paper_axis] == pytest.approx(extent[axis] * scale, abs=1e-9)
+    # the post is seen end-on in the top view only: its diameter there, and centre lines
+    diameters = [g for g in root.iter(f"{SVG}g") if g.get("class") == "diameter"]
+    assert [g.get("id") for g in diameters] == ["top-diameter-0"]
+    assert (
+        float(diameters[0].get("data-value")) == pytest.approx(20.0) and diameters[0].find(f"{SVG}text").text == "⌀20"
+    )
+    # centre lines: a cross through the circle in the top view, the post's axis in the side views (30 mm tall,
+    # 2 mm past each end), vertical and on the post's axis (x = 5 in the front view, z = −4 in the right view)
+    assert _group(root, "top-centre-lines") is not None
+    for view, axis_paper_x in (("front", 5.0 - (part.bounds[0][0] + part.bounds[1][0]) / 2),
+                               ("right", 4.0 + (part.bounds[0][2] + part.bounds[1][2]) / 2)):  # fmt: skip
+        group = _group(root, f"{view}-centre-lines")
+        (x0, y0), (x1, y1) = np.array([float(v) for v in NUMBER.findall(group.find(f"{SVG}path").get("d"))]).reshape(
+            2, 2
+        )
+        centre = [float(v) for v in _group(root, f"view-{view}").get("data-centre").split()]
+        assert x0 == pytest.approx(x1, abs=1e-9) and x0 == pytest.approx(centre[0] + axis_paper_x * scale, abs=1e-9)
+        assert abs(y1 - y0) == pytest.approx(30.0 * scale + 4.0, abs=1e-9)
+    arrowheads = [p for p in root.iter(f"{SVG}path") if p.get("class") == "arrowheads"]
+    assert len(arrowheads) == 7 and all(p.get("d").count("Z") in (1, 2) for p in arrowheads)
+
+
+def test_dimensions_false_draws_no_dimensions():
+    scene, _ = _box_with_cylinder()
+    root = ET.fromstring(drawing_sheet(scene, dimensions=False).encode())
+    assert not [g for g in root.iter(f"{SVG}g") if g.get("class") in ("dimension", "diameter")]
+    assert _group(root, "top-centre-lines") is not None
+
+
+def test_dimension_text():
+    assert [dimension_text(v) for v in (40.0, 2.4, 0.16, 1234.6, 60.00000000001, 0.0)] == [
+        "40", "2.4", "0.16", "1235", "60", "0",
+    ]  # fmt: skip
+
+
+def _dark(image: Image.Image, size: tuple[int, int]) -> np.ndarray:
+    """Line pixels: darker than 200 of 255 after compositing on white paper (cairosvg leaves it transparent)."""
+    paper = Image.new("RGBA", image.size, (255, 255, 255, 255))
+    paper.alpha_composite(image.convert("RGBA"))
+    return np.asarray(paper.convert("L").resize(size, Image.Resampling.BOX)) < 200
+
+
+def _near(a: np.ndarray, b: np.ndarray, radius: int) -> float:
+    """Fraction of a's True pixels with a True pixel of b within `radius` pixels (square neighbourhood)."""
+    grown = b.copy()
+    for dy in range(-radius, radius + 1):
+        for dx in range(-radius, radius + 1):
+            grown |= np.roll(np.roll(b, dy, axis=0), dx, axis=1)
+    return float((a & grown).sum() / max(a.sum(), 1))
+
+
+@pytest.mark.skipif(shutil.which("pdftoppm") is None, reason="pdftoppm (Debian poppler-utils) is not installed")
+def test_pdf_and_svg_outputs_read_back_like_the_png(tmp_path):
+    scene, _ = _box_with_cylinder()
+    text = drawing_sheet(scene, paper="A4", title="Plate with post")
+    png_path, pdf_path = save_svg(text, tmp_path / "sheet.png"), save_svg(text, tmp_path / "sheet.pdf")
+    png = Image.open(png_path)
+    size = png.size
+    # PDF → PNG through poppler's pdftoppm, a reader independent of cairo's SVG parser
+    subprocess.run(["pdftoppm", "-r", "150", "-png", "-singlefile", str(pdf_path), str(tmp_path / "poppler")],
+                   check=True, capture_output=True)  # fmt: skip
+    poppler = Image.open(tmp_path / "poppler.png")
+    assert abs(poppler.size[0] / poppler.size[1] - size[0] / size[1]) < 0.01  # same A4 landscape page
+    ours, theirs = _dark(png, size), _dark(poppler, size)
+    # line pixels agree within 2 px both ways (anti-aliasing and hinting differ between the two renderers)
+    assert ours.mean() > 0.005 and _near(ours, theirs, 2) > 0.97 and _near(theirs, ours, 2) > 0.97
+    # the SVG parsed as XML: its path segments, drawn with PIL, lie on the PNG's line pixels
+    root = ET.parse(io.StringIO(text)).getroot()
+    width_mm = float(root.get("width").removesuffix("mm"))
+    drawing = Image.new("L", size, 255)
+    pen = ImageDraw.Draw(drawing)
+    factor = size[0] / width_mm
+    for group in root.iter(f"{SVG}g"):
+        if group.get("id", "").endswith(("-visible", "-hidden")):
+            for (x0, y0), (x1, y1) in _segments(root, group.get("id")):
+                pen.line([(x0 * factor, y0 * factor), (x1 * factor, y1 * factor)], fill=0, width=1)
+    lines = np.asarray(drawing) < 128
+    assert lines.sum() > 1000 and _near(lines, ours, 2) > 0.97
+
+
+def test_a_flat_part_seen_edge_on_gets_no_zero_dimension():
+    scene = Scene()
+    scene.add(Mesh([[0, 0, 0], [40, 0, 0], [40, 0, 20.0]], [[0, 1, 2]]))  # in the y = 0 plane
+    root = ET.fromstring(drawing_sheet(scene, views=("front", "top")).encode())
+    values = {g.get("id"): float(g.get("data-value")) for g in root.iter(f"{SVG}g") if g.get("class") == "dimension"}
+    assert values == {
+        "front-dimension-horizontal": 40.0,
+        "top-dimension-horizontal": 40.0,
+        "top-dimension-vertical": 20.0,
+    }

@@ -273,6 +273,11 @@ from frustum.visibility import (
 # of their names is first used (PEP 562): ``import frustum`` stays fast and never imports Numba.
 _LAZY = {
     "set_threads": "frustum.raster._jit",
+    "DatasetResult": "frustum.batch",
+    "RenderJob": "frustum.batch",
+    "ViewResult": "frustum.batch",
+    "render_dataset": "frustum.batch",
+    "render_many": "frustum.batch",
     "warmup": "frustum.warmup",
     "ANAGLYPH_METHODS": "frustum.output.stereo",
     "RENDER_MODES": "frustum.render",
@@ -298,6 +303,7 @@ _LAZY = {
 }
 
 if TYPE_CHECKING:  # pragma: no cover
+    from frustum.batch import DatasetResult, RenderJob, ViewResult, render_dataset, render_many
     from frustum.output.animation import turntable, write_animation
     from frustum.output.stereo import (
         ANAGLYPH_METHODS,
@@ -402,6 +408,7 @@ __all__ = [
     "ClippingError",
     "Continuity",
     "CubicSpline",
+    "DatasetResult",
     "DepthCue",
     "DepthOrder",
     "DirectionalLight",
@@ -432,6 +439,7 @@ __all__ = [
     "Projection",
     "Quaternion",
     "Ray",
+    "RenderJob",
     "Scene",
     "SceneFile",
     "SceneFileError",
@@ -448,6 +456,7 @@ __all__ = [
     "TriangleClipping",
     "TurtlePath",
     "ViewFrame",
+    "ViewResult",
     "__version__",
     "anaglyph",
     "apply",
@@ -544,7 +553,9 @@ __all__ = [
     "release_memory",
     "remove_hidden_lines",
     "render",
+    "render_dataset",
     "render_examples",
+    "render_many",
     "render_scene_file",
     "render_stereo",
     "render_svg",

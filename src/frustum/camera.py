@@ -113,11 +113,13 @@ class ViewFrame:
         The view point P0 in world coordinates.
     target : (3,) array_like, optional
         A look-at point; N = eye − target. Give exactly one of `target` and `normal`.
-    normal : (3,) array_like, optional
-        The view-plane normal N directly (pointing from the scene toward the eye), any nonzero length.
     up : (3,) array_like
-        The view-up vector V, any length, not parallel to N.
-    handedness : "right" or "left"
+        The view-up vector V, any length, not parallel to N. Positional order ``ViewFrame(eye, target, up)``
+        matches ``look_at(eye, target, up)``.
+    normal : (3,) array_like, optional, keyword-only
+        The view-plane normal N directly (pointing from the scene toward the eye), any nonzero length:
+        ``ViewFrame(eye, normal=N, up=V)``.
+    handedness : "right" or "left", keyword-only
 
     Raises
     ------
@@ -134,9 +136,9 @@ class ViewFrame:
 
     eye: Vector3
     target: Vector3 | None = None
-    normal: Vector3 | None = None
     up: Vector3 = (0.0, 1.0, 0.0)  # type: ignore[assignment]  # converted to an array in __post_init__
-    handedness: Literal["right", "left"] = "right"
+    normal: Vector3 | None = field(default=None, kw_only=True)
+    handedness: Literal["right", "left"] = field(default="right", kw_only=True)
 
     def __post_init__(self) -> None:
         where = "ViewFrame"

@@ -4,7 +4,8 @@ Commands: ``render`` (a TOML scene file to PNG, SVG, PDF, GIF or MP4), ``explain
 points through every stage, with every matrix), ``view`` (a scene as an engineering sheet of views),
 ``examples`` (the gallery), ``compose`` (transformation steps and their composite), ``trace`` (one camera,
 points through every stage of the pipeline), ``info`` (a mesh file's counts, bounds, watertightness and
-normals) and ``turntable`` (a GIF or MP4 orbiting a mesh). Errors print as one line, ``error: <message>``,
+normals), ``turntable`` (a GIF or MP4 orbiting a mesh) and ``dataset`` (many views with depth,
+normals, ids and cameras). Errors print as one line, ``error: <message>``,
 without a traceback (the global ``--debug`` option shows it): exit status 1 for a bad value or an unreadable
 file, 2 for a command line that cannot be parsed (unknown option, missing argument, malformed numbers).
 """
@@ -418,11 +419,19 @@ def view_command(
     views: Annotated[str, typer.Option(help="Comma-separated views: front, top, right, left, rear, bottom, iso.")] = (
         "front,top,right,iso"
     ),
+    paper: Annotated[str, typer.Option(help="Sheet size: A4, A3, A2, A1, A0, Letter or Tabloid.")] = "A3",
+    orientation: Annotated[str, typer.Option(help="landscape or portrait.")] = "landscape",
+    angle: Annotated[str, typer.Option(help="Projection angle: third (US, ISO E) or first (ISO, Europe).")] = "third",
+    dimensions: Annotated[bool, typer.Option(help="Draw overall dimensions and diameters.")] = True,
 ) -> None:
-    """Draw the scene as an engineering sheet: orthographic views with hidden lines, title block and scale bar."""
+    """Draw the scene as an engineering sheet: orthographic views at the largest standard scale that fits, with
+    hidden lines, dimensions, title block and scale bar."""
     from frustum.scenefile import render_view_sheet
 
-    written = render_view_sheet(scene, output, tuple(v.strip() for v in views.split(",") if v.strip()))
+    written = render_view_sheet(
+        scene, output, tuple(v.strip() for v in views.split(",") if v.strip()),
+        paper=paper, orientation=orientation, projection_angle=angle, dimensions=dimensions,
+    )  # fmt: skip
     console.print(f"wrote {written}", markup=False, highlight=False, soft_wrap=True)
 
 
@@ -447,6 +456,50 @@ def examples_command(
 
     for path in render_examples(out, _image_size(size)):
         console.print(f"wrote {path}", markup=False, highlight=False, soft_wrap=True)
+
+
+# --- datasets ---------------------------------------------------------------------------------------------------
+
+
+@app.command("dataset")
+def dataset_command(
+    scene: Annotated[Path, typer.Argument(help="A TOML scene file (its camera sets projection, size and distance).")],
+    out: Annotated[Path, typer.Option("--out", help="Output folder (created; rerun the command to resume).")],
+    views: Annotated[int | None, typer.Option(help="Number of views (default 100; --layout file: the file's).")] = None,
+    layout: Annotated[str, typer.Option(help="orbit, sphere, random or file.")] = "orbit",
+    format_: Annotated[str, typer.Option("--format", help="nerf, nerfstudio, colmap, files or webdataset.")] = "nerf",
+    size: Annotated[str | None, typer.Option(help="Image size WIDTHxHEIGHT, overriding the file's.")] = None,
+    seed: Annotated[int, typer.Option(help="Base seed; each view's seed derives from it and the view's key.")] = 0,
+    cameras: Annotated[Path | None, typer.Option(help="--layout file: a JSON list of {eye, target, up}.")] = None,
+    depth_format: Annotated[str, typer.Option(help="npy (float32) or png16 (uint16, scale in README.txt).")] = "npy",
+    executor: Annotated[str, typer.Option(help="serial, process or ray.")] = "process",
+    workers: Annotated[int | None, typer.Option(help="Worker processes or Ray actors (default: all cores).")] = None,
+    address: Annotated[str | None, typer.Option(help="Ray cluster address (e.g. auto) for --executor ray.")] = None,
+    overwrite: Annotated[bool, typer.Option("--overwrite", help="Start again over a different configuration.")] = False,
+    retries: Annotated[int, typer.Option(help="Tries again for failed views before listing them.")] = 1,
+    progress: Annotated[bool, typer.Option("--progress/--no-progress", help="Show the progress bar.")] = True,
+) -> None:
+    """Render a multi-view dataset: color, metric depth, normals, object ids, masks and the cameras of a format.
+
+    Exit status 3 when views failed (listed with their errors after the retries).
+    """
+    from frustum.batch import render_dataset
+
+    result = render_dataset(
+        scene, out, views=views if views is not None or layout == "file" else 100, layout=layout, format=format_,
+        size=_image_size(size) if size else None, seed=seed, cameras_file=cameras, depth_format=depth_format,
+        executor=executor, workers=workers, progress=progress, overwrite=overwrite, retries=retries,
+        address=address,
+    )  # fmt: skip
+    for key, error in sorted(result.failed.items()):
+        error_console.print(f"failed {key}: {error}", markup=False)
+    console.print(
+        f"wrote {out}: {len(result.rendered)} views rendered, {len(result.skipped)} skipped (done before), "
+        f"{len(result.failed)} failed",
+        markup=False, highlight=False, soft_wrap=True,
+    )  # fmt: skip
+    if result.failed:
+        raise typer.Exit(3)
 
 
 # --- entry point ------------------------------------------------------------------------------------------------

@@ -3,9 +3,10 @@
 The seed's object-space methods compare objects with each other "to float data precision", independent of any
 pixel grid. For line drawings that means: for every drawn edge, find the parts that other faces hide.
 
-1. **Edges to draw.** From each placed mesh: *boundary* edges (one adjacent face), *creases* (the angle between
-   the two adjacent unit world normals exceeds ``crease_angle``), *silhouettes* (one adjacent face front-facing,
-   the other not, by the plane test against the centre of projection) or *all* edges; and the segments of
+1. **Edges to draw.** From each placed mesh, faces adjacent by shared vertex positions: *boundary* edges (one
+   adjacent face), *creases* (the angle between the two adjacent unit world normals exceeds ``crease_angle``),
+   *silhouettes* (one adjacent face front-facing, the other not, by the plane test against the centre of
+   projection) — never between coplanar neighbours (``COPLANAR_ANGLE``) — or *all* edges; and the segments of
    every ``Polyline`` (curves, control polygons), which faces hide but which hide nothing.
 2. **Clip.** Edges (Liang–Barsky) and occluding triangles (Sutherland–Hodgman) are clipped in homogeneous clip
    space against the view volume, so edges that cross the near plane or pass behind the eye keep only their
@@ -35,6 +36,7 @@ References
 from __future__ import annotations
 
 import math
+import weakref
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from types import ModuleType
@@ -50,6 +52,7 @@ from frustum.errors import FrustumError, GeometryError
 from frustum.geometry import Mesh, Polyline
 
 __all__ = [
+    "COPLANAR_ANGLE",
     "EDGE_BOUNDARY",
     "EDGE_CREASE",
     "EDGE_KINDS",
@@ -100,6 +103,21 @@ _GAP_FRACTION = 1e-7
 _POINT_FRACTION = 1e-12
 # A face whose |(P1 − P0) × (P2 − P0)| is below this fraction of its longest squared edge has no normal.
 _DEGENERATE_FRACTION = 1e-12
+# Two neighbouring faces whose unit normals differ by at most this angle (radians) are coplanar: their shared
+# edge is never a crease or a silhouette, whatever crease_angle says, so a flat face split into triangles draws
+# no inner lines. 1e-4 rad covers float32 vertices (relative error 6e-8) on slivers up to ~1000:1, and is far
+# below the facet angle of any tessellated curved surface (2π/60000 for a 60000-segment circle).
+COPLANAR_ANGLE = 1e-4
+# A projected triangle whose doubled area is below this fraction of its longest squared window edge is seen
+# edge-on (height <= 1e-9 of its length): it hides nothing.
+_SLIVER_FRACTION = 1e-9
+# A face whose plane test det[a; b; c] is within this fraction of |a|·|b − a|·|c − a| is seen edge-on.
+_EDGE_ON_FRACTION = 1e-9
+# Round-off of a dihedral angle computed from float64 unit normals, radians.
+_ANGLE_ROUNDOFF = 1e-9
+# Vertices closer than this fraction of the mesh's extent are one vertex for the edge adjacency (meshes with
+# split vertices for flat normals or texture seams): positions are rounded to this grid before matching.
+_WELD_FRACTION = 1e-9
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -243,12 +261,15 @@ def feature_edges(
 ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
     """Every undirected edge of a triangle mesh with its adjacent faces and kind bits.
 
-    An edge is a *boundary* with one adjacent face (or more than two), a *crease* when its two unit face
-    normals n1, n2 satisfy ``n1·n2 < cos(crease_angle)``, a *silhouette* when exactly one of the two faces is
-    front-facing for `camera`. Front-facing is the plane test against the centre of projection, computed in
-    clip space as ``det[(x, y, w)_0; (x, y, w)_1; (x, y, w)_2] > 0`` (the signed window area times
-    ``w0·w1·w2``, valid also for corners behind the eye). Faces of zero area have no normal: their edges are
-    neither creases nor silhouettes.
+    Faces are adjacent when they share two vertex *positions* (``welded_faces``: split vertices at shading
+    seams do not make boundaries). An edge is a *boundary* with one adjacent face (or more than two), a
+    *crease* when the angle between its two unit face normals, ``atan2(|n1 × n2|, n1·n2)``, exceeds
+    `crease_angle`, a *silhouette* when exactly one of the two faces is front-facing for `camera`. Neighbours
+    within ``COPLANAR_ANGLE`` (1e-4 rad) of each other are coplanar: their edge is neither, so the triangles of
+    a flat face never draw lines between them. Front-facing is the plane test against the centre of
+    projection, computed in clip space as ``det[(x, y, w)_0; (x, y, w)_1; (x, y, w)_2] > 0`` (the signed
+    window area times ``w0·w1·w2``, valid also for corners behind the eye). Faces of zero area have no
+    normal: their edges are neither creases nor silhouettes.
 
     Parameters
     ----------
@@ -287,10 +308,17 @@ def _crease(value: Any, where: str) -> float:
 
 def front_facing(clip_from_world: Matrix4, points_world: NDArray, faces: NDArray) -> NDArray[np.bool_]:
     """(M,) True for faces whose front the camera sees: the plane test against the centre of projection, as
-    ``det[(x, y, w)_0; (x, y, w)_1; (x, y, w)_2] > 0`` of the corners' clip rows (valid behind the eye too)."""
+    ``det[(x, y, w)_0; (x, y, w)_1; (x, y, w)_2] > 0`` of the corners' clip rows (valid behind the eye too).
+
+    A face seen edge-on (``det = a·((b − a) × (c − a))`` within 1e-9 of ``|a|·|b − a|·|c − a|``, about 1e-9
+    rad) counts as not front-facing, whatever the round-off sign: the silhouette is then the boundary of the
+    front-facing region, the nearest of the edges that project onto the edge-on face's line.
+    """
     clip = points_world @ clip_from_world[[0, 1, 3], :3].T + clip_from_world[[0, 1, 3], 3]
     a, b, c = clip[faces[:, 0]], clip[faces[:, 1]], clip[faces[:, 2]]
-    return np.einsum("ij,ij->i", a, np.cross(b, c)) > 0.0  # det[a; b; c] = a·(b × c)
+    determinant = np.einsum("ij,ij->i", a, np.cross(b, c))  # det[a; b; c] = a·(b × c)
+    size = np.linalg.norm(a, axis=1) * np.linalg.norm(b - a, axis=1) * np.linalg.norm(c - a, axis=1)
+    return determinant > _EDGE_ON_FRACTION * size
 
 
 def _unit_normals(points: NDArray, faces: NDArray) -> tuple[NDArray, NDArray[np.bool_]]:
@@ -348,18 +376,58 @@ def classify_edges(
     kinds = np.where(counts != 2, EDGE_BOUNDARY, 0).astype(np.int64)
     normals, degenerate = _unit_normals(points, faces)
     other = np.maximum(second, 0)
-    both = (counts == 2) & ~degenerate[first] & ~degenerate[other]
-    cosine = (normals[first] * normals[other]).sum(axis=1)
-    kinds |= np.where(both & (cosine < math.cos(crease_angle)), EDGE_CREASE, 0)
+    # the dihedral angle from atan2(|n1 × n2|, n1 · n2): accurate near 0 and pi, where acos(n1 · n2) is not
+    n1, n2 = normals[first], normals[other]
+    angle = np.arctan2(np.linalg.norm(np.cross(n1, n2), axis=1), (n1 * n2).sum(axis=1))
+    # coplanar neighbours (within COPLANAR_ANGLE) share no drawn edge: neither crease nor silhouette
+    both = (counts == 2) & ~degenerate[first] & ~degenerate[other] & (angle > COPLANAR_ANGLE)
+    # "exceeds": by more than the normals' round-off, so a regular 12-gon prism (exactly 30°) has no creases
+    kinds |= np.where(both & (angle > crease_angle + _ANGLE_ROUNDOFF), EDGE_CREASE, 0)
     if facing is not None:
         kinds |= np.where(both & (facing[first] != facing[other]), EDGE_SILHOUETTE, 0)
     return kinds
 
 
+def welded_faces(points: NDArray, faces: NDArray) -> NDArray[np.int64]:
+    """(M, 3) faces re-indexed so that vertices at the same position (within 1e-9 of the extent) are one vertex.
+
+    Meshes often split a vertex where shading needs two normals (the rim of a cylinder's cap) or two texture
+    coordinates (a seam): by index those edges have one face each and would read as boundaries. The
+    representative of each position is its lowest index, so the result still indexes `points`. Positions are
+    rounded to a grid of 1e-9 of the extent; two copies of a vertex that straddle a grid line (round-off of
+    about 1e-9 of the extent exactly at a cell border) stay apart.
+    """
+    faces = np.asarray(faces, dtype=np.int64)
+    if points.shape[0] == 0:
+        return faces
+    low, high = points.min(axis=0), points.max(axis=0)
+    step = max(float((high - low).max()), 1e-300) * _WELD_FRACTION
+    keys = np.round((points - low) / step).astype(np.int64)
+    order = np.lexsort(keys.T[::-1])  # stable: equal positions keep index order, the lowest first
+    ordered = keys[order]
+    starts = np.concatenate([[True], (ordered[1:] != ordered[:-1]).any(axis=1)])
+    representative = np.empty(points.shape[0], dtype=np.int64)
+    representative[order] = order[np.flatnonzero(starts)][np.cumsum(starts) - 1]
+    return representative[faces]
+
+
+_WELDED: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def welded_adjacency(mesh: Mesh) -> EdgeAdjacency:
+    """The mesh's edges by shared vertex positions, computed once per mesh (welding in model space equals welding
+    after any affine modeling transform)."""
+    cached = _WELDED.get(mesh)
+    if cached is None:
+        faces = np.asarray(mesh.faces, dtype=np.int64)
+        cached = _WELDED[mesh] = edge_adjacency(welded_faces(mesh.vertices, faces), mesh.vertex_count)
+    return cached
+
+
 def _edges_of(
     points: NDArray, faces: NDArray, facing: NDArray[np.bool_] | None, crease_angle: float
 ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
-    adjacency = edge_adjacency(faces, points.shape[0])
+    adjacency = edge_adjacency(welded_faces(points, faces), points.shape[0])
     kinds = classify_edges(adjacency, points, faces, facing, crease_angle)
     return adjacency.edges, np.stack([adjacency.first, adjacency.second], axis=1), kinds
 
@@ -441,7 +509,9 @@ def remove_hidden_lines(
         points = mesh.vertices @ world_from_model[:3, :3].T + world_from_model[:3, 3]
         faces = np.asarray(mesh.faces, dtype=np.int64)
         facing = front_facing(clip_from_world, points, faces)
-        pairs, pair_faces, kinds = _edges_of(points, faces, facing, angle)
+        adjacency = welded_adjacency(mesh)
+        kinds = classify_edges(adjacency, points, faces, facing, angle)
+        pairs, pair_faces = adjacency.edges, np.stack([adjacency.first, adjacency.second], axis=1)
         chosen = np.ones(kinds.shape, bool) if mask == 0 else (kinds & mask) != 0
         points_parts.append(points)
         faces_parts.append(faces + vertex_offset)
@@ -489,8 +559,13 @@ def _window_triangles(
         keep &= front_facing(np.asarray(camera.clip_from_world), points_world, faces)
     source = np.flatnonzero(keep)
     clipped = clip_triangles(points_clip, faces[source])
-    window = _to_window(clipped.vertices, camera)
-    return np.ascontiguousarray(window[clipped.faces]), source[clipped.face_sources]
+    window = _to_window(clipped.vertices, camera)[clipped.faces]
+    # a face seen edge-on projects to a sliver that covers nothing, but its plane's depth, interpolated over a
+    # round-off area, is noise that would hide the edges lying along it (a tessellated cylinder's silhouette)
+    sides = window[:, [1, 2, 0], :2] - window[:, :, :2]
+    area = np.abs(sides[:, 0, 0] * sides[:, 2, 1] - sides[:, 0, 1] * sides[:, 2, 0])
+    covers = area > _SLIVER_FRACTION * (sides**2).sum(axis=2).max(axis=1)
+    return np.ascontiguousarray(window[covers]), source[clipped.face_sources][covers]
 
 
 def _window_segments(

@@ -50,7 +50,7 @@ from frustum.clipping import VIEW_VOLUME_PLANES
 from frustum.errors import FrustumError
 from frustum.frame import Frame
 from frustum.geometry import Mesh
-from frustum.hidden_lines import EdgeAdjacency, classify_edges, edge_adjacency, front_facing
+from frustum.hidden_lines import EdgeAdjacency, classify_edges, edge_adjacency, front_facing, welded_adjacency
 from frustum.raster import lines, shade, tiles, triangles
 from frustum.raster._jit import threads
 from frustum.raster.vertices import project_vertices, transform_normals, transform_vertices, world_points
@@ -669,7 +669,8 @@ def _draw_edges(items: list[SceneItem], camera: Camera, options: _Options, depth
         if options.mode == "points":
             lines.draw_points(clip, view_depth, vertex_codes, view, style, depth, color)
             continue
-        adjacency = _adjacency(mesh)
+        # feature edges by shared positions: a cap's rim or a seam split for normals or UVs is not a boundary
+        adjacency = welded_adjacency(mesh) if options.edges == "feature" else _adjacency(mesh)
         edges = adjacency.edges
         if edge_modes or options.edges == "feature":
             faces = _world_faces(item)

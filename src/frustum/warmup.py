@@ -41,7 +41,8 @@ class WarmupReport:
 def _api() -> SimpleNamespace:
     """The public names the tasks use, from their own modules (the interface layer imports downward only)."""
     names = {}
-    for module in ("camera", "clipping", "geometry", "projection", "render", "scene", "shading", "output.svg"):
+    for module in ("camera", "clipping", "geometry", "projection", "render", "scene", "shading", "transforms",
+                   "output.svg"):  # fmt: skip
         loaded = importlib.import_module(f"frustum.{module}")  # (``from frustum import render`` is the function)
         names.update({name: getattr(loaded, name) for name in loaded.__all__})
     return SimpleNamespace(**names)
@@ -126,8 +127,8 @@ def _vector() -> None:
 def _fractals() -> None:
     fr = _api()
 
-    fr.mandelbrot(8, 8, max_iter=8)
-    fr.julia(8, 8, max_iter=8)
+    fr.mandelbrot(width=8, height=8, max_iter=8)
+    fr.julia(-0.8 + 0.156j, width=8, height=8, max_iter=8)
     fr.quaternion_julia(resolution=4, max_iter=4)
     fr.barnsley_fern().chaos_game(200, seed=0)
     fr.CLASSIC_LSYSTEMS["koch"].path(1)

@@ -1,0 +1,493 @@
+"""Multi-view datasets: cameras laid out around a scene, every buffer written per view, resumable and safe.
+
+``render_dataset`` (and ``frustum dataset``) renders N views of a scene file and writes, under one folder::
+
+    images/<key>.png      color, RGBA 8-bit
+    depth/<key>.npy       metric z-depth, float32, 0 on background (or depth/<key>.png, uint16 · depth_scale)
+    normals/<key>.npy     unit world normals, float32 (H, W, 3), 0 on background
+    object_id/<key>.png   uint16 scene item index + 1, 0 on background
+    masks/<key>.png       uint8 255 where a surface was drawn
+    cameras.json          every view's intrinsics and poses in every convention (``cameras.camera_record``)
+    transforms.json | sparse/0/*.txt | shards/*.tar   the format's camera files
+    README.txt            the conventions
+    manifest.jsonl        the run log: the configuration, then one line per finished view
+
+Safety: every file is written under a temporary name and renamed; a run that stops (Ctrl-C, a crash, SIGKILL)
+is resumed by running the same command again, which skips the views the manifest lists whose files exist.
+A different configuration is refused (saying what changed) unless ``overwrite=True``. Views that fail are
+retried, then listed with their errors.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import json
+import math
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from frustum._arrays import describe
+from frustum.batch.cameras import camera_record
+from frustum.batch.executors import EXECUTORS, render_many
+from frustum.batch.formats import CAMERA_WRITERS, SHARD_SIZE, check_format_camera
+from frustum.batch.jobs import TEMPORARY_MARK, RenderJob, write_atomically
+from frustum.batch.progress import ViewProgress
+from frustum.camera import Camera
+from frustum.errors import CameraError, FrustumError, OutputError
+
+__all__ = ["DEPTH_FORMATS", "FORMATS", "LAYOUTS", "DatasetResult", "dataset_cameras", "render_dataset", "view_seed"]
+
+LAYOUTS = ("orbit", "sphere", "random", "file")
+"""Camera layouts: a circle at the scene camera's height, a Fibonacci sphere, seeded random directions, a file."""
+FORMATS = tuple(CAMERA_WRITERS)
+"""Dataset formats (camera files): nerf, nerfstudio, colmap, files, webdataset."""
+DEPTH_FORMATS = ("npy", "png16")
+"""Depth files: float32 .npy, or 16-bit PNG in steps of ``depth_scale`` world units."""
+_FOLDERS = {"color": "images", "depth": "depth", "normals": "normals", "object_id": "object_id", "mask": "masks"}
+_SUFFIXES = {"color": ".png", "depth": ".npy", "normals": ".npy", "object_id": ".png", "mask": ".png"}
+_MANIFEST = "manifest.jsonl"
+_SHARED_FILES = ("cameras.json", "README.txt", "transforms.json", "sparse/0/cameras.txt", "sparse/0/images.txt",
+                 "sparse/0/points3D.txt")  # fmt: skip
+_BYTES_PER_PIXEL = 64
+"""Render work per drawn sample: color 4, depth 4, normals 12, ids 4, face codes 8, barycentrics 8, slack."""
+_BYTES_PER_OUTPUT_PIXEL = 48
+"""Encoding per output pixel: metric depth in float64 and float32, ids in int64, the mask."""
+_POLE = 0.999
+"""|direction · y| above which a view uses z as its up vector (y would be nearly parallel to the line of sight)."""
+
+
+@dataclass(frozen=True)
+class DatasetResult:
+    """What ``render_dataset`` did: views rendered now, skipped (done before), failed (key → error), files."""
+
+    out: Path
+    rendered: tuple[str, ...]
+    skipped: tuple[str, ...]
+    failed: dict[str, str] = field(default_factory=dict)
+    camera_files: tuple[Path, ...] = ()
+
+    @property
+    def ok(self) -> bool:
+        return not self.failed
+
+
+def view_seed(seed: int, key: str) -> int:
+    """A view's 64-bit seed from the base `seed` and its key (BLAKE2b): independent of view order and count."""
+    digest = hashlib.blake2b(f"{int(seed)}/{key}".encode(), digest_size=8).digest()
+    return int.from_bytes(digest, "little")
+
+
+def _view_keys(count: int) -> list[str]:
+    digits = max(5, len(str(count - 1)))
+    return [f"view_{i:0{digits}d}" for i in range(count)]
+
+
+def _aimed(camera: Camera, eye: np.ndarray, target: np.ndarray) -> Camera:
+    direction = (target - eye) / np.linalg.norm(target - eye)
+    up = (0.0, 1.0, 0.0) if abs(direction[1]) < _POLE else (0.0, 0.0, -1.0)
+    return Camera.look_at(eye, target, up, camera.projection, camera.width, camera.height)
+
+
+def _cameras_from_file(path: Path, camera: Camera, where: str) -> list[Camera]:
+    try:
+        entries = json.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as error:
+        raise CameraError(f"{where}: cameras = {str(path)!r} cannot be read as JSON ({error}); give a JSON list "
+                          'of {"eye": [x, y, z], "target": [x, y, z], "up": [x, y, z]}') from None  # fmt: skip
+    if not isinstance(entries, list) or not entries:
+        raise CameraError(f"{where}: cameras = {str(path)!r} holds {describe(entries)}; expected a non-empty JSON list")
+    cameras = []
+    for i, entry in enumerate(entries):
+        if not isinstance(entry, dict) or "eye" not in entry or "target" not in entry:
+            raise CameraError(f"{where}: {path}[{i}] = {describe(entry)} needs 'eye' and 'target' (and optional 'up')")
+        try:
+            cameras.append(Camera.look_at(entry["eye"], entry["target"], entry.get("up", (0.0, 1.0, 0.0)),
+                                          camera.projection, camera.width, camera.height))  # fmt: skip
+        except FrustumError as error:
+            raise CameraError(f"{where}: {path}[{i}]: {error}") from None
+    return cameras
+
+
+def dataset_cameras(
+    camera: Camera,
+    views: int | None,
+    layout: str = "orbit",
+    *,
+    seed: int = 0,
+    target: Any = None,
+    cameras_file: str | os.PathLike | None = None,
+) -> list[tuple[str, Camera]]:
+    """``(key, camera)`` per view: `camera`'s projection and size, placed by `layout` around `target`.
+
+    The radius is `camera`'s distance to `target` (default: its look-at point). ``"orbit"``: azimuths
+    ``a₀ + 2πi/N`` at the camera's elevation (y up). ``"sphere"``: the Fibonacci sphere,
+    ``y_i = 1 − (2i + 1)/N``, longitude ``i·π(3 − √5)``. ``"random"``: a direction uniform on the sphere drawn
+    from ``view_seed(seed, key)``. ``"file"``: a JSON list of ``{"eye", "target", "up"}`` (`views` None or
+    equal to its length). Views within 2.6° of the poles use z as the up vector.
+
+    Raises
+    ------
+    CameraError
+        Unknown layout (the valid ones listed), views < 1, an unreadable cameras file, a camera on the target.
+    """
+    where = "dataset_cameras"
+    if layout not in LAYOUTS:
+        raise CameraError(f"{where}: layout = {layout!r} is unknown; expected one of {', '.join(LAYOUTS)}")
+    if layout == "file":
+        if cameras_file is None:
+            raise CameraError(f"{where}: layout = 'file' needs cameras_file (--cameras), a JSON list of cameras")
+        cameras = _cameras_from_file(Path(cameras_file), camera, where)
+        if views is not None and views != len(cameras):
+            raise CameraError(f"{where}: views = {views!r} but {cameras_file} lists {len(cameras)} cameras; "
+                              "leave views out or give the same count")  # fmt: skip
+        return list(zip(_view_keys(len(cameras)), cameras, strict=True))
+    if isinstance(views, bool) or not isinstance(views, int | np.integer) or views < 1:
+        raise CameraError(f"{where}: views = {describe(views)} must be a positive integer")
+    views = int(views)
+    center = np.asarray(camera.frame.target if target is None else target, dtype=np.float64)
+    eye = np.asarray(camera.frame.eye, dtype=np.float64)
+    radius = float(np.linalg.norm(eye - center))
+    if radius == 0.0:
+        raise CameraError(f"{where}: the camera's eye {describe(eye)} sits on the target; the radius must be > 0")
+    keys = _view_keys(views)
+    offset = (eye - center) / radius
+    if layout == "orbit":
+        elevation = math.asin(max(-_POLE, min(_POLE, offset[1])))
+        azimuth = math.atan2(offset[0], offset[2])
+        directions = []
+        for i in range(views):
+            a = azimuth + 2.0 * math.pi * i / views
+            ring = math.cos(elevation)
+            directions.append((ring * math.sin(a), math.sin(elevation), ring * math.cos(a)))
+    elif layout == "sphere":
+        golden = math.pi * (3.0 - math.sqrt(5.0))
+        directions = []
+        for i in range(views):
+            y = 1.0 - (2.0 * i + 1.0) / views
+            r = math.sqrt(max(0.0, 1.0 - y * y))
+            directions.append((r * math.cos(golden * i), y, r * math.sin(golden * i)))
+    else:
+        directions = []
+        for key in keys:
+            d = np.random.default_rng(view_seed(seed, key)).normal(size=3)
+            directions.append(tuple(d / np.linalg.norm(d)))
+    eyes = center + radius * np.asarray(directions)
+    return [(key, _aimed(camera, eye_i, center)) for key, eye_i in zip(keys, eyes, strict=True)]
+
+
+# --- manifest ---------------------------------------------------------------------------------------------------
+
+
+def _read_manifest(path: Path) -> tuple[dict | None, dict[str, dict]]:
+    """The configuration line and the finished views of a run log; a torn last line (a killed run) is ignored."""
+    if not path.exists():
+        return None, {}
+    config, views = None, {}
+    for line in path.read_text(encoding="utf-8", errors="replace").splitlines():
+        try:
+            entry = json.loads(line)
+        except json.JSONDecodeError:
+            continue
+        if "config" in entry and config is None:
+            config = entry["config"]
+        elif "view" in entry:
+            views[entry["view"]] = entry
+    return config, views
+
+
+def _changes(old: dict, new: dict) -> list[str]:
+    return [f"{k} = {old.get(k)!r} → {new.get(k)!r}" for k in sorted(set(old) | set(new)) if old.get(k) != new.get(k)]
+
+
+def _sha256(path: Path | None) -> str | None:
+    return None if path is None else hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+def _check_budget(scene_file: Any, camera: Camera, executor: str, workers: int | None, where: str) -> None:
+    """Memory of the views drawn at once on this machine: frame buffers and a copy of the scene per worker."""
+    from frustum.budgets import check_memory
+
+    concurrent = 1 if executor != "process" else (workers or os.cpu_count() or 1)
+    samples = int(scene_file.options.get("samples", 1))
+    per_view = camera.width * camera.height * (_BYTES_PER_PIXEL * samples + _BYTES_PER_OUTPUT_PIXEL)
+    scene_bytes = sum(item.mesh.vertices.nbytes * 3 + item.mesh.faces.nbytes for item in scene_file.scene.items)
+    cause = f"size = {camera.width}x{camera.height}, samples = {samples}, {concurrent} views at once"
+    check_memory(concurrent * (per_view + scene_bytes), where=where, cause=cause, error=OutputError)
+
+
+def _check_folder(out: Path, where: str) -> None:
+    if out.exists() and not out.is_dir():
+        raise OutputError(f"{where}: out = {str(out)!r} is a file; give a folder (it is created if missing)")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        write_atomically(out / ".write-test", lambda file: file.write(b"frustum"))
+        os.remove(out / ".write-test")
+    except OSError as error:
+        raise OutputError(
+            f"{where}: out = {str(out)!r} is not writable ({error.strerror or error}); give a folder you can write"
+        ) from None
+
+
+def _remove_partial_files(out: Path) -> None:
+    """Temporary files of a run that was killed: never finished outputs."""
+    for sub in (*_FOLDERS.values(), "shards", "sparse/0", "."):
+        folder = out / sub
+        if folder.is_dir():
+            for path in folder.iterdir():
+                if TEMPORARY_MARK in path.name:
+                    with contextlib.suppress(OSError):
+                        path.unlink()
+
+
+class _LoggedProgress(ViewProgress):
+    """The progress bar that also appends each finished view to the run log, flushed at once."""
+
+    def __init__(self, total: int, enabled: bool, log: Any, out: Path) -> None:
+        super().__init__(total, enabled=enabled, description="dataset")
+        self.log, self.out = log, out
+
+    def advance(self, result: Any) -> None:
+        if result.ok:
+            files = {kind: Path(path).relative_to(self.out).as_posix() for kind, path in result.files.items()}
+            entry = {"view": result.key, "files": files, "render_seconds": round(result.render_seconds, 4),
+                     "write_seconds": round(result.write_seconds, 4), "worker": result.worker}  # fmt: skip
+            self.log.write(json.dumps(entry) + "\n")
+            self.log.flush()
+        super().advance(result)
+
+    def retrying(self, count: int) -> None:
+        self.failed -= count
+        self._refresh(-count)
+
+
+def _paths(out: Path, files: dict[str, str]) -> dict[str, Path]:
+    return {kind: out / relative for kind, relative in files.items()}
+
+
+def _readme(config: dict, camera: Camera, extra: dict) -> str:
+    lines = [
+        "frustum multi-view dataset",
+        "==========================",
+        "",
+        f"Made by frustum {config['frustum']} from {config['scene']} ({config['views']} views, layout "
+        f"{config['layout']}, format {config['format']}, {camera.width}x{camera.height} pixels, "
+        f"seed {config['seed']}).",
+        "Rerun the same command to resume; manifest.jsonl is the run log (configuration, then finished views).",
+        "",
+        "Files per view (key = view_NNNNN, no dots):",
+        "  images/<key>.png     color, RGBA 8 bits per channel, linear unless the scene asks for sRGB",
+    ]
+    if config["depth_format"] == "npy":
+        lines.append("  depth/<key>.npy      metric z-depth, float32: distance along the camera's viewing axis in")
+        lines.append("                       world units (not the distance to the eye); 0 where nothing was drawn")
+    else:
+        lines.append(f"  depth/<key>.png      metric z-depth as uint16 steps of {extra['depth_unit_scale_factor']!r} "
+                     "world units (depth = value * scale); 0 where nothing was drawn")  # fmt: skip
+    lines += [
+        "  normals/<key>.npy    unit world-space normals, float32 (H, W, 3); 0 where nothing was drawn",
+        "  object_id/<key>.png  uint16: index of the scene item seen + 1; 0 = background",
+        "  masks/<key>.png      uint8: 255 where a surface was drawn, 0 elsewhere",
+        "",
+        "Cameras (cameras.json has every view in every convention below):",
+        "  camera_to_world_opengl  4x4, OpenGL camera axes: x right, y up, looking down -z",
+        "                          (the transform_matrix of transforms.json)",
+        "  world_to_camera_opencv  4x4, OpenCV camera axes: x right, y down, looking down +z (COLMAP's)",
+        "  fx, fy, cx, cy          pixels; u to the right, v down, the centre of the top-left pixel at (0.5, 0.5)",
+        "                          (COLMAP's and nerfstudio's convention): u = fx*X/Z + cx, v = fy*Y/Z + cy in",
+        "                          OpenCV camera coordinates",
+        "  camera_angle_x          horizontal field of view in radians (Blender NeRF)",
+        "  view_from_world, clip_from_view  frustum's own matrices (column vectors, OpenGL clip space)",
+        "",
+        "Back-projection of pixel (row r, column i) with z-depth d: X = (i + 0.5 - cx)/fx * d,",
+        "Y = (r + 0.5 - cy)/fy * d, Z = d in OpenCV camera axes;",
+        "world = inverse(world_to_camera_opencv) @ (X, Y, Z, 1).",
+    ]
+    fmt = config["format"]
+    if fmt == "nerf":
+        lines += ["", "transforms.json: Blender NeRF; file_path omits .png (as in the NeRF synthetic scenes)."]
+    elif fmt == "nerfstudio":
+        lines += ["", "transforms.json: nerfstudio (OPENCV model without distortion); depth_file_path and mask_path",
+                  "are relative to this folder."]  # fmt: skip
+    elif fmt == "colmap":
+        lines += ["", "sparse/0/cameras.txt (PINHOLE fx fy cx cy), images.txt (world-to-camera, QW QX QY QZ scalar",
+                  "first, TX TY TZ; NAME relative to images/), points3D.txt (empty)."]  # fmt: skip
+    elif fmt == "webdataset":
+        lines += ["", f"shards/shard-NNNNNN.tar: WebDataset shards of {SHARD_SIZE} samples: <key>.png,",
+                  "<key>.depth.npy, <key>.normals.npy, <key>.object_id.png, <key>.mask.png,",
+                  "<key>.json (the view's camera record).",
+                  "The per-view folders are kept (resuming reads them)."]  # fmt: skip
+    lines += ["", "Supersampled scenes (samples > 1): depth is the nearest sample of each pixel's block, normals and",
+              "object ids the block's middle sample.", ""]  # fmt: skip
+    return "\n".join(lines)
+
+
+def render_dataset(
+    scene: Any,
+    out: str | os.PathLike,
+    *,
+    views: int | None = 100,
+    layout: str = "orbit",
+    format: str = "nerf",
+    size: tuple[int, int] | None = None,
+    seed: int = 0,
+    cameras_file: str | os.PathLike | None = None,
+    depth_format: str = "npy",
+    executor: str = "process",
+    workers: int | None = None,
+    progress: bool = True,
+    overwrite: bool = False,
+    retries: int = 1,
+    address: str | None = None,
+) -> DatasetResult:
+    """Render a multi-view dataset of a scene file into the folder `out` (see the module docstring).
+
+    Parameters
+    ----------
+    scene : str, Path or SceneFile
+        A TOML scene file (its camera gives projection, size, distance and the target), or a loaded one.
+    views, layout, seed, cameras_file
+        ``dataset_cameras``.
+    format : {"nerf", "nerfstudio", "colmap", "files", "webdataset"}
+    size : (width, height) or None
+        Overrides the scene file's image size.
+    depth_format : {"npy", "png16"}
+        png16 stores ``round(depth / scale)`` with ``scale = far / 65535``, written in README.txt (and as
+        nerfstudio's ``depth_unit_scale_factor``).
+    executor, workers, progress, address
+        ``render_many``.
+    overwrite : bool
+        Start again in a folder that holds a dataset made with another configuration.
+    retries : int
+        How often failed views are tried again before they are listed.
+
+    Returns
+    -------
+    DatasetResult
+
+    Raises
+    ------
+    FrustumError
+        Bad arguments (unknown names listed), a scene file that does not load (once), an output folder that is
+        a file or not writable, a changed configuration without `overwrite`, a projection the format cannot
+        describe.
+    """
+    where = "render_dataset"
+    from frustum import __version__
+    from frustum.scenefile import SceneFile, load_scene_file
+
+    if format not in CAMERA_WRITERS:
+        raise OutputError(f"{where}: format = {format!r} is unknown; expected one of {', '.join(FORMATS)}")
+    if layout not in LAYOUTS:
+        raise CameraError(f"{where}: layout = {layout!r} is unknown; expected one of {', '.join(LAYOUTS)}")
+    if depth_format not in DEPTH_FORMATS:
+        raise OutputError(f"{where}: depth_format = {depth_format!r} is unknown; expected one of "
+                          f"{', '.join(DEPTH_FORMATS)}")  # fmt: skip
+    if executor not in EXECUTORS:
+        raise FrustumError(f"{where}: executor = {executor!r} is unknown; expected one of {', '.join(EXECUTORS)}")
+    if isinstance(retries, bool) or not isinstance(retries, int) or retries < 0:
+        raise FrustumError(f"{where}: retries = {describe(retries)} must be an integer >= 0")
+    scene_path = None
+    if isinstance(scene, SceneFile):
+        scene_file = scene
+        scene_path = scene.path
+    elif isinstance(scene, str | os.PathLike):
+        scene_path = Path(scene)
+        scene_file = load_scene_file(scene_path)  # a scene that does not load fails here, once
+    else:
+        raise FrustumError(f"{where}: scene = {describe(scene)} is not a scene file path or a SceneFile")
+    if size is not None:
+        scene_file = scene_file.resized(tuple(size))
+    base = scene_file.cameras[0]
+    check_format_camera(format, base, where)
+    target = base.frame.target
+    if target is None:  # a camera given by its view-plane normal: aim at the middle of the scene
+        items = scene_file.scene.items
+        corners = [item.world_from_model[:3, :3] @ item.mesh.bounds.T + item.world_from_model[:3, 3:4]
+                   for item in items if item.mesh.vertex_count]  # fmt: skip
+        target = np.hstack(corners).mean(axis=1) if corners else np.zeros(3)
+    cameras = dataset_cameras(base, views, layout, seed=seed, target=target, cameras_file=cameras_file)
+    _check_budget(scene_file, base, executor, workers, where)
+    out = Path(out)
+    _check_folder(out, where)
+    extra: dict[str, Any] = {}
+    depth_scale = 1e-3
+    if depth_format == "png16":
+        far = getattr(base.projection, "far", None)
+        depth_scale = float(far) / 65535 if far else 1e-3
+        extra["depth_unit_scale_factor"] = depth_scale
+    config = {
+        "frustum": __version__,
+        "scene": "<SceneFile>" if scene_path is None else scene_path.name,
+        "scene_sha256": _sha256(scene_path),
+        "views": len(cameras),
+        "layout": layout,
+        "format": format,
+        "size": [base.width, base.height],
+        "seed": int(seed),
+        "depth_format": depth_format,
+        "cameras_sha256": _sha256(Path(cameras_file)) if layout == "file" and cameras_file else None,
+    }
+    manifest = out / _MANIFEST
+    old_config, finished = _read_manifest(manifest)
+    if old_config is not None and old_config != config and not overwrite:
+        raise OutputError(
+            f"{where}: out = {str(out)!r} holds a dataset made with another configuration ("
+            + "; ".join(_changes(old_config, config))
+            + "); rerun with overwrite=True (--overwrite) to start again, or give another folder"
+        )
+    if overwrite and (old_config is not None or finished):
+        for entry in finished.values():
+            for relative in entry.get("files", {}).values():
+                with contextlib.suppress(OSError):
+                    (out / relative).unlink()
+        for path in [*(out / name for name in _SHARED_FILES), *out.glob("shards/shard-*.tar")]:
+            with contextlib.suppress(OSError):
+                path.unlink()
+        manifest.unlink()
+        old_config, finished = None, {}
+    _remove_partial_files(out)
+    kinds = dict(_SUFFIXES)
+    if depth_format == "png16":
+        kinds["depth"] = ".png"
+
+    def files_of(key: str) -> dict[str, str]:
+        return {kind: f"{_FOLDERS[kind]}/{key}{suffix}" for kind, suffix in kinds.items()}
+
+    done = {key for key, _ in cameras
+            if key in finished and finished[key].get("files") == files_of(key)
+            and all((out / p).is_file() for p in files_of(key).values())}  # fmt: skip
+    jobs = [
+        RenderJob(key, scene_file.scene, camera, _paths(out, files_of(key)), scene_file.options, depth_scale)
+        for key, camera in cameras
+        if key not in done
+    ]
+    failed: dict[str, str] = {}
+    rendered: list[str] = []
+    with open(manifest, "a", encoding="utf-8") as log:
+        if old_config is None:
+            log.write(json.dumps({"config": config}) + "\n")
+            log.flush()
+        bar = _LoggedProgress(len(cameras), bool(progress), log, out)
+        with bar:
+            bar.skip(len(done))
+            remaining = jobs
+            for attempt in range(retries + 1):
+                if attempt:
+                    bar.retrying(len(remaining))
+                results = render_many(remaining, executor=executor, workers=workers, progress=bar, address=address)
+                rendered += [r.key for r in results if r.ok]
+                failed = {r.key: r.error for r in results if not r.ok}
+                remaining = [job for job in remaining if job.key in failed]
+                if not remaining:
+                    break
+    complete = [(key, camera, files_of(key)) for key, camera in cameras if key not in failed]
+    records = {key: camera_record(camera) for key, camera, _ in complete}
+    write_atomically(out / "cameras.json", lambda file: file.write((json.dumps(records, indent=2) + "\n").encode()))
+    written = [out / "cameras.json", *CAMERA_WRITERS[format](out, complete, extra)]
+    write_atomically(out / "README.txt", lambda file: file.write(_readme(config, base, extra).encode("utf-8")))
+    return DatasetResult(out, tuple(sorted(rendered)), tuple(sorted(done)), failed, (*written, out / "README.txt"))
