@@ -375,3 +375,21 @@ def test_explain_method_prints_the_counts(tmp_path, capsys) -> None:
         main(["explain", str(path), "--method", "z-buffer"])
     err = capsys.readouterr().err
     assert exit_info.value.code == 1 and "expected one of 'depth-buffer', 'scan-line'" in err
+
+
+def test_scene_file_render_method_and_transparency(tmp_path) -> None:
+    from frustum.errors import SceneFileError
+    from frustum.scenefile import load_scene_file
+
+    path = tmp_path / "ball.toml"
+    path.write_text(
+        SCENE_FILE.replace("size = [48, 32]", 'size = [48, 32]\nmethod = "scan-line"\ntransparency = "a-buffer"')
+    )
+    scene_file = load_scene_file(path)
+    assert scene_file.options["method"] == "scan-line" and scene_file.options["transparency"] == "a-buffer"
+    frame = render(scene_file.scene, scene_file.cameras[0], **scene_file.options)
+    assert frame.stats["method"] == "scan-line"
+    assert_same_picture(frame, render(scene_file.scene, scene_file.cameras[0]))
+    path.write_text(SCENE_FILE.replace("size = [48, 32]", 'size = [48, 32]\nmethod = "ray-casting"'))
+    with pytest.raises(SceneFileError, match=r"ball.toml:8: render.method = 'ray-casting' .*'scan-line'"):
+        load_scene_file(path)

@@ -48,7 +48,7 @@ from frustum.frame import Frame
 from frustum.geometry import Mesh
 from frustum.projection import MULTIVIEWS, Axonometric, Frustum, Oblique, Orthographic, Perspective
 from frustum.quaternion import Quaternion
-from frustum.render import RENDER_MODES, SHADING_MODES, render
+from frustum.render import RENDER_MODES, SHADING_MODES, TRANSPARENCY_MODES, VISIBILITY_METHODS, render
 from frustum.scene import Node, Scene, cutaway, exploded
 from frustum.shading import AmbientLight, DepthCue, DirectionalLight, Material, PointLight, SpotLight
 from frustum.transforms import compose, reflect, rotate, rotate_x, rotate_y, rotate_z, scale, shear, translate
@@ -115,7 +115,8 @@ _CAMERA_KEYS = (
 _STEREO_KEYS = ("eye_separation", "convergence_distance", "layout", "anaglyph_method", "cross_eyed")
 _RENDER_KEYS = (
     "size", "shading", "specular", "background", "cull_back_faces", "mode", "edges", "crease_angle_deg", "edge_color",
-    "hidden", "hidden_color", "line_width", "depth_cue", "samples", "filter", "color_space", "columns",
+    "hidden", "hidden_color", "line_width", "depth_cue", "samples", "filter", "color_space", "columns", "method",
+    "transparency",
 )  # fmt: skip
 _DEPTH_CUE_KEYS = ("near", "far", "min_intensity", "max_intensity", "color")
 _LIGHT_TYPES = {"ambient": AmbientLight, "directional": DirectionalLight, "point": PointLight, "spot": SpotLight}
@@ -1384,6 +1385,8 @@ def _render_options(report: _Report, path: tuple, value: Any) -> tuple[dict, tup
         "samples": lambda p, v: _number(report, p, v, low=1, high=64, integer=True),
         "filter": lambda p, v: _choice(report, p, v, ("box", "tent")),
         "color_space": lambda p, v: _choice(report, p, v, ("linear", "srgb")),
+        "method": lambda p, v: _choice(report, p, v, tuple(VISIBILITY_METHODS)),
+        "transparency": lambda p, v: _choice(report, p, v, TRANSPARENCY_MODES),
     }
     for key, check in simple.items():
         if key in params:
