@@ -3,8 +3,9 @@
 A fragment is one triangle's part of one pixel: the triangle t, a 16-bit coverage mask of the 4×4 subsamples
 at ``(256·i + 32 + 64·a, 256·j + 32 + 64·b)`` (fixed point, a, b = 0..3; bit ``4·b + a``; top-left rule at each
 subsample), and the shading inputs at the centroid of its covered subsamples (depth, face code, barycentrics:
-shaded once per fragment by the shading kernel, as a column image). ``count_fragments`` counts them per pixel,
-``write_fragments`` writes them (pixel by pixel in triangle order, from the prefix sum of the counts), and
+shaded once per fragment by the shading kernel). ``count_fragments`` counts them per triangle and
+``write_fragments`` writes them triangle by triangle (both in parallel over triangles), ``group_by_pixel`` orders
+them pixel by pixel (a counting sort keeping the triangle order within a pixel), and
 ``resolve`` composites each subsample: the fragments covering it sorted by their plane's depth at the subsample,
 ``C = Σ_k T_k·α_k·c_k + T·under`` with ``T_k = Π_{m<k} (1 − α_m)`` (premultiplied colors), the pixel the mean of
 its 16 subsamples. Intersecting and cyclically overlapping surfaces come out right per subsample.
@@ -18,7 +19,7 @@ from frustum.raster._jit import kernel, parallel_kernel
 from frustum.raster.fixed_point import HALF_SUBPIXEL, SUBPIXEL
 from frustum.raster.window import edge_setup
 
-__all__ = ["SAMPLES", "count_fragments", "resolve", "write_fragments"]
+__all__ = ["SAMPLES", "count_fragments", "group_by_pixel", "resolve", "write_fragments"]
 
 SAMPLES = 16
 _STEP = SUBPIXEL // 4
@@ -59,32 +60,37 @@ def _mask(xy: np.ndarray, t: int, i: int, j: int) -> tuple[int, int, int]:
     return mask, sum_x, sum_y
 
 
-@kernel
-def count_fragments(xy: np.ndarray, counts: np.ndarray) -> None:
-    """counts (H, W) int64 (zeroed by the caller): the number of fragments of each pixel (window row j is array
-    row H − 1 − j)."""
-    height, width = counts.shape[0], counts.shape[1]
-    for t in range(xy.shape[0]):
+@parallel_kernel(lambda xy, *_: xy.shape[0])
+def count_fragments(xy: np.ndarray, size: np.ndarray, counts: np.ndarray, start: int, stop: int) -> None:
+    """counts (T,) int64: the fragments (pixels with a nonzero coverage mask) of each triangle; size = (W, H)."""
+    width, height = size[0], size[1]
+    for t in range(start, stop):
         i_min, i_max, j_min, j_max = _sample_box(xy, t, width, height)
+        n = 0
         for j in range(j_min, j_max + 1):
             for i in range(i_min, i_max + 1):
                 mask, _sum_x, _sum_y = _mask(xy, t, i, j)
                 if mask != 0:
-                    counts[height - 1 - j, i] += 1
+                    n += 1
+        counts[t] = n
 
 
-@kernel
+@parallel_kernel(lambda xy, *_: xy.shape[0])
 def write_fragments(
-    xy: np.ndarray, zq: np.ndarray, weights: np.ndarray, code: np.ndarray, cursor: np.ndarray,
-    triangle: np.ndarray, masks: np.ndarray, frag_depth: np.ndarray, frag_code: np.ndarray, frag_bary: np.ndarray,
+    xy: np.ndarray, zq: np.ndarray, weights: np.ndarray, code: np.ndarray, size: np.ndarray, first: np.ndarray,
+    pixel: np.ndarray, triangle: np.ndarray, masks: np.ndarray, frag_depth: np.ndarray, frag_code: np.ndarray,
+    frag_bary: np.ndarray,
+    start: int, stop: int,
 ) -> None:  # fmt: skip
-    """Write every fragment: cursor (H, W) int64 holds each pixel's first slot (advanced as slots fill);
-    triangle (N,) int64, masks (N,) uint16; the shading column image frag_depth (N, 1) float32 (below 1),
-    frag_code (N, 1) int64 and frag_bary (N, 1, 2) float32 at the centroid of the covered subsamples."""
-    height, width = cursor.shape[0], cursor.shape[1]
-    for t in range(xy.shape[0]):
+    """Write triangle t's fragments from slot ``first[t]`` on (triangle-major, row by row): pixel (N,) int64
+    (row-major, top row first), triangle (N,) int64, masks (N,) uint16, and the shading column frag_depth (N,)
+    float32 (below 1), frag_code (N,) int32 or int64 and frag_bary (N, 2) float32 at the centroid of the covered
+    subsamples. size = (W, H)."""
+    width, height = size[0], size[1]
+    for t in range(start, stop):
         i_min, i_max, j_min, j_max = _sample_box(xy, t, width, height)
         dx0, dy0, dx1, dy1, dx2, dy2, _bias0, _bias1, _bias2, area = edge_setup(xy, t)
+        slot = first[t]
         for j in range(j_min, j_max + 1):
             for i in range(i_min, i_max + 1):
                 mask, sum_x, sum_y = _mask(xy, t, i, j)
@@ -101,19 +107,24 @@ def write_fragments(
                 g0, g1, g2 = f0 * zq[t, 0, 1], f1 * zq[t, 1, 1], f2 * zq[t, 2, 1]
                 total = (g0 + g1) + g2
                 b0, b1, b2 = g0 / total, g1 / total, g2 / total
-                row = height - 1 - j
-                slot = cursor[row, i]
-                cursor[row, i] = slot + 1
+                pixel[slot] = (height - 1 - j) * width + i
                 triangle[slot] = t
                 masks[slot] = mask
-                frag_depth[slot, 0] = np.float32(min(max(z, 0.0), 0.99999994))
-                frag_code[slot, 0] = code[t]
-                frag_bary[slot, 0, 0] = np.float32(
-                    (b0 * weights[t, 0, 0] + b1 * weights[t, 1, 0]) + b2 * weights[t, 2, 0]
-                )
-                frag_bary[slot, 0, 1] = np.float32(
-                    (b0 * weights[t, 0, 1] + b1 * weights[t, 1, 1]) + b2 * weights[t, 2, 1]
-                )
+                frag_depth[slot] = np.float32(min(max(z, 0.0), 0.99999994))
+                frag_code[slot] = code[t]
+                frag_bary[slot, 0] = np.float32((b0 * weights[t, 0, 0] + b1 * weights[t, 1, 0]) + b2 * weights[t, 2, 0])
+                frag_bary[slot, 1] = np.float32((b0 * weights[t, 0, 1] + b1 * weights[t, 1, 1]) + b2 * weights[t, 2, 1])
+                slot += 1
+
+
+@kernel
+def group_by_pixel(pixel: np.ndarray, cursor: np.ndarray, order: np.ndarray) -> None:
+    """Counting sort: ``order`` (N,) the fragments pixel by pixel, triangle order kept within a pixel; cursor
+    (H·W,) int64 holds each pixel's first slot (advanced)."""
+    for f in range(pixel.shape[0]):
+        p = pixel[f]
+        order[cursor[p]] = f
+        cursor[p] += 1
 
 
 @parallel_kernel(lambda starts, *_: starts.shape[0] - 1)

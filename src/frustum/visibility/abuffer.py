@@ -57,7 +57,7 @@ class Fragments:
 
 
 def build_fragments(triangles: WindowTriangles, where: str = "render") -> Fragments:
-    """Count the fragments of every pixel, check the memory they need, and write them.
+    """Count the fragments of every triangle, check the memory they need, write them and order them by pixel.
 
     Raises
     ------
@@ -67,27 +67,33 @@ def build_fragments(triangles: WindowTriangles, where: str = "render") -> Fragme
     from frustum.raster import abuffer
 
     height, width = triangles.height, triangles.width
-    counts = np.zeros((height, width), dtype=np.int64)
-    abuffer.count_fragments(triangles.xy, counts)
-    starts = np.zeros(height * width + 1, dtype=np.int64)
-    np.cumsum(counts.ravel(), out=starts[1:])
-    total = int(starts[-1])
+    size = np.array([width, height], dtype=np.int64)
+    per_triangle = np.empty(triangles.count, dtype=np.int64)
+    abuffer.count_fragments(triangles.xy, size, per_triangle)
+    first = np.zeros(triangles.count + 1, dtype=np.int64)
+    np.cumsum(per_triangle, out=first[1:])
+    total = int(first[-1])
     check_memory(
-        total * FRAGMENT_BYTES, where=where,
+        total * (2 * FRAGMENT_BYTES + 16) + 8 * (height * width + 1), where=where,
         cause=f"an A-buffer of {total} fragments ({total / max(1, height * width):.2f} per pixel) at {width}x{height}",
         error=GeometryError,
     )  # fmt: skip
-    fragments = Fragments(
-        starts, np.empty(total, dtype=np.int64), np.empty(total, dtype=np.uint16),
-        np.empty((total, 1), dtype=np.float32), np.empty((total, 1), dtype=np.int64),
-        np.empty((total, 1, 2), dtype=np.float32),
+    code_type = triangles.code_type
+    pixel = np.empty(total, dtype=np.int64)
+    columns = (
+        np.empty(total, dtype=np.int64), np.empty(total, dtype=np.uint16), np.empty(total, dtype=np.float32),
+        np.empty(total, dtype=code_type), np.empty((total, 2), dtype=np.float32),
     )  # fmt: skip
-    cursor = starts[:-1].reshape(height, width).copy()
     abuffer.write_fragments(
-        triangles.xy, triangles.zq, triangles.weights, triangles.code, cursor, fragments.triangle, fragments.mask,
-        fragments.depth, fragments.code, fragments.bary,
+        triangles.xy, triangles.zq, triangles.weights, triangles.code, size, first, pixel, *columns
     )  # fmt: skip
-    return fragments
+    starts = np.zeros(height * width + 1, dtype=np.int64)
+    np.cumsum(np.bincount(pixel, minlength=height * width), out=starts[1:])
+    order = np.empty(total, dtype=np.int64)
+    abuffer.group_by_pixel(pixel, starts[:-1].copy(), order)
+    del pixel
+    triangle, mask, depth, code, bary = (np.take(column, order, axis=0) for column in columns)
+    return Fragments(starts, triangle, mask, depth.reshape(-1, 1), code.reshape(-1, 1), bary.reshape(-1, 1, 2))
 
 
 def resolve_fragments(

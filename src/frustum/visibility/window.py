@@ -44,6 +44,11 @@ class WindowTriangles:
     height: int
 
     @property
+    def code_type(self) -> type:
+        """dtype of a face-code buffer for these triangles (the depth buffer's: int32 while codes fit)."""
+        return np.int32 if int(self.code.max(initial=0)) < 2**31 - 1 else np.int64
+
+    @property
     def count(self) -> int:
         """Number of triangles T."""
         return int(self.code.shape[0])
