@@ -147,6 +147,7 @@ def resolve(
     height = color.shape[0]
     order = np.empty(64, dtype=np.int64)
     keys = np.empty(64)
+    planes = np.empty((64, 3))
     for p in range(start, stop):
         row, i = p // width, p % width
         j = height - 1 - row
@@ -159,24 +160,32 @@ def resolve(
         if last - first > order.shape[0]:
             order = np.empty(2 * (last - first), dtype=np.int64)
             keys = np.empty(2 * (last - first))
+            planes = np.empty((2 * (last - first), 3))
         limit = under_depth[row, i]
+        # each fragment's plane over the subsample grid: z(a, b) = z00 + a·step_x + b·step_y (depth is affine)
+        for f in range(first, last):
+            t = triangle[f]
+            dx0, dy0, dx1, dy1, dx2, dy2, _bias0, _bias1, _bias2, area = edge_setup(xy, t)
+            for corner in range(3):
+                px = float(SUBPIXEL * i + _FIRST + (_STEP if corner == 1 else 0))
+                py = float(SUBPIXEL * j + _FIRST + (_STEP if corner == 2 else 0))
+                f0 = dx0 * (py - xy[t, 3]) - dy0 * (px - xy[t, 2])
+                f1 = dx1 * (py - xy[t, 5]) - dy1 * (px - xy[t, 4])
+                f2 = dx2 * (py - xy[t, 1]) - dy2 * (px - xy[t, 0])
+                planes[f - first, corner] = ((f0 * zq[t, 0, 0] + f1 * zq[t, 1, 0]) + f2 * zq[t, 2, 0]) / area
+            planes[f - first, 1] -= planes[f - first, 0]
+            planes[f - first, 2] -= planes[f - first, 0]
         total_r, total_g, total_b, total_a = 0.0, 0.0, 0.0, 0.0
         pairs = 0
         for b in range(4):
-            py = float(SUBPIXEL * j + _FIRST + _STEP * b)
             for a in range(4):
-                px = float(SUBPIXEL * i + _FIRST + _STEP * a)
                 bit = 1 << (4 * b + a)
                 n = 0
                 for f in range(first, last):
                     if masks[f] & bit == 0:
                         continue
-                    t = triangle[f]
-                    dx0, dy0, dx1, dy1, dx2, dy2, bias0, bias1, bias2, area = edge_setup(xy, t)
-                    f0 = dx0 * (py - xy[t, 3]) - dy0 * (px - xy[t, 2])
-                    f1 = dx1 * (py - xy[t, 5]) - dy1 * (px - xy[t, 4])
-                    f2 = dx2 * (py - xy[t, 1]) - dy2 * (px - xy[t, 0])
-                    z = ((f0 * zq[t, 0, 0] + f1 * zq[t, 1, 0]) + f2 * zq[t, 2, 0]) / area
+                    k = f - first
+                    z = planes[k, 0] + a * planes[k, 1] + b * planes[k, 2]
                     if not z < limit:
                         continue
                     m = n - 1  # insertion by depth; equal depths keep the drawing order
