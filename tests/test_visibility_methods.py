@@ -393,3 +393,19 @@ def test_scene_file_render_method_and_transparency(tmp_path) -> None:
     path.write_text(SCENE_FILE.replace("size = [48, 32]", 'size = [48, 32]\nmethod = "ray-casting"'))
     with pytest.raises(SceneFileError, match=r"ball.toml:8: render.method = 'ray-casting' .*'scan-line'"):
         load_scene_file(path)
+
+
+def test_polylines_are_drawn_as_lines_against_each_methods_depth() -> None:
+    """Items a surface method cannot fill (curves as Polyline) are converted: drawn as lines, depth-tested against
+    whatever depth the chosen method found, as the depth buffer draws them."""
+    from frustum.geometry import Polyline
+
+    camera = flat_camera()
+    scene = flat_scene(quad(2.0, 2.0, 12.0, 12.0, 0.0))
+    scene.add(Polyline([[1.0, 7.0, 1.0], [15.0, 7.0, -1.0]]), material=Material(color=(1.0, 1.0, 0.0)))
+    reference = render(scene, camera)
+    for method in ("scan-line", "area-subdivision", "bsp", "a-buffer"):
+        frame = render(scene, camera, method=method)
+        yellow = (frame.color[..., 0] == 255) & (frame.color[..., 1] == 255) & (frame.color[..., 2] == 0)
+        expected = (reference.color[..., 0] == 255) & (reference.color[..., 1] == 255) & (reference.color[..., 2] == 0)
+        assert yellow.sum() > 4 and (yellow == expected).all(), method
