@@ -9,7 +9,8 @@ Two sweeps, each method timed on the same scenes (the seed's comparison of objec
 * **image**: the Stanford bunny (``../shared/data/bunny/bun_zipper.ply``, 69 451 faces) at 256² to 2048².
 
 Every method runs once on a tiny scene first (compilation, or loading Numba's cache, is not timed); then each
-point is the median of ``--repeat`` renders (one where a render takes over a second). A method whose render took
+point is the best of ``--repeat`` renders (one where a render takes over a second): on a shared machine the
+fastest run is the one least disturbed by other work. A method whose render took
 longer than ``--limit`` seconds is not run at larger sizes (shown as "-"). The table is printed; with ``--plots``
 two Matplotlib PNGs are written (time against faces, time against pixels, log-log), and the A-buffer's cost
 relative to the depth buffer and to 16× supersampling on the bunny at 1024² is printed at the end.
@@ -19,7 +20,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import statistics
 import sys
 import time
 from pathlib import Path
@@ -68,7 +68,7 @@ def timed(scene, camera, method: str, repeat: int, **options) -> tuple[float, di
         times.append(time.perf_counter() - start)
         if times[-1] > 1.0:
             break
-    return statistics.median(times), frame.stats if frame is not None else None
+    return min(times), frame.stats if frame is not None else None
 
 
 def sweep(label: str, points: list[int], build, methods: list[str], limit: float, repeat: int) -> dict:

@@ -57,7 +57,10 @@ from frustum.raster.vertices import project_vertices, transform_normals, transfo
 from frustum.scene import Scene, SceneItem
 from frustum.shading import SPECULAR_MODELS, DepthCue, pack_lights
 
-__all__ = ["HIDDEN_STYLES", "RENDER_MODES", "SHADING_MODES", "TILE_SIZE", "mesh_edges", "release_memory", "render"]
+__all__ = [
+    "HIDDEN_STYLES", "RENDER_MODES", "SHADING_MODES", "TILE_SIZE", "TRANSPARENCY_MODES", "VISIBILITY_METHODS",
+    "mesh_edges", "release_memory", "render",
+]  # fmt: skip
 
 SHADING_MODES = {
     "phong": shade.SHADE_PHONG,

@@ -102,8 +102,8 @@ def resolve_fragments(
 ) -> dict:  # fmt: skip
     """Composite every pixel's fragments over `under` (module docstring) into `color`; the nearest opaque
     fragment's depth at each pixel centre into `depth` (a triangle that covers the centre but none of the 16
-    subsamples makes no fragment, as it would not show in 16× supersampling either). premultiplied (N, 4) uint8: ``α·c`` and ``α`` per
-    fragment (what the shading kernel writes blending over transparent black).
+    subsamples makes no fragment, as it would not show in 16× supersampling either). premultiplied (N, 4) uint8:
+    ``α·c`` and ``α`` per fragment (what the shading kernel writes blending over transparent black).
 
     Returns the counts ``fragments``, ``fragments_per_pixel`` (mean over pixels with any), ``max_fragments``
     (in one pixel), ``pixels_with_fragments``, ``sample_composites`` (fragment–subsample pairs blended).
