@@ -137,7 +137,7 @@ def subdivide(
         n = 0
         best, best_far = -1, np.inf
         for m in range(parent, parent + length):
-            t = lists[m]
+            t = np.int64(lists[m])  # one compiled version of the helpers, whatever the list type
             relation = _relation(xy, box, t, i0, j0, i1, j1)
             stats[s + 4 + relation] += 1
             if relation == OUTSIDE:
@@ -154,7 +154,7 @@ def subdivide(
         if best >= 0:  # does the nearest surrounding surface hide all others?
             hides = True
             for m in range(top, top + n):
-                t = lists[m]
+                t = np.int64(lists[m])  # one compiled version of the helpers, whatever the list type
                 if t == best:
                     continue
                 stats[s + 8] += 1
@@ -169,14 +169,14 @@ def subdivide(
                 continue
         if n == 1:
             stats[s + 2] += 1
-            _draw(xy, zq, weights, code, lists[top], i0, j0, i1, j1, True, depth, codes, bary)
+            _draw(xy, zq, weights, code, np.int64(lists[top]), i0, j0, i1, j1, True, depth, codes, bary)
             continue
         if i1 - i0 == 1 and j1 - j0 == 1:
             stats[s + 3] += 1
             px, py = SUBPIXEL * i0 + HALF_SUBPIXEL, SUBPIXEL * j0 + HALF_SUBPIXEL
             chosen, chosen_z = -1, np.float32(2.0)
             for m in range(top, top + n):
-                t = lists[m]
+                t = np.int64(lists[m])  # one compiled version of the helpers, whatever the list type
                 dx0, dy0, dx1, dy1, dx2, dy2, bias0, bias1, bias2, area = edge_setup(xy, t)
                 e0 = dx0 * (py - xy[t, 3]) - dy0 * (px - xy[t, 2])
                 e1 = dx1 * (py - xy[t, 5]) - dy1 * (px - xy[t, 4])
