@@ -579,6 +579,7 @@ def test_import_frustum_loads_neither_ray_nor_a_process_pool() -> None:
 
 
 def test_dataset_over_the_memory_budget_is_refused_before_any_work(scene_path, tmp_path) -> None:
-    with frustum.budget(bytes=10_000), pytest.raises(OutputError, match=r"size = 64x48, .* over the memory budget"):
+    # 100 kB: above one 64x48 image (the scene file's own image check, 61 kB), below the dataset's estimate (344 kB)
+    with frustum.budget(bytes=100_000), pytest.raises(OutputError, match=r"size = 64x48, .* over the memory budget"):
         render_dataset(scene_path, tmp_path / "out", views=3, executor="serial", progress=False)
     assert not (tmp_path / "out").exists()

@@ -302,7 +302,8 @@ def test_negative_level_is_refused_naming_it(make):
     ("make", "level"), [(koch_curve, 40), (menger_sponge, 12), (sierpinski_triangle, 30), (hilbert_curve_3d, 20)]
 )
 def test_levels_over_the_memory_budget_fail_before_allocating(make, level):
-    with pytest.raises(GeometryError, match=r"would need \d+ bytes .*max_bytes = 1073741824.*raise max_bytes"):
+    expected = r"level = \d+ needs about .* over the memory budget of 8\.0 GiB.*FRUSTUM_MAX_BYTES"
+    with pytest.raises(GeometryError, match=expected):
         make(level)
 
 

@@ -992,6 +992,7 @@ _MINIMAL_GEOMETRY = {
     "cardinal_spline": {"points": _POLYGON, "tension": 0.5},
     "terrain": {"level": 2, "seed": 0},
     "menger_sponge": {"level": 1},
+    "octree": {"depth": 3, "source": {"type": "box"}},
     "sierpinski_tetrahedron": {"level": 1},
     "koch_snowflake": {"level": 1},
     "hilbert_curve_3d": {"level": 1},

@@ -16,10 +16,11 @@ from frustum.budgets import budget
 from frustum.geometry import Mesh
 from frustum.geometry.io import load
 from frustum.geometry.teapot import teapot
-from frustum.render import VISIBILITY_METHODS, render
+from frustum.render import RENDER_METHODS, render
 from frustum.scene import Scene
 from frustum.shading import DirectionalLight, Material
 from frustum.transforms import translate
+from frustum.visibility.abuffer import FRAGMENT_BYTES
 
 OPAQUE_METHODS = ["scan-line", "area-subdivision", "depth-sort", "bsp"]
 LIGHT = DirectionalLight(direction=(-0.4, -0.8, -0.5))
@@ -301,8 +302,13 @@ def test_a_buffer_edges_match_16x_supersampling() -> None:
 
 def test_a_buffer_fragments_are_checked_against_the_budget() -> None:
     scene, camera = soup_scene(4)
-    with budget(bytes=10_000), pytest.raises(GeometryError, match=r"A-buffer of .* fragments"):
+    camera = Camera.look_at(camera.frame.eye, (0.0, 0.0, 0.0), projection=camera.projection, width=256, height=192)
+    fragments = render(scene, camera, method="a-buffer").stats["fragments"]
+    needed = fragments * (2 * FRAGMENT_BYTES + 16) + 8 * (256 * 192 + 1)  # what build_fragments estimates
+    with budget(bytes=needed - 1), pytest.raises(GeometryError, match=rf"A-buffer of {fragments} fragments"):
         render(scene, camera, method="a-buffer")
+    with budget(bytes=needed):
+        assert render(scene, camera, method="a-buffer").stats["fragments"] == fragments
 
 
 # --- bad input ---------------------------------------------------------------------------------------------
@@ -316,11 +322,11 @@ def test_unknown_method_lists_the_valid_ones() -> None:
         render(scene, camera, method="z-buffer")
     with pytest.raises(FrustumError) as error:
         render(scene, camera, method=3)
-    assert all(repr(name) in str(error.value) for name in VISIBILITY_METHODS)
+    assert all(repr(name) in str(error.value) for name in RENDER_METHODS)
     with pytest.raises(FrustumError, match=r"method = 'ray-casting' is not available yet.*available: 'depth-buffer'"):
         render(scene, camera, method="ray-casting")
-    with pytest.raises(FrustumError, match="method = 'octree' is not available yet"):
-        render(scene, camera, method="octree")
+    with pytest.raises(FrustumError, match=r"method = 'ray-casting' is not available yet.*'a-buffer', 'octree'"):
+        render(scene, camera, method="ray-casting")
     with pytest.raises(FrustumError, match="transparency = 'depth-peeling' is unknown; expected one of 'sort'"):
         render(scene, camera, transparency="depth-peeling")
     with pytest.raises(FrustumError, match="mode = 'wireframe' draws lines"):
@@ -409,3 +415,18 @@ def test_polylines_are_drawn_as_lines_against_each_methods_depth() -> None:
         yellow = (frame.color[..., 0] == 255) & (frame.color[..., 1] == 255) & (frame.color[..., 2] == 0)
         expected = (reference.color[..., 0] == 255) & (reference.color[..., 1] == 255) & (reference.color[..., 2] == 0)
         assert yellow.sum() > 4 and (yellow == expected).all(), method
+
+
+def test_octrees_are_drawn_by_every_method_as_their_cell_faces() -> None:
+    """A placed Octree is, for the mesh methods, its cell faces (``Scene.items``): each method draws them as the
+    depth buffer does; ``method="octree"`` is the octree method itself."""
+    from frustum.geometry import Octree
+
+    solid = Octree.from_function(lambda x, y, z: x * x + y * y + z * z - 0.8**2, ((-1, -1, -1), (1, 1, 1)), 3)
+    scene = Scene(lights=[LIGHT])
+    scene.add(solid, material=Material(color=(0.8, 0.5, 0.3)))
+    camera = Camera.look_at((1.5, 2.0, 3.0), (0.0, 0.0, 0.0), width=48, height=40)
+    reference = render(scene, camera)
+    assert (reference.depth < 1.0).sum() > 100
+    for method in ("scan-line", "area-subdivision", "bsp"):
+        assert_same_picture(render(scene, camera, method=method), reference)

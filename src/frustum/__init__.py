@@ -66,6 +66,7 @@ from frustum.errors import (
     OutputError,
     SceneFileError,
     ShadingError,
+    SimulationError,
     TransformError,
 )
 from frustum.frame import (
@@ -92,6 +93,8 @@ from frustum.geometry import (
     MeshPart,
     NURBSCurve,
     NURBSSurface,
+    Octree,
+    OctreeHits,
     PiecewiseBezier,
     Polyline,
     TurtlePath,
@@ -211,6 +214,8 @@ from frustum.quaternion import (
 )
 from frustum.scene import (
     Node,
+    ParticleLayer,
+    Pick,
     Placed,
     Scene,
     SceneItem,
@@ -229,6 +234,27 @@ from frustum.shading import (
     blinn_phong,
     illuminate,
     pack_lights,
+)
+from frustum.simulation import (
+    INTEGRATORS,
+    Attractor,
+    DiskEmitter,
+    Drag,
+    Gravity,
+    LineEmitter,
+    MassSpringSystem,
+    MeshCollider,
+    MeshEmitter,
+    ParticleSystem,
+    PlaneCollider,
+    PointEmitter,
+    SphereCollider,
+    SphereEmitter,
+    Vortex,
+    Wind,
+    cloth,
+    rope,
+    soft_body,
 )
 from frustum.stereo import (
     StereoCamera,
@@ -268,6 +294,9 @@ from frustum.visibility import (
     signed_window_areas,
     viewing_position,
 )
+from frustum.visibility.octree import (
+    render_octree,
+)
 
 # The pipeline and everything above it load Numba and compile kernels on first use, so they are imported when one
 # of their names is first used (PEP 562): ``import frustum`` stays fast and never imports Numba.
@@ -280,6 +309,7 @@ _LAZY = {
     "render_many": "frustum.batch",
     "warmup": "frustum.warmup",
     "ANAGLYPH_METHODS": "frustum.output.stereo",
+    "RENDER_METHODS": "frustum.render",
     "RENDER_MODES": "frustum.render",
     "SHADING_MODES": "frustum.render",
     "STEREO_LAYOUTS": "frustum.output.stereo",
@@ -298,13 +328,17 @@ _LAZY = {
     "render_stereo": "frustum.output.stereo",
     "render_view_sheet": "frustum.scenefile",
     "side_by_side": "frustum.output.stereo",
+    "simulate": "frustum.output.simulate",
     "turntable": "frustum.output.animation",
     "write_animation": "frustum.output.animation",
+    # needs the viewer extra (anywidget); left out of __all__ so that `from frustum import *` works without it
+    "Viewer": "frustum.viewer",
 }
 
 if TYPE_CHECKING:  # pragma: no cover
     from frustum.batch import DatasetResult, RenderJob, ViewResult, render_dataset, render_many
     from frustum.output.animation import turntable, write_animation
+    from frustum.output.simulate import simulate
     from frustum.output.stereo import (
         ANAGLYPH_METHODS,
         STEREO_LAYOUTS,
@@ -314,7 +348,7 @@ if TYPE_CHECKING:  # pragma: no cover
         side_by_side,
     )
     from frustum.raster._jit import set_threads
-    from frustum.render import RENDER_MODES, SHADING_MODES, VISIBILITY_METHODS, release_memory, render
+    from frustum.render import RENDER_METHODS, RENDER_MODES, SHADING_MODES, VISIBILITY_METHODS, release_memory, render
     from frustum.scenefile import (
         SceneFile,
         explain_method,
@@ -368,6 +402,7 @@ __all__ = [
     "FILL_ORDERS",
     "HIDDEN_STYLES",
     "IFS",
+    "INTEGRATORS",
     "MAX_KERNEL_PLANES",
     "MULTIVIEWS",
     "M_B",
@@ -379,6 +414,7 @@ __all__ = [
     "REGION_NEAR",
     "REGION_RIGHT",
     "REGION_TOP",
+    "RENDER_METHODS",
     "RENDER_MODES",
     "SHADING_MODES",
     "SHEET_VIEWS",
@@ -390,6 +426,7 @@ __all__ = [
     "VIEW_VOLUME_PLANES",
     "VISIBILITY_METHODS",
     "AmbientLight",
+    "Attractor",
     "Axonometric",
     "BSPTree",
     "BSpline",
@@ -412,27 +449,41 @@ __all__ = [
     "DepthCue",
     "DepthOrder",
     "DirectionalLight",
+    "DiskEmitter",
+    "Drag",
     "Frame",
     "Frustum",
     "FrustumError",
     "GeometryError",
+    "Gravity",
     "HermiteCurve",
     "HiddenLines",
     "LSystem",
     "Light",
+    "LineEmitter",
+    "MassSpringSystem",
     "Material",
     "Mesh",
+    "MeshCollider",
+    "MeshEmitter",
     "MeshPart",
     "MultiView",
     "NURBSCurve",
     "NURBSSurface",
     "Node",
     "Oblique",
+    "Octree",
+    "OctreeHits",
     "Orthographic",
     "OutputError",
+    "ParticleLayer",
+    "ParticleSystem",
     "Perspective",
+    "Pick",
     "PiecewiseBezier",
     "Placed",
+    "PlaneCollider",
+    "PointEmitter",
     "PointLight",
     "Polyline",
     "PrincipalVanishingPoints",
@@ -446,6 +497,9 @@ __all__ = [
     "SceneItem",
     "SegmentClipping",
     "ShadingError",
+    "SimulationError",
+    "SphereCollider",
+    "SphereEmitter",
     "SpotLight",
     "Stage",
     "Step",
@@ -457,6 +511,8 @@ __all__ = [
     "TurtlePath",
     "ViewFrame",
     "ViewResult",
+    "Vortex",
+    "Wind",
     "__version__",
     "anaglyph",
     "apply",
@@ -486,6 +542,7 @@ __all__ = [
     "clip_lines",
     "clip_polygon",
     "clip_triangles",
+    "cloth",
     "compose",
     "cone",
     "continuity",
@@ -556,10 +613,12 @@ __all__ = [
     "render_dataset",
     "render_examples",
     "render_many",
+    "render_octree",
     "render_scene_file",
     "render_stereo",
     "render_svg",
     "render_view_sheet",
+    "rope",
     "rotate",
     "rotate_steps",
     "rotate_x",
@@ -577,7 +636,9 @@ __all__ = [
     "sierpinski_triangle",
     "signed_window_areas",
     "similarity_dimension",
+    "simulate",
     "slerp",
+    "soft_body",
     "sphere",
     "superellipse",
     "superellipsoid",

@@ -27,6 +27,7 @@ __all__ = [
     "as_scalar",
     "as_vector3",
     "describe",
+    "escape_control",
     "read_only",
 ]
 
@@ -40,31 +41,65 @@ Vector3: TypeAlias = NDArray[np.float64]
 ErrorType: TypeAlias = type[FrustumError]
 
 
+_CONTROL = {c: f"\\x{c:02x}" for c in (*range(0x20), 0x7F)} | {c: f"\\u{c:04x}" for c in range(0x80, 0xA0)}
+_CONTROL |= {c: f"\\u{c:04x}" for c in (0x2028, 0x2029, *range(0x202A, 0x202F), *range(0x2066, 0x206A))}
+_CONTROL |= {ord("\n"): "\\n", ord("\t"): "\\t", ord("\r"): "\\r"}
+
+
+def escape_control(text: str, *, keep_newlines: bool = False) -> str:
+    """`text` with control characters (C0, DEL, C1, line/paragraph separators, bidi overrides) written as escapes.
+
+    Every message that quotes input goes through this (``describe`` does), so a scene-file key such as
+    ``"x\\nerror: all good\\x1b[31m"`` cannot forge an ``error:`` line or color the terminal. `keep_newlines`
+    keeps ``\\n`` (for multi-line reports whose parts were escaped already).
+    """
+    table = _CONTROL if not keep_newlines else {k: v for k, v in _CONTROL.items() if k != ord("\n")}
+    return str(text).translate(table)
+
+
 def describe(value: Any, *, limit: int = 80) -> str:
-    """Short, readable text of a value for an error message: floats as Python writes them, long arrays cut."""
+    """Short, readable text of a value for an error message: floats as Python writes them, long arrays cut,
+    control characters escaped."""
     if isinstance(value, np.ndarray):
-        value = value.tolist()
-    if isinstance(value, list | tuple) and all(isinstance(v, int | float | np.number) for v in value):
+        value = (value.ravel()[:limit] if value.size > limit else value).tolist()  # a huge array is never listed
+    if isinstance(value, list | tuple) and len(value) <= limit and all(isinstance(v, int | float | np.number)
+                                                                       for v in value):  # fmt: skip
         text = "(" + ", ".join(repr(float(v)) for v in value) + ("," if len(value) == 1 else "") + ")"
     elif isinstance(value, np.number):
         text = repr(value.item())
+    elif isinstance(value, list | tuple | dict) and len(value) > limit:
+        text = f"<{type(value).__name__} of {len(value)} items>"
     else:
-        text = repr(value)
+        try:
+            text = repr(value)
+        except Exception:  # a hostile __repr__ (or a recursion-deep structure) must not hide the real error
+            text = f"<{type(value).__name__}>"
+    text = escape_control(text)
     return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
 def read_only(array: np.ndarray) -> np.ndarray:
-    """Mark `array` read-only in place and return it: frozen frustum objects hand out arrays nobody can edit."""
-    array.flags.writeable = False
-    return array
+    """A read-only view of `array`: frozen frustum objects hand out arrays nobody can edit, and the flags of the
+    array passed in (possibly the caller's own) stay as they were."""
+    view = array.view()
+    view.flags.writeable = False
+    return view
 
 
 def _as_float_array(value: ArrayLike, name: str, where: str, error: ErrorType, expected: str) -> NDArray:
+    """A C-contiguous float64 array that never is (or views) the caller's own array; complex input is refused."""
     try:
-        array = np.asarray(value, dtype=np.float64)
+        raw = np.asarray(value)
+        complex_input = raw.dtype.kind == "c"
+        array = None if complex_input else np.asarray(raw, dtype=np.float64)
     except (TypeError, ValueError):
         raise error(f"{where}: {name} = {describe(value)} is not numeric; expected {expected}") from None
-    return np.ascontiguousarray(array)
+    if array is None:
+        raise error(f"{where}: {name} = {describe(value)} is complex; expected {expected} (real numbers)")
+    array = np.ascontiguousarray(array)
+    if isinstance(value, np.ndarray) and np.may_share_memory(array, value):
+        array = array.copy()  # the checked array is ours: later read-only flags must not reach the caller's
+    return array
 
 
 def as_scalar(value: Any, name: str, *, where: str, error: ErrorType = TransformError) -> float:
@@ -172,4 +207,5 @@ def as_faces(
             f"{where}: {name}[{i}] = {faces[i].tolist()} indexes outside the {vertex_count} vertices; "
             f"indices must lie in [0, {vertex_count - 1}]"
         )
-    return np.ascontiguousarray(faces, dtype=np.int64)
+    checked = np.ascontiguousarray(faces, dtype=np.int64)
+    return checked.copy() if isinstance(value, np.ndarray) and np.may_share_memory(checked, value) else checked

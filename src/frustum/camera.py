@@ -257,6 +257,10 @@ def _as_window_points(value: ArrayLike, name: str, where: str, width: int) -> tu
     return single, np.ascontiguousarray(rows)
 
 
+MAX_IMAGE_SIZE = 65536
+"""Largest image width or height a Camera accepts (an 8192-pixel image supersampled 64 times, ×8 a side, fits)."""
+
+
 @dataclass(frozen=True, eq=False)
 class Camera:
     """A viewing frame, a projection and an image size: everything that maps world points to pixels.
@@ -270,12 +274,12 @@ class Camera:
     frame : ViewFrame
     projection : Perspective, Frustum, Orthographic, Oblique or Axonometric
     width, height : int
-        Image size in pixels, > 0.
+        Image size in pixels, in [1, MAX_IMAGE_SIZE] (65536).
 
     Raises
     ------
     CameraError
-        If the frame or projection has the wrong type, or the image size is not a positive integer.
+        If the frame or projection has the wrong type, or the image size is not an integer in [1, 65536].
 
     References
     ----------
@@ -303,6 +307,12 @@ class Camera:
                 raise CameraError(
                     f"{where}: {name} = {describe(value)} is not a positive integer; an image needs at least "
                     "one pixel in each direction"
+                )
+            if value > MAX_IMAGE_SIZE:
+                raise CameraError(
+                    f"{where}: {name} = {int(value)} is above the limit of {MAX_IMAGE_SIZE} pixels a side; give "
+                    f"width and height in [1, {MAX_IMAGE_SIZE}] (render's work budget, frustum.set_budget, bounds "
+                    "the whole image)"
                 )
             object.__setattr__(self, name, int(value))
 

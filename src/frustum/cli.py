@@ -7,13 +7,17 @@ points through every stage of the pipeline), ``info`` (a mesh file's counts, bou
 normals), ``turntable`` (a GIF or MP4 orbiting a mesh) and ``dataset`` (many views with depth,
 normals, ids and cameras). Errors print as one line, ``error: <message>``,
 without a traceback (the global ``--debug`` option shows it): exit status 1 for a bad value or an unreadable
-file, 2 for a command line that cannot be parsed (unknown option, missing argument, malformed numbers).
+file, 2 for a command line that cannot be parsed (unknown option, missing argument, malformed numbers), 130
+after Ctrl-C (honoured at once: the work runs on a worker thread; no partial output file is left). The global
+options ``--max-bytes`` and ``--max-operations`` set the work budget (``frustum.set_budget``).
 """
 
 from __future__ import annotations
 
 import math
+import os
 import sys
+import threading
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Annotated, Any
@@ -25,6 +29,7 @@ from rich.table import Table
 
 import frustum.raster
 from frustum import __version__
+from frustum._arrays import escape_control
 from frustum.camera import Camera
 from frustum.errors import FrustumError, GeometryError
 from frustum.geometry import Mesh
@@ -139,9 +144,27 @@ def _main(
         bool, typer.Option("--version", callback=_version, is_eager=True, help="Print the version and exit.")
     ] = False,
     debug: Annotated[bool, typer.Option("--debug", help="Show the full traceback of an error.")] = False,
+    max_bytes: Annotated[
+        str | None,
+        typer.Option("--max-bytes", help="Memory budget of one request, e.g. 16G or 2e9 (default 8G; "
+                     "env FRUSTUM_MAX_BYTES).", metavar="BYTES"),
+    ] = None,
+    max_operations: Annotated[
+        str | None,
+        typer.Option("--max-operations", help="Work budget of one request in inner iterations, e.g. 1e11 "
+                     "(default 5e10; env FRUSTUM_MAX_OPERATIONS).", metavar="COUNT"),
+    ] = None,
 ) -> None:
     """The classical 3D graphics pipeline, inspectable at every stage."""
     _STATE["debug"] = debug
+    if max_bytes is not None or max_operations is not None:
+        from frustum.budgets import set_budget
+
+        try:
+            set_budget(bytes=max_bytes, operations=max_operations)
+        except FrustumError as error:
+            raise UsageError(str(error).replace("set_budget: bytes", "--max-bytes").replace(
+                "set_budget: operations", "--max-operations")) from None
 
 
 _STEP_HELP = "; ".join([syntax for _, _, syntax in _STEPS.values()] + ["shear=x|y|z,a,b[,ref]"])
@@ -188,6 +211,10 @@ def _vector3(text: str, option: str) -> list[float]:
     return values
 
 
+MAX_SIZE = 8192
+"""Largest --size width or height (the scene files' ``[render] size`` limit)."""
+
+
 def _image_size(text: str) -> tuple[int, int]:
     """``WxH`` (e.g. 640x480) as two positive integers, or a UsageError."""
     width, sep, height = text.lower().partition("x")
@@ -197,6 +224,11 @@ def _image_size(text: str) -> tuple[int, int]:
         size = None
     if size is None or min(size) <= 0:
         raise UsageError(f"--size = {text!r} is not WIDTHxHEIGHT; write two positive integers, e.g. 640x480")
+    if max(size) > MAX_SIZE:
+        raise UsageError(
+            f"--size = {text!r} is over the limit of {MAX_SIZE} pixels a side; give width and height in "
+            f"[1, {MAX_SIZE}]"
+        )
     return size
 
 
@@ -502,6 +534,27 @@ def dataset_command(
         raise typer.Exit(3)
 
 
+@app.command("serve")
+def serve_command(
+    scene: Annotated[Path, typer.Argument(help="A TOML scene file (reloaded whenever it is saved).")],
+    host: Annotated[
+        str, typer.Option(help="Interface to listen on; 127.0.0.1 is this machine only, 0.0.0.0 every interface.")
+    ] = "127.0.0.1",
+    port: Annotated[int, typer.Option(help="TCP port; 0 picks a free one.")] = 8000,
+) -> None:
+    """Open an interactive viewer of a scene file in the browser (orbit, pan, zoom, the pipeline beside it)."""
+    from frustum.viewer.server import serve
+
+    def ready(url: str) -> None:
+        console.print(f"frustum serve: {scene} at {url}", markup=False, highlight=False, soft_wrap=True)
+        if host in ("127.0.0.1", "localhost", "::1"):
+            console.print("listening on this machine only; --host 0.0.0.0 serves other machines too; Ctrl-C stops",
+                          markup=False, highlight=False, soft_wrap=True)  # fmt: skip
+        console.file.flush()
+
+    serve(scene, host, port, ready=ready)
+
+
 # --- entry point ------------------------------------------------------------------------------------------------
 
 
@@ -515,8 +568,46 @@ _CLICK_EXCEPTION = _click_exception("ClickException")
 
 
 def _fail(message: str, status: int) -> None:
-    error_console.print(f"error: {message}", markup=False)
+    error_console.print(f"error: {escape_control(message, keep_newlines=True)}", markup=False)
     raise SystemExit(status)
+
+
+INTERRUPTED_STATUS = 130
+"""Exit status after Ctrl-C (128 + SIGINT), as shells report it."""
+
+
+def _run_interruptible(work: Callable[[], Any]) -> Any:
+    """Run `work` on a worker thread while the main thread waits in short timeouts, so Ctrl-C is honoured at once.
+
+    Python delivers SIGINT to the main thread only; a Numba kernel (nogil) or an import that catches
+    ``BaseException`` (trimesh's optional imports) on the worker cannot swallow or delay it. On Ctrl-C the
+    output files still being written (temporaries, ``frustum._files``) are removed, one line is printed and
+    the process exits with status 130 at once, abandoning the worker.
+    """
+    outcome: dict[str, Any] = {}
+
+    def target() -> None:
+        try:
+            outcome["value"] = work()
+        except BaseException as error:  # handed to the main thread, which re-raises it
+            outcome["error"] = error
+
+    worker = threading.Thread(target=target, name="frustum-work", daemon=True)
+    try:
+        worker.start()
+        while worker.is_alive():
+            worker.join(0.1)
+    except KeyboardInterrupt:
+        from frustum._files import remove_partial_files
+
+        remove_partial_files()
+        error_console.print("error: interrupted (Ctrl-C); no output file was written or changed", markup=False)
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(INTERRUPTED_STATUS)
+    if "error" in outcome:
+        raise outcome["error"]
+    return outcome.get("value")
 
 
 def _compile_notice() -> None:
@@ -526,12 +617,16 @@ def _compile_notice() -> None:
 
 
 def main(arguments: Sequence[str] | None = None) -> None:
-    """Entry point of the ``frustum`` console script: one-line errors, exit 1 (2 for usage), tracebacks on --debug."""
+    """Entry point of the ``frustum`` console script: one-line errors, exit 1 (2 for usage), tracebacks on --debug.
+
+    The command runs on a worker thread (``_run_interruptible``): Ctrl-C exits with status 130 within a fraction
+    of a second, leaving no partial output file.
+    """
     argv = list(sys.argv[1:] if arguments is None else arguments)
     _STATE["debug"] = "--debug" in argv
     frustum.raster.compile_notice = _compile_notice
     try:
-        status = app(args=argv, prog_name="frustum", standalone_mode=False)
+        status = _run_interruptible(lambda: app(args=argv, prog_name="frustum", standalone_mode=False))
     except _CLICK_USAGE_ERROR as error:
         message = " ".join(error.format_message().split())
         if not message:  # no command given: the help was printed instead
@@ -539,6 +634,10 @@ def main(arguments: Sequence[str] | None = None) -> None:
         _fail(message, 2)
     except typer.Abort:
         _fail("aborted", 1)
+    except RecursionError:
+        if _STATE["debug"]:
+            raise
+        _fail("the input is nested too deeply to process", 1)
     except _CLICK_EXCEPTION as error:
         _fail(" ".join(error.format_message().split()), error.exit_code)
     except UsageError as error:

@@ -15,6 +15,7 @@ __all__ = [
     "OutputError",
     "SceneFileError",
     "ShadingError",
+    "SimulationError",
     "TransformError",
 ]
 
@@ -49,3 +50,7 @@ class SceneFileError(FrustumError):
 
 class OutputError(FrustumError):
     """A frame, drawing or animation that cannot be written: unknown format, unwritable path."""
+
+
+class SimulationError(FrustumError):
+    """A bad particle or mass-spring system, or a simulation whose state stopped being finite (a blow-up)."""

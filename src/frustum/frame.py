@@ -85,13 +85,17 @@ class Frame:
         suffix = os.path.splitext(os.fspath(path))[1].lower()
         if suffix != ".png":
             raise OutputError(f"Frame.save: path = {os.fspath(path)!r} has suffix {suffix!r}; expected '.png'")
-        try:
-            self.to_pil().save(path, format="PNG")
-        except OSError as error:
-            raise OutputError(
-                f"Frame.save: path = {os.fspath(path)!r} cannot be written ({error.strerror or error}); "
-                "give a path in an existing, writable folder"
-            ) from None
+        from frustum._files import atomic_path, os_reason
+
+        image = self.to_pil()
+        with atomic_path(path, where="Frame.save") as temporary:  # the old file survives a failed write
+            try:
+                image.save(temporary, format="PNG")
+            except OSError as error:
+                raise OutputError(
+                    f"Frame.save: path = {os.fspath(path)!r} cannot be written ({os_reason(error)}); "
+                    "give a path in an existing, writable folder with free space"
+                ) from None
 
     def _repr_png_(self) -> bytes:
         """PNG bytes of the color buffer, for Jupyter."""

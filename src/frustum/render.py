@@ -45,6 +45,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from frustum._arrays import as_scalar, describe
+from frustum.budgets import check_memory
 from frustum.camera import Camera
 from frustum.clipping import VIEW_VOLUME_PLANES
 from frustum.errors import FrustumError
@@ -58,8 +59,8 @@ from frustum.scene import Scene, SceneItem
 from frustum.shading import SPECULAR_MODELS, DepthCue, pack_lights
 
 __all__ = [
-    "HIDDEN_STYLES", "RENDER_MODES", "SHADING_MODES", "TILE_SIZE", "TRANSPARENCY_MODES", "VISIBILITY_METHODS",
-    "mesh_edges", "release_memory", "render",
+    "HIDDEN_STYLES", "RENDER_METHODS", "RENDER_MODES", "SHADING_MODES", "TILE_SIZE", "TRANSPARENCY_MODES",
+    "VISIBILITY_METHODS", "mesh_edges", "release_memory", "render",
 ]  # fmt: skip
 
 SHADING_MODES = {
@@ -240,11 +241,13 @@ def render(
         Extra per-pixel outputs on the Frame: unit world normals (0 on background) and the index of the item
         in ``scene.items`` (−1 on background).
     method : str
-        The visible-surface method (``VISIBILITY_METHODS``, docs/visibility.md): ``"depth-buffer"`` (the
-        default), ``"scan-line"``, ``"area-subdivision"`` (Warnock), ``"depth-sort"``, ``"bsp"`` or
-        ``"a-buffer"`` (anti-aliased edges, exact transparency). All shade with the same model, so where they
-        find the same surface they give the same bytes. Surface modes only; each returns its counts in
-        ``Frame.stats``.
+        The visible-surface method (``RENDER_METHODS``, docs/visibility.md). For the meshes
+        (``VISIBILITY_METHODS``): ``"depth-buffer"`` (the default), ``"scan-line"``, ``"area-subdivision"``
+        (Warnock), ``"depth-sort"``, ``"bsp"`` or ``"a-buffer"`` (anti-aliased edges, exact transparency). All
+        shade with the same model, so where they find the same surface they give the same bytes. Surface modes
+        only; each returns its counts in ``Frame.stats``. ``"octree"``: the scene's octrees (``Scene.octrees``)
+        by ``visibility.octree.render_octree``, front to back, each face orientation shaded once with the
+        scene's lights; only `background` of the other options applies, and meshes are not drawn.
     transparency : {"sort", "a-buffer"}
         How transparent items are composited: whole items back to front by the view distance of their centres
         (fast; right for transparent objects that do not cut through or overlap each other cyclically), or
@@ -264,6 +267,9 @@ def render(
     [seed] "Back-face detection", "Depth-buffer method", "wire-frame displays".
     """
     where = "render"
+    _check_method(method, where)
+    if RENDER_METHODS[method] is not None:
+        return RENDER_METHODS[method](scene, camera, background=background)
     options = _check_arguments(
         scene, camera, shading, specular, background, cull_back_faces, mode, edges, crease_angle, edge_color,
         hidden, hidden_color, line_width, depth_cue, buffers, where,
@@ -272,6 +278,7 @@ def render(
     options = _method_options(options, method, transparency, stats, where)
     _choice(filter, FILTERS, "filter", where)
     _choice(color_space, COLOR_SPACES, "color_space", where)
+    _check_image_budget(camera, factor, options.buffers, filter, color_space, where)
     if factor == 1:
         color, depth, normals, ids = _render_buffers(scene, camera, options)
         linear = None
@@ -300,6 +307,36 @@ def render(
     return Frame(color=color, depth=depth, normals=normals, object_id=ids, stats=options.counts)
 
 
+def _render_octrees(scene: Scene, camera: Camera, *, background: Any) -> Frame:
+    """``method="octree"``: every placed octree by the octree method, nearest surface kept between octrees."""
+    from frustum.visibility.octree import draw_octree_into, octree_face_colors
+
+    if not isinstance(scene, Scene) or not isinstance(camera, Camera):
+        _check_arguments(scene, camera, "phong", "blinn-phong", background, True, "surface", None, 0.0, None, None,
+                         (0.6, 0.6, 0.6), 1.0, None, (), "render")  # fmt: skip
+    rgba = _background_bytes(background, "render")
+    color = np.empty((camera.height, camera.width, 4), dtype=np.uint8)
+    color[:, :] = rgba
+    depth = np.ones((camera.height, camera.width), dtype=np.float32)
+    lights = scene.world_lights()
+    for item in scene.octrees:
+        item_color, item_depth = color.copy(), np.ones_like(depth)
+        written = np.zeros(depth.shape, dtype=bool)
+        faces = octree_face_colors(item.mesh, item.material, lights, item.world_from_model, camera.frame.eye)
+        draw_octree_into(item.mesh, camera, item.world_from_model, faces, item_color, item_depth, written)
+        nearer = written & (item_depth < depth)
+        color[nearer], depth[nearer] = item_color[nearer], item_depth[nearer]
+    return Frame(color=color, depth=depth)
+
+
+RENDER_METHODS = {
+    "depth-buffer": None, "scan-line": None, "area-subdivision": None, "depth-sort": None, "bsp": None,
+    "a-buffer": None, "octree": _render_octrees,
+}  # fmt: skip
+"""Visible-surface methods of ``render(..., method=...)``: None for the methods of the mesh pipeline
+(``VISIBILITY_METHODS``), else the function that draws the frame."""
+
+
 def _render_buffers(
     scene: Scene, camera: Camera, options: _Options
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None]:
@@ -314,6 +351,7 @@ def _render_buffers(
         color[:, :] = options.background
         _draw_edges(items, camera, options, depth, color)
         _draw_polylines(scene.polylines, camera, options, depth, color)
+        _draw_particles(scene, camera, depth, color)
         return color, depth, normal_out, id_out
     scratch = Scratch()
     if options.method == "depth-buffer" and options.transparency == "sort":
@@ -328,7 +366,16 @@ def _render_buffers(
     if options.mode in ("hidden-line", "surface+edges"):
         _draw_edges(items, camera, options, depth, color)
     _draw_polylines(scene.polylines, camera, options, depth, color)
+    _draw_particles(scene, camera, depth, color)
     return color, depth, normal_out, id_out
+
+
+def _draw_particles(scene: Scene, camera: Camera, depth: np.ndarray, color: np.ndarray) -> None:
+    """Particle layers over the finished surfaces: depth-tested, depth not written (``frustum.particle_pass``)."""
+    if getattr(scene, "particle_layers", None):
+        from frustum.particle_pass import draw_particles
+
+        draw_particles(scene.particle_layers, camera, depth, color)
 
 
 def _draw_surfaces(
@@ -354,12 +401,12 @@ def _draw_surfaces(
     offsets = np.cumsum([0] + [item.mesh.face_count for item in items])
     drawn = []
     for index in opaque:
-        world, normals = _draw_item(items[index], camera, options.cull, int(offsets[index]), depth, codes, bary,
-                                    scratch)  # fmt: skip
-        drawn.append((index, world, normals))
-    for index, world, normals in drawn:
+        world, normals, rows = _draw_item(items[index], camera, options.cull, int(offsets[index]), depth, codes,
+                                          bary, scratch)  # fmt: skip
+        drawn.append((index, world, normals, rows))
+    for index, world, normals, rows in drawn:
         _shade_item(items[index], index, int(offsets[index]), camera, options, ambient, lights, world, normals,
-                    depth, codes, bary, color, extra, blend=False)  # fmt: skip
+                    depth, codes, bary, color, extra, rows, blend=False)  # fmt: skip
     if clear_items:
         axis = np.asarray(camera.frame.n, dtype=np.float64)
         eye = np.asarray(camera.frame.eye, dtype=np.float64)
@@ -376,11 +423,11 @@ def _draw_surfaces(
             item = items[index]
             layer_depth = depth.copy()
             layer_codes = np.full((height, width), -1, dtype=code_type)
-            world, normals = _draw_item(
+            world, normals, rows = _draw_item(
                 item, camera, options.cull, int(offsets[index]), layer_depth, layer_codes, bary, scratch
             )
             _shade_item(item, index, int(offsets[index]), camera, options, ambient, lights, world, normals,
-                        layer_depth, layer_codes, bary, color, extra, blend=True)  # fmt: skip
+                        layer_depth, layer_codes, bary, color, extra, rows, blend=True)  # fmt: skip
     return depth, color
 
 
@@ -412,10 +459,16 @@ def _item_flags(
 def _shade_item(
     item: SceneItem, index: int, face_offset: int, camera: Camera, options: _Options, ambient: np.ndarray,
     lights: np.ndarray, world: np.ndarray, normals: np.ndarray, depth: np.ndarray, codes: np.ndarray,
-    bary: np.ndarray, color: np.ndarray, extra: tuple[np.ndarray, np.ndarray], blend: bool,
+    bary: np.ndarray, color: np.ndarray, extra: tuple[np.ndarray, np.ndarray], rows: tuple[int, int], blend: bool,
 ) -> None:  # fmt: skip
-    """Stage 5 for one item: shade its pixels (the background is painted when the buffers are cleared)."""
+    """Stage 5 for one item: shade its pixels (the background is painted when the buffers are cleared), scanning
+    only the image rows [rows[0], rows[1]) its tiles cover (a scene of many small meshes shades each in its band)."""
     mesh, material = item.mesh, item.material
+    write_normals = extra[0].shape[:2] == codes.shape
+    write_ids = extra[1].shape == codes.shape
+    band = slice(*rows)
+    depth, codes, bary, color = depth[band], codes[band], bary[band], color[band]
+    extra = (extra[0][band] if write_normals else extra[0], extra[1][band] if write_ids else extra[1])
     params = _shading_parameters(item, camera, options, ambient)
     mode = options.shade_mode
     faces = _world_faces(item) if mesh.face_count else np.empty((0, 3), dtype=np.int64)
@@ -439,8 +492,7 @@ def _shade_item(
         texture, uvs = np.empty((0, 0, 4), dtype=np.float32), np.empty((0, 2))
     else:
         uvs = np.ascontiguousarray(uvs, dtype=np.float64)
-    write_normals = extra[0].shape[:2] == codes.shape
-    flags = _item_flags(index, face_offset, options, blend, write_normals, extra[1].shape == codes.shape)
+    flags = _item_flags(index, face_offset, options, blend, write_normals, write_ids)
     shade.shade_pixels(depth, codes, bary, faces, world, normals, lit, vertex_colors, uvs, texture, params, lights,
                        flags, color, extra[0], extra[1])  # fmt: skip
 
@@ -449,7 +501,8 @@ def _world_faces(item: SceneItem) -> np.ndarray:
     """The item's faces, counter-clockwise seen from the front *after* its modeling transform: a transform that
     swaps handedness (det < 0, e.g. a reflection) turns the winding around, so corners 1 and 2 are swapped."""
     faces = item.mesh.faces
-    if np.linalg.det(np.asarray(item.world_from_model)[:3, :3]) < 0.0:
+    (a, b, c), (d, e, f), (g, h, i) = np.asarray(item.world_from_model)[:3, :3].tolist()
+    if a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g) < 0.0:  # det < 0
         return np.ascontiguousarray(faces[:, [0, 2, 1]])
     return faces
 
@@ -490,19 +543,24 @@ def _page_aligned(shape: tuple[int, ...], dtype: Any) -> np.ndarray:
 def _draw_item(
     item: SceneItem, camera: Camera, cull: bool, face_offset: int,
     depth: np.ndarray, codes: np.ndarray, bary: np.ndarray, scratch: Scratch,
-) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
-    """Stages 1–4 for one placed mesh into the buffers; returns its world positions and unit world normals."""
+) -> tuple[np.ndarray, np.ndarray, tuple[int, int]]:  # fmt: skip
+    """Stages 1–4 for one placed mesh into the buffers; returns its world positions, unit world normals and the
+    image rows [first, last) of the tiles it touches."""
     mesh = item.mesh
     if mesh.face_count == 0:
-        return np.empty((0, 3)), np.empty((0, 3))
+        return np.empty((0, 3)), np.empty((0, 3)), (0, 0)
     binned = bin_item(item, camera, cull, face_offset, scratch)
+    used = np.flatnonzero(np.diff(binned.tile_starts)) // binned.tiles_x  # tile rows, window y up
+    height = depth.shape[0]
+    rows = (0, 0) if used.size == 0 else (max(height - (int(used[-1]) + 1) * TILE_SIZE, 0),
+                                          min(height - int(used[0]) * TILE_SIZE, height))  # fmt: skip
     tiling = np.array([TILE_SIZE, binned.tiles_x, face_offset], dtype=np.int64)
     triangles.rasterize_tiles(
         binned.faces, binned.win_int, binned.win_float, binned.tri_int, binned.tri_float, binned.tri_weights,
         binned.tile_starts, binned.tile_entries, tiling, depth, codes, bary,
     )  # fmt: skip
     scratch.recycle(binned.win_int, binned.win_float, binned.vertex_codes, binned.tile_entries)
-    return _world_attributes(item, scratch)
+    return (*_world_attributes(item, scratch), rows)
 
 
 def _world_attributes(item: SceneItem, scratch: Scratch) -> tuple[np.ndarray, np.ndarray]:
@@ -804,6 +862,26 @@ def _color_bytes(value: Any, name: str, where: str) -> np.ndarray:
     return np.floor(array * 255.0 + 0.5)
 
 
+def _check_image_budget(camera: Camera, factor: int, buffers: tuple[str, ...], filter: str, color_space: str,
+                       where: str) -> None:  # fmt: skip
+    """Refuse, before any buffer is allocated, an image whose buffers exceed the memory budget (``frustum.budgets``).
+
+    Per rendered pixel (``width·height·samples`` of them): color 4 + depth 4 bytes, about 4 bytes of the
+    renderer's work arrays (measured with tracemalloc: 12 bytes a pixel at 1024², surface mode), 12 for a
+    ``normals`` buffer and 4 for ``object_id``; a float64 copy for the tent filter or sRGB (2 × 32 bytes).
+    """
+    pixels = camera.width * camera.height * factor * factor
+    per_pixel = 12 + 12 * ("normals" in buffers) + 4 * ("object_id" in buffers)
+    if filter != "box" or color_space != "linear":
+        per_pixel += 64
+    cause = f"a {camera.width} x {camera.height} image x samples = {factor * factor}"
+    check_memory(pixels * per_pixel, where=where, cause=cause, error=FrustumError)
+
+
+_MAX_LINE_WIDTH = 256.0
+"""Widest line (and largest point) ``render`` draws, in output pixels."""
+
+
 def _check_arguments(
     scene: Any, camera: Any, shading: Any, specular: Any, background: Any, cull_back_faces: Any, mode: Any,
     edges: Any, crease_angle: Any, edge_color: Any, hidden: Any, hidden_color: Any, line_width: Any,
@@ -836,6 +914,11 @@ def _check_arguments(
     width = as_scalar(line_width, "line_width", where=where, error=FrustumError)
     if width < 1.0:
         raise FrustumError(f"{where}: line_width = {width!r} is below 1; give a width in pixels >= 1")
+    if width > _MAX_LINE_WIDTH:
+        raise FrustumError(
+            f"{where}: line_width = {width!r} is above {_MAX_LINE_WIDTH:g}; give a width in pixels in [1, "
+            f"{_MAX_LINE_WIDTH:g}]"
+        )
     if depth_cue is not None and not isinstance(depth_cue, DepthCue):
         raise FrustumError(
             f"{where}: depth_cue = {describe(depth_cue)} is not a DepthCue; build one with DepthCue(near, far)"
@@ -901,22 +984,26 @@ VISIBILITY_METHODS = {
 """``render(..., method=...)``: name → the visibility function that fills depth, codes and barycentrics (the
 depth buffer is the renderer's own path; the A-buffer resolves fragments instead)."""
 PLANNED_METHODS = {
-    "octree": "octree solids (the octree method of frustum.visibility.octree)",
     "ray-casting": "a ray per pixel through the scene's spatial index (the BVH of Scene.pick)",
 }
 """Methods of the visible-surface chapter that this version does not draw yet."""
 TRANSPARENCY_MODES = ("sort", "a-buffer")
 
 
-def _method_options(options: _Options, method: Any, transparency: Any, stats: Any, where: str) -> _Options:
-    """Check `method`, `transparency` and `stats`; the options with them (and a counts dict where counted)."""
-    valid = ", ".join(repr(name) for name in VISIBILITY_METHODS)
+def _check_method(method: Any, where: str) -> None:
+    """A FrustumError listing the available methods for an unknown or not yet available `method`."""
+    valid = ", ".join(repr(name) for name in RENDER_METHODS)
     if isinstance(method, str) and method in PLANNED_METHODS:
         raise FrustumError(
             f"{where}: method = {method!r} is not available yet ({PLANNED_METHODS[method]}); available: {valid}"
         )
-    if not isinstance(method, str) or method not in VISIBILITY_METHODS:
+    if not isinstance(method, str) or method not in RENDER_METHODS:
         raise FrustumError(f"{where}: method = {describe(method)} is unknown; expected one of {valid}")
+
+
+def _method_options(options: _Options, method: Any, transparency: Any, stats: Any, where: str) -> _Options:
+    """Check `transparency` and `stats`; the options with the method (a mesh pipeline one, ``_check_method``
+    first), the transparency and a counts dict where counted."""
     _choice(transparency, TRANSPARENCY_MODES, "transparency", where)
     if not isinstance(stats, bool | np.bool_):
         raise FrustumError(f"{where}: stats = {describe(stats)} is not a bool; give True or False")
@@ -1006,7 +1093,7 @@ def _draw_surfaces_by_method(
         for index in opaque:
             world, normals = _world_attributes(items[index], scratch)
             _shade_item(items[index], index, offsets[index], camera, options, ambient, lights, world, normals,
-                        depth, codes, bary, color, extra, blend=False)  # fmt: skip
+                        depth, codes, bary, color, extra, (0, height), blend=False)  # fmt: skip
     if not clear_items:
         return depth, color
     if options.transparency == "a-buffer":
@@ -1030,9 +1117,11 @@ def _draw_surfaces_by_method(
         item = items[index]
         layer_depth = depth.copy()
         layer_codes = np.full((height, width), -1, dtype=code_type)
-        world, normals = _draw_item(item, camera, options.cull, offsets[index], layer_depth, layer_codes, bary, scratch)
+        world, normals, rows = _draw_item(
+            item, camera, options.cull, offsets[index], layer_depth, layer_codes, bary, scratch
+        )
         _shade_item(item, index, offsets[index], camera, options, ambient, lights, world, normals, layer_depth,
-                    layer_codes, bary, color, extra, blend=True)  # fmt: skip
+                    layer_codes, bary, color, extra, rows, blend=True)  # fmt: skip
     return depth, color
 
 
@@ -1065,7 +1154,7 @@ def _composite(
         world, normals = _world_attributes(items[index], scratch)
         _shade_item(items[index], index, offsets[index], camera, options, ambient, lights, world, normals,
                     depth_image.reshape(rows, columns), code_image.reshape(rows, columns),
-                    bary_image.reshape(rows, columns, 2), color_image, dummy,
+                    bary_image.reshape(rows, columns, 2), color_image, dummy, (0, rows),
                     blend=items[index].material.opacity < 1.0)  # fmt: skip
         premultiplied[chosen] = color_image.reshape(-1, 4)[: chosen.shape[0]]
     if under_depth is None:

@@ -12,15 +12,32 @@ from collections.abc import Iterable, Iterator
 from typing import Any, NamedTuple
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from frustum._arrays import Matrix4, as_matrix, as_scalar, as_vector3, describe
 from frustum.errors import FrustumError, GeometryError
-from frustum.geometry import Mesh, Polyline
+from frustum.geometry import Mesh, Octree, Polyline
 from frustum.shading import LIGHT_TYPES, Light, Material
+from frustum.simulation import MassSpringSystem, ParticleSystem
 from frustum.transforms import translate
 
-__all__ = ["Node", "Placed", "Scene", "SceneItem", "cutaway", "exploded"]
+__all__ = [
+    "PARTICLE_BLENDING",
+    "PARTICLE_STYLES",
+    "Node",
+    "ParticleLayer",
+    "Pick",
+    "Placed",
+    "Scene",
+    "SceneItem",
+    "cutaway",
+    "exploded",
+]
+
+PARTICLE_STYLES = ("sprites", "points", "streaks")
+"""How ``Scene.add_particles`` draws particles: soft round sprites, hard squares, or motion streaks."""
+PARTICLE_BLENDING = ("additive", "alpha")
+"""How particles combine with what is under them: ``C + α·c`` (fire, sparks) or ``α·c + (1 − α)·C`` (smoke)."""
 
 _IDENTITY = np.eye(4)
 _IDENTITY.flags.writeable = False
@@ -32,6 +49,24 @@ class SceneItem(NamedTuple):
     mesh: Mesh
     material: Material
     world_from_model: Matrix4
+
+
+class Pick(NamedTuple):
+    """What ``Scene.pick`` finds: the placed item, the face index in its mesh, the world point and the distance
+    from the ray's origin on the near plane."""
+
+    item: SceneItem
+    face: int
+    point: NDArray[np.float64]
+    distance: float
+
+
+class ParticleLayer(NamedTuple):
+    """A particle system drawn over the surfaces (``Scene.add_particles``); particles are in world coordinates."""
+
+    system: ParticleSystem
+    style: str
+    blending: str
 
 
 class Placed(NamedTuple):
@@ -62,6 +97,14 @@ def _modeling_transform(transform: ArrayLike | None, where: str) -> Matrix4:
             f"{where}: transform bottom row = {describe(matrix[3])} makes it projective; a modeling transform "
             "is affine (bottom row 0, 0, 0, 1)"
         )
+    block = matrix[:3, :3]
+    scale = float(np.abs(block).max())
+    if scale == 0.0 or abs(float(np.linalg.det(block))) <= 1e-12 * scale**3:
+        raise FrustumError(
+            f"{where}: transform upper 3x3 = {describe(block)} is singular (determinant 0): it flattens the model "
+            "onto a plane, a line or a point, where normals are undefined; give an invertible transform "
+            "(no scale factor of 0)"
+        )
     matrix.flags.writeable = False
     return matrix
 
@@ -86,7 +129,7 @@ class Node:
         where = f"Node({name!r})"
         if not isinstance(name, str) or "/" in name:
             raise FrustumError(f"{where}: name = {describe(name)} is not a string without '/'; '/' separates paths")
-        if geometry is not None and not isinstance(geometry, Mesh | Polyline):
+        if geometry is not None and not isinstance(geometry, Mesh | Polyline | Octree):
             raise FrustumError(
                 f"{where}: geometry = {describe(geometry)} is not a Mesh or Polyline; build one with Mesh(vertices, "
                 "faces) or a primitive, tessellate a surface, or draw a curve as Polyline(points)"
@@ -148,6 +191,8 @@ class Node:
     def __repr__(self) -> str:
         if isinstance(self.geometry, Mesh):
             kind = f"{self.geometry.face_count} faces"
+        elif isinstance(self.geometry, Octree):
+            kind = f"octree of depth {self.geometry.depth}"
         else:
             kind = "group" if self.geometry is None else f"polyline of {self.geometry.vertex_count} points"
         return f"Node({self.name!r}, {kind}, {len(self.children)} children)"
@@ -162,6 +207,8 @@ class Scene:
 
     def __init__(self, lights: Iterable[Light] = ()) -> None:
         self.root = Node("")
+        self.particle_layers: list[ParticleLayer] = []
+        self.mass_springs: list[tuple[Node, MassSpringSystem]] = []
         for light in lights:
             self.add_light(light)
 
@@ -177,7 +224,7 @@ class Scene:
 
     def add(
         self,
-        geometry: Mesh | Polyline | Node,
+        geometry: Mesh | Polyline | Octree | Node,
         material: Material | None = None,
         transform: ArrayLike | None = None,
         *,
@@ -196,12 +243,40 @@ class Scene:
             if material is not None or transform is not None:
                 raise FrustumError(f"{where}: give material and transform on the Node itself, not with a Node")
             return host.add(geometry)
-        if not isinstance(geometry, Mesh | Polyline):
+        if not isinstance(geometry, Mesh | Polyline | Octree):
             raise FrustumError(
                 f"{where}: geometry = {describe(geometry)} is not a Mesh, Polyline or Node; build one with "
                 "Mesh(vertices, faces)"
             )
         return host.add(Node(name, transform, geometry, material))
+
+    def add_particles(self, system: ParticleSystem, *, style: str = "sprites",
+                      blending: str = "additive") -> ParticleLayer:  # fmt: skip
+        """Draw `system` (a ``ParticleSystem``, world coordinates) as `style` with `blending`; returns its layer.
+
+        Particles are drawn after the opaque surfaces, depth-tested against them without writing depth
+        (``frustum.particle_pass``); ``frustum.simulate`` steps the system between frames.
+        """
+        where = "Scene.add_particles"
+        if not isinstance(system, ParticleSystem):
+            raise FrustumError(f"{where}: system = {describe(system)} is not a ParticleSystem")
+        for name, value, valid in (("style", style, PARTICLE_STYLES), ("blending", blending, PARTICLE_BLENDING)):
+            if not isinstance(value, str) or value not in valid:
+                raise FrustumError(f"{where}: {name} = {describe(value)} is unknown; expected one of "
+                                   + ", ".join(repr(v) for v in valid))  # fmt: skip
+        layer = ParticleLayer(system, style, blending)
+        self.particle_layers.append(layer)
+        return layer
+
+    def add_mass_spring(self, system: MassSpringSystem, material: Material | None = None, *, name: str = "",
+                        parent: Node | str | None = None) -> Node:  # fmt: skip
+        """Place `system`'s current ``mesh`` (cloth, soft body) as a node; ``frustum.simulate`` replaces the
+        node's geometry by the new mesh after every frame's steps. Returns the node."""
+        if not isinstance(system, MassSpringSystem):
+            raise FrustumError(f"Scene.add_mass_spring: system = {describe(system)} is not a MassSpringSystem")
+        node = self.add(system.mesh, material, name=name, parent=parent)
+        self.mass_springs.append((node, system))
+        return node
 
     def walk(self) -> Iterator[Placed]:
         """Every node (root excluded) with its ``world_from_model``, depth-first, parents first."""
@@ -215,13 +290,58 @@ class Scene:
 
     @property
     def items(self) -> list[SceneItem]:
-        """Placed meshes in drawing order, each with its (inherited) material and world transform."""
+        """Placed meshes in drawing order, each with its (inherited) material and world transform; a placed
+        Octree counts as its cell faces (``Octree.surface``), as the depth buffer draws it."""
         return self._placed(Mesh)
 
     @property
     def polylines(self) -> list[SceneItem]:
         """Placed polylines in drawing order (``SceneItem.mesh`` holds the Polyline)."""
         return self._placed(Polyline)
+
+    @property
+    def octrees(self) -> list[SceneItem]:
+        """Placed octrees in drawing order (``SceneItem.mesh`` holds the Octree; ``render(..., method="octree")``)."""
+        return self._placed(Octree)
+
+    def pick(self, camera: Any, x: float, y: float) -> Pick | None:
+        """The surface seen at window position (x, y) (``Camera.ray``'s convention: y up, pixel centres at
+        half-integers): the item, the face index in its mesh, the world point and the distance along the ray;
+        None where the ray meets no mesh.
+
+        All placed meshes are put in world coordinates into one triangle index (a bounding-volume hierarchy,
+        ``raster.bvh``, built once and kept until the scene's meshes or transforms change); the first hit of
+        the ray from the near plane is the nearest triangle with t >= 0.
+        """
+        from frustum.camera import Camera
+        from frustum.raster import bvh
+
+        where = "Scene.pick"
+        if not isinstance(camera, Camera):
+            raise FrustumError(f"{where}: camera = {describe(camera)} is not a Camera; build one with Camera.look_at")
+        px = as_scalar(x, "x", where=where, error=FrustumError)
+        py = as_scalar(y, "y", where=where, error=FrustumError)
+        items = [item for item in self.items if item.mesh.face_count]
+        if not items:
+            return None
+        key = tuple((id(item.mesh), item.world_from_model.tobytes()) for item in items)
+        cached = getattr(self, "_pick_index", None)
+        if cached is None or cached[0] != key:
+            corners = [
+                item.mesh.vertices[item.mesh.faces] @ item.world_from_model[:3, :3].T + item.world_from_model[:3, 3]
+                for item in items
+            ]
+            starts = np.cumsum([0] + [c.shape[0] for c in corners])
+            cached = (key, bvh.build(np.concatenate(corners)), starts, [item.mesh for item in items])
+            self._pick_index = cached
+        _, index, starts, _ = cached
+        ray = camera.ray((px, py))
+        t, face = bvh.first_hits(index, ray.origin[None], ray.direction[None])
+        if face[0] < 0:
+            return None
+        item_index = int(np.searchsorted(starts, face[0], side="right") - 1)
+        point = ray.origin + t[0] * ray.direction
+        return Pick(items[item_index], int(face[0] - starts[item_index]), point, float(t[0]))
 
     def _placed(self, kind: type) -> list[SceneItem]:
         result: list[SceneItem] = []
@@ -231,6 +351,8 @@ class Scene:
             material = node.material if node.material is not None else inherited
             if isinstance(node.geometry, kind):
                 result.append(SceneItem(node.geometry, material, world))
+            elif kind is Mesh and isinstance(node.geometry, Octree):
+                result.append(SceneItem(node.geometry.surface, material, world))
             for child in node.children:
                 visit(child, world, material)
 
@@ -239,7 +361,12 @@ class Scene:
 
     def world_lights(self) -> list[Light]:
         """Every light in world coordinates (those riding nodes moved by the node's world transform)."""
-        return [light.transformed(world) for node, world in self.root.walk() for light in node.lights]
+        lights: list[Light] = []
+        for node, world in self.root.walk():
+            if node.lights:  # lights at the identity (the root's, usually all of them) need no copy
+                identity = world is _IDENTITY or np.array_equal(world, _IDENTITY)
+                lights.extend(node.lights if identity else [light.transformed(world) for light in node.lights])
+        return lights
 
     def __len__(self) -> int:
         return len(self.items)
@@ -247,6 +374,7 @@ class Scene:
     def _with_root(self, root: Node) -> Scene:
         scene = Scene()
         scene.root = root
+        scene.particle_layers = list(self.particle_layers)
         return scene
 
 
@@ -373,7 +501,8 @@ def _cut_node(
             copy.geometry = Polyline(points, line.closed, line.markers)
             copy.material = child_material
         elif child.geometry is not None:
-            kept, removed = _cut_mesh(child.geometry, child_world, region, cap)
+            mesh = child.geometry.surface if isinstance(child.geometry, Octree) else child.geometry  # its cell faces
+            kept, removed = _cut_mesh(mesh, child_world, region, cap)
             if kept is not None:
                 body, section = _split_section(kept, region) if cap else (kept, None)
                 copy.geometry = body

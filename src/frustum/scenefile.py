@@ -17,7 +17,12 @@ Conventions of the format (``docs/topics.md`` has a tour, ``scene.schema.json`` 
   z]`` and ``matrix`` (4x4 rows).
 - Geometry parameters are checked against the building function's own signature (``inspect.signature``), so a
   keyword argument that a geometry function gains later works in scene files at once.
-- Paths (mesh files, outputs) are relative to the scene file's folder.
+- Paths (mesh files, outputs) are relative to the scene file's folder. Output files named in ``[output]
+  files`` must stay inside that folder (no ``..`` escape, no absolute path, no symlink pointing out): rendering
+  an untrusted scene file cannot write anywhere else. The command line's ``-o`` goes wherever the user says.
+- Hostile input is refused early, with ``file:line``: files over ``MAX_SCENE_FILE_BYTES`` (16 MiB), arrays or
+  tables nested deeper than ``_MAX_NESTING`` (64), dotted keys of more than 64 parts; keys and values are quoted
+  in messages with control characters escaped.
 
 References
 ----------
@@ -29,6 +34,7 @@ from __future__ import annotations
 
 import dataclasses
 import difflib
+import functools
 import importlib
 import inspect
 import math
@@ -41,14 +47,15 @@ from typing import Any
 
 import numpy as np
 
-from frustum._arrays import describe
+from frustum._arrays import describe, escape_control
+from frustum.budgets import check_memory
 from frustum.camera import Camera
 from frustum.errors import FrustumError, OutputError, SceneFileError
 from frustum.frame import Frame
 from frustum.geometry import Mesh
 from frustum.projection import MULTIVIEWS, Axonometric, Frustum, Oblique, Orthographic, Perspective
 from frustum.quaternion import Quaternion
-from frustum.render import RENDER_MODES, SHADING_MODES, TRANSPARENCY_MODES, VISIBILITY_METHODS, render
+from frustum.render import RENDER_METHODS, RENDER_MODES, SHADING_MODES, TRANSPARENCY_MODES, render
 from frustum.scene import Node, Scene, cutaway, exploded
 from frustum.shading import AmbientLight, DepthCue, DirectionalLight, Material, PointLight, SpotLight
 from frustum.transforms import compose, reflect, rotate, rotate_x, rotate_y, rotate_z, scale, shear, translate
@@ -90,12 +97,16 @@ TRANSFORM_STEPS = (
 """The named steps a node's ``transform`` list may hold (each step is a table with one of these keys)."""
 
 _MAX_PIXELS = 8192
+MAX_SCENE_FILE_BYTES = 16 * 2**20
+"""Largest scene file read (16 MiB): ``frustum render /dev/zero`` stops there instead of reading gigabytes."""
+_MAX_NESTING = 64
+"""Deepest nesting of arrays / inline tables, and most parts of a dotted key, a scene file may use."""
 """Largest image width or height a scene file may ask for."""
 _MAX_INTEGER_PARAMETER = 100_000
 """Largest integer geometry parameter (segments, resolution, ...): guards against runaway tessellation."""
 _ANGLE_PARAMETERS = frozenset(
     {"angle", "fovy", "alpha", "phi", "rotation_x", "rotation_y", "crease_angle", "inner_angle", "outer_angle",
-     "azimuth", "elevation", "start", "end"}
+     "azimuth", "elevation", "start", "end", "spread"}
 )  # fmt: skip
 """Radian parameters of the Python API: scene files must give them in degrees, as ``<name>_deg``."""
 _DEGREE_PARAMETERS = frozenset({"LSystem.angle", "union.sharp_angle", "difference.sharp_angle",
@@ -104,7 +115,7 @@ _DEGREE_PARAMETERS = frozenset({"LSystem.angle", "union.sharp_angle", "differenc
 
 _TOP_LEVEL = (
     "title", "description", "camera", "cameras", "lights", "materials", "nodes", "render", "exploded", "cutaway",
-    "output", "animation", "svg",
+    "output", "animation", "svg", "particles", "cloth",
 )  # fmt: skip
 _NODE_KEYS = ("name", "geometry", "material", "transform", "children", "lights")
 _CAMERA_KEYS = (
@@ -178,11 +189,20 @@ GEOMETRY_TYPES: dict[str, tuple[str, str, str]] = {
     "union": ("csg", "frustum.geometry.csg", "union"),
     "difference": ("csg", "frustum.geometry.csg", "difference"),
     "intersection": ("csg", "frustum.geometry.csg", "intersection"),
+    # a solid as an octree of the cells of another geometry table (drawn by [render] method = "octree")
+    "octree": ("octree", "frustum.geometry.octree", "Octree"),
 }
 """``geometry.type`` values: (kind, module, attribute) of the function or class that builds each one."""
 
 
 # --- key lines: where each key path is written in the TOML text --------------------------------------------
+
+
+_SPACES = re.compile(r"[ \t\r]*")
+_BARE_KEY = re.compile(r"[\w-]*")  # letters, digits, "_" and "-"
+_BARE_VALUE = re.compile(r"[^,\]}\n#]*")
+_BASIC_STRING = re.compile(r'"((?:[^"\\\n]|\\.)*)"')
+_LITERAL_STRING = re.compile(r"'([^'\n]*)'")
 
 
 class _Scanner:
@@ -201,8 +221,7 @@ class _Scanner:
         self.pos += count
 
     def _skip_spaces(self) -> None:
-        while self._char() in (" ", "\t", "\r") and self._char():
-            self.pos += 1
+        self.pos = _SPACES.match(self.text, self.pos).end()  # type: ignore[union-attr]
 
     def _skip_blank(self) -> None:
         """Spaces, newlines and comments (inside arrays)."""
@@ -222,6 +241,12 @@ class _Scanner:
     def _string(self) -> str:
         quote = self._char()
         triple = self.text.startswith(quote * 3, self.pos)
+        if not triple:  # one-line strings (nearly all of them) in one regular-expression step
+            found = (_BASIC_STRING if quote == '"' else _LITERAL_STRING).match(self.text, self.pos)
+            if found:
+                self.pos = found.end()
+                body = found.group(1)
+                return _unescape(body) if quote == '"' and "\\" in body else body
         start = self.pos + (3 if triple else 1)
         self._advance(start - self.pos)
         chars = []
@@ -251,8 +276,7 @@ class _Scanner:
                 parts.append(self._string())
             else:
                 start = self.pos
-                while self._char() and (self._char().isalnum() or self._char() in "_-"):
-                    self.pos += 1
+                self.pos = _BARE_KEY.match(self.text, self.pos).end()  # type: ignore[union-attr]
                 parts.append(self.text[start : self.pos])
             self._skip_spaces()
             if self._char() != ".":
@@ -291,8 +315,7 @@ class _Scanner:
         if char in ('"', "'"):
             self._string()
             return
-        while self._char() and self._char() not in ",]}\n#":
-            self.pos += 1
+        self.pos = _BARE_VALUE.match(self.text, self.pos).end()  # type: ignore[union-attr]
 
     def _pair(self, table: tuple) -> None:
         keys = self._key()
@@ -366,22 +389,29 @@ def _path_text(path: Sequence) -> str:
             text += f"[{part}]"
         else:
             bare = part.replace("_", "").replace("-", "").isalnum()
-            shown = part if bare else f'"{part}"'
+            shown = part if bare else f'"{escape_control(part)}"'
             text += ("." if text else "") + shown
     return text or "(file)"
 
 
 def _problem_text(error: Exception) -> str:
-    return str(error).splitlines()[0] if str(error) else type(error).__name__
+    return escape_control(str(error).splitlines()[0]) if str(error) else type(error).__name__
 
 
 class _Report:
     """Collects every problem as ``file:line: key = value problem; what is valid``."""
 
-    def __init__(self, source: str, lines: dict[tuple, int] | None) -> None:
+    def __init__(self, source: str, lines: dict[tuple, int] | str | None) -> None:
         self.source = source
-        self.lines = lines
+        self._lines = lines  # TOML text: scanned for key lines only when a problem needs one
         self.problems: list[str] = []
+        self.built: dict[tuple, Any] = {}  # (builder, arguments) -> result, for deterministic builders
+
+    @property
+    def lines(self) -> dict[tuple, int] | None:
+        if isinstance(self._lines, str):
+            self._lines = _key_lines(self._lines)
+        return self._lines
 
     def line(self, path: Sequence) -> int | None:
         if self.lines is None:
@@ -395,7 +425,8 @@ class _Report:
 
     def _where(self, path: Sequence) -> str:
         line = self.line(path)
-        return f"{self.source}:{line}" if line is not None else self.source
+        source = escape_control(self.source)
+        return f"{source}:{line}" if line is not None else source
 
     def add(self, path: Sequence, value: Any, problem: str, valid: str) -> None:
         """``key = value problem; valid``."""
@@ -560,6 +591,28 @@ def _check_plain_value(report: _Report, path: tuple, value: Any) -> bool:
     return True
 
 
+_SIGNATURES: dict[Any, inspect.Signature | None] = {}
+
+
+def _signature(function: Callable) -> inspect.Signature | None:
+    """``inspect.signature``, cached (it is slow, and a large scene file calls the same builders 10⁴ times)."""
+    key = getattr(function, "__func__", function)  # bound methods: one entry per function
+    if isinstance(key, functools.partial):  # made per call: not worth a cache entry
+        try:
+            return inspect.signature(key)
+        except (TypeError, ValueError):  # pragma: no cover
+            return None
+    if key not in _SIGNATURES:
+        try:
+            _SIGNATURES[key] = inspect.signature(key)
+        except (TypeError, ValueError):  # pragma: no cover - builtins without signatures
+            _SIGNATURES[key] = None
+    signature = _SIGNATURES[key]
+    if signature is not None and key is not function:  # a bound method: drop `self`
+        signature = signature.replace(parameters=list(signature.parameters.values())[1:])
+    return signature
+
+
 def _call(
     report: _Report,
     path: tuple,
@@ -570,10 +623,7 @@ def _call(
     skip: Sequence[str] = (),
 ) -> Any:
     """``function(**params)`` with keys checked against its signature; `_deg` keys converted to radians."""
-    try:
-        signature = inspect.signature(function)
-    except (TypeError, ValueError):  # pragma: no cover - builtins without signatures
-        signature = None
+    signature = _signature(function)
     accepted = {
         name: p
         for name, p in (signature.parameters.items() if signature else ())
@@ -624,6 +674,10 @@ def _call(
             missing = True
     if missing:
         return _BAD
+    cacheable = ok and getattr(function, "__module__", "") in _DETERMINISTIC_MODULES
+    key = (function, repr(sorted(kwargs.items()))) if cacheable else None
+    if key is not None and key in report.built:  # the same primitive again: share the immutable result
+        return report.built[key]
     try:  # even after a bad key: the function's own checks may find more problems in the other values
         built = function(**kwargs)
     except FrustumError as error:
@@ -632,7 +686,14 @@ def _call(
     except (TypeError, ValueError, ArithmeticError, IndexError, MemoryError) as error:
         report.refused(path, dict(params), error)
         return _BAD
+    if key is not None:
+        report.built[key] = built
     return built if ok else _BAD
+
+
+_DETERMINISTIC_MODULES = frozenset({"frustum.geometry.primitives", "frustum.geometry.quadrics", "frustum.shading"})
+"""Builders whose results depend only on their arguments and are immutable: a scene file of 10⁴ equal spheres
+builds one Mesh and shares it (``_call``)."""
 
 
 def _resolve(report: _Report, path: tuple, kind: str, module: str, attribute: str) -> Any:
@@ -910,6 +971,8 @@ def _geometry(report: _Report, path: tuple, value: Any, base: Path, materials: d
         return _csg(report, path, params, builder, base, materials), []
     if kind == "lsystem":
         return _lsystem(report, path, params, builder), []
+    if kind == "octree":
+        return _octree(report, path, params, builder, base, materials), []
     # curves and point fractals: sampled into a polyline, drawn as a tube or line
     options = _curve_options(report, path, params)
     rest = {k: v for k, v in params.items() if k not in _CURVE_KEYS}
@@ -995,6 +1058,39 @@ def _csg(report: _Report, path: tuple, params: dict, boolean: Callable, base: Pa
         return boolean(*meshes, sharp_angle=angle)
     except (FrustumError, ValueError, RuntimeError) as error:
         report.refused(path, {"operands": "..."}, error)
+        return _BAD
+
+
+def _octree(report: _Report, path: tuple, params: dict, octree: Any, base: Path, materials: dict) -> Any:
+    """``Octree.from_mesh`` of the closed mesh the ``source`` geometry table builds (a mesh file, a primitive or a
+    CSG expression, with its own ``transform`` list), down to ``depth`` levels (``shell`` for a surface)."""
+    keys = ("source", "depth", "shell")
+    _unknown_keys(report, path, params, keys)
+    if "source" not in params:
+        report.missing((*path, "source"), "give the solid as a geometry table, e.g. source = { type = 'sphere' }")
+        return _BAD
+    depth = _number(report, (*path, "depth"), params.get("depth", 6), low=0, high=12, integer=True)
+    shell = _boolean(report, (*path, "shell"), params.get("shell", False))
+    table = _table(report, (*path, "source"), params["source"])
+    mesh = _BAD
+    if table is not _BAD:
+        table = dict(table)
+        steps = table.pop("transform", None)
+        mesh, _ = _geometry(report, (*path, "source"), table, base, materials)
+        if mesh is not _BAD and not isinstance(mesh, Mesh):
+            report.add((*path, "source", "type"), table.get("type"), "is not a solid", "give a closed mesh geometry")
+            mesh = _BAD
+        matrix = None if steps is None else _transform(report, (*path, "source", "transform"), steps)
+        if matrix is _BAD:
+            mesh = _BAD
+        elif mesh is not _BAD and matrix is not None:
+            mesh = mesh.transformed(matrix)
+    if _bad(depth, shell, mesh) or any(key not in keys for key in params):
+        return _BAD
+    try:
+        return octree.from_mesh(mesh, int(depth), shell=bool(shell))
+    except FrustumError as error:
+        report.refused(path, {"source": "...", "depth": depth}, error)
         return _BAD
 
 
@@ -1385,7 +1481,7 @@ def _render_options(report: _Report, path: tuple, value: Any) -> tuple[dict, tup
         "samples": lambda p, v: _number(report, p, v, low=1, high=64, integer=True),
         "filter": lambda p, v: _choice(report, p, v, ("box", "tent")),
         "color_space": lambda p, v: _choice(report, p, v, ("linear", "srgb")),
-        "method": lambda p, v: _choice(report, p, v, tuple(VISIBILITY_METHODS)),
+        "method": lambda p, v: _choice(report, p, v, tuple(RENDER_METHODS)),
         "transparency": lambda p, v: _choice(report, p, v, TRANSPARENCY_MODES),
     }
     for key, check in simple.items():
@@ -1412,6 +1508,26 @@ def _render_options(report: _Report, path: tuple, value: Any) -> tuple[dict, tup
         checked = _number(report, (*path, "columns"), params["columns"], low=1, high=64, integer=True)
         columns = 0 if checked is _BAD else checked
     return options, size, columns
+
+
+def _check_image_memory(report: _Report, options: dict, size: tuple[int, int], cameras: int) -> None:
+    """The image budget (``render._check_image_budget``'s estimate) at load time, so the error has file:line:
+    one camera's supersampled buffers (12 bytes a rendered pixel, more for extra buffers and filters) plus
+    every camera's finished 8-byte pixels (a contact sheet keeps them all)."""
+    width, height = size
+    samples = int(options.get("samples", 1))
+    buffers = options.get("buffers", ())
+    per_pixel = 12 + 12 * ("normals" in buffers) + 4 * ("object_id" in buffers)
+    if options.get("filter", "box") != "box" or options.get("color_space", "linear") != "linear":
+        per_pixel += 64
+    needed = width * height * (samples * per_pixel + 8 * cameras)
+    key = "samples" if "samples" in options else "size"
+    try:
+        check_memory(needed, where="render", cause=f"{width} x {height} pixels x samples = {samples} x {cameras} "
+                     f"camera{'s' if cameras > 1 else ''}", error=SceneFileError)  # fmt: skip
+    except SceneFileError as error:
+        report.add(("render", key), options.get(key, list(size)), "is over the memory budget",
+                   str(error).split(": ", 1)[1])  # fmt: skip
 
 
 def _explode_and_cut(report: _Report, data: dict, scene: Scene) -> Scene:
@@ -1482,6 +1598,100 @@ def _cut(report: _Report, path: tuple, params: dict, scene: Scene) -> Scene:
         return scene
 
 
+def _inside(base: Path, name: str) -> bool:
+    """Whether output `name` of a scene file in folder `base` resolves inside `base` (symlinks followed)."""
+    relative = Path(name)
+    if relative.is_absolute() or relative.drive or ".." in relative.parts or "\0" in name:
+        return False
+    try:
+        folder = base.resolve()
+        target = (folder / relative).resolve()
+    except (OSError, RuntimeError, ValueError):  # a symlink loop
+        return False
+    return target != folder and target.is_relative_to(folder)
+
+
+# --- simulations: [[particles]] and [[cloth]] ---------------------------------------------------------------
+
+_EMITTERS = {"point": "PointEmitter", "line": "LineEmitter", "disk": "DiskEmitter", "sphere": "SphereEmitter"}
+_FORCES = {"gravity": "Gravity", "drag": "Drag", "wind": "Wind", "vortex": "Vortex", "attractor": "Attractor"}
+_COLLIDERS = {"plane": "PlaneCollider", "sphere": "SphereCollider"}
+_PARTICLE_KEYS = ("emitter", "forces", "colliders", "style", "blending")
+_CLOTH_KEYS = ("material", "colliders", "name")
+
+
+def _typed(report: _Report, path: tuple, value: Any, kinds: dict[str, str]) -> Any:
+    """``{ type = "...", ... }`` → the simulation class of that type built from the other keys."""
+    params = _table(report, path, value)
+    if params is _BAD:
+        return _BAD
+    kind = params.pop("type", None)
+    if kind not in kinds:
+        report.add((*path, "type"), kind, "is unknown" if kind is not None else "is missing",
+                   f"expected one of {', '.join(repr(k) for k in kinds)}")  # fmt: skip
+        return _BAD
+    simulation = importlib.import_module("frustum.simulation")
+    return _call(report, path, getattr(simulation, kinds[kind]), params, label=kinds[kind])
+
+
+def _typed_list(report: _Report, path: tuple, value: Any, kinds: dict[str, str]) -> Any:
+    if not isinstance(value, list):
+        report.add(path, value, "is not a list of tables", "write e.g. [{ type = ... }, ...]")
+        return _BAD
+    built = [_typed(report, (*path, i), item, kinds) for i, item in enumerate(value)]
+    return _BAD if any(item is _BAD for item in built) else built
+
+
+def _simulations(report: _Report, data: dict, scene: Scene, materials: dict) -> None:
+    """``[[particles]]`` (a ParticleSystem with its emitter, forces, colliders, style, blending) and ``[[cloth]]``
+    (``frustum.cloth`` with its material and colliders) added to `scene`; ``[animation].warmup`` steps them."""
+    simulation = importlib.import_module("frustum.simulation")
+    for i, entry in enumerate(_table_list(report, ("particles",), data.get("particles", []))):
+        path, params = ("particles", i), dict(entry)
+        if "emitter" not in params:
+            report.missing((*path, "emitter"), "give an emitter = { type = 'point', position = [x, y, z] }")
+            continue
+        emitter = _typed(report, (*path, "emitter"), params["emitter"], _EMITTERS)
+        forces = _typed_list(report, (*path, "forces"), params.get("forces", []), _FORCES)
+        colliders = _typed_list(report, (*path, "colliders"), params.get("colliders", []), _COLLIDERS)
+        style = _choice(report, (*path, "style"), params.get("style", "sprites"), ("sprites", "points", "streaks"))
+        blending = _choice(report, (*path, "blending"), params.get("blending", "additive"), ("additive", "alpha"))
+        if _bad(emitter, forces, colliders, style, blending):
+            continue
+        build = functools.partial(simulation.ParticleSystem, emitter=emitter, forces=forces, colliders=colliders)
+        system = _call(report, path, build, params, label="ParticleSystem", skip=_PARTICLE_KEYS)
+        if system is not _BAD:
+            scene.add_particles(system, style=style, blending=blending)
+    for i, entry in enumerate(_table_list(report, ("cloth",), data.get("cloth", []))):
+        path, params = ("cloth", i), dict(entry)
+        material = _material_reference(report, (*path, "material"), params["material"], materials) \
+            if "material" in params else None  # fmt: skip
+        colliders = _typed_list(report, (*path, "colliders"), params.get("colliders", []), _COLLIDERS)
+        name = params.get("name", "")
+        if not isinstance(name, str):
+            report.add((*path, "name"), name, "is not a string", "give a node name in quotes")
+            continue
+        if _bad(material, colliders):
+            continue
+        build = functools.partial(simulation.cloth, colliders=colliders)
+        system = _call(report, path, build, params, label="cloth", skip=_CLOTH_KEYS)
+        if system is not _BAD:
+            scene.add_mass_spring(system, material, name=name)
+
+
+def _warm_up(report: _Report, scene: Scene, animation: dict) -> None:
+    """Step the simulations ``[animation].warmup`` seconds (in steps of ``1/(fps·substeps)``) before any frame."""
+    warmup = animation.get("warmup", 0.0)
+    if not warmup or not (scene.particle_layers or scene.mass_springs):
+        return
+    step_scene = importlib.import_module("frustum.output.simulate").step_scene
+    dt = 1.0 / (animation.get("fps", 12.0) * animation.get("substeps", 1))
+    try:
+        step_scene(scene, dt, round(warmup / dt))
+    except FrustumError as error:
+        report.refused(("animation", "warmup"), warmup, error)
+
+
 def _outputs(report: _Report, data: dict, base: Path) -> tuple[tuple[Path, ...], dict, dict]:
     outputs: list[Path] = []
     if "output" in data:
@@ -1496,6 +1706,11 @@ def _outputs(report: _Report, data: dict, base: Path) -> tuple[tuple[Path, ...],
                     if Path(name).suffix.lower() not in OUTPUT_SUFFIXES:
                         report.add(("output", "files", i), name, "has an unknown suffix",
                                    f"expected one of {', '.join(OUTPUT_SUFFIXES)}")  # fmt: skip
+                    elif not _inside(base, name):
+                        report.add(("output", "files", i), name, "is outside the scene file's folder",
+                                   "outputs named in a scene file must stay in its folder (no '..', no absolute "
+                                   "path, no symlink pointing out); give a relative path, or use -o on the "
+                                   "command line")  # fmt: skip
                     else:
                         outputs.append(base / name)
     animation: dict[str, Any] = {}
@@ -1503,7 +1718,12 @@ def _outputs(report: _Report, data: dict, base: Path) -> tuple[tuple[Path, ...],
         path = ("animation",)
         params = _table(report, path, data["animation"])
         if params is not _BAD:
-            _unknown_keys(report, path, params, ("frames", "fps", "axis"))
+            _unknown_keys(report, path, params, ("frames", "fps", "axis", "substeps", "warmup"))
+            if "substeps" in params:
+                animation["substeps"] = _number(report, (*path, "substeps"), params["substeps"], low=1, high=1000,
+                                                integer=True)  # fmt: skip
+            if "warmup" in params:
+                animation["warmup"] = _number(report, (*path, "warmup"), params["warmup"], low=0.0, high=3600.0)
             if "frames" in params:
                 animation["frames"] = _number(report, (*path, "frames"), params["frames"], low=1, high=3600,
                                               integer=True)  # fmt: skip
@@ -1653,15 +1873,21 @@ def load_scene(data: Mapping[str, Any] | str, *, source: str = "<scene>", base_d
     SceneFileError
         Malformed TOML (tomllib's own line and column), or any invalid key or value.
     """
-    lines: dict[tuple, int] | None = None
+    lines: dict[tuple, int] | str | None = None
     if isinstance(data, str):
+        _check_shape(data, source)
         try:
             parsed = tomllib.loads(data)
         except tomllib.TOMLDecodeError as error:
             found = re.search(r"at line (\d+), column (\d+)", str(error))
-            at = f"{source}:{found.group(1)}" if found else source
-            raise SceneFileError(f"{at}: the text is not valid TOML: {error}; fix the syntax there") from None
-        lines = _key_lines(data)
+            at = f"{escape_control(source)}:{found.group(1)}" if found else escape_control(source)
+            raise SceneFileError(
+                f"{at}: the text is not valid TOML: {escape_control(str(error))}; fix the syntax there"
+            ) from None
+        except RecursionError:
+            raise SceneFileError(f"{escape_control(source)}: the text nests too deeply to parse; "
+                                 f"nest arrays and tables at most {_MAX_NESTING} deep") from None  # fmt: skip
+        lines = data  # the key-line scan (linear, but slow in Python) runs only if a problem is reported
     elif isinstance(data, Mapping):
         parsed = dict(data)
     else:
@@ -1671,6 +1897,56 @@ def load_scene(data: Mapping[str, Any] | str, *, source: str = "<scene>", base_d
     report.raise_if_any()
     assert scene_file is not None
     return dataclasses.replace(scene_file, path=None)
+
+
+_TOKENS = re.compile(r'"""|\'\'\'|"(?:\\.|[^"\\\n])*"|\'[^\'\n]*\'|#[^\n]*|[\[\]{}]|\n')
+_DOTTED = re.compile(r"(?:(?:[A-Za-z0-9_-]+|\"[^\"\n]*\"|'[^'\n]*')[ \t]*\.[ \t]*){" + str(_MAX_NESTING) + "}")
+
+
+def _check_shape(text: str, source: str) -> None:
+    """Refuse text the TOML parser and the key-line scanner would take very long (or recurse too deep) on.
+
+    One linear pass over the tokens outside strings and comments: the depth of ``[`` / ``{``, then dotted
+    keys of more than `_MAX_NESTING` parts in the text with its strings blanked; the ``SceneFileError`` names
+    the line.
+    """
+    where = escape_control(source)
+    depth, line, multiline = 0, 1, None
+    code: list[str] = []  # the text with strings emptied and comments dropped (newlines kept)
+    last = 0
+    for token in _TOKENS.finditer(text):
+        value = token.group()
+        if multiline is None:
+            code.append(text[last : token.start()])
+        last = token.end()
+        if value == "\n":
+            line += 1
+            code.append("\n")
+        elif multiline is not None:  # inside a multi-line string: only its closing quotes matter
+            if value == multiline:
+                multiline = None
+                code.append('""')
+        elif value in ('"""', "\'\'\'"):
+            multiline = value
+        elif value in "[{":
+            code.append(value)
+            depth += 1
+            if depth > _MAX_NESTING:
+                raise SceneFileError(f"{where}:{line}: arrays or tables nest more than {_MAX_NESTING} deep here; "
+                                     f"nest them at most {_MAX_NESTING} deep")  # fmt: skip
+        elif value in "]}":
+            code.append(value)
+            depth = max(depth - 1, 0)
+        elif value[0] in "\"'":
+            code.append('""')
+    if multiline is None:
+        code.append(text[last:])
+    stripped = "".join(code)
+    dotted = _DOTTED.search(stripped)
+    if dotted:
+        line = stripped.count("\n", 0, dotted.start()) + 1
+        raise SceneFileError(f"{where}:{line}: a dotted key has more than {_MAX_NESTING} parts; write at most "
+                             f"{_MAX_NESTING} levels of tables")  # fmt: skip
 
 
 def _build(report: _Report, data: dict, base: Path) -> SceneFile | None:
@@ -1693,6 +1969,7 @@ def _build(report: _Report, data: dict, base: Path) -> SceneFile | None:
         if node is not _BAD:
             scene.add(node)
     scene = _explode_and_cut(report, data, scene)
+    _simulations(report, data, scene, materials)
     cameras: list[Camera] = []
     stereo = None
     if "camera" in data and "cameras" in data:
@@ -1718,6 +1995,9 @@ def _build(report: _Report, data: dict, base: Path) -> SceneFile | None:
     else:
         report.missing(("camera",), "add a [camera] table with eye and target (or [[cameras]])")
     outputs, animation, svg = _outputs(report, data, base)
+    _check_image_memory(report, options, size, max(len(cameras), 1))
+    if not report.problems:
+        _warm_up(report, scene, animation)
     if report.problems:
         return None
     title = data.get("title", "")
@@ -1735,11 +2015,17 @@ def load_scene_file(path: str | Path) -> SceneFile:
         problem as ``file:line: key = value problem; what is valid``.
     """
     file = Path(path)
+    shown = escape_control(str(file))
     try:
-        text = file.read_text(encoding="utf-8")
+        with open(file, "rb") as handle:
+            raw = handle.read(MAX_SCENE_FILE_BYTES + 1)  # /dev/zero or a huge file: stop at the cap
+        if len(raw) > MAX_SCENE_FILE_BYTES:
+            raise SceneFileError(f"{shown}: is larger than {MAX_SCENE_FILE_BYTES // 2**20} MiB; a scene file "
+                                 "describes a scene (put large data in mesh files it names)")  # fmt: skip
+        text = raw.decode("utf-8")
     except (OSError, UnicodeDecodeError) as error:
         reason = getattr(error, "strerror", None) or str(error)
-        raise SceneFileError(f"{file}: cannot be read ({reason}); give an existing UTF-8 TOML scene file") from None
+        raise SceneFileError(f"{shown}: cannot be read ({reason}); give an existing UTF-8 TOML scene file") from None
     scene_file = load_scene(text, source=str(file), base_dir=file.parent)
     return dataclasses.replace(scene_file, path=file)
 
@@ -1776,6 +2062,12 @@ def _write(scene_file: SceneFile, target: Path) -> Path:
     except ImportError:
         raise OutputError("render_scene_file: GIF/MP4 output is not available in this version") from None
     settings = {"frames": 36, "fps": 12.0, **scene_file.animation}
+    if scene_file.scene.particle_layers or scene_file.scene.mass_springs:  # [[particles]] / [[cloth]]: simulate
+        simulate = importlib.import_module("frustum.output.simulate").simulate
+        simulate(scene_file.scene, camera, int(settings["frames"]), fps=settings["fps"],
+                 substeps=int(settings.get("substeps", 1)), path=target, progress=False,
+                 **scene_file.options)  # fmt: skip
+        return target
     animation.turntable(scene_file.scene, camera, settings["frames"], settings.get("axis"), target,
                         settings["fps"], progress=False, **scene_file.options)  # fmt: skip
     return target
@@ -1881,7 +2173,7 @@ def explain_method(path: str | Path, method: str) -> dict:
     options = {key: value for key, value in scene_file.options.items() if key not in ("method", "stats")}
     start = time.perf_counter()
     frame = render(scene_file.scene, scene_file.cameras[0], method=method, stats=True, **options)
-    stats = dict(frame.stats or {})
+    stats = dict(frame.stats or {"method": method})
     stats["seconds"] = round(time.perf_counter() - start, 4)
     return stats
 

@@ -1,5 +1,5 @@
 """Modeling: things to draw, in their own (model) coordinates: meshes, primitives, quadrics and superquadrics,
-curves and surfaces, fractals, mesh files and CSG."""
+curves and surfaces, fractals, mesh files and CSG, octrees."""
 
 from frustum.geometry.csg import (
     difference,
@@ -72,6 +72,11 @@ from frustum.geometry.lsystem import (
 from frustum.geometry.mesh import (
     Mesh,
 )
+from frustum.geometry.octree import (
+    TEXTBOOK_OCTANTS,
+    Octree,
+    OctreeHits,
+)
 from frustum.geometry.polyline import (
     Polyline,
 )
@@ -119,6 +124,7 @@ __all__ = [
     "M_B",
     "M_H",
     "SUPPORTED_SUFFIXES",
+    "TEXTBOOK_OCTANTS",
     "BSpline",
     "BSplineSurface",
     "BezierCurve",
@@ -133,6 +139,8 @@ __all__ = [
     "MeshPart",
     "NURBSCurve",
     "NURBSSurface",
+    "Octree",
+    "OctreeHits",
     "PiecewiseBezier",
     "Polyline",
     "TurtlePath",

@@ -257,6 +257,23 @@ def _distance_to_segment(points: FloatArray, a: FloatArray, b: FloatArray) -> Fl
     return np.sqrt(((points - closest) ** 2).sum(axis=-1))
 
 
+MIN_RELATIVE_TOLERANCE = 1e-10
+"""Smallest flattening tolerance (and pixel size) relative to a curve's or surface's extent: finer ones
+would ask for more pieces than float64 can tell apart (1e-300 used to loop for minutes)."""
+
+
+def _check_flatness_limit(points: FloatArray, limit: float, name: str, where: str) -> None:
+    """Refuse a tolerance below MIN_RELATIVE_TOLERANCE × the extent of `points` (..., dim)."""
+    flat = points.reshape(-1, points.shape[-1])
+    extent = float((flat.max(axis=0) - flat.min(axis=0)).max()) if flat.size else 0.0
+    floor = MIN_RELATIVE_TOLERANCE * extent
+    if limit < floor:
+        raise GeometryError(
+            f"{where}: {name} = {limit!r} is below {MIN_RELATIVE_TOLERANCE:g} of the curve's extent ({extent:.6g}); "
+            f"give {name} >= {floor:.3g}"
+        )
+
+
 def _flatten_pieces(
     control_points: FloatArray,
     tolerance: float | None,
@@ -302,6 +319,8 @@ def _flatten_pieces(
                     f"{where}: project returned non-finite window coordinates; clip the curve to the view first"
                 )
             measured = projected[:, :2].reshape(*measured.shape[:2], 2)
+        if depth == 0:
+            _check_flatness_limit(measured, limit, "tolerance" if tolerance is not None else "pixel_size", where)
         if tolerance is not None:  # flat: every control point within `limit` of the chord P0–Pn
             size = _distance_to_segment(measured[:, 1:-1], measured[:, 0], measured[:, -1]).max(axis=1, initial=0.0)
         else:  # the seed: "until the sections are no bigger than individual pixels"

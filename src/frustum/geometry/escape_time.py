@@ -25,8 +25,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from frustum._arrays import as_scalar, describe
+from frustum.budgets import check_operations
 from frustum.errors import GeometryError
-from frustum.geometry.fractals import DEFAULT_MAX_BYTES, _budget, _check_memory
+from frustum.geometry.fractals import _budget, _check_memory
 from frustum.geometry.mesh import Mesh
 
 __all__ = ["escape_time_colors", "julia", "mandelbrot", "quaternion_julia", "quaternion_julia_mesh"]
@@ -71,6 +72,7 @@ def _image(where: str, window: Any, width: Any, height: Any, max_iter: Any, esca
     if radius < 2.0:
         raise GeometryError(f"{where}: escape_radius = {radius!r} is below 2; give R >= 2 (orbits past 2 escape)")
     _check_memory(w * h * 8, _budget(max_bytes, where), where=where, name="width·height", value=w * h)
+    check_operations(w * h * iters, where=where, cause=f"{w} x {h} pixels x max_iter = {iters}", error=GeometryError)
     xs = x0 + (np.arange(w) + 0.5) * ((x1 - x0) / w)
     ys = y1 - (np.arange(h) + 0.5) * ((y1 - y0) / h)
     out = np.empty((h, w))
@@ -81,7 +83,7 @@ def _image(where: str, window: Any, width: Any, height: Any, max_iter: Any, esca
 
 def mandelbrot(window: ArrayLike = (-2.0, 1.0, -1.5, 1.5), width: int = 512, height: int = 512, *,
                max_iter: int = 256, escape_radius: float = 256.0, smooth: bool = True,
-               max_bytes: int = DEFAULT_MAX_BYTES) -> NDArray[np.float64]:  # fmt: skip
+               max_bytes: int | None = None) -> NDArray[np.float64]:  # fmt: skip
     """Mandelbrot set image: escape time of z ← z² + c from z₀ = 0, with c the pixel's point.
 
     z_{n+1} = z_n² + c; ν = n + 1 − log₂(ln|z_n| / ln R) when smooth.
@@ -110,7 +112,7 @@ def mandelbrot(window: ArrayLike = (-2.0, 1.0, -1.5, 1.5), width: int = 512, hei
 
 def julia(c: complex, window: ArrayLike = (-1.6, 1.6, -1.2, 1.2), width: int = 512, height: int = 384, *,
           max_iter: int = 256, escape_radius: float = 256.0, smooth: bool = True,
-          max_bytes: int = DEFAULT_MAX_BYTES) -> NDArray[np.float64]:  # fmt: skip
+          max_bytes: int | None = None) -> NDArray[np.float64]:  # fmt: skip
     """Julia set image of z ← z² + c: escape time from z₀ = the pixel's point (same conventions as
     ``mandelbrot``).
 
@@ -155,7 +157,7 @@ def escape_time_colors(image: ArrayLike, *, period: float = 32.0, inside: ArrayL
 
 def quaternion_julia(c: ArrayLike = (-0.2, 0.6, 0.2, 0.0), *, resolution: int = 64, bound: float = 1.5,
                      slice_w: float = 0.0, max_iter: int = 12, escape_radius: float = 4.0,
-                     max_bytes: int = DEFAULT_MAX_BYTES) -> NDArray[np.float64]:  # fmt: skip
+                     max_bytes: int | None = None) -> NDArray[np.float64]:  # fmt: skip
     """Smooth escape time of the quaternion map q ← q² + c on the 3D slice w = `slice_w` of 4D space.
 
     q = (x, y, z, w) = x + y i + z j + w k; q² = (s² − |v|², 2 s v) for q = (s, v). Points that stay within
@@ -188,6 +190,8 @@ def quaternion_julia(c: ArrayLike = (-0.2, 0.6, 0.2, 0.0), *, resolution: int = 
     if radius < 2.0:
         raise GeometryError(f"{where}: escape_radius = {radius!r} is below 2; give R >= 2")
     _check_memory(n**3 * 8 * 4, _budget(max_bytes, where), where=where, name="resolution", value=n)
+    check_operations(n**3 * iters, where=where, cause=f"resolution = {n} (n³ = {n**3} points) x max_iter = {iters}",
+                     error=GeometryError)  # fmt: skip
     axis = np.linspace(-b, b, n)
     out = np.empty((n, n, n))
     _kernels()._quaternion_field(axis, axis, axis, w, np.ascontiguousarray(cq), iters, radius * radius, out)
@@ -196,7 +200,7 @@ def quaternion_julia(c: ArrayLike = (-0.2, 0.6, 0.2, 0.0), *, resolution: int = 
 
 def quaternion_julia_mesh(c: ArrayLike = (-0.2, 0.6, 0.2, 0.0), *, resolution: int = 64, bound: float = 1.5,
                           slice_w: float = 0.0, max_iter: int = 12, level: float | None = None,
-                          max_bytes: int = DEFAULT_MAX_BYTES) -> Mesh:  # fmt: skip
+                          max_bytes: int | None = None) -> Mesh:  # fmt: skip
     """The quaternion Julia set's 3D slice as a triangle mesh (marching cubes, scikit-image).
 
     Contours ``quaternion_julia(...)`` at `level` (default ``max_iter − 1``: points that survive nearly all

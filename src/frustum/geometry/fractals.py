@@ -1,8 +1,9 @@
 """Fractals: deterministic self-similar curves and solids, iterated function systems, fractal terrain.
 
 Every generator takes a ``level`` (the number of refinement steps, 0 = the initiator) and refuses, before
-allocating anything, a level whose output would exceed ``max_bytes`` (default ``DEFAULT_MAX_BYTES``, 1 GiB):
-the ``GeometryError`` states the bytes needed, the budget and that ``max_bytes`` raises it. Random fractals
+allocating anything, a level whose output would exceed the memory budget (``frustum.set_budget``,
+``FRUSTUM_MAX_BYTES``, ``--max-bytes``; default 8 GiB) or the per-call override ``max_bytes=``: the
+``GeometryError`` states the bytes needed, the budget and how to raise it. Random fractals
 take a ``seed`` (``numpy.random.default_rng``): same seed, same bytes.
 
 Curves are returned as (N, 3) float64 polylines (2D curves lie in the plane z = 0); solids as a ``Mesh``.
@@ -25,6 +26,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from frustum._arrays import Points, as_points, as_scalar, describe, read_only
+from frustum.budgets import DEFAULT_BYTES, check_memory
 from frustum.errors import GeometryError
 from frustum.geometry.mesh import Mesh
 
@@ -56,8 +58,10 @@ def _kernels() -> ModuleType:
 
     return fractals
 
-DEFAULT_MAX_BYTES = 2**30
-"""Default memory budget (1 GiB) of one generator's output; raise it per call with ``max_bytes=``."""
+
+DEFAULT_MAX_BYTES = DEFAULT_BYTES
+"""Default memory budget (8 GiB, ``frustum.budgets.DEFAULT_BYTES``); ``max_bytes=None`` (every generator's
+default) follows the global budget in force, ``max_bytes=n`` overrides it for one call."""
 
 _SQRT3 = math.sqrt(3.0)
 _MAX_LEVEL = 1000
@@ -86,7 +90,10 @@ def _positive_int(value: Any, where: str, name: str, minimum: int = 1) -> int:
     return int(value)
 
 
-def _budget(max_bytes: Any, where: str) -> int:
+def _budget(max_bytes: Any, where: str) -> int | None:
+    """The per-call override `max_bytes` as an int, or None (the global budget, ``frustum.budgets``)."""
+    if max_bytes is None:
+        return None
     if isinstance(max_bytes, bool) or not isinstance(max_bytes, int | np.integer) or max_bytes <= 0:
         raise GeometryError(f"{where}: max_bytes = {describe(max_bytes)} is not a positive integer; give bytes > 0")
     return int(max_bytes)
@@ -101,13 +108,16 @@ def _human(nbytes: int) -> str:
     return f"{nbytes} B"  # pragma: no cover
 
 
-def _check_memory(nbytes: int, max_bytes: int, *, where: str, name: str, value: Any) -> None:
-    """Raise ``GeometryError`` if an output of `nbytes` bytes would exceed the budget `max_bytes`.
+def _check_memory(nbytes: int, max_bytes: int | None, *, where: str, name: str, value: Any) -> None:
+    """Raise ``GeometryError`` if an output of `nbytes` bytes would exceed the budget.
 
-    The message states the bytes needed, the budget and the parameter that raises it (``max_bytes``), so a
-    too-deep level fails at once instead of running out of memory.
+    `max_bytes` None: the global budget (``frustum.budgets.check_memory``); an int: the per-call override. The
+    message states the bytes needed, the budget and how to raise it, so a too-deep level fails at once instead
+    of running out of memory.
     """
-    if nbytes > max_bytes:
+    if max_bytes is None:
+        check_memory(nbytes, where=where, cause=f"{name} = {describe(value)}", error=GeometryError)
+    elif nbytes > max_bytes:
         raise GeometryError(
             f"{where}: {name} = {describe(value)} would need {nbytes} bytes ({_human(nbytes)}), over the memory "
             f"budget max_bytes = {max_bytes} ({_human(max_bytes)}); lower {name} or raise max_bytes"
@@ -176,7 +186,7 @@ def _koch_refine(points: NDArray[np.float64]) -> NDArray[np.float64]:
 
 
 def koch_curve(level: int, start: ArrayLike = (0.0, 0.0), end: ArrayLike = (1.0, 0.0), *,
-               max_bytes: int = DEFAULT_MAX_BYTES) -> Points:  # fmt: skip
+               max_bytes: int | None = None) -> Points:  # fmt: skip
     """Koch curve from `start` to `end`: a polyline of 4^level segments in the plane z = 0.
 
     Each segment is replaced by four of a third of its length, the middle third raised into an equilateral
@@ -199,7 +209,7 @@ def koch_curve(level: int, start: ArrayLike = (0.0, 0.0), end: ArrayLike = (1.0,
     return _with_z(points)
 
 
-def koch_snowflake(level: int, size: float = 1.0, *, max_bytes: int = DEFAULT_MAX_BYTES) -> Points:
+def koch_snowflake(level: int, size: float = 1.0, *, max_bytes: int | None = None) -> Points:
     """Koch snowflake: a Koch curve on each side of an equilateral triangle, bumps outward.
 
     The triangle has corners (0, 0), (size/2, size·√3/2), (size, 0), traversed clockwise so the bumps point
@@ -229,7 +239,7 @@ def koch_snowflake(level: int, size: float = 1.0, *, max_bytes: int = DEFAULT_MA
 
 
 def cantor_set(level: int, start: float = 0.0, end: float = 1.0, *,
-               max_bytes: int = DEFAULT_MAX_BYTES) -> NDArray[np.float64]:  # fmt: skip
+               max_bytes: int | None = None) -> NDArray[np.float64]:  # fmt: skip
     """Cantor set: remove the open middle third of every interval, `level` times.
 
     D = log 2 / log 3 ≈ 0.6309.
@@ -261,7 +271,7 @@ def cantor_set(level: int, start: float = 0.0, end: float = 1.0, *,
 
 
 def sierpinski_triangle(level: int, corners: ArrayLike = ((0.0, 0.0), (1.0, 0.0), (0.5, _SQRT3 / 2.0)), *,
-                        max_bytes: int = DEFAULT_MAX_BYTES) -> Mesh:  # fmt: skip
+                        max_bytes: int | None = None) -> Mesh:  # fmt: skip
     """Sierpinski triangle (gasket): keep the three corner half-size triangles, `level` times.
 
     D = log 3 / log 2 ≈ 1.5850. Each kept triangle is one face with its own three vertices (no sharing),
@@ -303,7 +313,7 @@ def sierpinski_triangle(level: int, corners: ArrayLike = ((0.0, 0.0), (1.0, 0.0)
 _TETRA_FACES = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]], dtype=np.int64)
 
 
-def sierpinski_tetrahedron(level: int, size: float = 1.0, *, max_bytes: int = DEFAULT_MAX_BYTES) -> Mesh:
+def sierpinski_tetrahedron(level: int, size: float = 1.0, *, max_bytes: int | None = None) -> Mesh:
     """Sierpinski tetrahedron: keep the four corner half-size tetrahedra, `level` times.
 
     D = log 4 / log 2 = 2. The initiator is the regular tetrahedron with corners (0, 0, 0), (s, 0, 0),
@@ -364,7 +374,7 @@ def _menger_cells(n: int) -> NDArray[np.int64]:
 
 
 def menger_sponge(
-    level: int, size: float = 1.0, *, shared_vertices: bool = True, max_bytes: int = DEFAULT_MAX_BYTES
+    level: int, size: float = 1.0, *, shared_vertices: bool = True, max_bytes: int | None = None
 ) -> Mesh:
     """Menger sponge on the cube [0, size]³, with the faces between touching cubes removed.
 
@@ -425,7 +435,7 @@ def _curve_budget(count: int, where: str, n: int, max_bytes: Any) -> None:
     _check_memory(count * 3 * 8 * 4, _budget(max_bytes, where), where=where, name="level", value=n)
 
 
-def hilbert_curve(level: int, *, max_bytes: int = DEFAULT_MAX_BYTES) -> Points:
+def hilbert_curve(level: int, *, max_bytes: int | None = None) -> Points:
     """2D Hilbert curve: the 4^level cell centres of the unit square's 2^level × 2^level grid in curve order.
 
     Starts at the cell at (0, 0), ends at the cell at (1, 0); consecutive points are one cell (2^-level)
@@ -461,7 +471,7 @@ def hilbert_curve(level: int, *, max_bytes: int = DEFAULT_MAX_BYTES) -> Points:
     return _with_z((np.column_stack([x, y]).astype(np.float64) + 0.5) / side)
 
 
-def hilbert_curve_3d(level: int, *, max_bytes: int = DEFAULT_MAX_BYTES) -> Points:
+def hilbert_curve_3d(level: int, *, max_bytes: int | None = None) -> Points:
     """3D Hilbert curve: the 8^level cell centres of the unit cube's grid in curve order (Skilling's method).
 
     Consecutive points are one cell (2^-level) apart, and every cell is visited once.
@@ -507,7 +517,7 @@ def hilbert_curve_3d(level: int, *, max_bytes: int = DEFAULT_MAX_BYTES) -> Point
     return (np.column_stack(X).astype(np.float64) + 0.5) / (1 << n)
 
 
-def peano_curve(level: int, *, max_bytes: int = DEFAULT_MAX_BYTES) -> Points:
+def peano_curve(level: int, *, max_bytes: int | None = None) -> Points:
     """Peano curve: the 9^level cell centres of the unit square's 3^level × 3^level grid in curve order.
 
     From the base-3 digits a₁…a₂ₙ of the index: xⱼ = k^(a₂+a₄+…+a₂ⱼ₋₂)(a₂ⱼ₋₁), yⱼ = k^(a₁+a₃+…+a₂ⱼ₋₁)(a₂ⱼ)
@@ -652,7 +662,7 @@ class IFS:
         point[:d] = np.linalg.solve(np.eye(d) - self.linear[i, :d, :d], self.offset[i, :d])
         return point
 
-    def points(self, level: int, *, max_bytes: int = DEFAULT_MAX_BYTES) -> Points:
+    def points(self, level: int, *, max_bytes: int | None = None) -> Points:
         """Deterministic algorithm: apply every map to the point set `level` times, from map 0's fixed point.
 
         S_{n+1} = ∪ᵢ wᵢ(S_n), S_0 = {fixed point of w₀}; every point lies on the attractor.
@@ -671,7 +681,7 @@ class IFS:
         return pts
 
     def chaos_game(self, n_points: int, *, seed: int, skip: int = 100,
-                   max_bytes: int = DEFAULT_MAX_BYTES) -> Points:  # fmt: skip
+                   max_bytes: int | None = None) -> Points:  # fmt: skip
         """Random iteration (chaos game): x ← w_k(x) with k drawn with the map probabilities.
 
         Starts at map 0's fixed point; the first `skip` iterates are dropped. Same seed, same bytes.
@@ -765,7 +775,7 @@ def _square_step_means(h: NDArray, step: int) -> tuple[NDArray, NDArray]:
 
 
 def fbm_terrain(level: int, hurst: float = 0.8, *, seed: int, method: str = "diamond-square",
-                sigma: float = 1.0, max_bytes: int = DEFAULT_MAX_BYTES) -> NDArray[np.float64]:  # fmt: skip
+                sigma: float = 1.0, max_bytes: int | None = None) -> NDArray[np.float64]:  # fmt: skip
     """Fractional Brownian heightfield on a (2^level + 1)² grid by random midpoint displacement.
 
     Corners start as N(0, σ²) samples. At refinement step k (squares of side 2^(level-k) cells) every new point
@@ -825,7 +835,7 @@ def fbm_terrain(level: int, hurst: float = 0.8, *, seed: int, method: str = "dia
     return h
 
 
-def heightfield_mesh(heights: ArrayLike, size: float = 1.0, *, max_bytes: int = DEFAULT_MAX_BYTES) -> Mesh:
+def heightfield_mesh(heights: ArrayLike, size: float = 1.0, *, max_bytes: int | None = None) -> Mesh:
     """Triangulate a heightfield z = heights[i, j] over the square [0, size]² (x = column, y = row).
 
     Two counter-clockwise triangles per grid cell (seen from +z); vertex normals from central differences,
@@ -864,7 +874,7 @@ def heightfield_mesh(heights: ArrayLike, size: float = 1.0, *, max_bytes: int = 
 
 
 def fractal_coastline(polyline: ArrayLike, level: int, *, seed: int, hurst: float = 0.5, amplitude: float = 0.3,
-                      max_bytes: int = DEFAULT_MAX_BYTES) -> Points:  # fmt: skip
+                      max_bytes: int | None = None) -> Points:  # fmt: skip
     """Fractal coastline: midpoint displacement of a polyline in the xy plane, `level` times.
 
     Each segment p→q gains the midpoint (p + q)/2 + g·σ_k·n̂, with n̂ the unit normal of p→q in the xy plane,

@@ -16,6 +16,8 @@ References
 
 from __future__ import annotations
 
+import io
+import re
 from pathlib import Path
 from typing import Any, NamedTuple
 
@@ -23,6 +25,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from frustum._arrays import describe
+from frustum._files import atomic_path, os_reason
+from frustum.budgets import check_memory, format_bytes
 from frustum.errors import GeometryError
 from frustum.geometry.mesh import Mesh
 
@@ -109,8 +113,20 @@ def load_parts(path: str | Path, texture: str | Path | None = None) -> list[Mesh
     explicit = None if texture is None else _read_image(Path(texture), "load")
     if file.suffix.lower() == ".stl":
         _check_binary_stl_size(file)
+    _check_file_memory(file)
+    text = _obj_text(file) if file.suffix.lower() == ".obj" else None
     try:
-        scene = trimesh.load_scene(str(file), process=False)
+        if text is not None:
+            scene = trimesh.load_scene(io.BytesIO(text), file_type="obj", process=False,
+                                       resolver=trimesh.resolvers.FilePathResolver(str(file)))  # fmt: skip
+        else:
+            scene = trimesh.load_scene(str(file), process=False)
+    except MemoryError:
+        raise GeometryError(
+            f"load: path = {str(file)!r} ({format_bytes(file.stat().st_size)}) ran out of memory while loading; "
+            "the file is valid but too large for this machine: free memory or lower the budget with "
+            "frustum.set_budget(bytes=...) so such files are refused up front"
+        ) from None
     except Exception as error:  # trimesh raises many types (ValueError, KeyError, struct.error, ...)
         raise _read_error(file, error) from None
     parts: list[MeshPart] = []
@@ -199,11 +215,13 @@ def save(mesh: Mesh, path: str | Path, binary: bool = True, texture: Any = None)
             data = data.encode("utf-8")
         if suffix == ".obj" and isinstance(data, bytes) and texture is not None:
             data = _obj_with_texture(geometry, file)
-        file.write_bytes(data)
+        _write_atomically(file, data)
     except OSError as error:
         raise GeometryError(
-            f"save: path = {str(file)!r} cannot be written ({error.strerror}); check the folder"
+            f"save: path = {str(file)!r} cannot be written ({os_reason(error)}); check the folder"
         ) from None
+    except GeometryError:
+        raise
     except Exception as error:
         raise GeometryError(
             f"save: path = {str(file)!r} could not be written as {suffix} ({type(error).__name__}: {error})"
@@ -250,11 +268,49 @@ def _check_binary_stl_size(file: Path) -> None:
             "truncated or not an STL file"
         )
     count = int(np.frombuffer(head[80:84], dtype="<u4")[0])
+    check_memory(count * _LOAD_BYTES_PER_TRIANGLE, where="load",
+                 cause=f"path = {str(file)!r} with {count} triangles", error=GeometryError)  # fmt: skip
     if size < 84 + 50 * count:
         raise GeometryError(
             f"load: path = {str(file)!r} has {size} bytes but its header announces {count} triangles "
             f"({84 + 50 * count} bytes); the file is truncated"
         )
+
+
+_LOAD_BYTES_PER_FILE_BYTE = 12
+"""Peak memory of trimesh's loaders per byte of a text mesh file (OBJ, PLY, OFF), a generous estimate."""
+_LOAD_BYTES_PER_TRIANGLE = 400
+"""Peak memory of loading one binary STL triangle (50 bytes on disk): float64 copies, merging, normals."""
+
+
+def _check_file_memory(file: Path) -> None:
+    """Refuse, through the work budget, a mesh file whose loading would take more memory than allowed."""
+    size = file.stat().st_size
+    check_memory(size * _LOAD_BYTES_PER_FILE_BYTE, where="load",
+                 cause=f"path = {str(file)!r} ({format_bytes(size)})", error=GeometryError)  # fmt: skip
+
+
+_OBJ_ZERO_INDEX = re.compile(rb"^[ \t]*f[ \t].*?(?<![\w./+-])[+]?0+(?=[/\s]|$)", re.MULTILINE)
+
+
+def _obj_text(file: Path) -> bytes:
+    """An OBJ file's bytes as UTF-8: decoded as UTF-8, else as Latin-1 (any byte is a character; names and
+    comments are all an OBJ keeps as text), so no charset detector is needed. Face index 0 is refused: OBJ
+    indices start at 1 (negative ones count back from the last vertex)."""
+    data = file.read_bytes()
+    zero = _OBJ_ZERO_INDEX.search(data)
+    if zero:
+        line = data.count(b"\n", 0, zero.start()) + 1
+        text = data[zero.start() : zero.end()].decode("latin-1").strip()
+        raise GeometryError(
+            f"load: path = {str(file)!r}, line {line}: face {text!r}... uses vertex index 0; OBJ indices start at 1 "
+            "(negative ones count back from the last vertex), so the file is malformed"
+        )
+    try:
+        data.decode("utf-8")
+        return data
+    except UnicodeDecodeError:
+        return data.decode("latin-1").encode("utf-8")
 
 
 def _read_error(file: Path, error: BaseException) -> GeometryError:
@@ -369,8 +425,14 @@ def _obj_with_texture(geometry: Any, file: Path) -> bytes:
 
     text, files = export_obj(geometry, return_texture=True, mtl_name=file.stem + ".mtl")
     for name, data in files.items():
-        (file.parent / name).write_bytes(data)
+        _write_atomically(file.parent / name, data)
     return text.encode("utf-8")
+
+
+def _write_atomically(file: Path, data: bytes) -> None:
+    """Write `data` to a temporary beside `file` and rename it: an existing file survives a failed write."""
+    with atomic_path(file, where="save", error=GeometryError) as temporary:
+        temporary.write_bytes(data)
 
 
 def _is_identity(matrix: NDArray[np.float64]) -> bool:

@@ -36,7 +36,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from frustum._arrays import Points, as_scalar, as_vector3, describe
 from frustum.errors import GeometryError
-from frustum.geometry.fractals import DEFAULT_MAX_BYTES, _budget, _check_memory, _level
+from frustum.geometry.fractals import _budget, _check_memory, _level
 from frustum.geometry.mesh import Mesh
 
 __all__ = ["CLASSIC_LSYSTEMS", "LSystem", "TurtlePath", "interpret", "parse_rules", "tube_mesh"]
@@ -178,7 +178,7 @@ class LSystem:
             counts = [sum(counts[a] * growth[a][b] for a in range(len(symbols))) for b in range(len(symbols))]
         return sum(counts)
 
-    def expand(self, level: int, *, max_bytes: int = DEFAULT_MAX_BYTES) -> str:
+    def expand(self, level: int, *, max_bytes: int | None = None) -> str:
         """The word after `level` parallel rewritings of the axiom (every symbol at once).
 
         Raises ``GeometryError`` before expanding when the word (plus the turtle's arrays, ~64 bytes per symbol)
@@ -194,7 +194,7 @@ class LSystem:
         return word
 
     def path(self, level: int, *, start: ArrayLike = (0.0, 0.0, 0.0), heading: ArrayLike = (1.0, 0.0, 0.0),
-             left: ArrayLike = (0.0, 1.0, 0.0), max_bytes: int = DEFAULT_MAX_BYTES) -> TurtlePath:  # fmt: skip
+             left: ArrayLike = (0.0, 1.0, 0.0), max_bytes: int | None = None) -> TurtlePath:  # fmt: skip
         """``interpret(self.expand(level), self.angle, step=self.scale**level, ...)``."""
         return interpret(self.expand(level, max_bytes=max_bytes), self.angle, step=self.scale**level,
                          start=start, heading=heading, left=left)  # fmt: skip
@@ -289,7 +289,7 @@ def interpret(word: str, angle: float, *, step: float = 1.0, start: ArrayLike = 
 
 
 def tube_mesh(path: TurtlePath, radius: float = 0.1, *, taper: float = 0.7, sides: int = 6,
-              max_bytes: int = DEFAULT_MAX_BYTES) -> Mesh:  # fmt: skip
+              max_bytes: int | None = None) -> Mesh:  # fmt: skip
     """A closed prism (tube with end caps) around every segment of `path`.
 
     A segment at branch depth d has radius ``radius·taper**d``. Each tube has `sides` quads (two triangles

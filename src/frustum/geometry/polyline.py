@@ -9,7 +9,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from frustum._arrays import Points, as_points, read_only
+from frustum._arrays import Points, as_count, as_points, read_only
+from frustum.budgets import check_memory
 from frustum.errors import GeometryError
 
 __all__ = ["Polyline"]
@@ -66,12 +67,16 @@ class Polyline:
     def from_curve(cls, curve: Any, tolerance: float = 1e-3, samples: int | None = None) -> Polyline:
         """A curve of ``frustum.geometry.curves`` as a polyline: adaptive ``curve.flatten(tolerance)`` (chord
         within `tolerance` of the curve) or, with `samples`, that many parameter values evenly over its domain."""
+        if samples is not None:
+            as_count(samples, "samples", 2, where="Polyline.from_curve")
         if samples is None and hasattr(curve, "flatten"):
             return cls(curve.flatten(tolerance), curve=curve)
         if not hasattr(curve, "evaluate") or not hasattr(curve, "domain"):
             raise GeometryError(f"Polyline.from_curve: curve = {curve!r} has no evaluate/domain; give a curve")
         low, high = curve.domain
-        return cls(curve.evaluate(np.linspace(low, high, 200 if samples is None else int(samples))), curve=curve)
+        count = 200 if samples is None else as_count(samples, "samples", 2, where="Polyline.from_curve")
+        check_memory(count * 3 * 8 * 4, where="Polyline.from_curve", cause=f"samples = {count}", error=GeometryError)
+        return cls(curve.evaluate(np.linspace(low, high, count)), curve=curve)
 
     @classmethod
     def control_polygon(cls, curve: Any, markers: bool = False) -> Polyline:

@@ -21,6 +21,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from frustum._arrays import as_count, as_scalar, as_vector3, describe
+from frustum.budgets import check_memory
 from frustum.errors import GeometryError
 from frustum.geometry.mesh import Mesh, _grid_faces
 from frustum.transforms import rotate, translate
@@ -83,6 +84,7 @@ def plane(size: ArrayLike = (1.0, 1.0), divisions: int | ArrayLike = (1, 1)) -> 
     for value, name in ((nx, "divisions[0]"), (ny, "divisions[1]")):
         if value < 1:
             raise GeometryError(f"{where}: {name} = {value} is below 1; give at least 1 division")
+    _check_grid_memory((nx + 1) * (ny + 1), where, f"divisions = ({nx}, {ny})")
     s, t = np.linspace(0.0, 1.0, nx + 1), np.linspace(0.0, 1.0, ny + 1)
     u, v = np.meshgrid(s, t, indexing="ij")  # row i along +x, column j along +y: (∂P/∂i × ∂P/∂j) = +z
     points = np.stack([(u - 0.5) * width, (v - 0.5) * depth, np.zeros_like(u)], axis=-1).reshape(-1, 3)
@@ -105,6 +107,7 @@ def uv_sphere(radius: float = 1.0, segments: int = 32, rings: int = 16) -> Mesh:
     r = _positive(radius, "radius", where)
     n_seg = as_count(segments, "segments", 3, where=where)
     n_ring = as_count(rings, "rings", 2, where=where)
+    _check_grid_memory((n_seg + 1) * (n_ring + 1), where, f"segments = {n_seg}, rings = {n_ring}")
     latitude = np.pi / 2 - np.pi * np.arange(n_ring + 1) / n_ring  # north (i = 0) to south
     cos_lat, sin_lat = np.cos(latitude), np.sin(latitude)
     cos_lat[[0, -1]], sin_lat[[0, -1]] = 0.0, (1.0, -1.0)
@@ -156,6 +159,7 @@ def cylinder(radius: float = 1.0, height: float = 1.0, segments: int = 32, caps:
     r = _positive(radius, "radius", where)
     half = 0.5 * _positive(height, "height", where)
     n_seg = as_count(segments, "segments", 3, where=where)
+    _check_grid_memory(4 * (n_seg + 1), where, f"segments = {n_seg}")
     side = _revolve(np.array([[r, half], [r, -half]]), np.array([[1.0, 0.0], [1.0, 0.0]]), np.array([1.0, 0.0]), n_seg)
     if not _flag(caps, "caps", where):
         return side
@@ -172,6 +176,7 @@ def cone(radius: float = 1.0, height: float = 1.0, segments: int = 32, cap: bool
     r = _positive(radius, "radius", where)
     h = _positive(height, "height", where)
     n_seg = as_count(segments, "segments", 3, where=where)
+    _check_grid_memory(4 * (n_seg + 1), where, f"segments = {n_seg}")
     slope = np.array([h, r]) / np.hypot(h, r)
     side = _revolve(np.array([[0.0, h / 2], [r, -h / 2]]), np.array([slope, slope]), np.array([1.0, 0.0]), n_seg)
     return side.merged(_cap(r, -h / 2, n_seg, up=False)) if _flag(cap, "cap", where) else side
@@ -194,6 +199,8 @@ def torus(
         )
     n_major = as_count(major_segments, "major_segments", 3, where=where)
     n_minor = as_count(minor_segments, "minor_segments", 3, where=where)
+    _check_grid_memory((n_major + 1) * (n_minor + 1), where,
+                       f"major_segments = {n_major}, minor_segments = {n_minor}")  # fmt: skip
     phi = 2 * np.pi * np.arange(n_minor) / n_minor
     cos_phi, sin_phi = np.append(np.cos(phi), 1.0), np.append(np.sin(phi), 0.0)
     # the profile circle runs downward on its outer side, so ∂P/∂i × ∂P/∂θ points out of the tube
@@ -205,7 +212,9 @@ def torus(
 def disk(radius: float = 1.0, segments: int = 32) -> Mesh:
     """A flat disk of `radius` in z = 0 facing +z: `segments` >= 3 triangles around the centre; planar UVs."""
     where = "disk"
-    return _cap(_positive(radius, "radius", where), 0.0, as_count(segments, "segments", 3, where=where), up=True)
+    n_seg = as_count(segments, "segments", 3, where=where)
+    _check_grid_memory(2 * (n_seg + 1), where, f"segments = {n_seg}")
+    return _cap(_positive(radius, "radius", where), 0.0, n_seg, up=True)
 
 
 def arrow(
@@ -228,6 +237,7 @@ def arrow(
     r_head = _positive(head_radius, "head_radius", where)
     h_head = _positive(head_length, "head_length", where)
     n_seg = as_count(segments, "segments", 3, where=where)
+    _check_grid_memory(12 * (n_seg + 1), where, f"segments = {n_seg}")
     if h_head >= total:
         raise GeometryError(f"{where}: head_length = {h_head!r} is not below length = {total!r}; make the head shorter")
     if r_shaft >= r_head:
@@ -269,6 +279,16 @@ def axes(length: float = 1.0, shaft_radius: float = 0.02, head_radius: float = 0
 
 
 # --- helpers ------------------------------------------------------------------------------------------------
+
+
+BYTES_PER_VERTEX = 400
+"""Peak bytes a tessellated primitive takes per vertex while it is built (positions, normals, UVs, two
+triangles' indices, the temporaries of ``_revolve`` and ``Mesh``), a generous estimate for the budget."""
+
+
+def _check_grid_memory(vertices: int, where: str, cause: str) -> None:
+    """Refuse, before allocating, a tessellation of `vertices` vertices over the memory budget."""
+    check_memory(vertices * BYTES_PER_VERTEX, where=where, cause=f"{cause} ({vertices} vertices)", error=GeometryError)
 
 
 def _revolve(profile: NDArray, normals: NDArray, v: NDArray, segments: int) -> Mesh:

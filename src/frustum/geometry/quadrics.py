@@ -31,6 +31,7 @@ from numpy.typing import ArrayLike, NDArray
 from frustum._arrays import Points, as_count, as_points, as_scalar, as_vector3, describe
 from frustum.errors import GeometryError
 from frustum.geometry.mesh import Mesh, _area_weighted_normals, _grid_faces
+from frustum.geometry.primitives import _check_grid_memory
 
 __all__ = [
     "ellipsoid",
@@ -149,6 +150,7 @@ def superellipse(radii: ArrayLike = (1.0, 1.0), s: float = 1.0, segments: int = 
     r = _radii2(radii, where)
     e = _exponent(s, "s", where)
     n = as_count(segments, "segments", 3, where=where)
+    _check_grid_memory(n, where, f"segments = {n}")
     theta = 2 * np.pi * np.arange(n) / n
     return np.stack([r[0] * signed_power(np.cos(theta), e), r[1] * signed_power(np.sin(theta), e)], axis=1)
 
@@ -205,6 +207,8 @@ def supertoroid(
     e1, e2 = _exponent(s1, "s1", where), _exponent(s2, "s2", where)
     n_major = as_count(major_segments, "major_segments", 3, where=where)
     n_minor = as_count(minor_segments, "minor_segments", 3, where=where)
+    _check_grid_memory((n_major + 1) * (n_minor + 1), where,
+                       f"major_segments = {n_major}, minor_segments = {n_minor}")  # fmt: skip
     eta = -2 * np.pi * np.arange(n_minor) / n_minor  # decreasing: the outer side runs downward (outward front)
     cos_eta, sin_eta = np.append(np.cos(eta), 1.0), np.append(np.sin(eta), 0.0)
     cos_om, sin_om = _circle(n_major)
@@ -229,6 +233,7 @@ def supertoroid(
 def _superquadric_mesh(radii: Any, e1: float, e2: float, segments: Any, rings: Any, where: str) -> Mesh:
     n_seg = as_count(segments, "segments", 3, where=where)
     n_ring = as_count(rings, "rings", 2, where=where)
+    _check_grid_memory((n_seg + 1) * (n_ring + 1), where, f"segments = {n_seg}, rings = {n_ring}")
     r = np.asarray(radii, dtype=np.float64)
     eta = np.pi / 2 - np.pi * np.arange(n_ring + 1) / n_ring  # north (row 0) to south
     cos_eta, sin_eta = np.cos(eta), np.sin(eta)

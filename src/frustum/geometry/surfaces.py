@@ -23,8 +23,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from frustum._arrays import as_count, as_scalar, describe, read_only
+from frustum.budgets import check_memory
 from frustum.errors import GeometryError
 from frustum.geometry.curves import (
+    MIN_RELATIVE_TOLERANCE,
     BezierCurve,
     NURBSCurve,
     _as_degree,
@@ -175,6 +177,9 @@ class _Surface:
         """
         where = f"{type(self).__name__}.tessellate"
         nu, nv = as_count(nu, "nu", 1, where=where), as_count(nv, "nv", 1, where=where)
+        # 6 derivative arrays + normals + points (3 float64 each) per vertex, 2 triangles (3 int64) per cell
+        check_memory((nu + 1) * (nv + 1) * 8 * 24 + nu * nv * 48, where=where, cause=f"nu = {nu}, nv = {nv}",
+                     error=GeometryError)  # fmt: skip
         u = np.linspace(*self.domain_u, nu + 1)
         v = np.linspace(*self.domain_v, nv + 1)
         uu, vv = (a.ravel() for a in np.meshgrid(u, v, indexing="ij"))
@@ -197,14 +202,25 @@ class _Surface:
         tol = as_scalar(tolerance, "tolerance", where=where, error=GeometryError)
         if tol <= 0:
             raise GeometryError(f"{where}: tolerance = {tol!r} is not positive; give a positive distance")
+        extent = float(np.ptp(self.grid.reshape(-1, 3), axis=0).max())
+        if tol < MIN_RELATIVE_TOLERANCE * extent:
+            raise GeometryError(
+                f"{where}: tolerance = {tol!r} is below {MIN_RELATIVE_TOLERANCE:g} of the surface's extent "
+                f"({extent:.6g}); give tolerance >= {MIN_RELATIVE_TOLERANCE * extent:.3g}"
+            )
         m_uu, m_uv, m_vv = self._second_derivative_bounds()
         width_u = self.domain_u[1] - self.domain_u[0]
         width_v = self.domain_v[1] - self.domain_v[0]
         # split the budget in three: each term <= tol/3
         nu = max(1, math.ceil(width_u * math.sqrt(3 * m_uu / (8 * tol)))) if m_uu > 0 else 1
         nv = max(1, math.ceil(width_v * math.sqrt(3 * m_vv / (8 * tol)))) if m_vv > 0 else 1
-        while 2 * (width_u / nu) * (width_v / nv) * m_uv / 8 > tol / 3:
-            nu, nv = nu + 1, nv + 1
+        # the cross term: the smallest k with (nu + k)(nv + k) >= P, P = 3·2·w_u·w_v·M_uv / (8·tol), closed form
+        product = 3 * 2 * width_u * width_v * m_uv / (8 * tol)
+        if nu * nv < product:
+            k = math.ceil((-(nu + nv) + math.sqrt((nu - nv) ** 2 + 4 * product)) / 2)
+            while (nu + k) * (nv + k) < product:  # float rounding: at most a step or two
+                k += 1
+            nu, nv = nu + k, nv + k
         return nu, nv
 
     def _second_derivative_bounds(self) -> tuple[float, float, float]:

@@ -7,8 +7,12 @@ dithering), so the same frames give the same bytes; MP4 goes through imageio's f
 
 from __future__ import annotations
 
+import contextlib
+import io
 import math
 import os
+import struct
+import tempfile
 from collections.abc import Iterable, Iterator
 from typing import Any
 
@@ -16,6 +20,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from frustum._arrays import as_direction, as_scalar, describe
+from frustum._files import atomic_path, os_reason, track_process
 from frustum.camera import Camera, ViewFrame
 from frustum.errors import CameraError, OutputError
 from frustum.frame import Frame
@@ -80,65 +85,178 @@ def _gif_image(rgb: NDArray[np.uint8], marked: bool) -> Any:
     return image
 
 
+def _gif_frame_block(rgb: NDArray[np.uint8], marked: bool, duration_cs: int) -> bytes:
+    """One GIF frame (graphic control extension, image descriptor, local color table, LZW data) for streaming.
+
+    Pillow encodes the frame as a one-image GIF; its global color table becomes the frame's local table, so
+    every frame is written the moment it is rendered and none is kept ([GIF89a] sections 20, 21, 23).
+    """
+    buffer = io.BytesIO()
+    _gif_image(rgb, marked).save(buffer, format="GIF", optimize=False)
+    data = buffer.getvalue()
+    packed = data[10]
+    position, table, size_bits = 13, b"", 0
+    if packed & 0x80:
+        size_bits = packed & 0x07
+        length = 3 * (2 << size_bits)
+        table, position = data[13 : 13 + length], 13 + length
+    while data[position] == 0x21:  # extensions Pillow may add before the image: skip their sub-blocks
+        position += 2
+        while data[position]:
+            position += data[position] + 1
+        position += 1
+    if data[position] != 0x2C or data[-1] != 0x3B:  # pragma: no cover - Pillow always writes one image
+        raise OutputError("write_animation: Pillow wrote an unexpected GIF layout; cannot stream the frame")
+    descriptor = bytearray(data[position : position + 10])
+    body = data[position + 10 : -1]
+    if not descriptor[9] & 0x80:
+        descriptor[9] = (descriptor[9] & 0x40) | 0x80 | size_bits  # the global table becomes the local one
+        body = table + body
+    control = b"\x21\xf9\x04\x04" + struct.pack("<H", duration_cs) + b"\x00\x00"  # disposal: keep; no transparency
+    return control + bytes(descriptor) + body
+
+
 def _write_gif(frames: Iterator[NDArray[np.uint8]], path: str, fps: float, where: str) -> int:
-    images = []
-    previous: NDArray[np.uint8] | None = None
-    previous_marked = False
-    shape = None
-    for index, rgb in enumerate(frames):
-        if shape is None:
-            shape = rgb.shape
-        elif rgb.shape != shape:
-            raise OutputError(f"{where}: frames[{index}] has shape {rgb.shape}; expected {shape} like the first frame")
-        marked = previous is not None and not previous_marked and np.array_equal(rgb, previous)
-        images.append(_gif_image(rgb, marked))
-        previous, previous_marked = rgb, marked
-    if not images:
-        raise OutputError(f"{where}: frames is empty; an animation needs at least one frame")
     duration = max(20, round(1000.0 / fps / 10) * 10)  # GIF stores centiseconds; browsers treat < 20 ms as slow
-    try:
-        images[0].save(
-            path, format="GIF", save_all=True, append_images=images[1:], duration=duration, loop=0, optimize=False
-        )
-    except OSError as error:
-        raise OutputError(
-            f"{where}: path = {str(path)!r} cannot be written ({error.strerror or error}); give a path in an "
-            "existing, writable folder"
-        ) from None
-    return len(images)
+    count = 0
+    with atomic_path(path, where=where) as temporary:
+        try:
+            with open(temporary, "wb") as file:
+                previous: NDArray[np.uint8] | None = None
+                previous_marked = False
+                for index, rgb in enumerate(frames):
+                    if previous is None:
+                        height, width = rgb.shape[:2]
+                        if max(width, height) > 65535:
+                            raise OutputError(f"{where}: frames[0] is {width}x{height}; GIF allows at most 65535 "
+                                              "pixels a side")  # fmt: skip
+                        file.write(b"GIF89a" + struct.pack("<HHBBB", width, height, 0x70, 0, 0))
+                        file.write(b"\x21\xff\x0bNETSCAPE2.0\x03\x01\x00\x00\x00")  # loop forever
+                    elif rgb.shape != previous.shape:
+                        raise OutputError(f"{where}: frames[{index}] has shape {rgb.shape}; expected "
+                                          f"{previous.shape} like the first frame")  # fmt: skip
+                    # a frame equal to the one before is marked (same picture, other indices) so players and
+                    # Pillow keep it as its own frame
+                    marked = previous is not None and not previous_marked and np.array_equal(rgb, previous)
+                    file.write(_gif_frame_block(rgb, marked, duration // 10))
+                    previous, previous_marked = rgb, marked
+                    count += 1
+                if count == 0:
+                    raise OutputError(f"{where}: frames is empty; an animation needs at least one frame")
+                file.write(b"\x3b")
+        except OSError as error:
+            raise OutputError(
+                f"{where}: path = {str(path)!r} cannot be written ({os_reason(error)}); give a path in an "
+                "existing, writable folder with free space"
+            ) from None
+    return count
 
 
 def _write_mp4(frames: Iterator[NDArray[np.uint8]], path: str, fps: float, where: str) -> int:
+    """Pipe raw RGB frames to ffmpeg (from imageio-ffmpeg) as they come: H.264, yuv420p, crf 25 (imageio's
+    quality 5). frustum owns the process: its exit status reports a failed write, and a failure or Ctrl-C
+    kills it before the temporary file is removed."""
     try:
-        import imageio_ffmpeg  # noqa: F401  (the plugin imageio needs for MP4)
+        import imageio_ffmpeg
     except ImportError:
         raise OutputError(
             f"{where}: path = {str(path)!r} asks for MP4, which needs the imageio-ffmpeg package; install it "
             "(pip install imageio-ffmpeg) or write a '.gif'"
         ) from None
-    import imageio.v2 as imageio
+    import subprocess
+    from fractions import Fraction
 
     count = 0
-    try:
-        writer = imageio.get_writer(path, format="FFMPEG", mode="I", fps=fps, codec="libx264", macro_block_size=1)
-    except OSError as error:
-        raise OutputError(f"{where}: path = {str(path)!r} cannot be written ({error})") from None
-    with writer:
-        for rgb in frames:
-            # yuv420p needs even sizes: repeat the last row / column rather than let imageio rescale
-            writer.append_data(np.pad(rgb, ((0, rgb.shape[0] % 2), (0, rgb.shape[1] % 2), (0, 0)), mode="edge"))
-            count += 1
-    if count == 0:
-        raise OutputError(f"{where}: frames is empty; an animation needs at least one frame")
+    with atomic_path(path, where=where) as temporary:
+        process: subprocess.Popen | None = None
+        try:
+            with contextlib.ExitStack() as stack:
+                for rgb in frames:
+                    # yuv420p needs even sizes: repeat the last row / column rather than let ffmpeg rescale
+                    even = np.pad(rgb, ((0, rgb.shape[0] % 2), (0, rgb.shape[1] % 2), (0, 0)), mode="edge")
+                    if process is None:
+                        height, width = even.shape[:2]
+                        command = [imageio_ffmpeg.get_ffmpeg_exe(), "-y", "-v", "error", "-f", "rawvideo",
+                                   "-vcodec", "rawvideo", "-s", f"{width}x{height}", "-pix_fmt", "rgb24", "-r",
+                                   str(Fraction(fps).limit_denominator()), "-i", "-", "-an", "-vcodec", "libx264",
+                                   "-pix_fmt", "yuv420p", "-crf", "25", "-f", "mp4", str(temporary)]  # fmt: skip
+                        log = stack.enter_context(tempfile.TemporaryFile())
+                        # its own session: a terminal's Ctrl-C reaches frustum, which stops it
+                        process = subprocess.Popen(command, stdin=subprocess.PIPE, stdout=subprocess.DEVNULL,
+                                                   stderr=log, start_new_session=True)  # fmt: skip
+                        stack.enter_context(track_process(process))
+                    elif even.shape[:2] != (height, width):
+                        raise OutputError(f"{where}: frames[{count}] has shape {rgb.shape}; expected the first "
+                                          "frame's size")  # fmt: skip
+                    try:
+                        process.stdin.write(np.ascontiguousarray(even).tobytes())  # type: ignore[union-attr]
+                    except BrokenPipeError:  # ffmpeg stopped: say why (a full disk), not "broken pipe"
+                        process.wait()
+                        log.seek(0)
+                        reason = " ".join(log.read().decode("utf-8", "replace").split())
+                        raise OutputError(
+                            f"{where}: path = {str(path)!r} cannot be written (the encoder stopped: "
+                            f"{_ffmpeg_reason(reason)}); free space or choose another folder"
+                        ) from None
+                    count += 1
+                if process is None:
+                    raise OutputError(f"{where}: frames is empty; an animation needs at least one frame")
+                process.stdin.close()  # type: ignore[union-attr]
+                status = process.wait()
+                log.seek(0)
+                reason = " ".join(log.read().decode("utf-8", "replace").split())
+            if status != 0 or not _complete_mp4(temporary):
+                raise OutputError(
+                    f"{where}: path = {str(path)!r} cannot be written (the encoder could not finish the file: "
+                    f"{_ffmpeg_reason(reason)}); free space or choose another folder"
+                )
+        except (OSError, ValueError) as error:  # a broken pipe: ffmpeg stopped (a full disk, a bad folder)
+            if isinstance(error, OutputError):
+                raise
+            raise OutputError(
+                f"{where}: path = {str(path)!r} cannot be written ({os_reason(error)}); give a path in an "
+                "existing, writable folder with free space"
+            ) from None
     return count
+
+
+def _ffmpeg_reason(log: str) -> str:
+    """The cause in ffmpeg's error output (never its command line)."""
+    for known in ("No space left on device", "File too large", "Permission denied", "Disk quota exceeded"):
+        if known.lower() in log.lower():
+            return known
+    return "the disk is full or the file too large"
+
+
+def _complete_mp4(path: Any) -> bool:
+    """Whether the file is a whole MP4: top-level boxes (32-bit size, type) tile it exactly and one is ``moov``
+    (ffmpeg writes it last, so a truncated file lacks it) [ISO/IEC 14496-12 §4.2]."""
+    size = os.path.getsize(path)
+    position, found = 0, False
+    with open(path, "rb") as file:
+        while position < size:
+            file.seek(position)
+            header = file.read(16)
+            if len(header) < 8:
+                return False
+            length, kind = struct.unpack(">I4s", header[:8])
+            if length == 1 and len(header) == 16:  # 64-bit size
+                length = struct.unpack(">Q", header[8:16])[0]
+            elif length == 0:  # the box runs to the end of the file
+                length = size - position
+            if length < 8 or position + length > size:
+                return False
+            found = found or kind == b"moov"
+            position += length
+    return found
 
 
 def write_animation(frames: Iterable[Frame | ArrayLike], path: str | os.PathLike, fps: float = 30.0) -> int:
     """Write `frames` (``Frame`` objects or (H, W, 3|4) uint8 images, all one size) as a GIF or MP4.
 
     Each frame shows for 1/fps seconds (GIF: rounded to 10 ms, at least 20 ms; it loops forever). Alpha is
-    dropped. Frames are consumed one at a time (an MP4 never holds them all; a GIF keeps the 8-bit palette
-    images until it writes them).
+    dropped. Frames are consumed one at a time and written as they come (neither format holds them all);
+    the file appears under `path` only when complete (an existing one survives a failure or Ctrl-C).
 
     Parameters
     ----------
@@ -213,18 +331,21 @@ def orbit_cameras(camera: Camera, frames: int, axis: str | ArrayLike | None = No
             "Camera.look_at(eye, target, up) so the orbit has a center"
         )
     direction = _axis(axis, camera, where)
-    cameras = []
-    for turn in _turns(direction, frame.target, int(frames)):
-        eye = apply(turn, frame.eye[None, :])[0]
-        up = turn[:3, :3] @ frame.up
-        view = ViewFrame(eye, target=frame.target, up=up, handedness=frame.handedness)
-        cameras.append(Camera(view, camera.projection, camera.width, camera.height))
-    return cameras
+    return [_orbit_camera(camera, turn) for turn in _turns(direction, frame.target, int(frames))]
 
 
-def _turns(direction: NDArray[np.float64], center: NDArray[np.float64], frames: int) -> list[NDArray[np.float64]]:
-    """R(axis, 2πk/frames) about the line through `center`, k = 0 … frames − 1."""
-    return [rotate(direction, 2.0 * math.pi * k / frames, center) for k in range(frames)]
+def _orbit_camera(camera: Camera, turn: NDArray[np.float64]) -> Camera:
+    """`camera` with its eye and up turned by `turn` about its target."""
+    frame = camera.frame
+    eye = apply(turn, frame.eye[None, :])[0]
+    up = turn[:3, :3] @ frame.up
+    view = ViewFrame(eye, target=frame.target, up=up, handedness=frame.handedness)
+    return Camera(view, camera.projection, camera.width, camera.height)
+
+
+def _turns(direction: NDArray[np.float64], center: NDArray[np.float64], frames: int) -> Iterator[NDArray[np.float64]]:
+    """R(axis, 2πk/frames) about the line through `center`, k = 0 … frames − 1, one at a time."""
+    return (rotate(direction, 2.0 * math.pi * k / frames, center) for k in range(frames))
 
 
 def _with_lights_turned(scene: Scene, turn: NDArray[np.float64]) -> Scene:
@@ -236,6 +357,7 @@ def _with_lights_turned(scene: Scene, turn: NDArray[np.float64]) -> Scene:
     )  # fmt: skip
     turned = Scene()
     turned.root = turned_root
+    turned.particle_layers = list(getattr(scene, "particle_layers", ()))  # particles turn with the camera too
     return turned
 
 
@@ -314,17 +436,20 @@ def turntable(
     if camera is None:
         width, height = _size(size, where)
         camera = framing_camera(scene, width, height)
-    cameras = orbit_cameras(camera, frames, axis)
+    if isinstance(frames, bool) or not isinstance(frames, int | np.integer) or frames < 1:
+        orbit_cameras(camera, frames, axis)  # raises orbit_cameras' error for the frame count
+    orbit_cameras(camera, 1, axis)  # checks camera and axis (a one-frame orbit is the camera itself)
     if path is not None:
         _suffix(path, where)
         _fps(fps, where)
-    if lights_follow and cameras:
-        turns = _turns(_axis(axis, camera, where), camera.frame.target, len(cameras))
-        scenes = [_with_lights_turned(scene, turn) for turn in turns]
-    else:
-        scenes = [scene] * len(cameras)
-    jobs = zip(scenes, cameras, strict=True)
-    rendered = _with_progress((render(s, c, **render_options) for s, c in jobs), len(cameras), progress)
+    count = int(frames)
+    turns = _turns(_axis(axis, camera, where), camera.frame.target, count)
+
+    def jobs() -> Iterator[tuple[Scene, Camera]]:  # one frame's scene and camera at a time: none are kept
+        for turn in turns:
+            yield (_with_lights_turned(scene, turn) if lights_follow else scene), _orbit_camera(camera, turn)
+
+    rendered = _with_progress((render(s, c, **render_options) for s, c in jobs()), count, progress)
     if path is None:
         return list(rendered)
     return write_animation(rendered, path, fps)
@@ -340,7 +465,7 @@ def _size(size: Any, where: str) -> tuple[int, int]:
     return int(size[0]), int(size[1])
 
 
-def _with_progress(items: Iterator[Frame], total: int, progress: Any) -> Iterator[Frame]:
+def _with_progress(items: Iterator[Frame], total: int, progress: Any, label: str = "turntable") -> Iterator[Frame]:
     """Yield `items`, advancing a Rich progress bar on a terminal (or on the given Console)."""
     from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
@@ -352,7 +477,7 @@ def _with_progress(items: Iterator[Frame], total: int, progress: Any) -> Iterato
     if not console.is_terminal:
         yield from items
         return
-    columns = (TextColumn("turntable"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn())
+    columns = (TextColumn(label), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn())
     bar = Progress(*columns, console=console, transient=False)
     with bar:
         task = bar.add_task("render", total=total)

@@ -27,6 +27,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from frustum._arrays import as_scalar, describe
+from frustum._files import atomic_path, os_reason
 from frustum.bsp import BSPTree
 from frustum.camera import Camera
 from frustum.clipping import clip_polygon
@@ -504,6 +505,10 @@ def render_svg(
         polygons, used = _fill_polygons(placed, _lights(scene), camera, fill_order)
         body.append(f'<g id="faces" data-order="{used}">{"".join(polygons)}</g>')
     body += _drawing_groups(lines, placed, to_paper, width, hidden, bool(depth_cue), camera=camera)
+    if getattr(scene, "particle_layers", None):  # dots and segments over the drawing (output/svg_particles.py)
+        from frustum.output.svg_particles import particle_elements
+
+        body += particle_elements(scene, camera)
     return svg_document(camera.width, camera.height, body)
 
 
@@ -532,16 +537,43 @@ def save_svg(svg_text: str, path: str | os.PathLike) -> Path:
     suffix = target.suffix.lower()
     if suffix not in (".svg", ".pdf", ".png"):
         raise OutputError(f"{where}: path = {str(target)!r} has suffix {suffix!r}; expected '.svg', '.pdf' or '.png'")
-    try:
-        if suffix == ".svg":
-            target.write_text(svg_text, encoding="utf-8")
-        else:
+    convert = None
+    if suffix != ".svg":
+        try:
             import cairosvg
-
-            convert = cairosvg.svg2pdf if suffix == ".pdf" else cairosvg.svg2png
-            convert(bytestring=svg_text.encode("utf-8"), write_to=str(target))
-    except OSError as error:
-        raise OutputError(
-            f"{where}: path = {str(target)!r} cannot be written ({error.strerror}); choose a writable location"
-        ) from None
+        except ImportError:
+            raise OutputError(
+                f"{where}: path = {str(target)!r} asks for {suffix[1:].upper()}, which needs the cairosvg package "
+                "(pip install cairosvg); or write a '.svg'"
+            ) from None
+        convert = cairosvg.svg2pdf if suffix == ".pdf" else cairosvg.svg2png
+    with atomic_path(target, where=where) as temporary:  # the old file survives a failed or interrupted write
+        try:
+            if convert is None:
+                temporary.write_text(svg_text, encoding="utf-8")
+            else:
+                convert(bytestring=svg_text.encode("utf-8"), write_to=str(temporary))
+        except (OSError, MemoryError) as error:
+            raise OutputError(
+                f"{where}: path = {str(target)!r} cannot be written ({os_reason(error)}); choose a writable "
+                "location with free space"
+            ) from None
+        except Exception as error:  # cairo reports a failed write as its own error with a status number
+            raise OutputError(
+                f"{where}: path = {str(target)!r} cannot be written: cairo failed ({_cairo_reason(error)}); choose "
+                "a writable location with free space"
+            ) from None
     return target
+
+
+def _cairo_reason(error: Exception) -> str:
+    """cairo's status as words: ``(11)`` is CAIRO_STATUS_WRITE_ERROR, a full disk or a lost file."""
+    status = getattr(error, "status", None)
+    if status is None and error.args and isinstance(error.args[-1], int):
+        status = error.args[-1]
+    words = {1: "out of memory", 11: "write error: the disk is full or the file cannot be written",
+             13: "invalid size: the drawing is too large"}  # fmt: skip
+    if isinstance(status, int) and status in words:
+        return words[status]
+    text = " ".join(str(error).split())
+    return text[:120] if text else type(error).__name__

@@ -124,7 +124,7 @@ def _row_span(a, b, grid, row, box):  # pragma: no cover - compiled
     return max(first, box[0]), min(last, box[2])
 
 
-@parallel_kernel(lambda seg, *_: seg.shape[0])
+@parallel_kernel(lambda seg, *_: seg.shape[0], grain=256)
 def _segment_intervals(
     seg, lengths, boxes, edge_faces, occluders, occluder_faces, tri_boxes, cell_starts, cell_triangles,
     grid, tolerances, counts, offsets, out, write, start, stop,

@@ -140,7 +140,7 @@ def _illuminate(
     return dr, dg, db, sr, sg, sb
 
 
-@parallel_kernel(lambda world, *_: world.shape[0])
+@parallel_kernel(lambda world, *_: world.shape[0], grain=1024)
 def light_vertices(
     world: np.ndarray, normals: np.ndarray, params: np.ndarray, lights: np.ndarray, specular_model: int,
     lit: np.ndarray,
@@ -156,7 +156,7 @@ def light_vertices(
             lit[v, k] = terms[k]
 
 
-@parallel_kernel(lambda world, faces, *_: faces.shape[0])
+@parallel_kernel(lambda world, faces, *_: faces.shape[0], grain=1024)
 def light_faces(
     world: np.ndarray, faces: np.ndarray, params: np.ndarray, lights: np.ndarray, specular_model: int,
     lit: np.ndarray,
@@ -290,7 +290,7 @@ def _cue(params: np.ndarray, r: float, g: float, b: float, d: float) -> tuple[fl
     return f * r + (1.0 - f) * cue[0], f * g + (1.0 - f) * cue[1], f * b + (1.0 - f) * cue[2]
 
 
-@parallel_kernel(lambda depth, codes, *_: codes.shape[0])
+@parallel_kernel(lambda depth, codes, *_: codes.shape[0], work=lambda depth, *_: depth.size, grain=16384)
 def shade_pixels(
     depth: np.ndarray, codes: np.ndarray, bary: np.ndarray, faces: np.ndarray, world: np.ndarray, normals: np.ndarray,
     lit: np.ndarray, vertex_colors: np.ndarray, uvs: np.ndarray, texture: np.ndarray,
@@ -373,7 +373,8 @@ _NX, _NY, _NZ, _SIGN, _PX, _PY, _PZ, _VX, _VY, _VZ, _X, _NDL, _POW, _DR, _DG, _D
 _FIELDS = 19
 
 
-@parallel_kernel(lambda depth, codes, *_: (codes.shape[0] + _ROWS - 1) // _ROWS)
+@parallel_kernel(lambda depth, codes, *_: (codes.shape[0] + _ROWS - 1) // _ROWS,
+                 work=lambda depth, *_: depth.size, grain=16384)
 def shade_pixels_directional(
     depth: np.ndarray, codes: np.ndarray, bary: np.ndarray, faces: np.ndarray, world: np.ndarray,
     normals: np.ndarray, params: np.ndarray, lights: np.ndarray, item: np.ndarray, color: np.ndarray,

@@ -157,7 +157,7 @@ def _setup_triangle(
     return 1
 
 
-@parallel_kernel(lambda crossing, *_: crossing.shape[0])
+@parallel_kernel(lambda crossing, *_: crossing.shape[0], grain=64)
 def clip_faces(
     crossing: np.ndarray, faces: np.ndarray, vertices: np.ndarray, clip_from_model: np.ndarray,
     planes: np.ndarray, view: np.ndarray, options: np.ndarray, record_starts: np.ndarray,
@@ -196,7 +196,7 @@ def clip_faces(
             record_starts[k] = made
 
 
-@parallel_kernel(lambda depth, *_: depth.shape[0])
+@parallel_kernel(lambda depth, *_: depth.shape[0], work=lambda depth, *_: depth.size, grain=65536)
 def clear_buffers(depth: np.ndarray, color: np.ndarray, background: np.ndarray, start: int, stop: int) -> None:
     """Depth 1.0 (far) and the background color bytes (4,) everywhere, row by row (parallel over rows: clearing
     tile by tile, 128-byte pieces of rows, ran at a quarter of the bandwidth). Face codes need no clearing: a
@@ -303,7 +303,8 @@ def _fill_tile(
                 e2 -= dy2 * SUBPIXEL
 
 
-@parallel_kernel(lambda *args: args[6].shape[0] - 1)  # tile_starts: tiles + 1
+@parallel_kernel(lambda *args: args[6].shape[0] - 1, work=lambda *args: args[7].shape[0], grain=256)
+# items: tiles (tile_starts has tiles + 1 entries); work: the tile entries (tile_entries)
 def rasterize_tiles(
     faces: np.ndarray, win_int: np.ndarray, win_float: np.ndarray, tri_int: np.ndarray, tri_float: np.ndarray,
     tri_weights: np.ndarray, tile_starts: np.ndarray, tile_entries: np.ndarray, tiling: np.ndarray,

@@ -77,7 +77,7 @@ def view_volume_code(cx: float, cy: float, cz: float, cw: float) -> int:
     return code
 
 
-@parallel_kernel(lambda vertices, *_: vertices.shape[0])
+@parallel_kernel(lambda vertices, *_: vertices.shape[0], grain=4096)
 def project_vertices(
     vertices: np.ndarray, clip_from_model: np.ndarray, view: np.ndarray,
     win_int: np.ndarray, win_float: np.ndarray, codes: np.ndarray,
@@ -105,7 +105,7 @@ def project_vertices(
         win_float[i, 1] = 1.0 / cw
 
 
-@parallel_kernel(lambda vertices, *_: vertices.shape[0])
+@parallel_kernel(lambda vertices, *_: vertices.shape[0], grain=4096)
 def world_points(vertices: np.ndarray, world_from_model: np.ndarray, world: np.ndarray, start: int, stop: int) -> None:
     """``world = world_from_model·P`` per vertex (world (N, 3) float64, written)."""
     for i in range(start, stop):
@@ -114,7 +114,7 @@ def world_points(vertices: np.ndarray, world_from_model: np.ndarray, world: np.n
             world[i, k] = _affine_row(world_from_model, k, x, y, z)
 
 
-@parallel_kernel(lambda normals, *_: normals.shape[0])
+@parallel_kernel(lambda normals, *_: normals.shape[0], grain=4096)
 def transform_normals(normals: np.ndarray, normal_matrix: np.ndarray, out: np.ndarray, start: int, stop: int) -> None:
     """``n' = N·n / |N·n|`` per vertex, N the 3x3 block of normal_matrix (out (N, 3) float64, written)."""
     for i in range(start, stop):
@@ -125,7 +125,7 @@ def transform_normals(normals: np.ndarray, normal_matrix: np.ndarray, out: np.nd
         out[i, 0], out[i, 1], out[i, 2] = nx / length, ny / length, nz / length
 
 
-@parallel_kernel(lambda vertices, *_: vertices.shape[0])
+@parallel_kernel(lambda vertices, *_: vertices.shape[0], grain=4096)
 def transform_vertices(
     vertices: np.ndarray, normals: np.ndarray, matrices: np.ndarray, planes: np.ndarray,
     clip: np.ndarray, world: np.ndarray, world_normals: np.ndarray, codes: np.ndarray,

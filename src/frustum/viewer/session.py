@@ -1,0 +1,389 @@
+"""One viewer's state and its message protocol, shared by the Jupyter widget and ``frustum serve``.
+
+The page sends small JSON messages (pointer, wheel, key, control, pick); ``ViewerSession.handle`` validates
+each one (anything malformed or out of range is ignored and ``handle`` returns None) and says what to send back:
+
+============================================================  ================================================
+message                                                       effect
+============================================================  ================================================
+``{"type": "pointer", "action": "down", "x", "y", "button",   start an orbit drag (button 0) or a pan (button
+"shift"}``                                                    1 or 2, or shift held); x, y in image pixels, y down
+``{"type": "pointer", "action": "move", "x", "y"}``           drag: a low-resolution frame ("interactive")
+``{"type": "pointer", "action": "up"}``                       end the drag: a full frame ("rest")
+``{"type": "wheel", "delta"}``                                zoom: "interactive" (the page asks for "rest")
+``{"type": "rest"}``                                          the full-resolution, supersampled frame
+``{"type": "key", "key"}``                                    a preset or reset (``interaction.KEYS``)
+``{"type": "control", "name", "value"}``                      projection, shading, mode, depth_cue
+``{"type": "reset"}``                                         back to the starting camera
+``{"type": "pick", "x", "y"}``                                pick the surface point under pixel (x, y)
+============================================================  ================================================
+
+Frames go back as a header (``frame_header``, with the ``state()`` of the view it shows under ``"state"``) and
+the raw RGBA bytes of ``Frame.color`` (top row first, the layout of the browser's ``ImageData``): while the
+pointer drags, at half the width and height with one sample; at rest, at full size with ``rest_samples`` samples
+per pixel.
+
+Picking reads the depth buffer of a full-size frame: pixel (column c, row r from the top) is the window point
+``(c + 0.5, H − r − 0.5, depth[r, c])``, which ``Camera.unproject`` maps back to the world
+(``P = (window_from_world)⁻¹·(x, y, depth, 1)`` then divide by w); the frame's ``object_id`` buffer names the
+scene item, whose inverse modeling transformation gives the point in modeling coordinates, and
+``frustum.trace`` follows it through every stage.
+
+References: [HB 10] "The Three-Dimensional Viewing Pipeline"; [HB 16] "Depth-Buffer Method".
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from frustum._arrays import describe
+from frustum.camera import Camera
+from frustum.clipping import REGION_BOTTOM, REGION_FAR, REGION_LEFT, REGION_NEAR, REGION_RIGHT, REGION_TOP
+from frustum.errors import FrustumError
+from frustum.frame import Frame
+from frustum.scene import Scene
+from frustum.shading import DepthCue
+from frustum.transforms import apply
+from frustum.viewer.interaction import PROJECTIONS, CameraControl
+
+__all__ = ["CONTROLS", "MODES", "SHADINGS", "ViewerSession", "scene_bounds"]
+
+SHADINGS = ("phong", "gouraud", "flat", "normals", "depth", "none")
+"""Shading models the viewer offers (``render``'s ``shading``)."""
+MODES = ("surface", "wireframe", "hidden-line", "surface+edges")
+"""Render modes the viewer offers (``render``'s ``mode``)."""
+CONTROLS: dict[str, tuple[Any, ...]] = {
+    "projection": PROJECTIONS,
+    "shading": SHADINGS,
+    "mode": MODES,
+    "depth_cue": (False, True),
+}
+"""Each control's allowed values."""
+_REGIONS = (
+    (REGION_LEFT, "left"),
+    (REGION_RIGHT, "right"),
+    (REGION_BOTTOM, "bottom"),
+    (REGION_TOP, "top"),
+    (REGION_NEAR, "near"),
+    (REGION_FAR, "far"),
+)
+
+
+def scene_bounds(scene: Scene) -> tuple[np.ndarray, float]:
+    """(center, radius) of a sphere holding every placed mesh and polyline (world coordinates); unit at 0 if empty."""
+    lows, highs = [], []
+    for item in (*scene.items, *scene.polylines):
+        points = getattr(item.mesh, "vertices", None)
+        if points is None:
+            points = item.mesh.points
+        if len(points):
+            world = apply(item.world_from_model, points)
+            lows.append(world.min(axis=0))
+            highs.append(world.max(axis=0))
+    if not lows:
+        return np.zeros(3), 1.0
+    low, high = np.min(lows, axis=0), np.max(highs, axis=0)
+    radius = float(np.linalg.norm(high - low)) / 2.0
+    return (low + high) / 2.0, radius if radius > 0.0 else 1.0
+
+
+def _number(value: Any) -> float | None:
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        return None
+    return float(value) if math.isfinite(value) else None
+
+
+class ViewerSession:
+    """The state behind one view: scene, render options, camera control and controls (see the module docstring).
+
+    Parameters
+    ----------
+    scene : Scene
+    camera : Camera, optional
+        The starting camera (its size is the image size); default: a perspective view fitting the scene,
+        800×600.
+    options : mapping, optional
+        ``render`` keywords (a scene file's ``SceneFile.options``); the controls override shading, mode and
+        depth_cue.
+    rest_samples : int
+        Samples per pixel of the frame drawn when the pointer rests (``render``'s `samples`, a square).
+
+    Raises
+    ------
+    FrustumError
+        If `scene` is not a Scene, `camera` not a Camera, or `rest_samples` not a square (1, 4, 9, ...).
+    """
+
+    def __init__(
+        self,
+        scene: Scene,
+        camera: Camera | None = None,
+        options: Mapping[str, Any] | None = None,
+        *,
+        rest_samples: int = 4,
+    ) -> None:
+        if (
+            isinstance(rest_samples, bool)
+            or not isinstance(rest_samples, int)
+            or rest_samples < 1
+            or math.isqrt(rest_samples) ** 2 != rest_samples
+        ):
+            raise FrustumError(
+                f"Viewer: rest_samples = {describe(rest_samples)} is not a square number of samples; "
+                "expected 1, 4, 9, 16, ..."
+            )
+        self.error: str | None = None
+        self.control: CameraControl
+        self.set_scene(scene, camera, options)
+        self.rest_samples = rest_samples
+        self.frames = 0
+
+    def set_scene(self, scene: Scene, camera: Camera | None = None, options: Mapping[str, Any] | None = None) -> None:
+        """Show `scene` (a reloaded file): keep the current view if there is one, and the new home camera."""
+        where = "Viewer"
+        if not isinstance(scene, Scene):
+            raise FrustumError(
+                f"{where}: scene = {describe(scene)} is not a Scene; build one with Scene() or load_scene_file"
+            )
+        if camera is not None and not isinstance(camera, Camera):
+            raise FrustumError(f"{where}: camera = {describe(camera)} is not a Camera; build one with Camera.look_at")
+        center, radius = scene_bounds(scene)
+        if camera is not None:
+            eye_distance = float(np.linalg.norm(np.asarray(camera.frame.eye) - center))
+            home = CameraControl.from_camera(camera, radius=max(radius, 1e-6 * eye_distance))
+        else:
+            home = CameraControl.fitting(center, radius)
+        previous = getattr(self, "control", None)
+        if previous is not None:
+            state = previous.state()  # keep the user's view; take the file's image size and scene radius
+            state.update(radius=home.radius, width=home.width, height=home.height)
+            home_state = home.state()
+            self.control = CameraControl.from_state(state)
+            self.control.home = home_state
+        else:
+            self.control = home
+        base = dict(options or {})
+        self.options = {
+            key: value for key, value in base.items() if key not in ("shading", "mode", "depth_cue", "samples")
+        }
+        shading = base.get("shading", "phong")
+        self.controls = {
+            "projection": self.control.projection,
+            "shading": "none" if shading is None else shading,
+            "mode": base.get("mode", "surface") if base.get("mode", "surface") in MODES else "surface",
+            "depth_cue": base.get("depth_cue") is not None,
+        }
+        self._file_depth_cue = base.get("depth_cue")
+        self.scene = scene
+
+    # --- messages -----------------------------------------------------------------------------------------
+
+    def handle(self, message: Any) -> str | None:
+        """Apply one page message; returns "interactive", "rest", "pick" or "" (nothing to draw), None if ignored."""
+        if not isinstance(message, Mapping):
+            return None
+        kind = message.get("type")
+        control = self.control
+        if kind == "pointer":
+            action = message.get("action")
+            if action == "down":
+                button = message.get("button", 0)
+                if isinstance(button, bool) or button not in (0, 1, 2):
+                    return None
+                drag = "pan" if button != 0 or message.get("shift") is True else "orbit"
+                return "" if control.begin_drag(message.get("x"), message.get("y"), drag) else None
+            if action == "move":
+                return "interactive" if control.drag_to(message.get("x"), message.get("y")) else None
+            if action == "up":
+                return "rest" if control.end_drag() else None
+            return None
+        if kind == "wheel":
+            return "interactive" if control.wheel(message.get("delta")) else None
+        if kind == "rest":
+            return "rest"
+        if kind == "key":
+            if not control.key(message.get("key")):
+                return None
+            self.controls["projection"] = control.projection
+            return "rest"
+        if kind == "reset":
+            control.reset()
+            self.controls["projection"] = control.projection
+            return "rest"
+        if kind == "control":
+            name, value = message.get("name"), message.get("value")
+            if name not in CONTROLS or isinstance(value, bool) != (name == "depth_cue"):
+                return None
+            if value not in CONTROLS[name]:
+                return None
+            self.controls[name] = value
+            if name == "projection":
+                control.set_projection(value)
+            return "rest"
+        if kind == "pick":
+            x, y = _number(message.get("x")), _number(message.get("y"))
+            if x is None or y is None or not (0.0 <= x < control.width and 0.0 <= y < control.height):
+                return None
+            return "pick"
+        return None
+
+    # --- frames -------------------------------------------------------------------------------------------
+
+    def render_options(self, quality: str = "rest") -> dict[str, Any]:
+        """The ``render`` keywords of a frame of `quality` ("interactive" or "rest")."""
+        options = dict(self.options)
+        options["shading"] = self.controls["shading"]
+        options["mode"] = self.controls["mode"]
+        options["samples"] = 1 if quality == "interactive" else self.rest_samples
+        if self.controls["depth_cue"]:
+            cue = self._file_depth_cue
+            if cue is None:
+                d, r = self.control.distance, self.control.radius
+                cue = DepthCue(max(0.0, d - r), d + r, min_intensity=0.15)
+            options["depth_cue"] = cue
+        return options
+
+    def camera(self, quality: str = "rest") -> Camera:
+        """The camera of the current state: full size at rest, half width and height while interacting."""
+        control = self.control
+        if quality == "interactive":
+            return control.camera(max(1, control.width // 2), max(1, control.height // 2))
+        return control.camera()
+
+    def render(self, quality: str = "rest") -> Frame:
+        """Render the current view at `quality`."""
+        from frustum.render import render
+
+        self.frames += 1
+        return render(self.scene, self.camera(quality), **self.render_options(quality))
+
+    def frame_header(self, frame: Frame, quality: str, seq: Any = None) -> dict[str, Any]:
+        """The JSON header sent before a frame's RGBA bytes."""
+        height, width = frame.depth.shape
+        return {"type": "frame", "width": width, "height": height, "quality": quality,
+                "seq": seq if isinstance(seq, int) and not isinstance(seq, bool) else None}  # fmt: skip
+
+    def state(self) -> dict[str, Any]:
+        """Camera state, the three matrices of the full-size camera (column-vector form), controls and error."""
+        camera = self.control.camera()
+        return {
+            "type": "state",
+            "camera": self.control.state(),
+            "zoom": self.control.zoom,
+            "matrices": {
+                "view": camera.view_matrix.tolist(),
+                "projection": camera.projection_matrix.tolist(),
+                "viewport": camera.viewport_matrix.tolist(),
+            },
+            "controls": dict(self.controls),
+            "choices": {name: list(values) for name, values in CONTROLS.items()},
+            "error": self.error,
+        }
+
+    def replies(self, messages: Any) -> list[tuple[dict[str, Any], bytes | None]]:
+        """What to send back for page messages (one, or a list that arrived together): (JSON header, RGBA bytes
+        or None) pairs, in order: picks, then at most one frame (its header holding the state).
+
+        The messages are applied in order and the view is rendered once, at rest quality if any of them asks
+        for it; the frame header carries the last ``seq`` seen (the page measures latency with it). A pick is
+        answered where it comes. ``{"type": "hello"}`` (a page that has just opened) gets the state and a rest
+        frame; if every message was ignored the answer is ``{"type": "ignored"}`` (the page then sends its next
+        pointer move). A render that fails (a ``FrustumError``, e.g. over the work budget) is answered with
+        ``{"type": "error", "message": ...}``, shown above the picture.
+        """
+        batch = [messages] if isinstance(messages, Mapping) or not isinstance(messages, list | tuple) else messages
+        out: list[tuple[dict[str, Any], bytes | None]] = []
+        quality: str | None = None
+        seq = None
+        ignored = False
+        for message in batch:
+            action = "rest" if isinstance(message, Mapping) and message.get("type") == "hello" else self.handle(message)
+            if action is None:
+                ignored = True
+            elif action == "pick":
+                try:
+                    out.append((self.pick(message["x"], message["y"]), None))
+                except FrustumError as error:
+                    out.append(({"type": "error", "message": str(error)}, None))
+            elif action:
+                quality = "rest" if "rest" in (quality, action) else action
+                if isinstance(message.get("seq"), int):
+                    seq = message["seq"]
+        if quality is not None:
+            try:
+                frame = self.render(quality)
+            except FrustumError as error:  # e.g. over the work budget: say so on the page, keep serving
+                return [*out, ({"type": "error", "message": str(error)}, None)]
+            header = self.frame_header(frame, quality, seq)
+            header["state"] = self.state()  # the panel's numbers travel with the picture they belong to
+            out.append((header, frame.color.tobytes()))
+        elif ignored and not out:
+            out.append(({"type": "ignored"}, None))
+        return out
+
+    # --- picking ------------------------------------------------------------------------------------------
+
+    def pick(self, x: float, y: float) -> dict[str, Any]:
+        """The surface point under image position (x, y) (pixels, y down) and its trace, as JSON values.
+
+        Returns ``{"type": "pick", "hit": False, ...}`` on background, else ``hit``, ``pixel`` (column, row),
+        ``window`` (x, y up, depth), ``world``, ``item`` (index in ``scene.items`` or None for a line),
+        ``label`` and ``stages``: for each stage of ``frustum.trace`` its name, title, description, matrix
+        (column form, or None) and the point's coordinates; the clipping stage adds the region code and the
+        names of its set bits.
+        """
+        from frustum.render import render
+        from frustum.trace import trace
+
+        camera = self.control.camera()
+        column, row = int(x), int(y)
+        options = self.render_options("rest")
+        options["samples"] = 1
+        options["buffers"] = ("object_id",)
+        frame = render(self.scene, camera, **options)
+        depth = float(frame.depth[row, column])
+        result: dict[str, Any] = {"type": "pick", "pixel": [column, row], "hit": False}
+        if not depth < 1.0:
+            result["label"] = "background: nothing drawn at this pixel"
+            return result
+        window = np.array([column + 0.5, camera.height - row - 0.5, depth])
+        world = camera.unproject(window)
+        assert frame.object_id is not None
+        index = int(frame.object_id[row, column])
+        if index >= 0:
+            item = self.scene.items[index]
+            world_from_model = np.asarray(item.world_from_model, dtype=np.float64)
+            point_model = apply(np.linalg.inv(world_from_model), world[None, :])
+            label = f"scene item {index}: {item.mesh.vertex_count}-vertex mesh"
+        else:  # a line or point pixel: no item index, so modeling coordinates = world coordinates
+            world_from_model = np.eye(4)
+            point_model = world[None, :]
+            label = "a line (no mesh item): modeling coordinates shown as world coordinates"
+        traced = trace(point_model, camera, model=world_from_model)
+        stages = []
+        for stage in traced.stages:
+            entry: dict[str, Any] = {
+                "name": stage.name,
+                "title": stage.title,
+                "description": stage.description,
+                "matrix": None if stage.matrix is None else stage.matrix.tolist(),
+                "point": stage.points[0].tolist(),
+            }
+            if stage.codes is not None:
+                code = int(stage.codes[0])
+                entry["code"] = code
+                entry["regions"] = [name for bit, name in _REGIONS if code & bit]
+            stages.append(entry)
+        result.update(
+            hit=True,
+            window=window.tolist(),
+            world=world.tolist(),
+            item=index if index >= 0 else None,
+            label=label,
+            stages=stages,
+        )
+        return result
