@@ -430,3 +430,23 @@ def test_octrees_are_drawn_by_every_method_as_their_cell_faces() -> None:
     assert (reference.depth < 1.0).sum() > 100
     for method in ("scan-line", "area-subdivision", "bsp"):
         assert_same_picture(render(scene, camera, method=method), reference)
+
+
+def test_parallel_methods_give_the_same_bytes_and_counts_on_any_number_of_threads() -> None:
+    from frustum.raster._jit import set_threads
+
+    scene, camera = soup_scene(6)
+    scene.add(quad(-1, -1, 1, 1, 0.3), material=Material(color=(0.9, 0.9, 0.2), opacity=0.5))
+    try:
+        results = []
+        for count in (1, 3, 7):
+            set_threads(count)
+            results.append(
+                [render(scene, camera, method=m, transparency="a-buffer") for m in ("scan-line", "a-buffer")]
+            )
+    finally:
+        set_threads(None)
+    for frames in results[1:]:
+        for frame, first in zip(frames, results[0], strict=True):
+            assert frame.color.tobytes() == first.color.tobytes() and frame.depth.tobytes() == first.depth.tobytes()
+            assert frame.stats == first.stats
