@@ -98,7 +98,10 @@ def table(title: str, results: dict, points: list[int]) -> str:
 
 
 def plot(results: dict, x_of, xlabel: str, title: str, path: Path) -> None:
-    import matplotlib
+    try:
+        import matplotlib
+    except ImportError:
+        raise SystemExit("--plots needs Matplotlib: pip install 'frustum[bench]'") from None
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
