@@ -322,7 +322,9 @@ _LAZY = {
     "SHADING_MODES": "frustum.render",
     "STEREO_LAYOUTS": "frustum.output.stereo",
     "SceneFile": "frustum.scenefile",
+    "VISIBILITY_METHODS": "frustum.render",
     "anaglyph": "frustum.output.stereo",
+    "explain_method": "frustum.scenefile",
     "explain_scene_file": "frustum.scenefile",
     "load_scene": "frustum.scenefile",
     "load_scene_file": "frustum.scenefile",
@@ -354,9 +356,10 @@ if TYPE_CHECKING:  # pragma: no cover
         side_by_side,
     )
     from frustum.raster._jit import set_threads
-    from frustum.render import RENDER_METHODS, RENDER_MODES, SHADING_MODES, release_memory, render
+    from frustum.render import RENDER_METHODS, RENDER_MODES, SHADING_MODES, VISIBILITY_METHODS, release_memory, render
     from frustum.scenefile import (
         SceneFile,
+        explain_method,
         explain_scene_file,
         load_scene,
         load_scene_file,
@@ -430,6 +433,7 @@ __all__ = [
     "SUPPORTED_SUFFIXES",
     "TRANSFER_PRESETS",
     "VIEW_VOLUME_PLANES",
+    "VISIBILITY_METHODS",
     "VOLUME_MODES",
     "AmbientLight",
     "Attractor",
@@ -565,6 +569,7 @@ __all__ = [
     "drawing_sheet",
     "ellipsoid",
     "escape_time_colors",
+    "explain_method",
     "explain_scene_file",
     "exploded",
     "fbm_cloud",

@@ -423,9 +423,19 @@ def explain_command(
     point: Annotated[str | None, typer.Option(help="A world point x,y,z (default: the scene's vertices).")] = None,
     markdown: Annotated[bool, typer.Option("--markdown", help="Print Markdown instead of tables.")] = False,
     latex: Annotated[bool, typer.Option("--latex", help="Print LaTeX instead of tables.")] = False,
+    method: Annotated[
+        str | None,
+        typer.Option(help="A visible-surface method (scan-line, area-subdivision, a-buffer, ...): print its counts."),
+    ] = None,
 ) -> None:
-    """Print every stage of the pipeline (matrices in column- and row-vector form) for the scene's camera."""
-    from frustum.scenefile import explain_scene_file
+    """Print every stage of the pipeline (matrices in column- and row-vector form) for the scene's camera; with
+    --method, what that visible-surface method counted drawing the scene (spans, areas per level, fragments …)."""
+    from frustum.scenefile import explain_method, explain_scene_file
+
+    if method is not None:
+        for key, value in explain_method(scene, method).items():
+            console.print(f"{key:>24}  {value}", markup=False, highlight=False, soft_wrap=True)
+        return
 
     trace = explain_scene_file(scene, _vector3(point, "--point") if point else None)
     if markdown or latex:

@@ -22,13 +22,16 @@ class Frame:
     images are stored). ``depth`` is window depth in [0, 1], 1.0 where nothing was drawn. Color is linear RGB,
     not sRGB-encoded unless asked for. Optional buffers (``render(..., buffers=...)``): ``normals`` (H, W, 3)
     float32 unit world normals (0 where nothing was drawn) and ``object_id`` (H, W) int32, the index of the
-    scene item seen at each pixel (−1 for background). All arrays are read-only.
+    scene item seen at each pixel (−1 for background). All arrays are read-only. ``stats``: the visible-surface
+    method's counts (``render(..., method=...)``; spans, areas per level, depth tests, fragments per pixel …),
+    with ``stats["method"]`` its name, or None where none were asked for.
     """
 
     color: NDArray[np.uint8]
     depth: NDArray[np.float32]
     normals: NDArray[np.float32] | None = None
     object_id: NDArray[np.int32] | None = None
+    stats: dict | None = None
 
     def __post_init__(self) -> None:
         color = np.ascontiguousarray(self.color)

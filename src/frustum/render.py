@@ -59,8 +59,8 @@ from frustum.scene import Scene, SceneItem
 from frustum.shading import SPECULAR_MODELS, DepthCue, pack_lights
 
 __all__ = [
-    "HIDDEN_STYLES", "RENDER_METHODS", "RENDER_MODES", "SHADING_MODES", "TILE_SIZE", "mesh_edges", "release_memory",
-    "render",
+    "HIDDEN_STYLES", "RENDER_METHODS", "RENDER_MODES", "SHADING_MODES", "TILE_SIZE", "TRANSPARENCY_MODES",
+    "VISIBILITY_METHODS", "mesh_edges", "release_memory", "render",
 ]  # fmt: skip
 
 SHADING_MODES = {
@@ -104,6 +104,9 @@ class _Options:
     line_width: float
     depth_cue: DepthCue | None
     buffers: tuple[str, ...]
+    method: str = "depth-buffer"
+    transparency: str = "sort"
+    counts: dict | None = None  # the method's counts (Frame.stats), filled while drawing
 
 
 class Scratch:
@@ -186,6 +189,8 @@ def render(
     color_space: str = "linear",
     buffers: tuple[str, ...] = (),
     method: str = "depth-buffer",
+    transparency: str = "sort",
+    stats: bool = False,
 ) -> Frame:
     """Render `scene` seen by `camera` into a ``Frame`` (color (H, W, 4) uint8 and depth (H, W) float32).
 
@@ -235,11 +240,20 @@ def render(
     buffers : tuple of {"normals", "object_id"}
         Extra per-pixel outputs on the Frame: unit world normals (0 on background) and the index of the item
         in ``scene.items`` (−1 on background).
-    method : {"depth-buffer", "octree"}
-        The visible-surface method (``RENDER_METHODS``). ``"depth-buffer"``: the meshes, as described above.
-        ``"octree"``: the scene's octrees (``Scene.octrees``) by ``visibility.octree.render_octree``, front to
-        back, each face orientation shaded once with the scene's lights; only `background` of the other
-        options applies, and meshes are not drawn.
+    method : str
+        The visible-surface method (``RENDER_METHODS``, docs/visibility.md). For the meshes
+        (``VISIBILITY_METHODS``): ``"depth-buffer"`` (the default), ``"scan-line"``, ``"area-subdivision"``
+        (Warnock), ``"depth-sort"``, ``"bsp"`` or ``"a-buffer"`` (anti-aliased edges, exact transparency). All
+        shade with the same model, so where they find the same surface they give the same bytes. Surface modes
+        only; each returns its counts in ``Frame.stats``. ``"octree"``: the scene's octrees (``Scene.octrees``)
+        by ``visibility.octree.render_octree``, front to back, each face orientation shaded once with the
+        scene's lights; only `background` of the other options applies, and meshes are not drawn.
+    transparency : {"sort", "a-buffer"}
+        How transparent items are composited: whole items back to front by the view distance of their centres
+        (fast; right for transparent objects that do not cut through or overlap each other cyclically), or
+        per subsample through an A-buffer (exact whatever the order, anti-aliased edges; costs fragment memory).
+    stats : bool
+        ``method="depth-buffer"`` only: also count its depth tests (an extra counting pass) into ``Frame.stats``.
 
     Raises
     ------
@@ -253,7 +267,7 @@ def render(
     [seed] "Back-face detection", "Depth-buffer method", "wire-frame displays".
     """
     where = "render"
-    _choice(method, tuple(RENDER_METHODS), "method", where)
+    _check_method(method, where)
     if RENDER_METHODS[method] is not None:
         return RENDER_METHODS[method](scene, camera, background=background)
     options = _check_arguments(
@@ -261,6 +275,7 @@ def render(
         hidden, hidden_color, line_width, depth_cue, buffers, where,
     )  # fmt: skip
     factor = _supersampling(samples, where)
+    options = _method_options(options, method, transparency, stats, where)
     _choice(filter, FILTERS, "filter", where)
     _choice(color_space, COLOR_SPACES, "color_space", where)
     _check_image_budget(camera, factor, options.buffers, filter, color_space, where)
@@ -289,7 +304,7 @@ def render(
         linear = values
     if linear is not None:
         color = np.floor(np.clip(linear, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
-    return Frame(color=color, depth=depth, normals=normals, object_id=ids)
+    return Frame(color=color, depth=depth, normals=normals, object_id=ids, stats=options.counts)
 
 
 def _render_octrees(scene: Scene, camera: Camera, *, background: Any) -> Frame:
@@ -314,8 +329,12 @@ def _render_octrees(scene: Scene, camera: Camera, *, background: Any) -> Frame:
     return Frame(color=color, depth=depth)
 
 
-RENDER_METHODS = {"depth-buffer": None, "octree": _render_octrees}
-"""Visible-surface methods of ``render(..., method=...)``: None is the built-in depth-buffer pipeline."""
+RENDER_METHODS = {
+    "depth-buffer": None, "scan-line": None, "area-subdivision": None, "depth-sort": None, "bsp": None,
+    "a-buffer": None, "octree": _render_octrees,
+}  # fmt: skip
+"""Visible-surface methods of ``render(..., method=...)``: None for the methods of the mesh pipeline
+(``VISIBILITY_METHODS``), else the function that draws the frame."""
 
 
 def _render_buffers(
@@ -335,7 +354,12 @@ def _render_buffers(
         _draw_particles(scene, camera, depth, color)
         return color, depth, normal_out, id_out
     scratch = Scratch()
-    depth, color = _draw_surfaces(scene, items, camera, options, normal_out, id_out, scratch)
+    if options.method == "depth-buffer" and options.transparency == "sort":
+        depth, color = _draw_surfaces(scene, items, camera, options, normal_out, id_out, scratch)
+        if options.counts is not None:
+            _count_depth_tests(items, camera, options)
+    else:
+        depth, color = _draw_surfaces_by_method(scene, items, camera, options, normal_out, id_out, scratch)
     scratch.release()
     if options.mode == "hidden-line":
         color[:, :] = options.background
@@ -949,3 +973,194 @@ def _background_bytes(background: Any, where: str) -> np.ndarray:
             f"{where}: background = {describe(background)} is not an RGBA color; expected four finite numbers in [0, 1]"
         )
     return np.floor(values * 255.0 + 0.5).astype(np.uint8)
+
+
+# --- visible-surface methods (render(..., method=...), docs/visibility.md) -----------------------------------
+
+VISIBILITY_METHODS = {
+    "depth-buffer": None,
+    "scan-line": "frustum.visibility.scanline:scan_line",
+    "area-subdivision": "frustum.visibility.warnock:area_subdivision",
+    "depth-sort": "frustum.visibility.painter:depth_sort",
+    "bsp": "frustum.visibility.painter:bsp_tree",
+    "a-buffer": "frustum.visibility.abuffer",
+}
+"""``render(..., method=...)``: name → the visibility function that fills depth, codes and barycentrics (the
+depth buffer is the renderer's own path; the A-buffer resolves fragments instead)."""
+PLANNED_METHODS = {
+    "ray-casting": "a ray per pixel through the scene's spatial index (the BVH of Scene.pick)",
+}
+"""Methods of the visible-surface chapter that this version does not draw yet."""
+TRANSPARENCY_MODES = ("sort", "a-buffer")
+
+
+def _check_method(method: Any, where: str) -> None:
+    """A FrustumError listing the available methods for an unknown or not yet available `method`."""
+    valid = ", ".join(repr(name) for name in RENDER_METHODS)
+    if isinstance(method, str) and method in PLANNED_METHODS:
+        raise FrustumError(
+            f"{where}: method = {method!r} is not available yet ({PLANNED_METHODS[method]}); available: {valid}"
+        )
+    if not isinstance(method, str) or method not in RENDER_METHODS:
+        raise FrustumError(f"{where}: method = {describe(method)} is unknown; expected one of {valid}")
+
+
+def _method_options(options: _Options, method: Any, transparency: Any, stats: Any, where: str) -> _Options:
+    """Check `transparency` and `stats`; the options with the method (a mesh pipeline one, ``_check_method``
+    first), the transparency and a counts dict where counted."""
+    _choice(transparency, TRANSPARENCY_MODES, "transparency", where)
+    if not isinstance(stats, bool | np.bool_):
+        raise FrustumError(f"{where}: stats = {describe(stats)} is not a bool; give True or False")
+    if (method != "depth-buffer" or transparency != "sort") and options.mode in ("wireframe", "points"):
+        raise FrustumError(
+            f"{where}: method = {method!r} with transparency = {transparency!r} draws surfaces; mode = "
+            f"{options.mode!r} draws lines or points with the depth buffer: use mode 'surface', 'hidden-line' or "
+            "'surface+edges', or method 'depth-buffer'"
+        )
+    if method == "a-buffer" and options.buffers:
+        raise FrustumError(
+            f"{where}: buffers = {describe(options.buffers)} are not available with method 'a-buffer' (a pixel "
+            "holds several surfaces); use another method for per-pixel normals or object ids"
+        )
+    counted = method != "depth-buffer" or transparency != "sort" or bool(stats)
+    counts = {"method": method} if counted else None
+    return dataclasses.replace(options, method=method, transparency=transparency, counts=counts)
+
+
+def _code_type(items: list[SceneItem]) -> type:
+    """The dtype of the face-code buffer, as ``_draw_surfaces`` chooses it."""
+    return np.int32 if 2 * sum(item.mesh.face_count for item in items) < 2**31 else np.int64
+
+
+def _face_offsets(items: list[SceneItem]) -> list[int]:
+    return [int(n) for n in np.cumsum([0] + [item.mesh.face_count for item in items])[:-1]]
+
+
+def _count_depth_tests(items: list[SceneItem], camera: Camera, options: _Options) -> None:
+    """The depth buffer's counts: depth tests (pixel centres covered, summed over the drawn triangles)."""
+    from frustum.raster import window
+    from frustum.visibility.window import window_triangles
+
+    tris = window_triangles(items, list(range(len(items))), _face_offsets(items), camera, options.cull)
+    covered = np.empty(tris.count, dtype=np.int64)
+    window.count_covered(tris.xy, tris.box, covered)
+    assert options.counts is not None
+    options.counts.update(depth_tests=int(covered.sum()), triangles=tris.count)
+
+
+def _draw_surfaces_by_method(
+    scene: Scene, items: list[SceneItem], camera: Camera, options: _Options,
+    normal_out: np.ndarray | None, id_out: np.ndarray | None, scratch: Scratch,
+) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """Stages 1–6 by another visible-surface method, or with A-buffer transparency: the depth and color buffers.
+
+    The method writes the depth-buffer's depth, face code and barycentrics of the surface it finds at each pixel
+    (``visibility.window``); ``_shade_item`` shades them as for the depth buffer. The A-buffer shades one sample
+    per fragment (a column image through the same kernel) and composites.
+    """
+    import importlib
+
+    from frustum.visibility.window import window_triangles
+
+    height, width = camera.height, camera.width
+    counts = options.counts if options.counts is not None else {}
+    offsets = _face_offsets(items)
+    opaque = [i for i, item in enumerate(items) if item.material.opacity >= 1.0]
+    clear_items = [i for i, item in enumerate(items) if item.material.opacity < 1.0]
+    depth = np.empty((height, width), dtype=np.float32)
+    color = np.empty((height, width, 4), dtype=np.uint8)
+    triangles.clear_buffers(depth, color, options.background)
+    ambient, lights = pack_lights(scene.world_lights())
+    extra = (
+        np.zeros((1, 1, 3), dtype=np.float32) if normal_out is None else normal_out,
+        np.zeros((1, 1), dtype=np.int32) if id_out is None else id_out,
+    )
+    if options.method == "a-buffer":
+        tris = window_triangles(items, list(range(len(items))), offsets, camera, options.cull)
+        counts.update(_composite(tris, items, offsets, camera, options, ambient, lights, color, depth, scratch))
+        counts["triangles"] = tris.count
+        return depth, color
+    code_type = _code_type(items)  # the depth buffer's: the shading kernels are compiled for it already
+    codes = np.zeros((height, width), dtype=code_type)
+    bary = np.zeros((height, width, 2), dtype=np.float32)
+    if options.method == "depth-buffer":
+        hidden = [
+            item if item.material.opacity >= 1.0 else item._replace(mesh=Mesh(np.empty((0, 3)), np.empty((0, 3), int)))
+            for item in items
+        ]  # fmt: skip
+        depth, color = _draw_surfaces(scene, hidden, camera, options, normal_out, id_out, scratch)
+    else:
+        module, name = VISIBILITY_METHODS[options.method].split(":")  # type: ignore[union-attr]
+        draw = getattr(importlib.import_module(module), name)
+        tris = window_triangles(items, opaque, offsets, camera, options.cull)
+        counts.update(draw(tris, depth, codes, bary))
+        for index in opaque:
+            world, normals = _world_attributes(items[index], scratch)
+            _shade_item(items[index], index, offsets[index], camera, options, ambient, lights, world, normals,
+                        depth, codes, bary, color, extra, (0, height), blend=False)  # fmt: skip
+    if not clear_items:
+        return depth, color
+    if options.transparency == "a-buffer":
+        tris = window_triangles(items, clear_items, offsets, camera, options.cull)
+        found = _composite(tris, items, offsets, camera, options, ambient, lights, color, depth.copy(), scratch,
+                           under_depth=depth)  # fmt: skip
+        counts.update({f"transparent_{key}": value for key, value in found.items()})
+        return depth, color
+    axis = np.asarray(camera.frame.n, dtype=np.float64)
+    eye = np.asarray(camera.frame.eye, dtype=np.float64)
+
+    def distance(index: int) -> float:
+        item = items[index]
+        if item.mesh.vertex_count == 0:
+            return 0.0
+        centre = item.mesh.bounds.mean(axis=0)
+        centre = item.world_from_model[:3, :3] @ centre + item.world_from_model[:3, 3]
+        return float((eye - centre) @ axis)
+
+    for index in sorted(clear_items, key=distance, reverse=True):  # per-object sort, as the depth buffer does
+        item = items[index]
+        layer_depth = depth.copy()
+        layer_codes = np.full((height, width), -1, dtype=code_type)
+        world, normals, rows = _draw_item(
+            item, camera, options.cull, offsets[index], layer_depth, layer_codes, bary, scratch
+        )
+        _shade_item(item, index, offsets[index], camera, options, ambient, lights, world, normals, layer_depth,
+                    layer_codes, bary, color, extra, rows, blend=True)  # fmt: skip
+    return depth, color
+
+
+def _composite(
+    tris: Any, items: list[SceneItem], offsets: list[int], camera: Camera, options: _Options, ambient: np.ndarray,
+    lights: np.ndarray, color: np.ndarray, depth: np.ndarray, scratch: Scratch, under_depth: np.ndarray | None = None,
+) -> dict:  # fmt: skip
+    """A-buffer: fragments of `tris`, each shaded once (blended over transparent black: premultiplied bytes),
+    composited per subsample over `color` (behind `under_depth`, default the far plane) into `color`; the
+    nearest opaque fragment's depth at each pixel centre into `depth`."""
+    from frustum.visibility import abuffer
+
+    fragments = abuffer.build_fragments(tris)
+    premultiplied = np.zeros((fragments.count, 4), dtype=np.uint8)
+    dummy = (np.zeros((1, 1, 3), dtype=np.float32), np.zeros((1, 1), dtype=np.int32))
+    owner = tris.item[fragments.triangle]
+    columns = 256
+    for index in sorted(set(tris.item.tolist())):
+        # the item's fragments as a (rows, 256) image, padded with depth 1 (nothing drawn), shaded by the one kernel:
+        # opaque items as the depth buffer shades them, transparent ones blended over transparent black
+        chosen = np.flatnonzero(owner == index)
+        rows = -(-chosen.shape[0] // columns)
+        depth_image = np.ones(rows * columns, dtype=np.float32)
+        code_image = np.zeros(rows * columns, dtype=_code_type(items))
+        bary_image = np.zeros((rows * columns, 2), dtype=np.float32)
+        depth_image[: chosen.shape[0]] = fragments.depth[chosen, 0]
+        code_image[: chosen.shape[0]] = fragments.code[chosen, 0]
+        bary_image[: chosen.shape[0]] = fragments.bary[chosen, 0]
+        color_image = np.zeros((rows, columns, 4), dtype=np.uint8)
+        world, normals = _world_attributes(items[index], scratch)
+        _shade_item(items[index], index, offsets[index], camera, options, ambient, lights, world, normals,
+                    depth_image.reshape(rows, columns), code_image.reshape(rows, columns),
+                    bary_image.reshape(rows, columns, 2), color_image, dummy, (0, rows),
+                    blend=items[index].material.opacity < 1.0)  # fmt: skip
+        premultiplied[chosen] = color_image.reshape(-1, 4)[: chosen.shape[0]]
+    if under_depth is None:
+        under_depth = np.ones(depth.shape, dtype=np.float32)
+    return abuffer.resolve_fragments(fragments, premultiplied, tris, color, under_depth, color, depth)

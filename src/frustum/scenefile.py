@@ -55,7 +55,7 @@ from frustum.frame import Frame
 from frustum.geometry import Mesh
 from frustum.projection import MULTIVIEWS, Axonometric, Frustum, Oblique, Orthographic, Perspective
 from frustum.quaternion import Quaternion
-from frustum.render import RENDER_METHODS, RENDER_MODES, SHADING_MODES, render
+from frustum.render import RENDER_METHODS, RENDER_MODES, SHADING_MODES, TRANSPARENCY_MODES, render
 from frustum.scene import Node, Scene, cutaway, exploded
 from frustum.shading import AmbientLight, DepthCue, DirectionalLight, Material, PointLight, SpotLight
 from frustum.transforms import compose, reflect, rotate, rotate_x, rotate_y, rotate_z, scale, shear, translate
@@ -127,6 +127,7 @@ _STEREO_KEYS = ("eye_separation", "convergence_distance", "layout", "anaglyph_me
 _RENDER_KEYS = (
     "size", "shading", "specular", "background", "cull_back_faces", "mode", "edges", "crease_angle_deg", "edge_color",
     "hidden", "hidden_color", "line_width", "depth_cue", "samples", "filter", "color_space", "columns", "method",
+    "transparency",
 )  # fmt: skip
 _DEPTH_CUE_KEYS = ("near", "far", "min_intensity", "max_intensity", "color")
 _LIGHT_TYPES = {"ambient": AmbientLight, "directional": DirectionalLight, "point": PointLight, "spot": SpotLight}
@@ -1481,6 +1482,7 @@ def _render_options(report: _Report, path: tuple, value: Any) -> tuple[dict, tup
         "filter": lambda p, v: _choice(report, p, v, ("box", "tent")),
         "color_space": lambda p, v: _choice(report, p, v, ("linear", "srgb")),
         "method": lambda p, v: _choice(report, p, v, tuple(RENDER_METHODS)),
+        "transparency": lambda p, v: _choice(report, p, v, TRANSPARENCY_MODES),
     }
     for key, check in simple.items():
         if key in params:
@@ -2247,6 +2249,30 @@ def explain_scene_file(path: str | Path, point: Sequence[float] | None = None) -
     if point is None:
         return trace(scene_file.scene, camera)
     return trace(np.asarray(point, dtype=float), camera)
+
+
+def explain_method(path: str | Path, method: str) -> dict:
+    """Render the scene file's first camera with the visible-surface `method` (``render(..., method=...)``, with
+    the file's render options) and return ``Frame.stats``: what the method counted (spans and edge updates,
+    areas per level, depth tests, fragments per pixel …) and, under ``"seconds"``, how long the render took.
+
+    Raises
+    ------
+    SceneFileError
+        For an invalid scene file.
+    FrustumError
+        For an unknown method (the message lists the valid ones).
+    """
+    import time
+
+    scene_file = load_scene_file(path)
+    render = importlib.import_module("frustum.render").render
+    options = {key: value for key, value in scene_file.options.items() if key not in ("method", "stats")}
+    start = time.perf_counter()
+    frame = render(scene_file.scene, scene_file.cameras[0], method=method, stats=True, **options)
+    stats = dict(frame.stats or {"method": method})
+    stats["seconds"] = round(time.perf_counter() - start, 4)
+    return stats
 
 
 def render_examples(

@@ -5,7 +5,8 @@ first render in a new environment pays for compilation (about 8 s of CPU for the
 modes it does not use). ``warmup`` runs one small task per family of kernels — the surface paths (the fast
 directional shader, the general shader with textures, vertex colors, point and spot lights, depth cueing,
 transparency and extra buffers, Gouraud and flat), the line and point modes, clipping of faces that cross the view
-volume, exact hidden lines, and the fractal generators — in parallel processes, each filling the shared cache.
+volume, exact hidden lines, the fractal generators, and the visible-surface methods of ``render(..., method=...)``
+— in parallel processes, each filling the shared cache.
 """
 
 from __future__ import annotations
@@ -134,6 +135,17 @@ def _fractals() -> None:
     fr.CLASSIC_LSYSTEMS["koch"].path(1)
 
 
+def _visibility_methods() -> None:
+    fr = _api()
+
+    scene = _scene()
+    camera = _camera()
+    for method in fr.VISIBILITY_METHODS:
+        if method != "depth-buffer":
+            fr.render(scene, camera, method=method)
+    fr.render(scene, camera, stats=True)
+
+
 TASKS: dict[str, Callable[[], None]] = {
     "surfaces (general shader)": _surfaces_general,
     "surfaces (fast path, supersampling, clipping)": _surfaces_fast,
@@ -141,6 +153,7 @@ TASKS: dict[str, Callable[[], None]] = {
     "lines and points": _lines,
     "hidden lines and clipping": _vector,
     "fractals": _fractals,
+    "visible-surface methods (scan-line, area subdivision, painter, A-buffer)": _visibility_methods,
 }
 """The families of kernels ``warmup`` compiles, each by running small examples of what uses them."""
 
