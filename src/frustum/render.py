@@ -243,7 +243,8 @@ def render(
     method : str
         The visible-surface method (``RENDER_METHODS``, docs/visibility.md). For the meshes
         (``VISIBILITY_METHODS``): ``"depth-buffer"`` (the default), ``"scan-line"``, ``"area-subdivision"``
-        (Warnock), ``"depth-sort"``, ``"bsp"`` or ``"a-buffer"`` (anti-aliased edges, exact transparency). All
+        (Warnock), ``"depth-sort"``, ``"bsp"``, ``"ray-casting"`` (a ray per pixel through the scene's BVH) or
+        ``"a-buffer"`` (anti-aliased edges, exact transparency). All
         shade with the same model, so where they find the same surface they give the same bytes. Surface modes
         only; each returns its counts in ``Frame.stats``. ``"octree"``: the scene's octrees (``Scene.octrees``)
         by ``visibility.octree.render_octree``, front to back, each face orientation shaded once with the
@@ -331,7 +332,7 @@ def _render_octrees(scene: Scene, camera: Camera, *, background: Any) -> Frame:
 
 RENDER_METHODS = {
     "depth-buffer": None, "scan-line": None, "area-subdivision": None, "depth-sort": None, "bsp": None,
-    "a-buffer": None, "octree": _render_octrees,
+    "a-buffer": None, "octree": _render_octrees, "ray-casting": None,
 }  # fmt: skip
 """Visible-surface methods of ``render(..., method=...)``: None for the methods of the mesh pipeline
 (``VISIBILITY_METHODS``), else the function that draws the frame."""
@@ -984,12 +985,11 @@ VISIBILITY_METHODS = {
     "depth-sort": "frustum.visibility.painter:depth_sort",
     "bsp": "frustum.visibility.painter:bsp_tree",
     "a-buffer": "frustum.visibility.abuffer",
+    "ray-casting": "frustum.visibility.raycast:ray_casting",
 }
 """``render(..., method=...)``: name → the visibility function that fills depth, codes and barycentrics (the
 depth buffer is the renderer's own path; the A-buffer resolves fragments instead)."""
-PLANNED_METHODS = {
-    "ray-casting": "a ray per pixel through the scene's spatial index (the BVH of Scene.pick)",
-}
+PLANNED_METHODS: dict[str, str] = {}
 """Methods of the visible-surface chapter that this version does not draw yet."""
 TRANSPARENCY_MODES = ("sort", "a-buffer")
 
@@ -1092,8 +1092,11 @@ def _draw_surfaces_by_method(
     else:
         module, name = VISIBILITY_METHODS[options.method].split(":")  # type: ignore[union-attr]
         draw = getattr(importlib.import_module(module), name)
-        tris = window_triangles(items, opaque, offsets, camera, options.cull)
-        counts.update(draw(tris, depth, codes, bary))
+        if options.method == "ray-casting":  # world-space rays through the scene's index, not window triangles
+            counts.update(draw(scene, camera, options.cull, depth, codes, bary))
+        else:
+            tris = window_triangles(items, opaque, offsets, camera, options.cull)
+            counts.update(draw(tris, depth, codes, bary))
         for index in opaque:
             world, normals = _world_attributes(items[index], scratch)
             _shade_item(items[index], index, offsets[index], camera, options, ambient, lights, world, normals,

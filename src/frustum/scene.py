@@ -405,20 +405,10 @@ class Scene:
             raise FrustumError(f"{where}: camera = {describe(camera)} is not a Camera; build one with Camera.look_at")
         px = as_scalar(x, "x", where=where, error=FrustumError)
         py = as_scalar(y, "y", where=where, error=FrustumError)
-        items = [item for item in self.items if item.mesh.face_count]
-        if not items:
+        found = self._triangle_index(where=where)
+        if found is None:
             return None
-        key = tuple((id(item.mesh), item.world_from_model.tobytes()) for item in items)
-        cached = getattr(self, "_pick_index", None)
-        if cached is None or cached[0] != key:
-            corners = [
-                item.mesh.vertices[item.mesh.faces] @ item.world_from_model[:3, :3].T + item.world_from_model[:3, 3]
-                for item in items
-            ]
-            starts = np.cumsum([0] + [c.shape[0] for c in corners])
-            cached = (key, bvh.build(np.concatenate(corners)), starts, [item.mesh for item in items])
-            self._pick_index = cached
-        _, index, starts, _ = cached
+        items, index, starts = found
         ray = camera.ray((px, py))
         t, face = bvh.first_hits(index, ray.origin[None], ray.direction[None])
         if face[0] < 0:
@@ -426,6 +416,47 @@ class Scene:
         item_index = int(np.searchsorted(starts, face[0], side="right") - 1)
         point = ray.origin + t[0] * ray.direction
         return Pick(items[item_index], int(face[0] - starts[item_index]), point, float(t[0]))
+
+    def _triangle_index(self, where: str = "Scene.pick") -> tuple[list[SceneItem], Any, np.ndarray] | None:
+        """The scene's triangle index: ``(items, hierarchy, starts)`` or None when no mesh has a face.
+
+        `items` are ``self.items`` that have faces, `hierarchy` the ``raster.bvh.Hierarchy`` of all their
+        triangles in world coordinates (item by item, face by face: triangle ``starts[k] + f`` is face f of
+        ``items[k]``, the renderer's face numbering), corners counter-clockwise seen from the front after the
+        modeling transform (corners 1 and 2 swapped where it reverses handedness, as the renderer draws them).
+        Built once and kept until the scene's meshes or transforms change (``pick`` and
+        ``render(..., method="ray-casting")`` share it); its memory is checked against the work budget first.
+
+        Raises
+        ------
+        GeometryError
+            The index would exceed the memory budget (``frustum.budgets``).
+        """
+        from frustum.budgets import check_memory
+        from frustum.raster import bvh
+
+        items = [item for item in self.items if item.mesh.face_count]
+        if not items:
+            return None
+        key = tuple((id(item.mesh), item.world_from_model.tobytes()) for item in items)
+        cached = getattr(self, "_pick_index", None)
+        if cached is None or cached[0] != key:
+            count = sum(item.mesh.face_count for item in items)
+            rows = bvh.LEAF_SIZE * (1 << (max(1, -(-count // bvh.LEAF_SIZE)) - 1).bit_length())
+            check_memory(3 * 72 * count + rows * (72 + 56) + 2 * rows // bvh.LEAF_SIZE * 48, where=where,
+                         cause=f"a triangle index (BVH) over {count} triangles", error=GeometryError)  # fmt: skip
+            corners = []
+            for item in items:
+                matrix = np.asarray(item.world_from_model, dtype=np.float64)
+                faces = item.mesh.faces
+                if np.linalg.det(matrix[:3, :3]) < 0.0:
+                    faces = faces[:, [0, 2, 1]]
+                corners.append(item.mesh.vertices[faces] @ matrix[:3, :3].T + matrix[:3, 3])
+            starts = np.cumsum([0] + [c.shape[0] for c in corners])
+            cached = (key, bvh.build(np.concatenate(corners)), starts, [item.mesh for item in items])
+            self._pick_index = cached
+        _, index, starts, _ = cached
+        return items, index, starts
 
     def _placed(self, kind: type) -> list[SceneItem]:
         result: list[SceneItem] = []

@@ -5,6 +5,8 @@ leaves of ``LEAF_SIZE`` consecutive triangles, and an implicit complete binary t
 layout: node i has children 2i + 1 and 2i + 2; the ``P`` leaves are nodes P − 1 … 2P − 2), each node's box the
 union of its children's. Traversal: per ray, a stack of nodes, slab test against each box, nearer child first,
 Möller–Trumbore against the triangles of a leaf; the nearest t >= 0 wins (ties: the lower triangle index).
+``first_hits`` casts given rays (``Scene.pick``); ``cast_pixels`` casts one ray per pixel through the view volume
+and writes what the depth buffer writes (``render(..., method="ray-casting")``, ``frustum.visibility.raycast``).
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ import numpy as np
 
 from frustum.raster._jit import kernel, parallel_kernel
 
-__all__ = ["LEAF_SIZE", "Hierarchy", "build", "first_hits"]
+__all__ = ["CAST_STATS", "LEAF_SIZE", "Hierarchy", "build", "cast_pixels", "first_hits"]
 
 LEAF_SIZE = 4
 
@@ -106,34 +108,53 @@ def _box_entry(lo, hi, node, ox, oy, oz, ix, iy, iz, t_max):
 
 
 @kernel
-def _trace_ray(lo, hi, triangles, order, ox, oy, oz, dx, dy, dz):
-    """(t, face): nearest t >= 0 over all triangles (inf, −1 if none) of one ray."""
+def _cast_ray(lo, hi, triangles, order, skip, ox, oy, oz, dx, dy, dz, t_max, cull):
+    """First hit of one ray: ``(t, face, u, v, back, box_tests, nodes, tests)``.
+
+    The nearest t in [0, t_max) over the triangles (ties: the lower triangle index), skipping those with
+    ``skip[face] != 0`` (`skip` empty: none) and, when `cull`, the back faces (Möller–Trumbore's determinant
+    ``e1·(d × e2) = −d·N`` negative: the ray meets the side the counter-clockwise normal N points away from).
+    u, v are the weights of corners 1 and 2 at the hit (world barycentrics: perspective-correct), back = 1 for a
+    back face; inf, −1 for a miss. The counts: box (slab) tests, nodes visited (popped and still nearer than the
+    best hit so far), ray–triangle tests. A node is entered nearer child first; a node whose box entry is
+    beyond the best hit found since it was pushed is not visited.
+    """
     leaves = (lo.shape[0] + 1) // 2
     ix = 1.0 / dx if dx != 0.0 else np.inf
     iy = 1.0 / dy if dy != 0.0 else np.inf
     iz = 1.0 / dz if dz != 0.0 else np.inf
-    best = np.inf
+    masked = skip.shape[0] > 0
+    best = t_max
     best_face = -1
+    best_u, best_v, best_back = 0.0, 0.0, 0
+    box_tests, nodes, tests = 1, 0, 0
     stack = np.empty(64, dtype=np.int64)
+    entry = np.empty(64)
     top = 0
-    if _box_entry(lo, hi, 0, ox, oy, oz, ix, iy, iz, best) < np.inf:
+    t_root = _box_entry(lo, hi, 0, ox, oy, oz, ix, iy, iz, best)
+    if t_root < np.inf:
         stack[0] = 0
+        entry[0] = t_root
         top = 1
     while top > 0:
         top -= 1
         node = stack[top]
+        if entry[top] > best:
+            continue
+        nodes += 1
         if node >= leaves - 1:
             first = (node - (leaves - 1)) * 4
             for row in range(first, first + 4):
                 face = order[row]
-                if face < 0:
+                if face < 0 or (masked and skip[face] != 0):
                     continue
+                tests += 1
                 ax, ay, az = triangles[row, 0, 0], triangles[row, 0, 1], triangles[row, 0, 2]
                 e1x, e1y, e1z = triangles[row, 1, 0] - ax, triangles[row, 1, 1] - ay, triangles[row, 1, 2] - az
                 e2x, e2y, e2z = triangles[row, 2, 0] - ax, triangles[row, 2, 1] - ay, triangles[row, 2, 2] - az
                 px, py, pz = dy * e2z - dz * e2y, dz * e2x - dx * e2z, dx * e2y - dy * e2x
                 det = e1x * px + e1y * py + e1z * pz
-                if det == 0.0:
+                if det == 0.0 or (cull != 0 and det < 0.0):
                     continue
                 inv = 1.0 / det
                 sx, sy, sz = ox - ax, oy - ay, oz - az
@@ -146,22 +167,34 @@ def _trace_ray(lo, hi, triangles, order, ox, oy, oz, dx, dy, dz):
                     continue
                 t = (e2x * qx + e2y * qy + e2z * qz) * inv
                 if t >= 0.0 and (t < best or (t == best and face < best_face)):
-                    best = t
-                    best_face = face
+                    best, best_face, best_u, best_v = t, face, u, v
+                    best_back = 1 if det < 0.0 else 0
             continue
         left, right = 2 * node + 1, 2 * node + 2
         t_left = _box_entry(lo, hi, left, ox, oy, oz, ix, iy, iz, best)
         t_right = _box_entry(lo, hi, right, ox, oy, oz, ix, iy, iz, best)
+        box_tests += 2
         near, far, t_near, t_far = (
             (left, right, t_left, t_right) if t_left <= t_right else (right, left, t_right, t_left)
         )
         if t_far < np.inf:  # the farther child is pushed first: the nearer one is popped next
             stack[top] = far
+            entry[top] = t_far
             top += 1
         if t_near < np.inf:
             stack[top] = near
+            entry[top] = t_near
             top += 1
-    return best, best_face
+    if best_face < 0:
+        best = np.inf
+    return best, best_face, best_u, best_v, best_back, box_tests, nodes, tests
+
+
+@kernel
+def _trace_ray(lo, hi, triangles, order, ox, oy, oz, dx, dy, dz):
+    """(t, face): nearest t >= 0 over all triangles (inf, −1 if none) of one ray."""
+    hit = _cast_ray(lo, hi, triangles, order, np.empty(0, dtype=np.uint8), ox, oy, oz, dx, dy, dz, np.inf, 0)
+    return hit[0], hit[1]
 
 
 @kernel
@@ -189,3 +222,60 @@ def first_hits(hierarchy: Hierarchy, origins: np.ndarray, directions: np.ndarray
     trace = _trace if o.shape[0] < 64 else _trace_parallel
     trace(hierarchy.lo, hierarchy.hi, hierarchy.triangles, hierarchy.order, o, d, t, face)
     return t, face
+
+
+CAST_STATS = ("rays", "hits", "box_tests", "nodes_visited", "triangle_tests")
+"""Columns of ``cast_pixels``' per-row counts."""
+
+
+@parallel_kernel(lambda lo, hi, triangles, order, skip, world_from_window, window_from_world, cull, depth, *_:
+                 depth.shape[0], work=lambda *args: args[8].size, grain=4096)  # fmt: skip
+def cast_pixels(lo, hi, triangles, order, skip, world_from_window, window_from_world, cull, depth, codes, bary,
+                stats, start, stop):  # fmt: skip
+    """A ray through the centre of every pixel of window rows [start, stop) (y up); the first hit's window depth,
+    face code and barycentrics, as the depth buffer writes them.
+
+    Pixel (i, j) casts ``origin + t·(end − origin)``, t in [0, 1), from ``origin = unproject(i + ½, j + ½, 0)``
+    on the near plane to ``end = unproject(i + ½, j + ½, 1)`` on the far plane (``Camera.ray``'s line; for a
+    parallel projection the projection direction): hits inside the view volume only. At a hit, ``depth`` (H, W)
+    float32 (top row first: row H − 1 − j) receives the window depth ``z_w = (M₂·P)/(M₃·P)`` (M =
+    `window_from_world`), ``codes`` ``2·face + back``, ``bary`` the weights of the face's corners 1 and 2; a
+    depth that rounds to 1 is not written (the depth buffer's test "less" against its clear value). ``stats``
+    (H, len(CAST_STATS)) int64 receives each row's counts. `cull` != 0 skips back faces (the ray goes on to
+    what lies behind them, as the depth buffer never draws them); `skip` (F,) uint8 marks triangles not drawn.
+    """
+    height, width = depth.shape[0], depth.shape[1]
+    m = world_from_window
+    for j in range(start, stop):
+        row = height - 1 - j
+        y = j + 0.5
+        rays, hits, box_tests, nodes, tests = 0, 0, 0, 0, 0
+        for i in range(width):
+            x = i + 0.5
+            nw = m[3, 0] * x + m[3, 1] * y + m[3, 3]
+            ox = (m[0, 0] * x + m[0, 1] * y + m[0, 3]) / nw
+            oy = (m[1, 0] * x + m[1, 1] * y + m[1, 3]) / nw
+            oz = (m[2, 0] * x + m[2, 1] * y + m[2, 3]) / nw
+            fw = nw + m[3, 2]
+            dx = (m[0, 0] * x + m[0, 1] * y + m[0, 2] + m[0, 3]) / fw - ox
+            dy = (m[1, 0] * x + m[1, 1] * y + m[1, 2] + m[1, 3]) / fw - oy
+            dz = (m[2, 0] * x + m[2, 1] * y + m[2, 2] + m[2, 3]) / fw - oz
+            t, face, u, v, back, b, n, k = _cast_ray(lo, hi, triangles, order, skip, ox, oy, oz, dx, dy, dz, 1.0,
+                                                     cull)  # fmt: skip
+            rays += 1
+            box_tests += b
+            nodes += n
+            tests += k
+            if face < 0:
+                continue
+            px, py, pz = ox + t * dx, oy + t * dy, oz + t * dz
+            w = window_from_world
+            z = np.float32((w[2, 0] * px + w[2, 1] * py + w[2, 2] * pz + w[2, 3])
+                           / (w[3, 0] * px + w[3, 1] * py + w[3, 2] * pz + w[3, 3]))  # fmt: skip
+            if not z < 1.0:
+                continue
+            hits += 1
+            depth[row, i] = z
+            codes[row, i] = 2 * face + back
+            bary[row, i, 0], bary[row, i, 1] = np.float32(u), np.float32(v)
+        stats[j, 0], stats[j, 1], stats[j, 2], stats[j, 3], stats[j, 4] = rays, hits, box_tests, nodes, tests
