@@ -1,5 +1,6 @@
 """render(method=...): every visible-surface method against the depth buffer; Warnock's relations and exits;
-scan-line cyclic overlaps and interpenetration; the A-buffer against a brute-force per-subsample fragment sort,
+scan-line cyclic overlaps and interpenetration; ray casting through the BVH (view volume, culling, parallel and
+oblique cameras, mirrored items, exact ties); the A-buffer against a brute-force per-subsample fragment sort,
 against the per-object sort and against 16× supersampling; exact counts on hand-made scenes; bad input."""
 
 from __future__ import annotations
@@ -11,7 +12,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from frustum import Camera, FrustumError, GeometryError, Orthographic, Perspective
+from frustum import Camera, FrustumError, GeometryError, Oblique, Orthographic, Perspective
 from frustum.budgets import budget
 from frustum.geometry import Mesh
 from frustum.geometry.io import load
@@ -19,10 +20,10 @@ from frustum.geometry.teapot import teapot
 from frustum.render import RENDER_METHODS, render
 from frustum.scene import Scene
 from frustum.shading import DirectionalLight, Material
-from frustum.transforms import translate
+from frustum.transforms import reflect, translate
 from frustum.visibility.abuffer import FRAGMENT_BYTES
 
-OPAQUE_METHODS = ["scan-line", "area-subdivision", "depth-sort", "bsp"]
+OPAQUE_METHODS = ["scan-line", "area-subdivision", "depth-sort", "bsp", "ray-casting"]
 LIGHT = DirectionalLight(direction=(-0.4, -0.8, -0.5))
 BUNNY = "/work/shared/data/bunny/bun_zipper_res4.ply"
 
@@ -59,19 +60,25 @@ def test_triangle_soup_matches_depth_buffer(method: str, seed: int) -> None:
     reference = render(scene, camera, cull_back_faces=False, stats=True)
     frame = render(scene, camera, cull_back_faces=False, method=method)
     assert_same_picture(frame, reference)
-    assert frame.stats["method"] == method and frame.stats["triangles"] == reference.stats["triangles"] >= 60
+    assert frame.stats["method"] == method
+    if method == "ray-casting":  # world-space triangles, unclipped: every one is in the index
+        assert frame.stats["indexed_triangles"] == 60 and frame.stats["rays"] == camera.width * camera.height
+        assert frame.stats["hits"] == (frame.depth < 1.0).sum()
+    else:
+        assert frame.stats["triangles"] == reference.stats["triangles"] >= 60
 
 
 @settings(max_examples=12, deadline=None)
 @given(seed=st.integers(0, 2**31 - 1), count=st.integers(1, 24), two_sided=st.booleans())
 def test_image_space_methods_find_the_depth_buffers_surface(seed: int, count: int, two_sided: bool) -> None:
-    """Property: on any soup, scan-line and area subdivision pick, pixel by pixel, the depth buffer's surface."""
+    """Property: on any soup, scan-line, area subdivision and ray casting pick, pixel by pixel, the depth buffer's
+    surface."""
     scene = Scene(lights=[LIGHT])
     scene.add(soup(seed, count), material=Material(color=(0.8, 0.5, 0.3)))
     camera = Camera.look_at((0.3, 0.4, 4.0), (0.0, 0.0, 0.0), projection=Perspective(0.9, 0.5, 20.0), width=24,
                             height=20)  # fmt: skip
     reference = render(scene, camera, cull_back_faces=not two_sided)
-    for method in ("scan-line", "area-subdivision"):
+    for method in ("scan-line", "area-subdivision", "ray-casting"):
         frame = render(scene, camera, cull_back_faces=not two_sided, method=method)
         assert ((frame.depth < 1.0) == (reference.depth < 1.0)).mean() >= 0.99
         close = np.abs(frame.color.astype(int) - reference.color.astype(int)).max(axis=2) <= 1
@@ -88,7 +95,7 @@ def bunny_scene() -> tuple[Scene, Camera]:
     return scene, camera
 
 
-@pytest.mark.parametrize("method", ["scan-line", "area-subdivision", "bsp"])
+@pytest.mark.parametrize("method", ["scan-line", "area-subdivision", "bsp", "ray-casting"])
 def test_bunny_matches_depth_buffer(bunny_scene, method: str) -> None:
     scene, camera = bunny_scene
     assert_same_picture(render(scene, camera, method=method), render(scene, camera))
@@ -99,7 +106,7 @@ def test_teapot_two_sided_matches_depth_buffer() -> None:
     scene.add(teapot().tessellate(4), material=Material(color=(0.7, 0.7, 0.9)))
     camera = Camera.look_at((3.0, 4.0, 6.0), (0.0, 1.2, 0.0), width=64, height=48)
     reference = render(scene, camera, cull_back_faces=False)
-    for method in ["scan-line", "area-subdivision", "bsp"]:
+    for method in ["scan-line", "area-subdivision", "bsp", "ray-casting"]:
         assert_same_picture(render(scene, camera, cull_back_faces=False, method=method), reference)
 
 
@@ -153,6 +160,14 @@ def test_one_quad_counts_are_exact() -> None:
     assert cut > 0
     assert buffer.stats["fragments"] == 24 + cut  # every pixel once, those the diagonal cuts twice
     assert buffer.stats["pixels_with_fragments"] == 24
+    # ray casting: the index is one leaf (the root) holding both triangles; every ray tests the root's box, the
+    # 24 whose centre lies over the quad enter it and test both triangles, and hit one
+    rays = render(scene, camera, method="ray-casting")
+    assert rays.stats == {
+        "method": "ray-casting", "rays": 256, "hits": 24, "box_tests": 256, "nodes_visited": 24,
+        "triangle_tests": 48, "tests_per_ray": 0.188, "indexed_triangles": 2, "bvh_nodes": 1,
+    }  # fmt: skip
+    assert_same_picture(rays, reference, 1.0)
 
 
 def test_warnock_empty_and_surrounding_exits() -> None:
@@ -218,6 +233,94 @@ def test_scan_line_cyclic_overlap_and_interpenetration() -> None:
     frame = render(pierce, camera, cull_back_faces=False, method="scan-line")
     assert frame.stats["split_spans"] > 0
     assert_same_picture(frame, reference, 0.995)
+
+
+# --- ray casting -------------------------------------------------------------------------------------------
+
+
+def parallel_cameras() -> list[Camera]:
+    eye, target = (0.5, 0.8, 4.0), (0.0, 0.0, 0.0)
+    return [
+        Camera.look_at(eye, target, projection=Orthographic(3.2, 0.5, 20.0), width=48, height=40),
+        Camera.look_at(eye, target, projection=Oblique(math.radians(60.0), math.radians(30.0), 3.2, 0.5, 20.0, -4.1),
+                       width=48, height=40),
+    ]  # fmt: skip
+
+
+@pytest.mark.parametrize("cull", [True, False])
+def test_ray_casting_with_parallel_and_perspective_cameras_and_a_mirrored_item(cull: bool) -> None:
+    """Parallel rays (orthographic, oblique) and rays from the eye; a reflected item (its winding turned
+    around: front and back, and the corners the barycentrics weigh, as the depth buffer draws it)."""
+    scene, camera = soup_scene(7)
+    scene.add(soup(8, 20), material=Material(color=(0.4, 0.9, 0.4)), transform=reflect("yz"))
+    for view in [camera, *parallel_cameras()]:
+        reference = render(scene, view, cull_back_faces=cull)
+        frame = render(scene, view, cull_back_faces=cull, method="ray-casting")
+        assert_same_picture(frame, reference)
+        assert (frame.depth < 1.0).sum() > 200
+
+
+def test_ray_casting_culls_back_faces_and_sees_what_lies_behind() -> None:
+    """A back face in front of a front face: culled, the ray goes on to the front face (as the depth buffer,
+    which never draws it); not culled, the back face is hit and lit two-sided."""
+    camera = flat_camera()
+    back = Mesh([[2.2, 2.3, 1.0], [2.1, 12.4, 1.0], [12.3, 2.2, 1.0]], [[0, 1, 2]])  # clockwise seen from +z
+    scene = flat_scene(back, quad(1.0, 1.0, 10.0, 10.0, -1.0))
+    for cull in (True, False):
+        reference = render(scene, camera, cull_back_faces=cull)
+        frame = render(scene, camera, cull_back_faces=cull, method="ray-casting")
+        assert_same_picture(frame, reference, 1.0)
+        assert np.abs(frame.depth - reference.depth).max() < 1e-6
+    culled = render(scene, camera, method="ray-casting")
+    shown = render(scene, camera, cull_back_faces=False, method="ray-casting")
+    assert (culled.depth[8, 3] > shown.depth[8, 3]) and culled.stats["hits"] == 81
+
+
+def test_ray_casting_stops_at_the_near_and_far_planes() -> None:
+    """Near and far planes cutting through the soups: hits only inside the view volume, as clipping leaves it."""
+    scene, camera = soup_scene(9)
+    for near, far in [(3.6, 20.0), (0.5, 4.3), (3.5, 4.6)]:
+        view = Camera.look_at(camera.frame.eye, (0.0, 0.0, 0.0), projection=Perspective(0.9, near, far), width=64,
+                              height=48)  # fmt: skip
+        reference = render(scene, view, cull_back_faces=False)
+        frame = render(scene, view, cull_back_faces=False, method="ray-casting")
+        assert_same_picture(frame, reference)
+        unclipped = render(scene, camera, cull_back_faces=False, method="ray-casting")
+        assert (~np.isclose(frame.color, unclipped.color, atol=2)).any()  # the planes did cut something off
+    ortho = Camera.look_at(camera.frame.eye, (0.0, 0.0, 0.0), projection=Orthographic(3.2, 3.7, 4.4), width=48,
+                           height=40)  # fmt: skip
+    assert_same_picture(render(scene, ortho, method="ray-casting"), render(scene, ortho))
+
+
+def test_ray_casting_exact_ties_take_the_closed_triangle() -> None:
+    """Pixel centres exactly on edges: the depth buffer's top-left rule draws a pixel once, a ray hits a closed
+    triangle, so the quad [3.5, 9.5] × [5.5, 9.5] covers its 7×5 centres, not the rule's 6×4 (the difference is
+    the right column and the bottom row; generic scenes have no exact ties)."""
+    camera = flat_camera()
+    scene = flat_scene(quad(3.5, 5.5, 9.5, 9.5))
+    reference = render(scene, camera)
+    frame = render(scene, camera, method="ray-casting")
+    assert (reference.depth < 1.0).sum() == 24 and (frame.depth < 1.0).sum() == 35
+    extra = np.argwhere((frame.depth < 1.0) & ~(reference.depth < 1.0))
+    assert extra.shape[0] == 11 and set(map(tuple, extra)) == {(r, 9) for r in range(6, 11)} | {
+        (10, c) for c in range(3, 10)
+    }
+    assert ((reference.depth < 1.0) <= (frame.depth < 1.0)).all()
+
+
+def test_ray_casting_index_is_checked_against_the_budget_and_shared_with_pick() -> None:
+    scene, camera = soup_scene(10)
+    small = Camera.look_at(camera.frame.eye, (0.0, 0.0, 0.0), projection=camera.projection, width=8, height=6)
+    message = r"render: a triangle index \(BVH\) over 60 triangles needs about"
+    with budget(bytes=20_000), pytest.raises(GeometryError, match=message):
+        render(scene, small, method="ray-casting")
+    with budget(bytes=30_000):
+        assert render(scene, small, method="ray-casting").stats["rays"] == 48
+    frame = render(scene, camera, method="ray-casting", buffers=("object_id",))
+    index = scene._pick_index
+    hit = scene.pick(camera, 30.5, 20.5)
+    assert scene._pick_index is index  # built once, for both
+    assert hit is not None and scene.items[frame.object_id[camera.height - 1 - 20, 30]].mesh is hit.item.mesh
 
 
 # --- the A-buffer ------------------------------------------------------------------------------------------
@@ -323,10 +426,8 @@ def test_unknown_method_lists_the_valid_ones() -> None:
     with pytest.raises(FrustumError) as error:
         render(scene, camera, method=3)
     assert all(repr(name) in str(error.value) for name in RENDER_METHODS)
-    with pytest.raises(FrustumError, match=r"method = 'ray-casting' is not available yet.*available: 'depth-buffer'"):
-        render(scene, camera, method="ray-casting")
-    with pytest.raises(FrustumError, match=r"method = 'ray-casting' is not available yet.*'a-buffer', 'octree'"):
-        render(scene, camera, method="ray-casting")
+    with pytest.raises(FrustumError, match=r"method = 'ray-tracing' is unknown; expected one of .*'ray-casting'"):
+        render(scene, camera, method="ray-tracing")
     with pytest.raises(FrustumError, match="transparency = 'depth-peeling' is unknown; expected one of 'sort'"):
         render(scene, camera, transparency="depth-peeling")
     with pytest.raises(FrustumError, match="mode = 'wireframe' draws lines"):
@@ -342,7 +443,7 @@ def test_methods_draw_edges_and_transparent_items_like_the_depth_buffer() -> Non
     scene.add(quad(-1, -1, 1, 1, 0.5), material=Material(color=(0.9, 0.9, 0.2), opacity=0.5))
     reference = render(scene, camera, mode="surface+edges")
     assert reference.stats is None
-    for method in ["scan-line", "area-subdivision"]:
+    for method in ["scan-line", "area-subdivision", "ray-casting"]:
         assert_same_picture(render(scene, camera, mode="surface+edges", method=method), reference, 0.995)
     assert math.isfinite(render(scene, camera, method="scan-line", samples=4).stats["spans"])
 
@@ -377,6 +478,10 @@ def test_explain_method_prints_the_counts(tmp_path, capsys) -> None:
     main(["explain", str(path), "--method", "area-subdivision"])
     lines = dict(line.split(None, 1) for line in capsys.readouterr().out.splitlines() if line.strip())
     assert lines["areas_per_level"].startswith("[1, 4,")
+    main(["explain", str(path), "--method", "ray-casting"])
+    lines = dict(line.split(None, 1) for line in capsys.readouterr().out.splitlines() if line.strip())
+    assert int(lines["rays"]) == 48 * 32 and 0 < int(lines["hits"]) < int(lines["rays"])
+    assert int(lines["triangle_tests"]) > 0 and int(lines["nodes_visited"]) > 0
     with pytest.raises(SystemExit) as exit_info:
         main(["explain", str(path), "--method", "z-buffer"])
     err = capsys.readouterr().err
@@ -397,7 +502,9 @@ def test_scene_file_render_method_and_transparency(tmp_path) -> None:
     assert frame.stats["method"] == "scan-line"
     assert_same_picture(frame, render(scene_file.scene, scene_file.cameras[0]))
     path.write_text(SCENE_FILE.replace("size = [48, 32]", 'size = [48, 32]\nmethod = "ray-casting"'))
-    with pytest.raises(SceneFileError, match=r"ball.toml:8: render.method = 'ray-casting' .*'scan-line'"):
+    assert load_scene_file(path).options["method"] == "ray-casting"
+    path.write_text(SCENE_FILE.replace("size = [48, 32]", 'size = [48, 32]\nmethod = "ray-tracing"'))
+    with pytest.raises(SceneFileError, match=r"ball.toml:8: render.method = 'ray-tracing' .*'ray-casting'"):
         load_scene_file(path)
 
 
@@ -410,7 +517,7 @@ def test_polylines_are_drawn_as_lines_against_each_methods_depth() -> None:
     scene = flat_scene(quad(2.0, 2.0, 12.0, 12.0, 0.0))
     scene.add(Polyline([[1.0, 7.0, 1.0], [15.0, 7.0, -1.0]]), material=Material(color=(1.0, 1.0, 0.0)))
     reference = render(scene, camera)
-    for method in ("scan-line", "area-subdivision", "bsp", "a-buffer"):
+    for method in ("scan-line", "area-subdivision", "bsp", "a-buffer", "ray-casting"):
         frame = render(scene, camera, method=method)
         yellow = (frame.color[..., 0] == 255) & (frame.color[..., 1] == 255) & (frame.color[..., 2] == 0)
         expected = (reference.color[..., 0] == 255) & (reference.color[..., 1] == 255) & (reference.color[..., 2] == 0)
@@ -428,7 +535,7 @@ def test_octrees_are_drawn_by_every_method_as_their_cell_faces() -> None:
     camera = Camera.look_at((1.5, 2.0, 3.0), (0.0, 0.0, 0.0), width=48, height=40)
     reference = render(scene, camera)
     assert (reference.depth < 1.0).sum() > 100
-    for method in ("scan-line", "area-subdivision", "bsp"):
+    for method in ("scan-line", "area-subdivision", "bsp", "ray-casting"):
         assert_same_picture(render(scene, camera, method=method), reference)
 
 
@@ -441,9 +548,8 @@ def test_parallel_methods_give_the_same_bytes_and_counts_on_any_number_of_thread
         results = []
         for count in (1, 3, 7):
             set_threads(count)
-            results.append(
-                [render(scene, camera, method=m, transparency="a-buffer") for m in ("scan-line", "a-buffer")]
-            )
+            methods = ("scan-line", "a-buffer", "ray-casting")
+            results.append([render(scene, camera, method=m, transparency="a-buffer") for m in methods])
     finally:
         set_threads(None)
     for frames in results[1:]:
