@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-METHODS = ("depth-buffer", "scan-line", "area-subdivision", "a-buffer", "depth-sort", "bsp")
+METHODS = ("depth-buffer", "scan-line", "area-subdivision", "ray-casting", "a-buffer", "depth-sort", "bsp")
 BUNNY = next(
     (path for path in (Path(__file__).resolve().parents[1].parent / "shared", Path("/work/shared"))
      if (path / "data" / "bunny" / "bun_zipper.ply").exists()), Path("/work/shared"),
