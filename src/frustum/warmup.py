@@ -153,7 +153,7 @@ TASKS: dict[str, Callable[[], None]] = {
     "lines and points": _lines,
     "hidden lines and clipping": _vector,
     "fractals": _fractals,
-    "visible-surface methods (scan-line, area subdivision, painter, A-buffer)": _visibility_methods,
+    "visible-surface methods (scan-line, area subdivision, painter, ray casting, A-buffer)": _visibility_methods,
 }
 """The families of kernels ``warmup`` compiles, each by running small examples of what uses them."""
 
