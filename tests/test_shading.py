@@ -454,3 +454,24 @@ def test_the_directional_fast_path_equals_the_general_shading_kernel_bit_for_bit
     fast = render(scene, camera)
     general = render(scene, camera, buffers=("object_id",))
     assert (fast.color == general.color).all() and (fast.depth == general.depth).all()
+
+
+def test_the_phong_kernel_for_any_lights_equals_the_general_shading_kernel_bit_for_bit():
+    """Per-pixel Phong with point, spot and directional lights and no extras runs ``shade_pixels_phong``; an extra
+    buffer forces the general ``shade_pixels``: the colors must be the same bytes, both sides lit."""
+    sphere = trimesh.creation.icosphere(subdivisions=3)
+    half = sphere.faces[sphere.triangles_center[:, 2] < 0.3]  # open at the top: back faces seen inside
+    lights = [
+        PointLight((2.0, 1.5, 3.0), color=(1.0, 0.9, 0.8), attenuation=(1.0, 0.1, 0.02)),
+        SpotLight((0.0, 3.0, 1.0), (0.0, -1.0, -0.3), inner_angle=0.3, outer_angle=0.6),
+        DirectionalLight((-0.3, -0.6, -0.7), intensity=0.5),
+        AmbientLight(intensity=0.2),
+    ]
+    scene = Scene(lights=lights)
+    scene.add(Mesh(sphere.vertices, half), Material(color=(0.7, 0.5, 0.3), shininess=20, emissive=(0.02, 0, 0)))
+    camera = Camera.look_at((0.5, 2.5, 2.0), (0, 0, 0), (0, 1, 0), width=96, height=72)
+    for specular in ("blinn-phong", "phong"):
+        fast = render(scene, camera, cull_back_faces=False, specular=specular)
+        general = render(scene, camera, cull_back_faces=False, specular=specular, buffers=("object_id",))
+        assert (fast.color == general.color).all() and (fast.depth == general.depth).all()
+        assert (fast.depth < 1).sum() > 1000

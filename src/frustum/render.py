@@ -449,6 +449,18 @@ def _directional(item: SceneItem, options: _Options, lights: np.ndarray) -> bool
     )  # fmt: skip
 
 
+def _plain_phong(item: SceneItem, options: _Options) -> bool:
+    """Whether the item shades through ``shade.shade_pixels_phong``: per-pixel Phong with any lights and no vertex
+    colors, texture, depth cue, blending or extra buffers."""
+    mesh = item.mesh
+    return (
+        item.material.opacity >= 1.0 and options.shade_mode == shade.SHADE_PHONG
+        and getattr(mesh, "vertex_colors", None) is None
+        and (item.material.texture is None or getattr(mesh, "uvs", None) is None)
+        and options.depth_cue is None and not options.buffers
+    )  # fmt: skip
+
+
 def _item_flags(
     index: int, face_offset: int, options: _Options, blend: bool, write_normals: bool, write_ids: bool
 ) -> np.ndarray:  # fmt: skip
@@ -480,6 +492,10 @@ def _shade_item(
     if not blend and _directional(item, options, lights):  # the same bytes without the general branches
         flags = _item_flags(index, face_offset, options, blend, False, False)
         shade.shade_pixels_directional(depth, codes, bary, faces, world, normals, params, lights, flags, color)
+        return
+    if not blend and _plain_phong(item, options):  # the same bytes, without the other models' branches
+        flags = _item_flags(index, face_offset, options, blend, False, False)
+        shade.shade_pixels_phong(depth, codes, bary, faces, world, normals, params, lights, flags, color)
         return
     if mode == shade.SHADE_GOURAUD and mesh.face_count:
         lit = np.empty((mesh.vertex_count, 6))

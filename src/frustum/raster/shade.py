@@ -43,6 +43,7 @@ __all__ = [
     "power",
     "shade_pixels",
     "shade_pixels_directional",
+    "shade_pixels_phong",
 ]
 
 SHADE_NONE, SHADE_PHONG, SHADE_FLAT, SHADE_GOURAUD, SHADE_NORMALS, SHADE_DEPTH = 0, 1, 2, 3, 4, 5
@@ -361,6 +362,37 @@ def _shade_row(
             normal_out[row, col, 0], normal_out[row, col, 1], normal_out[row, col, 2] = nx, ny, nz
         if item[I_WRITE_IDS] != 0:
             id_out[row, col] = item[I_OBJECT_ID]
+
+
+@parallel_kernel(lambda depth, codes, *_: codes.shape[0], work=lambda depth, *_: depth.size, grain=16384)
+def shade_pixels_phong(
+    depth: np.ndarray, codes: np.ndarray, bary: np.ndarray, faces: np.ndarray, world: np.ndarray,
+    normals: np.ndarray, params: np.ndarray, lights: np.ndarray, item: np.ndarray, color: np.ndarray,
+    start: int, stop: int,
+) -> None:  # fmt: skip
+    """``shade_pixels`` specialized to per-pixel Phong shading with any lights, bit for bit, and nothing else: no
+    texture, vertex colors, depth cueing, blending or extra buffers (the README example's case). It compiles in
+    half the time of the general kernel, which holds every model and option."""
+    face_offset = item[I_FACE_OFFSET]
+    specular_model = item[I_SPECULAR_MODEL]
+    for row in range(start, stop):
+        for col in range(codes.shape[1]):
+            if depth[row, col] >= 1.0:
+                continue
+            code = codes[row, col]
+            if code < 0:
+                continue
+            f = code // 2 - face_offset
+            if f < 0 or f >= faces.shape[0]:
+                continue
+            u1, u2 = float(bary[row, col, 0]), float(bary[row, col, 1])
+            u0 = (1.0 - u1) - u2
+            nx, ny, nz, px, py, pz = _surface(f, code % 2 == 1, u0, u1, u2, faces, world, normals)
+            dr, dg, db, sr, sg, sb = _illuminate(params, lights, specular_model, px, py, pz, nx, ny, nz)
+            color[row, col, 0] = _to_byte((params[P_COLOR] * dr + sr) + params[P_EMISSIVE])
+            color[row, col, 1] = _to_byte((params[P_COLOR + 1] * dg + sg) + params[P_EMISSIVE + 1])
+            color[row, col, 2] = _to_byte((params[P_COLOR + 2] * db + sb) + params[P_EMISSIVE + 2])
+            color[row, col, 3] = 255
 
 
 # Scratch of the directional fast path: one row of _CHUNK float64 per quantity (structure of arrays), at fixed
