@@ -5,13 +5,15 @@ from __future__ import annotations
 import io
 import os
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from frustum.errors import OutputError
+from frustum._arrays import describe
+from frustum.errors import FrustumError, OutputError
 
-__all__ = ["Frame"]
+__all__ = ["Frame", "background_bytes"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -102,3 +104,22 @@ class Frame:
         buffer = io.BytesIO()
         self.to_pil().save(buffer, format="PNG")
         return buffer.getvalue()
+
+
+def background_bytes(background: Any, where: str) -> np.ndarray:
+    """An RGBA color in [0, 1] as the (4,) uint8 bytes every renderer paints, ``floor(255·v + 1/2)``."""
+    try:
+        values = np.asarray(background, dtype=np.float64)
+    except (TypeError, ValueError):
+        values = None
+    if (
+        values is None
+        or values.shape != (4,)
+        or not np.isfinite(values).all()
+        or (values < 0).any()
+        or (values > 1).any()
+    ):
+        raise FrustumError(
+            f"{where}: background = {describe(background)} is not an RGBA color; expected four finite numbers in [0, 1]"
+        )
+    return np.floor(values * 255.0 + 0.5).astype(np.uint8)

@@ -49,7 +49,7 @@ from frustum.budgets import check_memory
 from frustum.camera import Camera
 from frustum.clipping import VIEW_VOLUME_PLANES
 from frustum.errors import FrustumError
-from frustum.frame import Frame
+from frustum.frame import Frame, background_bytes
 from frustum.geometry import Mesh
 from frustum.hidden_lines import EdgeAdjacency, classify_edges, edge_adjacency, front_facing, welded_adjacency
 from frustum.raster import lines, shade, tiles, triangles
@@ -315,7 +315,7 @@ def _render_octrees(scene: Scene, camera: Camera, *, background: Any) -> Frame:
     if not isinstance(scene, Scene) or not isinstance(camera, Camera):
         _check_arguments(scene, camera, "phong", "blinn-phong", background, True, "surface", None, 0.0, None, None,
                          (0.6, 0.6, 0.6), 1.0, None, (), "render")  # fmt: skip
-    rgba = _background_bytes(background, "render")
+    rgba = background_bytes(background, "render")
     color = np.empty((camera.height, camera.width, 4), dtype=np.uint8)
     color[:, :] = rgba
     depth = np.ones((camera.height, camera.width), dtype=np.float32)
@@ -412,28 +412,33 @@ def _draw_surfaces(
         from frustum.volume_pass import draw_volumes
 
         draw_volumes(scene, camera, depth, color)
-    if clear_items:
-        axis = np.asarray(camera.frame.n, dtype=np.float64)
-        eye = np.asarray(camera.frame.eye, dtype=np.float64)
-
-        def distance(index: int) -> float:
-            item = items[index]
-            if item.mesh.vertex_count == 0:
-                return 0.0
-            centre = item.mesh.bounds.mean(axis=0)
-            centre = item.world_from_model[:3, :3] @ centre + item.world_from_model[:3, 3]
-            return float((eye - centre) @ axis)
-
-        for index in sorted(clear_items, key=distance, reverse=True):
-            item = items[index]
-            layer_depth = depth.copy()
-            layer_codes = np.full((height, width), -1, dtype=code_type)
-            world, normals, rows = _draw_item(
-                item, camera, options.cull, int(offsets[index]), layer_depth, layer_codes, bary, scratch
-            )
-            _shade_item(item, index, int(offsets[index]), camera, options, ambient, lights, world, normals,
-                        layer_depth, layer_codes, bary, color, extra, rows, blend=True)  # fmt: skip
+    for index in back_to_front(items, clear_items, camera):
+        item = items[index]
+        layer_depth = depth.copy()
+        layer_codes = np.full((height, width), -1, dtype=code_type)
+        world, normals, rows = _draw_item(
+            item, camera, options.cull, int(offsets[index]), layer_depth, layer_codes, bary, scratch
+        )
+        _shade_item(item, index, int(offsets[index]), camera, options, ambient, lights, world, normals,
+                    layer_depth, layer_codes, bary, color, extra, rows, blend=True)  # fmt: skip
     return depth, color
+
+
+def back_to_front(items: list[SceneItem], indices: list[int], camera: Camera) -> list[int]:
+    """The items `indices` farthest first, by the view distance ``(eye − c)·n`` of their bounding-box centres c
+    (the per-object sort of transparent items: right when they do not interpenetrate or cyclically overlap)."""
+    axis = np.asarray(camera.frame.n, dtype=np.float64)
+    eye = np.asarray(camera.frame.eye, dtype=np.float64)
+
+    def distance(index: int) -> float:
+        item = items[index]
+        if item.mesh.vertex_count == 0:
+            return 0.0
+        centre = item.mesh.bounds.mean(axis=0)
+        centre = item.world_from_model[:3, :3] @ centre + item.world_from_model[:3, 3]
+        return float((eye - centre) @ axis)
+
+    return sorted(indices, key=distance, reverse=True)
 
 
 def _directional(item: SceneItem, options: _Options, lights: np.ndarray) -> bool:
@@ -949,9 +954,9 @@ def _check_arguments(
             f"{where}: buffers = {describe(buffers)} is not a tuple of buffer names; valid names: "
             + ", ".join(repr(b) for b in BUFFERS)
         )
-    background_bytes = _background_bytes(background, where)
+    background_rgba = background_bytes(background, where)
     if edge_color is None:  # material colors for wireframes; black on light backgrounds, white on dark ones
-        light = background_bytes[:3].astype(float) @ (0.2126, 0.7152, 0.0722) > 127.5
+        light = background_rgba[:3].astype(float) @ (0.2126, 0.7152, 0.0722) > 127.5
         edge = (
             None if mode in ("wireframe", "points") else np.array([0.0, 0.0, 0.0, 255.0]) * light + 255.0 * (not light)
         )
@@ -960,7 +965,7 @@ def _check_arguments(
     return _Options(
         shade_mode=SHADING_MODES[name],
         specular_model=shade.SPECULAR_PHONG if specular == "phong" else shade.SPECULAR_BLINN,
-        background=background_bytes,
+        background=background_rgba,
         cull=bool(cull_back_faces),
         mode=mode,
         edges=edges,
@@ -972,24 +977,6 @@ def _check_arguments(
         depth_cue=depth_cue,
         buffers=tuple(buffers),
     )
-
-
-def _background_bytes(background: Any, where: str) -> np.ndarray:
-    try:
-        values = np.asarray(background, dtype=np.float64)
-    except (TypeError, ValueError):
-        values = None
-    if (
-        values is None
-        or values.shape != (4,)
-        or not np.isfinite(values).all()
-        or (values < 0).any()
-        or (values > 1).any()
-    ):
-        raise FrustumError(
-            f"{where}: background = {describe(background)} is not an RGBA color; expected four finite numbers in [0, 1]"
-        )
-    return np.floor(values * 255.0 + 0.5).astype(np.uint8)
 
 
 # --- visible-surface methods (render(..., method=...), docs/visibility.md) -----------------------------------
@@ -1125,18 +1112,7 @@ def _draw_surfaces_by_method(
                            under_depth=depth)  # fmt: skip
         counts.update({f"transparent_{key}": value for key, value in found.items()})
         return depth, color
-    axis = np.asarray(camera.frame.n, dtype=np.float64)
-    eye = np.asarray(camera.frame.eye, dtype=np.float64)
-
-    def distance(index: int) -> float:
-        item = items[index]
-        if item.mesh.vertex_count == 0:
-            return 0.0
-        centre = item.mesh.bounds.mean(axis=0)
-        centre = item.world_from_model[:3, :3] @ centre + item.world_from_model[:3, 3]
-        return float((eye - centre) @ axis)
-
-    for index in sorted(clear_items, key=distance, reverse=True):  # per-object sort, as the depth buffer does
+    for index in back_to_front(items, clear_items, camera):  # per-object sort, as the depth buffer does
         item = items[index]
         layer_depth = depth.copy()
         layer_codes = np.full((height, width), -1, dtype=code_type)

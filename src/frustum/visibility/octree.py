@@ -21,7 +21,7 @@ from numpy.typing import ArrayLike
 from frustum._arrays import as_matrix, describe
 from frustum.camera import Camera
 from frustum.errors import FrustumError
-from frustum.frame import Frame
+from frustum.frame import Frame, background_bytes
 from frustum.geometry.octree import Octree
 from frustum.shading import LIGHT_TYPES, DirectionalLight, Light, Material, illuminate
 
@@ -123,7 +123,7 @@ def render_octree(
         raise FrustumError(f"{where}: lights = {describe(lights)} holds a non-light; give AmbientLight, "
                            "DirectionalLight, PointLight or SpotLight objects")  # fmt: skip
     matrix = np.eye(4) if world_from_model is None else as_matrix(world_from_model, where=where, error=FrustumError)
-    rgba = _background(background, where)
+    rgba = background_bytes(background, where)
     color = np.empty((camera.height, camera.width, 4), dtype=np.uint8)
     color[:, :] = rgba
     depth = np.ones((camera.height, camera.width), dtype=np.float32)
@@ -133,19 +133,3 @@ def render_octree(
     return Frame(color=color, depth=depth)
 
 
-def _background(value: Any, where: str) -> np.ndarray:
-    try:
-        values = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError):
-        values = None
-    if (
-        values is None
-        or values.shape != (4,)
-        or not np.isfinite(values).all()
-        or (values < 0).any()
-        or (values > 1).any()
-    ):
-        raise FrustumError(
-            f"{where}: background = {describe(value)} is not an RGBA color; expected four finite numbers in [0, 1]"
-        )
-    return np.floor(values * 255.0 + 0.5).astype(np.uint8)
