@@ -88,24 +88,6 @@ def block_ranges(data, blocks):  # pragma: no cover - compiled
 
 
 @kernel
-def _sample(data, u0, u1, u2):  # pragma: no cover - compiled
-    """Trilinear value at grid position (u0, u1, u2), clamped into the box."""
-    nx, ny, nz = data.shape
-    u0 = min(max(u0, 0.0), nx - 1.0)
-    u1 = min(max(u1, 0.0), ny - 1.0)
-    u2 = min(max(u2, 0.0), nz - 1.0)
-    i, j, k = min(int(u0), nx - 2), min(int(u1), ny - 2), min(int(u2), nz - 2)
-    fx, fy, fz = u0 - i, u1 - j, u2 - k
-    c00 = data[i, j, k] * (1.0 - fz) + data[i, j, k + 1] * fz
-    c01 = data[i, j + 1, k] * (1.0 - fz) + data[i, j + 1, k + 1] * fz
-    c10 = data[i + 1, j, k] * (1.0 - fz) + data[i + 1, j, k + 1] * fz
-    c11 = data[i + 1, j + 1, k] * (1.0 - fz) + data[i + 1, j + 1, k + 1] * fz
-    c0 = c00 * (1.0 - fy) + c01 * fy
-    c1 = c10 * (1.0 - fy) + c11 * fy
-    return c0 * (1.0 - fx) + c1 * fx
-
-
-@kernel
 def _cell(data, u0, u1, u2):  # pragma: no cover - compiled
     """The cell (i, j, k) holding grid position u (clamped into the box) and the fractions (fx, fy, fz) in it."""
     nx, ny, nz = data.shape
@@ -126,6 +108,13 @@ def _trilinear(data, i, j, k, fx, fy, fz):  # pragma: no cover - compiled
     c0 = c00 * (1.0 - fy) + c01 * fy
     c1 = c10 * (1.0 - fy) + c11 * fy
     return c0 * (1.0 - fx) + c1 * fx
+
+
+@kernel
+def _sample(data, u0, u1, u2):  # pragma: no cover - compiled
+    """Trilinear value at grid position (u0, u1, u2), clamped into the box."""
+    i, j, k, fx, fy, fz = _cell(data, u0, u1, u2)
+    return _trilinear(data, i, j, k, fx, fy, fz)
 
 
 @kernel
