@@ -56,8 +56,8 @@ P_STEP, P_UNIT, P_LEVEL, P_SHADE = 0, 1, 2, 3
 P_KA, P_KD, P_KS, P_SHININESS = 4, 5, 6, 7
 P_AMBIENT = 8  # 3 values
 P_EYE = 11  # 3 values
-P_SPECULAR_PHONG, P_TABLE_LOW, P_TABLE_SCALE, P_TERMINATE, P_BISECTIONS = 14, 15, 16, 17, 18
-PARAMS = 19
+P_SPECULAR_PHONG, P_TABLE_LOW, P_TABLE_SCALE, P_TERMINATE, P_BISECTIONS, P_ANCHORED = 14, 15, 16, 17, 18, 19
+PARAMS = 20
 # matrices (5, 4, 4)
 M_GRID_FROM_WINDOW, M_MODEL_FROM_GRID, M_WINDOW_FROM_GRID, M_WORLD_FROM_GRID, M_NORMAL_FROM_GRID = 0, 1, 2, 3, 4
 # blocks (bx, by, bz, 3) float32: min, max, empty (1.0: opacity 0 over the block's range)
@@ -233,116 +233,255 @@ def _shade(data, matrices, params, lights, u, view_dir, r, g, b):  # pragma: no 
 
 
 @kernel
-def _position(s0, ds, count, last, k):  # pragma: no cover - compiled
-    """Ray parameter of sample k and its segment length in s: middles of segments ds, the last one `last` long."""
-    if k < count - 1:
-        return s0 + (k + 0.5) * ds, ds
-    return s0 + (count - 1) * ds + 0.5 * last, last
+def _samples(s0, s1, ds, anchored):  # pragma: no cover - compiled
+    """Where the samples of the ray part [s0, s1] lie: (first, count, tail_s, tail).
+
+    Full samples k = 0 … count − 1 at ``first + k·ds`` each stand for a segment ds; when ``tail > 0`` one more at
+    ``tail_s`` stands for a segment tail (<= ds). ``anchored`` false (sampling "entry"): the middles of segments
+    ds from s0, the last one (the tail) shorter. True (sampling "near"): every whole multiple of ds from the
+    ray's point on the near plane (s = 0) inside [s0, s1], no tail.
+    """
+    if anchored:
+        k0 = math.ceil(s0 / ds)
+        return k0 * ds, max(math.floor(s1 / ds) - k0 + 1, 0), s1, 0.0
+    count = math.ceil((s1 - s0) / ds)
+    last = (s1 - s0) - (count - 1) * ds
+    return s0 + 0.5 * ds, count - 1, s0 + (count - 1) * ds + 0.5 * last, last
+
+
+@kernel
+def _walk_start(origin, direction, shape, u0, u1, u2):  # pragma: no cover - compiled
+    """Start of a 3D DDA over the blocks along the ray u = origin + s·direction from grid position u: the block
+    (bi, bj, bk) of u's cell, the step (±1, 0) per axis, the ray parameter where the ray leaves the block through
+    each axis (inf if never) and the increments of those parameters per block."""
+    nx, ny, nz = shape
+    bi = max(min(int(u0), nx - 2), 0) // BLOCK
+    bj = max(min(int(u1), ny - 2), 0) // BLOCK
+    bk = max(min(int(u2), nz - 2), 0) // BLOCK
+    step0, t0, dt0 = _axis_start(origin[0], direction[0], bi)
+    step1, t1, dt1 = _axis_start(origin[1], direction[1], bj)
+    step2, t2, dt2 = _axis_start(origin[2], direction[2], bk)
+    return bi, bj, bk, step0, step1, step2, t0, t1, t2, dt0, dt1, dt2
+
+
+@kernel
+def _axis_start(o, d, b):  # pragma: no cover - compiled
+    """One axis of ``_walk_start``: (step, exit parameter, parameter per block)."""
+    if d > 0.0:
+        return 1, ((b + 1) * BLOCK - o) / d, BLOCK / d
+    if d < 0.0:
+        return -1, (b * BLOCK - o) / d, -BLOCK / d
+    return 0, np.inf, np.inf
+
+
+@kernel
+def _cell_at(data, u0, u1, u2):  # pragma: no cover - compiled
+    """``_cell`` for a position inside the box up to rounding (integer clamps only)."""
+    nx, ny, nz = data.shape
+    i = max(min(int(u0), nx - 2), 0)
+    j = max(min(int(u1), ny - 2), 0)
+    k = max(min(int(u2), nz - 2), 0)
+    return i, j, k, u0 - i, u1 - j, u2 - k
+
+
+@kernel
+def _classify(data, table, params, lights, matrices, u, view_dir, u0, u1, u2, column, shade,
+              rgba):  # pragma: no cover - compiled  # fmt: skip
+    """Trilinear value at u, its opacity from table column `column` (4: corrected for Δ, 3: raw) into rgba[3]
+    and, when that is > 0, its (shaded) color into rgba[:3]."""
+    i, j, k, fx, fy, fz = _cell_at(data, u0, u1, u2)
+    value = _trilinear(data, i, j, k, fx, fy, fz)
+    t_index, t = _table_index(table, params, value)
+    alpha = table[t_index, column] * (1.0 - t) + table[t_index + 1, column] * t
+    rgba[3] = alpha
+    if alpha > 0.0:
+        r = table[t_index, 0] * (1.0 - t) + table[t_index + 1, 0] * t
+        g = table[t_index, 1] * (1.0 - t) + table[t_index + 1, 1] * t
+        b = table[t_index, 2] * (1.0 - t) + table[t_index + 1, 2] * t
+        if shade:
+            u[0], u[1], u[2] = u0, u1, u2
+            r, g, b = _shade(data, matrices, params, lights, u, view_dir, r, g, b)
+        rgba[0], rgba[1], rgba[2] = r, g, b
 
 
 @kernel
 def _composite(data, blocks, table, matrices, params, lights, origin, direction, s0, s1, ds, model_length,
-               view_dir, out):  # pragma: no cover - compiled  # fmt: skip
-    """Front-to-back compositing along one ray; (r, g, b, A) into `out`."""
-    count = math.ceil((s1 - s0) / ds)
-    last = (s1 - s0) - (count - 1) * ds
-    unit = params[P_UNIT]
+               view_dir, u, rgba, out):  # pragma: no cover - compiled  # fmt: skip
+    """Front-to-back compositing along one ray; (r, g, b, A) into `out` (`u`, `rgba`: scratch).
+
+    Empty-space skipping walks the blocks the ray crosses (a 3D DDA over the block grid: Amanatides & Woo); the
+    samples before an empty block's exit are skipped, the others run without a block lookup each.
+    """
+    first, count, tail_s, tail = _samples(s0, s1, ds, params[P_ANCHORED] != 0.0)
     threshold = params[P_TERMINATE]
     shade = params[P_SHADE] != 0.0
     cr, cg, cb, acc = 0.0, 0.0, 0.0, 0.0
-    u = np.empty(3)
-    k = 0
-    while k < count:
-        s = s0 + (k + 0.5) * ds if k < count - 1 else s0 + (count - 1) * ds + 0.5 * last
-        u0, u1, u2 = origin[0] + s * direction[0], origin[1] + s * direction[1], origin[2] + s * direction[2]
-        i, j, kk, fx, fy, fz = _cell(data, u0, u1, u2)
-        bi, bj, bk = i // BLOCK, j // BLOCK, kk // BLOCK
-        if blocks[bi, bj, bk, B_EMPTY] != 0.0:  # jump to the first sample at or past the block's exit
-            exit_s = _block_exit(origin, direction, bi, bj, bk, data.shape)
-            k = max(k + 1, math.ceil((exit_s - s0) / ds - 0.5))
-            continue
-        value = _trilinear(data, i, j, kk, fx, fy, fz)
-        t_index, t = _table_index(table, params, value)
-        if k < count - 1:  # opacity corrected for Δ in the table (0 exactly where the raw opacity is 0)
-            alpha = table[t_index, 4] * (1.0 - t) + table[t_index + 1, 4] * t
-        else:
-            alpha = table[t_index, 3] * (1.0 - t) + table[t_index + 1, 3] * t
-            alpha = 1.0 - (1.0 - alpha) ** (last * model_length / unit) if alpha > 0.0 else 0.0
-        if alpha > 0.0:
-            r = table[t_index, 0] * (1.0 - t) + table[t_index + 1, 0] * t
-            g = table[t_index, 1] * (1.0 - t) + table[t_index + 1, 1] * t
-            b = table[t_index, 2] * (1.0 - t) + table[t_index + 1, 2] * t
-            if shade:
-                u[0], u[1], u[2] = u0, u1, u2
-                r, g, b = _shade(data, matrices, params, lights, u, view_dir, r, g, b)
-            weight = (1.0 - acc) * alpha
-            cr += weight * r
-            cg += weight * g
-            cb += weight * b
-            acc += weight
-            if acc >= threshold:
+    if count > 0:
+        nbx, nby, nbz = blocks.shape[0], blocks.shape[1], blocks.shape[2]
+        b0, b1, b2 = (origin[0] + first * direction[0], origin[1] + first * direction[1],
+                      origin[2] + first * direction[2])  # fmt: skip
+        d0, d1, d2 = ds * direction[0], ds * direction[1], ds * direction[2]
+        bi, bj, bk, step0, step1, step2, t0, t1, t2, dt0, dt1, dt2 = _walk_start(origin, direction, data.shape,
+                                                                                 b0, b1, b2)  # fmt: skip
+        inverse_ds = 1.0 / ds
+        k = 0
+        while True:
+            exit_s = min(t0, t1, t2)
+            end = (exit_s - first) * inverse_ds  # samples before the block's exit: k < ceil(end)
+            stop = count if end >= count else math.ceil(end)
+            if blocks[bi, bj, bk, B_EMPTY] == 0.0:  # else opacity 0 over the block: its samples add nothing
+                while k < stop:
+                    u0, u1, u2 = b0 + k * d0, b1 + k * d1, b2 + k * d2
+                    k += 1
+                    t_index, t = _table_index(table, params, _value(data, u0, u1, u2))
+                    alpha = table[t_index, 4] * (1.0 - t) + table[t_index + 1, 4] * t  # corrected for Δ
+                    if alpha > 0.0:
+                        r = table[t_index, 0] * (1.0 - t) + table[t_index + 1, 0] * t
+                        g = table[t_index, 1] * (1.0 - t) + table[t_index + 1, 1] * t
+                        b = table[t_index, 2] * (1.0 - t) + table[t_index + 1, 2] * t
+                        if shade:
+                            u[0], u[1], u[2] = u0, u1, u2
+                            r, g, b = _shade(data, matrices, params, lights, u, view_dir, r, g, b)
+                        weight = (1.0 - acc) * alpha
+                        cr += weight * r
+                        cg += weight * g
+                        cb += weight * b
+                        acc += weight
+                        if acc >= threshold:  # early ray termination
+                            out[0], out[1], out[2], out[3] = cr, cg, cb, acc
+                            return
+            k = max(k, stop)
+            if k >= count:
                 break
-        k += 1
+            if t0 <= t1 and t0 <= t2:
+                bi += step0
+                t0 += dt0
+            elif t1 <= t2:
+                bj += step1
+                t1 += dt1
+            else:
+                bk += step2
+                t2 += dt2
+            if bi < 0 or bj < 0 or bk < 0 or bi >= nbx or bj >= nby or bk >= nbz:  # rounding at the box's faces
+                bi, bj, bk = min(max(bi, 0), nbx - 1), min(max(bj, 0), nby - 1), min(max(bk, 0), nbz - 1)
+    if tail > 0.0:  # the last, shorter segment: its opacity corrected for its own length
+        _classify(data, table, params, lights, matrices, u, view_dir, origin[0] + tail_s * direction[0],
+                  origin[1] + tail_s * direction[1], origin[2] + tail_s * direction[2], 3, shade, rgba)  # fmt: skip
+        if rgba[3] > 0.0:
+            alpha = 1.0 - (1.0 - rgba[3]) ** (tail * model_length / params[P_UNIT])
+            weight = (1.0 - acc) * alpha
+            cr += weight * rgba[0]
+            cg += weight * rgba[1]
+            cb += weight * rgba[2]
+            acc += weight
     out[0], out[1], out[2], out[3] = cr, cg, cb, acc
 
 
 @kernel
-def _extreme(data, blocks, origin, direction, s0, s1, ds, sign):  # pragma: no cover - compiled
-    """sign = +1: the largest sample along the ray (MIP); −1: the smallest (MinIP)."""
-    count = math.ceil((s1 - s0) / ds)
-    last = (s1 - s0) - (count - 1) * ds
+def _value(data, u0, u1, u2):  # pragma: no cover - compiled
+    """Trilinear value at a position inside the box up to rounding."""
+    i, j, k, fx, fy, fz = _cell_at(data, u0, u1, u2)
+    return _trilinear(data, i, j, k, fx, fy, fz)
+
+
+@kernel
+def _extreme(data, blocks, origin, direction, s0, s1, ds, sign, anchored):  # pragma: no cover - compiled
+    """sign = +1: the largest sample along the ray (MIP); −1: the smallest (MinIP); NaN when there is none."""
+    first, count, tail_s, tail = _samples(s0, s1, ds, anchored)
     best = -np.inf
-    bound = B_MAX if sign > 0.0 else B_MIN
-    k = 0
-    while k < count:
-        s = s0 + (k + 0.5) * ds if k < count - 1 else s0 + (count - 1) * ds + 0.5 * last
-        i, j, kk, fx, fy, fz = _cell(data, origin[0] + s * direction[0], origin[1] + s * direction[1],
-                                     origin[2] + s * direction[2])  # fmt: skip
-        bi, bj, bk = i // BLOCK, j // BLOCK, kk // BLOCK
-        if sign * blocks[bi, bj, bk, bound] <= best:  # nothing in this block can beat the current extreme
-            exit_s = _block_exit(origin, direction, bi, bj, bk, data.shape)
-            k = max(k + 1, math.ceil((exit_s - s0) / ds - 0.5))
-            continue
-        best = max(best, sign * _trilinear(data, i, j, kk, fx, fy, fz))
-        k += 1
+    if count > 0:
+        nbx, nby, nbz = blocks.shape[0], blocks.shape[1], blocks.shape[2]
+        b0, b1, b2 = (origin[0] + first * direction[0], origin[1] + first * direction[1],
+                      origin[2] + first * direction[2])  # fmt: skip
+        d0, d1, d2 = ds * direction[0], ds * direction[1], ds * direction[2]
+        bi, bj, bk, step0, step1, step2, t0, t1, t2, dt0, dt1, dt2 = _walk_start(origin, direction, data.shape,
+                                                                                 b0, b1, b2)  # fmt: skip
+        bound = B_MAX if sign > 0.0 else B_MIN
+        inverse_ds = 1.0 / ds
+        k = 0
+        while True:
+            exit_s = min(t0, t1, t2)
+            end = (exit_s - first) * inverse_ds  # samples before the block's exit: k < ceil(end)
+            stop = count if end >= count else math.ceil(end)
+            limit = sign * blocks[bi, bj, bk, bound]
+            if limit > best:  # else nothing in this block can beat the current extreme
+                while k < stop:
+                    best = max(best, sign * _value(data, b0 + k * d0, b1 + k * d1, b2 + k * d2))
+                    k += 1
+                    if best >= limit:
+                        break
+            k = max(k, stop)
+            if k >= count:
+                break
+            if t0 <= t1 and t0 <= t2:
+                bi += step0
+                t0 += dt0
+            elif t1 <= t2:
+                bj += step1
+                t1 += dt1
+            else:
+                bk += step2
+                t2 += dt2
+            if bi < 0 or bj < 0 or bk < 0 or bi >= nbx or bj >= nby or bk >= nbz:  # rounding at the box's faces
+                bi, bj, bk = min(max(bi, 0), nbx - 1), min(max(bj, 0), nby - 1), min(max(bk, 0), nbz - 1)
+    if tail > 0.0:
+        best = max(best, sign * _value(data, origin[0] + tail_s * direction[0], origin[1] + tail_s * direction[1],
+                                       origin[2] + tail_s * direction[2]))  # fmt: skip
+    if count == 0 and not tail > 0.0:
+        return np.nan
     return sign * best
 
 
 @kernel
-def _average(data, origin, direction, s0, s1, ds):  # pragma: no cover - compiled
-    """Length-weighted mean of the samples along the ray."""
-    count = math.ceil((s1 - s0) / ds)
-    last = (s1 - s0) - (count - 1) * ds
-    total, length = 0.0, 0.0
+def _average(data, origin, direction, s0, s1, ds, anchored):  # pragma: no cover - compiled
+    """Length-weighted mean of the samples along the ray (NaN when there is none)."""
+    first, count, tail_s, tail = _samples(s0, s1, ds, anchored)
+    total = 0.0
     for k in range(count):
-        s, seg = _position(s0, ds, count, last, k)
-        total += seg * _sample(data, origin[0] + s * direction[0], origin[1] + s * direction[1],
-                               origin[2] + s * direction[2])  # fmt: skip
-        length += seg
-    return total / length
+        s = first + k * ds
+        total += _value(data, origin[0] + s * direction[0], origin[1] + s * direction[1], origin[2] + s * direction[2])
+    total *= ds
+    if tail > 0.0:
+        total += tail * _value(data, origin[0] + tail_s * direction[0], origin[1] + tail_s * direction[1],
+                               origin[2] + tail_s * direction[2])  # fmt: skip
+    length = count * ds + tail
+    return total / length if length > 0.0 else np.nan
 
 
 @kernel
-def _first_crossing(data, blocks, origin, direction, s0, s1, ds, level, bisections):  # pragma: no cover - compiled
-    """Ray parameter of the first crossing of `level` (bisection between the samples around it), or −1."""
-    count = math.ceil((s1 - s0) / ds)
-    last = (s1 - s0) - (count - 1) * ds
+def _position(first, ds, count, tail_s, tail, s1, m):  # pragma: no cover - compiled
+    """Ray parameter of the m-th of the isosurface search's points: the full samples, the tail sample, then s1."""
+    if m < count:
+        return first + m * ds
+    if m == count and tail > 0.0:
+        return tail_s
+    return s1
+
+
+@kernel
+def _first_crossing(data, blocks, origin, direction, s0, s1, ds, level, bisections,
+                    anchored):  # pragma: no cover - compiled  # fmt: skip
+    """Ray parameter of the first crossing of `level` (bisection between the samples around it), or −1.
+
+    The values compared are at s0, every sample, and s1."""
+    first, count, tail_s, tail = _samples(s0, s1, ds, anchored)
+    points = count + (1 if tail > 0.0 else 0) + 1
     previous_s, previous = s0, _sample(data, origin[0] + s0 * direction[0], origin[1] + s0 * direction[1],
                                        origin[2] + s0 * direction[2]) - level  # fmt: skip
-    k = 0
-    while k < count + 1:
-        s = _position(s0, ds, count, last, k)[0] if k < count else s1
+    m = 0
+    while m < points:
+        s = _position(first, ds, count, tail_s, tail, s1, m)
         u0, u1, u2 = origin[0] + s * direction[0], origin[1] + s * direction[1], origin[2] + s * direction[2]
-        if k < count:
+        if m < count:
             bi, bj, bk = _block_of(blocks, data, u0, u1, u2)
             low, high = blocks[bi, bj, bk, B_MIN] - level, blocks[bi, bj, bk, B_MAX] - level
             if (previous < 0.0 and high < 0.0) or (previous > 0.0 and low > 0.0):  # the block stays on one side
                 exit_s = _block_exit(origin, direction, bi, bj, bk, data.shape)
-                k_next = math.ceil((exit_s - s0) / ds - 0.5)
-                if k_next > k + 1:
-                    k = min(k_next, count) - 1  # keep the sample before the next block as `previous`
-                    previous_s = _position(s0, ds, count, last, k)[0]
-                    k += 1
+                m_next = math.ceil((exit_s - first) / ds)
+                if m_next > m + 1:
+                    m = min(m_next, count) - 1  # keep the sample before the next block as `previous`
+                    previous_s = first + m * ds
+                    m += 1
                     continue
         value = _sample(data, u0, u1, u2) - level
         if value == 0.0 or (value > 0.0) != (previous > 0.0):
@@ -350,16 +489,16 @@ def _first_crossing(data, blocks, origin, direction, s0, s1, ds, level, bisectio
                 return s
             a, b, fa = previous_s, s, previous
             for _ in range(bisections):
-                m = 0.5 * (a + b)
-                fm = _sample(data, origin[0] + m * direction[0], origin[1] + m * direction[1],
-                             origin[2] + m * direction[2]) - level  # fmt: skip
+                mid = 0.5 * (a + b)
+                fm = _sample(data, origin[0] + mid * direction[0], origin[1] + mid * direction[1],
+                             origin[2] + mid * direction[2]) - level  # fmt: skip
                 if (fm > 0.0) == (fa > 0.0) and fm != 0.0:
-                    a, fa = m, fm
+                    a, fa = mid, fm
                 else:
-                    b = m
+                    b = mid
             return 0.5 * (a + b)
         previous_s, previous = s, value
-        k += 1
+        m += 1
     return -1.0
 
 
@@ -434,6 +573,7 @@ def cast_composite(data, blocks, table, matrices, planes, params, lights, depth,
     height, width = depth.shape
     shape = np.array(data.shape, dtype=np.float64)
     origin, direction, view_dir, out = np.empty(3), np.empty(3), np.empty(3), np.empty(4)
+    u, rgba = np.empty(3), np.empty(4)
     for row in range(start, stop):
         y = height - 1 - row + 0.5
         for column in range(width):
@@ -441,7 +581,7 @@ def cast_composite(data, blocks, table, matrices, planes, params, lights, depth,
                                                   depth[row, column], origin, direction, view_dir)  # fmt: skip
             if s0 < s1:
                 _composite(data, blocks, table, matrices, params, lights, origin, direction, s0, s1, ds,
-                           model_length, view_dir, out)  # fmt: skip
+                           model_length, view_dir, u, rgba, out)  # fmt: skip
                 _blend(color, row, column, out)
 
 
@@ -453,6 +593,7 @@ def cast_projection(mode, data, blocks, table, matrices, planes, params, depth, 
     height, width = depth.shape
     shape = np.array(data.shape, dtype=np.float64)
     origin, direction, view_dir, out = np.empty(3), np.empty(3), np.empty(3), np.empty(4)
+    anchored = params[P_ANCHORED] != 0.0
     for row in range(start, stop):
         y = height - 1 - row + 0.5
         for column in range(width):
@@ -461,9 +602,12 @@ def cast_projection(mode, data, blocks, table, matrices, planes, params, depth, 
             if not s0 < s1:
                 continue
             if mode == MODE_AVERAGE:
-                value = _average(data, origin, direction, s0, s1, ds)
+                value = _average(data, origin, direction, s0, s1, ds, anchored)
             else:
-                value = _extreme(data, blocks, origin, direction, s0, s1, ds, 1.0 if mode == MODE_MIP else -1.0)
+                value = _extreme(data, blocks, origin, direction, s0, s1, ds, 1.0 if mode == MODE_MIP else -1.0,
+                                 anchored)  # fmt: skip
+            if math.isnan(value):  # no sample on this ray
+                continue
             alpha = _lookup(table, params, value, 3)
             for c in range(3):
                 out[c] = alpha * _lookup(table, params, value, c)
@@ -491,7 +635,8 @@ def cast_isosurface(data, blocks, table, matrices, planes, params, lights, depth
                                                   depth[row, column], origin, direction, view_dir)  # fmt: skip
             if not s0 < s1:
                 continue
-            hit = _first_crossing(data, blocks, origin, direction, s0, s1, ds, level, int(params[P_BISECTIONS]))
+            hit = _first_crossing(data, blocks, origin, direction, s0, s1, ds, level, int(params[P_BISECTIONS]),
+                                  params[P_ANCHORED] != 0.0)  # fmt: skip
             if hit < 0.0:
                 continue
             for a in range(3):
