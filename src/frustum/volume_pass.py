@@ -75,10 +75,10 @@ def volume_arrays(item: VolumeItem, camera: Camera, lights_packed: tuple[np.ndar
     for index, (point, normal) in enumerate(item.clip_planes):
         planes[index] = np.append(-normal, normal @ point) @ world_from_grid
     tf = item.transfer_function
-    table = np.empty((TABLE_SIZE, 5))
-    table[:, :4] = tf.table(TABLE_SIZE)
+    table = np.empty((5, TABLE_SIZE))  # rows r, g, b, α, α' (kernels read one row per lookup)
+    table[:4] = tf.table(TABLE_SIZE).T
     unit = volume.unit_distance
-    table[:, 4] = 1.0 - (1.0 - table[:, 3]) ** (item.step / unit)  # α' = 1 − (1 − α)^(Δ/Δ₀)
+    table[4] = 1.0 - (1.0 - table[3]) ** (item.step / unit)  # α' = 1 − (1 − α)^(Δ/Δ₀)
     low, high = tf.range
     scale = (TABLE_SIZE - 1) / (high - low)
     blocks = _blocks(volume).copy()
@@ -87,7 +87,7 @@ def volume_arrays(item: VolumeItem, camera: Camera, lights_packed: tuple[np.ndar
         f_high = np.clip((blocks[..., 1] - low) * scale, 0.0, TABLE_SIZE - 1.0)
         first = np.floor(f_low).astype(np.int64)
         last = np.minimum(np.floor(f_high).astype(np.int64) + 1, TABLE_SIZE - 1)
-        opaque = np.concatenate([[0], np.cumsum(table[:, 3] > 0.0)])
+        opaque = np.concatenate([[0], np.cumsum(table[3] > 0.0)])
         blocks[..., 2] = (opaque[last + 1] - opaque[first] == 0).astype(np.float32)
     ambient, lights = pack_lights([]) if lights_packed is None else lights_packed
     material = item.material
@@ -100,6 +100,7 @@ def volume_arrays(item: VolumeItem, camera: Camera, lights_packed: tuple[np.ndar
     params[kernels.P_EYE : kernels.P_EYE + 3] = camera.frame.eye
     params[kernels.P_TABLE_LOW], params[kernels.P_TABLE_SCALE] = low, scale
     params[kernels.P_TERMINATE], params[kernels.P_BISECTIONS] = TERMINATE, BISECTIONS
+    params[kernels.P_ANCHORED] = float(item.sampling == "near")
     return (MODES[item.mode], volume.data, blocks, table, matrices, planes, params,
             np.ascontiguousarray(lights, dtype=np.float64))  # fmt: skip
 

@@ -120,7 +120,7 @@ def _sample(data, u0, u1, u2):  # pragma: no cover - compiled
 @kernel
 def _table_index(table, params, value):  # pragma: no cover - compiled
     """Entry i and fraction t of `value` in the transfer-function table (clamped at the ends)."""
-    size = table.shape[0]
+    size = table.shape[1]
     f = (value - params[P_TABLE_LOW]) * params[P_TABLE_SCALE]
     f = min(max(f, 0.0), size - 1.0)
     i = min(int(f), size - 2)
@@ -130,12 +130,12 @@ def _table_index(table, params, value):  # pragma: no cover - compiled
 @kernel
 def _lookup(table, params, value, channel):  # pragma: no cover - compiled
     """One channel of the transfer-function table at `value` (linear between entries, clamped at the ends)."""
-    size = table.shape[0]
+    size = table.shape[1]
     f = (value - params[P_TABLE_LOW]) * params[P_TABLE_SCALE]
     f = min(max(f, 0.0), size - 1.0)
     i = min(int(f), size - 2)
     t = f - i
-    return table[i, channel] * (1.0 - t) + table[i + 1, channel] * t
+    return table[channel, i] * (1.0 - t) + table[channel, i + 1] * t
 
 
 @kernel
@@ -250,17 +250,16 @@ def _samples(s0, s1, ds, anchored):  # pragma: no cover - compiled
 
 
 @kernel
-def _walk_start(origin, direction, shape, u0, u1, u2):  # pragma: no cover - compiled
-    """Start of a 3D DDA over the blocks along the ray u = origin + s·direction from grid position u: the block
-    (bi, bj, bk) of u's cell, the step (±1, 0) per axis, the ray parameter where the ray leaves the block through
-    each axis (inf if never) and the increments of those parameters per block."""
-    nx, ny, nz = shape
+def _walk_start(o0, o1, o2, e0, e1, e2, nx, ny, nz, u0, u1, u2):  # pragma: no cover - compiled
+    """Start of a 3D DDA over the blocks along the ray u = o + s·e (grid of shape (nx, ny, nz)) from grid position
+    u: the block (bi, bj, bk) of u's cell, the step (±1, 0) per axis, the ray parameter where the ray leaves the
+    block through each axis (inf if never) and the increments of those parameters per block."""
     bi = max(min(int(u0), nx - 2), 0) // BLOCK
     bj = max(min(int(u1), ny - 2), 0) // BLOCK
     bk = max(min(int(u2), nz - 2), 0) // BLOCK
-    step0, t0, dt0 = _axis_start(origin[0], direction[0], bi)
-    step1, t1, dt1 = _axis_start(origin[1], direction[1], bj)
-    step2, t2, dt2 = _axis_start(origin[2], direction[2], bk)
+    step0, t0, dt0 = _axis_start(o0, e0, bi)
+    step1, t1, dt1 = _axis_start(o1, e1, bj)
+    step2, t2, dt2 = _axis_start(o2, e2, bk)
     return bi, bj, bk, step0, step1, step2, t0, t1, t2, dt0, dt1, dt2
 
 
@@ -285,151 +284,10 @@ def _cell_at(data, u0, u1, u2):  # pragma: no cover - compiled
 
 
 @kernel
-def _classify(data, table, params, lights, matrices, u, view_dir, u0, u1, u2, column, shade,
-              rgba):  # pragma: no cover - compiled  # fmt: skip
-    """Trilinear value at u, its opacity from table column `column` (4: corrected for Δ, 3: raw) into rgba[3]
-    and, when that is > 0, its (shaded) color into rgba[:3]."""
-    i, j, k, fx, fy, fz = _cell_at(data, u0, u1, u2)
-    value = _trilinear(data, i, j, k, fx, fy, fz)
-    t_index, t = _table_index(table, params, value)
-    alpha = table[t_index, column] * (1.0 - t) + table[t_index + 1, column] * t
-    rgba[3] = alpha
-    if alpha > 0.0:
-        r = table[t_index, 0] * (1.0 - t) + table[t_index + 1, 0] * t
-        g = table[t_index, 1] * (1.0 - t) + table[t_index + 1, 1] * t
-        b = table[t_index, 2] * (1.0 - t) + table[t_index + 1, 2] * t
-        if shade:
-            u[0], u[1], u[2] = u0, u1, u2
-            r, g, b = _shade(data, matrices, params, lights, u, view_dir, r, g, b)
-        rgba[0], rgba[1], rgba[2] = r, g, b
-
-
-@kernel
-def _composite(data, blocks, table, matrices, params, lights, origin, direction, s0, s1, ds, model_length,
-               view_dir, u, rgba, out):  # pragma: no cover - compiled  # fmt: skip
-    """Front-to-back compositing along one ray; (r, g, b, A) into `out` (`u`, `rgba`: scratch).
-
-    Empty-space skipping walks the blocks the ray crosses (a 3D DDA over the block grid: Amanatides & Woo); the
-    samples before an empty block's exit are skipped, the others run without a block lookup each.
-    """
-    first, count, tail_s, tail = _samples(s0, s1, ds, params[P_ANCHORED] != 0.0)
-    threshold = params[P_TERMINATE]
-    shade = params[P_SHADE] != 0.0
-    cr, cg, cb, acc = 0.0, 0.0, 0.0, 0.0
-    if count > 0:
-        nbx, nby, nbz = blocks.shape[0], blocks.shape[1], blocks.shape[2]
-        b0, b1, b2 = (origin[0] + first * direction[0], origin[1] + first * direction[1],
-                      origin[2] + first * direction[2])  # fmt: skip
-        d0, d1, d2 = ds * direction[0], ds * direction[1], ds * direction[2]
-        bi, bj, bk, step0, step1, step2, t0, t1, t2, dt0, dt1, dt2 = _walk_start(origin, direction, data.shape,
-                                                                                 b0, b1, b2)  # fmt: skip
-        inverse_ds = 1.0 / ds
-        k = 0
-        while True:
-            exit_s = min(t0, t1, t2)
-            end = (exit_s - first) * inverse_ds  # samples before the block's exit: k < ceil(end)
-            stop = count if end >= count else math.ceil(end)
-            if blocks[bi, bj, bk, B_EMPTY] == 0.0:  # else opacity 0 over the block: its samples add nothing
-                while k < stop:
-                    u0, u1, u2 = b0 + k * d0, b1 + k * d1, b2 + k * d2
-                    k += 1
-                    t_index, t = _table_index(table, params, _value(data, u0, u1, u2))
-                    alpha = table[t_index, 4] * (1.0 - t) + table[t_index + 1, 4] * t  # corrected for Δ
-                    if alpha > 0.0:
-                        r = table[t_index, 0] * (1.0 - t) + table[t_index + 1, 0] * t
-                        g = table[t_index, 1] * (1.0 - t) + table[t_index + 1, 1] * t
-                        b = table[t_index, 2] * (1.0 - t) + table[t_index + 1, 2] * t
-                        if shade:
-                            u[0], u[1], u[2] = u0, u1, u2
-                            r, g, b = _shade(data, matrices, params, lights, u, view_dir, r, g, b)
-                        weight = (1.0 - acc) * alpha
-                        cr += weight * r
-                        cg += weight * g
-                        cb += weight * b
-                        acc += weight
-                        if acc >= threshold:  # early ray termination
-                            out[0], out[1], out[2], out[3] = cr, cg, cb, acc
-                            return
-            k = max(k, stop)
-            if k >= count:
-                break
-            if t0 <= t1 and t0 <= t2:
-                bi += step0
-                t0 += dt0
-            elif t1 <= t2:
-                bj += step1
-                t1 += dt1
-            else:
-                bk += step2
-                t2 += dt2
-            if bi < 0 or bj < 0 or bk < 0 or bi >= nbx or bj >= nby or bk >= nbz:  # rounding at the box's faces
-                bi, bj, bk = min(max(bi, 0), nbx - 1), min(max(bj, 0), nby - 1), min(max(bk, 0), nbz - 1)
-    if tail > 0.0:  # the last, shorter segment: its opacity corrected for its own length
-        _classify(data, table, params, lights, matrices, u, view_dir, origin[0] + tail_s * direction[0],
-                  origin[1] + tail_s * direction[1], origin[2] + tail_s * direction[2], 3, shade, rgba)  # fmt: skip
-        if rgba[3] > 0.0:
-            alpha = 1.0 - (1.0 - rgba[3]) ** (tail * model_length / params[P_UNIT])
-            weight = (1.0 - acc) * alpha
-            cr += weight * rgba[0]
-            cg += weight * rgba[1]
-            cb += weight * rgba[2]
-            acc += weight
-    out[0], out[1], out[2], out[3] = cr, cg, cb, acc
-
-
-@kernel
 def _value(data, u0, u1, u2):  # pragma: no cover - compiled
     """Trilinear value at a position inside the box up to rounding."""
     i, j, k, fx, fy, fz = _cell_at(data, u0, u1, u2)
     return _trilinear(data, i, j, k, fx, fy, fz)
-
-
-@kernel
-def _extreme(data, blocks, origin, direction, s0, s1, ds, sign, anchored):  # pragma: no cover - compiled
-    """sign = +1: the largest sample along the ray (MIP); −1: the smallest (MinIP); NaN when there is none."""
-    first, count, tail_s, tail = _samples(s0, s1, ds, anchored)
-    best = -np.inf
-    if count > 0:
-        nbx, nby, nbz = blocks.shape[0], blocks.shape[1], blocks.shape[2]
-        b0, b1, b2 = (origin[0] + first * direction[0], origin[1] + first * direction[1],
-                      origin[2] + first * direction[2])  # fmt: skip
-        d0, d1, d2 = ds * direction[0], ds * direction[1], ds * direction[2]
-        bi, bj, bk, step0, step1, step2, t0, t1, t2, dt0, dt1, dt2 = _walk_start(origin, direction, data.shape,
-                                                                                 b0, b1, b2)  # fmt: skip
-        bound = B_MAX if sign > 0.0 else B_MIN
-        inverse_ds = 1.0 / ds
-        k = 0
-        while True:
-            exit_s = min(t0, t1, t2)
-            end = (exit_s - first) * inverse_ds  # samples before the block's exit: k < ceil(end)
-            stop = count if end >= count else math.ceil(end)
-            limit = sign * blocks[bi, bj, bk, bound]
-            if limit > best:  # else nothing in this block can beat the current extreme
-                while k < stop:
-                    best = max(best, sign * _value(data, b0 + k * d0, b1 + k * d1, b2 + k * d2))
-                    k += 1
-                    if best >= limit:
-                        break
-            k = max(k, stop)
-            if k >= count:
-                break
-            if t0 <= t1 and t0 <= t2:
-                bi += step0
-                t0 += dt0
-            elif t1 <= t2:
-                bj += step1
-                t1 += dt1
-            else:
-                bk += step2
-                t2 += dt2
-            if bi < 0 or bj < 0 or bk < 0 or bi >= nbx or bj >= nby or bk >= nbz:  # rounding at the box's faces
-                bi, bj, bk = min(max(bi, 0), nbx - 1), min(max(bj, 0), nby - 1), min(max(bk, 0), nbz - 1)
-    if tail > 0.0:
-        best = max(best, sign * _value(data, origin[0] + tail_s * direction[0], origin[1] + tail_s * direction[1],
-                                       origin[2] + tail_s * direction[2]))  # fmt: skip
-    if count == 0 and not tail > 0.0:
-        return np.nan
-    return sign * best
 
 
 @kernel
@@ -550,7 +408,8 @@ def cast_rays(mode, data, blocks, table, matrices, planes, params, lights, depth
     kernel of `mode` runs over pieces of the rows on a pool of threads; only that mode's kernel is compiled).
 
     `data` (nx, ny, nz) float32; `blocks` (bx, by, bz, 3) float32 from ``block_ranges`` plus the empty flags;
-    `table` (T, 5) float64 rows (r, g, b, α, α corrected for the step Δ) over the scalar range
+    `table` (5, T) float64 rows r, g, b, α, α corrected for the step Δ (each row one contiguous run: the
+    opacity lookups of every sample stay in one small array) over the scalar range
     ``value = low + t / scale``; `matrices` (5, 4, 4) as the ``M_*`` constants; `planes` (P, 4) clip planes in
     grid coordinates; `params` (PARAMS,) as the ``P_*`` constants; `lights` (K, 16) from
     ``shading.pack_lights``; `depth` (H, W) float32 window depth (read; the isosurface mode writes its hits).
@@ -569,31 +428,112 @@ def cast_rays(mode, data, blocks, table, matrices, planes, params, lights, depth
 @parallel_kernel(lambda *arguments: arguments[-2].shape[0], pieces_per_thread=16)
 def cast_composite(data, blocks, table, matrices, planes, params, lights, depth, color, start,
                    stop):  # pragma: no cover  # fmt: skip
-    """``MODE_COMPOSITE`` over image rows [start, stop) (see ``cast_rays``)."""
+    """``MODE_COMPOSITE`` over image rows [start, stop) (see ``cast_rays``): front to back along each ray.
+
+    Empty-space skipping walks the blocks the ray crosses (a 3D DDA over the block grid, Amanatides & Woo): the
+    samples before an empty block's exit are skipped, the others run without a block lookup each. (The ray loop
+    is written out here, not called per pixel: a call passing this many arrays cost ~0.3 µs per ray.)
+    """
     height, width = depth.shape
     shape = np.array(data.shape, dtype=np.float64)
-    origin, direction, view_dir, out = np.empty(3), np.empty(3), np.empty(3), np.empty(4)
-    u, rgba = np.empty(3), np.empty(4)
+    origin, direction, view_dir, out, u = np.empty(3), np.empty(3), np.empty(3), np.empty(4), np.empty(3)
+    nbx, nby, nbz = blocks.shape[0], blocks.shape[1], blocks.shape[2]
+    nx, ny, nz = data.shape
+    threshold = params[P_TERMINATE]
+    shade = params[P_SHADE] != 0.0
+    anchored = params[P_ANCHORED] != 0.0
     for row in range(start, stop):
         y = height - 1 - row + 0.5
         for column in range(width):
             s0, s1, ds, model_length = _pixel_ray(matrices, planes, shape, params, column + 0.5, y,
                                                   depth[row, column], origin, direction, view_dir)  # fmt: skip
-            if s0 < s1:
-                _composite(data, blocks, table, matrices, params, lights, origin, direction, s0, s1, ds,
-                           model_length, view_dir, u, rgba, out)  # fmt: skip
-                _blend(color, row, column, out)
+            if not s0 < s1:
+                continue
+            first, count, tail_s, tail = _samples(s0, s1, ds, anchored)
+            cr, cg, cb, acc = 0.0, 0.0, 0.0, 0.0
+            done = False
+            if count > 0:
+                b0, b1, b2 = (origin[0] + first * direction[0], origin[1] + first * direction[1],
+                              origin[2] + first * direction[2])  # fmt: skip
+                d0, d1, d2 = ds * direction[0], ds * direction[1], ds * direction[2]
+                bi, bj, bk, step0, step1, step2, t0, t1, t2, dt0, dt1, dt2 = _walk_start(
+                    origin[0], origin[1], origin[2], direction[0], direction[1], direction[2], nx, ny, nz, b0, b1, b2)
+                inverse_ds = 1.0 / ds
+                k = 0
+                while True:
+                    end = (min(t0, t1, t2) - first) * inverse_ds  # samples before the block's exit: k < ceil(end)
+                    k_stop = count if end >= count else math.ceil(end)
+                    if blocks[bi, bj, bk, B_EMPTY] == 0.0:  # else opacity 0 over the block: its samples add nothing
+                        while k < k_stop:
+                            u0, u1, u2 = b0 + k * d0, b1 + k * d1, b2 + k * d2
+                            k += 1
+                            t_index, t = _table_index(table, params, _value(data, u0, u1, u2))
+                            alpha = table[4, t_index] * (1.0 - t) + table[4, t_index + 1] * t  # corrected for Δ
+                            if alpha > 0.0:
+                                r = table[0, t_index] * (1.0 - t) + table[0, t_index + 1] * t
+                                g = table[1, t_index] * (1.0 - t) + table[1, t_index + 1] * t
+                                b = table[2, t_index] * (1.0 - t) + table[2, t_index + 1] * t
+                                if shade:
+                                    u[0], u[1], u[2] = u0, u1, u2
+                                    r, g, b = _shade(data, matrices, params, lights, u, view_dir, r, g, b)
+                                weight = (1.0 - acc) * alpha
+                                cr += weight * r
+                                cg += weight * g
+                                cb += weight * b
+                                acc += weight
+                                if acc >= threshold:  # early ray termination
+                                    done = True
+                                    break
+                    k = max(k, k_stop)
+                    if done or k >= count:
+                        break
+                    if t0 <= t1 and t0 <= t2:
+                        bi += step0
+                        t0 += dt0
+                    elif t1 <= t2:
+                        bj += step1
+                        t1 += dt1
+                    else:
+                        bk += step2
+                        t2 += dt2
+                    if bi < 0 or bj < 0 or bk < 0 or bi >= nbx or bj >= nby or bk >= nbz:  # rounding at the faces
+                        bi, bj, bk = min(max(bi, 0), nbx - 1), min(max(bj, 0), nby - 1), min(max(bk, 0), nbz - 1)
+            if tail > 0.0 and not done:  # the last, shorter segment: its opacity corrected for its own length
+                u0, u1, u2 = (origin[0] + tail_s * direction[0], origin[1] + tail_s * direction[1],
+                              origin[2] + tail_s * direction[2])  # fmt: skip
+                t_index, t = _table_index(table, params, _value(data, u0, u1, u2))
+                alpha = table[3, t_index] * (1.0 - t) + table[3, t_index + 1] * t
+                if alpha > 0.0:
+                    alpha = 1.0 - (1.0 - alpha) ** (tail * model_length / params[P_UNIT])
+                    r = table[0, t_index] * (1.0 - t) + table[0, t_index + 1] * t
+                    g = table[1, t_index] * (1.0 - t) + table[1, t_index + 1] * t
+                    b = table[2, t_index] * (1.0 - t) + table[2, t_index + 1] * t
+                    if shade:
+                        u[0], u[1], u[2] = u0, u1, u2
+                        r, g, b = _shade(data, matrices, params, lights, u, view_dir, r, g, b)
+                    weight = (1.0 - acc) * alpha
+                    cr += weight * r
+                    cg += weight * g
+                    cb += weight * b
+                    acc += weight
+            out[0], out[1], out[2], out[3] = cr, cg, cb, acc
+            _blend(color, row, column, out)
 
 
 @parallel_kernel(lambda *arguments: arguments[-2].shape[0], pieces_per_thread=16)
 def cast_projection(mode, data, blocks, table, matrices, planes, params, depth, color, start,
                     stop):  # pragma: no cover  # fmt: skip
     """``MODE_MIP``, ``MODE_MINIP`` or ``MODE_AVERAGE`` over image rows [start, stop): one value per ray,
-    classified by the table (no opacity correction) and blended over the buffer."""
+    classified by the table (no opacity correction) and blended over the buffer. MIP / MinIP walk the blocks
+    along the ray as ``cast_composite`` does and skip a block whose max (min) cannot beat the current extreme."""
     height, width = depth.shape
     shape = np.array(data.shape, dtype=np.float64)
     origin, direction, view_dir, out = np.empty(3), np.empty(3), np.empty(3), np.empty(4)
     anchored = params[P_ANCHORED] != 0.0
+    nbx, nby, nbz = blocks.shape[0], blocks.shape[1], blocks.shape[2]
+    nx, ny, nz = data.shape
+    sign = -1.0 if mode == MODE_MINIP else 1.0
+    bound = B_MIN if mode == MODE_MINIP else B_MAX
     for row in range(start, stop):
         y = height - 1 - row + 0.5
         for column in range(width):
@@ -603,11 +543,51 @@ def cast_projection(mode, data, blocks, table, matrices, planes, params, depth, 
                 continue
             if mode == MODE_AVERAGE:
                 value = _average(data, origin, direction, s0, s1, ds, anchored)
+                if math.isnan(value):  # no sample on this ray
+                    continue
             else:
-                value = _extreme(data, blocks, origin, direction, s0, s1, ds, 1.0 if mode == MODE_MIP else -1.0,
-                                 anchored)  # fmt: skip
-            if math.isnan(value):  # no sample on this ray
-                continue
+                first, count, tail_s, tail = _samples(s0, s1, ds, anchored)
+                if count == 0 and not tail > 0.0:  # no sample on this ray
+                    continue
+                best = -np.inf  # the largest of sign · value
+                if count > 0:
+                    b0, b1, b2 = (origin[0] + first * direction[0], origin[1] + first * direction[1],
+                                  origin[2] + first * direction[2])  # fmt: skip
+                    d0, d1, d2 = ds * direction[0], ds * direction[1], ds * direction[2]
+                    bi, bj, bk, step0, step1, step2, t0, t1, t2, dt0, dt1, dt2 = _walk_start(
+                        origin[0], origin[1], origin[2], direction[0], direction[1], direction[2], nx, ny, nz, b0, b1,
+                        b2)  # fmt: skip
+                    inverse_ds = 1.0 / ds
+                    k = 0
+                    while True:
+                        end = (min(t0, t1, t2) - first) * inverse_ds  # samples before the block's exit
+                        k_stop = count if end >= count else math.ceil(end)
+                        limit = sign * blocks[bi, bj, bk, bound]
+                        if limit > best:  # else nothing in this block can beat the current extreme
+                            while k < k_stop:
+                                best = max(best, sign * _value(data, b0 + k * d0, b1 + k * d1, b2 + k * d2))
+                                k += 1
+                                if best >= limit:
+                                    break
+                        k = max(k, k_stop)
+                        if k >= count:
+                            break
+                        if t0 <= t1 and t0 <= t2:
+                            bi += step0
+                            t0 += dt0
+                        elif t1 <= t2:
+                            bj += step1
+                            t1 += dt1
+                        else:
+                            bk += step2
+                            t2 += dt2
+                        if bi < 0 or bj < 0 or bk < 0 or bi >= nbx or bj >= nby or bk >= nbz:  # rounding
+                            bi, bj, bk = min(max(bi, 0), nbx - 1), min(max(bj, 0), nby - 1), min(max(bk, 0), nbz - 1)
+                if tail > 0.0:
+                    best = max(best, sign * _value(data, origin[0] + tail_s * direction[0],
+                                                   origin[1] + tail_s * direction[1],
+                                                   origin[2] + tail_s * direction[2]))  # fmt: skip
+                value = sign * best
             alpha = _lookup(table, params, value, 3)
             for c in range(3):
                 out[c] = alpha * _lookup(table, params, value, c)
