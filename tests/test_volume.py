@@ -583,3 +583,70 @@ def test_scene_file_volume_errors_name_file_line_and_key(tmp_path, replace, line
         load_scene_file(tmp_path / "scene.toml")
     problems = getattr(caught.value, "problems", [str(caught.value)])
     assert any(p.startswith(f"{tmp_path / 'scene.toml'}:{line}: ") and fragment in p for p in problems), problems
+
+
+# --- overlapping volumes -----------------------------------------------------------------------------------
+
+
+def test_overlapping_composite_volumes_mix_sample_by_sample_like_one_volume_holding_both():
+    # A on x in [0, 1], B on x in [0.5, 1.5] (same spacing, grids aligned); in the overlap, along the view axis z, A has
+    # blobs in front of and behind B's: drawn one after the other the order would be wrong for one of them. The
+    # supports never share a cell, and near-plane sampling puts every volume's samples at the same ray parameters,
+    # so the two must composite exactly like one volume U = A + B on the union grid.
+    h = 0.1
+    z = np.arange(11) * h
+    a = np.zeros((11, 11, 11))
+    b = np.zeros((11, 11, 11))
+    a[6:10, 2:9, :4] = 0.5 + 0.4 * z[:4]  # back (z <= 0.3)
+    a[6:10, 2:9, 7:] = 0.9  # front (z >= 0.7)
+    a[1:4, 2:9, 3:8] = 0.6  # outside B's box
+    b[1:5, 2:9, 5] = 0.8  # x = 0.6 … 0.9: the middle (z = 0.5), between A's two
+    b[7:10, 2:9, 2:9] = 0.45  # x = 1.2 … 1.4: outside A's box
+    union = np.zeros((16, 11, 11))
+    union[:11] += a
+    union[5:] += b
+    tf = TransferFunction([0.0, 0.4, 0.6, 1.0], [(0, 0, 0), (0.2, 0.4, 1.0), (1.0, 0.3, 0.1), (1, 1, 0.6)],
+                          [0.0, 0.3, 0.5, 0.7])  # fmt: skip
+    projection = f.Orthographic(height=1.4, near=0.5, far=10.0)
+    camera = f.Camera.look_at((0.75, 0.5, 3.0), (0.75, 0.5, 0.5), projection=projection, width=28, height=20)
+    scene = f.Scene()
+    scene.add_volume(Volume(a, (h,) * 3), tf, step=0.03, sampling="near")
+    scene.add_volume(Volume(b, (h,) * 3, (0.5, 0.0, 0.0)), tf, step=0.03, sampling="near")
+    both = f.render(scene, camera).color
+    single = f.Scene()
+    single.add_volume(Volume(union, (h,) * 3), tf, step=0.03, sampling="near")
+    expected = f.render(single, camera).color
+    _assert_close(both, expected)
+    # the same union checked pixel by pixel against the numpy reference (so the comparison is not kernel to kernel)
+    _assert_close(expected, _reference(Volume(union, (h,) * 3), tf, "composite", camera, step=0.03, sampling="near"))
+    # drawn one after the other (each alone, B over A's picture) the middle blob would be wrong
+    alone = [f.Scene(), f.Scene()]
+    alone[0].add_volume(Volume(a, (h,) * 3), tf, step=0.03, sampling="near")
+    alone[1].add_volume(Volume(b, (h,) * 3, (0.5, 0.0, 0.0)), tf, step=0.03, sampling="near")
+    first, second = (f.render(s, camera).color.astype(float) / 255.0 for s in alone)
+    layered = second + (1.0 - second[..., 3:]) * first
+    assert np.abs(layered * 255.0 - expected).max() > 20
+
+
+def test_composite_volumes_apart_in_depth_merge_to_the_one_over_the_other_picture():
+    # B lies wholly in front of A on every ray: the merged rays take all of B's samples, then A's, which is B's
+    # picture over A's; entry sampling (the shorter last segment), shading and a clip plane on one of them only
+    volume = _phantom(16)
+    camera = f.Camera.look_at((0.3, 0.4, 4.2), (0.0, 0.0, 0.0), width=22, height=18)
+    plane = ((0.0, 0.3, 0.0), (0.0, 1.0, 0.0))
+    placed = [dict(transform=f.translate(0.0, 0.0, -1.2), shade=True, clip_planes=[plane]),
+              dict(transform=f.translate(0.3, 0.0, 1.2), shade=True)]  # fmt: skip
+    scene = f.Scene(lights=_LIGHTS)
+    for options in placed:
+        scene.add_volume(volume, _TF, step=0.05, **options)
+    clear = (0.0, 0.0, 0.0, 0.0)  # a transparent background keeps each volume's own opacity in the alpha byte
+    both = f.render(scene, camera, background=clear).color
+    pictures = []
+    for options in placed:
+        alone = f.Scene(lights=_LIGHTS)
+        alone.add_volume(volume, _TF, step=0.05, **options)
+        pictures.append(f.render(alone, camera, background=clear).color.astype(float) / 255.0)
+    back, front = pictures
+    layered = np.floor(np.clip(front + (1.0 - front[..., 3:]) * back, 0.0, 1.0) * 255.0 + 0.5)
+    _assert_close(both, layered, tolerance=2)  # two roundings to bytes in the layered picture
+    assert (np.abs(front - back) > 0.1).any()

@@ -3,7 +3,9 @@
 ``draw_volumes(scene, camera, depth, color)`` runs once the opaque meshes are in the buffers: each ray stops at
 the opaque depth (the window depth of its pixel, turned back into the ray's parameter), so a mesh inside a
 volume hides what lies behind it and is seen through what lies in front. Volumes are drawn back to front by the
-view distance of their centres (overlapping composite volumes are not merged sample by sample). The kernels
+view distance of their centres, except that two or more composite volumes are drawn together: each ray
+composites the samples of all of them in depth order (``raster.volume.cast_composite_merged``), so overlapping
+volumes mix sample by sample. The kernels
 are ``raster.volume``'s; this module builds their arrays: the grid ↔ window matrices, clip planes in grid
 coordinates, the transfer function's table with its opacity corrected for the step, and the per-block
 min/max/empty flags of empty-space skipping.
@@ -122,7 +124,32 @@ def draw_volumes(scene: Scene, camera: Camera, depth: np.ndarray, color: np.ndar
         centre = item.world_from_model[:3, :3] @ centre + item.world_from_model[:3, 3]
         return float((eye - centre) @ axis)
 
+    merged = [item for item in scene.volumes if item.mode == "composite"]
+    merged = merged if len(merged) > 1 else []
+    drawn = False
     for item in sorted(scene.volumes, key=distance, reverse=True):
+        if any(item is other for other in merged):  # drawn together, where the farthest of them comes
+            if not drawn:
+                _draw_merged(merged, camera, packed, depth, color)
+                drawn = True
+            continue
         arguments = volume_arrays(item, camera, packed)
         kernels.cast_rays(*arguments, depth, color)
+
+
+def _draw_merged(items: list[VolumeItem], camera: Camera, packed: tuple, depth: np.ndarray, color: np.ndarray) -> None:
+    """Composite volumes drawn together (``raster.volume.cast_composite_merged``): their kernel arguments stacked,
+    the clip planes padded with rows of zeros (always kept)."""
+    from numba.typed import List
+
+    from frustum.raster import volume as kernels
+
+    arguments = [volume_arrays(item, camera, packed) for item in items]
+    datas, blocks = List([a[1] for a in arguments]), List([a[2] for a in arguments])
+    planes = np.zeros((len(items), max(a[5].shape[0] for a in arguments), 4))
+    for index, a in enumerate(arguments):
+        planes[index, : a[5].shape[0]] = a[5]
+    kernels.cast_composite_merged(datas, blocks, np.stack([a[3] for a in arguments]),
+                                  np.stack([a[4] for a in arguments]), planes, np.stack([a[6] for a in arguments]),
+                                  arguments[0][7], depth, color)  # fmt: skip
 

@@ -42,6 +42,7 @@ __all__ = [
     "PARAMS",
     "block_ranges",
     "cast_composite",
+    "cast_composite_merged",
     "cast_isosurface",
     "cast_projection",
     "cast_rays",
@@ -626,6 +627,92 @@ def cast_isosurface(data, blocks, table, matrices, planes, params, lights, depth
             zw = wm[2, 0] * u[0] + wm[2, 1] * u[1] + wm[2, 2] * u[2] + wm[2, 3]
             ww = wm[3, 0] * u[0] + wm[3, 1] * u[1] + wm[3, 2] * u[2] + wm[3, 3]
             depth[row, column] = min(depth[row, column], zw / ww)
+            _blend(color, row, column, out)
+
+
+@parallel_kernel(lambda *arguments: arguments[-2].shape[0], pieces_per_thread=16)
+def cast_composite_merged(datas, blocks, tables, matrices, planes, params, lights, depth, color, start,
+                          stop):  # pragma: no cover  # fmt: skip
+    """Several ``MODE_COMPOSITE`` volumes composited together over image rows [start, stop): every ray takes the
+    samples of all the volumes it crosses in the order of the ray parameter (their sequences merged), each sample
+    classified by its own volume's table and opacity-corrected for its own step, so overlapping volumes mix.
+
+    `datas`, `blocks`: typed lists of the volumes' grids and block arrays; `tables` (V, 5, T), `matrices`
+    (V, 5, 4, 4), `planes` (V, P, 4) (rows of zeros pad), `params` (V, PARAMS): the single-volume arguments
+    stacked. Each volume's samples lie where ``cast_composite`` puts them (the ray parameter s is the same for
+    every volume: 0 on the near plane, 1 on the far plane), and its empty blocks are skipped per sample.
+    """
+    height, width = depth.shape
+    count_v = len(datas)
+    origins, directions, view_dirs = np.empty((count_v, 3)), np.empty((count_v, 3)), np.empty((count_v, 3))
+    first, ds, tail_s, tail, model_length = (np.empty(count_v), np.empty(count_v), np.empty(count_v),
+                                             np.empty(count_v), np.empty(count_v))  # fmt: skip
+    count, k = np.empty(count_v, dtype=np.int64), np.empty(count_v, dtype=np.int64)
+    shapes = np.empty((count_v, 3))
+    for v in range(count_v):
+        for a in range(3):
+            shapes[v, a] = datas[v].shape[a]
+    out, u = np.empty(4), np.empty(3)
+    threshold = params[0, P_TERMINATE]
+    for row in range(start, stop):
+        y = height - 1 - row + 0.5
+        for column in range(width):
+            any_ray = False
+            for v in range(count_v):
+                s0, s1, ds[v], model_length[v] = _pixel_ray(matrices[v], planes[v], shapes[v], params[v],
+                                                            column + 0.5, y, depth[row, column], origins[v],
+                                                            directions[v], view_dirs[v])  # fmt: skip
+                k[v], count[v], tail[v] = 0, 0, 0.0
+                if s0 < s1:
+                    first[v], count[v], tail_s[v], tail[v] = _samples(s0, s1, ds[v], params[v, P_ANCHORED] != 0.0)
+                    any_ray = True
+            if not any_ray:
+                continue
+            cr, cg, cb, acc = 0.0, 0.0, 0.0, 0.0
+            while acc < threshold:
+                v, s = -1, np.inf  # the volume whose next sample comes first along the ray
+                for w in range(count_v):
+                    if k[w] < count[w]:
+                        candidate = first[w] + k[w] * ds[w]
+                    elif k[w] == count[w] and tail[w] > 0.0:
+                        candidate = tail_s[w]
+                    else:
+                        continue
+                    if candidate < s:
+                        v, s = w, candidate
+                if v < 0:
+                    break
+                data, origin, direction = datas[v], origins[v], directions[v]
+                u0, u1, u2 = origin[0] + s * direction[0], origin[1] + s * direction[1], origin[2] + s * direction[2]
+                full = k[v] < count[v]
+                if full:
+                    bi, bj, bk = _block_of(blocks[v], data, u0, u1, u2)
+                    if blocks[v][bi, bj, bk, B_EMPTY] != 0.0:  # jump to this volume's first sample past the block
+                        exit_s = _block_exit(origin, direction, bi, bj, bk, data.shape)
+                        k[v] = max(k[v] + 1, math.ceil((exit_s - first[v]) / ds[v]))
+                        continue
+                k[v] += 1
+                table, p = tables[v], params[v]
+                t_index, t = _table_index(table, p, _value(data, u0, u1, u2))
+                if full:
+                    alpha = table[4, t_index] * (1.0 - t) + table[4, t_index + 1] * t
+                else:
+                    alpha = table[3, t_index] * (1.0 - t) + table[3, t_index + 1] * t
+                    if alpha > 0.0:
+                        alpha = 1.0 - (1.0 - alpha) ** (tail[v] * model_length[v] / p[P_UNIT])
+                if alpha > 0.0:
+                    r = table[0, t_index] * (1.0 - t) + table[0, t_index + 1] * t
+                    g = table[1, t_index] * (1.0 - t) + table[1, t_index + 1] * t
+                    b = table[2, t_index] * (1.0 - t) + table[2, t_index + 1] * t
+                    if p[P_SHADE] != 0.0:
+                        u[0], u[1], u[2] = u0, u1, u2
+                        r, g, b = _shade(data, matrices[v], p, lights, u, view_dirs[v], r, g, b)
+                    weight = (1.0 - acc) * alpha
+                    cr += weight * r
+                    cg += weight * g
+                    cb += weight * b
+                    acc += weight
+            out[0], out[1], out[2], out[3] = cr, cg, cb, acc
             _blend(color, row, column, out)
 
 
