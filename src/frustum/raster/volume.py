@@ -9,14 +9,18 @@ Per pixel (window centre (x + ½, y + ½), y up), in grid-index coordinates u (v
 2. Entry and exit: s clipped by the box ``0 <= u <= n − 1`` (slabs), by each clip plane ``a·u + d >= 0``, and by
    the opaque depth buffer: a pixel whose window depth is ``z < 1`` ends the ray at its point's s.
 3. Samples at the middles of segments of model length Δ (the last one shorter), trilinear; a segment of
-   model length δ uses the opacity ``α' = 1 − (1 − α)^(δ/Δ₀)``.
+   model length δ uses the opacity ``α' = 1 − (1 − α)^(δ/Δ₀)``. With ``P_ANCHORED`` set (sampling "near"):
+   at every whole multiple of Δ from the ray's point on the near plane (s = 0) instead, each standing for Δ.
 4. Modes: composite front to back ``C += (1 − A)·α'·c``, ``A += (1 − A)·α'``, stopped once A reaches the
    termination threshold (early ray termination); ``mip`` / ``minip`` the largest / smallest sample; ``average``
    the length-weighted mean; ``isosurface`` the first sign change of ``value − level`` between two samples,
    refined by bisection. The last three classify their value through the table and blend it over the buffer.
-5. Empty-space skipping: blocks of ``BLOCK`` cells carry (min, max, empty); a composite ray jumps over a block
-   whose value range the transfer function maps to opacity 0, a MIP ray over a block whose max cannot beat its
-   current maximum; the samples kept are exactly the ones a ray without skipping would use.
+5. Empty-space skipping: blocks of ``BLOCK`` cells carry (min, max, empty); a ray walks the blocks it crosses
+   (3D DDA, Amanatides & Woo 1987) and skips the samples of a block whose value range the transfer function
+   maps to opacity 0 (composite) or whose max cannot beat its current maximum (MIP); the samples kept are
+   exactly the ones a ray without skipping would use (up to rounding at block faces, where the values of both
+   blocks are the face's).
+6. Several composite volumes: ``cast_composite_merged`` merges their sample sequences along each ray.
 
 Gradient shading uses ``frustum.shading``'s model with the base color of the transfer function and the normal
 ``−∇f/|∇f|`` (central differences of the trilinear field, one voxel apart) turned toward the viewer.
