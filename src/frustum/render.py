@@ -222,7 +222,7 @@ def render(
         Placed volumes (``Scene.add_volume``) are ray cast in every mode and by every `method`: in the surface
         modes after the opaque surfaces (rays stop at their depth) and before transparent items; in
         ``"wireframe"`` and ``"points"`` after the lines or points, each ray stopped at the depth they write; in
-        ``"hidden-line"`` after the visible edges, rays stopped at the (invisible) surfaces (docs/volumes.md).
+        ``"hidden-line"`` after the visible edges, rays stopped at the (invisible) surfaces (docs/rendering.md).
     edges : {"all", "feature"} or None
         Which edges the line modes draw: every edge, or ``hidden_lines`` feature edges (boundaries, creases
         sharper than `crease_angle`, silhouettes). None: "all" for wireframe, "feature" for the others.
