@@ -250,3 +250,11 @@ def test_svg_volume_image_leaves_a_line_in_front_of_the_cloud_uncovered_and_dims
     assert front.sum() >= 5 and back.sum() >= 5
     assert (image[front, 3] == 0).all()  # the rays stop at the line: nothing of the cloud lies in front of it
     assert (image[back, 3] > 10).all()  # the cloud in front of the far line covers it partly
+
+
+def test_a_drawing_sheet_refuses_a_scene_with_volumes_naming_what_draws_them():
+    scene = _with_volume(_meshes())
+    with pytest.raises(f.OutputError, match=r"drawing_sheet: scene has 1 volume \(Scene.add_volume\).*render_svg"):
+        f.drawing_sheet(scene)
+    scene.volumes.clear()
+    assert "<svg" in f.drawing_sheet(scene)  # the meshes alone draw
