@@ -600,8 +600,9 @@ def drawing_sheet(
     FrustumError
         If `scene` is not a Scene.
     OutputError
-        For a scene with volumes (a drawing sheet shows meshes only), an empty scene, an unknown or repeated view, a bad scale, paper, orientation or projection angle, or
-        views that do not fit on the paper at the given scale (the message says the largest scale that fits).
+        For a scene with volumes (a drawing sheet shows meshes only), an empty scene, an unknown or repeated view,
+        a bad scale, paper, orientation or projection angle, or views that do not fit on the paper at the given
+        scale (the message says the largest scale that fits).
 
     References
     ----------
