@@ -67,6 +67,23 @@ def test_line_modes_composite_the_volume_over_their_lines_stopped_at_their_depth
         np.testing.assert_array_equal(frame.depth, lines_only.depth)  # a composite volume writes no depth
 
 
+@pytest.mark.parametrize("mode", ["surface+edges", "surface"])
+def test_surface_modes_cast_the_volume_over_their_edges_and_polylines(mode):
+    def scene(volume: bool) -> f.Scene:
+        result = _meshes()
+        result.add(f.Polyline([[-0.8, 0.5, -0.4], [0.8, 0.6, -0.4]]), f.Material(color=(0.0, 1.0, 0.0)))  # behind cloud
+        return _with_volume(result) if volume else result
+
+    without = f.render(scene(False), _CAMERA, mode=mode, edge_color=(1.0, 0.0, 1.0))
+    frame = f.render(scene(True), _CAMERA, mode=mode, edge_color=(1.0, 0.0, 1.0))
+    _assert_close(frame.color, _expected(without))  # the rays stop at the surfaces and the polyline
+    lines = np.all(without.color == (0, 255, 0, 255), axis=-1)
+    if mode == "surface+edges":
+        lines |= np.all(without.color == (255, 0, 255, 255), axis=-1)
+    assert lines.sum() >= 5
+    assert (np.abs(frame.color.astype(int) - without.color.astype(int)).max(axis=-1)[lines] > 8).any()  # dimmed
+
+
 def test_wireframe_line_in_front_of_the_cloud_is_not_covered_and_one_behind_is_dimmed():
     volume = _phantom(20)
     front = f.Polyline([[-1.5, 0.0, 1.4], [1.5, 0.0, 1.4]])  # in front of the box [-1, 1]³ (eye at z = 3)

@@ -220,7 +220,8 @@ def render(
         ``"surface+edges"``: shaded surfaces with their visible edges on top. With `cull_back_faces`, edges of back
         faces only (``hidden_lines.front_facing``) count as hidden whatever the depth buffer says.
         Placed volumes (``Scene.add_volume``) are ray cast in every mode and by every `method`: in the surface
-        modes after the opaque surfaces (rays stop at their depth) and before transparent items; in
+        modes after the opaque surfaces, their edges and the polylines (rays stop at the surfaces and polylines)
+        and before transparent items; in
         ``"wireframe"`` and ``"points"`` after the lines or points, each ray stopped at the depth they write; in
         ``"hidden-line"`` after the visible edges, rays stopped at the (invisible) surfaces (docs/rendering.md).
     edges : {"all", "feature"} or None
@@ -374,9 +375,10 @@ def _render_buffers(
     scratch.release()
     if options.mode == "hidden-line":
         color[:, :] = options.background
-    if options.mode in ("hidden-line", "surface+edges"):
-        _draw_edges(items, camera, options, depth, color)
-    _draw_polylines(scene.polylines, camera, options, depth, color)
+    if not (scene.volumes and _volumes_with_surfaces(options)):  # else drawn before the volumes
+        if options.mode in ("hidden-line", "surface+edges"):
+            _draw_edges(items, camera, options, depth, color)
+        _draw_polylines(scene.polylines, camera, options, depth, color)
     _draw_volumes_after_lines(scene, camera, options, depth, color)
     _draw_particles(scene, camera, depth, color)
     return color, depth, normal_out, id_out
@@ -454,10 +456,15 @@ def _draw_volumes_over_surfaces(
     scene: Scene, camera: Camera, options: _Options, depth: np.ndarray, color: np.ndarray
 ) -> None:  # fmt: skip
     """The surface modes: every volume ray cast after the opaque surfaces (rays stop at their depth), before the
-    transparent items, whatever visible-surface method filled the depth buffer."""
+    transparent items, whatever visible-surface method filled the depth buffer. In a scene with volumes the
+    edges (``"surface+edges"``) and polylines come first (``_render_buffers`` then leaves them out), so the part
+    of a cloud in front of a line covers it; polylines write depth, so they stop the rays too."""
     if scene.volumes and _volumes_with_surfaces(options):
         from frustum.volume_pass import draw_volumes
 
+        if options.mode == "surface+edges":
+            _draw_edges(scene.items, camera, options, depth, color)
+        _draw_polylines(scene.polylines, camera, options, depth, color)
         draw_volumes(scene, camera, depth, color)
 
 
