@@ -221,6 +221,11 @@ def render(
         color and only the visible parts of the edges are drawn (hidden parts per `hidden`).
         ``"surface+edges"``: shaded surfaces with their visible edges on top. With `cull_back_faces`, edges of back
         faces only (``hidden_lines.front_facing``) count as hidden whatever the depth buffer says.
+        Placed volumes (``Scene.add_volume``) are ray cast in every mode and by every `method`: in the surface
+        modes after the opaque surfaces, their edges and the polylines (rays stop at the surfaces and polylines)
+        and before transparent items; in
+        ``"wireframe"`` and ``"points"`` after the lines or points, each ray stopped at the depth they write; in
+        ``"hidden-line"`` after the visible edges, rays stopped at the (invisible) surfaces (docs/rendering.md).
     edges : {"all", "feature"} or None
         Which edges the line modes draw: every edge, or ``hidden_lines`` feature edges (boundaries, creases
         sharper than `crease_angle`, silhouettes). None: "all" for wireframe, "feature" for the others.
@@ -250,7 +255,8 @@ def render(
         shade with the same model, so where they find the same surface they give the same bytes. Surface modes
         only; each returns its counts in ``Frame.stats``. ``"octree"``: the scene's octrees (``Scene.octrees``)
         by ``visibility.octree.render_octree``, front to back, each face orientation shaded once with the
-        scene's lights; only `background` of the other options applies, and meshes are not drawn.
+        scene's lights; only `background` of the other options applies, and meshes are not drawn (volumes are,
+        over the octrees).
     transparency : {"sort", "a-buffer"}
         How transparent items are composited: whole items back to front by the view distance of their centres
         (fast; right for transparent objects that do not cut through or overlap each other cyclically), or
@@ -329,6 +335,10 @@ def _render_octrees(scene: Scene, camera: Camera, *, background: Any) -> Frame:
         draw_octree_into(item.mesh, camera, item.world_from_model, faces, item_color, item_depth, written)
         nearer = written & (item_depth < depth)
         color[nearer], depth[nearer] = item_color[nearer], item_depth[nearer]
+    if scene.volumes:  # ray cast over the octrees, each ray stopped at their depth
+        from frustum.volume_pass import draw_volumes
+
+        draw_volumes(scene, camera, depth, color)
     return Frame(color=color, depth=depth)
 
 
@@ -354,6 +364,7 @@ def _render_buffers(
         color[:, :] = options.background
         _draw_edges(items, camera, options, depth, color)
         _draw_polylines(scene.polylines, camera, options, depth, color)
+        _draw_volumes_after_lines(scene, camera, options, depth, color)
         _draw_particles(scene, camera, depth, color)
         return color, depth, normal_out, id_out
     scratch = Scratch()
@@ -366,11 +377,31 @@ def _render_buffers(
     scratch.release()
     if options.mode == "hidden-line":
         color[:, :] = options.background
-    if options.mode in ("hidden-line", "surface+edges"):
-        _draw_edges(items, camera, options, depth, color)
-    _draw_polylines(scene.polylines, camera, options, depth, color)
+    if not (scene.volumes and _volumes_with_surfaces(options)):  # else drawn before the volumes
+        if options.mode in ("hidden-line", "surface+edges"):
+            _draw_edges(items, camera, options, depth, color)
+        _draw_polylines(scene.polylines, camera, options, depth, color)
+    _draw_volumes_after_lines(scene, camera, options, depth, color)
     _draw_particles(scene, camera, depth, color)
     return color, depth, normal_out, id_out
+
+
+def _volumes_with_surfaces(options: _Options) -> bool:
+    """Whether the volumes are ray cast right after the opaque surfaces (``"surface"``, ``"surface+edges"``:
+    before transparent items) rather than after the lines (``_draw_volumes_after_lines``)."""
+    return options.mode in ("surface", "surface+edges")
+
+
+def _draw_volumes_after_lines(
+    scene: Scene, camera: Camera, options: _Options, depth: np.ndarray, color: np.ndarray
+) -> None:  # fmt: skip
+    """``"wireframe"``, ``"points"``, ``"hidden-line"``: the volumes ray cast over the finished lines or points,
+    each ray stopped at the depth they (wireframe, points) or the invisible surfaces (hidden-line) left, so a
+    line inside a cloud is seen through the part of the cloud in front of it (``frustum.volume_pass``)."""
+    if scene.volumes and not _volumes_with_surfaces(options):
+        from frustum.volume_pass import draw_volumes
+
+        draw_volumes(scene, camera, depth, color)
 
 
 def _draw_particles(scene: Scene, camera: Camera, depth: np.ndarray, color: np.ndarray) -> None:
@@ -411,10 +442,7 @@ def _draw_surfaces(
         for index, world, normals, rows in drawn:
             _shade_item(items[index], index, int(offsets[index]), camera, options, ambient, lights, world, normals,
                         depth, codes, bary, color, extra, rows, blend=False)  # fmt: skip
-    if scene.volumes:  # ray cast after the opaque surfaces (rays stop at their depth), before transparent items
-        from frustum.volume_pass import draw_volumes
-
-        draw_volumes(scene, camera, depth, color)
+    _draw_volumes_over_surfaces(scene, camera, options, depth, color)
     if clear_items and bary is None:
         bary = scratch.empty((height, width, 2), np.float32)
     for index in back_to_front(items, clear_items, camera):
@@ -456,6 +484,22 @@ def _draw_tiled(
         binned.tile_starts, binned.tile_entries, tiling, depth, world, normals, params, lights, flags,
         options.background, color,
     )  # fmt: skip
+
+
+def _draw_volumes_over_surfaces(
+    scene: Scene, camera: Camera, options: _Options, depth: np.ndarray, color: np.ndarray
+) -> None:  # fmt: skip
+    """The surface modes: every volume ray cast after the opaque surfaces (rays stop at their depth), before the
+    transparent items, whatever visible-surface method filled the depth buffer. In a scene with volumes the
+    edges (``"surface+edges"``) and polylines come first (``_render_buffers`` then leaves them out), so the part
+    of a cloud in front of a line covers it; polylines write depth, so they stop the rays too."""
+    if scene.volumes and _volumes_with_surfaces(options):
+        from frustum.volume_pass import draw_volumes
+
+        if options.mode == "surface+edges":
+            _draw_edges(scene.items, camera, options, depth, color)
+        _draw_polylines(scene.polylines, camera, options, depth, color)
+        draw_volumes(scene, camera, depth, color)
 
 
 def back_to_front(items: list[SceneItem], indices: list[int], camera: Camera) -> list[int]:
@@ -1140,9 +1184,20 @@ def _draw_surfaces_by_method(
     ambient, lights = pack_lights(scene.world_lights())
     extra = _extra(normal_out, id_out)
     if options.method == "a-buffer":
-        tris = window_triangles(items, list(range(len(items))), offsets, camera, options.cull)
+        # with volumes: the opaque fragments, the volumes (rays stop at their depth), then the transparent ones
+        volumes_between = bool(scene.volumes) and _volumes_with_surfaces(options)
+        first = opaque if volumes_between else list(range(len(items)))
+        tris = window_triangles(items, first, offsets, camera, options.cull)
         counts.update(_composite(tris, items, offsets, camera, options, ambient, lights, color, depth, scratch))
         counts["triangles"] = tris.count
+        if volumes_between:
+            _draw_volumes_over_surfaces(scene, camera, options, depth, color)
+            if clear_items:
+                tris = window_triangles(items, clear_items, offsets, camera, options.cull)
+                found = _composite(tris, items, offsets, camera, options, ambient, lights, color, depth.copy(),
+                                   scratch, under_depth=depth)  # fmt: skip
+                counts.update({f"transparent_{key}": value for key, value in found.items()})
+                counts["triangles"] += tris.count
         return depth, color
     code_type = _code_type(items)  # the depth buffer's: the shading kernels are compiled for it already
     codes = np.zeros((height, width), dtype=code_type)
@@ -1165,6 +1220,7 @@ def _draw_surfaces_by_method(
             world, normals = _world_attributes(items[index], scratch)
             _shade_item(items[index], index, offsets[index], camera, options, ambient, lights, world, normals,
                         depth, codes, bary, color, extra, (0, height), blend=False)  # fmt: skip
+        _draw_volumes_over_surfaces(scene, camera, options, depth, color)  # (_draw_surfaces casts them itself)
     if not clear_items:
         return depth, color
     if options.transparency == "a-buffer":
