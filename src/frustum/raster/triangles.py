@@ -39,6 +39,8 @@ of zero area, or whose box holds no pixel centre, is dropped.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from frustum.raster._jit import kernel, parallel_kernel
@@ -61,6 +63,8 @@ __all__ = [
 ]
 
 RECORD_FIELDS = 11
+NARROW = 8
+"""Rows of a triangle's box at most this wide test every centre; wider ones find their covered span first."""
 FACE_NONE, FACE_DRAWN, FACE_CROSSING = 0, 1, 2
 """``face_box`` states: nothing to draw (rejected, culled, no area or no pixel centre), drawn from its vertices,
 or crossing the view volume (to be clipped)."""
@@ -70,6 +74,29 @@ or crossing the view volume (to be clipped)."""
 def _first_centre(low: int) -> int:
     """Smallest pixel index whose centre ``256·i + 128`` is >= `low` (fixed point): ``−floor((128 − low)/256)``."""
     return -((HALF_SUBPIXEL - low) >> SUBPIXEL_BITS)
+
+
+@kernel
+def _span(e: int, step: int, bias: int, inverse: float, first: int, last: int) -> tuple[int, int]:
+    """``[first, last]`` narrowed to the columns k where ``e − step·k >= bias`` (an edge function stepped along a
+    row), exactly: k bound by ``(e − bias)/step`` estimated in float64 (``inverse = 1/step``; off by at most one
+    for |E| < 2^51) and corrected by the integer test, no division and almost no mispredicted branch."""
+    if step == 0:
+        return (first, last) if e >= bias else (last + 1, last)
+    k = (e - bias) * inverse
+    if step > 0:  # falling: k <= (e − bias)/step
+        bound = np.int64(math.floor(k)) if k < last else last
+        if e - step * (bound + 1) >= bias:
+            bound += 1
+        elif e - step * bound < bias:
+            bound -= 1
+        return first, min(last, bound)
+    bound = np.int64(math.ceil(k)) if k > first else first  # rising: k >= (e − bias)/step
+    if e - step * (bound - 1) >= bias:
+        bound -= 1
+    elif e - step * bound < bias:
+        bound += 1
+    return max(first, bound), last
 
 
 @kernel
@@ -253,7 +280,9 @@ def _fill_tile(
     perspective-correct barycentric weights (u1, u2) of the pixel with respect to the source face (float32).
     Coordinates are read as int64 (the edge-function products need 64 bits whatever their stored type).
     Buffers are top row first: window row j is array row ``H − 1 − j``. The triangle loop is inline (no
-    per-triangle call taking arrays: for pixel-sized triangles the call would cost more than the fill).
+    per-triangle call taking arrays: for pixel-sized triangles the call would cost more than the fill). A box
+    wider than ``NARROW`` columns finds each row's first and last covered centre (``_span``) and visits only
+    those: testing each centre in turn mispredicts a branch at both ends of every row.
     """
     size, tiles_x, face_offset, width, height = tiling[0], tiling[1], tiling[2], tiling[3], tiling[4]
     col0 = (tile % tiles_x) * size
@@ -298,6 +327,11 @@ def _fill_tile(
         alpha, beta = depth_gradients(x0, y0, x1, y1, x2, y2, z0, z1, z2)
         swap = code % 2  # unclipped: source corner 1 is drawn as corner 1 + swap, corner 2 as 2 − swap
         px0 = SUBPIXEL * i_min + HALF_SUBPIXEL
+        columns = i_max - i_min + 1
+        step0, step1, step2 = dy0 * SUBPIXEL, dy1 * SUBPIXEL, dy2 * SUBPIXEL  # E_k falls by these per column
+        inverse0 = 1.0 / step0 if step0 != 0 else 0.0
+        inverse1 = 1.0 / step1 if step1 != 0 else 0.0
+        inverse2 = 1.0 / step2 if step2 != 0 else 0.0
         for j in range(j_min, j_max + 1):
             py = SUBPIXEL * j + HALF_SUBPIXEL
             e0 = dx0 * (py - y1) - dy0 * (px0 - x1)
@@ -306,8 +340,15 @@ def _fill_tile(
             z_row = z0 + beta * float(py - y0)
             x_off = float(px0 - x0)  # X_P − X_0, exact in float64
             row = height - 1 - j - origin_row
-            for i in range(i_min - origin_col, i_max + 1 - origin_col):
-                if e0 >= bias0 and e1 >= bias1 and e2 >= bias2:
+            first, last = 0, columns - 1
+            if columns > NARROW:  # the covered centres of a row are consecutive (three half-planes): find them
+                first, last = _span(e0, step0, bias0, inverse0, first, last)
+                first, last = _span(e1, step1, bias1, inverse1, first, last)
+                first, last = _span(e2, step2, bias2, inverse2, first, last)
+                e0, e1, e2 = e0 - step0 * first, e1 - step1 * first, e2 - step2 * first
+                x_off += SUBPIXEL * first
+            for i in range(i_min + first - origin_col, i_min + last + 1 - origin_col):
+                if columns > NARROW or (e0 >= bias0 and e1 >= bias1 and e2 >= bias2):
                     z = np.float32(z_row + alpha * x_off)
                     if z < depth[row, i]:
                         depth[row, i] = z
@@ -328,9 +369,9 @@ def _fill_tile(
                                     tri_weights[record, 2, k],
                                 )
                                 bary[row, i, k] = np.float32((b0 * w0 + b1 * w1) + b2 * w2)
-                e0 -= dy0 * SUBPIXEL
-                e1 -= dy1 * SUBPIXEL
-                e2 -= dy2 * SUBPIXEL
+                e0 -= step0
+                e1 -= step1
+                e2 -= step2
                 x_off += SUBPIXEL
 
 
