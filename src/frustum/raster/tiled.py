@@ -67,6 +67,12 @@ def draw_tiles_directional(
         for t in range(band * tiles_x + first, band * tiles_x + min(first + SEGMENT, tiles_x)):
             col0 = (t % tiles_x) * size
             col1 = min(col0 + size, width)
+            if tile_starts[t] == tile_starts[t + 1]:  # no triangle: background
+                for row in range(bottom - top):
+                    for col in range(col0 - left, col1 - left):
+                        band_depth[row, col] = 1.0
+                        band_words[row, col, 0] = word
+                continue
             near[:, :] = 1.0
             _fill_tile(
                 t, faces, win_int, win_float, tri_int, tri_float, tri_weights, tile_starts, tile_entries, tiling,
