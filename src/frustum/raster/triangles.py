@@ -27,7 +27,7 @@ the pixel's own barycentrics instead, which is bit-identical to weighting by one
 
 Depth and weights at a covered pixel centre P. Window depth is affine in screen space, so it is the plane through
 the snapped corners ``(X_k, Y_k, z_k)`` written from corner 0 with its gradients (``depth_gradients``):
-``z(P) = (z_0 + β·(Y_P − Y_0)) + α·(X_P − X_0)``, ``α = −Σ dy_k z_k / (2·area)``, ``β = Σ dx_k z_k / (2·area)``
+``z(P) = (z_0 + β·(Y_P − Y_0)) + α·(X_P − X_0)``, ``α = −Σ dy_k z_k · r``, ``β = Σ dx_k z_k · r``, ``r = 1/(2·area)``
 (edge k opposite corner k) — the depth-buffer method's incremental form ``z' = z − A/C`` per step along a scan
 line [HB 9 "Depth-Buffer Method"], evaluated from the corner instead of accumulated, so every pixel's value is
 independent of the tiles and of the order pixels are visited in (no division per pixel). The perspective-correct
@@ -104,14 +104,14 @@ def depth_gradients(
     x0: int, y0: int, x1: int, y1: int, x2: int, y2: int, z0: float, z1: float, z2: float
 ) -> tuple[float, float]:  # fmt: skip
     """``(α, β)``: change of window depth per 1/256 pixel in x and y on the plane through the snapped corners,
-    ``α = −((dy_0 z_0 + dy_1 z_1) + dy_2 z_2) / (2·area)``, ``β = ((dx_0 z_0 + dx_1 z_1) + dx_2 z_2) / (2·area)``
-    (module docstring; 2·area ≠ 0)."""
+    ``α = −((dy_0 z_0 + dy_1 z_1) + dy_2 z_2)·r``, ``β = ((dx_0 z_0 + dx_1 z_1) + dx_2 z_2)·r`` with
+    ``r = 1/(2·area)`` (module docstring; 2·area ≠ 0)."""
     dx0, dy0 = x2 - x1, y2 - y1
     dx1, dy1 = x0 - x2, y0 - y2
     dx2, dy2 = x1 - x0, y1 - y0
-    area = float(dx2 * (y2 - y0) - dy2 * (x2 - x0))
-    alpha = -((float(dy0) * z0 + float(dy1) * z1) + float(dy2) * z2) / area
-    beta = ((float(dx0) * z0 + float(dx1) * z1) + float(dx2) * z2) / area
+    reciprocal = 1.0 / float(dx2 * (y2 - y0) - dy2 * (x2 - x0))
+    alpha = -((float(dy0) * z0 + float(dy1) * z1) + float(dy2) * z2) * reciprocal
+    beta = ((float(dx0) * z0 + float(dx1) * z1) + float(dx2) * z2) * reciprocal
     return alpha, beta
 
 
@@ -329,9 +329,11 @@ def _fill_tile(
         px0 = SUBPIXEL * i_min + HALF_SUBPIXEL
         columns = i_max - i_min + 1
         step0, step1, step2 = dy0 * SUBPIXEL, dy1 * SUBPIXEL, dy2 * SUBPIXEL  # E_k falls by these per column
-        inverse0 = 1.0 / step0 if step0 != 0 else 0.0
-        inverse1 = 1.0 / step1 if step1 != 0 else 0.0
-        inverse2 = 1.0 / step2 if step2 != 0 else 0.0
+        inverse0, inverse1, inverse2 = 0.0, 0.0, 0.0
+        if columns > NARROW:
+            inverse0 = 1.0 / step0 if step0 != 0 else 0.0
+            inverse1 = 1.0 / step1 if step1 != 0 else 0.0
+            inverse2 = 1.0 / step2 if step2 != 0 else 0.0
         for j in range(j_min, j_max + 1):
             py = SUBPIXEL * j + HALF_SUBPIXEL
             e0 = dx0 * (py - y1) - dy0 * (px0 - x1)
