@@ -774,7 +774,7 @@ def bin_item(
     tri_float, tri_weights = np.empty((0, 3, 2)), np.empty((0, 3, 2))
     record_starts = np.zeros(crossing.shape[0] + 1, dtype=np.int64)
     if crossing.shape[0]:
-        triangles.list_crossing(faces, vertex_codes, chunk, listed, listed_counts, crossing_starts[:-1], crossing)
+        triangles.list_crossing(listed, listed_tiles, chunk, listed_counts, crossing_starts[:-1], crossing)
         clip_options = np.array([width, height, int(cull), face_offset, 0], dtype=np.int64)
         arguments = (crossing, faces, mesh.vertices, clip_from_model, VIEW_VOLUME_PLANES, view, clip_options)
         triangles.clip_faces(*arguments, record_starts[1:], tri_int, tri_float, tri_weights)

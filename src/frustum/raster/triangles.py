@@ -49,6 +49,7 @@ from frustum.raster.fixed_point import HALF_SUBPIXEL, SUBPIXEL, SUBPIXEL_BITS, s
 from frustum.raster.vertices import clip_vertex
 
 __all__ = [
+    "CROSSING",
     "FACE_CROSSING",
     "FACE_DRAWN",
     "FACE_NONE",
@@ -68,6 +69,9 @@ NARROW = 8
 AHEAD = 16
 """Tile entries between a prefetch of an entry's face and its fill (``_jit.prefetch``): gathers of a mesh that does
 not fit in cache (2M triangles) took 10–25 % less time."""
+CROSSING = -2
+"""``tiles.count_tiles``'s ``listed_tiles`` mark of a face crossing the view volume (its clipped records are
+filled in its place)."""
 FACE_NONE, FACE_DRAWN, FACE_CROSSING = 0, 1, 2
 """``face_box`` states: nothing to draw (rejected, culled, no area or no pixel centre), drawn from its vertices,
 or crossing the view volume (to be clipped)."""
@@ -159,22 +163,20 @@ def face_box(
     return (FACE_DRAWN if made != 0 else FACE_NONE), back, i_min, i_max, j_min, j_max
 
 
-@parallel_kernel(lambda faces, codes, chunk, listed, listed_counts, crossing_starts, *_: crossing_starts.shape[0])
+@parallel_kernel(lambda listed, listed_tiles, chunk, listed_counts, crossing_starts, *_: crossing_starts.shape[0])
 def list_crossing(
-    faces: np.ndarray, codes: np.ndarray, chunk: int, listed: np.ndarray, listed_counts: np.ndarray,
-    crossing_starts: np.ndarray, crossing: np.ndarray,
+    listed: np.ndarray, listed_tiles: np.ndarray, chunk: int, listed_counts: np.ndarray, crossing_starts: np.ndarray,
+    crossing: np.ndarray,
     start: int, stop: int,
 ) -> None:  # fmt: skip
-    """The faces crossing the view volume, in order, picked from the faces ``tiles.count_tiles`` listed: chunk c
-    (``listed[c·chunk : c·chunk + listed_counts[c]]``) writes its crossing faces' indices into ``crossing`` from
-    ``crossing_starts[c]`` on."""
+    """The faces crossing the view volume, in order, picked from the faces ``tiles.count_tiles`` listed (those
+    marked ``CROSSING`` in ``listed_tiles``): chunk c (``listed[c·chunk : c·chunk + listed_counts[c]]``)
+    writes its crossing faces' indices into ``crossing`` from ``crossing_starts[c]`` on."""
     for c in range(start, stop):
         k = crossing_starts[c]
         for n in range(c * chunk, c * chunk + listed_counts[c]):
-            f = listed[n]
-            c0, c1, c2 = codes[faces[f, 0]], codes[faces[f, 1]], codes[faces[f, 2]]
-            if (c0 & c1 & c2) == 0 and (c0 | c1 | c2) != 0:
-                crossing[k] = f
+            if listed_tiles[n] == CROSSING:
+                crossing[k] = listed[n]
                 k += 1
 
 
