@@ -8,7 +8,7 @@ multiplied compile time: the generalized shading kernel took 15 s to compile wit
 ``parallel_kernel(items)`` makes the three tiers of STYLE habit 6 from one function: the decorated function is a
 single-thread kernel over a slice ``[start, stop)`` of independent items (its last two parameters); the name it
 is bound to is a Python driver taking the same arguments without the slice, which splits ``items(*args)`` items
-into pieces and runs them on a pool of threads (``threads()`` of them; the kernel releases the GIL). Each piece
+into pieces and runs them on the calling thread and ``threads() − 1`` pool threads (kernels release the GIL). Each piece
 owns its slice of the outputs, so results are the same bytes on any number of threads. This replaces Numba's
 ``parallel=True``/``prange``: a parfor costs 0.25–0.5 s more to compile per kernel (and compiled every helper it
 calls twice, for an int64 and a uint64 index), and a pool of Python threads lets the main thread take Ctrl-C
@@ -22,6 +22,7 @@ measure coverage of) every kernel line as Python.
 from __future__ import annotations
 
 import functools
+import itertools
 import threading
 import time
 from collections.abc import Callable
@@ -29,16 +30,48 @@ from concurrent.futures import Future, ThreadPoolExecutor
 from typing import Any
 
 import numba
-from numba.core import event
+from llvmlite import ir
+from numba.core import cgutils, event, types
+from numba.extending import intrinsic
 from numba.np.ufunc import parallel as _numba_parallel
 
 import frustum.raster
 
-__all__ = ["kernel", "parallel_for", "parallel_kernel", "prange", "set_threads", "threads"]
+__all__ = ["kernel", "parallel_for", "parallel_kernel", "prange", "prefetch", "set_threads", "threads"]
 
 kernel = numba.njit(cache=True, nogil=True)
 _parfor_kernel = numba.njit(cache=True, nogil=True, parallel=True)
 prange = numba.prange
+
+
+
+@intrinsic
+def _prefetch(typingctx, array, i, j):
+    """LLVM's ``llvm.prefetch`` (read, high locality) of the cache line holding ``array[i, j]``."""
+
+    def codegen(context, builder, signature, args):
+        kind = signature.args[0]
+        data = context.make_array(kind)(context, builder, args[0])
+        pointer = cgutils.get_item_pointer(context, builder, kind, data, [args[1], args[2]], wraparound=False)
+        byte = ir.IntType(8).as_pointer()
+        int32 = ir.IntType(32)
+        function = cgutils.get_or_insert_function(
+            builder.module, ir.FunctionType(ir.VoidType(), [byte, int32, int32, int32]), "llvm.prefetch.p0i8"
+        )
+        builder.call(function, [builder.bitcast(pointer, byte), int32(0), int32(3), int32(1)])
+        return context.get_dummy_value()
+
+    return types.void(array, i, j), codegen
+
+
+def _no_prefetch(array: Any, i: int, j: int) -> None:
+    """``prefetch`` as plain Python (``NUMBA_DISABLE_JIT=1``): nothing to do."""
+
+
+prefetch = _no_prefetch if numba.config.DISABLE_JIT else _prefetch
+"""``prefetch(array, i, j)`` in a kernel: start loading the cache line of the 2-D ``array[i, j]`` (no effect on
+results). For loops that gather rows by index (tile entry → face → its vertices), issued some iterations ahead,
+so the loads of many iterations are in flight at once instead of each waiting in turn."""
 
 NOTICE_AFTER = 1.0
 """Seconds of kernel compilation after which ``frustum.raster.compile_notice`` is called (once per process)."""
@@ -116,9 +149,11 @@ def parallel_for(compiled: Callable[..., None], count: int, args: tuple, *, piec
 
     `work` (default `count`) estimates the whole job in any unit and `grain` is the least of it worth a piece of
     its own: a small job runs on the calling thread (handing a piece to a thread costs tens of microseconds, which
-    a scene of 10⁴ small meshes pays per kernel and item). The calling thread waits in an interruptible wait: on
-    Ctrl-C (or any error in a piece) the pieces not yet started are cancelled, the running ones finish (each is
-    short), and the exception propagates.
+    a scene of 10⁴ small meshes pays per kernel and item). Otherwise the calling thread and ``threads() − 1`` pool
+    threads take pieces in order from a shared counter until none are left (the caller works instead of waiting:
+    one thread fewer to wake per kernel). Ctrl-C reaches the caller between its pieces; on it, or on any error in
+    a piece, the pieces not yet taken are skipped, the running ones finish (each is short: they write into the
+    caller's arrays), and the exception propagates.
     """
     size = threads()
     pieces = min(count, size * pieces_per_thread, (count if work is None else work) // max(grain, 1))
@@ -126,15 +161,26 @@ def parallel_for(compiled: Callable[..., None], count: int, args: tuple, *, piec
         compiled(*args, 0, count)
         return
     bounds = [count * i // pieces for i in range(pieces + 1)]
-    pool = _executor(size)
-    futures: list[Future] = [pool.submit(compiled, *args, bounds[i], bounds[i + 1]) for i in range(pieces)]
+    taken = itertools.count()  # next() on it is atomic: each piece is taken once
+    stop = threading.Event()
+
+    def take() -> None:
+        for piece in taken:
+            if piece >= pieces or stop.is_set():
+                return
+            compiled(*args, bounds[piece], bounds[piece + 1])
+
+    pool = _executor(size - 1)
+    helpers: list[Future] = [pool.submit(take) for _ in range(min(size, pieces) - 1)]
     try:
-        for future in futures:
+        take()
+        for future in helpers:
             future.result()
     except BaseException:
-        for future in futures:
+        stop.set()
+        for future in helpers:
             future.cancel()
-        for future in futures:
+        for future in helpers:
             if not future.cancelled():
                 future.exception()  # wait for the running pieces: they write into the caller's arrays
         raise
