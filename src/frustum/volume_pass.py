@@ -103,6 +103,9 @@ def volume_arrays(item: VolumeItem, camera: Camera, lights_packed: tuple[np.ndar
     params[kernels.P_TABLE_LOW], params[kernels.P_TABLE_SCALE] = low, scale
     params[kernels.P_TERMINATE], params[kernels.P_BISECTIONS] = TERMINATE, BISECTIONS
     params[kernels.P_ANCHORED] = float(item.sampling == "near")
+    # entries up to first − 1 have opacity 0, and so has the table between them: values mapping there need no lookup
+    first = int(np.argmax(table[3] > 0.0)) if (table[3] > 0.0).any() else TABLE_SIZE
+    params[kernels.P_CLEAR_BELOW] = low + (first - 1) / scale if first >= 1 else -np.inf
     return (MODES[item.mode], volume.data, blocks, table, matrices, planes, params,
             np.ascontiguousarray(lights, dtype=np.float64))  # fmt: skip
 

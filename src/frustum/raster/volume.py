@@ -62,7 +62,8 @@ P_KA, P_KD, P_KS, P_SHININESS = 4, 5, 6, 7
 P_AMBIENT = 8  # 3 values
 P_EYE = 11  # 3 values
 P_SPECULAR_PHONG, P_TABLE_LOW, P_TABLE_SCALE, P_TERMINATE, P_BISECTIONS, P_ANCHORED = 14, 15, 16, 17, 18, 19
-PARAMS = 20
+P_CLEAR_BELOW = 20  # values at or below this have opacity 0 in the table (no lookup needed)
+PARAMS = 21
 # matrices (5, 4, 4)
 M_GRID_FROM_WINDOW, M_MODEL_FROM_GRID, M_WINDOW_FROM_GRID, M_WORLD_FROM_GRID, M_NORMAL_FROM_GRID = 0, 1, 2, 3, 4
 # blocks (bx, by, bz, 3) float32: min, max, empty (1.0: opacity 0 over the block's range)
@@ -447,11 +448,12 @@ def cast_composite(data, blocks, table, matrices, planes, params, lights, depth,
     threshold = params[P_TERMINATE]
     shade = params[P_SHADE] != 0.0
     anchored = params[P_ANCHORED] != 0.0
+    clear_below = params[P_CLEAR_BELOW]
     for row in range(start, stop):
         y = height - 1 - row + 0.5
         for column in range(width):
             s0, s1, ds, model_length = _pixel_ray(matrices, planes, shape, params, column + 0.5, y,
-                                                  depth[row, column], origin, direction, view_dir)  # fmt: skip
+                                                  depth[row, column], origin, direction, view_dir, shade)  # fmt: skip
             if not s0 < s1:
                 continue
             first, count, tail_s, tail = _samples(s0, s1, ds, anchored)
@@ -472,7 +474,10 @@ def cast_composite(data, blocks, table, matrices, planes, params, lights, depth,
                         while k < k_stop:
                             u0, u1, u2 = b0 + k * d0, b1 + k * d1, b2 + k * d2
                             k += 1
-                            t_index, t = _table_index(table, params, _value(data, u0, u1, u2))
+                            value = _value(data, u0, u1, u2)
+                            if value <= clear_below:  # opacity 0: no lookup
+                                continue
+                            t_index, t = _table_index(table, params, value)
                             alpha = table[4, t_index] * (1.0 - t) + table[4, t_index + 1] * t  # corrected for Δ
                             if alpha > 0.0:
                                 r = table[0, t_index] * (1.0 - t) + table[0, t_index + 1] * t
@@ -542,8 +547,8 @@ def cast_projection(mode, data, blocks, table, matrices, planes, params, depth, 
     for row in range(start, stop):
         y = height - 1 - row + 0.5
         for column in range(width):
-            s0, s1, ds, _ = _pixel_ray(matrices, planes, shape, params, column + 0.5, y,
-                                                  depth[row, column], origin, direction, view_dir)  # fmt: skip
+            s0, s1, ds, _ = _pixel_ray(matrices, planes, shape, params, column + 0.5, y, depth[row, column],
+                                       origin, direction, view_dir, False)  # fmt: skip
             if not s0 < s1:
                 continue
             if mode == MODE_AVERAGE:
@@ -721,10 +726,10 @@ def cast_composite_merged(datas, blocks, tables, matrices, planes, params, light
 
 
 @kernel
-def _pixel_ray(matrices, planes, shape, params, x, y, window_depth, origin, direction,
-               view_dir):  # pragma: no cover - compiled  # fmt: skip
-    """The ray of window point (x, y) in grid coordinates (origin, direction, and the unit world vector toward the
-    eye in view_dir); returns (s0, s1, ds, model_length), empty when s0 >= s1."""
+def _pixel_ray(matrices, planes, shape, params, x, y, window_depth, origin, direction, view_dir,
+               shaded=True):  # pragma: no cover - compiled  # fmt: skip
+    """The ray of window point (x, y) in grid coordinates (origin, direction, and, when `shaded`, the unit world
+    vector toward the eye in view_dir); returns (s0, s1, ds, model_length), empty when s0 >= s1."""
     s0, s1 = _ray(matrices, planes, shape, x, y, window_depth, origin, direction)
     if not s0 < s1:
         return s0, s1, 0.0, 0.0
@@ -733,6 +738,8 @@ def _pixel_ray(matrices, planes, shape, params, x, y, window_depth, origin, dire
     d1 = model[1, 0] * direction[0] + model[1, 1] * direction[1] + model[1, 2] * direction[2]
     d2 = model[2, 0] * direction[0] + model[2, 1] * direction[1] + model[2, 2] * direction[2]
     model_length = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)  # model units per unit of s
+    if not shaded:
+        return s0, s1, params[P_STEP] / model_length, model_length
     world = matrices[M_WORLD_FROM_GRID]
     for a in range(3):  # toward the eye: minus the ray direction, in world coordinates
         view_dir[a] = -(world[a, 0] * direction[0] + world[a, 1] * direction[1] + world[a, 2] * direction[2])
