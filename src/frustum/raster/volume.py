@@ -479,7 +479,7 @@ def cast_composite(data, blocks, table, matrices, planes, params, lights, depth,
                                 continue
                             t_index, t = _table_index(table, params, value)
                             alpha = table[4, t_index] * (1.0 - t) + table[4, t_index + 1] * t  # corrected for Δ
-                            if alpha > 0.0:
+                            if alpha > 0.0 or not shade:  # (unshaded, α = 0 adds 0: no branch on α)
                                 r = table[0, t_index] * (1.0 - t) + table[0, t_index + 1] * t
                                 g = table[1, t_index] * (1.0 - t) + table[1, t_index + 1] * t
                                 b = table[2, t_index] * (1.0 - t) + table[2, t_index + 1] * t
