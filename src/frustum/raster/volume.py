@@ -621,8 +621,8 @@ def cast_isosurface(data, blocks, table, matrices, planes, params, lights, depth
     for row in range(start, stop):
         y = height - 1 - row + 0.5
         for column in range(width):
-            s0, s1, ds, _ = _pixel_ray(matrices, planes, shape, params, column + 0.5, y,
-                                                  depth[row, column], origin, direction, view_dir)  # fmt: skip
+            s0, s1, ds, _ = _pixel_ray(matrices, planes, shape, params, column + 0.5, y, depth[row, column],
+                                       origin, direction, view_dir, True)  # fmt: skip
             if not s0 < s1:
                 continue
             hit = _first_crossing(data, blocks, origin, direction, s0, s1, ds, level, int(params[P_BISECTIONS]),
@@ -670,7 +670,7 @@ def cast_composite_merged(datas, blocks, tables, matrices, planes, params, light
             for v in range(count_v):
                 s0, s1, ds[v], model_length[v] = _pixel_ray(matrices[v], planes[v], shapes[v], params[v],
                                                             column + 0.5, y, depth[row, column], origins[v],
-                                                            directions[v], view_dirs[v])  # fmt: skip
+                                                            directions[v], view_dirs[v], True)  # fmt: skip
                 k[v], count[v], tail[v] = 0, 0, 0.0
                 if s0 < s1:
                     first[v], count[v], tail_s[v], tail[v] = _samples(s0, s1, ds[v], params[v, P_ANCHORED] != 0.0)
@@ -727,7 +727,7 @@ def cast_composite_merged(datas, blocks, tables, matrices, planes, params, light
 
 @kernel
 def _pixel_ray(matrices, planes, shape, params, x, y, window_depth, origin, direction, view_dir,
-               shaded=True):  # pragma: no cover - compiled  # fmt: skip
+               shaded):  # pragma: no cover - compiled  # fmt: skip
     """The ray of window point (x, y) in grid coordinates (origin, direction, and, when `shaded`, the unit world
     vector toward the eye in view_dir); returns (s0, s1, ds, model_length), empty when s0 >= s1."""
     s0, s1 = _ray(matrices, planes, shape, x, y, window_depth, origin, direction)
