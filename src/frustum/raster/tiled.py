@@ -27,7 +27,7 @@ SEGMENT = 32
 
 
 @parallel_kernel(lambda *args: segments(args[6].shape[0] - 1, args[8][1]), work=lambda *args: args[9].size,
-                 grain=65536)  # fmt: skip
+                 grain=65536, pieces_per_thread=8)  # fmt: skip
 def draw_tiles_directional(
     faces: np.ndarray, win_int: np.ndarray, win_float: np.ndarray, tri_int: np.ndarray, tri_float: np.ndarray,
     tri_weights: np.ndarray, tile_starts: np.ndarray, tile_entries: np.ndarray, tiling: np.ndarray,
