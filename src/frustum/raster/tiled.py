@@ -109,14 +109,13 @@ def _shade_tile(
     face_offset = item[I_FACE_OFFSET]
     for row in range(rows):
         for col in range(cols):
-            code = codes[row, col]
-            f = code // 2 - face_offset
-            if depth[row, col] >= 1.0 or f < 0 or f >= faces.shape[0]:
+            if not depth[row, col] < 1.0:
                 words[row, offset + col, 0] = word
                 continue
+            code = codes[row, col]  # the one mesh's: written wherever depth < 1
             scratch[_X + n], scratch[_NDL + n] = float(bary[row, col, 0]), float(bary[row, col, 1])
-            scratch[_SIGN + n] = -1.0 if code % 2 == 1 else 1.0
-            where[n], where[_CHUNK + n], where[2 * _CHUNK + n] = row, offset + col, f
+            scratch[_SIGN + n] = -1.0 if code & 1 else 1.0
+            where[n], where[_CHUNK + n], where[2 * _CHUNK + n] = row, offset + col, (code >> 1) - face_offset
             n += 1
             if n == _CHUNK:
                 _gather_chunk(n, scratch, where, corners, faces, world, normals)
