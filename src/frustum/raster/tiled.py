@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from frustum.raster._jit import kernel, parallel_kernel
+from frustum.raster._jit import fence, kernel, parallel_kernel, stream
 from frustum.raster.shade import _CHUNK, _FIELDS, _NDL, _SIGN, _X, I_FACE_OFFSET, _gather_chunk, _shade_chunk
 from frustum.raster.triangles import _fill_tile
 
@@ -55,7 +55,7 @@ def draw_tiles_directional(
     scratch = np.empty(_FIELDS * _CHUNK)
     where = np.empty(3 * _CHUNK, dtype=np.int64)
     corners = np.empty(3 * _CHUNK, dtype=np.int64)
-    words = color.view(np.uint32)
+    image_words = color.view(np.uint32).reshape((height, width))
     word = background.view(np.uint32)[0]
     per_row = -(-tiles_x // SEGMENT)
     for segment in range(start, stop):
@@ -85,10 +85,12 @@ def draw_tiles_directional(
                     band_depth[row, col0 - left + col] = near[row, col]
         _gather_chunk(n, scratch, where, corners, faces, world, normals)
         _shade_chunk(n, scratch, where, params, lights, band_words)
-        for row in range(bottom - top):
+        for row in range(bottom - top):  # the image is output only: written past the caches (no line read first)
             for col in range(right - left):
-                depth[top + row, left + col] = band_depth[row, col]
-                words[top + row, left + col, 0] = band_words[row, col, 0]
+                stream(depth, top + row, left + col, band_depth[row, col])
+            for col in range(right - left):
+                stream(image_words, top + row, left + col, band_words[row, col, 0])
+    fence()
 
 
 def segments(tiles: int, tiles_x: int) -> int:
