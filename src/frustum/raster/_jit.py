@@ -22,11 +22,13 @@ measure coverage of) every kernel line as Python.
 from __future__ import annotations
 
 import functools
+import hashlib
 import itertools
 import threading
 import time
 from collections.abc import Callable
 from concurrent.futures import Future, ThreadPoolExecutor
+from pathlib import Path
 from typing import Any
 
 import numba
@@ -41,8 +43,40 @@ __all__ = [
     "fence", "kernel", "parallel_for", "parallel_kernel", "prange", "prefetch", "set_threads", "stream", "threads",
 ]
 
-kernel = numba.njit(cache=True, nogil=True)
-_parfor_kernel = numba.njit(cache=True, nogil=True, parallel=True)
+
+
+def package_digest(folder: Path) -> str:
+    """SHA-1 of the names and contents of the modules in `folder`: for ``frustum.raster``, part of each kernel's
+    cache stamp (``_cached``)."""
+    digest = hashlib.sha1()
+    for path in sorted(folder.glob("*.py")):
+        digest.update(path.name.encode())
+        digest.update(path.read_bytes())
+    return digest.hexdigest()
+
+
+_DIGEST = package_digest(Path(frustum.raster.__file__).parent)
+
+
+def _cached(options: dict[str, Any]) -> Callable[[Callable], Any]:
+    """``numba.njit(cache=True, **options)`` whose on-disk cache is also invalidated when any other module of
+    ``frustum.raster`` changes. Numba stamps a cache with its function's own source file only, so a kernel that
+    calls (and inlines) a helper from another module kept running the helper's old code after an edit there
+    (a ``git pull`` into an editable install does just that)."""
+    jit = numba.njit(cache=True, **options)
+
+    def decorate(function: Callable) -> Any:
+        dispatcher = jit(function)
+        cache_file = getattr(getattr(dispatcher, "_cache", None), "_cache_file", None)
+        if cache_file is not None and hasattr(cache_file, "_source_stamp"):
+            cache_file._source_stamp = (cache_file._source_stamp, _DIGEST)
+        return dispatcher
+
+    return decorate
+
+
+kernel = _cached({"nogil": True})
+_parfor_kernel = _cached({"nogil": True, "parallel": True})
 prange = numba.prange
 
 
