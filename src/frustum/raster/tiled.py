@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from frustum.raster._jit import kernel, parallel_kernel
+from frustum.raster._jit import fence, kernel, parallel_kernel, stream
 from frustum.raster.shade import _CHUNK, _FIELDS, _NDL, _SIGN, _X, I_FACE_OFFSET, _gather_chunk, _shade_chunk
 from frustum.raster.triangles import _fill_tile
 
@@ -27,7 +27,7 @@ SEGMENT = 32
 
 
 @parallel_kernel(lambda *args: segments(args[6].shape[0] - 1, args[8][1]), work=lambda *args: args[9].size,
-                 grain=65536)  # fmt: skip
+                 grain=65536, pieces_per_thread=8)  # fmt: skip
 def draw_tiles_directional(
     faces: np.ndarray, win_int: np.ndarray, win_float: np.ndarray, tri_int: np.ndarray, tri_float: np.ndarray,
     tri_weights: np.ndarray, tile_starts: np.ndarray, tile_entries: np.ndarray, tiling: np.ndarray,
@@ -55,7 +55,7 @@ def draw_tiles_directional(
     scratch = np.empty(_FIELDS * _CHUNK)
     where = np.empty(3 * _CHUNK, dtype=np.int64)
     corners = np.empty(3 * _CHUNK, dtype=np.int64)
-    words = color.view(np.uint32)
+    image_words = color.view(np.uint32).reshape((height, width))
     word = background.view(np.uint32)[0]
     per_row = -(-tiles_x // SEGMENT)
     for segment in range(start, stop):
@@ -85,10 +85,12 @@ def draw_tiles_directional(
                     band_depth[row, col0 - left + col] = near[row, col]
         _gather_chunk(n, scratch, where, corners, faces, world, normals)
         _shade_chunk(n, scratch, where, params, lights, band_words)
-        for row in range(bottom - top):
+        for row in range(bottom - top):  # the image is output only: written past the caches (no line read first)
             for col in range(right - left):
-                depth[top + row, left + col] = band_depth[row, col]
-                words[top + row, left + col, 0] = band_words[row, col, 0]
+                stream(depth, top + row, left + col, band_depth[row, col])
+            for col in range(right - left):
+                stream(image_words, top + row, left + col, band_words[row, col, 0])
+    fence()
 
 
 def segments(tiles: int, tiles_x: int) -> int:
@@ -109,14 +111,13 @@ def _shade_tile(
     face_offset = item[I_FACE_OFFSET]
     for row in range(rows):
         for col in range(cols):
-            code = codes[row, col]
-            f = code // 2 - face_offset
-            if depth[row, col] >= 1.0 or f < 0 or f >= faces.shape[0]:
+            if not depth[row, col] < 1.0:
                 words[row, offset + col, 0] = word
                 continue
+            code = codes[row, col]  # the one mesh's: written wherever depth < 1
             scratch[_X + n], scratch[_NDL + n] = float(bary[row, col, 0]), float(bary[row, col, 1])
-            scratch[_SIGN + n] = -1.0 if code % 2 == 1 else 1.0
-            where[n], where[_CHUNK + n], where[2 * _CHUNK + n] = row, offset + col, f
+            scratch[_SIGN + n] = -1.0 if code & 1 else 1.0
+            where[n], where[_CHUNK + n], where[2 * _CHUNK + n] = row, offset + col, (code >> 1) - face_offset
             n += 1
             if n == _CHUNK:
                 _gather_chunk(n, scratch, where, corners, faces, world, normals)
