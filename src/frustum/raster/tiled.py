@@ -7,8 +7,7 @@ are in the core's L1 cache: its triangles are filled (``triangles._fill_tile``) 
 live in tile-sized contiguous scratch (no image-sized codes or weights at all; an image row stride that is a
 multiple of 4 KiB would put a tile's rows of the image in one cache set), its drawn pixels gathered and shaded
 (``shade._gather_chunk``, ``shade._shade_chunk``, a chunk filling across tiles) and the others painted with the
-background.
-Each tile is owned by one thread, so the bytes are those of the general path on any number of threads.
+background. Each tile is owned by one thread, so the bytes are those of the general path on any number of threads.
 """
 
 from __future__ import annotations
@@ -42,7 +41,8 @@ def draw_tiles_directional(
     as in ``shade.shade_pixels_directional``; background (4,) uint8, the clear color's bytes. Each finished tile
     goes to a segment buffer whose rows are padded by a cache line (copied from a tile, the rows of an image whose
     stride is a multiple of 4 KiB would all fall in one cache set), and each finished segment (2 × 128 KiB, in
-    L2 cache) to the image, row by row, which the hardware prefetches.
+    L2 cache) to the image, row by row, by non-temporal stores (``_jit.stream``: the image is output only, and
+    ordinary stores read each of its lines before writing it; 10 % of a 4096² frame).
     """
     size, tiles_x = tiling[0], tiling[1]
     height, width = depth.shape[0], depth.shape[1]
