@@ -57,6 +57,7 @@ __all__ = [
     "SUBPIXEL",
     "clear_buffers",
     "clip_faces",
+    "covers_centre",
     "depth_gradients",
     "face_box",
     "list_crossing",
@@ -129,9 +130,8 @@ def _window_box(
     """Cull and pixel bounding box of a triangle with snapped corners, scalars only (so it inlines).
 
     Returns ``(made, back, i_min, i_max, j_min, j_max)``: back = 1 for a clockwise triangle (the caller swaps
-    corners b and c; the box does not depend on the order); made = 0 for zero area, a culled back face, a box
-    (clamped to the image) that holds no pixel centre, or a box of one centre that the triangle does not cover
-    (``_covers``: most sub-pixel triangles of a fine mesh, which the fill would visit for nothing).
+    corners b and c; the box does not depend on the order); made = 0 for zero area, a culled back face or a box
+    (clamped to the image) that holds no pixel centre.
     """
     area = (xb - xa) * (yc - ya) - (xc - xa) * (yb - ya)
     back = 1 if area < 0 else 0
@@ -142,15 +142,11 @@ def _window_box(
     j_min = max(_first_centre(min(ya, min(yb, yc))), 0)
     j_max = min((max(ya, max(yb, yc)) - HALF_SUBPIXEL) >> SUBPIXEL_BITS, height - 1)
     made = 0 if (i_min > i_max or j_min > j_max) else 1
-    if made == 1 and i_min == i_max and j_min == j_max:
-        px, py = SUBPIXEL * i_min + HALF_SUBPIXEL, SUBPIXEL * j_min + HALF_SUBPIXEL
-        inside = _covers(xa, ya, xc, yc, xb, yb, px, py) if back == 1 else _covers(xa, ya, xb, yb, xc, yc, px, py)
-        made = 1 if inside else 0
     return made, back, i_min, i_max, j_min, j_max
 
 
 @kernel
-def _covers(x0: int, y0: int, x1: int, y1: int, x2: int, y2: int, px: int, py: int) -> bool:
+def covers_centre(x0: int, y0: int, x1: int, y1: int, x2: int, y2: int, px: int, py: int) -> bool:
     """Whether the counter-clockwise triangle covers the centre (px, py) by the top-left rule: the fill's edge
     functions ``E = dx·(Y − Y_a) − dy·(X − X_a)`` and biases (``_fill_tile``)."""
     dx0, dy0 = x2 - x1, y2 - y1
@@ -159,10 +155,10 @@ def _covers(x0: int, y0: int, x1: int, y1: int, x2: int, y2: int, px: int, py: i
     bias0 = 0 if (dy0 < 0 or (dy0 == 0 and dx0 < 0)) else 1
     bias1 = 0 if (dy1 < 0 or (dy1 == 0 and dx1 < 0)) else 1
     bias2 = 0 if (dy2 < 0 or (dy2 == 0 and dx2 < 0)) else 1
-    return (
-        dx0 * (py - y1) - dy0 * (px - x1) >= bias0
-        and dx1 * (py - y2) - dy1 * (px - x2) >= bias1
-        and dx2 * (py - y0) - dy2 * (px - x0) >= bias2
+    return (  # & rather than and: no branch per edge (whether a sub-pixel triangle covers its centre is random)
+        (dx0 * (py - y1) - dy0 * (px - x1) >= bias0)
+        & (dx1 * (py - y2) - dy1 * (px - x2) >= bias1)
+        & (dx2 * (py - y0) - dy2 * (px - x0) >= bias2)
     )
 
 
