@@ -60,9 +60,11 @@ def main() -> None:
 
     for name in ("project_vertices", "world_points", "transform_normals"):
         timed(pipeline, name)
+    for name in ("clear_buffers", "tile_offsets"):
+        timed(pipeline, name)
     for name in ("count_tiles", "add_record_tiles", "fill_tiles"):
         timed(tiles, name)
-    for name in ("clear_buffers", "clip_faces", "rasterize_tiles"):
+    for name in ("clip_faces", "rasterize_tiles"):
         timed(triangles, name)
     for name in ("shade_pixels", "shade_pixels_directional"):
         timed(shade, name)

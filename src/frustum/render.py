@@ -15,8 +15,8 @@ Fast path, per scene item (one compiled pass each, buffers shared between items)
    the mesh's own arrays when the modeling transform leaves them unchanged.
 4. ``raster.triangles.rasterize_tiles``: edge functions with the top-left rule (rows of wide boxes visit only
    their covered span), depth on the triangle's plane (``z = (z_0 + β·ΔY) + α·ΔX``, no division per pixel),
-   depth test "less" against a float32 buffer cleared to 1.0 (``clear_buffers``, parallel over rows, which also
-   paints the background color), face code and perspective-correct barycentrics stored per drawn pixel
+   depth test "less" against a float32 buffer cleared to 1.0 (``clear_buffers``, NumPy fills, which also
+   paint the background color), face code and perspective-correct barycentrics stored per drawn pixel
    (parallel over tiles).
 5. ``raster.shade.shade_pixels``: deferred shading once per visible pixel (``frustum.shading``'s model,
    flat, Gouraud or Phong; per-vertex or per-face terms first by ``light_vertices`` / ``light_faces``), or
@@ -444,7 +444,7 @@ def _draw_surfaces(
     else:
         codes = scratch.empty((height, width), code_type)
         bary = scratch.empty((height, width, 2), np.float32)  # codes and bary are read only where depth < 1
-        triangles.clear_buffers(depth, color, options.background)
+        clear_buffers(depth, color, options.background)
         drawn = []
         for index in opaque:
             world, normals, rows = _draw_item(items[index], camera, options.cull, int(offsets[index]), depth,
@@ -797,9 +797,7 @@ def bin_item(
         clip_options[4] = 1
         triangles.clip_faces(*arguments, record_starts[:-1], tri_int, tri_float, tri_weights)
         tiles.add_record_tiles(tri_int, options, counts)
-    offsets = np.empty_like(counts)
-    tile_starts = np.empty(tiles_x * tiles_y + 1, dtype=np.int64)
-    tiles.tile_offsets(counts, offsets, tile_starts)
+    offsets, tile_starts = tile_offsets(counts)
     entry_type = np.int32 if max(faces.shape[0], tri_int.shape[0] + 1) < 2**31 else np.int64
     tile_entries = empty((int(tile_starts[-1]),), entry_type)
     tiles.fill_tiles(
@@ -810,6 +808,27 @@ def bin_item(
         scratch.recycle(listed, listed_tiles)
     return Binned(faces, win_int, win_float, vertex_codes, crossing, tri_int, tri_float, tri_weights, tile_starts,
                   tile_entries, tiles_x)  # fmt: skip
+
+
+def clear_buffers(depth: np.ndarray, color: np.ndarray, background: np.ndarray) -> None:
+    """Depth 1.0 (far) and the background color bytes (4,) everywhere (NumPy's fills run at memory bandwidth, as
+    a compiled loop did, without its compile time). Face codes need no clearing: a pixel is drawn exactly where
+    its depth is below 1, and only there are codes and barycentrics read."""
+    depth.fill(1.0)
+    color.view(np.uint32).fill(background.view(np.uint32)[0])
+
+
+def tile_offsets(counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(offsets, tile_starts)`` of the binning's counts (C, tiles): the exclusive prefix sum in tile-major order,
+    ``offsets[c, t]`` (C-contiguous int64) where chunk c writes in tile t's list, and each tile's first slot
+    followed by the total, (tiles + 1,) int64."""
+    flat = counts.T.ravel()  # tile-major: chunk c's entries precede chunk c + 1's within every tile
+    ends = np.cumsum(flat)
+    starts = (ends - flat).reshape(counts.shape[1], counts.shape[0])
+    tile_starts = np.empty(counts.shape[1] + 1, dtype=np.int64)
+    tile_starts[:-1] = starts[:, 0]
+    tile_starts[-1] = ends[-1]
+    return np.ascontiguousarray(starts.T), tile_starts
 
 
 def _item_matrices(item: SceneItem, camera: Camera | None) -> np.ndarray:
@@ -1192,7 +1211,7 @@ def _draw_surfaces_by_method(
     clear_items = [i for i, item in enumerate(items) if item.material.opacity < 1.0]
     depth = np.empty((height, width), dtype=np.float32)
     color = np.empty((height, width, 4), dtype=np.uint8)
-    triangles.clear_buffers(depth, color, options.background)
+    clear_buffers(depth, color, options.background)
     ambient, lights = pack_lights(scene.world_lights())
     extra = _extra(normal_out, id_out)
     if options.method == "a-buffer":

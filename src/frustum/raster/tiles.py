@@ -4,10 +4,10 @@ This is also the per-face half of triangle setup (``triangles.face_box``: trivia
 codes, back-face cull by the signed window area, pixel bounding box): nothing per face is stored but its tile
 list entries, and the count pass's list of the faces that draw anything (with the one tile of each small face),
 so the fill visits those only. Count (parallel over chunks of faces), records of the clipped faces added to
-their face's chunk, prefix sum (serial, tile-major so chunk c's entries precede chunk c + 1's within every
-tile), fill (parallel over chunks). A face goes to every tile its pixel
-bounding box touches; a crossing face's clipped triangles (``triangles.clip_faces``) go, in fan order, where the
-face is. options = (width, height, cull, tile_bits, tiles_x, chunk, face_offset) int64: tiles are
+their face's chunk, prefix sum (``render.tile_offsets``, NumPy, tile-major so chunk c's entries precede chunk
+c + 1's within every tile), fill (parallel over chunks). A face goes to every tile its pixel bounding box
+touches; a crossing face's clipped triangles (``triangles.clip_faces``) go, in fan order, where the face is.
+options = (width, height, cull, tile_bits, tiles_x, chunk, face_offset) int64: tiles are
 ``2^tile_bits`` pixels square, so a pixel's tile index is a shift.
 """
 
@@ -19,7 +19,7 @@ from frustum.raster._jit import kernel, parallel_kernel
 from frustum.raster.fixed_point import HALF_SUBPIXEL, SUBPIXEL
 from frustum.raster.triangles import CROSSING, FACE_CROSSING, FACE_DRAWN, covers_centre, face_box
 
-__all__ = ["add_record_tiles", "count_tiles", "fill_tiles", "tile_offsets"]
+__all__ = ["add_record_tiles", "count_tiles", "fill_tiles"]
 
 O_WIDTH, O_HEIGHT, O_CULL, O_BITS, O_TILES_X, O_CHUNK, O_FACE_OFFSET = 0, 1, 2, 3, 4, 5, 6
 
@@ -88,21 +88,6 @@ def add_record_tiles(tri_int: np.ndarray, options: np.ndarray, counts: np.ndarra
         for ty in range(tri_int[r, 9] >> bits, (tri_int[r, 10] >> bits) + 1):
             for tx in range(tri_int[r, 7] >> bits, (tri_int[r, 8] >> bits) + 1):
                 counts[c, ty * tiles_x + tx] += 1
-
-
-@kernel
-def tile_offsets(counts: np.ndarray, offsets: np.ndarray, tile_starts: np.ndarray) -> None:
-    """Exclusive prefix sum in tile-major order: ``offsets[c, t]`` where chunk c writes in tile t's list.
-
-    tile_starts (tiles + 1,) int64 receives each tile's first slot and, last, the total.
-    """
-    running = 0
-    for t in range(counts.shape[1]):
-        tile_starts[t] = running
-        for c in range(counts.shape[0]):
-            offsets[c, t] = running
-            running += counts[c, t]
-    tile_starts[counts.shape[1]] = running
 
 
 @parallel_kernel(lambda *args: args[7].shape[0])  # offsets: one row per chunk of faces

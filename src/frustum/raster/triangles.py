@@ -55,7 +55,6 @@ __all__ = [
     "FACE_NONE",
     "RECORD_FIELDS",
     "SUBPIXEL",
-    "clear_buffers",
     "clip_faces",
     "covers_centre",
     "depth_gradients",
@@ -271,19 +270,6 @@ def clip_faces(
             record_starts[k] = made
 
 
-@parallel_kernel(lambda depth, *_: depth.shape[0], work=lambda depth, *_: depth.size, grain=65536)
-def clear_buffers(depth: np.ndarray, color: np.ndarray, background: np.ndarray, start: int, stop: int) -> None:
-    """Depth 1.0 (far) and the background color bytes (4,) everywhere, row by row (parallel over rows: clearing
-    tile by tile, 128-byte pieces of rows, ran at a quarter of the bandwidth). Face codes need no clearing: a
-    pixel is drawn exactly where its depth is below 1, and only there are codes and barycentrics read."""
-    words = color.view(np.uint32)
-    word = background.view(np.uint32)[0]
-    for row in range(start, stop):
-        for col in range(depth.shape[1]):
-            depth[row, col] = 1.0
-            words[row, col, 0] = word
-
-
 @kernel
 def _fill_tile(
     tile: int, faces: np.ndarray, win_int: np.ndarray, win_float: np.ndarray, tri_int: np.ndarray,
@@ -421,8 +407,8 @@ def rasterize_tiles(
     """Each tile owns its pixels of ``depth``, ``codes`` and ``bary``: no write races, deterministic output.
 
     tiling = (tile_size, tiles_x, face_offset, width, height) int64; the buffers hold earlier items' results
-    (``clear_buffers`` first). Tile ``t`` covers columns ``[tx·s, tx·s + s)`` and window rows ``[ty·s, ty·s + s)``
-    with ``tx = t % tiles_x``, ``ty = t // tiles_x``; its triangles, in drawing order, are
+    (``render.clear_buffers`` first). Tile ``t`` covers columns ``[tx·s, tx·s + s)`` and window rows
+    ``[ty·s, ty·s + s)`` with ``tx = t % tiles_x``, ``ty = t // tiles_x``; its triangles, in drawing order, are
     ``tile_entries[tile_starts[t]:tile_starts[t + 1]]`` (``raster.tiles``): a face index f >= 0 (drawn from
     ``win_int``/``win_float`` of its vertices) or ``−1 − r`` for clipped record r.
     """
