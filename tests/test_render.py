@@ -358,3 +358,44 @@ def test_a_reflected_mesh_keeps_its_front_faces_outward(shading):
     assert ((a.depth < 1) == (b.depth < 1)).all()  # the mirrored triangulation differs: depths to round-off
     assert np.abs(a.depth - b.depth).max() < 1e-5
     assert (np.abs(a.color.astype(int) - b.color.astype(int)).max(axis=2) <= 1).mean() > 0.999
+
+
+# --- compact Mesh storage (issue 16, memory) -----------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "options",
+    [
+        dict(shading="phong"),
+        dict(shading="phong", specular="phong"),
+        dict(shading="gouraud"),
+        dict(shading="flat", buffers=("normals", "object_id")),
+        dict(shading="normals"),
+        dict(mode="surface+edges"),
+        dict(mode="hidden-line"),
+        dict(shading="phong", method="scan-line"),
+        dict(shading="gouraud", method="depth-sort"),
+    ],
+    ids=lambda o: ",".join(f"{k}={v}" for k, v in o.items()),
+)
+def test_a_float32_int32_mesh_renders_the_same_bytes_as_its_float64_int64_copy(options):
+    # float32 → float64 is exact: a Mesh keeping float32 vertices must draw exactly what their float64 copy draws
+    sphere = trimesh.creation.icosphere(subdivisions=2)
+    vertices32 = (sphere.vertices * [1.0, 0.8, 1.2]).astype(np.float32)
+    normals32 = sphere.vertex_normals.astype(np.float32)
+    compact = Mesh(vertices32, sphere.faces.astype(np.int32), vertex_normals=normals32)
+    wide = Mesh(vertices32.astype(np.float64), sphere.faces.astype(np.int64), vertex_normals=normals32.astype(float))
+    assert compact.vertices.dtype == np.float32
+    camera = Camera.look_at((0.4, 0.6, 3.2), (0, 0, 0), (0, 1, 0), projection=Perspective(0.9, 0.5, 10.0),
+                            width=96, height=80)  # fmt: skip
+    frames = []
+    for mesh in (compact, wide):
+        scene = Scene(lights=[LIGHT])
+        scene.add(mesh, Material(color=(0.8, 0.5, 0.3), specular=0.4, shininess=20.0))
+        scene.add(mesh, Material(color=(0.3, 0.6, 0.9), opacity=0.5), rotate_y(0.3) @ translate(0.9, 0.1, -0.4))
+        frames.append(render(scene, camera, background=BACKGROUND, **options))
+    np.testing.assert_array_equal(frames[0].color, frames[1].color)
+    np.testing.assert_array_equal(frames[0].depth, frames[1].depth)
+    for name in ("normals", "object_id"):
+        if getattr(frames[1], name) is not None:
+            np.testing.assert_array_equal(getattr(frames[0], name), getattr(frames[1], name))
