@@ -382,3 +382,22 @@ def test_edge_keys_of_int32_faces_do_not_overflow_with_large_vertex_counts():
     corners = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], dtype=np.float32)
     closed = Mesh(np.concatenate([vertices[: n - 4] + 5.0, corners]), tetra)
     assert closed.is_watertight and closed.volume == pytest.approx(1.0 / 6.0)
+
+
+def test_given_normals_are_normalized_in_float64_and_float32_ones_stored_float32():
+    rng = np.random.default_rng(5)
+    normals = rng.normal(size=(70_000, 3)) * rng.uniform(0.1, 10.0, (70_000, 1))  # more rows than one block
+    vertices = rng.random((70_000, 3))
+    wide = Mesh(vertices, [[0, 1, 2]], vertex_normals=normals)
+    assert wide.vertex_normals.dtype == np.float64
+    np.testing.assert_array_equal(wide.vertex_normals, normals / np.sqrt((normals * normals).sum(axis=1))[:, None])
+    normals32 = normals.astype(np.float32)
+    compact = Mesh(vertices.astype(np.float32), [[0, 1, 2]], vertex_normals=normals32)
+    wide32 = normals32.astype(np.float64)
+    unit = wide32 / np.sqrt((wide32 * wide32).sum(axis=1))[:, None]
+    assert compact.vertex_normals.dtype == np.float32
+    np.testing.assert_array_equal(compact.vertex_normals, unit.astype(np.float32))  # rounded once
+    np.testing.assert_allclose(np.linalg.norm(compact.vertex_normals.astype(np.float64), axis=1), 1.0, atol=2e-7)
+    normals32[66_000] = 0.0  # a zero normal in the second block is named by its own index
+    with pytest.raises(GeometryError, match=r"vertex_normals\[66000\] = \[0.0, 0.0, 0.0\] has zero length"):
+        Mesh(vertices, [[0, 1, 2]], vertex_normals=normals32)

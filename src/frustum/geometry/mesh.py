@@ -52,7 +52,8 @@ class Mesh:
         Vertex indices in [0, N), stored int32 (N <= 2**31: every index fits; code that combines indices, such as
         an edge key ``i·N + j``, widens to int64 first). An empty mesh (M = 0) is valid.
     vertex_normals : (N, 3) array_like, optional
-        Finite, nonzero per-vertex normals; normalized on construction.
+        Finite, nonzero per-vertex normals; normalized on construction (in float64; a float32 array is stored
+        float32 again, the nearest float32 of the unit vector). Computed normals are float64.
     uvs : (N, 2) array_like, optional
         Finite texture coordinates (u, v) per vertex, v up (OpenGL/OBJ convention: (0, 0) is the image's
         bottom-left corner). Values outside [0, 1] are allowed (textures repeat).
@@ -82,16 +83,9 @@ class Mesh:
         if self.vertex_normals is None:
             normals = _area_weighted_normals(vertices, faces)
         else:
-            normals = as_points(self.vertex_normals, "vertex_normals", where=where)
+            normals = as_points(self.vertex_normals, "vertex_normals", where=where, keep_float32=True)
             _check_rows(normals, vertices.shape[0], "vertex_normals", where)
-            lengths = _row_lengths(normals)
-            zero = np.flatnonzero(lengths == 0.0)
-            if zero.size:
-                i = int(zero[0])
-                raise GeometryError(
-                    f"{where}: vertex_normals[{i}] = {normals[i].tolist()} has zero length; normals must be nonzero"
-                )
-            normals /= lengths[:, None]  # our own copy: in place, no second (N, 3) temporary
+            _normalize_rows(normals, where)
         object.__setattr__(self, "vertex_normals", read_only(np.ascontiguousarray(normals)))
         if self.uvs is not None:
             object.__setattr__(self, "uvs", read_only(_as_uvs(self.uvs, vertices.shape[0], where)))
@@ -449,6 +443,29 @@ def _row_lengths(rows: np.ndarray) -> np.ndarray:
     squares += rows[:, 1] * rows[:, 1]
     squares += rows[:, 2] * rows[:, 2]
     return np.sqrt(squares, out=squares)
+
+
+_BLOCK_ROWS = 1 << 16
+"""Rows per block of ``_normalize_rows`` (its float64 temporaries stay a few MiB whatever the mesh size)."""
+
+
+def _normalize_rows(rows: np.ndarray, where: str) -> None:
+    """Divide the (N, 3) rows (our own copy) by their lengths in place, computing in float64 block by block: float64
+    rows as ``rows / |rows|``, float32 rows normalized in float64 and rounded once (|n| = 1 within 2⁻²⁴).
+
+    Raises GeometryError naming the first zero-length row."""
+    for start in range(0, rows.shape[0], _BLOCK_ROWS):
+        block = np.asarray(rows[start : start + _BLOCK_ROWS], dtype=np.float64)  # a view when rows are float64
+        lengths = _row_lengths(block)
+        zero = np.flatnonzero(lengths == 0.0)
+        if zero.size:
+            i = start + int(zero[0])
+            raise GeometryError(
+                f"{where}: vertex_normals[{i}] = {rows[i].tolist()} has zero length; normals must be nonzero"
+            )
+        block /= lengths[:, None]
+        if block.dtype != rows.dtype:
+            rows[start : start + _BLOCK_ROWS] = block
 
 
 def _face_cross_products(vertices: Points, faces: NDArray[np.int64]) -> Points:
