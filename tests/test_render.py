@@ -224,6 +224,68 @@ def test_crossing_faces_are_clipped_into_records_in_drawing_order():
             assert all(e < 0 for e in entries[: entries.index(1)]) and entries[entries.index(1) + 1 :] == []
 
 
+def _one_mesh_scenes():
+    ground = Mesh(
+        [[-20.0, -1.2, -20.0], [20.0, -1.2, -20.0], [20.0, -1.2, 20.0], [-20.0, -1.2, 20.0]], [[0, 2, 1], [0, 3, 2]]
+    )
+    return {
+        "sphere": (sphere_mesh(2), np.eye(4)),
+        "open tube, turned": (open_cylinder(), translate(0.3, 0.0, 0.5) @ rotate_y(0.7)),
+        "ground crossing the near plane": (ground, np.eye(4)),
+    }
+
+
+@pytest.mark.parametrize("name", list(_one_mesh_scenes()))
+@pytest.mark.parametrize("cull", [True, False])
+@pytest.mark.parametrize("size", [(48, 36), (1100, 40)])  # 1100: two segments of 32 tiles, a partial last tile
+def test_one_mesh_tile_pipeline_equals_reference_byte_for_byte(name, cull, size, monkeypatch):
+    """A frame of one opaque mesh on the directional fast path is cleared, filled and shaded tile by tile
+    (``raster.tiled``): the same bytes as the reference, which shares no rasterizer code with it."""
+    from frustum.raster import tiled
+
+    calls = []
+    original = tiled.draw_tiles_directional
+    monkeypatch.setattr(tiled, "draw_tiles_directional", lambda *args: calls.append(1) or original(*args))
+    mesh, transform = _one_mesh_scenes()[name]
+    scene = Scene(lights=[LIGHT])
+    scene.add(mesh, material=Material(color=(0.8, 0.5, 0.3)), transform=transform)
+    camera = Camera.look_at(
+        (0.4, 0.9, 3.2), (0.3, 0.0, 0.0), (0, 1, 0), projection=Perspective(0.8, 0.3, 30.0), width=size[0],
+        height=size[1],
+    )  # fmt: skip
+    frame = render(scene, camera, background=BACKGROUND, cull_back_faces=cull)
+    color, depth = reference_render(scene, camera, background=BACKGROUND, cull_back_faces=cull)
+    assert calls, "the tile pipeline was not used"
+    assert (frame.depth < 1.0).any() and (frame.depth == 1.0).any()
+    np.testing.assert_array_equal(frame.depth, depth)
+    np.testing.assert_array_equal(frame.color, color)
+
+
+def test_frame_buffers_are_reused_only_when_no_frame_holds_them():
+    """``FrameBuffers``: a Frame the caller keeps is never written by the next render; once dropped (and no view
+    of it is alive), its buffers serve a later frame."""
+    scene = Scene(lights=[LIGHT])
+    scene.add(sphere_mesh(2), material=Material(color=(0.8, 0.5, 0.3)))
+    camera = Camera.look_at((0, 0, 3.0), (0, 0, 0), (0, 1, 0), width=1024, height=1024)  # 4 MiB: pooled
+    other = Camera.look_at((0, 2.0, 2.0), (0, 0, 0), (0, 1, 0), width=1024, height=1024)
+    first = render(scene, camera, background=BACKGROUND)
+    kept = first.color.copy(), first.depth.copy()
+    second = render(scene, other, background=BACKGROUND)  # first is held: new buffers
+    assert not np.shares_memory(first.color, second.color) and not np.shares_memory(first.depth, second.depth)
+    np.testing.assert_array_equal(first.color, kept[0])
+    np.testing.assert_array_equal(first.depth, kept[1])
+    row = first.depth[100]  # a view keeps first's depth buffer (and only it) alive
+    address = first.color.__array_interface__["data"][0]
+    del first
+    third = render(scene, other, background=BACKGROUND)
+    # first's color buffer is reused (as color or depth: both are 4 MiB); the others are still held
+    assert address in (third.color.__array_interface__["data"][0], third.depth.__array_interface__["data"][0])
+    for held in (row, second.color, second.depth):
+        assert not np.shares_memory(held, third.color) and not np.shares_memory(held, third.depth)
+    np.testing.assert_array_equal(row, kept[1][100])
+    np.testing.assert_array_equal(third.color, second.color)
+
+
 # --- determinism ---------------------------------------------------------------------------------------------
 
 

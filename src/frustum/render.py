@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import sys
 import threading
 import weakref
 from typing import Any, ClassVar
@@ -157,7 +158,8 @@ class Scratch:
 
 def release_memory() -> int:
     """Free the work arrays ``render`` keeps between calls (face codes, barycentrics, window records, tile lists
-    of the last frame: about 200 MiB after a 4096² frame); return how many bytes were released.
+    of the last frame: about 200 MiB after a 4096² frame) and the color and depth buffers of the last two frames
+    that no Frame holds any more (``FrameBuffers``); return how many bytes were released.
 
     The next ``render`` allocates (and first-touches) them anew. Call it when a program that rendered large
     frames goes on to other work.
@@ -165,7 +167,7 @@ def release_memory() -> int:
     with Scratch._lock:
         released = sum(a.nbytes for arrays in Scratch._pool.values() for a in arrays)
         Scratch._pool = {}
-    return released
+    return released + FrameBuffers.release()
 
 
 def render(
@@ -219,6 +221,11 @@ def render(
         color and only the visible parts of the edges are drawn (hidden parts per `hidden`).
         ``"surface+edges"``: shaded surfaces with their visible edges on top. With `cull_back_faces`, edges of back
         faces only (``hidden_lines.front_facing``) count as hidden whatever the depth buffer says.
+        Placed volumes (``Scene.add_volume``) are ray cast in every mode and by every `method`: in the surface
+        modes after the opaque surfaces, their edges and the polylines (rays stop at the surfaces and polylines)
+        and before transparent items; in
+        ``"wireframe"`` and ``"points"`` after the lines or points, each ray stopped at the depth they write; in
+        ``"hidden-line"`` after the visible edges, rays stopped at the (invisible) surfaces (docs/rendering.md).
     edges : {"all", "feature"} or None
         Which edges the line modes draw: every edge, or ``hidden_lines`` feature edges (boundaries, creases
         sharper than `crease_angle`, silhouettes). None: "all" for wireframe, "feature" for the others.
@@ -248,7 +255,8 @@ def render(
         shade with the same model, so where they find the same surface they give the same bytes. Surface modes
         only; each returns its counts in ``Frame.stats``. ``"octree"``: the scene's octrees (``Scene.octrees``)
         by ``visibility.octree.render_octree``, front to back, each face orientation shaded once with the
-        scene's lights; only `background` of the other options applies, and meshes are not drawn.
+        scene's lights; only `background` of the other options applies, and meshes are not drawn (volumes are,
+        over the octrees).
     transparency : {"sort", "a-buffer"}
         How transparent items are composited: whole items back to front by the view distance of their centres
         (fast; right for transparent objects that do not cut through or overlap each other cyclically), or
@@ -327,6 +335,10 @@ def _render_octrees(scene: Scene, camera: Camera, *, background: Any) -> Frame:
         draw_octree_into(item.mesh, camera, item.world_from_model, faces, item_color, item_depth, written)
         nearer = written & (item_depth < depth)
         color[nearer], depth[nearer] = item_color[nearer], item_depth[nearer]
+    if scene.volumes:  # ray cast over the octrees, each ray stopped at their depth
+        from frustum.volume_pass import draw_volumes
+
+        draw_volumes(scene, camera, depth, color)
     return Frame(color=color, depth=depth)
 
 
@@ -352,6 +364,7 @@ def _render_buffers(
         color[:, :] = options.background
         _draw_edges(items, camera, options, depth, color)
         _draw_polylines(scene.polylines, camera, options, depth, color)
+        _draw_volumes_after_lines(scene, camera, options, depth, color)
         _draw_particles(scene, camera, depth, color)
         return color, depth, normal_out, id_out
     scratch = Scratch()
@@ -364,11 +377,31 @@ def _render_buffers(
     scratch.release()
     if options.mode == "hidden-line":
         color[:, :] = options.background
-    if options.mode in ("hidden-line", "surface+edges"):
-        _draw_edges(items, camera, options, depth, color)
-    _draw_polylines(scene.polylines, camera, options, depth, color)
+    if not (scene.volumes and _volumes_with_surfaces(options)):  # else drawn before the volumes
+        if options.mode in ("hidden-line", "surface+edges"):
+            _draw_edges(items, camera, options, depth, color)
+        _draw_polylines(scene.polylines, camera, options, depth, color)
+    _draw_volumes_after_lines(scene, camera, options, depth, color)
     _draw_particles(scene, camera, depth, color)
     return color, depth, normal_out, id_out
+
+
+def _volumes_with_surfaces(options: _Options) -> bool:
+    """Whether the volumes are ray cast right after the opaque surfaces (``"surface"``, ``"surface+edges"``:
+    before transparent items) rather than after the lines (``_draw_volumes_after_lines``)."""
+    return options.mode in ("surface", "surface+edges")
+
+
+def _draw_volumes_after_lines(
+    scene: Scene, camera: Camera, options: _Options, depth: np.ndarray, color: np.ndarray
+) -> None:  # fmt: skip
+    """``"wireframe"``, ``"points"``, ``"hidden-line"``: the volumes ray cast over the finished lines or points,
+    each ray stopped at the depth they (wireframe, points) or the invisible surfaces (hidden-line) left, so a
+    line inside a cloud is seen through the part of the cloud in front of it (``frustum.volume_pass``)."""
+    if scene.volumes and not _volumes_with_surfaces(options):
+        from frustum.volume_pass import draw_volumes
+
+        draw_volumes(scene, camera, depth, color)
 
 
 def _draw_particles(scene: Scene, camera: Camera, depth: np.ndarray, color: np.ndarray) -> None:
@@ -387,31 +420,31 @@ def _draw_surfaces(
     height, width = camera.height, camera.width
     opaque = [i for i, item in enumerate(items) if item.material.opacity >= 1.0]
     clear_items = [i for i, item in enumerate(items) if item.material.opacity < 1.0]
-    depth = _page_aligned((height, width), np.float32)
+    depth = FrameBuffers.take((height, width), np.float32)
+    color = FrameBuffers.take((height, width, 4), np.uint8)
     face_total = sum(item.mesh.face_count for item in items)
     code_type = np.int32 if 2 * face_total < 2**31 else np.int64
-    codes = scratch.empty((height, width), code_type)
-    bary = scratch.empty((height, width, 2), np.float32)  # codes and bary are read only where depth < 1
-    color = _page_aligned((height, width, 4), np.uint8)
-    triangles.clear_buffers(depth, color, options.background)
     ambient, lights = pack_lights(scene.world_lights())
-    extra = (
-        np.zeros((1, 1, 3), dtype=np.float32) if normal_out is None else normal_out,
-        np.zeros((1, 1), dtype=np.int32) if id_out is None else id_out,
-    )
     offsets = np.cumsum([0] + [item.mesh.face_count for item in items])
-    drawn = []
-    for index in opaque:
-        world, normals, rows = _draw_item(items[index], camera, options.cull, int(offsets[index]), depth, codes,
-                                          bary, scratch)  # fmt: skip
-        drawn.append((index, world, normals, rows))
-    for index, world, normals, rows in drawn:
-        _shade_item(items[index], index, int(offsets[index]), camera, options, ambient, lights, world, normals,
-                    depth, codes, bary, color, extra, rows, blend=False)  # fmt: skip
-    if scene.volumes:  # ray cast after the opaque surfaces (rays stop at their depth), before transparent items
-        from frustum.volume_pass import draw_volumes
-
-        draw_volumes(scene, camera, depth, color)
+    extra = _extra(normal_out, id_out)
+    bary = None
+    if len(items) == 1 and opaque and face_total and _directional(items[0], options, lights):
+        _draw_tiled(items[0], camera, options, ambient, lights, depth, color, scratch)
+    else:
+        codes = scratch.empty((height, width), code_type)
+        bary = scratch.empty((height, width, 2), np.float32)  # codes and bary are read only where depth < 1
+        triangles.clear_buffers(depth, color, options.background)
+        drawn = []
+        for index in opaque:
+            world, normals, rows = _draw_item(items[index], camera, options.cull, int(offsets[index]), depth,
+                                              codes, bary, scratch)  # fmt: skip
+            drawn.append((index, world, normals, rows))
+        for index, world, normals, rows in drawn:
+            _shade_item(items[index], index, int(offsets[index]), camera, options, ambient, lights, world, normals,
+                        depth, codes, bary, color, extra, rows, blend=False)  # fmt: skip
+    _draw_volumes_over_surfaces(scene, camera, options, depth, color)
+    if clear_items and bary is None:
+        bary = scratch.empty((height, width, 2), np.float32)
     for index in back_to_front(items, clear_items, camera):
         item = items[index]
         layer_depth = depth.copy()
@@ -422,6 +455,51 @@ def _draw_surfaces(
         _shade_item(item, index, int(offsets[index]), camera, options, ambient, lights, world, normals,
                     layer_depth, layer_codes, bary, color, extra, rows, blend=True)  # fmt: skip
     return depth, color
+
+
+def _extra(normal_out: np.ndarray | None, id_out: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    """The normal and object-id buffers ``shade.shade_pixels`` writes, or 1-pixel dummies where not asked for."""
+    return (
+        np.zeros((1, 1, 3), dtype=np.float32) if normal_out is None else normal_out,
+        np.zeros((1, 1), dtype=np.int32) if id_out is None else id_out,
+    )
+
+
+def _draw_tiled(
+    item: SceneItem, camera: Camera, options: _Options, ambient: np.ndarray, lights: np.ndarray,
+    depth: np.ndarray, color: np.ndarray, scratch: Scratch,
+) -> None:  # fmt: skip
+    """Stages 1–5 for a frame of one opaque mesh on the directional fast path: bin, then clear, fill and shade
+    tile by tile (``raster.tiled``): the same bytes as the stage-by-stage path, without image-sized codes and
+    weights or a second pass over the image."""
+    from frustum.raster import tiled
+
+    binned = bin_item(item, camera, options.cull, 0, scratch)
+    world, normals = _world_attributes(item, scratch)
+    tiling = np.array([TILE_SIZE, binned.tiles_x, 0, camera.width, camera.height], dtype=np.int64)
+    params = _shading_parameters(item, camera, options, ambient)
+    flags = _item_flags(0, 0, options, False, False, False)
+    tiled.draw_tiles_directional(
+        binned.faces, binned.win_int, binned.win_float, binned.tri_int, binned.tri_float, binned.tri_weights,
+        binned.tile_starts, binned.tile_entries, tiling, depth, world, normals, params, lights, flags,
+        options.background, color,
+    )  # fmt: skip
+
+
+def _draw_volumes_over_surfaces(
+    scene: Scene, camera: Camera, options: _Options, depth: np.ndarray, color: np.ndarray
+) -> None:  # fmt: skip
+    """The surface modes: every volume ray cast after the opaque surfaces (rays stop at their depth), before the
+    transparent items, whatever visible-surface method filled the depth buffer. In a scene with volumes the
+    edges (``"surface+edges"``) and polylines come first (``_render_buffers`` then leaves them out), so the part
+    of a cloud in front of a line covers it; polylines write depth, so they stop the rays too."""
+    if scene.volumes and _volumes_with_surfaces(options):
+        from frustum.volume_pass import draw_volumes
+
+        if options.mode == "surface+edges":
+            _draw_edges(scene.items, camera, options, depth, color)
+        _draw_polylines(scene.polylines, camera, options, depth, color)
+        draw_volumes(scene, camera, depth, color)
 
 
 def back_to_front(items: list[SceneItem], indices: list[int], camera: Camera) -> list[int]:
@@ -553,20 +631,50 @@ def _adjacency(mesh: Mesh) -> EdgeAdjacency:
     return cached
 
 
-def _page_aligned(shape: tuple[int, ...], dtype: Any) -> np.ndarray:
-    """``np.empty(shape, dtype)`` starting on a 2 MiB boundary (a view into a buffer up to 2 MiB longer).
+class FrameBuffers:
+    """The color and depth arrays a Frame returns, recycled once nobody holds them (double buffering).
 
-    The Frame's color and depth are new every call, so every frame first-touches them. NumPy asks the kernel for
-    huge pages on large arrays, but only the aligned 2 MiB pieces inside an allocation can have them: aligned,
-    a 4 MiB buffer takes 2 page faults instead of about a thousand.
+    A new large array costs a first-touch pass (the kernel zeroes each page on first write) on top of the clear:
+    about 18 ms of a 4096² frame. The buffers of the last few frames stay in a short list; a request takes one of
+    them when no array outside the list still refers to it (its reference count says so: every view of a NumPy
+    array holds its base), so a program that keeps the previous Frame while rendering the next (an animation
+    loop) alternates between two sets, and one that keeps every Frame gets new arrays each time. Buffers start on
+    a 2 MiB boundary, so the kernel can back them with huge pages (2 page faults per 4 MiB instead of ~1000).
+    ``release_memory()`` empties the list.
     """
-    dtype = np.dtype(dtype)
-    size = math.prod(shape) * dtype.itemsize
-    if size < _HUGE_PAGE:
-        return np.empty(shape, dtype=dtype)
-    raw = np.empty(size + _HUGE_PAGE, dtype=np.uint8)
-    start = -raw.ctypes.data % _HUGE_PAGE
-    return raw[start : start + size].view(dtype).reshape(shape)
+
+    KEEP = 4
+    """Buffers kept: color and depth of two frames."""
+    _kept: ClassVar[list[np.ndarray]] = []
+    _lock: ClassVar[threading.Lock] = threading.Lock()
+
+    @classmethod
+    def take(cls, shape: tuple[int, ...], dtype: Any) -> np.ndarray:
+        """An uninitialized ``np.empty(shape, dtype)``, 2 MiB-aligned: a kept buffer nobody holds, or a new one."""
+        dtype = np.dtype(dtype)
+        size = math.prod(shape) * dtype.itemsize
+        if size < _HUGE_PAGE:
+            return np.empty(shape, dtype=dtype)
+        with cls._lock:
+            for index in range(len(cls._kept)):
+                raw = cls._kept[index]  # free when only the list, this name and getrefcount's argument hold it
+                if raw.nbytes == size + _HUGE_PAGE and sys.getrefcount(raw) == 3:
+                    del cls._kept[index]
+                    break
+            else:
+                raw = np.empty(size + _HUGE_PAGE, dtype=np.uint8)
+            cls._kept.append(raw)  # most recently used last; the oldest go first
+            del cls._kept[: -cls.KEEP]
+            start = -raw.ctypes.data % _HUGE_PAGE
+            return raw[start : start + size].view(dtype).reshape(shape)
+
+    @classmethod
+    def release(cls) -> int:
+        """Forget the kept buffers; return their bytes (those still held by Frames stay alive with them)."""
+        with cls._lock:
+            released = sum(raw.nbytes for raw in cls._kept if sys.getrefcount(raw) == 3)
+            cls._kept = []
+        return released
 
 
 def _draw_item(
@@ -583,7 +691,7 @@ def _draw_item(
     height = depth.shape[0]
     rows = (0, 0) if used.size == 0 else (max(height - (int(used[-1]) + 1) * TILE_SIZE, 0),
                                           min(height - int(used[0]) * TILE_SIZE, height))  # fmt: skip
-    tiling = np.array([TILE_SIZE, binned.tiles_x, face_offset], dtype=np.int64)
+    tiling = np.array([TILE_SIZE, binned.tiles_x, face_offset, depth.shape[1], height], dtype=np.int64)
     triangles.rasterize_tiles(
         binned.faces, binned.win_int, binned.win_float, binned.tri_int, binned.tri_float, binned.tri_weights,
         binned.tile_starts, binned.tile_entries, tiling, depth, codes, bary,
@@ -1077,14 +1185,22 @@ def _draw_surfaces_by_method(
     color = np.empty((height, width, 4), dtype=np.uint8)
     triangles.clear_buffers(depth, color, options.background)
     ambient, lights = pack_lights(scene.world_lights())
-    extra = (
-        np.zeros((1, 1, 3), dtype=np.float32) if normal_out is None else normal_out,
-        np.zeros((1, 1), dtype=np.int32) if id_out is None else id_out,
-    )
+    extra = _extra(normal_out, id_out)
     if options.method == "a-buffer":
-        tris = window_triangles(items, list(range(len(items))), offsets, camera, options.cull)
+        # with volumes: the opaque fragments, the volumes (rays stop at their depth), then the transparent ones
+        volumes_between = bool(scene.volumes) and _volumes_with_surfaces(options)
+        first = opaque if volumes_between else list(range(len(items)))
+        tris = window_triangles(items, first, offsets, camera, options.cull)
         counts.update(_composite(tris, items, offsets, camera, options, ambient, lights, color, depth, scratch))
         counts["triangles"] = tris.count
+        if volumes_between:
+            _draw_volumes_over_surfaces(scene, camera, options, depth, color)
+            if clear_items:
+                tris = window_triangles(items, clear_items, offsets, camera, options.cull)
+                found = _composite(tris, items, offsets, camera, options, ambient, lights, color, depth.copy(),
+                                   scratch, under_depth=depth)  # fmt: skip
+                counts.update({f"transparent_{key}": value for key, value in found.items()})
+                counts["triangles"] += tris.count
         return depth, color
     code_type = _code_type(items)  # the depth buffer's: the shading kernels are compiled for it already
     codes = np.zeros((height, width), dtype=code_type)
@@ -1107,6 +1223,7 @@ def _draw_surfaces_by_method(
             world, normals = _world_attributes(items[index], scratch)
             _shade_item(items[index], index, offsets[index], camera, options, ambient, lights, world, normals,
                         depth, codes, bary, color, extra, (0, height), blend=False)  # fmt: skip
+        _draw_volumes_over_surfaces(scene, camera, options, depth, color)  # (_draw_surfaces casts them itself)
     if not clear_items:
         return depth, color
     if options.transparency == "a-buffer":

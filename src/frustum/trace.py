@@ -486,6 +486,23 @@ def _placed_meshes(scene: Any) -> Iterator[tuple[str, Mesh, Matrix4]]:
         yield label, mesh, np.asarray(matrix, dtype=np.float64)
 
 
+_BOX_FACES = np.array([[0, 3, 2], [0, 1, 3], [4, 7, 5], [4, 6, 7], [0, 5, 1], [0, 4, 5], [2, 7, 6], [2, 3, 7],
+                       [0, 6, 4], [0, 2, 6], [1, 7, 3], [1, 5, 7]], dtype=np.int64)  # fmt: skip
+"""The 12 triangles of a box whose corner ``4i + 2j + k`` is (i, j, k) ∈ {0, 1}³ (outward winding)."""
+
+
+def _placed_volumes(scene: Any) -> Iterator[tuple[str, NDArray[np.float64], Matrix4]]:
+    """(label, the 8 model-space corners of the grid's box, world_from_model) of every placed volume."""
+    for index, item in enumerate(getattr(scene, "volumes", ())):
+        volume = item.volume
+        grid = np.array([[i, j, k] for i in (0, 1) for j in (0, 1) for k in (0, 1)], dtype=np.float64)
+        grid *= np.array(volume.shape, dtype=np.float64) - 1.0
+        model = grid @ volume.model_from_grid[:3, :3].T + volume.model_from_grid[:3, 3]
+        shape = "x".join(str(n) for n in volume.shape)
+        label = f"volume {index} ({item.mode}, {shape} grid): the 8 corners of its box"
+        yield label, model, np.asarray(item.world_from_model, dtype=np.float64)
+
+
 def _projection_steps(camera: Camera) -> tuple[tuple[str, Matrix4 | None], tuple[str, Matrix4 | None]]:
     """(description, matrix) of the projection and the normalization stage; their product is clip_from_view."""
     steps = list(camera.projection.steps(camera.aspect))
@@ -598,7 +615,10 @@ def trace(
     ----------
     points_or_scene : (N, 3) or (3,) array_like, Mesh, or Scene
         Points in model coordinates; a ``Mesh`` (its vertices, and what clipping does to its triangles); or a
-        ``Scene`` (every vertex of every placed mesh, one ``TracedPart`` per mesh, in drawing order).
+        ``Scene`` (every vertex of every placed mesh, one ``TracedPart`` per mesh, in drawing order; then one
+        part per placed volume (``Scene.add_volume``): the 8 corners of its grid's box, model coordinates
+        ``model_from_grid·(i, j, k)``, and what clipping does to the box's 12 triangles — the region its rays
+        are cast through).
     camera : Camera
     model : (4, 4) array_like, optional
         world_from_model for points or a mesh (identity by default). A scene places its meshes itself.
@@ -636,6 +656,9 @@ def trace(
         for label, mesh, world_from_model in _placed_meshes(points_or_scene):
             part = _trace_points(mesh.vertices, world_from_model, camera, label)
             parts.append(part._replace(triangles=_clip_faces(part, mesh.faces)))
+        for label, corners, world_from_model in _placed_volumes(points_or_scene):  # ray cast inside their boxes
+            part = _trace_points(corners, world_from_model, camera, label)
+            parts.append(part._replace(triangles=_clip_faces(part, _BOX_FACES)))
         if not parts:
             parts.append(_trace_points(np.empty((0, 3)), np.eye(4), camera, "empty scene"))
         return Trace(camera, tuple(parts))

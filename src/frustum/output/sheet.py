@@ -600,8 +600,9 @@ def drawing_sheet(
     FrustumError
         If `scene` is not a Scene.
     OutputError
-        For an empty scene, an unknown or repeated view, a bad scale, paper, orientation or projection angle, or
-        views that do not fit on the paper at the given scale (the message says the largest scale that fits).
+        For a scene with volumes (a drawing sheet shows meshes only), an empty scene, an unknown or repeated view,
+        a bad scale, paper, orientation or projection angle, or views that do not fit on the paper at the given
+        scale (the message says the largest scale that fits).
 
     References
     ----------
@@ -628,6 +629,13 @@ def drawing_sheet(
         given_scale = as_scalar(scale, "scale", where=where, error=OutputError)
         if not given_scale > 0.0:
             raise OutputError(f"{where}: scale = {given_scale!r} must be > 0; paper length / model length")
+    if scene.volumes:  # a dimensioned line drawing has no form for a scalar field: say so rather than drop it
+        count = len(scene.volumes)
+        raise OutputError(
+            f"{where}: scene has {count} volume{'s' * (count != 1)} (Scene.add_volume), which an engineering drawing "
+            "cannot show; draw volumes with render_svg (an embedded image) or render, place volume.isosurface(level) "
+            "as a mesh, or remove them from scene.volumes for a drawing of the meshes"
+        )
     placed = _placed_meshes(scene)
     if not any(isinstance(item.mesh, Mesh) and item.mesh.face_count > 0 for item in placed):
         raise OutputError(f"{where}: scene has no faces to draw; add a mesh with at least one triangle")

@@ -442,6 +442,9 @@ def render_svg(
     a window point (x, y_w) is drawn at (x, height − y_w). Visible pieces are solid, hidden pieces dashed or
     gray (``hidden``); with ``depth_cue`` each visible piece gets a gray level and a width that fall off
     linearly with window depth, ``f = (z − z_near)/(z_far − z_near)``: gray = 0.75·f, width ·(1 − 0.6·f).
+    Placed volumes (``Scene.add_volume``) have no vector form: their ray-cast picture (``render``'s kernels)
+    is embedded as one PNG ``<image>`` in the group ``volumes`` over the faces and lines, each ray stopped at the
+    nearest face or visible line (``frustum.output.svg_volumes``).
 
     Parameters
     ----------
@@ -505,6 +508,10 @@ def render_svg(
         polygons, used = _fill_polygons(placed, _lights(scene), camera, fill_order)
         body.append(f'<g id="faces" data-order="{used}">{"".join(polygons)}</g>')
     body += _drawing_groups(lines, placed, to_paper, width, hidden, bool(depth_cue), camera=camera)
+    if scene.volumes:  # a raster layer over faces and lines, its rays stopped by both (output/svg_volumes.py)
+        from frustum.output.svg_volumes import volume_image_element
+
+        body.append(volume_image_element(scene, camera, lines.visible, lines.visible_depth, width))
     if getattr(scene, "particle_layers", None):  # dots and segments over the drawing (output/svg_particles.py)
         from frustum.output.svg_particles import particle_elements
 

@@ -8,7 +8,7 @@ multiplied compile time: the generalized shading kernel took 15 s to compile wit
 ``parallel_kernel(items)`` makes the three tiers of STYLE habit 6 from one function: the decorated function is a
 single-thread kernel over a slice ``[start, stop)`` of independent items (its last two parameters); the name it
 is bound to is a Python driver taking the same arguments without the slice, which splits ``items(*args)`` items
-into pieces and runs them on a pool of threads (``threads()`` of them; the kernel releases the GIL). Each piece
+into pieces and runs them on the calling thread and ``threads() − 1`` pool threads (kernels release the GIL). Each piece
 owns its slice of the outputs, so results are the same bytes on any number of threads. This replaces Numba's
 ``parallel=True``/``prange``: a parfor costs 0.25–0.5 s more to compile per kernel (and compiled every helper it
 calls twice, for an int64 and a uint64 index), and a pool of Python threads lets the main thread take Ctrl-C
@@ -22,6 +22,7 @@ measure coverage of) every kernel line as Python.
 from __future__ import annotations
 
 import functools
+import itertools
 import threading
 import time
 from collections.abc import Callable
@@ -116,9 +117,11 @@ def parallel_for(compiled: Callable[..., None], count: int, args: tuple, *, piec
 
     `work` (default `count`) estimates the whole job in any unit and `grain` is the least of it worth a piece of
     its own: a small job runs on the calling thread (handing a piece to a thread costs tens of microseconds, which
-    a scene of 10⁴ small meshes pays per kernel and item). The calling thread waits in an interruptible wait: on
-    Ctrl-C (or any error in a piece) the pieces not yet started are cancelled, the running ones finish (each is
-    short), and the exception propagates.
+    a scene of 10⁴ small meshes pays per kernel and item). Otherwise the calling thread and ``threads() − 1`` pool
+    threads take pieces in order from a shared counter until none are left (the caller works instead of waiting:
+    one thread fewer to wake per kernel). Ctrl-C reaches the caller between its pieces; on it, or on any error in
+    a piece, the pieces not yet taken are skipped, the running ones finish (each is short: they write into the
+    caller's arrays), and the exception propagates.
     """
     size = threads()
     pieces = min(count, size * pieces_per_thread, (count if work is None else work) // max(grain, 1))
@@ -126,15 +129,26 @@ def parallel_for(compiled: Callable[..., None], count: int, args: tuple, *, piec
         compiled(*args, 0, count)
         return
     bounds = [count * i // pieces for i in range(pieces + 1)]
-    pool = _executor(size)
-    futures: list[Future] = [pool.submit(compiled, *args, bounds[i], bounds[i + 1]) for i in range(pieces)]
+    taken = itertools.count()  # next() on it is atomic: each piece is taken once
+    stop = threading.Event()
+
+    def take() -> None:
+        for piece in taken:
+            if piece >= pieces or stop.is_set():
+                return
+            compiled(*args, bounds[piece], bounds[piece + 1])
+
+    pool = _executor(size - 1)
+    helpers: list[Future] = [pool.submit(take) for _ in range(min(size, pieces) - 1)]
     try:
-        for future in futures:
+        take()
+        for future in helpers:
             future.result()
     except BaseException:
-        for future in futures:
+        stop.set()
+        for future in helpers:
             future.cancel()
-        for future in futures:
+        for future in helpers:
             if not future.cancelled():
                 future.exception()  # wait for the running pieces: they write into the caller's arrays
         raise

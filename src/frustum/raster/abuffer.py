@@ -17,7 +17,7 @@ import numpy as np
 
 from frustum.raster._jit import kernel, parallel_kernel
 from frustum.raster.fixed_point import HALF_SUBPIXEL, SUBPIXEL
-from frustum.raster.window import edge_setup
+from frustum.raster.window import edge_setup, plane_depth
 
 __all__ = ["SAMPLES", "count_fragments", "group_by_pixel", "resolve", "write_fragments"]
 
@@ -223,12 +223,12 @@ def resolve(
             if premultiplied[f, 3] != 255:
                 continue
             t = triangle[f]
-            dx0, dy0, dx1, dy1, dx2, dy2, bias0, bias1, bias2, area = edge_setup(xy, t)
+            dx0, dy0, dx1, dy1, dx2, dy2, bias0, bias1, bias2, _area = edge_setup(xy, t)
             e0 = dx0 * (cy - xy[t, 3]) - dy0 * (cx - xy[t, 2])
             e1 = dx1 * (cy - xy[t, 5]) - dy1 * (cx - xy[t, 4])
             e2 = dx2 * (cy - xy[t, 1]) - dy2 * (cx - xy[t, 0])
             if e0 >= bias0 and e1 >= bias1 and e2 >= bias2:
-                z = np.float32(((float(e0) * zq[t, 0, 0] + float(e1) * zq[t, 1, 0]) + float(e2) * zq[t, 2, 0]) / area)
+                z = np.float32(plane_depth(xy, zq, t, cx, cy))
                 if z < best:
                     best = z
         depth[row, i] = best

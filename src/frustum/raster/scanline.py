@@ -29,7 +29,7 @@ import numpy as np
 
 from frustum.raster._jit import kernel, parallel_kernel
 from frustum.raster.fixed_point import HALF_SUBPIXEL, SUBPIXEL
-from frustum.raster.window import edge_setup, pixel_values
+from frustum.raster.window import edge_setup, pixel_values, plane_depth
 
 __all__ = ["STATS", "scan_lines"]
 
@@ -54,12 +54,7 @@ def _nearest(
     px = SUBPIXEL * i + HALF_SUBPIXEL
     for n in range(count):
         t = current[n]
-        dx0, dy0, dx1, dy1, dx2, dy2, _bias0, _bias1, _bias2, area = edge_setup(xy, t)
-        x0, y0, x1, y1, x2, y2 = xy[t, 0], xy[t, 1], xy[t, 2], xy[t, 3], xy[t, 4], xy[t, 5]
-        e0 = dx0 * (py - y1) - dy0 * (px - x1)
-        e1 = dx1 * (py - y2) - dy1 * (px - x2)
-        e2 = dx2 * (py - y0) - dy2 * (px - x0)
-        z = np.float32(((float(e0) * zq[t, 0, 0] + float(e1) * zq[t, 1, 0]) + float(e2) * zq[t, 2, 0]) / area)
+        z = np.float32(plane_depth(xy, zq, t, px, py))
         if z < best_z or (z == best_z and t < best):
             best, best_z = t, z
     return best
@@ -71,7 +66,7 @@ def _fill(
     depth: np.ndarray, codes: np.ndarray, bary: np.ndarray,
 ) -> None:  # fmt: skip
     """Triangle t on row j over columns [i0, i1): edge functions stepped per pixel, the depth buffer's values."""
-    dx0, dy0, dx1, dy1, dx2, dy2, _bias0, _bias1, _bias2, area = edge_setup(xy, t)
+    dx0, dy0, dx1, dy1, dx2, dy2, _bias0, _bias1, _bias2, _area = edge_setup(xy, t)
     x0, y0, x1, y1, x2, y2 = xy[t, 0], xy[t, 1], xy[t, 2], xy[t, 3], xy[t, 4], xy[t, 5]
     py = SUBPIXEL * j + HALF_SUBPIXEL
     px = SUBPIXEL * i0 + HALF_SUBPIXEL
@@ -81,7 +76,7 @@ def _fill(
     row = depth.shape[0] - 1 - j
     c = code[t]
     for i in range(i0, i1):
-        z, u1, u2 = pixel_values(zq, weights, t, e0, e1, e2, area)
+        z, u1, u2 = pixel_values(xy, zq, weights, t, e0, e1, e2, px, py)
         if z < 1.0:
             depth[row, i] = z
             codes[row, i] = c
@@ -89,6 +84,7 @@ def _fill(
         e0 -= dy0 * SUBPIXEL
         e1 -= dy1 * SUBPIXEL
         e2 -= dy2 * SUBPIXEL
+        px += SUBPIXEL
 
 
 @parallel_kernel(lambda xy, zq, weights, code, box, order, bucket, capacity, depth, *_: depth.shape[0])

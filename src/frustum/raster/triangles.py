@@ -25,6 +25,14 @@ corners 0, 1, 2 in drawing order (1 and 2 swapped when back = 1), so its weights
 the pixel's own barycentrics instead, which is bit-identical to weighting by one-hot vectors
 (``(b0·0 + b1·1) + b2·0 = b1`` exactly for b_k >= 0).
 
+Depth and weights at a covered pixel centre P. Window depth is affine in screen space, so it is the plane through
+the snapped corners ``(X_k, Y_k, z_k)`` written from corner 0 with its gradients (``depth_gradients``):
+``z(P) = (z_0 + β·(Y_P − Y_0)) + α·(X_P − X_0)``, ``α = −Σ dy_k z_k / (2·area)``, ``β = Σ dx_k z_k / (2·area)``
+(edge k opposite corner k) — the depth-buffer method's incremental form ``z' = z − A/C`` per step along a scan
+line [HB 9 "Depth-Buffer Method"], evaluated from the corner instead of accumulated, so every pixel's value is
+independent of the tiles and of the order pixels are visited in (no division per pixel). The perspective-correct
+weights: ``g_k = E_k(P)·(1/w_k)``, ``r = 1 / Σ g_k``, ``b_k = g_k·r``.
+
 A clockwise triangle is culled, or (two-sided) drawn with corners 1 and 2 swapped and ``back = 1``; a triangle
 of zero area, or whose box holds no pixel centre, is dropped.
 """
@@ -46,6 +54,7 @@ __all__ = [
     "SUBPIXEL",
     "clear_buffers",
     "clip_faces",
+    "depth_gradients",
     "face_box",
     "list_crossing",
     "rasterize_tiles",
@@ -61,6 +70,22 @@ or crossing the view volume (to be clipped)."""
 def _first_centre(low: int) -> int:
     """Smallest pixel index whose centre ``256·i + 128`` is >= `low` (fixed point): ``−floor((128 − low)/256)``."""
     return -((HALF_SUBPIXEL - low) >> SUBPIXEL_BITS)
+
+
+@kernel
+def depth_gradients(
+    x0: int, y0: int, x1: int, y1: int, x2: int, y2: int, z0: float, z1: float, z2: float
+) -> tuple[float, float]:  # fmt: skip
+    """``(α, β)``: change of window depth per 1/256 pixel in x and y on the plane through the snapped corners,
+    ``α = −((dy_0 z_0 + dy_1 z_1) + dy_2 z_2) / (2·area)``, ``β = ((dx_0 z_0 + dx_1 z_1) + dx_2 z_2) / (2·area)``
+    (module docstring; 2·area ≠ 0)."""
+    dx0, dy0 = x2 - x1, y2 - y1
+    dx1, dy1 = x0 - x2, y0 - y2
+    dx2, dy2 = x1 - x0, y1 - y0
+    area = float(dx2 * (y2 - y0) - dy2 * (x2 - x0))
+    alpha = -((float(dy0) * z0 + float(dy1) * z1) + float(dy2) * z2) / area
+    beta = ((float(dx0) * z0 + float(dx1) * z1) + float(dx2) * z2) / area
+    return alpha, beta
 
 
 @kernel
@@ -213,9 +238,14 @@ def clear_buffers(depth: np.ndarray, color: np.ndarray, background: np.ndarray, 
 def _fill_tile(
     tile: int, faces: np.ndarray, win_int: np.ndarray, win_float: np.ndarray, tri_int: np.ndarray,
     tri_float: np.ndarray, tri_weights: np.ndarray, tile_starts: np.ndarray, tile_entries: np.ndarray,
-    tiling: np.ndarray, depth: np.ndarray, codes: np.ndarray, bary: np.ndarray,
+    tiling: np.ndarray, depth: np.ndarray, codes: np.ndarray, bary: np.ndarray, origin_row: int, origin_col: int,
 ) -> None:  # fmt: skip
-    """Tile `tile` of ``rasterize_tiles``: edge-function fill of its triangles in order.
+    """Tile `tile` of ``rasterize_tiles``: edge-function fill of its triangles in order (depth and weights by the
+    module docstring's formulas).
+
+    Image pixel (row, col) is element ``[row − origin_row, col − origin_col]`` of ``depth``, ``codes`` and
+    ``bary``: origin (0, 0) for image-sized buffers, the tile's top-left pixel for a tile's own (``raster.tiled``:
+    contiguous, so the tile stays in L1 cache whatever the image's row stride).
 
     The tile owns the pixel columns [col0, col1) and window rows [row0, row1). Per triangle: top-left rule,
     depth test "less"; each covered pixel whose depth ``z = (E_12·z_0 + E_20·z_1 + E_01·z_2) / (2·area)`` (affine
@@ -225,8 +255,7 @@ def _fill_tile(
     Buffers are top row first: window row j is array row ``H − 1 − j``. The triangle loop is inline (no
     per-triangle call taking arrays: for pixel-sized triangles the call would cost more than the fill).
     """
-    size, tiles_x, face_offset = tiling[0], tiling[1], tiling[2]
-    height, width = depth.shape[0], depth.shape[1]
+    size, tiles_x, face_offset, width, height = tiling[0], tiling[1], tiling[2], tiling[3], tiling[4]
     col0 = (tile % tiles_x) * size
     col1 = min(col0 + size, width)
     row0 = (tile // tiles_x) * size
@@ -266,7 +295,7 @@ def _fill_tile(
         bias0 = 0 if (dy0 < 0 or (dy0 == 0 and dx0 < 0)) else 1
         bias1 = 0 if (dy1 < 0 or (dy1 == 0 and dx1 < 0)) else 1
         bias2 = 0 if (dy2 < 0 or (dy2 == 0 and dx2 < 0)) else 1
-        area = float(dx2 * (y2 - y0) - dy2 * (x2 - x0))
+        alpha, beta = depth_gradients(x0, y0, x1, y1, x2, y2, z0, z1, z2)
         swap = code % 2  # unclipped: source corner 1 is drawn as corner 1 + swap, corner 2 as 2 − swap
         px0 = SUBPIXEL * i_min + HALF_SUBPIXEL
         for j in range(j_min, j_max + 1):
@@ -274,23 +303,24 @@ def _fill_tile(
             e0 = dx0 * (py - y1) - dy0 * (px0 - x1)
             e1 = dx1 * (py - y2) - dy1 * (px0 - x2)
             e2 = dx2 * (py - y0) - dy2 * (px0 - x0)
-            row = height - 1 - j
-            for i in range(i_min, i_max + 1):
+            z_row = z0 + beta * float(py - y0)
+            x_off = float(px0 - x0)  # X_P − X_0, exact in float64
+            row = height - 1 - j - origin_row
+            for i in range(i_min - origin_col, i_max + 1 - origin_col):
                 if e0 >= bias0 and e1 >= bias1 and e2 >= bias2:
-                    f0, f1, f2 = float(e0), float(e1), float(e2)
-                    z = np.float32(((f0 * z0 + f1 * z1) + f2 * z2) / area)
+                    z = np.float32(z_row + alpha * x_off)
                     if z < depth[row, i]:
                         depth[row, i] = z
                         codes[row, i] = code
                         # perspective-correct weights b_k = (E_k / w_k) / Σ E_j / w_j, then onto the source face
-                        g0, g1, g2 = f0 * q0, f1 * q1, f2 * q2
-                        total = (g0 + g1) + g2
-                        b1, b2 = g1 / total, g2 / total
+                        g0, g1, g2 = float(e0) * q0, float(e1) * q1, float(e2) * q2
+                        reciprocal = 1.0 / ((g0 + g1) + g2)
+                        b1, b2 = g1 * reciprocal, g2 * reciprocal
                         if record < 0:  # one-hot weights: (b0·0 + b1·1) + b2·0 is b1 exactly (b_k >= 0)
                             bary[row, i, 0] = np.float32(b2 if swap == 1 else b1)
                             bary[row, i, 1] = np.float32(b1 if swap == 1 else b2)
                         else:
-                            b0 = g0 / total
+                            b0 = g0 * reciprocal
                             for k in range(2):
                                 w0, w1, w2 = (
                                     tri_weights[record, 0, k],
@@ -301,6 +331,7 @@ def _fill_tile(
                 e0 -= dy0 * SUBPIXEL
                 e1 -= dy1 * SUBPIXEL
                 e2 -= dy2 * SUBPIXEL
+                x_off += SUBPIXEL
 
 
 @parallel_kernel(lambda *args: args[6].shape[0] - 1, work=lambda *args: args[7].shape[0], grain=256)
@@ -313,14 +344,14 @@ def rasterize_tiles(
 ) -> None:  # fmt: skip
     """Each tile owns its pixels of ``depth``, ``codes`` and ``bary``: no write races, deterministic output.
 
-    tiling = (tile_size, tiles_x, face_offset) int64; the buffers hold earlier items' results (``clear_buffers``
-    first). Tile ``t`` covers columns ``[tx·s, tx·s + s)`` and
-    window rows ``[ty·s, ty·s + s)`` with ``tx = t % tiles_x``, ``ty = t // tiles_x``; its triangles, in drawing
-    order, are ``tile_entries[tile_starts[t]:tile_starts[t + 1]]`` (``raster.tiles``): a face index f >= 0 (drawn
-    from ``win_int``/``win_float`` of its vertices) or ``−1 − r`` for clipped record r.
+    tiling = (tile_size, tiles_x, face_offset, width, height) int64; the buffers hold earlier items' results
+    (``clear_buffers`` first). Tile ``t`` covers columns ``[tx·s, tx·s + s)`` and window rows ``[ty·s, ty·s + s)``
+    with ``tx = t % tiles_x``, ``ty = t // tiles_x``; its triangles, in drawing order, are
+    ``tile_entries[tile_starts[t]:tile_starts[t + 1]]`` (``raster.tiles``): a face index f >= 0 (drawn from
+    ``win_int``/``win_float`` of its vertices) or ``−1 − r`` for clipped record r.
     """
     for t in range(start, stop):
         _fill_tile(
             t, faces, win_int, win_float, tri_int, tri_float, tri_weights, tile_starts, tile_entries, tiling,
-            depth, codes, bary,
+            depth, codes, bary, 0, 0,
         )  # fmt: skip

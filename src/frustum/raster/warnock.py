@@ -28,7 +28,7 @@ import numpy as np
 
 from frustum.raster._jit import kernel
 from frustum.raster.fixed_point import HALF_SUBPIXEL, SUBPIXEL
-from frustum.raster.window import edge_setup, pixel_values
+from frustum.raster.window import edge_setup, pixel_values, plane_depth
 
 __all__ = ["LEVELS", "STATS", "subdivide"]
 
@@ -73,15 +73,11 @@ def _relation(xy: np.ndarray, box: np.ndarray, t: int, i0: int, j0: int, i1: int
 @kernel
 def _plane_range(xy: np.ndarray, zq: np.ndarray, t: int, i0: int, j0: int, i1: int, j1: int) -> tuple[float, float]:
     """Least and greatest depth of triangle t's plane over the corner pixel centres of the area."""
-    dx0, dy0, dx1, dy1, dx2, dy2, _bias0, _bias1, _bias2, area = edge_setup(xy, t)
     low, high = np.inf, -np.inf
     for corner in range(4):
         px = SUBPIXEL * (i0 if corner % 2 == 0 else i1 - 1) + HALF_SUBPIXEL
         py = SUBPIXEL * (j0 if corner < 2 else j1 - 1) + HALF_SUBPIXEL
-        e0 = dx0 * (py - xy[t, 3]) - dy0 * (px - xy[t, 2])
-        e1 = dx1 * (py - xy[t, 5]) - dy1 * (px - xy[t, 4])
-        e2 = dx2 * (py - xy[t, 1]) - dy2 * (px - xy[t, 0])
-        z = ((float(e0) * zq[t, 0, 0] + float(e1) * zq[t, 1, 0]) + float(e2) * zq[t, 2, 0]) / area
+        z = plane_depth(xy, zq, t, px, py)
         low, high = min(low, z), max(high, z)
     return low, high
 
@@ -92,7 +88,7 @@ def _draw(
     j1: int, test: bool, depth: np.ndarray, codes: np.ndarray, bary: np.ndarray,
 ) -> None:  # fmt: skip
     """Triangle t into the area (only where it covers the pixel centre when `test`), the depth buffer's values."""
-    dx0, dy0, dx1, dy1, dx2, dy2, bias0, bias1, bias2, area = edge_setup(xy, t)
+    dx0, dy0, dx1, dy1, dx2, dy2, bias0, bias1, bias2, _area = edge_setup(xy, t)
     height = depth.shape[0]
     c = code[t]
     for j in range(j0, j1):
@@ -103,7 +99,7 @@ def _draw(
         e2 = dx2 * (py - xy[t, 1]) - dy2 * (px - xy[t, 0])
         for i in range(i0, i1):
             if not test or (e0 >= bias0 and e1 >= bias1 and e2 >= bias2):
-                z, u1, u2 = pixel_values(zq, weights, t, e0, e1, e2, area)
+                z, u1, u2 = pixel_values(xy, zq, weights, t, e0, e1, e2, SUBPIXEL * i + HALF_SUBPIXEL, py)
                 if z < 1.0:
                     depth[height - 1 - j, i] = z
                     codes[height - 1 - j, i] = c
@@ -177,13 +173,13 @@ def subdivide(
             chosen, chosen_z = -1, np.float32(2.0)
             for m in range(top, top + n):
                 t = np.int64(lists[m])  # one compiled version of the helpers, whatever the list type
-                dx0, dy0, dx1, dy1, dx2, dy2, bias0, bias1, bias2, area = edge_setup(xy, t)
+                dx0, dy0, dx1, dy1, dx2, dy2, bias0, bias1, bias2, _area = edge_setup(xy, t)
                 e0 = dx0 * (py - xy[t, 3]) - dy0 * (px - xy[t, 2])
                 e1 = dx1 * (py - xy[t, 5]) - dy1 * (px - xy[t, 4])
                 e2 = dx2 * (py - xy[t, 1]) - dy2 * (px - xy[t, 0])
                 if e0 >= bias0 and e1 >= bias1 and e2 >= bias2:
                     stats[s + 8] += 1
-                    z, _u1, _u2 = pixel_values(zq, weights, t, e0, e1, e2, area)
+                    z, _u1, _u2 = pixel_values(xy, zq, weights, t, e0, e1, e2, px, py)
                     if z < chosen_z:
                         chosen, chosen_z = t, z
             if chosen >= 0:

@@ -12,8 +12,9 @@ or a clipped triangle record, with counter-clockwise snapped corners. Arrays (T 
 * ``box`` (T, 4) int64: pixel bounding box ``i_min, i_max, j_min, j_max`` (inclusive, inside the image).
 
 Edge functions at a point ``(X, Y)`` (1/256 pixel): ``E_k = dx_k·(Y − Y_a) − dy_k·(X − X_a)`` for the edge
-opposite corner k, top-left rule by ``bias_k`` (``E_k >= bias_k``); depth ``z = (E_0 z_0 + E_1 z_1 + E_2 z_2)/(2·area)``
-and the perspective-correct barycentrics as in ``triangles._fill_tile``.
+opposite corner k, top-left rule by ``bias_k`` (``E_k >= bias_k``); depth on the plane through the corners,
+``z = (z_0 + β·(Y − Y_0)) + α·(X − X_0)`` (``plane_depth``), and the perspective-correct barycentrics, as in
+``triangles._fill_tile`` (its module docstring).
 """
 
 from __future__ import annotations
@@ -22,16 +23,16 @@ import numpy as np
 
 from frustum.raster._jit import kernel, parallel_kernel
 from frustum.raster.fixed_point import HALF_SUBPIXEL, SUBPIXEL
-from frustum.raster.triangles import FACE_DRAWN, face_box
+from frustum.raster.triangles import FACE_DRAWN, depth_gradients, face_box
 
 __all__ = [
     "count_covered",
     "covers",
-    "depth_at",
     "edge_setup",
     "edges_at",
     "gather_faces",
     "pixel_values",
+    "plane_depth",
     "write_pixel",
 ]
 
@@ -105,27 +106,25 @@ def covers(xy: np.ndarray, t: int, px: int, py: int) -> bool:
 
 
 @kernel
-def depth_at(xy: np.ndarray, zq: np.ndarray, t: int, px: float, py: float) -> float:
-    """Window depth of triangle t's plane at (px, py) (fixed point): ``(E_0 z_0 + E_1 z_1 + E_2 z_2)/(2·area)``."""
-    x0, y0, x1, y1, x2, y2 = float(xy[t, 0]), float(xy[t, 1]), float(xy[t, 2]), float(xy[t, 3]), float(xy[t, 4]), \
-        float(xy[t, 5])  # fmt: skip
-    f0 = (x2 - x1) * (py - y1) - (y2 - y1) * (px - x1)
-    f1 = (x0 - x2) * (py - y2) - (y0 - y2) * (px - x2)
-    f2 = (x1 - x0) * (py - y0) - (y1 - y0) * (px - x0)
-    area = (x1 - x0) * (y2 - y0) - (y1 - y0) * (x2 - x0)
-    return ((f0 * zq[t, 0, 0] + f1 * zq[t, 1, 0]) + f2 * zq[t, 2, 0]) / area
+def plane_depth(xy: np.ndarray, zq: np.ndarray, t: int, px: int, py: int) -> float:
+    """Window depth (float64) of triangle t's plane at the fixed-point point (px, py):
+    ``(z_0 + β·(py − Y_0)) + α·(px − X_0)`` with ``(α, β) = triangles.depth_gradients`` (the depth buffer's bits)."""
+    x0, y0 = xy[t, 0], xy[t, 1]
+    z0 = zq[t, 0, 0]
+    alpha, beta = depth_gradients(x0, y0, xy[t, 2], xy[t, 3], xy[t, 4], xy[t, 5], z0, zq[t, 1, 0], zq[t, 2, 0])
+    return (z0 + beta * float(py - y0)) + alpha * float(px - x0)
 
 
 @kernel
 def pixel_values(
-    zq: np.ndarray, weights: np.ndarray, t: int, e0: int, e1: int, e2: int, area: float
+    xy: np.ndarray, zq: np.ndarray, weights: np.ndarray, t: int, e0: int, e1: int, e2: int, px: int, py: int
 ) -> tuple[np.float32, np.float32, np.float32]:  # fmt: skip
-    """``(z, u1, u2)`` float32 of triangle t where its edge functions are e0, e1, e2: the depth buffer's formulas."""
-    f0, f1, f2 = float(e0), float(e1), float(e2)
-    z = np.float32(((f0 * zq[t, 0, 0] + f1 * zq[t, 1, 0]) + f2 * zq[t, 2, 0]) / area)
-    g0, g1, g2 = f0 * zq[t, 0, 1], f1 * zq[t, 1, 1], f2 * zq[t, 2, 1]
-    total = (g0 + g1) + g2
-    b0, b1, b2 = g0 / total, g1 / total, g2 / total
+    """``(z, u1, u2)`` float32 of triangle t at the fixed-point point (px, py), where its edge functions are e0, e1,
+    e2: the depth buffer's formulas."""
+    z = np.float32(plane_depth(xy, zq, t, px, py))
+    g0, g1, g2 = float(e0) * zq[t, 0, 1], float(e1) * zq[t, 1, 1], float(e2) * zq[t, 2, 1]
+    reciprocal = 1.0 / ((g0 + g1) + g2)
+    b0, b1, b2 = g0 * reciprocal, g1 * reciprocal, g2 * reciprocal
     u1 = np.float32((b0 * weights[t, 0, 0] + b1 * weights[t, 1, 0]) + b2 * weights[t, 2, 0])
     u2 = np.float32((b0 * weights[t, 0, 1] + b1 * weights[t, 1, 1]) + b2 * weights[t, 2, 1])
     return z, u1, u2
@@ -138,9 +137,9 @@ def write_pixel(
 ) -> None:  # fmt: skip
     """Write triangle t's depth, code and barycentrics at pixel column i, window row j (no depth test; a depth
     of 1 or more, which the depth buffer's test "less" against its clear value never draws, is not written)."""
-    _dx0, _dy0, _dx1, _dy1, _dx2, _dy2, _bias0, _bias1, _bias2, area = edge_setup(xy, t)
-    e0, e1, e2 = edges_at(xy, t, SUBPIXEL * i + HALF_SUBPIXEL, SUBPIXEL * j + HALF_SUBPIXEL)
-    z, u1, u2 = pixel_values(zq, weights, t, e0, e1, e2, area)
+    px, py = SUBPIXEL * i + HALF_SUBPIXEL, SUBPIXEL * j + HALF_SUBPIXEL
+    e0, e1, e2 = edges_at(xy, t, px, py)
+    z, u1, u2 = pixel_values(xy, zq, weights, t, e0, e1, e2, px, py)
     if not z < 1.0:
         return
     row = depth.shape[0] - 1 - j
