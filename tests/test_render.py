@@ -449,17 +449,19 @@ def test_a_float32_int32_mesh_renders_the_same_bytes_as_its_float64_int64_copy(o
     assert compact.vertices.dtype == np.float32 and compact.faces.dtype == np.int32
     camera = Camera.look_at((0.4, 0.6, 3.2), (0, 0, 0), (0, 1, 0), projection=Perspective(0.9, 0.5, 10.0),
                             width=96, height=80)  # fmt: skip
-    frames = []
-    for mesh in (compact, wide):
-        scene = Scene(lights=[LIGHT])
-        scene.add(mesh, Material(color=(0.8, 0.5, 0.3), specular=0.4, shininess=20.0))
-        scene.add(mesh, Material(color=(0.3, 0.6, 0.9), opacity=0.5), rotate_y(0.3) @ translate(0.9, 0.1, -0.4))
-        frames.append(render(scene, camera, background=BACKGROUND, **options))
-    np.testing.assert_array_equal(frames[0].color, frames[1].color)
-    np.testing.assert_array_equal(frames[0].depth, frames[1].depth)
-    for name in ("normals", "object_id"):
-        if getattr(frames[1], name) is not None:
-            np.testing.assert_array_equal(getattr(frames[0], name), getattr(frames[1], name))
+    for both in (False, True):  # one opaque mesh (the tiled fast path where it applies), then two items
+        frames = []
+        for mesh in (compact, wide):
+            scene = Scene(lights=[LIGHT])
+            scene.add(mesh, Material(color=(0.8, 0.5, 0.3), specular=0.4, shininess=20.0))
+            if both:
+                scene.add(mesh, Material(color=(0.3, 0.6, 0.9), opacity=0.5), rotate_y(0.3) @ translate(0.9, 0.1, -0.4))
+            frames.append(render(scene, camera, background=BACKGROUND, **options))
+        np.testing.assert_array_equal(frames[0].color, frames[1].color)
+        np.testing.assert_array_equal(frames[0].depth, frames[1].depth)
+        for name in ("normals", "object_id"):
+            if getattr(frames[1], name) is not None:
+                np.testing.assert_array_equal(getattr(frames[0], name), getattr(frames[1], name))
 
 
 def test_float32_normals_render_within_one_level_of_float64_normals_on_the_same_pixels():
