@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 import frustum
-from frustum.raster import shade, tiles, triangles
+from frustum.raster import shade, tiled, tiles, triangles
 
 SHARED_BENCH = Path(__file__).resolve().parents[2] / "shared" / "bench"
 
@@ -66,6 +66,7 @@ def main() -> None:
         timed(triangles, name)
     for name in ("shade_pixels", "shade_pixels_directional"):
         timed(shade, name)
+    timed(tiled, "draw_tiles_directional")  # one opaque mesh: clear, fill and shade per tile
     frustum.render(scene, camera, background=background)  # compile or load the kernels
     rows: list[dict[str, float]] = []
     for _ in range(args.frames):

@@ -16,7 +16,7 @@ Rules, written out once more (the arithmetic order matters for byte equality):
 - pixel centre (256i + 128, 256j + 128); E_ab = (Xb − Xa)(Yp − Ya) − (Yb − Ya)(Xp − Xa); inside when E >= 0 on
   top/left edges (dy < 0, or dy = 0 and dx < 0) and E > 0 on the others.
 - depth on the plane through the drawn corners, from corner 0: float32((z0 + β·(Yp − Y0)) + α·(Xp − X0)) with
-  α = −((dy12·z0 + dy20·z1) + dy01·z2) / area2 and β = ((dx12·z0 + dx20·z1) + dx01·z2) / area2 (d_ab = b − a),
+  α = −((dy12·z0 + dy20·z1) + dy01·z2)·r and β = ((dx12·z0 + dx20·z1) + dx01·z2)·r, r = 1 / area2 (d_ab = b − a),
   test "less"; weights g_k = E_k / w_k, r = 1 / Σ g_k, b_k = g_k·r, mapped onto the source face through the clip
   weights, stored as float32.
 """
@@ -127,8 +127,9 @@ def _fill(corners, area, index, px, py, depth, owner, bary):
         edge = dx * (py - ay) - dy * (px - ax)  # (H, W) int64, exact
         inside &= edge >= 0 if _top_left(dx, dy) else edge > 0
         e.append(edge.astype(np.float64))
-    alpha = -((float(y2 - y1) * z0 + float(y0 - y2) * z1) + float(y1 - y0) * z2) / float(area)
-    beta = ((float(x2 - x1) * z0 + float(x0 - x2) * z1) + float(x1 - x0) * z2) / float(area)
+    reciprocal = 1.0 / float(area)
+    alpha = -((float(y2 - y1) * z0 + float(y0 - y2) * z1) + float(y1 - y0) * z2) * reciprocal
+    beta = ((float(x2 - x1) * z0 + float(x0 - x2) * z1) + float(x1 - x0) * z2) * reciprocal
     z = ((z0 + beta * (py - y0).astype(np.float64)) + alpha * (px - x0).astype(np.float64)).astype(np.float32)
     visible = inside & (z < depth)
     g0, g1, g2 = e[0] * q0, e[1] * q1, e[2] * q2

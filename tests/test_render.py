@@ -9,6 +9,8 @@ import numba
 import numpy as np
 import pytest
 import trimesh
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from PIL import Image
 from tests.reference_raster import placed, reference_render
 
@@ -132,6 +134,70 @@ def test_fan_around_a_vertex_covers_every_pixel_once():
     assert hits.max() == 1  # no pixel twice
     np.testing.assert_array_equal(hits == 1, coverage(points, faces, camera))  # no gaps: the union is the fan
     assert hits[40 - 1 - 20, 24] == 1  # the shared centre vertex itself is covered exactly once
+
+
+def _fixed(low: int, high: int) -> st.SearchStrategy[int]:
+    """A window coordinate in 1/256 pixel: anywhere, or on a pixel centre (edges through centres: E = 0)."""
+    return st.one_of(st.integers(low, high), st.integers(low // 256, high // 256).map(lambda i: 256 * i + 128))
+
+
+@settings(max_examples=100, deadline=None)
+@given(corners=st.lists(st.tuples(_fixed(-2000, 30000), _fixed(-2000, 12000)), min_size=3, max_size=3),
+       fan=st.integers(3, 9))  # fmt: skip
+def test_wide_and_thin_triangles_cover_exactly_the_centres_the_edge_functions_say(corners, fan):
+    """Rows wider than ``triangles.NARROW`` find their covered span from the edge functions (float estimate,
+    integer correction): the coverage equals the brute-force top-left rule at every centre (the reference's, for
+    a triangle clipped at the image border), and a fan of such triangles around a point covers each centre of
+    their union once."""
+    camera = window_camera(112, 44)
+    points = np.array([[x / 256.0, y / 256.0, 0.0] for x, y in corners])  # about on the 1/256 grid
+    scene = placed(Scene(), Mesh(points, [[0, 1, 2]]))
+    binned = bin_item(scene.items[0], camera, False)
+    covered = render(scene, camera, shading=None, cull_back_faces=False).depth < 1.0
+    if binned.vertex_codes.any():  # partly outside the image: clipped into records, against the reference
+        _, depth = reference_render(scene, camera, shading=None, cull_back_faces=False)
+        np.testing.assert_array_equal(covered, depth < 1.0)
+        return
+    snapped = binned.win_int.astype(np.int64)  # as the renderer snapped them
+    (ux, uy), (vx, vy) = snapped[1] - snapped[0], snapped[2] - snapped[0]
+    area = ux * vy - uy * vx
+    order = [0, 1, 2] if area > 0 else [0, 2, 1]
+    px = (256 * np.arange(112) + 128)[None, :]
+    py = (256 * np.arange(44) + 128)[::-1, None]  # top row first
+    inside = np.full((44, 112), area != 0)
+    for a, b in ((order[1], order[2]), (order[2], order[0]), (order[0], order[1])):
+        (ax, ay), (bx, by) = snapped[a], snapped[b]
+        edge = (bx - ax) * (py - ay) - (by - ay) * (px - ax)
+        inside &= edge >= 0 if (by - ay < 0 or (by == ay and bx - ax < 0)) else edge > 0
+    np.testing.assert_array_equal(covered, inside)
+    centre = np.array([56.0, 22.0, 0.0]) + (points.mean(axis=0) % 1.0)
+    ring = [centre + np.array([60 * math.cos(t), 20 * math.sin(t), 0.0]) for t in np.linspace(0, 2 * math.pi, fan + 1)]
+    rim = np.array([centre, *ring[:-1]])
+    faces = [[0, 1 + k, 1 + (k + 1) % fan] for k in range(fan)]
+    hits = sum(coverage(rim, [face], camera).astype(np.int64) for face in faces)
+    assert hits.max() <= 1
+    np.testing.assert_array_equal(hits == 1, coverage(rim, faces, camera))
+
+
+def test_span_of_an_edge_along_a_row_is_exact_where_the_float_estimate_rounds_wrong():
+    """``triangles._span`` against the brute-force columns k with ``e − step·k >= bias``, at e exactly on and one
+    away from every multiple of the step (where (e − bias)/step estimated in float64 can round across an
+    integer), for steps of both signs, big and small, and windows that clip the span."""
+    from frustum.raster.triangles import _span
+
+    columns = np.arange(40)
+    rounding = [-75, -77, -91, -93, -99, -105, 75, 91]  # m·step·fl(1/step) lands above m (m = 7, 3): ceil/floor off
+    for step in [*range(-300 * 256, 301 * 256, 37 * 256 + 3), *rounding, -768, 768, -2**20 - 256, 2**20 + 256, 0]:
+        for bias in (0, 1):
+            for m in (-3, 0, 1, 3, 7, 17, 39, 45):
+                for e in {m * step + d for d in (-1, 0, 1)}:
+                    for first, last in ((0, 39), (5, 30)):
+                        keep = columns[(e - step * columns >= bias) & (columns >= first) & (columns <= last)]
+                        low, high = _span(e, step, bias, 1.0 / step if step else 0.0, first, last)
+                        if keep.size:
+                            assert (low, high) == (keep[0], keep[-1]), (step, bias, e, first, last)
+                        else:
+                            assert low > high, (step, bias, e, first, last)
 
 
 # --- near plane and behind the eye ---------------------------------------------------------------------------

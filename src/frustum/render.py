@@ -13,12 +13,20 @@ Fast path, per scene item (one compiled pass each, buffers shared between items)
    triangle records that take their face's place in the tile lists.
 3. World positions and unit normals for shading (``raster.vertices.world_points``, ``transform_normals``), or
    the mesh's own arrays when the modeling transform leaves them unchanged.
-4. ``raster.triangles.rasterize_tiles``: edge functions with the top-left rule, depth test "less" against a
-   float32 buffer cleared to 1.0 (``clear_buffers``, parallel over rows, which also paints the background color),
-   face code and perspective-correct barycentrics stored per drawn pixel (parallel over tiles).
+4. ``raster.triangles.rasterize_tiles``: edge functions with the top-left rule (rows of wide boxes visit only
+   their covered span), depth on the triangle's plane (``z = (z_0 + β·ΔY) + α·ΔX``, no division per pixel),
+   depth test "less" against a float32 buffer cleared to 1.0 (``clear_buffers``, parallel over rows, which also
+   paints the background color), face code and perspective-correct barycentrics stored per drawn pixel
+   (parallel over tiles).
 5. ``raster.shade.shade_pixels``: deferred shading once per visible pixel (``frustum.shading``'s model,
    flat, Gouraud or Phong; per-vertex or per-face terms first by ``light_vertices`` / ``light_faces``), or
    ``shade_pixels_directional`` where it applies (per-pixel Blinn-Phong, directional lights: the same bytes).
+
+A frame of one opaque mesh on the directional path runs stages 4–5 tile by tile instead (``raster.tiled``, as
+llvmpipe does): each tile's depth, codes and weights live in L1-sized scratch, are shaded there and copied out
+once, with no image-sized codes or weights and no second pass over the image; the same bytes. The Frame's color
+and depth arrays are recycled once no Frame holds them (``FrameBuffers``), so an animation loop does not
+first-touch new pages every frame.
 6. Transparent items (``Material.opacity < 1``) after all opaque ones, back to front by the view distance of
    their centres: each rasterized alone against a copy of the opaque depth buffer (its nearest surface) and
    blended ``α·I + (1 − α)·under``.
@@ -777,7 +785,7 @@ def bin_item(
     tri_float, tri_weights = np.empty((0, 3, 2)), np.empty((0, 3, 2))
     record_starts = np.zeros(crossing.shape[0] + 1, dtype=np.int64)
     if crossing.shape[0]:
-        triangles.list_crossing(faces, vertex_codes, chunk, listed, listed_counts, crossing_starts[:-1], crossing)
+        triangles.list_crossing(listed, listed_tiles, chunk, listed_counts, crossing_starts[:-1], crossing)
         clip_options = np.array([width, height, int(cull), face_offset, 0], dtype=np.int64)
         arguments = (crossing, faces, mesh.vertices, clip_from_model, VIEW_VOLUME_PLANES, view, clip_options)
         triangles.clip_faces(*arguments, record_starts[1:], tri_int, tri_float, tri_weights)

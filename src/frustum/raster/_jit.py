@@ -30,16 +30,48 @@ from concurrent.futures import Future, ThreadPoolExecutor
 from typing import Any
 
 import numba
-from numba.core import event
+from llvmlite import ir
+from numba.core import cgutils, event, types
+from numba.extending import intrinsic
 from numba.np.ufunc import parallel as _numba_parallel
 
 import frustum.raster
 
-__all__ = ["kernel", "parallel_for", "parallel_kernel", "prange", "set_threads", "threads"]
+__all__ = ["kernel", "parallel_for", "parallel_kernel", "prange", "prefetch", "set_threads", "threads"]
 
 kernel = numba.njit(cache=True, nogil=True)
 _parfor_kernel = numba.njit(cache=True, nogil=True, parallel=True)
 prange = numba.prange
+
+
+
+@intrinsic
+def _prefetch(typingctx, array, i, j):
+    """LLVM's ``llvm.prefetch`` (read, high locality) of the cache line holding ``array[i, j]``."""
+
+    def codegen(context, builder, signature, args):
+        kind = signature.args[0]
+        data = context.make_array(kind)(context, builder, args[0])
+        pointer = cgutils.get_item_pointer(context, builder, kind, data, [args[1], args[2]], wraparound=False)
+        byte = ir.IntType(8).as_pointer()
+        int32 = ir.IntType(32)
+        function = cgutils.get_or_insert_function(
+            builder.module, ir.FunctionType(ir.VoidType(), [byte, int32, int32, int32]), "llvm.prefetch.p0i8"
+        )
+        builder.call(function, [builder.bitcast(pointer, byte), int32(0), int32(3), int32(1)])
+        return context.get_dummy_value()
+
+    return types.void(array, i, j), codegen
+
+
+def _no_prefetch(array: Any, i: int, j: int) -> None:
+    """``prefetch`` as plain Python (``NUMBA_DISABLE_JIT=1``): nothing to do."""
+
+
+prefetch = _no_prefetch if numba.config.DISABLE_JIT else _prefetch
+"""``prefetch(array, i, j)`` in a kernel: start loading the cache line of the 2-D ``array[i, j]`` (no effect on
+results). For loops that gather rows by index (tile entry → face → its vertices), issued some iterations ahead,
+so the loads of many iterations are in flight at once instead of each waiting in turn."""
 
 NOTICE_AFTER = 1.0
 """Seconds of kernel compilation after which ``frustum.raster.compile_notice`` is called (once per process)."""

@@ -28,7 +28,7 @@ import math
 
 import numpy as np
 
-from frustum.raster._jit import kernel, parallel_kernel
+from frustum.raster._jit import kernel, parallel_kernel, prefetch
 from frustum.raster.power import SQUARING_MAX, textbook_power
 
 __all__ = [
@@ -473,7 +473,11 @@ def _gather_chunk(
     the loads of many pixels are in flight at once (one long loop per pixel waited on each cache miss in turn)."""
     for i in range(n):
         f = where[2 * _CHUNK + i]
-        corners[i], corners[_CHUNK + i], corners[2 * _CHUNK + i] = faces[f, 0], faces[f, 1], faces[f, 2]
+        a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
+        corners[i], corners[_CHUNK + i], corners[2 * _CHUNK + i] = a, b, c
+        for v in (a, b, c):  # the second loop's rows, loading meanwhile (_jit.prefetch)
+            prefetch(normals, v, 0)
+            prefetch(world, v, 0)
     for i in range(n):
         a, b, c = corners[i], corners[_CHUNK + i], corners[2 * _CHUNK + i]
         u1, u2 = s[_X + i], s[_NDL + i]

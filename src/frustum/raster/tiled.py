@@ -27,7 +27,7 @@ SEGMENT = 32
 
 
 @parallel_kernel(lambda *args: segments(args[6].shape[0] - 1, args[8][1]), work=lambda *args: args[9].size,
-                 grain=65536)  # fmt: skip
+                 grain=65536, pieces_per_thread=8)  # fmt: skip
 def draw_tiles_directional(
     faces: np.ndarray, win_int: np.ndarray, win_float: np.ndarray, tri_int: np.ndarray, tri_float: np.ndarray,
     tri_weights: np.ndarray, tile_starts: np.ndarray, tile_entries: np.ndarray, tiling: np.ndarray,
@@ -67,6 +67,12 @@ def draw_tiles_directional(
         for t in range(band * tiles_x + first, band * tiles_x + min(first + SEGMENT, tiles_x)):
             col0 = (t % tiles_x) * size
             col1 = min(col0 + size, width)
+            if tile_starts[t] == tile_starts[t + 1]:  # no triangle: background
+                for row in range(bottom - top):
+                    for col in range(col0 - left, col1 - left):
+                        band_depth[row, col] = 1.0
+                        band_words[row, col, 0] = word
+                continue
             near[:, :] = 1.0
             _fill_tile(
                 t, faces, win_int, win_float, tri_int, tri_float, tri_weights, tile_starts, tile_entries, tiling,

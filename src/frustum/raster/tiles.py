@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from frustum.raster._jit import kernel, parallel_kernel
-from frustum.raster.triangles import FACE_CROSSING, FACE_DRAWN, face_box
+from frustum.raster.triangles import CROSSING, FACE_CROSSING, FACE_DRAWN, face_box
 
 __all__ = ["add_record_tiles", "count_tiles", "fill_tiles", "tile_offsets"]
 
@@ -35,8 +35,9 @@ def count_tiles(
     [c·chunk, (c+1)·chunk). The chunk's drawn and crossing faces, in order, go to ``listed`` (M,) from
     ``c·chunk`` on, ``listed_counts[c]`` of them: the fill visits only those (most faces of a fine mesh draw
     nothing, being back faces or falling between pixel centres). ``listed_tiles`` (M,) beside each: the one
-    tile a drawn face touches, or −1 when it touches several or crosses the view volume (the fill then reads the
-    face again; small faces, the many, are filled from these two sequential arrays alone).
+    tile a drawn face touches, −1 when it touches several (the fill then reads the face again; small faces, the
+    many, are filled from these two sequential arrays alone), ``triangles.CROSSING`` when it crosses the view
+    volume.
     """
     width, height, cull = options[O_WIDTH], options[O_HEIGHT], options[O_CULL]
     bits, tiles_x, chunk = options[O_BITS], options[O_TILES_X], options[O_CHUNK]
@@ -49,7 +50,7 @@ def count_tiles(
             state, _, i_min, i_max, j_min, j_max = face_box(faces, codes, win_int, f, width, height, cull)
             if state == FACE_CROSSING:
                 crossed += 1
-                listed[n], listed_tiles[n] = f, -1
+                listed[n], listed_tiles[n] = f, CROSSING
                 n += 1
             elif state == FACE_DRAWN:
                 one = (j_min >> bits) == (j_max >> bits) and (i_min >> bits) == (i_max >> bits)
@@ -112,14 +113,7 @@ def fill_tiles(
                 tile_entries[offsets[c, t]] = f
                 offsets[c, t] += 1
                 continue
-            state, _, i_min, i_max, j_min, j_max = face_box(faces, codes, win_int, f, width, height, cull)
-            if state == FACE_DRAWN:
-                for ty in range(j_min >> bits, (j_max >> bits) + 1):
-                    for tx in range(i_min >> bits, (i_max >> bits) + 1):
-                        t = ty * tiles_x + tx
-                        tile_entries[offsets[c, t]] = f
-                        offsets[c, t] += 1
-            elif state == FACE_CROSSING:
+            if t == CROSSING:
                 for r in range(record_starts[k], record_starts[k + 1]):
                     for ty in range(tri_int[r, 9] >> bits, (tri_int[r, 10] >> bits) + 1):
                         for tx in range(tri_int[r, 7] >> bits, (tri_int[r, 8] >> bits) + 1):
@@ -127,3 +121,11 @@ def fill_tiles(
                             tile_entries[offsets[c, t]] = -1 - r
                             offsets[c, t] += 1
                 k += 1
+                continue
+            state, _, i_min, i_max, j_min, j_max = face_box(faces, codes, win_int, f, width, height, cull)
+            if state == FACE_DRAWN:
+                for ty in range(j_min >> bits, (j_max >> bits) + 1):
+                    for tx in range(i_min >> bits, (i_max >> bits) + 1):
+                        t = ty * tiles_x + tx
+                        tile_entries[offsets[c, t]] = f
+                        offsets[c, t] += 1
