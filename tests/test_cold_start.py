@@ -131,3 +131,23 @@ def test_warmup_command_reports_what_it_compiled(tmp_path):
     again = subprocess.run([sys.executable, "-m", "frustum", "warmup"], capture_output=True, text=True, env=env,
                            cwd=ROOT, timeout=300)  # fmt: skip
     assert "already compiled" in again.stdout, again.stdout
+
+
+def test_kernel_caches_are_stamped_with_every_raster_module(tmp_path):
+    """A kernel's on-disk cache is stale when any module of ``frustum.raster`` changes, not only its own file
+    (Numba's stamp): a kernel inlines helpers from other modules."""
+    import shutil
+    from pathlib import Path
+
+    import frustum.raster
+    from frustum.raster import _jit, triangles
+
+    folder = Path(frustum.raster.__file__).parent
+    copy = tmp_path / "raster"
+    shutil.copytree(folder, copy, ignore=shutil.ignore_patterns("__pycache__"))
+    assert _jit.package_digest(copy) == _jit.package_digest(folder) == _jit._DIGEST
+    helper = copy / "fixed_point.py"
+    helper.write_text(helper.read_text() + "\n# an edit of a helper module\n")
+    assert _jit.package_digest(copy) != _jit._DIGEST
+    stamp = triangles.rasterize_tiles.kernel._cache._cache_file._source_stamp
+    assert stamp[1] == _jit._DIGEST

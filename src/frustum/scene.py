@@ -17,7 +17,7 @@ from numpy.typing import ArrayLike, NDArray
 from frustum._arrays import Matrix4, as_matrix, as_scalar, as_vector3, describe
 from frustum.errors import FrustumError, GeometryError
 from frustum.geometry import Mesh, Octree, Polyline
-from frustum.geometry.volume import VOLUME_MODES, TransferFunction, Volume
+from frustum.geometry.volume import VOLUME_MODES, VOLUME_SAMPLINGS, TransferFunction, Volume
 from frustum.shading import LIGHT_TYPES, Light, Material
 from frustum.simulation import MassSpringSystem, ParticleSystem
 from frustum.transforms import translate
@@ -58,7 +58,8 @@ class VolumeItem(NamedTuple):
 
     ``clip_planes`` (P, 2, 3) world (point, normal) rows: the side each normal points to is cut away, as
     ``cutaway`` cuts meshes. ``step`` is the sample distance Δ in model units; ``shade`` gradient shading with
-    the scene's lights and ``material``'s coefficients (base color from the transfer function).
+    the scene's lights and ``material``'s coefficients (base color from the transfer function); ``sampling``
+    where the samples lie along a ray (``VOLUME_SAMPLINGS``).
     """
 
     volume: Volume
@@ -70,6 +71,7 @@ class VolumeItem(NamedTuple):
     shade: bool
     material: Material
     clip_planes: np.ndarray
+    sampling: str = "entry"
 
 
 class Pick(NamedTuple):
@@ -284,13 +286,19 @@ class Scene:
         shade: bool | None = None,
         material: Material | None = None,
         clip_planes: Iterable[tuple[ArrayLike, ArrayLike]] = (),
+        sampling: str = "entry",
     ) -> VolumeItem:
         """Place a ``Volume`` (``world = transform · model``) to be ray cast by ``render``; returns its record.
 
         `transfer_function` defaults to the grayscale preset over the data's range; `mode` is one of
         ``VOLUME_MODES``; `step` the sample distance in model units (default half the smallest spacing);
         `level` the isosurface value (default the middle of the data's range); `shade` gradient shading
-        (default on for "isosurface" only); `clip_planes` world (point, normal) pairs whose normal side is cut.
+        (default on for "isosurface" only); `clip_planes` world (point, normal) pairs whose normal side is cut;
+        `sampling` where a ray's samples lie: ``"entry"`` (default) the middles of segments Δ from where the ray
+        enters the volume, the last one shorter (its opacity corrected for its length), so the samples cover the
+        ray's part exactly; ``"near"`` every whole multiple of Δ from the ray's point on the near plane, each
+        standing for Δ (a parallel camera's samples then lie on the same planes for every ray, as in VTK's
+        fixed-point ray caster).
         """
         where = "Scene.add_volume"
         if not isinstance(volume, Volume):
@@ -314,6 +322,9 @@ class Scene:
             raise GeometryError(f"{where}: shade = {describe(shade)} is not a bool; give True or False")
         if material is not None and not isinstance(material, Material):
             raise GeometryError(f"{where}: material = {describe(material)} is not a Material")
+        if not isinstance(sampling, str) or sampling not in VOLUME_SAMPLINGS:
+            raise GeometryError(f"{where}: sampling = {describe(sampling)} is unknown; expected one of "
+                                + ", ".join(repr(s) for s in VOLUME_SAMPLINGS))  # fmt: skip
         planes = []
         for index, plane in enumerate(clip_planes):
             try:
@@ -330,7 +341,7 @@ class Scene:
         item = VolumeItem(volume, transfer_function, mode, _modeling_transform(transform, where), float(delta), value,
                           mode == "isosurface" if shade is None else bool(shade),
                           Material() if material is None else material,
-                          np.array(planes, dtype=np.float64).reshape(-1, 2, 3))  # fmt: skip
+                          np.array(planes, dtype=np.float64).reshape(-1, 2, 3), sampling)  # fmt: skip
         self.volumes.append(item)
         return item
 

@@ -1513,7 +1513,7 @@ def _render_options(report: _Report, path: tuple, value: Any) -> tuple[dict, tup
 # --- volumes ---------------------------------------------------------------------------------------------
 
 _VOLUME_KEYS = ("source", "transfer_function", "mode", "transform", "step", "level", "shade", "material",
-                "clip_planes")  # fmt: skip
+                "clip_planes", "sampling")  # fmt: skip
 _VOLUME_SOURCES = {"file": "load", "fbm_cloud": "fbm_cloud", "quaternion_julia": "quaternion_julia_volume",
                    "blobby": "blobby_volume", "head_phantom": "head_phantom"}  # fmt: skip
 _TRANSFER_KEYS = ("preset", "colormap", "range", "opacity", "values", "colors", "opacities")
@@ -1543,6 +1543,8 @@ def _volume(report: _Report, path: tuple, value: dict, base: Path, materials: di
     options: dict[str, Any] = {}
     if "mode" in value:
         options["mode"] = _choice(report, (*path, "mode"), value["mode"], module.VOLUME_MODES)
+    if "sampling" in value:
+        options["sampling"] = _choice(report, (*path, "sampling"), value["sampling"], module.VOLUME_SAMPLINGS)
     for key in ("step", "level"):
         if key in value:
             options[key] = _number(report, (*path, key), value[key], low=0.0 if key == "step" else None,

@@ -3,7 +3,9 @@
 ``draw_volumes(scene, camera, depth, color)`` runs once the opaque meshes are in the buffers: each ray stops at
 the opaque depth (the window depth of its pixel, turned back into the ray's parameter), so a mesh inside a
 volume hides what lies behind it and is seen through what lies in front. Volumes are drawn back to front by the
-view distance of their centres (overlapping composite volumes are not merged sample by sample). The kernels
+view distance of their centres, except that two or more composite volumes are drawn together: each ray
+composites the samples of all of them in depth order (``raster.volume.cast_composite_merged``), so overlapping
+volumes mix sample by sample. The kernels
 are ``raster.volume``'s; this module builds their arrays: the grid ↔ window matrices, clip planes in grid
 coordinates, the transfer function's table with its opacity corrected for the step, and the per-block
 min/max/empty flags of empty-space skipping.
@@ -75,10 +77,10 @@ def volume_arrays(item: VolumeItem, camera: Camera, lights_packed: tuple[np.ndar
     for index, (point, normal) in enumerate(item.clip_planes):
         planes[index] = np.append(-normal, normal @ point) @ world_from_grid
     tf = item.transfer_function
-    table = np.empty((TABLE_SIZE, 5))
-    table[:, :4] = tf.table(TABLE_SIZE)
+    table = np.empty((5, TABLE_SIZE))  # rows r, g, b, α, α' (kernels read one row per lookup)
+    table[:4] = tf.table(TABLE_SIZE).T
     unit = volume.unit_distance
-    table[:, 4] = 1.0 - (1.0 - table[:, 3]) ** (item.step / unit)  # α' = 1 − (1 − α)^(Δ/Δ₀)
+    table[4] = 1.0 - (1.0 - table[3]) ** (item.step / unit)  # α' = 1 − (1 − α)^(Δ/Δ₀)
     low, high = tf.range
     scale = (TABLE_SIZE - 1) / (high - low)
     blocks = _blocks(volume).copy()
@@ -87,7 +89,7 @@ def volume_arrays(item: VolumeItem, camera: Camera, lights_packed: tuple[np.ndar
         f_high = np.clip((blocks[..., 1] - low) * scale, 0.0, TABLE_SIZE - 1.0)
         first = np.floor(f_low).astype(np.int64)
         last = np.minimum(np.floor(f_high).astype(np.int64) + 1, TABLE_SIZE - 1)
-        opaque = np.concatenate([[0], np.cumsum(table[:, 3] > 0.0)])
+        opaque = np.concatenate([[0], np.cumsum(table[3] > 0.0)])
         blocks[..., 2] = (opaque[last + 1] - opaque[first] == 0).astype(np.float32)
     ambient, lights = pack_lights([]) if lights_packed is None else lights_packed
     material = item.material
@@ -100,6 +102,10 @@ def volume_arrays(item: VolumeItem, camera: Camera, lights_packed: tuple[np.ndar
     params[kernels.P_EYE : kernels.P_EYE + 3] = camera.frame.eye
     params[kernels.P_TABLE_LOW], params[kernels.P_TABLE_SCALE] = low, scale
     params[kernels.P_TERMINATE], params[kernels.P_BISECTIONS] = TERMINATE, BISECTIONS
+    params[kernels.P_ANCHORED] = float(item.sampling == "near")
+    # entries up to first − 1 have opacity 0, and so has the table between them: values mapping there need no lookup
+    first = int(np.argmax(table[3] > 0.0)) if (table[3] > 0.0).any() else TABLE_SIZE
+    params[kernels.P_CLEAR_BELOW] = low + (first - 1) / scale if first >= 1 else -np.inf
     return (MODES[item.mode], volume.data, blocks, table, matrices, planes, params,
             np.ascontiguousarray(lights, dtype=np.float64))  # fmt: skip
 
@@ -121,7 +127,32 @@ def draw_volumes(scene: Scene, camera: Camera, depth: np.ndarray, color: np.ndar
         centre = item.world_from_model[:3, :3] @ centre + item.world_from_model[:3, 3]
         return float((eye - centre) @ axis)
 
+    merged = [item for item in scene.volumes if item.mode == "composite"]
+    merged = merged if len(merged) > 1 else []
+    drawn = False
     for item in sorted(scene.volumes, key=distance, reverse=True):
+        if any(item is other for other in merged):  # drawn together, where the farthest of them comes
+            if not drawn:
+                _draw_merged(merged, camera, packed, depth, color)
+                drawn = True
+            continue
         arguments = volume_arrays(item, camera, packed)
         kernels.cast_rays(*arguments, depth, color)
+
+
+def _draw_merged(items: list[VolumeItem], camera: Camera, packed: tuple, depth: np.ndarray, color: np.ndarray) -> None:
+    """Composite volumes drawn together (``raster.volume.cast_composite_merged``): their kernel arguments stacked,
+    the clip planes padded with rows of zeros (always kept)."""
+    from numba.typed import List
+
+    from frustum.raster import volume as kernels
+
+    arguments = [volume_arrays(item, camera, packed) for item in items]
+    datas, blocks = List([a[1] for a in arguments]), List([a[2] for a in arguments])
+    planes = np.zeros((len(items), max(a[5].shape[0] for a in arguments), 4))
+    for index, a in enumerate(arguments):
+        planes[index, : a[5].shape[0]] = a[5]
+    kernels.cast_composite_merged(datas, blocks, np.stack([a[3] for a in arguments]),
+                                  np.stack([a[4] for a in arguments]), planes, np.stack([a[6] for a in arguments]),
+                                  arguments[0][7], depth, color)  # fmt: skip
 

@@ -119,6 +119,7 @@ from frustum.geometry.teapot import (
 from frustum.geometry.volume import (
     TRANSFER_PRESETS,
     VOLUME_MODES,
+    VOLUME_SAMPLINGS,
     TransferFunction,
     Volume,
     blobby_volume,
@@ -137,6 +138,7 @@ __all__ = [
     "TEXTBOOK_OCTANTS",
     "TRANSFER_PRESETS",
     "VOLUME_MODES",
+    "VOLUME_SAMPLINGS",
     "BSpline",
     "BSplineSurface",
     "BezierCurve",

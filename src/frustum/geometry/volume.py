@@ -41,6 +41,7 @@ from frustum.geometry.mesh import Mesh
 __all__ = [
     "TRANSFER_PRESETS",
     "VOLUME_MODES",
+    "VOLUME_SAMPLINGS",
     "TransferFunction",
     "Volume",
     "blobby_volume",
@@ -670,6 +671,9 @@ def quaternion_julia_volume(c: ArrayLike = (-0.2, 0.6, 0.2, 0.0), *, resolution:
 VOLUME_MODES = ("composite", "mip", "minip", "average", "isosurface")
 """How a placed volume is drawn: front-to-back compositing, maximum / minimum intensity projection, the mean
 along the ray, or the first crossing of a level (shaded)."""
+VOLUME_SAMPLINGS = ("entry", "near")
+"""Where a ray's samples lie (``Scene.add_volume(sampling=...)``): the middles of segments Δ from the ray's entry
+into the volume, or the whole multiples of Δ from its point on the near plane."""
 
 
 # (x0, y0, z0, a, b, c, rotation about z in degrees, added density): ellipsoids after the 3D Shepp–Logan head

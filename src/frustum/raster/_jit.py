@@ -22,11 +22,13 @@ measure coverage of) every kernel line as Python.
 from __future__ import annotations
 
 import functools
+import hashlib
 import itertools
 import threading
 import time
 from collections.abc import Callable
 from concurrent.futures import Future, ThreadPoolExecutor
+from pathlib import Path
 from typing import Any
 
 import numba
@@ -37,10 +39,44 @@ from numba.np.ufunc import parallel as _numba_parallel
 
 import frustum.raster
 
-__all__ = ["kernel", "parallel_for", "parallel_kernel", "prange", "prefetch", "set_threads", "threads"]
+__all__ = [
+    "fence", "kernel", "parallel_for", "parallel_kernel", "prange", "prefetch", "set_threads", "stream", "threads",
+]
 
-kernel = numba.njit(cache=True, nogil=True)
-_parfor_kernel = numba.njit(cache=True, nogil=True, parallel=True)
+
+
+def package_digest(folder: Path) -> str:
+    """SHA-1 of the names and contents of the modules in `folder`: for ``frustum.raster``, part of each kernel's
+    cache stamp (``_cached``)."""
+    digest = hashlib.sha1()
+    for path in sorted(folder.glob("*.py")):
+        digest.update(path.name.encode())
+        digest.update(path.read_bytes())
+    return digest.hexdigest()
+
+
+_DIGEST = package_digest(Path(frustum.raster.__file__).parent)
+
+
+def _cached(options: dict[str, Any]) -> Callable[[Callable], Any]:
+    """``numba.njit(cache=True, **options)`` whose on-disk cache is also invalidated when any other module of
+    ``frustum.raster`` changes. Numba stamps a cache with its function's own source file only, so a kernel that
+    calls (and inlines) a helper from another module kept running the helper's old code after an edit there
+    (a ``git pull`` into an editable install does just that)."""
+    jit = numba.njit(cache=True, **options)
+
+    def decorate(function: Callable) -> Any:
+        dispatcher = jit(function)
+        cache_file = getattr(getattr(dispatcher, "_cache", None), "_cache_file", None)
+        if cache_file is not None and hasattr(cache_file, "_source_stamp"):
+            cache_file._source_stamp = (cache_file._source_stamp, _DIGEST)
+        return dispatcher
+
+    return decorate
+
+
+kernel = _cached({"nogil": True})
+_parfor_kernel = _cached({"nogil": True, "parallel": True})
 prange = numba.prange
 
 
@@ -74,6 +110,50 @@ prefetch = _no_prefetch if numba.config.DISABLE_JIT else _prefetch
 """``prefetch(array, i, j)`` in a kernel: start loading the cache line of the 2-D ``array[i, j]`` (no effect on
 results). For loops that gather rows by index (tile entry → face → its vertices), issued some iterations ahead,
 so the loads of many iterations are in flight at once instead of each waiting in turn."""
+
+
+
+@intrinsic
+def _stream(typingctx, array, i, j, value):
+    """``array[i, j] = value`` as a non-temporal store (LLVM ``!nontemporal``)."""
+
+    def codegen(context, builder, signature, args):
+        kind = signature.args[0]
+        data = context.make_array(kind)(context, builder, args[0])
+        pointer = cgutils.get_item_pointer(context, builder, kind, data, [args[1], args[2]], wraparound=False)
+        stored = builder.store(context.cast(builder, args[3], signature.args[3], kind.dtype), pointer)
+        stored.set_metadata("nontemporal", builder.module.add_metadata([ir.IntType(32)(1)]))
+        return context.get_dummy_value()
+
+    return types.void(array, i, j, value), codegen
+
+
+@intrinsic
+def _fence(typingctx):
+    """A sequentially consistent memory fence (``mfence`` on x86: it orders non-temporal stores too)."""
+
+    def codegen(context, builder, signature, args):
+        builder.fence("seq_cst")
+        return context.get_dummy_value()
+
+    return types.void(), codegen
+
+
+def _store(array: Any, i: int, j: int, value: Any) -> None:
+    """``stream`` as plain Python (``NUMBA_DISABLE_JIT=1``): an ordinary store."""
+    array[i, j] = value
+
+
+def _no_fence() -> None:
+    """``fence`` as plain Python: nothing to order."""
+
+
+stream = _store if numba.config.DISABLE_JIT else _stream
+"""``stream(array, i, j, value)`` in a kernel: ``array[i, j] = value`` bypassing the caches (a non-temporal
+store: the line is not read first and does not evict what the kernel still uses), for output written once and not
+read again by the kernel; ``fence()`` after the last one."""
+fence = _no_fence if numba.config.DISABLE_JIT else _fence
+"""``fence()`` in a kernel: a full memory fence (after ``stream`` stores, before the piece returns)."""
 
 NOTICE_AFTER = 1.0
 """Seconds of kernel compilation after which ``frustum.raster.compile_notice`` is called (once per process)."""

@@ -7,26 +7,26 @@ are in the core's L1 cache: its triangles are filled (``triangles._fill_tile``) 
 live in tile-sized contiguous scratch (no image-sized codes or weights at all; an image row stride that is a
 multiple of 4 KiB would put a tile's rows of the image in one cache set), its drawn pixels gathered and shaded
 (``shade._gather_chunk``, ``shade._shade_chunk``, a chunk filling across tiles) and the others painted with the
-background.
-Each tile is owned by one thread, so the bytes are those of the general path on any number of threads.
+background. Each tile is owned by one thread, so the bytes are those of the general path on any number of threads.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from frustum.raster._jit import kernel, parallel_kernel
+from frustum.raster._jit import fence, kernel, parallel_kernel, stream
 from frustum.raster.shade import _CHUNK, _FIELDS, _NDL, _SIGN, _X, I_FACE_OFFSET, _gather_chunk, _shade_chunk
 from frustum.raster.triangles import _fill_tile
 
-__all__ = ["SEGMENT", "draw_tiles_directional", "segments"]
+__all__ = ["SPAN", "draw_tiles_directional", "segments"]
 
 
-SEGMENT = 32
-"""Tiles per segment: a segment of a tile row (32 × 1024 pixels) is finished in a buffer, then copied out."""
+SPAN = 1024
+"""Pixels per segment: a segment of a tile row (``SPAN // tile size`` tiles) is finished in a buffer (tile size ×
+1024 pixels, 2 × 128 KiB for 32-pixel tiles: it stays in L2 cache), then copied out."""
 
 
-@parallel_kernel(lambda *args: segments(args[6].shape[0] - 1, args[8][1]), work=lambda *args: args[9].size,
+@parallel_kernel(lambda *args: segments(args[6].shape[0] - 1, args[8][1], args[8][0]), work=lambda *args: args[9].size,
                  grain=65536, pieces_per_thread=8)  # fmt: skip
 def draw_tiles_directional(
     faces: np.ndarray, win_int: np.ndarray, win_float: np.ndarray, tri_int: np.ndarray, tri_float: np.ndarray,
@@ -35,36 +35,38 @@ def draw_tiles_directional(
     item: np.ndarray, background: np.ndarray, color: np.ndarray,
     start: int, stop: int,
 ) -> None:  # fmt: skip
-    """Segments [start, stop) of the frame (``segments``: up to SEGMENT tiles of one tile row, left to right):
+    """Segments [start, stop) of the frame (``segments``: up to ``SPAN`` pixels of tiles of one tile row):
     depth (H, W) float32 and color (H, W, 4) uint8 (C-contiguous) written.
 
     The binned triangles and `tiling` as in ``triangles.rasterize_tiles``; world, normals, params, lights and item
     as in ``shade.shade_pixels_directional``; background (4,) uint8, the clear color's bytes. Each finished tile
     goes to a segment buffer whose rows are padded by a cache line (copied from a tile, the rows of an image whose
     stride is a multiple of 4 KiB would all fall in one cache set), and each finished segment (2 × 128 KiB, in
-    L2 cache) to the image, row by row, which the hardware prefetches.
+    L2 cache) to the image, row by row, by non-temporal stores (``_jit.stream``: the image is output only, and
+    ordinary stores read each of its lines before writing it; 10 % of a 4096² frame).
     """
     size, tiles_x = tiling[0], tiling[1]
     height, width = depth.shape[0], depth.shape[1]
     near = np.empty((size, size), dtype=np.float32)  # the tile's own depth, codes and weights
     codes = np.empty((size, size), dtype=np.int64)
     bary = np.empty((size, size, 2), dtype=np.float32)
-    span = SEGMENT * size
+    per_segment = SPAN // size
+    span = per_segment * size
     band_depth = np.empty((size, span + 16), dtype=np.float32)
     band_words = np.empty((size, span + 16, 1), dtype=np.uint32)
     scratch = np.empty(_FIELDS * _CHUNK)
     where = np.empty(3 * _CHUNK, dtype=np.int64)
     corners = np.empty(3 * _CHUNK, dtype=np.int64)
-    words = color.view(np.uint32)
+    image_words = color.view(np.uint32).reshape((height, width))
     word = background.view(np.uint32)[0]
-    per_row = -(-tiles_x // SEGMENT)
+    per_row = -(-tiles_x // per_segment)
     for segment in range(start, stop):
-        band, first = segment // per_row, (segment % per_row) * SEGMENT
+        band, first = segment // per_row, (segment % per_row) * per_segment
         top = max(height - (band + 1) * size, 0)  # image rows [top, bottom): the band's window rows
         bottom = height - band * size
-        left, right = first * size, min((first + SEGMENT) * size, width)  # image columns [left, right)
+        left, right = first * size, min((first + per_segment) * size, width)  # image columns [left, right)
         n = 0  # pixels listed for shading: a chunk fills across the segment's tiles
-        for t in range(band * tiles_x + first, band * tiles_x + min(first + SEGMENT, tiles_x)):
+        for t in range(band * tiles_x + first, band * tiles_x + min(first + per_segment, tiles_x)):
             col0 = (t % tiles_x) * size
             col1 = min(col0 + size, width)
             if tile_starts[t] == tile_starts[t + 1]:  # no triangle: background
@@ -85,15 +87,18 @@ def draw_tiles_directional(
                     band_depth[row, col0 - left + col] = near[row, col]
         _gather_chunk(n, scratch, where, corners, faces, world, normals)
         _shade_chunk(n, scratch, where, params, lights, band_words)
-        for row in range(bottom - top):
+        for row in range(bottom - top):  # the image is output only: written past the caches (no line read first)
             for col in range(right - left):
-                depth[top + row, left + col] = band_depth[row, col]
-                words[top + row, left + col, 0] = band_words[row, col, 0]
+                stream(depth, top + row, left + col, band_depth[row, col])
+            for col in range(right - left):
+                stream(image_words, top + row, left + col, band_words[row, col, 0])
+    fence()
 
 
-def segments(tiles: int, tiles_x: int) -> int:
-    """How many segments ``draw_tiles_directional`` splits `tiles` tiles, `tiles_x` to a row, into."""
-    return tiles // tiles_x * -(-tiles_x // SEGMENT)
+def segments(tiles: int, tiles_x: int, size: int) -> int:
+    """How many segments ``draw_tiles_directional`` splits `tiles` tiles of `size` pixels, `tiles_x` to a row,
+    into."""
+    return tiles // tiles_x * -(-tiles_x // (SPAN // size))
 
 
 @kernel
@@ -109,14 +114,13 @@ def _shade_tile(
     face_offset = item[I_FACE_OFFSET]
     for row in range(rows):
         for col in range(cols):
-            code = codes[row, col]
-            f = code // 2 - face_offset
-            if depth[row, col] >= 1.0 or f < 0 or f >= faces.shape[0]:
+            if not depth[row, col] < 1.0:
                 words[row, offset + col, 0] = word
                 continue
+            code = codes[row, col]  # the one mesh's: written wherever depth < 1
             scratch[_X + n], scratch[_NDL + n] = float(bary[row, col, 0]), float(bary[row, col, 1])
-            scratch[_SIGN + n] = -1.0 if code % 2 == 1 else 1.0
-            where[n], where[_CHUNK + n], where[2 * _CHUNK + n] = row, offset + col, f
+            scratch[_SIGN + n] = -1.0 if code & 1 else 1.0
+            where[n], where[_CHUNK + n], where[2 * _CHUNK + n] = row, offset + col, (code >> 1) - face_offset
             n += 1
             if n == _CHUNK:
                 _gather_chunk(n, scratch, where, corners, faces, world, normals)

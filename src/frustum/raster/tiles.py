@@ -16,7 +16,8 @@ from __future__ import annotations
 import numpy as np
 
 from frustum.raster._jit import kernel, parallel_kernel
-from frustum.raster.triangles import CROSSING, FACE_CROSSING, FACE_DRAWN, face_box
+from frustum.raster.fixed_point import HALF_SUBPIXEL, SUBPIXEL
+from frustum.raster.triangles import CROSSING, FACE_CROSSING, FACE_DRAWN, covers_centre, face_box
 
 __all__ = ["add_record_tiles", "count_tiles", "fill_tiles", "tile_offsets"]
 
@@ -32,7 +33,8 @@ def count_tiles(
     """``counts[c, t]`` = how many drawn faces of chunk c touch tile t; ``crossing[c]`` = its crossing faces.
 
     counts (C, tiles), crossing (C,) and listed_counts (C,) int64 are written; chunk c is faces
-    [c·chunk, (c+1)·chunk). The chunk's drawn and crossing faces, in order, go to ``listed`` (M,) from
+    [c·chunk, (c+1)·chunk); a face whose box holds one pixel centre counts only if it covers it (most sub-pixel
+    triangles of a fine mesh do not). The chunk's drawn and crossing faces, in order, go to ``listed`` (M,) from
     ``c·chunk`` on, ``listed_counts[c]`` of them: the fill visits only those (most faces of a fine mesh draw
     nothing, being back faces or falling between pixel centres). ``listed_tiles`` (M,) beside each: the one
     tile a drawn face touches, −1 when it touches several (the fill then reads the face again; small faces, the
@@ -47,12 +49,14 @@ def count_tiles(
         crossed = 0
         n = c * chunk
         for f in range(c * chunk, min((c + 1) * chunk, faces.shape[0])):
-            state, _, i_min, i_max, j_min, j_max = face_box(faces, codes, win_int, f, width, height, cull)
+            state, back, i_min, i_max, j_min, j_max = face_box(faces, codes, win_int, f, width, height, cull)
             if state == FACE_CROSSING:
                 crossed += 1
                 listed[n], listed_tiles[n] = f, CROSSING
                 n += 1
             elif state == FACE_DRAWN:
+                if i_min == i_max and j_min == j_max and not _covers_its_centre(faces, win_int, f, back, i_min, j_min):
+                    continue  # a sub-pixel triangle missing the one centre of its box (most of a fine mesh's)
                 one = (j_min >> bits) == (j_max >> bits) and (i_min >> bits) == (i_max >> bits)
                 listed[n], listed_tiles[n] = f, ((j_min >> bits) * tiles_x + (i_min >> bits)) if one else -1
                 n += 1
@@ -61,6 +65,18 @@ def count_tiles(
                         counts[c, ty * tiles_x + tx] += 1
         crossing[c] = crossed
         listed_counts[c] = n - c * chunk
+
+
+@kernel
+def _covers_its_centre(faces: np.ndarray, win_int: np.ndarray, f: int, back: int, i: int, j: int) -> bool:
+    """Whether face f (drawn from its vertices; corners 1 and 2 swapped when back) covers pixel (i, j)'s centre."""
+    a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
+    if back == 1:
+        b, c = c, b
+    return covers_centre(
+        np.int64(win_int[a, 0]), np.int64(win_int[a, 1]), np.int64(win_int[b, 0]), np.int64(win_int[b, 1]),
+        np.int64(win_int[c, 0]), np.int64(win_int[c, 1]), SUBPIXEL * i + HALF_SUBPIXEL, SUBPIXEL * j + HALF_SUBPIXEL,
+    )  # fmt: skip
 
 
 @kernel

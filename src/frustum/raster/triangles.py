@@ -57,6 +57,7 @@ __all__ = [
     "SUBPIXEL",
     "clear_buffers",
     "clip_faces",
+    "covers_centre",
     "depth_gradients",
     "face_box",
     "list_crossing",
@@ -142,6 +143,23 @@ def _window_box(
     j_max = min((max(ya, max(yb, yc)) - HALF_SUBPIXEL) >> SUBPIXEL_BITS, height - 1)
     made = 0 if (i_min > i_max or j_min > j_max) else 1
     return made, back, i_min, i_max, j_min, j_max
+
+
+@kernel
+def covers_centre(x0: int, y0: int, x1: int, y1: int, x2: int, y2: int, px: int, py: int) -> bool:
+    """Whether the counter-clockwise triangle covers the centre (px, py) by the top-left rule: the fill's edge
+    functions ``E = dx·(Y − Y_a) − dy·(X − X_a)`` and biases (``_fill_tile``)."""
+    dx0, dy0 = x2 - x1, y2 - y1
+    dx1, dy1 = x0 - x2, y0 - y2
+    dx2, dy2 = x1 - x0, y1 - y0
+    bias0 = 0 if (dy0 < 0 or (dy0 == 0 and dx0 < 0)) else 1
+    bias1 = 0 if (dy1 < 0 or (dy1 == 0 and dx1 < 0)) else 1
+    bias2 = 0 if (dy2 < 0 or (dy2 == 0 and dx2 < 0)) else 1
+    return (  # & rather than and: no branch per edge (whether a sub-pixel triangle covers its centre is random)
+        (dx0 * (py - y1) - dy0 * (px - x1) >= bias0)
+        & (dx1 * (py - y2) - dy1 * (px - x2) >= bias1)
+        & (dx2 * (py - y0) - dy2 * (px - x0) >= bias2)
+    )
 
 
 @kernel
