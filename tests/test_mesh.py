@@ -328,3 +328,76 @@ def test_from_polygons_area_equals_the_shoelace_area_of_a_convex_polygon(k, radi
 def test_repr_is_short():
     mesh = Mesh(*_TRIANGLE, uvs=np.zeros((3, 2)))
     assert repr(mesh) == "Mesh(vertex_count=3, face_count=1, uvs=(3, 2))"
+
+
+# --- compact storage (issue 16, memory): float32 vertices kept, int32 faces, index arithmetic in int64 ----------
+
+
+def test_float32_vertices_and_int32_faces_are_stored_without_upcasting():
+    sphere = trimesh.creation.icosphere(subdivisions=1)
+    vertices32, faces32 = sphere.vertices.astype(np.float32), sphere.faces.astype(np.int32)
+    mesh = Mesh(vertices32, faces32)
+    assert mesh.vertices.dtype == np.float32 and mesh.faces.dtype == np.int32
+    np.testing.assert_array_equal(mesh.vertices, vertices32)
+    np.testing.assert_array_equal(mesh.faces, faces32)
+    assert not np.may_share_memory(mesh.vertices, vertices32) and not np.may_share_memory(mesh.faces, faces32)
+    assert vertices32.flags.writeable and faces32.flags.writeable  # the caller's arrays are untouched
+    # int64 faces are stored compactly too (every index < 2**31); float64 vertices are never narrowed
+    wide = Mesh(sphere.vertices, sphere.faces.astype(np.int64))
+    assert wide.vertices.dtype == np.float64 and wide.faces.dtype == np.int32
+    assert Mesh([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]]).vertices.dtype == np.float64
+    # operations keep the compact storage
+    assert mesh.flipped().vertices.dtype == np.float32 and mesh.merged(mesh).faces.dtype == np.int32
+
+
+def test_a_float32_mesh_derives_the_same_numbers_as_its_float64_copy():
+    sphere = trimesh.creation.icosphere(subdivisions=2)
+    vertices32 = (sphere.vertices * [1.0, 0.7, 1.3] + [3.0, -1.0, 0.25]).astype(np.float32)
+    compact, wide = Mesh(vertices32, sphere.faces), Mesh(vertices32.astype(np.float64), sphere.faces)
+    for name in ("vertex_normals", "face_normals", "face_areas", "bounds", "centroid", "edges"):
+        got, expected = getattr(compact, name), getattr(wide, name)
+        assert got.dtype == expected.dtype, name
+        np.testing.assert_array_equal(got, expected, err_msg=name)
+    assert compact.area == wide.area and compact.volume == wide.volume and compact.is_watertight
+    np.testing.assert_array_equal(compact.welded(1e-3).vertices, wide.welded(1e-3).vertices)
+
+
+def test_edge_keys_of_int32_faces_do_not_overflow_with_large_vertex_counts():
+    # i·n + j overflows int32 once n > 46341: with n = 70000 the keys of the edges below reach 4.9e9
+    n = 70_000
+    rng = np.random.default_rng(3)
+    vertices = rng.random((n, 3)).astype(np.float32)
+    faces = np.array([[n - 3, n - 2, n - 1], [0, n - 1, n - 2], [1, 50_000, n - 1]], dtype=np.int32)
+    mesh = Mesh(vertices, faces)
+    assert mesh.faces.dtype == np.int32
+    expected = sorted({tuple(sorted((int(f[a]), int(f[b])))) for f in faces for a, b in ((0, 1), (1, 2), (2, 0))})
+    assert mesh.edges.dtype == np.int64
+    assert [tuple(e) for e in mesh.edges.tolist()] == expected
+    from frustum.hidden_lines import edge_adjacency
+
+    adjacency = edge_adjacency(mesh.faces, n)
+    assert adjacency.edges.dtype == np.int64 and [tuple(e) for e in adjacency.edges.tolist()] == expected
+    # a closed tetrahedron on the last four indices: every directed edge finds its opposite
+    tetra = np.array([[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]], dtype=np.int32) + (n - 4)
+    corners = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], dtype=np.float32)
+    closed = Mesh(np.concatenate([vertices[: n - 4] + 5.0, corners]), tetra)
+    assert closed.is_watertight and closed.volume == pytest.approx(1.0 / 6.0)
+
+
+def test_given_normals_are_normalized_in_float64_and_float32_ones_stored_float32():
+    rng = np.random.default_rng(5)
+    normals = rng.normal(size=(70_000, 3)) * rng.uniform(0.1, 10.0, (70_000, 1))  # more rows than one block
+    vertices = rng.random((70_000, 3))
+    wide = Mesh(vertices, [[0, 1, 2]], vertex_normals=normals)
+    assert wide.vertex_normals.dtype == np.float64
+    np.testing.assert_array_equal(wide.vertex_normals, normals / np.sqrt((normals * normals).sum(axis=1))[:, None])
+    normals32 = normals.astype(np.float32)
+    compact = Mesh(vertices.astype(np.float32), [[0, 1, 2]], vertex_normals=normals32)
+    wide32 = normals32.astype(np.float64)
+    unit = wide32 / np.sqrt((wide32 * wide32).sum(axis=1))[:, None]
+    assert compact.vertex_normals.dtype == np.float32
+    np.testing.assert_array_equal(compact.vertex_normals, unit.astype(np.float32))  # rounded once
+    np.testing.assert_allclose(np.linalg.norm(compact.vertex_normals.astype(np.float64), axis=1), 1.0, atol=2e-7)
+    normals32[66_000] = 0.0  # a zero normal in the second block is named by its own index
+    with pytest.raises(GeometryError, match=r"vertex_normals\[66000\] = \[0.0, 0.0, 0.0\] has zero length"):
+        Mesh(vertices, [[0, 1, 2]], vertex_normals=normals32)

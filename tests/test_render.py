@@ -486,3 +486,67 @@ def test_a_reflected_mesh_keeps_its_front_faces_outward(shading):
     assert ((a.depth < 1) == (b.depth < 1)).all()  # the mirrored triangulation differs: depths to round-off
     assert np.abs(a.depth - b.depth).max() < 1e-5
     assert (np.abs(a.color.astype(int) - b.color.astype(int)).max(axis=2) <= 1).mean() > 0.999
+
+
+# --- compact Mesh storage (issue 16, memory) -----------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "options",
+    [
+        dict(shading="phong"),
+        dict(shading="phong", specular="phong"),
+        dict(shading="gouraud"),
+        dict(shading="flat", buffers=("normals", "object_id")),
+        dict(shading="normals"),
+        dict(mode="surface+edges"),
+        dict(mode="hidden-line"),
+        dict(shading="phong", method="scan-line"),
+        dict(shading="gouraud", method="depth-sort"),
+    ],
+    ids=lambda o: ",".join(f"{k}={v}" for k, v in o.items()),
+)
+def test_a_float32_int32_mesh_renders_the_same_bytes_as_its_float64_int64_copy(options):
+    # float32 → float64 is exact: a Mesh keeping float32 vertices must draw exactly what their float64 copy draws
+    sphere = trimesh.creation.icosphere(subdivisions=2)
+    vertices32 = (sphere.vertices * [1.0, 0.8, 1.2]).astype(np.float32)
+    compact = Mesh(vertices32, sphere.faces.astype(np.int32))
+    wide = Mesh(vertices32.astype(np.float64), sphere.faces.astype(np.int64))
+    assert compact.vertices.dtype == np.float32 and compact.faces.dtype == np.int32
+    camera = Camera.look_at((0.4, 0.6, 3.2), (0, 0, 0), (0, 1, 0), projection=Perspective(0.9, 0.5, 10.0),
+                            width=96, height=80)  # fmt: skip
+    for both in (False, True):  # one opaque mesh (the tiled fast path where it applies), then two items
+        frames = []
+        for mesh in (compact, wide):
+            scene = Scene(lights=[LIGHT])
+            scene.add(mesh, Material(color=(0.8, 0.5, 0.3), specular=0.4, shininess=20.0))
+            if both:
+                scene.add(mesh, Material(color=(0.3, 0.6, 0.9), opacity=0.5), rotate_y(0.3) @ translate(0.9, 0.1, -0.4))
+            frames.append(render(scene, camera, background=BACKGROUND, **options))
+        np.testing.assert_array_equal(frames[0].color, frames[1].color)
+        np.testing.assert_array_equal(frames[0].depth, frames[1].depth)
+        for name in ("normals", "object_id"):
+            if getattr(frames[1], name) is not None:
+                np.testing.assert_array_equal(getattr(frames[0], name), getattr(frames[1], name))
+
+
+def test_float32_normals_render_within_one_level_of_float64_normals_on_the_same_pixels():
+    # float32 normals are stored as the float32 nearest the float64 unit vector: not bit-identical shading, but the
+    # same coverage and depth, and colors within one level (the benchmark's tolerance against llvmpipe)
+    sphere = trimesh.creation.icosphere(subdivisions=3)
+    vertices32 = sphere.vertices.astype(np.float32)
+    normals = sphere.vertex_normals * (1.0 + np.arange(len(sphere.vertices)) % 3)[:, None]  # not unit: normalized
+    compact = Mesh(vertices32, sphere.faces, vertex_normals=normals.astype(np.float32))
+    wide = Mesh(vertices32, sphere.faces, vertex_normals=normals.astype(np.float32).astype(np.float64))
+    assert compact.vertex_normals.dtype == np.float32 and wide.vertex_normals.dtype == np.float64
+    camera = Camera.look_at((0.4, 0.6, 3.2), (0, 0, 0), (0, 1, 0), projection=Perspective(0.9, 0.5, 10.0),
+                            width=160, height=160)  # fmt: skip
+    for shading in ("phong", "gouraud"):
+        frames = []
+        for mesh in (compact, wide):
+            scene = Scene(lights=[LIGHT])
+            scene.add(mesh, Material(color=(0.8, 0.5, 0.3), specular=0.4, shininess=20.0))
+            frames.append(render(scene, camera, shading=shading, background=BACKGROUND))
+        np.testing.assert_array_equal(frames[0].depth, frames[1].depth)
+        difference = np.abs(frames[0].color.astype(int) - frames[1].color.astype(int)).max(axis=-1)
+        assert difference.max() <= 1 and (difference == 0).mean() >= 0.999, shading

@@ -40,6 +40,9 @@ Vector3: TypeAlias = NDArray[np.float64]
 
 ErrorType: TypeAlias = type[FrustumError]
 
+INT32_LIMIT = 2**31
+"""Vertex counts up to this keep their face indices in int32 (``as_faces(..., compact=True)``)."""
+
 
 _CONTROL = {c: f"\\x{c:02x}" for c in (*range(0x20), 0x7F)} | {c: f"\\u{c:04x}" for c in range(0x80, 0xA0)}
 _CONTROL |= {c: f"\\u{c:04x}" for c in (0x2028, 0x2029, *range(0x202A, 0x202F), *range(0x2066, 0x206A))}
@@ -86,12 +89,16 @@ def read_only(array: np.ndarray) -> np.ndarray:
     return view
 
 
-def _as_float_array(value: ArrayLike, name: str, where: str, error: ErrorType, expected: str) -> NDArray:
-    """A C-contiguous float64 array that never is (or views) the caller's own array; complex input is refused."""
+def _as_float_array(
+    value: ArrayLike, name: str, where: str, error: ErrorType, expected: str, keep_float32: bool = False
+) -> NDArray:
+    """A C-contiguous float64 array (float32 where `keep_float32` and the input is float32: a lossless copy) that
+    never is (or views) the caller's own array; complex input is refused."""
     try:
         raw = np.asarray(value)
         complex_input = raw.dtype.kind == "c"
-        array = None if complex_input else np.asarray(raw, dtype=np.float64)
+        dtype = np.float32 if keep_float32 and raw.dtype == np.float32 else np.float64
+        array = None if complex_input else np.asarray(raw, dtype=dtype)
     except (TypeError, ValueError):
         raise error(f"{where}: {name} = {describe(value)} is not numeric; expected {expected}") from None
     if array is None:
@@ -157,12 +164,14 @@ def as_matrix(value: ArrayLike, name: str = "matrix", *, where: str, error: Erro
     return matrix
 
 
-def _as_rows(value: ArrayLike, width: int, name: str, where: str, error: ErrorType, what: str) -> NDArray:
-    rows = _as_float_array(value, name, where, error, f"an (N, {width}) array of {what}")
+def _as_rows(
+    value: ArrayLike, width: int, name: str, where: str, error: ErrorType, what: str, keep_float32: bool = False
+) -> NDArray:
+    rows = _as_float_array(value, name, where, error, f"an (N, {width}) array of {what}", keep_float32)
     if rows.ndim == 2 and rows.shape[0] == 0 and rows.shape[1] in (0, width):
-        return np.empty((0, width), dtype=np.float64)
+        return np.empty((0, width), dtype=rows.dtype)
     if rows.ndim == 1 and rows.size == 0:
-        return np.empty((0, width), dtype=np.float64)
+        return np.empty((0, width), dtype=rows.dtype)
     if rows.ndim != 2 or rows.shape[1] != width:
         raise error(f"{where}: {name} has shape {rows.shape}; expected (N, {width}) {what}, one per row")
     bad = np.flatnonzero(~np.isfinite(rows).all(axis=1))
@@ -172,9 +181,15 @@ def _as_rows(value: ArrayLike, width: int, name: str, where: str, error: ErrorTy
     return rows
 
 
-def as_points(value: ArrayLike, name: str = "points", *, where: str, error: ErrorType = GeometryError) -> Points:
-    """Return `value` as a finite, C-contiguous (N, 3) float64 array; (0, 3) is valid."""
-    return _as_rows(value, 3, name, where, error, "points (x, y, z)")
+def as_points(
+    value: ArrayLike, name: str = "points", *, where: str, error: ErrorType = GeometryError, keep_float32: bool = False
+) -> Points:
+    """Return `value` as a finite, C-contiguous (N, 3) float64 array; (0, 3) is valid.
+
+    With `keep_float32`, a float32 array stays float32 (a copy: float32 → float64 is exact, so a caller computing
+    in float64 from it gets the same numbers; storage is half); every other input is converted to float64.
+    """
+    return _as_rows(value, 3, name, where, error, "points (x, y, z)", keep_float32)
 
 
 def as_homogeneous_points(
@@ -185,18 +200,27 @@ def as_homogeneous_points(
 
 
 def as_faces(
-    value: ArrayLike, vertex_count: int, name: str = "faces", *, where: str, error: ErrorType = GeometryError
+    value: ArrayLike,
+    vertex_count: int,
+    name: str = "faces",
+    *,
+    where: str,
+    error: ErrorType = GeometryError,
+    compact: bool = False,
 ) -> NDArray[np.int64]:
     """Return `value` as a C-contiguous (M, 3) int64 array of vertex indices in [0, vertex_count); (0, 3) is valid.
 
-    Indices must already be integers (an integer dtype): a float array is refused rather than rounded.
+    Indices must already be integers (an integer dtype): a float array is refused rather than rounded. With
+    `compact`, the array is int32 when every index fits (``vertex_count <= 2**31``): lossless, half the memory;
+    code combining such indices arithmetically (edge keys ``i·N + j``) must widen to int64 first.
     """
+    index_type = np.int32 if compact and vertex_count <= INT32_LIMIT else np.int64
     try:
         faces = np.asarray(value)
     except ValueError:  # ragged nested sequences
         raise error(f"{where}: {name} = {describe(value)} is not an array; expected (M, 3) vertex indices") from None
     if faces.size == 0 and (faces.ndim == 1 or (faces.ndim == 2 and faces.shape[1] in (0, 3))):
-        return np.empty((0, 3), dtype=np.int64)
+        return np.empty((0, 3), dtype=index_type)
     if faces.ndim != 2 or faces.shape[1] != 3:
         raise error(f"{where}: {name} has shape {faces.shape}; expected (M, 3) vertex indices, one triangle per row")
     if faces.dtype == np.bool_ or not np.issubdtype(faces.dtype, np.integer):
@@ -207,5 +231,5 @@ def as_faces(
             f"{where}: {name}[{i}] = {faces[i].tolist()} indexes outside the {vertex_count} vertices; "
             f"indices must lie in [0, {vertex_count - 1}]"
         )
-    checked = np.ascontiguousarray(faces, dtype=np.int64)
+    checked = np.ascontiguousarray(faces, dtype=index_type)
     return checked.copy() if isinstance(value, np.ndarray) and np.may_share_memory(checked, value) else checked

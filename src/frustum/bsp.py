@@ -330,7 +330,8 @@ class BSPTree:
         """BSP tree of a mesh's triangles placed by `world_from_model`; each fragment's id is its face index."""
         if not isinstance(mesh, Mesh):
             raise GeometryError(f"BSPTree.from_mesh: mesh = {describe(mesh)} is not a Mesh; build one with Mesh")
-        vertices = mesh.vertices if world_from_model is None else apply(world_from_model, mesh.vertices)
+        model = world_from_model
+        vertices = np.asarray(mesh.vertices, np.float64) if model is None else apply(model, mesh.vertices)
         return cls(vertices[mesh.faces], np.arange(mesh.face_count))
 
     @property

@@ -307,7 +307,7 @@ def _mesh_facts(mesh: Mesh) -> list[tuple[str, str]]:
     rows = [("vertices", f"{mesh.vertex_count}"), ("triangles", f"{mesh.face_count}")]
     if mesh.vertex_count == 0:
         return [*rows, ("bounds", "empty mesh")]
-    low, high = mesh.vertices.min(axis=0), mesh.vertices.max(axis=0)
+    low, high = mesh.bounds
     rows += [
         ("bounds min", _triple_text(low)),
         ("bounds max", _triple_text(high)),
@@ -329,10 +329,8 @@ def _mesh_facts(mesh: Mesh) -> list[tuple[str, str]]:
         rows += [("volume", f"{volume:.6g}"), ("Euler characteristic", f"{int(solid.euler_number)}")]
         if consistent:
             rows.append(("face normals", "outward" if volume > 0 else "inward (faces are clockwise from outside)"))
-    cross = np.cross(
-        mesh.vertices[mesh.faces[:, 1]] - mesh.vertices[mesh.faces[:, 0]],
-        mesh.vertices[mesh.faces[:, 2]] - mesh.vertices[mesh.faces[:, 0]],
-    )
+    corners = np.asarray(mesh.vertices, dtype=np.float64)[mesh.faces]
+    cross = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
     degenerate = int((np.linalg.norm(cross, axis=1) == 0).sum())
     rows.append(("zero-area triangles", f"{degenerate}"))
     computed = Mesh(mesh.vertices, mesh.faces).vertex_normals

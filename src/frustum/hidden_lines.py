@@ -322,6 +322,7 @@ def front_facing(clip_from_world: Matrix4, points_world: NDArray, faces: NDArray
 
 
 def _unit_normals(points: NDArray, faces: NDArray) -> tuple[NDArray, NDArray[np.bool_]]:
+    points = np.asarray(points, dtype=np.float64)  # float32 vertices: the same float64 arithmetic as before
     p0, p1, p2 = points[faces[:, 0]], points[faces[:, 1]], points[faces[:, 2]]
     cross = np.cross(p1 - p0, p2 - p0)
     length = np.sqrt((cross * cross).sum(axis=1))
@@ -352,8 +353,8 @@ def edge_adjacency(faces: NDArray, vertex_count: int) -> EdgeAdjacency:
     if face_count == 0:
         empty = np.empty(0, np.int64)
         return EdgeAdjacency(np.empty((0, 2), np.int64), empty, empty, empty)
-    pairs = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
-    pairs.sort(axis=1)
+    pairs = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]).astype(np.int64, copy=False)
+    pairs.sort(axis=1)  # int64 (a Mesh's faces are int32): the keys below and the edges returned
     owner = np.tile(np.arange(face_count, dtype=np.int64), 3)
     key = pairs[:, 0] * np.int64(max(vertex_count, 1)) + pairs[:, 1]
     order = np.argsort(key, kind="stable")
@@ -400,6 +401,7 @@ def welded_faces(points: NDArray, faces: NDArray) -> NDArray[np.int64]:
     faces = np.asarray(faces, dtype=np.int64)
     if points.shape[0] == 0:
         return faces
+    points = np.asarray(points, dtype=np.float64)  # float32 vertices: round on the same float64 grid as before
     low, high = points.min(axis=0), points.max(axis=0)
     step = max(float((high - low).max()), 1e-300) * _WELD_FRACTION
     keys = np.round((points - low) / step).astype(np.int64)

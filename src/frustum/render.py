@@ -591,6 +591,9 @@ def _shade_item(
         flags = _item_flags(index, face_offset, options, blend, False, False)
         shade.shade_pixels_phong(depth, codes, bary, faces, world, normals, params, lights, flags, color)
         return
+    # The two kernels above interpolate float32 positions and normals with float64 weights (the same numbers as
+    # from a float64 copy); the others do arithmetic on them directly, so a float32 Mesh gives them an exact copy.
+    world, normals = np.asarray(world, dtype=np.float64), np.asarray(normals, dtype=np.float64)
     if mode == shade.SHADE_GOURAUD and mesh.face_count:
         lit = np.empty((mesh.vertex_count, 6))
         shade.light_vertices(world, normals, params, lights, options.specular_model, lit)

@@ -82,6 +82,13 @@ def _surfaces_fast() -> None:
     fr.render(scene, _camera((0.0, 0.0, 0.5)))  # the eye inside the sphere: faces crossing the view volume
     scene.add(fr.uv_sphere(0.5, 8, 4), fr.Material(), fr.translate(1.5, 0, 0))  # two meshes: stage by stage
     fr.render(scene, _camera())
+    # float32 vertices and normals (mesh files, GPU-style buffers, the benchmark's scenes): their own specializations
+    sphere = fr.uv_sphere(1.0, 16, 8)
+    compact = fr.Scene(lights=[fr.DirectionalLight(direction=(0, -1, -1))])
+    compact.add(fr.Mesh(sphere.vertices.astype(np.float32), sphere.faces, sphere.vertex_normals.astype(np.float32)),
+                fr.Material(color=(0.8, 0.5, 0.2)))  # fmt: skip
+    fr.render(compact, _camera())
+    fr.render(compact, _camera((0.0, 0.0, 0.5)))
 
 
 def _surfaces_general() -> None:

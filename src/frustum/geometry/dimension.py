@@ -99,7 +99,7 @@ def _count_heightfield(z: NDArray, sizes_cells: NDArray, spacing: float) -> NDAr
 
 
 def _mesh_points(mesh: Mesh, finest: float) -> NDArray:
-    tri = mesh.vertices[mesh.faces]  # (M, 3, 3)
+    tri = np.asarray(mesh.vertices[mesh.faces], dtype=np.float64)  # (M, 3, 3)
     if tri.shape[0] == 0:
         raise GeometryError("box_counting_dimension: mesh has no faces; give a mesh with triangles")
     edges = np.linalg.norm(tri - np.roll(tri, 1, axis=1), axis=2).max()

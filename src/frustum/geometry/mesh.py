@@ -45,11 +45,15 @@ class Mesh:
     Parameters
     ----------
     vertices : (N, 3) array_like
-        Finite model coordinates (stored float64).
+        Finite model coordinates, stored float64, or float32 when given as a float32 array (mesh files, GPU-style
+        buffers: kept as given, half the memory; everything computed from them is float64, float32 → float64
+        being exact). Other inputs are never narrowed.
     faces : (M, 3) array_like of int
-        Vertex indices in [0, N). An empty mesh (M = 0) is valid.
+        Vertex indices in [0, N), stored int32 (N <= 2**31: every index fits; code that combines indices, such as
+        an edge key ``i·N + j``, widens to int64 first). An empty mesh (M = 0) is valid.
     vertex_normals : (N, 3) array_like, optional
-        Finite, nonzero per-vertex normals; normalized on construction.
+        Finite, nonzero per-vertex normals; normalized on construction (in float64; a float32 array is stored
+        float32 again, the nearest float32 of the unit vector). Computed normals are float64.
     uvs : (N, 2) array_like, optional
         Finite texture coordinates (u, v) per vertex, v up (OpenGL/OBJ convention: (0, 0) is the image's
         bottom-left corner). Values outside [0, 1] are allowed (textures repeat).
@@ -65,30 +69,23 @@ class Mesh:
     """
 
     vertices: Points
-    faces: NDArray[np.int64]
+    faces: NDArray[np.int32]
     vertex_normals: Points | None = None
     uvs: NDArray[np.float64] | None = None
     vertex_colors: NDArray[np.float64] | None = None
 
     def __post_init__(self) -> None:
         where = "Mesh"
-        vertices = as_points(self.vertices, "vertices", where=where)
-        faces = as_faces(self.faces, vertices.shape[0], "faces", where=where)
+        vertices = as_points(self.vertices, "vertices", where=where, keep_float32=True)
+        faces = as_faces(self.faces, vertices.shape[0], "faces", where=where, compact=True)
         object.__setattr__(self, "vertices", read_only(vertices))
         object.__setattr__(self, "faces", read_only(faces))
         if self.vertex_normals is None:
             normals = _area_weighted_normals(vertices, faces)
         else:
-            normals = as_points(self.vertex_normals, "vertex_normals", where=where)
+            normals = as_points(self.vertex_normals, "vertex_normals", where=where, keep_float32=True)
             _check_rows(normals, vertices.shape[0], "vertex_normals", where)
-            lengths = np.sqrt((normals * normals).sum(axis=1))
-            zero = np.flatnonzero(lengths == 0.0)
-            if zero.size:
-                i = int(zero[0])
-                raise GeometryError(
-                    f"{where}: vertex_normals[{i}] = {normals[i].tolist()} has zero length; normals must be nonzero"
-                )
-            normals = normals / lengths[:, None]
+            _normalize_rows(normals, where)
         object.__setattr__(self, "vertex_normals", read_only(np.ascontiguousarray(normals)))
         if self.uvs is not None:
             object.__setattr__(self, "uvs", read_only(_as_uvs(self.uvs, vertices.shape[0], where)))
@@ -136,7 +133,7 @@ class Mesh:
         """(2, 3): the minimum and maximum corner of the axis-aligned bounding box (NaN for no vertices)."""
         if self.vertex_count == 0:
             return read_only(np.full((2, 3), np.nan))
-        return read_only(np.stack([self.vertices.min(axis=0), self.vertices.max(axis=0)]))
+        return read_only(np.stack([self.vertices.min(axis=0), self.vertices.max(axis=0)]).astype(np.float64))
 
     @cached_property
     def area(self) -> float:
@@ -156,15 +153,15 @@ class Mesh:
         areas = self.face_areas
         total = areas.sum()
         if total > 0.0:
-            centers = self.vertices[self.faces].mean(axis=1)
+            centers = _float64(self.vertices[self.faces]).mean(axis=1)
             return read_only((areas @ centers) / total)
         used = np.unique(self.faces) if self.face_count else np.arange(self.vertex_count)
-        return read_only(self.vertices[used].mean(axis=0))
+        return read_only(_float64(self.vertices[used]).mean(axis=0))
 
     @cached_property
     def edges(self) -> NDArray[np.int64]:
         """(E, 2) the unique undirected edges, each row ``(i, j)`` with ``i < j``, sorted lexicographically."""
-        pairs = np.sort(_directed_edges(self.faces), axis=1)
+        pairs = np.sort(_directed_edges(self.faces), axis=1).astype(np.int64)  # int32 faces: i·n + j needs int64
         n = max(self.vertex_count, 1)
         keys = np.sort(pairs[:, 0] * n + pairs[:, 1])  # one int64 key per edge; sort + diff beats np.unique
         keys = keys[np.r_[True, keys[1:] != keys[:-1]]] if keys.size else keys
@@ -180,7 +177,7 @@ class Mesh:
         """
         if self.face_count == 0:
             return False
-        directed = _position_ids(self.vertices)[_directed_edges(self.faces)]
+        directed = _position_ids(self.vertices)[_directed_edges(self.faces)]  # int64 ids: the keys below fit
         if (directed[:, 0] == directed[:, 1]).any():
             return False
         n = self.vertex_count
@@ -211,9 +208,9 @@ class Mesh:
                 f"Mesh.volume: mesh with {self.face_count} faces is not watertight (open or inconsistently "
                 "wound); volume is defined only for closed, consistently oriented meshes (weld seams first)"
             )
-        v = self.vertices[self.faces]
+        v = _float64(self.vertices[self.faces])
         # subtract a point on the mesh first: same result for a closed surface, less cancellation far from 0
-        v = v - self.vertices[self.faces[0, 0]]
+        v = v - _float64(self.vertices[self.faces[0, 0]])
         return float(np.einsum("ij,ij->i", v[:, 0], np.cross(v[:, 1], v[:, 2])).sum() / 6.0)
 
     # --- operations returning new meshes ------------------------------------------------------------------
@@ -434,19 +431,56 @@ class Mesh:
 # --- helpers ------------------------------------------------------------------------------------------------
 
 
+def _float64(array: np.ndarray) -> np.ndarray:
+    """`array` in float64 (itself when it already is): float32 storage computes exactly as its float64 copy."""
+    return np.asarray(array, dtype=np.float64)
+
+
+def _row_lengths(rows: np.ndarray) -> np.ndarray:
+    """(N,) Euclidean lengths of (N, 3) float64 rows, ``sqrt((x² + y²) + z²)``: the same sums as
+    ``(rows * rows).sum(axis=1)`` without its (N, 3) temporary."""
+    squares = rows[:, 0] * rows[:, 0]
+    squares += rows[:, 1] * rows[:, 1]
+    squares += rows[:, 2] * rows[:, 2]
+    return np.sqrt(squares, out=squares)
+
+
+_BLOCK_ROWS = 1 << 16
+"""Rows per block of ``_normalize_rows`` (its float64 temporaries stay a few MiB whatever the mesh size)."""
+
+
+def _normalize_rows(rows: np.ndarray, where: str) -> None:
+    """Divide the (N, 3) rows (our own copy) by their lengths in place, computing in float64 block by block: float64
+    rows as ``rows / |rows|``, float32 rows normalized in float64 and rounded once (|n| = 1 within 2⁻²⁴).
+
+    Raises GeometryError naming the first zero-length row."""
+    for start in range(0, rows.shape[0], _BLOCK_ROWS):
+        block = np.asarray(rows[start : start + _BLOCK_ROWS], dtype=np.float64)  # a view when rows are float64
+        lengths = _row_lengths(block)
+        zero = np.flatnonzero(lengths == 0.0)
+        if zero.size:
+            i = start + int(zero[0])
+            raise GeometryError(
+                f"{where}: vertex_normals[{i}] = {rows[i].tolist()} has zero length; normals must be nonzero"
+            )
+        block /= lengths[:, None]
+        if block.dtype != rows.dtype:
+            rows[start : start + _BLOCK_ROWS] = block
+
+
 def _face_cross_products(vertices: Points, faces: NDArray[np.int64]) -> Points:
-    v0, v1, v2 = vertices[faces[:, 0]], vertices[faces[:, 1]], vertices[faces[:, 2]]
+    v0, v1, v2 = (_float64(vertices[faces[:, k]]) for k in range(3))
     return np.cross(v1 - v0, v2 - v0)
 
 
 def _area_weighted_normals(vertices: Points, faces: NDArray[np.int64]) -> Points:
     # sum of each face's (v1 − v0) × (v2 − v0) (length 2·area) over the faces at a vertex, then normalize
     cross = _face_cross_products(vertices, faces)
-    sums = np.zeros_like(vertices)
+    sums = np.zeros(vertices.shape, dtype=np.float64)
     for corner in range(3):
         np.add.at(sums, faces[:, corner], cross)
     lengths = np.sqrt((sums * sums).sum(axis=1))
-    normals = np.empty_like(vertices)
+    normals = np.empty(vertices.shape, dtype=np.float64)
     ok = lengths > 0.0
     normals[ok] = sums[ok] / lengths[ok, None]
     normals[~ok] = (0.0, 0.0, 1.0)

@@ -466,7 +466,7 @@ class Octree:
         else:
             region = _cube(bounds, where, expand=False)
         _check_surface_budget(d, where, faces=solid.face_count)
-        corners = np.ascontiguousarray(solid.vertices[solid.faces])  # (F, 3, 3)
+        corners = np.ascontiguousarray(solid.vertices[solid.faces], dtype=np.float64)  # (F, 3, 3)
         size = float(region[1, 0] - region[0, 0])
         cell_pairs = np.zeros(solid.face_count, dtype=np.uint64)  # (cell code, triangle) pairs of this level
         triangle_ids = np.arange(solid.face_count, dtype=np.int64)
@@ -776,7 +776,7 @@ class Octree:
         from frustum.raster import bvh
 
         mesh = self.surface
-        return mesh, (bvh.build(mesh.vertices[mesh.faces]) if mesh.face_count else None)
+        return mesh, (bvh.build(np.asarray(mesh.vertices[mesh.faces], dtype=np.float64)) if mesh.face_count else None)
 
     def ray_hits(self, origins: ArrayLike, directions: ArrayLike) -> OctreeHits:
         """First hit of each ray ``origin + t·direction`` (t >= 0) on the solid: distance, point and full leaf.

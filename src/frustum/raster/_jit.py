@@ -88,7 +88,9 @@ def _prefetch(typingctx, array, i, j):
     def codegen(context, builder, signature, args):
         kind = signature.args[0]
         data = context.make_array(kind)(context, builder, args[0])
-        pointer = cgutils.get_item_pointer(context, builder, kind, data, [args[1], args[2]], wraparound=False)
+        # indices as intp: an int32 index (a Mesh's int32 faces) beside an int64 one is not one LLVM type
+        index = [context.cast(builder, v, t, types.intp) for v, t in zip(args[1:], signature.args[1:], strict=True)]
+        pointer = cgutils.get_item_pointer(context, builder, kind, data, index, wraparound=False)
         byte = ir.IntType(8).as_pointer()
         int32 = ir.IntType(32)
         function = cgutils.get_or_insert_function(
