@@ -104,7 +104,9 @@ def frustum_child(name: str, args: argparse.Namespace) -> dict:
     width, height = int(sc["width"]), int(sc["height"])
 
     t0 = time.perf_counter()
-    mesh = frustum.Mesh(sc["vertices"], sc["faces"], vertex_normals=sc["normals"])
+    # copy=False: the Mesh renders from the scene's own vertex and face buffers (validated, read-only views) where
+    # the anchor's GL driver copies them into its buffers; both processes also hold the loaded scene arrays
+    mesh = frustum.Mesh(sc["vertices"], sc["faces"], vertex_normals=sc["normals"], copy=False)
     camera = frustum.Camera.look_at(
         sc["eye"],
         sc["target"],

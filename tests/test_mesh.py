@@ -401,3 +401,26 @@ def test_given_normals_are_normalized_in_float64_and_float32_ones_stored_float32
     normals32[66_000] = 0.0  # a zero normal in the second block is named by its own index
     with pytest.raises(GeometryError, match=r"vertex_normals\[66000\] = \[0.0, 0.0, 0.0\] has zero length"):
         Mesh(vertices, [[0, 1, 2]], vertex_normals=normals32)
+
+
+def test_copy_false_keeps_the_callers_vertex_and_face_buffers_and_still_validates():
+    vertices = np.random.default_rng(3).random((40, 3)).astype(np.float32)
+    faces = np.random.default_rng(4).integers(0, 40, (30, 3)).astype(np.int32)
+    shared = Mesh(vertices, faces, copy=False)
+    assert np.shares_memory(shared.vertices, vertices) and np.shares_memory(shared.faces, faces)
+    assert not shared.vertices.flags.writeable and not shared.faces.flags.writeable
+    assert vertices.flags.writeable and faces.flags.writeable  # the caller's own flags are left alone
+    copied = Mesh(vertices, faces)
+    assert not np.shares_memory(copied.vertices, vertices) and not np.shares_memory(copied.faces, faces)
+    np.testing.assert_array_equal(shared.vertex_normals, copied.vertex_normals)
+    v64 = vertices.astype(np.float64)
+    wide = Mesh(v64, faces.astype(np.int64), copy=False)  # int64 faces are stored int32: a copy
+    assert wide.faces.dtype == np.int32 and np.shares_memory(wide.vertices, v64)
+    bad = vertices.copy()
+    bad[7, 1] = np.nan
+    with pytest.raises(GeometryError, match=r"vertices\[7\]"):
+        Mesh(bad, faces, copy=False)
+    outside = faces.copy()
+    outside[5, 2] = 40
+    with pytest.raises(GeometryError, match=r"faces\[5\]"):
+        Mesh(vertices, outside, copy=False)

@@ -90,10 +90,12 @@ def read_only(array: np.ndarray) -> np.ndarray:
 
 
 def _as_float_array(
-    value: ArrayLike, name: str, where: str, error: ErrorType, expected: str, keep_float32: bool = False
-) -> NDArray:
+    value: ArrayLike, name: str, where: str, error: ErrorType, expected: str, keep_float32: bool = False,
+    share: bool = False,
+) -> NDArray:  # fmt: skip
     """A C-contiguous float64 array (float32 where `keep_float32` and the input is float32: a lossless copy) that
-    never is (or views) the caller's own array; complex input is refused."""
+    never is (or views) the caller's own array, unless `share` (then it is the caller's array itself when that
+    already has the dtype and layout); complex input is refused."""
     try:
         raw = np.asarray(value)
         complex_input = raw.dtype.kind == "c"
@@ -104,7 +106,7 @@ def _as_float_array(
     if array is None:
         raise error(f"{where}: {name} = {describe(value)} is complex; expected {expected} (real numbers)")
     array = np.ascontiguousarray(array)
-    if isinstance(value, np.ndarray) and np.may_share_memory(array, value):
+    if not share and isinstance(value, np.ndarray) and np.may_share_memory(array, value):
         array = array.copy()  # the checked array is ours: later read-only flags must not reach the caller's
     return array
 
@@ -165,31 +167,44 @@ def as_matrix(value: ArrayLike, name: str = "matrix", *, where: str, error: Erro
 
 
 def _as_rows(
-    value: ArrayLike, width: int, name: str, where: str, error: ErrorType, what: str, keep_float32: bool = False
-) -> NDArray:
-    rows = _as_float_array(value, name, where, error, f"an (N, {width}) array of {what}", keep_float32)
+    value: ArrayLike, width: int, name: str, where: str, error: ErrorType, what: str, keep_float32: bool = False,
+    share: bool = False,
+) -> NDArray:  # fmt: skip
+    rows = _as_float_array(value, name, where, error, f"an (N, {width}) array of {what}", keep_float32, share)
     if rows.ndim == 2 and rows.shape[0] == 0 and rows.shape[1] in (0, width):
         return np.empty((0, width), dtype=rows.dtype)
     if rows.ndim == 1 and rows.size == 0:
         return np.empty((0, width), dtype=rows.dtype)
     if rows.ndim != 2 or rows.shape[1] != width:
         raise error(f"{where}: {name} has shape {rows.shape}; expected (N, {width}) {what}, one per row")
-    bad = np.flatnonzero(~np.isfinite(rows).all(axis=1))
+    bad = _nonfinite_rows(rows)
     if bad.size:
         i = int(bad[0])
         raise error(f"{where}: {name}[{i}] = {describe(rows[i])} is not finite; coordinates must be finite numbers")
     return rows
 
 
+def _nonfinite_rows(rows: NDArray) -> NDArray[np.intp]:
+    """Indices of the rows holding a NaN or an infinity, checked in blocks (no full-size temporary)."""
+    step = 1 << 16
+    for start in range(0, rows.shape[0], step):
+        bad = np.flatnonzero(~np.isfinite(rows[start : start + step]).all(axis=1))
+        if bad.size:
+            return bad + start
+    return np.empty(0, dtype=np.intp)
+
+
 def as_points(
-    value: ArrayLike, name: str = "points", *, where: str, error: ErrorType = GeometryError, keep_float32: bool = False
-) -> Points:
+    value: ArrayLike, name: str = "points", *, where: str, error: ErrorType = GeometryError, keep_float32: bool = False,
+    share: bool = False,
+) -> Points:  # fmt: skip
     """Return `value` as a finite, C-contiguous (N, 3) float64 array; (0, 3) is valid.
 
     With `keep_float32`, a float32 array stays float32 (a copy: float32 → float64 is exact, so a caller computing
-    in float64 from it gets the same numbers; storage is half); every other input is converted to float64.
+    in float64 from it gets the same numbers; storage is half); every other input is converted to float64. With
+    `share`, an input array that already has that dtype and layout is returned itself, not copied.
     """
-    return _as_rows(value, 3, name, where, error, "points (x, y, z)", keep_float32)
+    return _as_rows(value, 3, name, where, error, "points (x, y, z)", keep_float32, share)
 
 
 def as_homogeneous_points(
@@ -207,12 +222,14 @@ def as_faces(
     where: str,
     error: ErrorType = GeometryError,
     compact: bool = False,
+    share: bool = False,
 ) -> NDArray[np.int64]:
     """Return `value` as a C-contiguous (M, 3) int64 array of vertex indices in [0, vertex_count); (0, 3) is valid.
 
     Indices must already be integers (an integer dtype): a float array is refused rather than rounded. With
     `compact`, the array is int32 when every index fits (``vertex_count <= 2**31``): lossless, half the memory;
-    code combining such indices arithmetically (edge keys ``i·N + j``) must widen to int64 first.
+    code combining such indices arithmetically (edge keys ``i·N + j``) must widen to int64 first. With `share`,
+    an input array that already has that dtype and layout is returned itself, not copied.
     """
     index_type = np.int32 if compact and vertex_count <= INT32_LIMIT else np.int64
     try:
@@ -232,4 +249,5 @@ def as_faces(
             f"indices must lie in [0, {vertex_count - 1}]"
         )
     checked = np.ascontiguousarray(faces, dtype=index_type)
-    return checked.copy() if isinstance(value, np.ndarray) and np.may_share_memory(checked, value) else checked
+    mine = share or not (isinstance(value, np.ndarray) and np.may_share_memory(checked, value))
+    return checked if mine else checked.copy()

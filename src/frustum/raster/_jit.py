@@ -120,7 +120,8 @@ def _stream(typingctx, array, i, j, value):
     def codegen(context, builder, signature, args):
         kind = signature.args[0]
         data = context.make_array(kind)(context, builder, args[0])
-        pointer = cgutils.get_item_pointer(context, builder, kind, data, [args[1], args[2]], wraparound=False)
+        index = [context.cast(builder, v, t, types.intp) for v, t in zip(args[1:3], signature.args[1:3], strict=True)]
+        pointer = cgutils.get_item_pointer(context, builder, kind, data, index, wraparound=False)
         stored = builder.store(context.cast(builder, args[3], signature.args[3], kind.dtype), pointer)
         stored.set_metadata("nontemporal", builder.module.add_metadata([ir.IntType(32)(1)]))
         return context.get_dummy_value()
