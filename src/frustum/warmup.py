@@ -155,6 +155,19 @@ def _visibility_methods() -> None:
     fr.render(scene, camera, stats=True)
 
 
+def _volumes() -> None:
+    fr = _api()
+
+    volume = fr.head_phantom(12)
+    camera = _camera((0.0, 0.5, 3.0))
+    for mode in ("composite", "mip", "isosurface"):
+        scene = fr.Scene(lights=[fr.DirectionalLight(direction=(0, -1, -1))])
+        scene.add_volume(volume, mode=mode, transform=fr.scale(1.5, 1.5, 1.5))
+        if mode == "composite":  # two overlapping composite volumes: the merged kernel
+            scene.add_volume(volume, transform=fr.translate(0.2, 0, 0) @ fr.scale(1.5, 1.5, 1.5))
+        fr.render(scene, camera)
+
+
 TASKS: dict[str, Callable[[], None]] = {
     "surfaces (general shader)": _surfaces_general,
     "surfaces (fast path, supersampling, clipping)": _surfaces_fast,
@@ -163,6 +176,7 @@ TASKS: dict[str, Callable[[], None]] = {
     "hidden lines and clipping": _vector,
     "fractals": _fractals,
     "visible-surface methods (scan-line, area subdivision, painter, ray casting, A-buffer)": _visibility_methods,
+    "volume ray casting (composite, merged, MIP, isosurface)": _volumes,
 }
 """The families of kernels ``warmup`` compiles, each by running small examples of what uses them."""
 
