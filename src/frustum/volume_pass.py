@@ -143,12 +143,11 @@ def draw_volumes(scene: Scene, camera: Camera, depth: np.ndarray, color: np.ndar
 def _draw_merged(items: list[VolumeItem], camera: Camera, packed: tuple, depth: np.ndarray, color: np.ndarray) -> None:
     """Composite volumes drawn together (``raster.volume.cast_composite_merged``): their kernel arguments stacked,
     the clip planes padded with rows of zeros (always kept)."""
-    from numba.typed import List
-
     from frustum.raster import volume as kernels
 
     arguments = [volume_arrays(item, camera, packed) for item in items]
-    datas, blocks = List([a[1] for a in arguments]), List([a[2] for a in arguments])
+    # tuples, not numba.typed.List: building a typed list from Python compiles its helpers in every process
+    datas, blocks = tuple(a[1] for a in arguments), tuple(a[2] for a in arguments)
     planes = np.zeros((len(items), max(a[5].shape[0] for a in arguments), 4))
     for index, a in enumerate(arguments):
         planes[index, : a[5].shape[0]] = a[5]

@@ -646,7 +646,8 @@ def cast_composite_merged(datas, blocks, tables, matrices, planes, params, light
     samples of all the volumes it crosses in the order of the ray parameter (their sequences merged), each sample
     classified by its own volume's table and opacity-corrected for its own step, so overlapping volumes mix.
 
-    `datas`, `blocks`: typed lists of the volumes' grids and block arrays; `tables` (V, 5, T), `matrices`
+    `datas`, `blocks`: tuples of the volumes' grids and block arrays (one compiled specialization per number of
+    volumes, cached like every kernel); `tables` (V, 5, T), `matrices`
     (V, 5, 4, 4), `planes` (V, P, 4) (rows of zeros pad), `params` (V, PARAMS): the single-volume arguments
     stacked. Each volume's samples lie where ``cast_composite`` puts them (the ray parameter s is the same for
     every volume: 0 on the near plane, 1 on the far plane), and its empty blocks are skipped per sample.
