@@ -151,3 +151,22 @@ def test_kernel_caches_are_stamped_with_every_raster_module(tmp_path):
     assert _jit.package_digest(copy) != _jit._DIGEST
     stamp = triangles.rasterize_tiles.kernel._cache._cache_file._source_stamp
     assert stamp[1] == _jit._DIGEST
+
+
+def test_kernels_load_without_importing_scipy_and_numba_still_finds_blas():
+    """Numba's array-math registry asks whether SciPy is installed by importing ``scipy.linalg`` (0.17 s of a warm
+    render); ``_jit`` answers it without the import, and Numba's own BLAS check is back for kernels that use it."""
+    code = (
+        "import sys, numpy as np, numba\n"
+        "import frustum.render\n"
+        "from numba.np import arraymath, linalg\n"
+        "assert 'scipy.linalg' not in sys.modules\n"
+        "assert arraymath._HAVE_BLAS is True\n"
+        "assert arraymath.ensure_blas is linalg.ensure_blas and linalg.ensure_blas.__module__ == 'numba.np.linalg'\n"
+        "dot = numba.njit(lambda a, b: np.dot(a, b))\n"
+        "assert dot(np.ones((2, 2)), np.ones((2, 2)))[0, 0] == 2.0\n"
+        "assert 'scipy.linalg' in sys.modules\n"
+        "print('ok')\n"
+    )
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert proc.stdout.strip() == "ok", proc.stderr

@@ -31,7 +31,6 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
-from xml.sax.saxutils import escape
 
 import numpy as np
 from numpy.typing import NDArray
@@ -49,7 +48,7 @@ from frustum.hidden_lines import (
     remove_hidden_lines,
     welded_adjacency,
 )
-from frustum.output.svg import _check_common, _drawing_groups, _number, _placed_meshes, svg_document
+from frustum.output.svg import _check_common, _drawing_groups, _escape, _number, _placed_meshes, svg_document
 from frustum.projection import ISOMETRIC_ROTATION_X, MULTIVIEWS, Axonometric, Orthographic, multiview
 from frustum.scene import Scene
 
@@ -488,7 +487,7 @@ def _mark_svg(mark: _Mark, prefix: str, dx: float, dy: float) -> str:
         turn = f' transform="rotate(-90 {X} {Y})"' if vertical else ""
         parts.append(
             f'<text x="{X}" y="{Y}" font-family="sans-serif" font-size="{_number(_LETTER)}" '
-            f'text-anchor="{anchor}"{turn}>{escape(text)}</text>'
+            f'text-anchor="{anchor}"{turn}>{_escape(text)}</text>'
         )
     value = "" if math.isnan(mark.value) else f' data-value="{_number(mark.value)}"'
     return f'<g id="{prefix}{mark.name}" class="{mark.kind}"{value}>{"".join(parts)}</g>'
@@ -755,7 +754,7 @@ def _paper_text(paper: Any) -> str:
 def _text(x: float, y: float, text: str, size: float, anchor: str = "start") -> str:
     return (
         f'<text x="{_number(x)}" y="{_number(y)}" font-family="sans-serif" font-size="{_number(size)}" '
-        f'text-anchor="{anchor}">{escape(text)}</text>'
+        f'text-anchor="{anchor}">{_escape(text)}</text>'
     )
 
 

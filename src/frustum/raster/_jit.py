@@ -32,12 +32,51 @@ from pathlib import Path
 from typing import Any
 
 import numba
-from llvmlite import ir
-from numba.core import cgutils, event, types
-from numba.extending import intrinsic
-from numba.np.ufunc import parallel as _numba_parallel
 
-import frustum.raster
+
+def _load_numba_array_math_without_scipy() -> None:
+    """Import ``numba.np.arraymath`` without the SciPy import it does only to ask whether SciPy is installed.
+
+    Numba loads its array-math implementations before it runs any kernel (cached or not), and that module's first
+    line of work, ``_HAVE_BLAS = _check_blas()``, imports ``scipy.linalg.cython_blas`` — 0.17 s of a 1.1 s warm
+    render, for a flag that only picks ``np.correlate``'s inner loop. SciPy is one of frustum's dependencies, so the
+    answer is yes: here the check asks ``find_spec("scipy")`` (no import) instead, while the module is imported, and
+    the real ``ensure_blas`` is put back at once (``np.dot`` and ``np.linalg`` in any kernel still import SciPy
+    when they compile, as before). On a Numba without these names nothing is changed."""
+    import importlib.util
+    import sys
+
+    if "numba.np.arraymath" in sys.modules or "scipy.linalg" in sys.modules:
+        return
+    try:
+        from numba.np import linalg
+    except ImportError:  # pragma: no cover - a Numba laid out differently: keep its own import order
+        return
+    real = getattr(linalg, "ensure_blas", None)
+    if real is None:  # pragma: no cover
+        return
+
+    def scipy_installed() -> None:
+        if importlib.util.find_spec("scipy") is None:
+            raise ImportError("scipy is required for linear algebra")
+
+    linalg.ensure_blas = scipy_installed
+    try:
+        from numba.np import arraymath
+    finally:
+        linalg.ensure_blas = real
+    if getattr(arraymath, "ensure_blas", None) is scipy_installed:
+        arraymath.ensure_blas = real
+
+
+_load_numba_array_math_without_scipy()
+
+from llvmlite import ir  # noqa: E402
+from numba.core import cgutils, event, types  # noqa: E402
+from numba.extending import intrinsic  # noqa: E402
+from numba.np.ufunc import parallel as _numba_parallel  # noqa: E402
+
+import frustum.raster  # noqa: E402
 
 __all__ = [
     "fence", "kernel", "parallel_for", "parallel_kernel", "prange", "prefetch", "set_threads", "stream", "threads",
