@@ -19,7 +19,7 @@ from frustum.errors import ShadingError
 from frustum.frame import Frame
 from frustum.geometry import Mesh
 from frustum.raster.vertices import transform_vertices
-from frustum.render import _item_matrices, bin_item, render
+from frustum.render import _block_min, _item_matrices, bin_item, render, resolve_color
 from frustum.scene import Scene
 from frustum.shading import DirectionalLight, Material
 from frustum.transforms import apply_homogeneous, rotate_y, translate
@@ -550,3 +550,47 @@ def test_float32_normals_render_within_one_level_of_float64_normals_on_the_same_
         np.testing.assert_array_equal(frames[0].depth, frames[1].depth)
         difference = np.abs(frames[0].color.astype(int) - frames[1].color.astype(int)).max(axis=-1)
         assert difference.max() <= 1 and (difference == 0).mean() >= 0.999, shading
+
+
+# --- supersampling resolve ----------------------------------------------------------------------------------------
+
+
+def _rounded_block_means(big: np.ndarray, factor: int) -> np.ndarray:
+    """Oracle: each s×s block's mean rounded half up, in exact Python fractions, pixel by pixel."""
+    from fractions import Fraction
+
+    height, width = big.shape[0] // factor, big.shape[1] // factor
+    out = np.zeros((height, width, big.shape[2]), dtype=np.uint8)
+    for y in range(height):
+        for x in range(width):
+            block = big[y * factor : (y + 1) * factor, x * factor : (x + 1) * factor].astype(int)
+            for c in range(big.shape[2]):
+                out[y, x, c] = math.floor(Fraction(int(block[:, :, c].sum()), factor * factor) + Fraction(1, 2))
+    return out
+
+
+@pytest.mark.parametrize("factor", [1, 2, 3, 4, 5, 16, 17])
+def test_resolve_color_is_the_rounded_block_mean(factor):
+    # 16 is the last factor summed in uint16 (255·256 + 128 < 2¹⁶); 17 takes the uint32 path
+    rng = np.random.default_rng(factor)
+    big = rng.integers(0, 256, size=(3 * factor, 4 * factor, 4), dtype=np.uint8)
+    big[:factor, :factor] = 255  # a saturated block: the largest sum
+    big[:factor, factor : 2 * factor] = 0
+    big[factor : 2 * factor, :factor, 0] = 128  # an exact .5 mean for even areas: rounds up
+    big[factor, 0, 0] = 127
+    resolved = resolve_color(big, factor)
+    assert resolved.dtype == np.uint8 and resolved.shape == (3, 4, 4)
+    np.testing.assert_array_equal(resolved, _rounded_block_means(big, factor))
+    assert (resolved[0, 0] == 255).all() and (resolved[0, 1] == 0).all()
+
+
+@given(factor=st.integers(1, 4), height=st.integers(1, 5), width=st.integers(1, 5), seed=st.integers(0, 2**32 - 1))
+@settings(max_examples=40, deadline=None)
+def test_block_min_matches_the_reduction(factor, height, width, seed):
+    rng = np.random.default_rng(seed)
+    depth = rng.random((height * factor, width * factor), dtype=np.float32)
+    depth[rng.random(depth.shape) < 0.3] = np.inf  # background samples
+    expected = depth.reshape(height, factor, width, factor).min(axis=(1, 3))
+    result = _block_min(depth, factor)
+    assert result.dtype == depth.dtype
+    np.testing.assert_array_equal(result, expected)

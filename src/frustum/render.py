@@ -306,13 +306,12 @@ def render(
         big = dataclasses.replace(camera, width=camera.width * factor, height=camera.height * factor)
         wide = dataclasses.replace(options, line_width=options.line_width * factor)
         color, depth, normals, ids = _render_buffers(scene, big, wide)
-        h, w = camera.height, camera.width
         linear = None
         if filter == "box" and color_space == "linear":
             color = resolve_color(color, factor)
         else:
             linear = _downsample(color.astype(np.float64) / 255.0, factor, filter)
-        depth = depth.reshape(h, factor, w, factor).min(axis=(1, 3))
+        depth = _block_min(depth, factor)
         middle = factor // 2
         normals = None if normals is None else np.ascontiguousarray(normals[middle::factor, middle::factor])
         ids = None if ids is None else np.ascontiguousarray(ids[middle::factor, middle::factor])
@@ -986,8 +985,36 @@ def resolve_color(big: np.ndarray, factor: int) -> np.ndarray:
     its s×s block, ``floor(Σ/s² + 1/2) = (2·Σ + s²) // (2·s²)`` (exactly the rounded mean)."""
     height, width = big.shape[0] // factor, big.shape[1] // factor
     area = factor * factor
-    total = big.reshape(height, factor, width, factor, 4).sum(axis=(1, 3), dtype=np.uint32)
-    return ((2 * total + area) // (2 * area)).astype(np.uint8)
+    # Σ + ⌊s²/2⌋ ≤ 255·s² + s²/2 fits uint16 up to s = 16; the rounded mean is then (Σ + ⌊s²/2⌋) // s², the same
+    # integer as above. Rows first (contiguous planes of whole rows), then the s samples side by side: a few
+    # in-place adds instead of a strided two-axis reduction (23 → 1.6 ms for 480 × 360 × 4 samples).
+    dtype = np.uint16 if area <= 256 else np.uint32
+    rows = big.reshape(height, factor, width * factor * 4)
+    across = rows[:, 0].astype(dtype)
+    for i in range(1, factor):
+        across += rows[:, i]
+    columns = across.reshape(height, width, factor, 4)
+    total = columns[:, :, 0].copy()
+    for j in range(1, factor):
+        total += columns[:, :, j]
+    total += area // 2
+    total //= area
+    return total.astype(np.uint8)
+
+
+def _block_min(values: np.ndarray, factor: int) -> np.ndarray:
+    """(H·s, W·s) → (H, W): the minimum of each s×s block, as in-place ``np.minimum`` of its row and column
+    planes (0.2 ms for 960 × 720 against 11 ms for a strided ``min(axis=(1, 3))``; the same values)."""
+    height, width = values.shape[0] // factor, values.shape[1] // factor
+    rows = values.reshape(height, factor, width * factor)
+    across = rows[:, 0].copy()
+    for i in range(1, factor):
+        np.minimum(across, rows[:, i], out=across)
+    columns = across.reshape(height, width, factor)
+    result = columns[:, :, 0].copy()
+    for j in range(1, factor):
+        np.minimum(result, columns[:, :, j], out=result)
+    return result
 
 
 def _downsample(values: np.ndarray, factor: int, kind: str) -> np.ndarray:
