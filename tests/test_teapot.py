@@ -162,6 +162,36 @@ def test_adaptive_tessellation_and_control_net():
     assert pot.tessellate(1).face_count <= 64
 
 
+def _patch_by_patch(patches: BezierPatchSet, n: int) -> Mesh:
+    """The reference: every patch tessellated on its own (``BezierSurface.tessellate``), meshes concatenated."""
+    meshes = [patch.tessellate(n, n) for patch in patches]
+    offsets = np.cumsum([0] + [m.vertex_count for m in meshes[:-1]])
+    faces = np.concatenate([m.faces.astype(np.int64) + o for m, o in zip(meshes, offsets, strict=True)])
+    return Mesh(np.concatenate([m.vertices for m in meshes]), faces,
+                np.concatenate([m.vertex_normals for m in meshes]))  # fmt: skip
+
+
+def _awkward_patches() -> BezierPatchSet:
+    """Biquadratic × cubic patches: a random one, one with its u = 0 edge collapsed to a point (a pole, limit
+    normals), one whose control points all lie on a line (no normal anywhere: the nudged fallback), one random."""
+    rng = np.random.default_rng(7)
+    grids = rng.normal(size=(4, 3, 4, 3))
+    grids[1, 0] = grids[1, 0, 0]
+    grids[2] = np.linspace(0.0, 1.0, 12).reshape(3, 4, 1) * np.array([1.0, 2.0, -0.5])
+    return BezierPatchSet(grids, name="awkward")
+
+
+@pytest.mark.parametrize(("patches", "n"), [(teapot(), 1), (teapot(), 4), (teapot(), 10), (teacup(), 5),
+                                            (teaspoon(), 3), (_awkward_patches(), 6)])  # fmt: skip
+def test_tessellating_all_patches_at_once_equals_patch_by_patch(patches, n):
+    # the batched tessellation must give the same float64 values, faces (degenerate ones dropped) and order
+    batched, reference = patches.tessellate(n), _patch_by_patch(patches, n)
+    np.testing.assert_array_equal(batched.vertices, reference.vertices)
+    np.testing.assert_array_equal(batched.faces, reference.faces)
+    np.testing.assert_array_equal(batched.vertex_normals, reference.vertex_normals)
+    assert batched.vertex_count == len(patches) * (n + 1) ** 2
+
+
 @pytest.mark.parametrize(
     ("grids", "fragment"),
     [

@@ -17,6 +17,7 @@ Surfaces", "B-Spline Surfaces", "Rational Splines".
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -38,7 +39,7 @@ from frustum.geometry.curves import (
     _knots_for,
     _split_batch,
 )
-from frustum.geometry.mesh import Mesh
+from frustum.geometry.mesh import Mesh, _normalize_rows
 
 __all__ = ["BSplineSurface", "BezierSurface", "NURBSSurface"]
 
@@ -271,6 +272,13 @@ def _unit_normals(
 
 def _grid_faces(nu: int, nv: int, vertices: FloatArray) -> NDArray[np.int64]:
     """Two counter-clockwise triangles per cell (a, b, c), (a, c, d); drops triangles with two coincident corners."""
+    return _grid_faces_batch(nu, nv, vertices[None])
+
+
+def _grid_faces_batch(nu: int, nv: int, vertices: FloatArray) -> NDArray[np.int64]:
+    """``_grid_faces`` of P grids at once, vertices (P, (nu + 1)·(nv + 1), 3): the faces of grid p index its
+    vertices from p·(nu + 1)·(nv + 1), in grid order (as concatenating the single-grid results would)."""
+    count, per_grid = vertices.shape[0], vertices.shape[1]
     i, j = np.meshgrid(np.arange(nu), np.arange(nv), indexing="ij")
     a = (i * (nv + 1) + j).ravel()
     b = a + nv + 1  # (i + 1, j)
@@ -279,11 +287,43 @@ def _grid_faces(nu: int, nv: int, vertices: FloatArray) -> NDArray[np.int64]:
     faces = np.concatenate([np.stack([a, b, c], axis=1), np.stack([a, c, d], axis=1)])
     order = np.argsort(np.concatenate([np.arange(a.size) * 2, np.arange(a.size) * 2 + 1]), kind="stable")
     faces = faces[order]
-    p = vertices[faces]
-    scale = max(1.0, float(np.abs(vertices).max(initial=0.0)))
-    shortest = np.sqrt(((p - p[:, [1, 2, 0]]) ** 2).sum(axis=2)).min(axis=1)
-    keep = shortest > 1e-12 * scale  # corners that coincide up to round-off (a collapsed edge)
-    return np.ascontiguousarray(faces[keep], dtype=np.int64)
+    p = vertices[np.arange(count)[:, None, None], faces]  # (P, F, 3 corners, 3)
+    scale = np.maximum(1.0, np.abs(vertices).reshape(count, -1).max(axis=1, initial=0.0))
+    shortest = np.sqrt(((p - p[:, :, [1, 2, 0]]) ** 2).sum(axis=3)).min(axis=2)
+    keep = shortest > 1e-12 * scale[:, None]  # corners that coincide up to round-off (a collapsed edge)
+    offsets = np.arange(count, dtype=np.int64)[:, None, None] * per_grid
+    return np.ascontiguousarray((faces + offsets)[keep], dtype=np.int64)
+
+
+def _tessellate_bezier_grids(patches: Sequence[BezierSurface], grids: FloatArray, nu: int, nv: int,
+                             where: str) -> Mesh:  # fmt: skip
+    """One ``Mesh`` of P Bézier patches of one degree, grids (P, m + 1, n + 1, 3), each tessellated nu × nv: the
+    vertices, normals and faces of ``patch.tessellate(nu, nv)`` for every patch, concatenated (the same float64
+    values), computed for all patches at once (the Bernstein matrices once, one einsum per derivative)."""
+    count = grids.shape[0]
+    per_patch = (nu + 1) * (nv + 1)
+    check_memory(count * (per_patch * 8 * 24 + nu * nv * 48), where=where, cause=f"{count} patches x nu = {nu}, "
+                 f"nv = {nv}", error=GeometryError)  # fmt: skip
+    u = np.linspace(0.0, 1.0, nu + 1)
+    v = np.linspace(0.0, 1.0, nv + 1)
+    m, n = grids.shape[1] - 1, grids.shape[2] - 1
+    bu = {order: _bernstein_matrix(m, u, order) for order in (0, 1)}
+    bv = {order: _bernstein_matrix(n, v, order) for order in (0, 1)}
+    d = {(a, b): np.einsum("ai,pijd,bj->pabd", bu[a], grids, bv[b]).reshape(count * per_patch, 3) for a, b in _ALL}
+    uu, vv = (a.ravel() for a in np.meshgrid(u, v, indexing="ij"))
+    scales = np.maximum(1.0, np.abs(grids).reshape(count, -1).max(axis=1))  # each patch's _scale()
+    normals = _unit_normals(d, np.tile(uu, count), np.tile(vv, count), (0.0, 1.0), (0.0, 1.0),
+                            np.repeat(scales, per_patch))  # fmt: skip
+    bad = np.flatnonzero(~np.isfinite(normals).all(axis=1))
+    for patch_index in np.unique(bad // per_patch):
+        rows = bad[bad // per_patch == patch_index]
+        local = rows - patch_index * per_patch
+        normals[rows] = patches[patch_index]._nudged_normals(uu[local], vv[local])
+    points = d[(0, 0)]
+    faces = _grid_faces_batch(nu, nv, points.reshape(count, per_patch, 3))
+    # each patch's Mesh normalized its normals once, and the concatenated Mesh again: the same two roundings
+    _normalize_rows(normals, where)
+    return Mesh(points, faces, normals)
 
 
 # --- Bézier ------------------------------------------------------------------------------------------------

@@ -25,7 +25,7 @@ from numpy.typing import ArrayLike, NDArray
 from frustum._arrays import as_count, describe, read_only
 from frustum.errors import GeometryError
 from frustum.geometry.mesh import Mesh
-from frustum.geometry.surfaces import BezierSurface
+from frustum.geometry.surfaces import BezierSurface, _tessellate_bezier_grids
 
 __all__ = ["BezierPatchSet", "teacup", "teapot", "teaspoon"]
 
@@ -86,7 +86,7 @@ class BezierPatchSet:
         dropped, as three.js does.
         """
         n = as_count(resolution, "resolution", 1, where="BezierPatchSet.tessellate")
-        return _concatenate([patch.tessellate(n, n) for patch in self.patches])
+        return _tessellate_bezier_grids(self.patches, self.grids, n, n, where="BezierPatchSet.tessellate")
 
     def tessellate_adaptive(self, tolerance: float) -> Mesh:
         """Every patch at the finest resolution any patch needs for `tolerance` (so no cracks between patches)."""
@@ -99,14 +99,6 @@ class BezierPatchSet:
         along_u = np.stack([g[:, :-1, :], g[:, 1:, :]], axis=3).reshape(-1, 2, 3)
         along_v = np.stack([g[:, :, :-1], g[:, :, 1:]], axis=3).reshape(-1, 2, 3)
         return np.concatenate([along_u, along_v])
-
-
-def _concatenate(meshes: list[Mesh]) -> Mesh:
-    offsets = np.cumsum([0] + [m.vertex_count for m in meshes[:-1]])
-    vertices = np.concatenate([m.vertices for m in meshes])
-    faces = np.concatenate([m.faces + o for m, o in zip(meshes, offsets, strict=True)])
-    normals = np.concatenate([m.vertex_normals for m in meshes])
-    return Mesh(vertices, faces, normals)
 
 
 def _read_patches(text: str, where: str) -> NDArray[np.float64]:
