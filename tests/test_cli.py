@@ -267,3 +267,55 @@ def test_scene_file_errors_are_one_line_without_traceback(tmp_path):
     result = run("render", str(bad))  # every problem at once, one line each
     assert result.returncode == 1 and "Traceback" not in result.stderr
     assert "bad.toml:1:" in result.stderr and "bad.toml:2:" in result.stderr and "bad.toml:4:" in result.stderr
+
+
+# --- the garbage collector of the short-lived program ------------------------------------------------------------
+
+_GC_PROBE = """
+import atexit, gc, sys
+seen = {}
+atexit.register(lambda: print("enabled-at-exit", seen.get("enabled"), "frozen", gc.get_freeze_count() > 0))
+import frustum.cli as cli
+original = cli._main
+def probe(argv):
+    seen["enabled"] = gc.isenabled()  # inside the command
+    original(argv)
+cli._main = probe
+sys.argv = ["frustum", *sys.argv[1:]]
+cli.main()
+"""
+
+
+def test_the_program_pauses_the_collector_and_freezes_its_objects_at_exit():
+    # run as the program: no collection during the first seconds, everything frozen before interpreter shutdown
+    proc = subprocess.run([sys.executable, "-c", _GC_PROBE, "compose", "translate=1,0,0"], capture_output=True,
+                          text=True, timeout=120, check=False)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert "enabled-at-exit False frozen True" in proc.stdout
+
+
+def test_main_called_from_python_leaves_the_collector_alone(capsys):
+    import gc
+
+    frozen = gc.get_freeze_count()
+    main(["compose", "translate=1,0,0"])
+    assert "composite" in capsys.readouterr().out
+    assert gc.isenabled() and gc.get_freeze_count() == frozen
+
+
+def test_the_collector_resumes_after_the_pause(monkeypatch):
+    import gc
+    import time
+
+    from frustum import cli
+
+    gc.disable()
+    try:
+        monkeypatch.setitem(cli._STATE, "resume_gc_at", time.monotonic() + 60.0)
+        cli._resume_gc_when_due()
+        assert not gc.isenabled()  # not yet due
+        monkeypatch.setitem(cli._STATE, "resume_gc_at", time.monotonic() - 0.01)
+        cli._resume_gc_when_due()
+        assert gc.isenabled() and cli._STATE["resume_gc_at"] is None
+    finally:
+        gc.enable()
