@@ -11,11 +11,6 @@ import sys
 import types
 from typing import TYPE_CHECKING, Any
 
-from frustum.bsp import (
-    BSPTree,
-    DepthOrder,
-    depth_sort,
-)
 from frustum.budgets import (
     DEFAULT_BYTES,
     DEFAULT_OPERATIONS,
@@ -164,32 +159,6 @@ from frustum.geometry import (
     union,
     uv_sphere,
 )
-from frustum.hidden_lines import (
-    EDGE_BOUNDARY,
-    EDGE_CREASE,
-    EDGE_KINDS,
-    EDGE_LINE,
-    EDGE_SILHOUETTE,
-    HiddenLines,
-    feature_edges,
-    remove_hidden_lines,
-)
-from frustum.output.sheet import (
-    PAPER_SIZES,
-    SHEET_VIEWS,
-    STANDARD_SCALES,
-    drawing_sheet,
-    scale_label,
-)
-from frustum.output.svg import (
-    FILL_ORDERS,
-    HIDDEN_STYLES,
-    render_svg,
-    save_svg,
-    svg_document,
-    svg_path_from_bezier,
-    svg_path_from_polyline,
-)
 from frustum.projection import (
     MULTIVIEWS,
     Axonometric,
@@ -244,39 +213,6 @@ from frustum.shading import (
     illuminate,
     pack_lights,
 )
-from frustum.simulation import (
-    INTEGRATORS,
-    Attractor,
-    DiskEmitter,
-    Drag,
-    Gravity,
-    LineEmitter,
-    MassSpringSystem,
-    MeshCollider,
-    MeshEmitter,
-    ParticleSystem,
-    PlaneCollider,
-    PointEmitter,
-    SphereCollider,
-    SphereEmitter,
-    Vortex,
-    Wind,
-    cloth,
-    rope,
-    soft_body,
-)
-from frustum.stereo import (
-    StereoCamera,
-)
-from frustum.trace import (
-    STAGE_NAMES,
-    SegmentClipping,
-    Stage,
-    Trace,
-    TracedPart,
-    TriangleClipping,
-    trace,
-)
 from frustum.transforms import (
     Step,
     apply,
@@ -296,15 +232,6 @@ from frustum.transforms import (
     swaps_handedness,
     to_row_major,
     translate,
-)
-from frustum.visibility import (
-    backface_mask,
-    plane_equations,
-    signed_window_areas,
-    viewing_position,
-)
-from frustum.visibility.octree import (
-    render_octree,
 )
 
 # The pipeline and everything above it load Numba and compile kernels on first use, so they are imported when one
@@ -340,13 +267,91 @@ _LAZY = {
     "simulate": "frustum.output.simulate",
     "turntable": "frustum.output.animation",
     "write_animation": "frustum.output.animation",
+    # modules the rendering path does not need: loaded on first use of one of their names
+    "BSPTree": "frustum.bsp",
+    "DepthOrder": "frustum.bsp",
+    "depth_sort": "frustum.bsp",
+    "EDGE_BOUNDARY": "frustum.hidden_lines",
+    "EDGE_CREASE": "frustum.hidden_lines",
+    "EDGE_KINDS": "frustum.hidden_lines",
+    "EDGE_LINE": "frustum.hidden_lines",
+    "EDGE_SILHOUETTE": "frustum.hidden_lines",
+    "HiddenLines": "frustum.hidden_lines",
+    "feature_edges": "frustum.hidden_lines",
+    "remove_hidden_lines": "frustum.hidden_lines",
+    "PAPER_SIZES": "frustum.output.sheet",
+    "SHEET_VIEWS": "frustum.output.sheet",
+    "STANDARD_SCALES": "frustum.output.sheet",
+    "drawing_sheet": "frustum.output.sheet",
+    "scale_label": "frustum.output.sheet",
+    "FILL_ORDERS": "frustum.output.svg",
+    "HIDDEN_STYLES": "frustum.output.svg",
+    "render_svg": "frustum.output.svg",
+    "save_svg": "frustum.output.svg",
+    "svg_document": "frustum.output.svg",
+    "svg_path_from_bezier": "frustum.output.svg",
+    "svg_path_from_polyline": "frustum.output.svg",
+    "INTEGRATORS": "frustum.simulation",
+    "Attractor": "frustum.simulation",
+    "DiskEmitter": "frustum.simulation",
+    "Drag": "frustum.simulation",
+    "Gravity": "frustum.simulation",
+    "LineEmitter": "frustum.simulation",
+    "MassSpringSystem": "frustum.simulation",
+    "MeshCollider": "frustum.simulation",
+    "MeshEmitter": "frustum.simulation",
+    "ParticleSystem": "frustum.simulation",
+    "PlaneCollider": "frustum.simulation",
+    "PointEmitter": "frustum.simulation",
+    "SphereCollider": "frustum.simulation",
+    "SphereEmitter": "frustum.simulation",
+    "Vortex": "frustum.simulation",
+    "Wind": "frustum.simulation",
+    "cloth": "frustum.simulation",
+    "rope": "frustum.simulation",
+    "soft_body": "frustum.simulation",
+    "StereoCamera": "frustum.stereo",
+    "STAGE_NAMES": "frustum.trace",
+    "SegmentClipping": "frustum.trace",
+    "Stage": "frustum.trace",
+    "Trace": "frustum.trace",
+    "TracedPart": "frustum.trace",
+    "TriangleClipping": "frustum.trace",
+    "trace": "frustum.trace",
+    "backface_mask": "frustum.visibility",
+    "plane_equations": "frustum.visibility",
+    "signed_window_areas": "frustum.visibility",
+    "viewing_position": "frustum.visibility",
+    "render_octree": "frustum.visibility.octree",
     # needs the viewer extra (anywidget); left out of __all__ so that `from frustum import *` works without it
     "Viewer": "frustum.viewer",
 }
 
 if TYPE_CHECKING:  # pragma: no cover
     from frustum.batch import DatasetResult, RenderJob, ViewResult, render_dataset, render_many
+    from frustum.bsp import (
+        BSPTree,
+        DepthOrder,
+        depth_sort,
+    )
+    from frustum.hidden_lines import (
+        EDGE_BOUNDARY,
+        EDGE_CREASE,
+        EDGE_KINDS,
+        EDGE_LINE,
+        EDGE_SILHOUETTE,
+        HiddenLines,
+        feature_edges,
+        remove_hidden_lines,
+    )
     from frustum.output.animation import turntable, write_animation
+    from frustum.output.sheet import (
+        PAPER_SIZES,
+        SHEET_VIEWS,
+        STANDARD_SCALES,
+        drawing_sheet,
+        scale_label,
+    )
     from frustum.output.simulate import simulate
     from frustum.output.stereo import (
         ANAGLYPH_METHODS,
@@ -355,6 +360,15 @@ if TYPE_CHECKING:  # pragma: no cover
         over_under,
         render_stereo,
         side_by_side,
+    )
+    from frustum.output.svg import (
+        FILL_ORDERS,
+        HIDDEN_STYLES,
+        render_svg,
+        save_svg,
+        svg_document,
+        svg_path_from_bezier,
+        svg_path_from_polyline,
     )
     from frustum.raster._jit import set_threads
     from frustum.render import RENDER_METHODS, RENDER_MODES, SHADING_MODES, VISIBILITY_METHODS, release_memory, render
@@ -367,6 +381,48 @@ if TYPE_CHECKING:  # pragma: no cover
         render_examples,
         render_scene_file,
         render_view_sheet,
+    )
+    from frustum.simulation import (
+        INTEGRATORS,
+        Attractor,
+        DiskEmitter,
+        Drag,
+        Gravity,
+        LineEmitter,
+        MassSpringSystem,
+        MeshCollider,
+        MeshEmitter,
+        ParticleSystem,
+        PlaneCollider,
+        PointEmitter,
+        SphereCollider,
+        SphereEmitter,
+        Vortex,
+        Wind,
+        cloth,
+        rope,
+        soft_body,
+    )
+    from frustum.stereo import (
+        StereoCamera,
+    )
+    from frustum.trace import (
+        STAGE_NAMES,
+        SegmentClipping,
+        Stage,
+        Trace,
+        TracedPart,
+        TriangleClipping,
+        trace,
+    )
+    from frustum.visibility import (
+        backface_mask,
+        plane_equations,
+        signed_window_areas,
+        viewing_position,
+    )
+    from frustum.visibility.octree import (
+        render_octree,
     )
     from frustum.warmup import warmup
 
