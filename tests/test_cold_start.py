@@ -61,6 +61,49 @@ def test_lazy_pipeline_names_resolve_and_the_function_render_survives_its_module
         _ = fr.nonexistent
 
 
+# modules the README's render (a teapot scene file to a PNG) has no use for: they load on first use of their names
+NOT_ON_THE_RENDER_PATH = (
+    "frustum.bsp", "frustum.geometry.csg", "frustum.geometry.dimension", "frustum.geometry.escape_time",
+    "frustum.geometry.fractals", "frustum.geometry.io", "frustum.geometry.lsystem", "frustum.geometry.octree",
+    "frustum.geometry.volume", "frustum.output.sheet", "frustum.output.svg", "frustum.simulation", "frustum.stereo",
+    "frustum.trace", "frustum.visibility",
+)  # fmt: skip
+
+
+def test_the_readme_render_path_loads_only_what_it_uses():
+    # the CLI, the renderer and the scene file (parsed, the teapot tessellated): everything but the kernel calls
+    code = (
+        "import sys, frustum, frustum.cli, frustum.render\n"
+        "from frustum.scenefile import load_scene_file\n"
+        "scene = load_scene_file('examples/teapot.toml')\n"
+        "assert scene.scene.items, 'the teapot was not built'\n"
+        "print(sorted(m for m in sys.modules if m.startswith('frustum.')))"
+    )
+    proc = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    loaded = set(eval(proc.stdout.strip()))
+    assert "frustum.geometry.teapot" in loaded and "frustum.scenefile" in loaded
+    unexpected = sorted(m for m in loaded if m.startswith(NOT_ON_THE_RENDER_PATH))
+    assert unexpected == [], f"the README render path imported {unexpected}"
+
+
+def test_every_public_name_resolves_in_a_fresh_interpreter():
+    # the lazy tables (frustum and frustum.geometry) name each attribute's real module; star-imports work
+    code = (
+        "import frustum as fr, frustum.geometry as g, frustum.geometry.octree as octree\n"
+        "values = [getattr(fr, n) for n in fr.__all__] + [getattr(g, n) for n in g.__all__]\n"
+        "namespace = {}\n"
+        "exec('from frustum import *; from frustum.geometry import *', namespace)\n"
+        "assert fr.Octree is octree.Octree is namespace['Octree'] and callable(fr.trace) and callable(fr.teapot)\n"
+        "assert set(fr.__all__) <= set(dir(fr)) and set(g.__all__) <= set(dir(g))\n"
+        "print(len(fr.__all__), len(g.__all__))"
+    )
+    proc = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    with pytest.raises(AttributeError, match=r"frustum\.geometry' has no attribute 'nonexistent'"):
+        _ = fr.geometry.nonexistent
+
+
 def _scene_and_camera():
     scene = fr.Scene(lights=[fr.PointLight((2, 3, 4)), fr.DirectionalLight(direction=(0, -1, -1))])
     scene.add(fr.uv_sphere(1.0, 48, 24), fr.Material(color=(0.8, 0.4, 0.2)), fr.rotate_y(0.4))

@@ -8,19 +8,23 @@ node's own transform is applied first) [HB 9] "Composite Transformations", [HB 1
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Iterable, Iterator
-from typing import Any, NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from frustum._arrays import Matrix4, as_matrix, as_scalar, as_vector3, describe
 from frustum.errors import FrustumError, GeometryError
-from frustum.geometry import Mesh, Octree, Polyline
-from frustum.geometry.volume import VOLUME_MODES, VOLUME_SAMPLINGS, TransferFunction, Volume
+from frustum.geometry import Mesh, Polyline
 from frustum.shading import LIGHT_TYPES, Light, Material
-from frustum.simulation import MassSpringSystem, ParticleSystem
 from frustum.transforms import translate
+
+if TYPE_CHECKING:  # imported where they are used: a scene of meshes and lines never loads these modules
+    from frustum.geometry.octree import Octree
+    from frustum.geometry.volume import TransferFunction, Volume
+    from frustum.simulation import MassSpringSystem, ParticleSystem
 
 __all__ = [
     "PARTICLE_BLENDING",
@@ -35,6 +39,13 @@ __all__ = [
     "cutaway",
     "exploded",
 ]
+
+
+def _is_octree(value: Any) -> bool:
+    """``isinstance(value, Octree)`` without importing ``frustum.geometry.octree``: no Octree exists before it is."""
+    module = sys.modules.get("frustum.geometry.octree")
+    return module is not None and isinstance(value, module.Octree)
+
 
 PARTICLE_STYLES = ("sprites", "points", "streaks")
 """How ``Scene.add_particles`` draws particles: soft round sprites, hard squares, or motion streaks."""
@@ -152,7 +163,7 @@ class Node:
         where = f"Node({name!r})"
         if not isinstance(name, str) or "/" in name:
             raise FrustumError(f"{where}: name = {describe(name)} is not a string without '/'; '/' separates paths")
-        if geometry is not None and not isinstance(geometry, Mesh | Polyline | Octree):
+        if geometry is not None and not (isinstance(geometry, Mesh | Polyline) or _is_octree(geometry)):
             raise FrustumError(
                 f"{where}: geometry = {describe(geometry)} is not a Mesh or Polyline; build one with Mesh(vertices, "
                 "faces) or a primitive, tessellate a surface, or draw a curve as Polyline(points)"
@@ -214,7 +225,7 @@ class Node:
     def __repr__(self) -> str:
         if isinstance(self.geometry, Mesh):
             kind = f"{self.geometry.face_count} faces"
-        elif isinstance(self.geometry, Octree):
+        elif _is_octree(self.geometry):
             kind = f"octree of depth {self.geometry.depth}"
         else:
             kind = "group" if self.geometry is None else f"polyline of {self.geometry.vertex_count} points"
@@ -267,7 +278,7 @@ class Scene:
             if material is not None or transform is not None:
                 raise FrustumError(f"{where}: give material and transform on the Node itself, not with a Node")
             return host.add(geometry)
-        if not isinstance(geometry, Mesh | Polyline | Octree):
+        if not (isinstance(geometry, Mesh | Polyline) or _is_octree(geometry)):
             raise FrustumError(
                 f"{where}: geometry = {describe(geometry)} is not a Mesh, Polyline or Node; build one with "
                 "Mesh(vertices, faces)"
@@ -300,6 +311,8 @@ class Scene:
         standing for Δ (a parallel camera's samples then lie on the same planes for every ray, as in VTK's
         fixed-point ray caster).
         """
+        from frustum.geometry.volume import VOLUME_MODES, VOLUME_SAMPLINGS, TransferFunction, Volume
+
         where = "Scene.add_volume"
         if not isinstance(volume, Volume):
             raise GeometryError(f"{where}: volume = {describe(volume)} is not a Volume; build one with Volume(data)")
@@ -352,6 +365,8 @@ class Scene:
         Particles are drawn after the opaque surfaces, depth-tested against them without writing depth
         (``frustum.particle_pass``); ``frustum.simulate`` steps the system between frames.
         """
+        from frustum.simulation import ParticleSystem
+
         where = "Scene.add_particles"
         if not isinstance(system, ParticleSystem):
             raise FrustumError(f"{where}: system = {describe(system)} is not a ParticleSystem")
@@ -367,6 +382,8 @@ class Scene:
                         parent: Node | str | None = None) -> Node:  # fmt: skip
         """Place `system`'s current ``mesh`` (cloth, soft body) as a node; ``frustum.simulate`` replaces the
         node's geometry by the new mesh after every frame's steps. Returns the node."""
+        from frustum.simulation import MassSpringSystem
+
         if not isinstance(system, MassSpringSystem):
             raise FrustumError(f"Scene.add_mass_spring: system = {describe(system)} is not a MassSpringSystem")
         node = self.add(system.mesh, material, name=name, parent=parent)
@@ -397,6 +414,8 @@ class Scene:
     @property
     def octrees(self) -> list[SceneItem]:
         """Placed octrees in drawing order (``SceneItem.mesh`` holds the Octree; ``render(..., method="octree")``)."""
+        from frustum.geometry.octree import Octree
+
         return self._placed(Octree)
 
     def pick(self, camera: Any, x: float, y: float) -> Pick | None:
@@ -477,7 +496,7 @@ class Scene:
             material = node.material if node.material is not None else inherited
             if isinstance(node.geometry, kind):
                 result.append(SceneItem(node.geometry, material, world))
-            elif kind is Mesh and isinstance(node.geometry, Octree):
+            elif kind is Mesh and _is_octree(node.geometry):
                 result.append(SceneItem(node.geometry.surface, material, world))
             for child in node.children:
                 visit(child, world, material)
@@ -639,7 +658,7 @@ def _cut_node(
             copy.geometry = Polyline(points, line.closed, line.markers)
             copy.material = child_material
         elif child.geometry is not None:
-            mesh = child.geometry.surface if isinstance(child.geometry, Octree) else child.geometry  # its cell faces
+            mesh = child.geometry.surface if _is_octree(child.geometry) else child.geometry  # its cell faces
             kept, removed = _cut_mesh(mesh, child_world, region, cap)
             if kept is not None:
                 body, section = _split_section(kept, region) if cap else (kept, None)

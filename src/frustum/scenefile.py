@@ -1742,6 +1742,8 @@ def _typed_list(report: _Report, path: tuple, value: Any, kinds: dict[str, str])
 def _simulations(report: _Report, data: dict, scene: Scene, materials: dict) -> None:
     """``[[particles]]`` (a ParticleSystem with its emitter, forces, colliders, style, blending) and ``[[cloth]]``
     (``frustum.cloth`` with its material and colliders) added to `scene`; ``[animation].warmup`` steps them."""
+    if "particles" not in data and "cloth" not in data:
+        return  # nothing to simulate: frustum.simulation is not loaded
     simulation = importlib.import_module("frustum.simulation")
     for i, entry in enumerate(_table_list(report, ("particles",), data.get("particles", []))):
         path, params = ("particles", i), dict(entry)

@@ -1,11 +1,9 @@
 """Modeling: things to draw, in their own (model) coordinates: meshes, primitives, quadrics and superquadrics,
 curves and surfaces, fractals, mesh files and CSG, octrees."""
 
-from frustum.geometry.csg import (
-    difference,
-    intersection,
-    union,
-)
+import importlib
+from typing import TYPE_CHECKING, Any
+
 from frustum.geometry.curves import (
     M_B,
     M_H,
@@ -25,57 +23,8 @@ from frustum.geometry.curves import (
     hermite_blending,
     open_uniform_knots,
 )
-from frustum.geometry.dimension import (
-    BoxCounting,
-    box_counting_dimension,
-)
-from frustum.geometry.escape_time import (
-    escape_time_colors,
-    julia,
-    mandelbrot,
-    quaternion_julia,
-    quaternion_julia_mesh,
-)
-from frustum.geometry.fractals import (
-    DEFAULT_MAX_BYTES,
-    IFS,
-    barnsley_fern,
-    cantor_set,
-    fbm_terrain,
-    fractal_coastline,
-    heightfield_mesh,
-    hilbert_curve,
-    hilbert_curve_3d,
-    koch_curve,
-    koch_snowflake,
-    menger_sponge,
-    peano_curve,
-    sierpinski_ifs,
-    sierpinski_tetrahedron,
-    sierpinski_triangle,
-    similarity_dimension,
-)
-from frustum.geometry.io import (
-    SUPPORTED_SUFFIXES,
-    MeshPart,
-    load,
-    load_parts,
-)
-from frustum.geometry.lsystem import (
-    CLASSIC_LSYSTEMS,
-    LSystem,
-    TurtlePath,
-    interpret,
-    parse_rules,
-    tube_mesh,
-)
 from frustum.geometry.mesh import (
     Mesh,
-)
-from frustum.geometry.octree import (
-    TEXTBOOK_OCTANTS,
-    Octree,
-    OctreeHits,
 )
 from frustum.geometry.polyline import (
     Polyline,
@@ -116,17 +65,141 @@ from frustum.geometry.teapot import (
     teapot,
     teaspoon,
 )
-from frustum.geometry.volume import (
-    TRANSFER_PRESETS,
-    VOLUME_MODES,
-    VOLUME_SAMPLINGS,
-    TransferFunction,
-    Volume,
-    blobby_volume,
-    fbm_cloud,
-    head_phantom,
-    quaternion_julia_volume,
-)
+
+# Fractals, L-systems, escape-time sets, mesh files, CSG, octrees and volumes load on first use of one of their names
+# (PEP 562): rendering a mesh, a primitive or a patch surface does not import them.
+_LAZY = {
+    "difference": "frustum.geometry.csg",
+    "intersection": "frustum.geometry.csg",
+    "union": "frustum.geometry.csg",
+    "BoxCounting": "frustum.geometry.dimension",
+    "box_counting_dimension": "frustum.geometry.dimension",
+    "escape_time_colors": "frustum.geometry.escape_time",
+    "julia": "frustum.geometry.escape_time",
+    "mandelbrot": "frustum.geometry.escape_time",
+    "quaternion_julia": "frustum.geometry.escape_time",
+    "quaternion_julia_mesh": "frustum.geometry.escape_time",
+    "DEFAULT_MAX_BYTES": "frustum.geometry.fractals",
+    "IFS": "frustum.geometry.fractals",
+    "barnsley_fern": "frustum.geometry.fractals",
+    "cantor_set": "frustum.geometry.fractals",
+    "fbm_terrain": "frustum.geometry.fractals",
+    "fractal_coastline": "frustum.geometry.fractals",
+    "heightfield_mesh": "frustum.geometry.fractals",
+    "hilbert_curve": "frustum.geometry.fractals",
+    "hilbert_curve_3d": "frustum.geometry.fractals",
+    "koch_curve": "frustum.geometry.fractals",
+    "koch_snowflake": "frustum.geometry.fractals",
+    "menger_sponge": "frustum.geometry.fractals",
+    "peano_curve": "frustum.geometry.fractals",
+    "sierpinski_ifs": "frustum.geometry.fractals",
+    "sierpinski_tetrahedron": "frustum.geometry.fractals",
+    "sierpinski_triangle": "frustum.geometry.fractals",
+    "similarity_dimension": "frustum.geometry.fractals",
+    "SUPPORTED_SUFFIXES": "frustum.geometry.io",
+    "MeshPart": "frustum.geometry.io",
+    "load": "frustum.geometry.io",
+    "load_parts": "frustum.geometry.io",
+    "CLASSIC_LSYSTEMS": "frustum.geometry.lsystem",
+    "LSystem": "frustum.geometry.lsystem",
+    "TurtlePath": "frustum.geometry.lsystem",
+    "interpret": "frustum.geometry.lsystem",
+    "parse_rules": "frustum.geometry.lsystem",
+    "tube_mesh": "frustum.geometry.lsystem",
+    "TEXTBOOK_OCTANTS": "frustum.geometry.octree",
+    "Octree": "frustum.geometry.octree",
+    "OctreeHits": "frustum.geometry.octree",
+    "TRANSFER_PRESETS": "frustum.geometry.volume",
+    "VOLUME_MODES": "frustum.geometry.volume",
+    "VOLUME_SAMPLINGS": "frustum.geometry.volume",
+    "TransferFunction": "frustum.geometry.volume",
+    "Volume": "frustum.geometry.volume",
+    "blobby_volume": "frustum.geometry.volume",
+    "fbm_cloud": "frustum.geometry.volume",
+    "head_phantom": "frustum.geometry.volume",
+    "quaternion_julia_volume": "frustum.geometry.volume",
+}
+
+if TYPE_CHECKING:  # pragma: no cover
+    from frustum.geometry.csg import (
+        difference,
+        intersection,
+        union,
+    )
+    from frustum.geometry.dimension import (
+        BoxCounting,
+        box_counting_dimension,
+    )
+    from frustum.geometry.escape_time import (
+        escape_time_colors,
+        julia,
+        mandelbrot,
+        quaternion_julia,
+        quaternion_julia_mesh,
+    )
+    from frustum.geometry.fractals import (
+        DEFAULT_MAX_BYTES,
+        IFS,
+        barnsley_fern,
+        cantor_set,
+        fbm_terrain,
+        fractal_coastline,
+        heightfield_mesh,
+        hilbert_curve,
+        hilbert_curve_3d,
+        koch_curve,
+        koch_snowflake,
+        menger_sponge,
+        peano_curve,
+        sierpinski_ifs,
+        sierpinski_tetrahedron,
+        sierpinski_triangle,
+        similarity_dimension,
+    )
+    from frustum.geometry.io import (
+        SUPPORTED_SUFFIXES,
+        MeshPart,
+        load,
+        load_parts,
+    )
+    from frustum.geometry.lsystem import (
+        CLASSIC_LSYSTEMS,
+        LSystem,
+        TurtlePath,
+        interpret,
+        parse_rules,
+        tube_mesh,
+    )
+    from frustum.geometry.octree import (
+        TEXTBOOK_OCTANTS,
+        Octree,
+        OctreeHits,
+    )
+    from frustum.geometry.volume import (
+        TRANSFER_PRESETS,
+        VOLUME_MODES,
+        VOLUME_SAMPLINGS,
+        TransferFunction,
+        Volume,
+        blobby_volume,
+        fbm_cloud,
+        head_phantom,
+        quaternion_julia_volume,
+    )
+
+
+def __getattr__(name: str) -> Any:
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'frustum.geometry' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY))
+
 
 __all__ = [
     "CLASSIC_LSYSTEMS",
