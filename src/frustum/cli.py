@@ -27,7 +27,6 @@ from typing import Annotated, Any
 import numpy as np
 import typer
 from rich.console import Console
-from rich.table import Table
 
 import frustum.raster
 from frustum import __version__
@@ -124,6 +123,8 @@ def parse_step(text: str) -> Step:
 
 def _print_matrix(title: str, matrix: np.ndarray) -> None:
     """A titled 4x4 grid; entries within 1e-12 of an integer print as that integer (cos 90° = 6e-17 → 0)."""
+    from rich.table import Table
+
     table = Table(show_header=False, box=None, pad_edge=False)
     for _ in range(matrix.shape[1]):
         table.add_column(justify="right")
@@ -357,6 +358,8 @@ def _triple_text(values: Sequence[float]) -> str:
 @app.command("info")
 def info_command(mesh: Annotated[Path, typer.Argument(help="A mesh file (.ply, .obj, .stl, .off, .glb).")]) -> None:
     """Print a mesh file's counts, bounds, watertightness and normals."""
+    from rich.table import Table
+
     loaded = _load_mesh(mesh, "info")
     table = Table(title=str(mesh), show_header=False, title_justify="left")
     table.add_column(style="bold")
