@@ -420,6 +420,18 @@ def test_frame_png_round_trip(tmp_path):
     assert not frame.color.flags.writeable and not frame.depth.flags.writeable
 
 
+def test_frame_save_writes_png_for_any_case_of_the_suffix(tmp_path):
+    # Frame.save lets Pillow pick the format from the temporary's suffix (".part.png"): an upper-case ".PNG" too
+    color = np.random.default_rng(3).integers(0, 256, size=(5, 7, 4), dtype=np.uint8)
+    frame = Frame(color, np.ones((5, 7), np.float32))
+    for name in ("upper.PNG", "mixed.Png", "name.with.dots.png"):
+        frame.save(tmp_path / name)
+        with Image.open(tmp_path / name) as image:
+            assert image.format == "PNG" and image.mode == "RGBA"
+            np.testing.assert_array_equal(np.asarray(image), color)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["mixed.Png", "name.with.dots.png", "upper.PNG"]
+
+
 def test_frame_save_rejects_other_suffixes(tmp_path):
     frame = Frame(np.zeros((2, 3, 4), np.uint8), np.ones((2, 3), np.float32))
     with pytest.raises(FrustumError, match=r"suffix '\.jpg'"):
