@@ -40,8 +40,9 @@ class Listener(event.Listener):
 
 event.register("numba:compile", Listener())
 from frustum.cli import main
+sys.argv[0] = "frustum"
 try:
-    main(sys.argv[1:])
+    main()  # as the console script runs it (the program's garbage-collector settings apply)
 except SystemExit as stop:
     if stop.code:
         raise
