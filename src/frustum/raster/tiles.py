@@ -2,13 +2,17 @@
 
 This is also the per-face half of triangle setup (``triangles.face_box``: trivial reject and accept by region
 codes, back-face cull by the signed window area, pixel bounding box): nothing per face is stored but its tile
-list entries, and the count pass's list of the faces that draw anything (with the one tile of each small face),
+list entries, and the count pass's list of the faces that draw anything (with the tiles of each small face),
 so the fill visits those only. Count (parallel over chunks of faces), records of the clipped faces added to
 their face's chunk, prefix sum (``render.tile_offsets``, NumPy, tile-major so chunk c's entries precede chunk
 c + 1's within every tile), fill (parallel over chunks). A face goes to every tile its pixel bounding box
 touches; a crossing face's clipped triangles (``triangles.clip_faces``) go, in fan order, where the face is.
 options = (width, height, cull, tile_bits, tiles_x, chunk, face_offset) int64: tiles are
 ``2^tile_bits`` pixels square, so a pixel's tile index is a shift.
+
+The per-face loop is bound by its instruction count (the faces of a mesh in grid order read their vertices
+from cache), so it indexes flat views with unsigned integers (``_U1``), keeps the box arithmetic to what
+changes the result, and turns the random outcomes into values rather than branches where that is cheap.
 """
 
 from __future__ import annotations
@@ -16,12 +20,23 @@ from __future__ import annotations
 import numpy as np
 
 from frustum.raster._jit import kernel, parallel_kernel
-from frustum.raster.fixed_point import HALF_SUBPIXEL, SUBPIXEL
-from frustum.raster.triangles import CROSSING, FACE_CROSSING, FACE_DRAWN, covers_centre, face_box
+from frustum.raster.fixed_point import HALF_SUBPIXEL, SUBPIXEL, SUBPIXEL_BITS
+from frustum.raster.triangles import CROSSING, FACE_DRAWN, covers_centre, face_box
 
-__all__ = ["add_record_tiles", "count_tiles", "fill_tiles"]
+__all__ = ["BOX_BITS", "SEVERAL", "add_record_tiles", "count_tiles", "fill_tiles"]
 
 O_WIDTH, O_HEIGHT, O_CULL, O_BITS, O_TILES_X, O_CHUNK, O_FACE_OFFSET = 0, 1, 2, 3, 4, 5, 6
+
+_U1, _U2, _U3 = np.uint64(1), np.uint64(2), np.uint64(3)
+"""Unsigned index arithmetic: Numba indexes with an unsigned integer without the negative-index fix-up, and a flat
+view with ``3·f + k`` without a multiplication by the row stride (an int literal with a uint64 gives int64)."""
+SEVERAL = -1
+"""``listed_tiles`` mark of a face touching more tiles than a box mark holds: the fill reads its vertices again."""
+BOX_BITS = 3
+"""A face touching several tiles, at most ``2^BOX_BITS`` columns and rows of them, is marked in ``listed_tiles``
+with its box, ``CROSSING − 1 − (t0·4^BOX_BITS + (columns − 1)·2^BOX_BITS + (rows − 1))`` (t0 its first tile), so
+the fill does not gather its vertices again (no longer in cache by then: that was most of the fill's time)."""
+_BOX_MASK = (1 << BOX_BITS) - 1
 
 
 @parallel_kernel(lambda *args: args[4].shape[0])  # counts: one row per chunk of faces
@@ -32,51 +47,88 @@ def count_tiles(
 ) -> None:  # fmt: skip
     """``counts[c, t]`` = how many drawn faces of chunk c touch tile t; ``crossing[c]`` = its crossing faces.
 
-    counts (C, tiles), crossing (C,) and listed_counts (C,) int64 are written; chunk c is faces
-    [c·chunk, (c+1)·chunk); a face whose box holds one pixel centre counts only if it covers it (most sub-pixel
-    triangles of a fine mesh do not). The chunk's drawn and crossing faces, in order, go to ``listed`` (M,) from
-    ``c·chunk`` on, ``listed_counts[c]`` of them: the fill visits only those (most faces of a fine mesh draw
-    nothing, being back faces or falling between pixel centres). ``listed_tiles`` (M,) beside each: the one
-    tile a drawn face touches, −1 when it touches several (the fill then reads the face again; small faces, the
-    many, are filled from these two sequential arrays alone), ``triangles.CROSSING`` when it crosses the view
-    volume.
+    faces (M, 3) and win_int (N, 2) C-contiguous; counts (C, tiles), crossing (C,) and listed_counts (C,) int64
+    are written; chunk c is faces [c·chunk, (c+1)·chunk). Per face, ``triangles.face_box`` written out (the same
+    results): trivial reject or crossing by region codes, cull by the signed area, pixel box; a face whose box
+    holds one pixel centre counts only if it covers it (most sub-pixel triangles of a fine mesh do not). The
+    chunk's drawn and crossing faces, in order, go to ``listed`` (M,) from ``c·chunk`` on, ``listed_counts[c]``
+    of them: the fill visits only those (most faces of a fine mesh draw nothing, being back faces or falling
+    between pixel centres). ``listed_tiles`` (M,) beside each: the one tile a drawn face touches (small faces,
+    the many, are filled from these two sequential arrays alone), the box mark of a face touching a few tiles
+    (``BOX_BITS``), ``SEVERAL`` for a larger one, ``triangles.CROSSING`` when it crosses the view volume.
+
+    Whether a one-centre box's face covers the centre (random on a fine mesh) is a value, not a branch: a face
+    that draws nothing writes its slot all the same (the next face overwrites it); the count of the current
+    tile stays in a register while consecutive faces stay in it (no store-to-load chain through ``counts``).
     """
     width, height, cull = options[O_WIDTH], options[O_HEIGHT], options[O_CULL]
     bits, tiles_x, chunk = options[O_BITS], options[O_TILES_X], options[O_CHUNK]
+    flat_faces, flat_win, flat_counts = faces.reshape(-1), win_int.reshape(-1), counts.reshape(-1)
+    tiles = counts.shape[1]
+    marks_fit = tiles <= 1 << (28 - 2 * BOX_BITS)  # a box mark fits in int32
     for c in range(start, stop):
-        for t in range(counts.shape[1]):
-            counts[c, t] = 0
+        row = c * tiles
+        for t in range(tiles):
+            flat_counts[np.uint64(row + t)] = 0
         crossed = 0
-        n = c * chunk
+        n = np.uint64(c * chunk)
+        last, run = 0, 0  # the current tile, and its count not yet added to counts
         for f in range(c * chunk, min((c + 1) * chunk, faces.shape[0])):
-            state, back, i_min, i_max, j_min, j_max = face_box(faces, codes, win_int, f, width, height, cull)
-            if state == FACE_CROSSING:
-                crossed += 1
-                listed[n], listed_tiles[n] = f, CROSSING
-                n += 1
-            elif state == FACE_DRAWN:
-                if i_min == i_max and j_min == j_max and not _covers_its_centre(faces, win_int, f, back, i_min, j_min):
-                    continue  # a sub-pixel triangle missing the one centre of its box (most of a fine mesh's)
-                one = (j_min >> bits) == (j_max >> bits) and (i_min >> bits) == (i_max >> bits)
-                listed[n], listed_tiles[n] = f, ((j_min >> bits) * tiles_x + (i_min >> bits)) if one else -1
-                n += 1
-                for ty in range(j_min >> bits, (j_max >> bits) + 1):
-                    for tx in range(i_min >> bits, (i_max >> bits) + 1):
-                        counts[c, ty * tiles_x + tx] += 1
+            k = np.uint64(f) * _U3
+            i0, i1, i2 = np.uint64(flat_faces[k]), np.uint64(flat_faces[k + _U1]), np.uint64(flat_faces[k + _U2])
+            c0, c1, c2 = codes[i0], codes[i1], codes[i2]
+            if (c0 | c1 | c2) != 0:
+                if (c0 & c1 & c2) == 0:
+                    crossed += 1
+                    listed[n], listed_tiles[n] = f, CROSSING
+                    n += _U1
+                continue
+            k0, k1, k2 = i0 * _U2, i1 * _U2, i2 * _U2
+            x0, y0 = np.int64(flat_win[k0]), np.int64(flat_win[k0 + _U1])
+            x1, y1 = np.int64(flat_win[k1]), np.int64(flat_win[k1 + _U1])
+            x2, y2 = np.int64(flat_win[k2]), np.int64(flat_win[k2 + _U1])
+            area = (x1 - x0) * (y2 - y0) - (x2 - x0) * (y1 - y0)
+            if area <= 0:
+                if area == 0 or cull != 0:
+                    continue
+                x1, y1, x2, y2 = x2, y2, x1, y1  # clockwise: drawn with corners 1 and 2 swapped
+            # the box's first centre 256·i + 128 >= min X is i = (min X + 127) >> 8; the clamp to the image is a
+            # no-op for vertices inside the view volume, so it is tested once rather than applied four times
+            i_min = (min(x0, min(x1, x2)) + (HALF_SUBPIXEL - 1)) >> SUBPIXEL_BITS
+            i_max = (max(x0, max(x1, x2)) - HALF_SUBPIXEL) >> SUBPIXEL_BITS
+            j_min = (min(y0, min(y1, y2)) + (HALF_SUBPIXEL - 1)) >> SUBPIXEL_BITS
+            j_max = (max(y0, max(y1, y2)) - HALF_SUBPIXEL) >> SUBPIXEL_BITS
+            if (i_min | j_min | (width - 1 - i_max) | (height - 1 - j_max)) < 0:
+                i_min, j_min = max(i_min, 0), max(j_min, 0)
+                i_max, j_max = min(i_max, width - 1), min(j_max, height - 1)
+            spread = (i_max - i_min) | (j_max - j_min)  # < 0: no pixel centre, 0: one, > 0: several
+            keep = spread >= 0
+            if spread == 0:
+                keep = covers_centre(
+                    x0, y0, x1, y1, x2, y2, SUBPIXEL * i_min + HALF_SUBPIXEL, SUBPIXEL * j_min + HALF_SUBPIXEL
+                )
+            tx0, tx1, ty0, ty1 = i_min >> bits, i_max >> bits, j_min >> bits, j_max >> bits
+            t = ty0 * tiles_x + tx0
+            listed[n] = f
+            if tx0 == tx1 and ty0 == ty1:
+                t = t if keep else last
+                listed_tiles[n] = t
+                if t != last:
+                    flat_counts[np.uint64(row + last)] += run
+                    last, run = t, 0
+                run += np.int64(keep)
+            elif keep:
+                columns, rows = tx1 - tx0, ty1 - ty0
+                box = (t << (2 * BOX_BITS)) | (columns << BOX_BITS) | rows
+                small = (columns | rows) <= _BOX_MASK and marks_fit
+                listed_tiles[n] = (CROSSING - 1 - box) if small else SEVERAL
+                for ty in range(ty0, ty1 + 1):
+                    for tx in range(tx0, tx1 + 1):
+                        flat_counts[np.uint64(row + ty * tiles_x + tx)] += 1
+            n += np.uint64(keep)
+        flat_counts[np.uint64(row + last)] += run
         crossing[c] = crossed
-        listed_counts[c] = n - c * chunk
-
-
-@kernel
-def _covers_its_centre(faces: np.ndarray, win_int: np.ndarray, f: int, back: int, i: int, j: int) -> bool:
-    """Whether face f (drawn from its vertices; corners 1 and 2 swapped when back) covers pixel (i, j)'s centre."""
-    a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
-    if back == 1:
-        b, c = c, b
-    return covers_centre(
-        np.int64(win_int[a, 0]), np.int64(win_int[a, 1]), np.int64(win_int[b, 0]), np.int64(win_int[b, 1]),
-        np.int64(win_int[c, 0]), np.int64(win_int[c, 1]), SUBPIXEL * i + HALF_SUBPIXEL, SUBPIXEL * j + HALF_SUBPIXEL,
-    )  # fmt: skip
+        listed_counts[c] = np.int64(n) - c * chunk
 
 
 @kernel
@@ -99,34 +151,57 @@ def fill_tiles(
 ) -> None:  # fmt: skip
     """Write each drawn face's index (and ``−1 − r`` for each record r of a clipped face) into the lists of the
     tiles it touches, in face order: the faces ``count_tiles`` listed, a one-tile face straight from
-    ``listed_tiles``, the others by ``face_box`` again. offsets (C, tiles) is consumed;
-    crossing_starts (C,) is the index of chunk c's first crossing face among all crossing faces, whose records
-    are ``record_starts[k]:record_starts[k + 1]``.
+    ``listed_tiles``, a few-tile one from its box mark, a larger one by ``face_box`` again. offsets (C, tiles)
+    C-contiguous is consumed (the current tile's offset stays in a register while consecutive faces stay in
+    it); crossing_starts (C,) is the index of chunk c's first crossing face among all crossing faces, whose
+    records are ``record_starts[k]:record_starts[k + 1]``.
     """
     width, height, cull = options[O_WIDTH], options[O_HEIGHT], options[O_CULL]
     bits, tiles_x, chunk = options[O_BITS], options[O_TILES_X], options[O_CHUNK]
+    flat_offsets = offsets.reshape(-1)
+    tiles = offsets.shape[1]
     for c in range(start, stop):
+        row = c * tiles
         k = crossing_starts[c]
+        last = 0
+        slot = flat_offsets[np.uint64(row)]  # offsets[c, last], stored back when another tile is written
         for n in range(c * chunk, c * chunk + listed_counts[c]):
-            f = listed[n]
-            t = listed_tiles[n]
+            f = listed[np.uint64(n)]
+            t = listed_tiles[np.uint64(n)]
             if t >= 0:
-                tile_entries[offsets[c, t]] = f
-                offsets[c, t] += 1
+                if t != last:
+                    flat_offsets[np.uint64(row + last)] = slot
+                    last = t
+                    slot = flat_offsets[np.uint64(row + t)]
+                tile_entries[np.uint64(slot)] = f
+                slot += 1
                 continue
+            flat_offsets[np.uint64(row + last)] = slot
             if t == CROSSING:
                 for r in range(record_starts[k], record_starts[k + 1]):
                     for ty in range(tri_int[r, 9] >> bits, (tri_int[r, 10] >> bits) + 1):
                         for tx in range(tri_int[r, 7] >> bits, (tri_int[r, 8] >> bits) + 1):
-                            t = ty * tiles_x + tx
-                            tile_entries[offsets[c, t]] = -1 - r
-                            offsets[c, t] += 1
+                            _append(tile_entries, flat_offsets, row + ty * tiles_x + tx, -1 - r)
                 k += 1
-                continue
-            state, _, i_min, i_max, j_min, j_max = face_box(faces, codes, win_int, f, width, height, cull)
-            if state == FACE_DRAWN:
-                for ty in range(j_min >> bits, (j_max >> bits) + 1):
-                    for tx in range(i_min >> bits, (i_max >> bits) + 1):
-                        t = ty * tiles_x + tx
-                        tile_entries[offsets[c, t]] = f
-                        offsets[c, t] += 1
+            elif t == SEVERAL:
+                state, _, i_min, i_max, j_min, j_max = face_box(faces, codes, win_int, f, width, height, cull)
+                if state == FACE_DRAWN:
+                    for ty in range(j_min >> bits, (j_max >> bits) + 1):
+                        for tx in range(i_min >> bits, (i_max >> bits) + 1):
+                            _append(tile_entries, flat_offsets, row + ty * tiles_x + tx, f)
+            else:
+                box = CROSSING - 1 - t
+                first = row + (box >> (2 * BOX_BITS))
+                for ty in range((box & _BOX_MASK) + 1):
+                    for tx in range(((box >> BOX_BITS) & _BOX_MASK) + 1):
+                        _append(tile_entries, flat_offsets, first + ty * tiles_x + tx, f)
+            slot = flat_offsets[np.uint64(row + last)]
+        flat_offsets[np.uint64(row + last)] = slot
+
+
+@kernel
+def _append(tile_entries: np.ndarray, flat_offsets: np.ndarray, o: int, entry: int) -> None:
+    """``tile_entries[flat_offsets[o]] = entry``, and advance that offset."""
+    slot = flat_offsets[np.uint64(o)]
+    tile_entries[np.uint64(slot)] = entry
+    flat_offsets[np.uint64(o)] = slot + 1
