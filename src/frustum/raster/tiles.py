@@ -21,7 +21,7 @@ import numpy as np
 
 from frustum.raster._jit import kernel, parallel_kernel
 from frustum.raster.fixed_point import HALF_SUBPIXEL, SUBPIXEL, SUBPIXEL_BITS
-from frustum.raster.triangles import CROSSING, FACE_DRAWN, covers_centre, face_box
+from frustum.raster.triangles import CROSSING, covers_centre
 
 __all__ = ["BOX_BITS", "SEVERAL", "add_record_tiles", "count_tiles", "fill_tiles"]
 
@@ -151,12 +151,12 @@ def fill_tiles(
 ) -> None:  # fmt: skip
     """Write each drawn face's index (and ``−1 − r`` for each record r of a clipped face) into the lists of the
     tiles it touches, in face order: the faces ``count_tiles`` listed, a one-tile face straight from
-    ``listed_tiles``, a few-tile one from its box mark, a larger one by ``face_box`` again. offsets (C, tiles)
-    C-contiguous is consumed (the current tile's offset stays in a register while consecutive faces stay in
-    it); crossing_starts (C,) is the index of chunk c's first crossing face among all crossing faces, whose
-    records are ``record_starts[k]:record_starts[k + 1]``.
+    ``listed_tiles``, a few-tile one from its box mark, a larger one from its vertices again (``_pixel_box``).
+    offsets (C, tiles) C-contiguous is consumed (the current tile's offset stays in a register while consecutive
+    faces stay in it); crossing_starts (C,) is the index of chunk c's first crossing face among all crossing faces,
+    whose records are ``record_starts[k]:record_starts[k + 1]``.
     """
-    width, height, cull = options[O_WIDTH], options[O_HEIGHT], options[O_CULL]
+    width, height = options[O_WIDTH], options[O_HEIGHT]
     bits, tiles_x, chunk = options[O_BITS], options[O_TILES_X], options[O_CHUNK]
     flat_offsets = offsets.reshape(-1)
     tiles = offsets.shape[1]
@@ -179,29 +179,48 @@ def fill_tiles(
             flat_offsets[np.uint64(row + last)] = slot
             if t == CROSSING:
                 for r in range(record_starts[k], record_starts[k + 1]):
-                    for ty in range(tri_int[r, 9] >> bits, (tri_int[r, 10] >> bits) + 1):
-                        for tx in range(tri_int[r, 7] >> bits, (tri_int[r, 8] >> bits) + 1):
-                            _append(tile_entries, flat_offsets, row + ty * tiles_x + tx, -1 - r)
+                    tx0, ty0 = tri_int[r, 7] >> bits, tri_int[r, 9] >> bits
+                    columns, rows = (tri_int[r, 8] >> bits) - tx0, (tri_int[r, 10] >> bits) - ty0
+                    _append_box(tile_entries, flat_offsets, row + ty0 * tiles_x + tx0, columns, rows, tiles_x, -1 - r)
                 k += 1
-            elif t == SEVERAL:
-                state, _, i_min, i_max, j_min, j_max = face_box(faces, codes, win_int, f, width, height, cull)
-                if state == FACE_DRAWN:
-                    for ty in range(j_min >> bits, (j_max >> bits) + 1):
-                        for tx in range(i_min >> bits, (i_max >> bits) + 1):
-                            _append(tile_entries, flat_offsets, row + ty * tiles_x + tx, f)
+                slot = flat_offsets[np.uint64(row + last)]
+                continue
+            if t == SEVERAL:
+                i_min, i_max, j_min, j_max = _pixel_box(faces, win_int, f, width, height)
+                first = row + (j_min >> bits) * tiles_x + (i_min >> bits)
+                columns, rows = (i_max >> bits) - (i_min >> bits), (j_max >> bits) - (j_min >> bits)
             else:
                 box = CROSSING - 1 - t
                 first = row + (box >> (2 * BOX_BITS))
-                for ty in range((box & _BOX_MASK) + 1):
-                    for tx in range(((box >> BOX_BITS) & _BOX_MASK) + 1):
-                        _append(tile_entries, flat_offsets, first + ty * tiles_x + tx, f)
+                columns, rows = (box >> BOX_BITS) & _BOX_MASK, box & _BOX_MASK
+            _append_box(tile_entries, flat_offsets, first, columns, rows, tiles_x, np.int64(f))
             slot = flat_offsets[np.uint64(row + last)]
         flat_offsets[np.uint64(row + last)] = slot
 
 
 @kernel
-def _append(tile_entries: np.ndarray, flat_offsets: np.ndarray, o: int, entry: int) -> None:
-    """``tile_entries[flat_offsets[o]] = entry``, and advance that offset."""
-    slot = flat_offsets[np.uint64(o)]
-    tile_entries[np.uint64(slot)] = entry
-    flat_offsets[np.uint64(o)] = slot + 1
+def _append_box(
+    tile_entries: np.ndarray, flat_offsets: np.ndarray, first: int, columns: int, rows: int, tiles_x: int, entry: int
+) -> None:  # fmt: skip
+    """Append `entry` to the lists of tiles ``first + ty·tiles_x + tx``, ty <= rows, tx <= columns, advancing their
+    offsets (``flat_offsets``, indexed like ``first``)."""
+    for ty in range(rows + 1):
+        for tx in range(columns + 1):
+            o = np.uint64(first + ty * tiles_x + tx)
+            slot = flat_offsets[o]
+            tile_entries[np.uint64(slot)] = entry
+            flat_offsets[o] = slot + 1
+
+
+@kernel
+def _pixel_box(faces: np.ndarray, win_int: np.ndarray, f: int, width: int, height: int) -> tuple[int, int, int, int]:
+    """``(i_min, i_max, j_min, j_max)``: the pixel centres' box of drawn face f, clamped to the image (as
+    ``triangles.face_box``; the corners' order does not matter, nor is the face tested again)."""
+    a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
+    x0, x1, x2 = np.int64(win_int[a, 0]), np.int64(win_int[b, 0]), np.int64(win_int[c, 0])
+    y0, y1, y2 = np.int64(win_int[a, 1]), np.int64(win_int[b, 1]), np.int64(win_int[c, 1])
+    i_min = max((min(x0, min(x1, x2)) + (HALF_SUBPIXEL - 1)) >> SUBPIXEL_BITS, 0)
+    i_max = min((max(x0, max(x1, x2)) - HALF_SUBPIXEL) >> SUBPIXEL_BITS, width - 1)
+    j_min = max((min(y0, min(y1, y2)) + (HALF_SUBPIXEL - 1)) >> SUBPIXEL_BITS, 0)
+    j_max = min((max(y0, max(y1, y2)) - HALF_SUBPIXEL) >> SUBPIXEL_BITS, height - 1)
+    return i_min, i_max, j_min, j_max
