@@ -10,9 +10,11 @@ touches; a crossing face's clipped triangles (``triangles.clip_faces``) go, in f
 options = (width, height, cull, tile_bits, tiles_x, chunk, face_offset) int64: tiles are
 ``2^tile_bits`` pixels square, so a pixel's tile index is a shift.
 
-The per-face loop is bound by its instruction count (the faces of a mesh in grid order read their vertices
-from cache), so it indexes flat views with unsigned integers (``_U1``), keeps the box arithmetic to what
-changes the result, and turns the random outcomes into values rather than branches where that is cheap.
+The count is bound by its instruction count and mispredicted branches, not by memory (a mesh in grid order
+reads its vertices from cache), so it runs over blocks of ``BLOCK`` faces in three passes: a scalar one gathers
+the corners of the faces that may draw, a branch-free one that LLVM vectorizes finds each one's pixel box,
+coverage and tile, a third lists and counts them. Flat views are indexed with unsigned integers (``_U1``).
+Measured single-thread on terrain_2m (2M faces, 1920x1080): count 31 -> 12-13 ms, fill 7 -> 1.4 ms.
 """
 
 from __future__ import annotations
@@ -34,9 +36,16 @@ SEVERAL = -1
 """``listed_tiles`` mark of a face touching more tiles than a box mark holds: the fill reads its vertices again."""
 BOX_BITS = 3
 """A face touching several tiles, at most ``2^BOX_BITS`` columns and rows of them, is marked in ``listed_tiles``
-with its box, ``CROSSING − 1 − (t0·4^BOX_BITS + (columns − 1)·2^BOX_BITS + (rows − 1))`` (t0 its first tile), so
-the fill does not gather its vertices again (no longer in cache by then: that was most of the fill's time)."""
+with its box, ``CROSSING − 1 − (t0·4^BOX_BITS + wide·2^BOX_BITS + tall)`` (t0 its first tile, wide and tall the
+columns and rows beyond it), so the fill does not gather its vertices again (no longer in cache by then: that
+was most of the fill's time)."""
 _BOX_MASK = (1 << BOX_BITS) - 1
+BLOCK = 512
+"""Faces per block of ``count_tiles``: the corners of those that may draw (7 rows of BLOCK int64, 28 KiB) stay in
+the L1 cache between its three passes."""
+_BLOCK = np.uint64(BLOCK)
+_NOTHING = -3
+"""``_classify`` state of a face that draws nothing (no pixel centre, or misses its one centre)."""
 
 
 @parallel_kernel(lambda *args: args[4].shape[0])  # counts: one row per chunk of faces
@@ -48,87 +57,122 @@ def count_tiles(
     """``counts[c, t]`` = how many drawn faces of chunk c touch tile t; ``crossing[c]`` = its crossing faces.
 
     faces (M, 3) and win_int (N, 2) C-contiguous; counts (C, tiles), crossing (C,) and listed_counts (C,) int64
-    are written; chunk c is faces [c·chunk, (c+1)·chunk). Per face, ``triangles.face_box`` written out (the same
-    results): trivial reject or crossing by region codes, cull by the signed area, pixel box; a face whose box
-    holds one pixel centre counts only if it covers it (most sub-pixel triangles of a fine mesh do not). The
-    chunk's drawn and crossing faces, in order, go to ``listed`` (M,) from ``c·chunk`` on, ``listed_counts[c]``
-    of them: the fill visits only those (most faces of a fine mesh draw nothing, being back faces or falling
-    between pixel centres). ``listed_tiles`` (M,) beside each: the one tile a drawn face touches (small faces,
-    the many, are filled from these two sequential arrays alone), the box mark of a face touching a few tiles
-    (``BOX_BITS``), ``SEVERAL`` for a larger one, ``triangles.CROSSING`` when it crosses the view volume.
-
-    Whether a one-centre box's face covers the centre (random on a fine mesh) is a value, not a branch: a face
-    that draws nothing writes its slot all the same (the next face overwrites it); the count of the current
-    tile stays in a register while consecutive faces stay in it (no store-to-load chain through ``counts``).
+    are written; chunk c is faces [c·chunk, (c+1)·chunk). Per face, ``triangles.face_box`` in three passes over
+    blocks of ``BLOCK`` faces (the same results): trivial reject or crossing by region codes and cull by the
+    signed area (``_gather_block``), the pixel box, whether a face whose box holds one pixel centre covers it
+    (most sub-pixel triangles of a fine mesh do not) and its tile (``_classify``, vectorized), then the lists and
+    counts. The chunk's drawn and crossing faces, in order, go to ``listed`` (M,) from ``c·chunk`` on,
+    ``listed_counts[c]`` of them: the fill visits only those (most faces of a fine mesh draw nothing, being back
+    faces or falling between pixel centres). ``listed_tiles`` (M,) beside each: the one tile a drawn face touches
+    (small faces, the many, are filled from these two sequential arrays alone), the box mark of a face touching a
+    few tiles (``BOX_BITS``), ``SEVERAL`` for a larger one, ``triangles.CROSSING`` when it crosses the view
+    volume. Every face of a block writes its slot, a face that draws nothing too (the next one overwrites it):
+    no branch on whether it draws, which is random on a fine mesh.
     """
     width, height, cull = options[O_WIDTH], options[O_HEIGHT], options[O_CULL]
     bits, tiles_x, chunk = options[O_BITS], options[O_TILES_X], options[O_CHUNK]
     flat_faces, flat_win, flat_counts = faces.reshape(-1), win_int.reshape(-1), counts.reshape(-1)
     tiles = counts.shape[1]
     marks_fit = tiles <= 1 << (28 - 2 * BOX_BITS)  # a box mark fits in int32
+    block = np.zeros(7 * BLOCK, np.int64)  # a crossing face's corners are never written: no garbage read
+    index = np.empty(BLOCK, np.int64)
+    state = np.empty(BLOCK, np.int64)
     for c in range(start, stop):
-        row = c * tiles
+        row = np.uint64(c * tiles)
         for t in range(tiles):
-            flat_counts[np.uint64(row + t)] = 0
+            flat_counts[row + np.uint64(t)] = 0
         crossed = 0
         n = np.uint64(c * chunk)
-        last, run = 0, 0  # the current tile, and its count not yet added to counts
-        for f in range(c * chunk, min((c + 1) * chunk, faces.shape[0])):
-            k = np.uint64(f) * _U3
-            i0, i1, i2 = np.uint64(flat_faces[k]), np.uint64(flat_faces[k + _U1]), np.uint64(flat_faces[k + _U2])
-            c0, c1, c2 = codes[i0], codes[i1], codes[i2]
-            if (c0 | c1 | c2) != 0:
-                if (c0 & c1 & c2) == 0:
-                    crossed += 1
-                    listed[n], listed_tiles[n] = f, CROSSING
-                    n += _U1
-                continue
-            k0, k1, k2 = i0 * _U2, i1 * _U2, i2 * _U2
-            x0, y0 = np.int64(flat_win[k0]), np.int64(flat_win[k0 + _U1])
-            x1, y1 = np.int64(flat_win[k1]), np.int64(flat_win[k1 + _U1])
-            x2, y2 = np.int64(flat_win[k2]), np.int64(flat_win[k2 + _U1])
-            area = (x1 - x0) * (y2 - y0) - (x2 - x0) * (y1 - y0)
-            if area <= 0:
-                if area == 0 or cull != 0:
-                    continue
-                x1, y1, x2, y2 = x2, y2, x1, y1  # clockwise: drawn with corners 1 and 2 swapped
-            # the box's first centre 256·i + 128 >= min X is i = (min X + 127) >> 8; the clamp to the image is a
-            # no-op for vertices inside the view volume, so it is tested once rather than applied four times
-            i_min = (min(x0, min(x1, x2)) + (HALF_SUBPIXEL - 1)) >> SUBPIXEL_BITS
-            i_max = (max(x0, max(x1, x2)) - HALF_SUBPIXEL) >> SUBPIXEL_BITS
-            j_min = (min(y0, min(y1, y2)) + (HALF_SUBPIXEL - 1)) >> SUBPIXEL_BITS
-            j_max = (max(y0, max(y1, y2)) - HALF_SUBPIXEL) >> SUBPIXEL_BITS
-            if (i_min | j_min | (width - 1 - i_max) | (height - 1 - j_max)) < 0:
-                i_min, j_min = max(i_min, 0), max(j_min, 0)
-                i_max, j_max = min(i_max, width - 1), min(j_max, height - 1)
-            spread = (i_max - i_min) | (j_max - j_min)  # < 0: no pixel centre, 0: one, > 0: several
-            keep = spread >= 0
-            if spread == 0:
-                keep = covers_centre(
-                    x0, y0, x1, y1, x2, y2, SUBPIXEL * i_min + HALF_SUBPIXEL, SUBPIXEL * j_min + HALF_SUBPIXEL
-                )
-            tx0, tx1, ty0, ty1 = i_min >> bits, i_max >> bits, j_min >> bits, j_max >> bits
-            t = ty0 * tiles_x + tx0
-            listed[n] = f
-            if tx0 == tx1 and ty0 == ty1:
-                t = t if keep else last
-                listed_tiles[n] = t
-                if t != last:
-                    flat_counts[np.uint64(row + last)] += run
-                    last, run = t, 0
-                run += np.int64(keep)
-            elif keep:
-                columns, rows = tx1 - tx0, ty1 - ty0
-                box = (t << (2 * BOX_BITS)) | (columns << BOX_BITS) | rows
-                small = (columns | rows) <= _BOX_MASK and marks_fit
-                listed_tiles[n] = (CROSSING - 1 - box) if small else SEVERAL
-                for ty in range(ty0, ty1 + 1):
-                    for tx in range(tx0, tx1 + 1):
-                        flat_counts[np.uint64(row + ty * tiles_x + tx)] += 1
-            n += np.uint64(keep)
-        flat_counts[np.uint64(row + last)] += run
+        end = min((c + 1) * chunk, faces.shape[0])
+        for first in range(c * chunk, end, BLOCK):
+            m = _gather_block(flat_faces, codes, flat_win, first, min(first + BLOCK, end), cull, block, index)
+            crossed += _classify(block, m, width, height, bits, tiles_x, state)
+            for j in range(m):
+                u = np.uint64(j)
+                s = state[u]
+                listed[n], listed_tiles[n] = index[u], s
+                flat_counts[row + np.uint64(max(s, 0))] += np.int64(s >= 0)
+                n += np.uint64(s != _NOTHING)
+                if s == SEVERAL:  # mark its box, count its tiles
+                    i_min, i_max = _pixel_range(block[u], block[u + 2 * _BLOCK], block[u + 4 * _BLOCK], width)
+                    j_min, j_max = _pixel_range(block[u + _BLOCK], block[u + 3 * _BLOCK], block[u + 5 * _BLOCK], height)
+                    tx0, tx1, ty0, ty1 = i_min >> bits, i_max >> bits, j_min >> bits, j_max >> bits
+                    wide, tall = tx1 - tx0, ty1 - ty0  # tiles beyond the first
+                    box = ((ty0 * tiles_x + tx0) << (2 * BOX_BITS)) | (wide << BOX_BITS) | tall
+                    if (wide | tall) <= _BOX_MASK and marks_fit:
+                        listed_tiles[n - _U1] = CROSSING - 1 - box
+                    for ty in range(ty0, ty1 + 1):
+                        for tx in range(tx0, tx1 + 1):
+                            counts[c, ty * tiles_x + tx] += 1  # not flat: a loop not worth vectorizing
         crossing[c] = crossed
         listed_counts[c] = np.int64(n) - c * chunk
+
+
+@kernel
+def _gather_block(
+    flat_faces: np.ndarray, codes: np.ndarray, flat_win: np.ndarray, first: int, stop: int, cull: int,
+    block: np.ndarray, index: np.ndarray,
+) -> int:  # fmt: skip
+    """The faces [first, stop) that may draw, in order: returns their number m; ``index[j]`` is the j-th one's
+    face and ``block[j + k·BLOCK]`` its corners ``X0, Y0, X1, Y1, X2, Y2`` (k = 0..5; counter-clockwise, corners
+    1 and 2 swapped for a drawn back face) and whether it crosses the view volume (k = 6; no corners then).
+    Faces rejected by their region codes, of zero area, or culled back faces are left out."""
+    m = np.uint64(0)
+    for f in range(first, stop):
+        k = np.uint64(f) * _U3
+        i0, i1, i2 = np.uint64(flat_faces[k]), np.uint64(flat_faces[k + _U1]), np.uint64(flat_faces[k + _U2])
+        c0, c1, c2 = codes[i0], codes[i1], codes[i2]
+        if (c0 | c1 | c2) != 0:
+            if (c0 & c1 & c2) == 0:
+                index[m], block[m + 6 * _BLOCK] = f, 1
+                m += _U1
+            continue
+        k0, k1, k2 = i0 * _U2, i1 * _U2, i2 * _U2
+        x0, y0 = np.int64(flat_win[k0]), np.int64(flat_win[k0 + _U1])
+        x1, y1 = np.int64(flat_win[k1]), np.int64(flat_win[k1 + _U1])
+        x2, y2 = np.int64(flat_win[k2]), np.int64(flat_win[k2 + _U1])
+        area = (x1 - x0) * (y2 - y0) - (x2 - x0) * (y1 - y0)
+        if area <= 0:
+            if area == 0 or cull != 0:
+                continue
+            x1, y1, x2, y2 = x2, y2, x1, y1  # clockwise: drawn with corners 1 and 2 swapped
+        block[m], block[m + _BLOCK], block[m + 2 * _BLOCK], block[m + 3 * _BLOCK] = x0, y0, x1, y1
+        block[m + 4 * _BLOCK], block[m + 5 * _BLOCK], block[m + 6 * _BLOCK] = x2, y2, 0
+        index[m] = f
+        m += _U1
+    return np.int64(m)
+
+
+@kernel
+def _classify(block: np.ndarray, m: int, width: int, height: int, bits: int, tiles_x: int, state: np.ndarray) -> int:
+    """``state[j]`` of the m faces of a ``_gather_block`` block: the one tile a face touches, ``SEVERAL``,
+    ``triangles.CROSSING``, or ``_NOTHING`` (no pixel centre in its box, or misses its one centre); returns how
+    many cross. No branch: every test is a value, so the loop is vectorized (8 faces per AVX-512 instruction)."""
+    crossed = 0
+    for j in range(m):
+        u = np.uint64(j)
+        x0, y0, x1, y1 = block[u], block[u + _BLOCK], block[u + 2 * _BLOCK], block[u + 3 * _BLOCK]
+        x2, y2, crosses = block[u + 4 * _BLOCK], block[u + 5 * _BLOCK], block[u + 6 * _BLOCK]
+        i_min, i_max = _pixel_range(x0, x1, x2, width)
+        j_min, j_max = _pixel_range(y0, y1, y2, height)
+        spread = (i_max - i_min) | (j_max - j_min)  # < 0: no pixel centre, 0: one, > 0: several
+        centre = SUBPIXEL * i_min + HALF_SUBPIXEL, SUBPIXEL * j_min + HALF_SUBPIXEL
+        drawn = (spread > 0) | ((spread == 0) & covers_centre(x0, y0, x1, y1, x2, y2, centre[0], centre[1]))
+        one = ((i_min ^ i_max) | (j_min ^ j_max)) >> bits == 0
+        s = ((j_min >> bits) * tiles_x + (i_min >> bits)) if one else SEVERAL
+        s = s if drawn else _NOTHING
+        state[u] = s if crosses == 0 else CROSSING
+        crossed += crosses
+    return crossed
+
+
+@kernel
+def _pixel_range(a: int, b: int, c: int, size: int) -> tuple[int, int]:
+    """``(first, last)`` pixel whose centre ``256·i + 128`` lies in [min, max] of the fixed-point coordinates
+    a, b, c, clamped to [0, size − 1] (``triangles._window_box``): the first is ``(min + 127) >> 8``."""
+    first = max((min(a, min(b, c)) + (HALF_SUBPIXEL - 1)) >> SUBPIXEL_BITS, 0)
+    last = min((max(a, max(b, c)) - HALF_SUBPIXEL) >> SUBPIXEL_BITS, size - 1)
+    return first, last
 
 
 @kernel
@@ -217,10 +261,6 @@ def _pixel_box(faces: np.ndarray, win_int: np.ndarray, f: int, width: int, heigh
     """``(i_min, i_max, j_min, j_max)``: the pixel centres' box of drawn face f, clamped to the image (as
     ``triangles.face_box``; the corners' order does not matter, nor is the face tested again)."""
     a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
-    x0, x1, x2 = np.int64(win_int[a, 0]), np.int64(win_int[b, 0]), np.int64(win_int[c, 0])
-    y0, y1, y2 = np.int64(win_int[a, 1]), np.int64(win_int[b, 1]), np.int64(win_int[c, 1])
-    i_min = max((min(x0, min(x1, x2)) + (HALF_SUBPIXEL - 1)) >> SUBPIXEL_BITS, 0)
-    i_max = min((max(x0, max(x1, x2)) - HALF_SUBPIXEL) >> SUBPIXEL_BITS, width - 1)
-    j_min = max((min(y0, min(y1, y2)) + (HALF_SUBPIXEL - 1)) >> SUBPIXEL_BITS, 0)
-    j_max = min((max(y0, max(y1, y2)) - HALF_SUBPIXEL) >> SUBPIXEL_BITS, height - 1)
+    i_min, i_max = _pixel_range(np.int64(win_int[a, 0]), np.int64(win_int[b, 0]), np.int64(win_int[c, 0]), width)
+    j_min, j_max = _pixel_range(np.int64(win_int[a, 1]), np.int64(win_int[b, 1]), np.int64(win_int[c, 1]), height)
     return i_min, i_max, j_min, j_max
