@@ -41,9 +41,11 @@ columns and rows beyond it), so the fill does not gather its vertices again (no 
 was most of the fill's time)."""
 _BOX_MASK = (1 << BOX_BITS) - 1
 BLOCK = 512
-"""Faces per block of ``count_tiles``: the corners of those that may draw (7 rows of BLOCK int64, 28 KiB) stay in
-the L1 cache between its three passes."""
-_BLOCK = np.uint64(BLOCK)
+"""Faces per block of ``count_tiles``: what its three passes hand on (9 rows of BLOCK int64, 36 KiB: ``_ROW1``)
+stays in the L1 cache."""
+_ROW1, _ROW2, _ROW3, _ROW4, _ROW5, _ROW6, _ROW7, _ROW8 = (np.uint64(k * BLOCK) for k in range(1, 9))
+"""Offsets of the rows of a block (unsigned): corners ``X0, Y0, X1, Y1, X2, Y2`` (rows 0–5), crossing (6),
+face (7), ``_classify`` state (8)."""
 _NOTHING = -3
 """``_classify`` state of a face that draws nothing (no pixel centre, or misses its one centre)."""
 
@@ -71,39 +73,30 @@ def count_tiles(
     """
     width, height, cull = options[O_WIDTH], options[O_HEIGHT], options[O_CULL]
     bits, tiles_x, chunk = options[O_BITS], options[O_TILES_X], options[O_CHUNK]
-    flat_faces, flat_win, flat_counts = faces.reshape(-1), win_int.reshape(-1), counts.reshape(-1)
+    flat_faces, flat_win = faces.reshape(-1), win_int.reshape(-1)
     tiles = counts.shape[1]
     marks_fit = tiles <= 1 << (28 - 2 * BOX_BITS)  # a box mark fits in int32
-    block = np.zeros(7 * BLOCK, np.int64)  # a crossing face's corners are never written: no garbage read
-    index = np.empty(BLOCK, np.int64)
-    state = np.empty(BLOCK, np.int64)
+    block = np.empty(9 * BLOCK, np.int64)
     for c in range(start, stop):
-        row = np.uint64(c * tiles)
         for t in range(tiles):
-            flat_counts[row + np.uint64(t)] = 0
+            counts[c, t] = 0
         crossed = 0
         n = np.uint64(c * chunk)
         end = min((c + 1) * chunk, faces.shape[0])
         for first in range(c * chunk, end, BLOCK):
-            m = _gather_block(flat_faces, codes, flat_win, first, min(first + BLOCK, end), cull, block, index)
-            crossed += _classify(block, m, width, height, bits, tiles_x, state)
+            m = _gather_block(flat_faces, codes, flat_win, first, min(first + BLOCK, end), cull, block)
+            crossed += _classify(block, m, width, height, bits, tiles_x, marks_fit)
             for j in range(m):
                 u = np.uint64(j)
-                s = state[u]
-                listed[n], listed_tiles[n] = index[u], s
-                flat_counts[row + np.uint64(max(s, 0))] += np.int64(s >= 0)
+                s = block[u + _ROW8]
+                listed[n], listed_tiles[n] = block[u + _ROW7], s
+                counts[c, max(s, 0)] += np.int64(s >= 0)
                 n += np.uint64(s != _NOTHING)
-                if s == SEVERAL:  # mark its box, count its tiles
-                    i_min, i_max = _pixel_range(block[u], block[u + 2 * _BLOCK], block[u + 4 * _BLOCK], width)
-                    j_min, j_max = _pixel_range(block[u + _BLOCK], block[u + 3 * _BLOCK], block[u + 5 * _BLOCK], height)
-                    tx0, tx1, ty0, ty1 = i_min >> bits, i_max >> bits, j_min >> bits, j_max >> bits
-                    wide, tall = tx1 - tx0, ty1 - ty0  # tiles beyond the first
-                    box = ((ty0 * tiles_x + tx0) << (2 * BOX_BITS)) | (wide << BOX_BITS) | tall
-                    if (wide | tall) <= _BOX_MASK and marks_fit:
-                        listed_tiles[n - _U1] = CROSSING - 1 - box
-                    for ty in range(ty0, ty1 + 1):
-                        for tx in range(tx0, tx1 + 1):
-                            counts[c, ty * tiles_x + tx] += 1  # not flat: a loop not worth vectorizing
+                if s == SEVERAL or s < _NOTHING:  # a face touching several tiles
+                    tx0, ty0, wide, tall = block[u], block[u + _ROW1], block[u + _ROW2], block[u + _ROW3]
+                    for ty in range(ty0, ty0 + tall + 1):
+                        for tx in range(tx0, tx0 + wide + 1):
+                            counts[c, ty * tiles_x + tx] += 1
         crossing[c] = crossed
         listed_counts[c] = np.int64(n) - c * chunk
 
@@ -111,11 +104,11 @@ def count_tiles(
 @kernel
 def _gather_block(
     flat_faces: np.ndarray, codes: np.ndarray, flat_win: np.ndarray, first: int, stop: int, cull: int,
-    block: np.ndarray, index: np.ndarray,
+    block: np.ndarray,
 ) -> int:  # fmt: skip
-    """The faces [first, stop) that may draw, in order: returns their number m; ``index[j]`` is the j-th one's
-    face and ``block[j + k·BLOCK]`` its corners ``X0, Y0, X1, Y1, X2, Y2`` (k = 0..5; counter-clockwise, corners
-    1 and 2 swapped for a drawn back face) and whether it crosses the view volume (k = 6; no corners then).
+    """The faces [first, stop) that may draw, in order: returns their number m; ``block[j + k·BLOCK]`` is the
+    j-th one's corners ``X0, Y0, X1, Y1, X2, Y2`` (k = 0..5; counter-clockwise, corners 1 and 2 swapped for a
+    drawn back face; zeros for a crossing face), whether it crosses the view volume (k = 6) and its face (k = 7).
     Faces rejected by their region codes, of zero area, or culled back faces are left out."""
     m = np.uint64(0)
     for f in range(first, stop):
@@ -124,7 +117,8 @@ def _gather_block(
         c0, c1, c2 = codes[i0], codes[i1], codes[i2]
         if (c0 | c1 | c2) != 0:
             if (c0 & c1 & c2) == 0:
-                index[m], block[m + 6 * _BLOCK] = f, 1
+                block[m], block[m + _ROW1], block[m + _ROW2], block[m + _ROW3] = 0, 0, 0, 0
+                block[m + _ROW4], block[m + _ROW5], block[m + _ROW6], block[m + _ROW7] = 0, 0, 1, f
                 m += _U1
             continue
         k0, k1, k2 = i0 * _U2, i1 * _U2, i2 * _U2
@@ -136,43 +130,42 @@ def _gather_block(
             if area == 0 or cull != 0:
                 continue
             x1, y1, x2, y2 = x2, y2, x1, y1  # clockwise: drawn with corners 1 and 2 swapped
-        block[m], block[m + _BLOCK], block[m + 2 * _BLOCK], block[m + 3 * _BLOCK] = x0, y0, x1, y1
-        block[m + 4 * _BLOCK], block[m + 5 * _BLOCK], block[m + 6 * _BLOCK] = x2, y2, 0
-        index[m] = f
+        block[m], block[m + _ROW1], block[m + _ROW2], block[m + _ROW3] = x0, y0, x1, y1
+        block[m + _ROW4], block[m + _ROW5], block[m + _ROW6], block[m + _ROW7] = x2, y2, 0, f
         m += _U1
     return np.int64(m)
 
 
 @kernel
-def _classify(block: np.ndarray, m: int, width: int, height: int, bits: int, tiles_x: int, state: np.ndarray) -> int:
-    """``state[j]`` of the m faces of a ``_gather_block`` block: the one tile a face touches, ``SEVERAL``,
-    ``triangles.CROSSING``, or ``_NOTHING`` (no pixel centre in its box, or misses its one centre); returns how
-    many cross. No branch: every test is a value, so the loop is vectorized (8 faces per AVX-512 instruction)."""
+def _classify(block: np.ndarray, m: int, width: int, height: int, bits: int, tiles_x: int, marks_fit: bool) -> int:
+    """The state ``block[j + 8·BLOCK]`` of the m faces of a ``_gather_block`` block, its ``listed_tiles`` entry
+    if it draws: the one tile a face touches, its box mark (``BOX_BITS``), ``SEVERAL``, ``triangles.CROSSING``, or
+    ``_NOTHING`` (no pixel centre in its box, or misses its one centre); its tiles ``tx0, ty0, wide, tall``
+    replace its corners X0, Y0, X1, Y1. Returns how many cross. No branch: every test is a value, so the loop is
+    vectorized (8 faces an AVX-512 instruction). The pixel box is ``triangles._window_box``'s: the first centre
+    ``256·i + 128 >= min X`` is ``i = (min X + 127) >> 8``."""
     crossed = 0
     for j in range(m):
         u = np.uint64(j)
-        x0, y0, x1, y1 = block[u], block[u + _BLOCK], block[u + 2 * _BLOCK], block[u + 3 * _BLOCK]
-        x2, y2, crosses = block[u + 4 * _BLOCK], block[u + 5 * _BLOCK], block[u + 6 * _BLOCK]
-        i_min, i_max = _pixel_range(x0, x1, x2, width)
-        j_min, j_max = _pixel_range(y0, y1, y2, height)
+        x0, y0, x1, y1 = block[u], block[u + _ROW1], block[u + _ROW2], block[u + _ROW3]
+        x2, y2, crosses = block[u + _ROW4], block[u + _ROW5], block[u + _ROW6]
+        i_min = max((min(x0, min(x1, x2)) + (HALF_SUBPIXEL - 1)) >> SUBPIXEL_BITS, 0)
+        i_max = min((max(x0, max(x1, x2)) - HALF_SUBPIXEL) >> SUBPIXEL_BITS, width - 1)
+        j_min = max((min(y0, min(y1, y2)) + (HALF_SUBPIXEL - 1)) >> SUBPIXEL_BITS, 0)
+        j_max = min((max(y0, max(y1, y2)) - HALF_SUBPIXEL) >> SUBPIXEL_BITS, height - 1)
         spread = (i_max - i_min) | (j_max - j_min)  # < 0: no pixel centre, 0: one, > 0: several
-        centre = SUBPIXEL * i_min + HALF_SUBPIXEL, SUBPIXEL * j_min + HALF_SUBPIXEL
-        drawn = (spread > 0) | ((spread == 0) & covers_centre(x0, y0, x1, y1, x2, y2, centre[0], centre[1]))
-        one = ((i_min ^ i_max) | (j_min ^ j_max)) >> bits == 0
-        s = ((j_min >> bits) * tiles_x + (i_min >> bits)) if one else SEVERAL
+        px, py = SUBPIXEL * i_min + HALF_SUBPIXEL, SUBPIXEL * j_min + HALF_SUBPIXEL
+        drawn = (spread > 0) | ((spread == 0) & covers_centre(x0, y0, x1, y1, x2, y2, px, py))
+        tx0, ty0 = i_min >> bits, j_min >> bits
+        wide, tall = (i_max >> bits) - tx0, (j_max >> bits) - ty0  # tiles beyond the first
+        t = ty0 * tiles_x + tx0
+        mark = (CROSSING - 1 - ((t << (2 * BOX_BITS)) | (wide << BOX_BITS) | tall)) if marks_fit else SEVERAL
+        s = t if (wide | tall) == 0 else (mark if (wide | tall) <= _BOX_MASK else SEVERAL)
         s = s if drawn else _NOTHING
-        state[u] = s if crosses == 0 else CROSSING
+        block[u + _ROW8] = s if crosses == 0 else CROSSING
+        block[u], block[u + _ROW1], block[u + _ROW2], block[u + _ROW3] = tx0, ty0, wide, tall
         crossed += crosses
     return crossed
-
-
-@kernel
-def _pixel_range(a: int, b: int, c: int, size: int) -> tuple[int, int]:
-    """``(first, last)`` pixel whose centre ``256·i + 128`` lies in [min, max] of the fixed-point coordinates
-    a, b, c, clamped to [0, size − 1] (``triangles._window_box``): the first is ``(min + 127) >> 8``."""
-    first = max((min(a, min(b, c)) + (HALF_SUBPIXEL - 1)) >> SUBPIXEL_BITS, 0)
-    last = min((max(a, max(b, c)) - HALF_SUBPIXEL) >> SUBPIXEL_BITS, size - 1)
-    return first, last
 
 
 @kernel
@@ -261,6 +254,10 @@ def _pixel_box(faces: np.ndarray, win_int: np.ndarray, f: int, width: int, heigh
     """``(i_min, i_max, j_min, j_max)``: the pixel centres' box of drawn face f, clamped to the image (as
     ``triangles.face_box``; the corners' order does not matter, nor is the face tested again)."""
     a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
-    i_min, i_max = _pixel_range(np.int64(win_int[a, 0]), np.int64(win_int[b, 0]), np.int64(win_int[c, 0]), width)
-    j_min, j_max = _pixel_range(np.int64(win_int[a, 1]), np.int64(win_int[b, 1]), np.int64(win_int[c, 1]), height)
+    x0, x1, x2 = np.int64(win_int[a, 0]), np.int64(win_int[b, 0]), np.int64(win_int[c, 0])
+    y0, y1, y2 = np.int64(win_int[a, 1]), np.int64(win_int[b, 1]), np.int64(win_int[c, 1])
+    i_min = max((min(x0, min(x1, x2)) + (HALF_SUBPIXEL - 1)) >> SUBPIXEL_BITS, 0)
+    i_max = min((max(x0, max(x1, x2)) - HALF_SUBPIXEL) >> SUBPIXEL_BITS, width - 1)
+    j_min = max((min(y0, min(y1, y2)) + (HALF_SUBPIXEL - 1)) >> SUBPIXEL_BITS, 0)
+    j_max = min((max(y0, max(y1, y2)) - HALF_SUBPIXEL) >> SUBPIXEL_BITS, height - 1)
     return i_min, i_max, j_min, j_max
