@@ -606,3 +606,25 @@ def test_block_min_matches_the_reduction(factor, height, width, seed):
     result = _block_min(depth, factor)
     assert result.dtype == depth.dtype
     np.testing.assert_array_equal(result, expected)
+
+
+@pytest.mark.parametrize("cull", [True, False])
+def test_tile_pipeline_of_a_fine_mesh_equals_reference_byte_for_byte(cull):
+    """Triangles of about a pixel, most of whose boxes hold at most 2 × 2 centres (``triangles._fill_tile`` tests
+    those four centres as one mask): the same bytes as the reference."""
+    from frustum.raster.fixed_point import SUBPIXEL
+    from frustum.render import bin_item
+
+    scene = Scene(lights=[LIGHT])
+    scene.add(sphere_mesh(5), material=Material(color=(0.8, 0.5, 0.3)))
+    camera = Camera.look_at((0.4, 0.9, 3.2), (0.0, 0.0, 0.0), (0, 1, 0), projection=Perspective(0.8, 0.3, 30.0),
+                            width=160, height=120)  # fmt: skip
+    binned = bin_item(scene.items[0], camera, cull=cull)
+    corners = binned.win_int[binned.faces].astype(np.int64)  # (F, 3, 2) snapped window coordinates
+    span = (corners.max(axis=1) - corners.min(axis=1)) / SUBPIXEL
+    assert (span.max(axis=1) < 2.0).mean() > 0.5  # most boxes are at most 2 x 2 centres: the test is not vacuous
+    frame = render(scene, camera, background=BACKGROUND, cull_back_faces=cull)
+    color, depth = reference_render(scene, camera, background=BACKGROUND, cull_back_faces=cull)
+    assert (frame.depth < 1.0).mean() > 0.3
+    np.testing.assert_array_equal(frame.depth, depth)
+    np.testing.assert_array_equal(frame.color, color)

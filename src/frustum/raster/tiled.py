@@ -113,12 +113,14 @@ def _shade_tile(
     at ``offset + c``), and paint the others with the background word; return how many are listed now."""
     face_offset = item[I_FACE_OFFSET]
     for row in range(rows):
+        at_row = np.uint64(row)  # unsigned indices: no negative-index fix-up
         for col in range(cols):
-            if not depth[row, col] < 1.0:
-                words[row, offset + col, 0] = word
+            at = np.uint64(col)
+            if not depth[at_row, at] < 1.0:
+                words[at_row, np.uint64(offset + col), 0] = word
                 continue
-            code = codes[row, col]  # the one mesh's: written wherever depth < 1
-            scratch[_X + n], scratch[_NDL + n] = float(bary[row, col, 0]), float(bary[row, col, 1])
+            code = codes[at_row, at]  # the one mesh's: written wherever depth < 1
+            scratch[_X + n], scratch[_NDL + n] = float(bary[at_row, at, 0]), float(bary[at_row, at, 1])
             scratch[_SIGN + n] = -1.0 if code & 1 else 1.0
             where[n], where[_CHUNK + n], where[2 * _CHUNK + n] = row, offset + col, (code >> 1) - face_offset
             n += 1
