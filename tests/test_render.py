@@ -628,3 +628,24 @@ def test_tile_pipeline_of_a_fine_mesh_equals_reference_byte_for_byte(cull):
     assert (frame.depth < 1.0).mean() > 0.3
     np.testing.assert_array_equal(frame.depth, depth)
     np.testing.assert_array_equal(frame.color, color)
+
+
+def test_clipping_in_one_pass_or_two_gives_the_same_frame(monkeypatch):
+    """Faces crossing the view volume are clipped once into ``FAN_MAX`` slots each (``render.ONE_PASS_CLIPPING``
+    or fewer of them) or counted first and then written: the same records, the same bytes as the reference."""
+    import importlib
+
+    pipeline = importlib.import_module("frustum.render")  # the module (``frustum.render`` is the function)
+    scene, camera = small_scene()  # its ground crosses the near plane
+    binned = pipeline.bin_item(scene.items[2], camera, cull=True)
+    assert binned.crossing.size and binned.tri_int.shape[0] > binned.crossing.size
+    one = render(scene, camera, background=BACKGROUND)
+    monkeypatch.setattr(pipeline, "ONE_PASS_CLIPPING", 0)
+    again = pipeline.bin_item(scene.items[2], camera, cull=True)
+    for name in ("tri_int", "tri_float", "tri_weights", "tile_starts", "tile_entries"):
+        np.testing.assert_array_equal(getattr(again, name), getattr(binned, name), err_msg=name)
+    two = render(scene, camera, background=BACKGROUND)
+    color, depth = reference_render(scene, camera, background=BACKGROUND)
+    for frame in (one, two):
+        np.testing.assert_array_equal(frame.color, color)
+        np.testing.assert_array_equal(frame.depth, depth)

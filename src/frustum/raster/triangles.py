@@ -53,6 +53,7 @@ __all__ = [
     "FACE_CROSSING",
     "FACE_DRAWN",
     "FACE_NONE",
+    "FAN_MAX",
     "RECORD_FIELDS",
     "SUBPIXEL",
     "clip_faces",
@@ -71,6 +72,9 @@ AHEAD = 16
 not fit in cache (2M triangles) took 10–25 % less time."""
 _LOWEST_BIT = np.array([0, 0, 1, 0, 2, 0, 1, 0, 3, 0, 1, 0, 2, 0, 1, 0], dtype=np.int64)
 """Index of the lowest set bit of a 4-bit mask (``_fill_tile``'s 2 × 2 boxes: bit ci + 2·cj)."""
+FAN_MAX = 7
+"""Most triangles one clipped face makes: a triangle clipped by the six view-volume planes has at most 3 + 6
+corners, a fan of at most 7 triangles (``clip_faces``'s one-pass mode)."""
 CROSSING = -2
 """``tiles.count_tiles``'s ``listed_tiles`` mark of a face crossing the view volume (its clipped records are
 filled in its place)."""
@@ -245,7 +249,8 @@ def clip_faces(
     The clip coordinates of the corners are recomputed (``vertices.clip_vertex``, the same bytes as the vertex
     stage). options = (width, height, cull, face_offset, write) int64. With write = 0, ``record_starts[k]``
     receives how many records crossing face k makes; with write = 1 its records go to slots
-    ``record_starts[k]`` on, in fan order.
+    ``record_starts[k]`` on, in fan order; with write = 2 they go there too and ``record_starts[k]`` then
+    receives their number (one pass, into ``FAN_MAX`` slots per face).
     """
     write = options[4]
     size = options[0:3]
@@ -268,7 +273,7 @@ def clip_faces(
             made += one
             if slot >= 0:
                 slot += one
-        if write == 0:
+        if write != 1:
             record_starts[k] = made
 
 
