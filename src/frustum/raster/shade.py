@@ -566,4 +566,4 @@ def _shade_chunk(
             | 255 << 24
         )
     for i in range(n):
-        words[where[i], where[_CHUNK + i], 0] = where[2 * _CHUNK + i]
+        words[np.uint64(where[i]), np.uint64(where[_CHUNK + i]), 0] = where[2 * _CHUNK + i]

@@ -84,14 +84,15 @@ def draw_tiles_directional(
                             params, lights, item, word, band_words, scratch, where, corners)  # fmt: skip
             for row in range(bottom - top):
                 for col in range(col1 - col0):
-                    band_depth[row, col0 - left + col] = near[row, col]
+                    band_depth[np.uint64(row), np.uint64(col0 - left + col)] = near[np.uint64(row), np.uint64(col)]
         _gather_chunk(n, scratch, where, corners, faces, world, normals)
         _shade_chunk(n, scratch, where, params, lights, band_words)
         for row in range(bottom - top):  # the image is output only: written past the caches (no line read first)
+            at_row = np.uint64(row)
             for col in range(right - left):
-                stream(depth, top + row, left + col, band_depth[row, col])
+                stream(depth, top + row, left + col, band_depth[at_row, np.uint64(col)])
             for col in range(right - left):
-                stream(image_words, top + row, left + col, band_words[row, col, 0])
+                stream(image_words, top + row, left + col, band_words[at_row, np.uint64(col), 0])
     fence()
 
 
