@@ -606,3 +606,46 @@ def test_block_min_matches_the_reduction(factor, height, width, seed):
     result = _block_min(depth, factor)
     assert result.dtype == depth.dtype
     np.testing.assert_array_equal(result, expected)
+
+
+@pytest.mark.parametrize("cull", [True, False])
+def test_tile_pipeline_of_a_fine_mesh_equals_reference_byte_for_byte(cull):
+    """Triangles of about a pixel, most of whose boxes hold at most 2 × 2 centres (``triangles._fill_tile`` tests
+    those four centres as one mask): the same bytes as the reference."""
+    from frustum.raster.fixed_point import SUBPIXEL
+    from frustum.render import bin_item
+
+    scene = Scene(lights=[LIGHT])
+    scene.add(sphere_mesh(5), material=Material(color=(0.8, 0.5, 0.3)))
+    camera = Camera.look_at((0.4, 0.9, 3.2), (0.0, 0.0, 0.0), (0, 1, 0), projection=Perspective(0.8, 0.3, 30.0),
+                            width=160, height=120)  # fmt: skip
+    binned = bin_item(scene.items[0], camera, cull=cull)
+    corners = binned.win_int[binned.faces].astype(np.int64)  # (F, 3, 2) snapped window coordinates
+    span = (corners.max(axis=1) - corners.min(axis=1)) / SUBPIXEL
+    assert (span.max(axis=1) < 2.0).mean() > 0.5  # most boxes are at most 2 x 2 centres: the test is not vacuous
+    frame = render(scene, camera, background=BACKGROUND, cull_back_faces=cull)
+    color, depth = reference_render(scene, camera, background=BACKGROUND, cull_back_faces=cull)
+    assert (frame.depth < 1.0).mean() > 0.3
+    np.testing.assert_array_equal(frame.depth, depth)
+    np.testing.assert_array_equal(frame.color, color)
+
+
+def test_clipping_in_one_pass_or_two_gives_the_same_frame(monkeypatch):
+    """Faces crossing the view volume are clipped once into ``FAN_MAX`` slots each (``render.ONE_PASS_CLIPPING``
+    or fewer of them) or counted first and then written: the same records, the same bytes as the reference."""
+    import importlib
+
+    pipeline = importlib.import_module("frustum.render")  # the module (``frustum.render`` is the function)
+    scene, camera = small_scene()  # its ground crosses the near plane
+    binned = pipeline.bin_item(scene.items[2], camera, cull=True)
+    assert binned.crossing.size and binned.tri_int.shape[0] > binned.crossing.size
+    one = render(scene, camera, background=BACKGROUND)
+    monkeypatch.setattr(pipeline, "ONE_PASS_CLIPPING", 0)
+    again = pipeline.bin_item(scene.items[2], camera, cull=True)
+    for name in ("tri_int", "tri_float", "tri_weights", "tile_starts", "tile_entries"):
+        np.testing.assert_array_equal(getattr(again, name), getattr(binned, name), err_msg=name)
+    two = render(scene, camera, background=BACKGROUND)
+    color, depth = reference_render(scene, camera, background=BACKGROUND)
+    for frame in (one, two):
+        np.testing.assert_array_equal(frame.color, color)
+        np.testing.assert_array_equal(frame.depth, depth)

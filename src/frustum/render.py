@@ -91,6 +91,9 @@ COLOR_SPACES = ("linear", "srgb")
 BUFFERS = ("normals", "object_id")
 TILE_BITS = 5
 TILE_SIZE = 1 << TILE_BITS
+ONE_PASS_CLIPPING = 16384
+"""Up to this many faces crossing the view volume are clipped in one pass into ``triangles.FAN_MAX`` record slots
+each (at most 21 MiB of records); more are counted first, then written (two passes, no slots to spare)."""
 TILED_BITS = 6
 """Tiles of the one-mesh tile pipeline (``raster.tiled``) are 64 pixels square: 3–5 % less CPU than 32 there (fewer
 triangles spanning two tiles); the general path keeps 32, whose bands bound each small item's shading rows."""
@@ -791,13 +794,24 @@ def bin_item(
         triangles.list_crossing(listed, listed_tiles, chunk, listed_counts, crossing_starts[:-1], crossing)
         clip_options = np.array([width, height, int(cull), face_offset, 0], dtype=np.int64)
         arguments = (crossing, faces, mesh.vertices, clip_from_model, VIEW_VOLUME_PLANES, view, clip_options)
-        triangles.clip_faces(*arguments, record_starts[1:], tri_int, tri_float, tri_weights)
-        record_starts = np.cumsum(record_starts)
-        total = int(record_starts[-1])
-        tri_int = np.empty((total, triangles.RECORD_FIELDS), dtype=np.int64)
-        tri_float, tri_weights = np.empty((total, 3, 2)), np.empty((total, 3, 2))
-        clip_options[4] = 1
-        triangles.clip_faces(*arguments, record_starts[:-1], tri_int, tri_float, tri_weights)
+        if crossing.shape[0] <= ONE_PASS_CLIPPING:  # clip once into FAN_MAX slots per face, then close the gaps
+            slots = crossing.shape[0] * triangles.FAN_MAX
+            tri_int = np.empty((slots, triangles.RECORD_FIELDS), dtype=np.int64)
+            tri_float, tri_weights = np.empty((slots, 3, 2)), np.empty((slots, 3, 2))
+            made = np.arange(0, slots, triangles.FAN_MAX, dtype=np.int64)  # first slots in, record counts out
+            clip_options[4] = 2
+            triangles.clip_faces(*arguments, made, tri_int, tri_float, tri_weights)
+            kept = (np.arange(triangles.FAN_MAX) < made[:, None]).ravel()
+            tri_int, tri_float, tri_weights = tri_int[kept], tri_float[kept], tri_weights[kept]
+            record_starts[1:] = np.cumsum(made)
+        else:  # count, prefix sum, write (no slots to spare for a mesh crossing the view volume everywhere)
+            triangles.clip_faces(*arguments, record_starts[1:], tri_int, tri_float, tri_weights)
+            record_starts = np.cumsum(record_starts)
+            total = int(record_starts[-1])
+            tri_int = np.empty((total, triangles.RECORD_FIELDS), dtype=np.int64)
+            tri_float, tri_weights = np.empty((total, 3, 2)), np.empty((total, 3, 2))
+            clip_options[4] = 1
+            triangles.clip_faces(*arguments, record_starts[:-1], tri_int, tri_float, tri_weights)
         tiles.add_record_tiles(tri_int, options, counts)
     offsets, tile_starts = tile_offsets(counts)
     entry_type = np.int32 if max(faces.shape[0], tri_int.shape[0] + 1) < 2**31 else np.int64

@@ -472,14 +472,14 @@ def _gather_chunk(
     weights (u1, u2 in the _X and _NDL rows). Corners first, then the vertex data, each in its own short loop:
     the loads of many pixels are in flight at once (one long loop per pixel waited on each cache miss in turn)."""
     for i in range(n):
-        f = where[2 * _CHUNK + i]
+        f = np.uint64(where[2 * _CHUNK + i])  # unsigned indices: no negative-index fix-up
         a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
         corners[i], corners[_CHUNK + i], corners[2 * _CHUNK + i] = a, b, c
         for v in (a, b, c):  # the second loop's rows, loading meanwhile (_jit.prefetch)
-            prefetch(normals, v, 0)
-            prefetch(world, v, 0)
+            prefetch(normals, np.uint64(v), 0)
+            prefetch(world, np.uint64(v), 0)
     for i in range(n):
-        a, b, c = corners[i], corners[_CHUNK + i], corners[2 * _CHUNK + i]
+        a, b, c = np.uint64(corners[i]), np.uint64(corners[_CHUNK + i]), np.uint64(corners[2 * _CHUNK + i])
         u1, u2 = s[_X + i], s[_NDL + i]
         u0 = (1.0 - u1) - u2
         s[_NX + i] = _interpolate(u0, u1, u2, normals[a, 0], normals[b, 0], normals[c, 0])
@@ -566,4 +566,4 @@ def _shade_chunk(
             | 255 << 24
         )
     for i in range(n):
-        words[where[i], where[_CHUNK + i], 0] = where[2 * _CHUNK + i]
+        words[np.uint64(where[i]), np.uint64(where[_CHUNK + i]), 0] = where[2 * _CHUNK + i]

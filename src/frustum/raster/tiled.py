@@ -84,14 +84,15 @@ def draw_tiles_directional(
                             params, lights, item, word, band_words, scratch, where, corners)  # fmt: skip
             for row in range(bottom - top):
                 for col in range(col1 - col0):
-                    band_depth[row, col0 - left + col] = near[row, col]
+                    band_depth[np.uint64(row), np.uint64(col0 - left + col)] = near[np.uint64(row), np.uint64(col)]
         _gather_chunk(n, scratch, where, corners, faces, world, normals)
         _shade_chunk(n, scratch, where, params, lights, band_words)
         for row in range(bottom - top):  # the image is output only: written past the caches (no line read first)
+            at_row = np.uint64(row)
             for col in range(right - left):
-                stream(depth, top + row, left + col, band_depth[row, col])
+                stream(depth, top + row, left + col, band_depth[at_row, np.uint64(col)])
             for col in range(right - left):
-                stream(image_words, top + row, left + col, band_words[row, col, 0])
+                stream(image_words, top + row, left + col, band_words[at_row, np.uint64(col), 0])
     fence()
 
 
@@ -113,12 +114,14 @@ def _shade_tile(
     at ``offset + c``), and paint the others with the background word; return how many are listed now."""
     face_offset = item[I_FACE_OFFSET]
     for row in range(rows):
+        at_row = np.uint64(row)  # unsigned indices: no negative-index fix-up
         for col in range(cols):
-            if not depth[row, col] < 1.0:
-                words[row, offset + col, 0] = word
+            at = np.uint64(col)
+            if not depth[at_row, at] < 1.0:
+                words[at_row, np.uint64(offset + col), 0] = word
                 continue
-            code = codes[row, col]  # the one mesh's: written wherever depth < 1
-            scratch[_X + n], scratch[_NDL + n] = float(bary[row, col, 0]), float(bary[row, col, 1])
+            code = codes[at_row, at]  # the one mesh's: written wherever depth < 1
+            scratch[_X + n], scratch[_NDL + n] = float(bary[at_row, at, 0]), float(bary[at_row, at, 1])
             scratch[_SIGN + n] = -1.0 if code & 1 else 1.0
             where[n], where[_CHUNK + n], where[2 * _CHUNK + n] = row, offset + col, (code >> 1) - face_offset
             n += 1

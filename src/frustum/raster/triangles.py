@@ -53,6 +53,7 @@ __all__ = [
     "FACE_CROSSING",
     "FACE_DRAWN",
     "FACE_NONE",
+    "FAN_MAX",
     "RECORD_FIELDS",
     "SUBPIXEL",
     "clip_faces",
@@ -69,6 +70,11 @@ NARROW = 8
 AHEAD = 16
 """Tile entries between a prefetch of an entry's face and its fill (``_jit.prefetch``): gathers of a mesh that does
 not fit in cache (2M triangles) took 10–25 % less time."""
+_LOWEST_BIT = np.array([0, 0, 1, 0, 2, 0, 1, 0, 3, 0, 1, 0, 2, 0, 1, 0], dtype=np.int64)
+"""Index of the lowest set bit of a 4-bit mask (``_fill_tile``'s 2 × 2 boxes: bit ci + 2·cj)."""
+FAN_MAX = 7
+"""Most triangles one clipped face makes: a triangle clipped by the six view-volume planes has at most 3 + 6
+corners, a fan of at most 7 triangles (``clip_faces``'s one-pass mode)."""
 CROSSING = -2
 """``tiles.count_tiles``'s ``listed_tiles`` mark of a face crossing the view volume (its clipped records are
 filled in its place)."""
@@ -243,7 +249,8 @@ def clip_faces(
     The clip coordinates of the corners are recomputed (``vertices.clip_vertex``, the same bytes as the vertex
     stage). options = (width, height, cull, face_offset, write) int64. With write = 0, ``record_starts[k]``
     receives how many records crossing face k makes; with write = 1 its records go to slots
-    ``record_starts[k]`` on, in fan order.
+    ``record_starts[k]`` on, in fan order; with write = 2 they go there too and ``record_starts[k]`` then
+    receives their number (one pass, into ``FAN_MAX`` slots per face).
     """
     write = options[4]
     size = options[0:3]
@@ -266,7 +273,7 @@ def clip_faces(
             made += one
             if slot >= 0:
                 slot += one
-        if write == 0:
+        if write != 1:
             record_starts[k] = made
 
 
@@ -291,7 +298,11 @@ def _fill_tile(
     Buffers are top row first: window row j is array row ``H − 1 − j``. The triangle loop is inline (no
     per-triangle call taking arrays: for pixel-sized triangles the call would cost more than the fill). A box
     wider than ``NARROW`` columns finds each row's first and last covered centre (``_span``) and visits only
-    those: testing each centre in turn mispredicts a branch at both ends of every row.
+    those: testing each centre in turn mispredicts a branch at both ends of every row. A face whose box holds at
+    most 2 × 2 centres (two thirds of a 2M-triangle terrain's) tests the four as one mask (``&``, no branch per
+    centre), computes the depth gradients only if one is covered, and visits the covered ones alone; the values
+    are those of the row loop. Indices are unsigned (``np.uint64``): Numba adds a negative-index fix-up to every
+    signed one, and the fill is mostly index arithmetic (−6 % of the terrain's tile pipeline with the mask).
     """
     size, tiles_x, face_offset, width, height = tiling[0], tiling[1], tiling[2], tiling[3], tiling[4]
     col0 = (tile % tiles_x) * size
@@ -301,18 +312,19 @@ def _fill_tile(
     last_slot = tile_starts[tile + 1]
     for slot in range(tile_starts[tile], last_slot):
         if slot + AHEAD < last_slot:  # prefetch the face AHEAD entries on and the corners of the one AHEAD/2 on
-            ahead = np.int64(tile_entries[slot + AHEAD])
+            ahead = np.int64(tile_entries[np.uint64(slot + AHEAD)])
             if ahead >= 0:
                 prefetch(faces, ahead, 0)
-            ahead = np.int64(tile_entries[slot + AHEAD // 2])
+            ahead = np.int64(tile_entries[np.uint64(slot + AHEAD // 2)])
             if ahead >= 0:
                 for v in range(3):
-                    prefetch(win_int, faces[ahead, v], 0)
-                    prefetch(win_float, faces[ahead, v], 0)
-        entry = np.int64(tile_entries[slot])
+                    prefetch(win_int, faces[np.uint64(ahead), v], 0)
+                    prefetch(win_float, faces[np.uint64(ahead), v], 0)
+        entry = np.int64(tile_entries[np.uint64(slot)])
         if entry >= 0:  # a trivially accepted face: its vertices' window records
             f = entry
-            v0, v1, v2 = faces[f, 0], faces[f, 1], faces[f, 2]
+            at = np.uint64(f)  # unsigned indices: no negative-index fix-up (gathers are most of a tiny triangle)
+            v0, v1, v2 = np.uint64(faces[at, 0]), np.uint64(faces[at, 1]), np.uint64(faces[at, 2])
             x0, y0 = np.int64(win_int[v0, 0]), np.int64(win_int[v0, 1])
             x1, y1 = np.int64(win_int[v1, 0]), np.int64(win_int[v1, 1])
             x2, y2 = np.int64(win_int[v2, 0]), np.int64(win_int[v2, 1])
@@ -343,9 +355,44 @@ def _fill_tile(
         bias0 = 0 if (dy0 < 0 or (dy0 == 0 and dx0 < 0)) else 1
         bias1 = 0 if (dy1 < 0 or (dy1 == 0 and dx1 < 0)) else 1
         bias2 = 0 if (dy2 < 0 or (dy2 == 0 and dx2 < 0)) else 1
-        alpha, beta = depth_gradients(x0, y0, x1, y1, x2, y2, z0, z1, z2)
         swap = code % 2  # unclipped: source corner 1 is drawn as corner 1 + swap, corner 2 as 2 − swap
         px0 = SUBPIXEL * i_min + HALF_SUBPIXEL
+        if record < 0 and i_max - i_min <= 1 and j_max - j_min <= 1:  # a box of at most 2 × 2 centres (most
+            # triangles of a fine mesh): the four centres' coverage as one mask, then only the covered ones
+            py0 = SUBPIXEL * j_min + HALF_SUBPIXEL
+            a0 = dx0 * (py0 - y1) - dy0 * (px0 - x1)  # E_k at the box's first centre; − dy·256 per column,
+            a1 = dx1 * (py0 - y2) - dy1 * (px0 - x2)  # + dx·256 per row
+            a2 = dx2 * (py0 - y0) - dy2 * (px0 - x0)
+            s0, s1, s2 = dy0 * SUBPIXEL, dy1 * SUBPIXEL, dy2 * SUBPIXEL
+            t0, t1, t2 = dx0 * SUBPIXEL, dx1 * SUBPIXEL, dx2 * SUBPIXEL
+            wide, tall = i_max > i_min, j_max > j_min
+            mask = (  # & rather than and: no branch per centre (whether a tiny triangle covers one is random)
+                np.int64((a0 >= bias0) & (a1 >= bias1) & (a2 >= bias2))
+                | np.int64((a0 - s0 >= bias0) & (a1 - s1 >= bias1) & (a2 - s2 >= bias2) & wide) << 1
+                | np.int64((a0 + t0 >= bias0) & (a1 + t1 >= bias1) & (a2 + t2 >= bias2) & tall) << 2
+                | np.int64((a0 - s0 + t0 >= bias0) & (a1 - s1 + t1 >= bias1) & (a2 - s2 + t2 >= bias2) & wide & tall)
+                << 3
+            )  # fmt: skip
+            if mask != 0:
+                alpha, beta = depth_gradients(x0, y0, x1, y1, x2, y2, z0, z1, z2)
+            while mask != 0:
+                k = _LOWEST_BIT[mask]
+                mask &= mask - 1
+                ci, cj = k & 1, k >> 1
+                e0, e1, e2 = a0 - s0 * ci + t0 * cj, a1 - s1 * ci + t1 * cj, a2 - s2 * ci + t2 * cj
+                # the general path's values: x_off there is float(px0 − X0) + 256·ci, exact in float64
+                z = np.float32((z0 + beta * float(py0 + SUBPIXEL * cj - y0)) + alpha * float(px0 + SUBPIXEL * ci - x0))
+                at_row, at = np.uint64(height - 1 - (j_min + cj) - origin_row), np.uint64(i_min + ci - origin_col)
+                if z < depth[at_row, at]:
+                    depth[at_row, at] = z
+                    codes[at_row, at] = code
+                    g0, g1, g2 = float(e0) * q0, float(e1) * q1, float(e2) * q2
+                    reciprocal = 1.0 / ((g0 + g1) + g2)
+                    b1, b2 = g1 * reciprocal, g2 * reciprocal
+                    bary[at_row, at, 0] = np.float32(b2 if swap == 1 else b1)
+                    bary[at_row, at, 1] = np.float32(b1 if swap == 1 else b2)
+            continue
+        alpha, beta = depth_gradients(x0, y0, x1, y1, x2, y2, z0, z1, z2)
         columns = i_max - i_min + 1
         step0, step1, step2 = dy0 * SUBPIXEL, dy1 * SUBPIXEL, dy2 * SUBPIXEL  # E_k falls by these per column
         inverse0, inverse1, inverse2 = 0.0, 0.0, 0.0
@@ -360,7 +407,7 @@ def _fill_tile(
             e2 = dx2 * (py - y0) - dy2 * (px0 - x0)
             z_row = z0 + beta * float(py - y0)
             x_off = float(px0 - x0)  # X_P − X_0, exact in float64
-            row = height - 1 - j - origin_row
+            at_row = np.uint64(height - 1 - j - origin_row)  # unsigned indices: no negative-index fix-up
             first, last = 0, columns - 1
             if columns > NARROW:  # the covered centres of a row are consecutive (three half-planes): find them
                 first, last = _span(e0, step0, bias0, inverse0, first, last)
@@ -371,16 +418,17 @@ def _fill_tile(
             for i in range(i_min + first - origin_col, i_min + last + 1 - origin_col):
                 if columns > NARROW or (e0 >= bias0 and e1 >= bias1 and e2 >= bias2):
                     z = np.float32(z_row + alpha * x_off)
-                    if z < depth[row, i]:
-                        depth[row, i] = z
-                        codes[row, i] = code
+                    at = np.uint64(i)
+                    if z < depth[at_row, at]:
+                        depth[at_row, at] = z
+                        codes[at_row, at] = code
                         # perspective-correct weights b_k = (E_k / w_k) / Σ E_j / w_j, then onto the source face
                         g0, g1, g2 = float(e0) * q0, float(e1) * q1, float(e2) * q2
                         reciprocal = 1.0 / ((g0 + g1) + g2)
                         b1, b2 = g1 * reciprocal, g2 * reciprocal
                         if record < 0:  # one-hot weights: (b0·0 + b1·1) + b2·0 is b1 exactly (b_k >= 0)
-                            bary[row, i, 0] = np.float32(b2 if swap == 1 else b1)
-                            bary[row, i, 1] = np.float32(b1 if swap == 1 else b2)
+                            bary[at_row, at, 0] = np.float32(b2 if swap == 1 else b1)
+                            bary[at_row, at, 1] = np.float32(b1 if swap == 1 else b2)
                         else:
                             b0 = g0 * reciprocal
                             for k in range(2):
@@ -389,7 +437,7 @@ def _fill_tile(
                                     tri_weights[record, 1, k],
                                     tri_weights[record, 2, k],
                                 )
-                                bary[row, i, k] = np.float32((b0 * w0 + b1 * w1) + b2 * w2)
+                                bary[at_row, at, k] = np.float32((b0 * w0 + b1 * w1) + b2 * w2)
                 e0 -= step0
                 e1 -= step1
                 e2 -= step2
