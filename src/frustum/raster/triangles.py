@@ -377,12 +377,6 @@ def _setup_entries(
         reciprocal = np.divide(1.0, float(dx2 * (y2 - y0) - dy2 * (x2 - x0)))
         alpha = -((float(dy0) * z0 + float(dy1) * z1) + float(dy2) * z2) * reciprocal
         beta = ((float(dx0) * z0 + float(dx1) * z1) + float(dx2) * z2) * reciprocal
-        z_row0, z_row1 = z0 + beta * float(py0 - y0), z0 + beta * float(py0 + SUBPIXEL - y0)
-        x_off0, x_off1 = float(px0 - x0), float(px0 + SUBPIXEL - x0)  # X_P − X_0, exact in float64
-        values[u + _ZA] = np.float64(np.float32(z_row0 + alpha * x_off0))
-        values[u + _ZB] = np.float64(np.float32(z_row0 + alpha * x_off1))
-        values[u + _ZC] = np.float64(np.float32(z_row1 + alpha * x_off0))
-        values[u + _ZD] = np.float64(np.float32(z_row1 + alpha * x_off1))
         values[u + _Z1], values[u + _Z2], values[u + _Q1], values[u + _Q2] = z1, z2, q1, q2
         values[u + _ALPHA], values[u + _BETA] = alpha, beta
         block[u + _X1], block[u + _X2], block[u + _Y1], block[u + _Y2] = x1, x2, y1, y2
@@ -448,18 +442,19 @@ def _fill_tile(
             q0, q1, q2 = values[u + _Q0], values[u + _Q1], values[u + _Q2]
             i_min, j_min = block[u + _IMIN], block[u + _JMIN]
             swap = code & 1  # unclipped: source corner 1 is drawn as corner 1 + swap, corner 2 as 2 − swap
+            z0, alpha, beta = values[u + _Z0], values[u + _ALPHA], values[u + _BETA]
             if kind < _GENERAL:  # a box of at most 2 × 2 centres: only the covered ones (the mask)
                 mask = kind
                 while mask != 0:
                     k = _LOWEST_BIT[mask]
-                    z = np.float32(values[u + _Z_ROW[mask]])
                     mask &= mask - 1
                     ci, cj = k & 1, k >> 1
+                    py, px = SUBPIXEL * (j_min + cj) + HALF_SUBPIXEL, SUBPIXEL * (i_min + ci) + HALF_SUBPIXEL
+                    z = np.float32((z0 + beta * float(py - y0)) + alpha * float(px - x0))  # the row loop's value
                     at_row, at = np.uint64(top - (j_min + cj)), np.uint64(i_min + ci - origin_col)
                     if z < depth[at_row, at]:
                         depth[at_row, at] = z
                         codes[at_row, at] = code
-                        py, px = SUBPIXEL * (j_min + cj) + HALF_SUBPIXEL, SUBPIXEL * (i_min + ci) + HALF_SUBPIXEL
                         e0 = (x2 - x1) * (py - y1) - (y2 - y1) * (px - x1)
                         e1 = (x0 - x2) * (py - y2) - (y0 - y2) * (px - x2)
                         e2 = (x1 - x0) * (py - y0) - (y1 - y0) * (px - x0)
@@ -471,7 +466,6 @@ def _fill_tile(
                 continue
             entry = block[u + _ENTRY]
             record = -1 - entry  # >= 0 for a clipped record
-            z0, alpha, beta = values[u + _Z0], values[u + _ALPHA], values[u + _BETA]
             i_max, j_max = block[u + _IMAX], block[u + _JMAX]
             dx0, dy0 = x2 - x1, y2 - y1  # edge 1 → 2, opposite corner 0
             dx1, dy1 = x0 - x2, y0 - y2  # edge 2 → 0
