@@ -303,7 +303,7 @@ def _one_mesh_scenes():
 
 @pytest.mark.parametrize("name", list(_one_mesh_scenes()))
 @pytest.mark.parametrize("cull", [True, False])
-@pytest.mark.parametrize("size", [(48, 36), (1100, 40)])  # 1100: two segments of 32 tiles, a partial last tile
+@pytest.mark.parametrize("size", [(48, 36), (1100, 40)])  # 1100: three segments of 8 tiles, a partial last tile
 def test_one_mesh_tile_pipeline_equals_reference_byte_for_byte(name, cull, size, monkeypatch):
     """A frame of one opaque mesh on the directional fast path is cleared, filled and shaded tile by tile
     (``raster.tiled``): the same bytes as the reference, which shares no rasterizer code with it."""
