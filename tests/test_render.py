@@ -20,7 +20,7 @@ from frustum.frame import Frame
 from frustum.geometry import Mesh
 from frustum.raster.vertices import transform_vertices
 from frustum.render import _block_min, _item_matrices, bin_item, render, resolve_color
-from frustum.scene import Scene
+from frustum.scene import Scene, SceneItem
 from frustum.shading import DirectionalLight, Material
 from frustum.transforms import apply_homogeneous, rotate_y, translate
 from frustum.visibility import backface_mask
@@ -272,6 +272,31 @@ def test_fast_path_window_coordinates_and_culling_equal_the_textbook_path():
     snapped = binned.win_int / 256.0
     assert np.abs(snapped - window[:, :2]).max() <= 0.5 / 256 + 1e-9  # snapping moves a point <= 1/512 px
     np.testing.assert_allclose(binned.win_float[:, 0], window[:, 2], rtol=0, atol=1e-12)  # depth: round-off only
+
+
+@pytest.mark.parametrize("dtype", [np.float64, np.float32])
+def test_line_path_vertex_stage_in_numpy_equals_the_kernel_bit_for_bit(dtype):
+    """Lines and edges take their clip coordinates, world points and region codes from NumPy
+    (``render._clip_vertices``, no kernel to compile): the kernel's operations in its order, so the same bits."""
+    import importlib
+
+    from frustum.clipping import VIEW_VOLUME_PLANES
+
+    pipeline = importlib.import_module("frustum.render")
+    points = (np.random.default_rng(1).normal(size=(2000, 3)) * 3).astype(dtype)
+    world_from_model = np.array([[0.9, 0.1, 0.0, 0.3], [-0.1, 0.9, 0.2, -0.4], [0.0, -0.2, 1.1, 0.5], [0, 0, 0, 1.0]])
+    camera = Camera.look_at(
+        (0.3, 0.5, 3.0), (0, 0, 0), (0, 1, 0), projection=Perspective(0.9, 0.5, 10.0), width=64, height=48
+    )
+    clip, world, codes = pipeline._clip_vertices(points, world_from_model, camera)
+    expected = np.empty((2000, 4)), np.empty((2000, 3)), np.empty((2000, 3)), np.empty(2000, dtype=np.int64)
+    item = SceneItem(None, None, world_from_model)
+    transform_vertices(points, np.ones((2000, 3)), _item_matrices(item, camera), VIEW_VOLUME_PLANES, expected[0],
+                       expected[1], expected[2], expected[3])  # fmt: skip
+    assert 0.3 < (codes != 0).mean() < 0.95  # points inside and outside: the codes are exercised
+    np.testing.assert_array_equal(clip, expected[0])
+    np.testing.assert_array_equal(world, expected[1])
+    np.testing.assert_array_equal(codes, expected[3])
 
 
 def test_crossing_faces_are_clipped_into_records_in_drawing_order():

@@ -63,7 +63,7 @@ from frustum.geometry import Mesh
 from frustum.hidden_lines import EdgeAdjacency, classify_edges, edge_adjacency, front_facing, welded_adjacency
 from frustum.raster import lines, shade, tiles, triangles
 from frustum.raster._jit import threads
-from frustum.raster.vertices import project_vertices, transform_normals, transform_vertices, world_points
+from frustum.raster.vertices import project_vertices, transform_normals, world_points
 from frustum.scene import Scene, SceneItem
 from frustum.shading import SPECULAR_MODELS, DepthCue, pack_lights
 
@@ -955,16 +955,23 @@ def _draw_polylines(
 
 
 def _clip_vertices(points: np.ndarray, world_from_model: np.ndarray, camera: Camera):
-    """Clip coordinates, world positions and region codes of model-space points (``transform_vertices``)."""
-    count = points.shape[0]
-    clip = np.empty((count, 4))
-    world = np.empty((count, 3))
-    vertex_codes = np.empty(count, dtype=np.int64)
+    """Clip coordinates (N, 4), world positions (N, 3) and view-volume region codes (N,) int64 of model-space
+    points, in NumPy (lines and edges have few points; no kernel to compile): each row of ``M·[x, y, z, 1]``
+    summed left to right, ``((m0·x + m1·y) + m2·z) + m3``, and bit k of the code set when
+    ``((p0·x_c + p1·y_c) + p2·z_c) + p3·w_c < 0`` for plane k of ``VIEW_VOLUME_PLANES`` — the operations, in the
+    order, of the kernels' vertex stage (``raster.vertices``), so the same bytes."""
     item = SceneItem(None, None, world_from_model)  # type: ignore[arg-type]
-    transform_vertices(
-        points, np.ones((count, 3)), _item_matrices(item, camera), VIEW_VOLUME_PLANES, clip, world,
-        np.empty((count, 3)), vertex_codes,
-    )  # fmt: skip
+    matrices = _item_matrices(item, camera)
+    x, y, z = (np.asarray(points[:, k], dtype=np.float64) for k in range(3))
+
+    def rows(m: np.ndarray, count: int) -> np.ndarray:
+        return np.stack([((m[k, 0] * x + m[k, 1] * y) + m[k, 2] * z) + m[k, 3] for k in range(count)], axis=1)
+
+    clip, world = rows(matrices[0], 4), rows(matrices[1], 3)
+    vertex_codes = np.zeros(points.shape[0], dtype=np.int64)
+    for k, p in enumerate(VIEW_VOLUME_PLANES):
+        distance = ((p[0] * clip[:, 0] + p[1] * clip[:, 1]) + p[2] * clip[:, 2]) + p[3] * clip[:, 3]
+        vertex_codes |= (distance < 0.0).astype(np.int64) << k
     return clip, world, vertex_codes
 
 
