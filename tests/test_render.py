@@ -674,3 +674,23 @@ def test_clipping_in_one_pass_or_two_gives_the_same_frame(monkeypatch):
     for frame in (one, two):
         np.testing.assert_array_equal(frame.color, color)
         np.testing.assert_array_equal(frame.depth, depth)
+
+
+def test_world_attributes_from_numpy_or_the_kernels_give_the_same_frame(monkeypatch):
+    """Meshes under ``render.KERNEL_MIN_VERTICES`` vertices get world points and normals from NumPy (no kernel to
+    compile), larger ones from ``raster.vertices``: the same operations in order, the same bits."""
+    import importlib
+
+    pipeline = importlib.import_module("frustum.render")
+    scene, camera = small_scene()  # its tube is moved and turned: world points and normals are transformed
+    item = scene.items[1]
+    numpy_world, numpy_normals = pipeline._world_attributes(item, pipeline.Scratch())
+    assert item.mesh.vertex_count < pipeline.KERNEL_MIN_VERTICES
+    first = render(scene, camera, background=BACKGROUND, shading="phong")
+    monkeypatch.setattr(pipeline, "KERNEL_MIN_VERTICES", 0)
+    kernel_world, kernel_normals = pipeline._world_attributes(item, pipeline.Scratch())
+    np.testing.assert_array_equal(numpy_world, kernel_world)
+    np.testing.assert_array_equal(numpy_normals, kernel_normals)
+    again = render(scene, camera, background=BACKGROUND, shading="phong")
+    np.testing.assert_array_equal(first.color, again.color)
+    np.testing.assert_array_equal(first.depth, again.depth)

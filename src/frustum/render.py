@@ -720,13 +720,37 @@ def _world_attributes(item: SceneItem, scratch: Scratch) -> tuple[np.ndarray, np
     mesh = item.mesh
     model = np.asarray(item.world_from_model, dtype=np.float64)
     world, normals = mesh.vertices, mesh.vertex_normals
+    small = mesh.vertex_count < KERNEL_MIN_VERTICES  # NumPy: the same operations in order, no kernel to compile
     if not np.array_equal(model, np.eye(4)):
-        world = scratch.empty((mesh.vertex_count, 3))
-        world_points(mesh.vertices, model, world)
+        if small:
+            world = _rows(mesh.vertices, model, 3, affine=True)
+        else:
+            world = scratch.empty((mesh.vertex_count, 3))
+            world_points(mesh.vertices, model, world)
     if not np.array_equal(model[:3, :3], np.eye(3)):
-        normals = scratch.empty((mesh.vertex_count, 3))
-        transform_normals(mesh.vertex_normals, _item_matrices(item, None)[2], normals)
+        normal_matrix = _item_matrices(item, None)[2]
+        if small:
+            normals = _rows(mesh.vertex_normals, normal_matrix, 3, affine=False)
+            normals /= np.sqrt((normals[:, :1] * normals[:, :1] + normals[:, 1:2] * normals[:, 1:2])
+                               + normals[:, 2:] * normals[:, 2:])  # fmt: skip
+        else:
+            normals = scratch.empty((mesh.vertex_count, 3))
+            transform_normals(mesh.vertex_normals, normal_matrix, normals)
     return world, normals
+
+
+KERNEL_MIN_VERTICES = 65536
+"""Meshes with fewer vertices get their world points and normals (and lines and edges their clip coordinates) from
+NumPy rather than the ``raster.vertices`` kernels: the same operations in the same order, so the same bits, and
+no kernel to compile for a small scene (the README example's cold start)."""
+
+
+def _rows(points: np.ndarray, m: np.ndarray, count: int, affine: bool) -> np.ndarray:
+    """Rows 0..count−1 of ``M·[x, y, z, 1]`` summed left to right, ``((m0·x + m1·y) + m2·z) + m3`` (``affine``),
+    or of ``A·[x, y, z]``, ``(a0·x + a1·y) + a2·z`` — ``raster.vertices._affine_row`` / ``_linear_row`` in NumPy."""
+    x, y, z = (np.asarray(points[:, k], dtype=np.float64) for k in range(3))
+    rows = [(m[k, 0] * x + m[k, 1] * y) + m[k, 2] * z for k in range(count)]
+    return np.stack([row + m[k, 3] for k, row in enumerate(rows)] if affine else rows, axis=1)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -962,12 +986,7 @@ def _clip_vertices(points: np.ndarray, world_from_model: np.ndarray, camera: Cam
     order, of the kernels' vertex stage (``raster.vertices``), so the same bytes."""
     item = SceneItem(None, None, world_from_model)  # type: ignore[arg-type]
     matrices = _item_matrices(item, camera)
-    x, y, z = (np.asarray(points[:, k], dtype=np.float64) for k in range(3))
-
-    def rows(m: np.ndarray, count: int) -> np.ndarray:
-        return np.stack([((m[k, 0] * x + m[k, 1] * y) + m[k, 2] * z) + m[k, 3] for k in range(count)], axis=1)
-
-    clip, world = rows(matrices[0], 4), rows(matrices[1], 3)
+    clip, world = _rows(points, matrices[0], 4, affine=True), _rows(points, matrices[1], 3, affine=True)
     vertex_codes = np.zeros(points.shape[0], dtype=np.int64)
     for k, p in enumerate(VIEW_VOLUME_PLANES):
         distance = ((p[0] * clip[:, 0] + p[1] * clip[:, 1]) + p[2] * clip[:, 2]) + p[3] * clip[:, 3]
