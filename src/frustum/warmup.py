@@ -89,6 +89,14 @@ def _surfaces_fast() -> None:
                 fr.Material(color=(0.8, 0.5, 0.2)))  # fmt: skip
     fr.render(compact, _camera())
     fr.render(compact, _camera((0.0, 0.0, 0.5)))
+    # a moved mesh: world points and normals computed (NumPy below render.KERNEL_MIN_VERTICES vertices, kernels
+    # above), so the tile pipeline's specialization for computed rather than the mesh's own arrays
+    large = fr.uv_sphere(1.0, 260, 256)  # 67,075 vertices
+    compact = fr.Mesh(large.vertices.astype(np.float32), large.faces, large.vertex_normals.astype(np.float32))
+    for mesh in (large, compact):
+        moved = fr.Scene(lights=[fr.DirectionalLight(direction=(0, -1, -1))])
+        moved.add(mesh, fr.Material(color=(0.8, 0.5, 0.2)), fr.rotate_y(0.3))
+        fr.render(moved, _camera())
 
 
 def _surfaces_general() -> None:
