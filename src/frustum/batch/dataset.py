@@ -269,6 +269,7 @@ class _RunLog:
             (self.out / _MANIFEST).write_bytes((text + "\n").encode("utf-8"))
             for part in parts:
                 part.unlink(missing_ok=True)
+            (self.out / _MANIFEST_PARTS).rmdir()
 
 
 def _changes(old: dict, new: dict) -> list[str]:

@@ -197,6 +197,12 @@ class RemotePath:
                 fs.rm_file(temporary)
             raise
 
+    def rmdir(self) -> None:
+        """Remove this folder if it is empty (object stores have none to remove)."""
+        if not self.atomic_put:
+            with contextlib.suppress(OSError):
+                self.fs.rmdir(self.path)
+
     def unlink(self, missing_ok: bool = False) -> None:
         try:
             self.fs.rm_file(self.path)
