@@ -13,10 +13,8 @@ Needs root (mount namespaces); skipped with the reason otherwise.
 
 from __future__ import annotations
 
-import contextlib
 import hashlib
 import json
-import os
 import secrets
 import shutil
 import signal
@@ -28,14 +26,14 @@ from pathlib import Path
 
 import pytest
 
-import frustum
 from frustum.batch import render_dataset
 
 psutil = pytest.importorskip("psutil")
 pytest.importorskip("ray")
+from ray_local_cluster import Cluster, free_port, skip_reason, stop_groups  # noqa: E402
 
-SRC = Path(frustum.__file__).resolve().parents[1]
-RAY = Path(sys.executable).with_name("ray")
+pytestmark = pytest.mark.skipif(skip_reason() is not None, reason=str(skip_reason()))
+
 SCENE = """
 title = "batch cluster test"
 [render]
@@ -57,119 +55,6 @@ name = "cube"
 geometry = { type = "box" }
 transform = [{ scale = 0.5 }, { translate = [0.9, 0.0, 0.3] }]
 """
-OBJECT_STORE = "200000000"  # bytes per node: the machine is shared
-# the head declares a node dead after 3 missed health checks 1 s apart (Ray's default waits longer)
-HEAD_CONFIG = json.dumps({"health_check_period_ms": 1000, "health_check_failure_threshold": 3})
-
-
-def _skip_reason() -> str | None:
-    if not hasattr(os, "geteuid") or os.geteuid() != 0:
-        return "needs root: worker nodes run in their own mount namespace (unshare --mount, mount -t tmpfs)"
-    if shutil.which("unshare") is None:
-        return "needs unshare (util-linux)"
-    if not RAY.exists():
-        return f"needs the ray command beside {sys.executable}"
-    probe = subprocess.run(["unshare", "--mount", "--propagation", "private", "sh", "-c",
-                            "mount -t tmpfs tmpfs /mnt"], capture_output=True)  # fmt: skip
-    if probe.returncode:
-        return f"cannot make a private tmpfs in a mount namespace: {probe.stderr.decode(errors='replace').strip()}"
-    return None
-
-
-pytestmark = pytest.mark.skipif(_skip_reason() is not None, reason=str(_skip_reason()))
-
-
-def _free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
-
-
-def _group_processes(groups: list[int]) -> list:
-    """Every live process in the given process groups, and their descendants."""
-    found = {}
-    for process in psutil.process_iter():
-        try:
-            if os.getpgid(process.pid) in groups and process.status() != psutil.STATUS_ZOMBIE:
-                found[process.pid] = process
-                for child in process.children(recursive=True):
-                    found[child.pid] = child
-        except (ProcessLookupError, psutil.Error):
-            continue
-    return list(found.values())
-
-
-def _stop(groups: list[int]) -> None:
-    """SIGTERM, then SIGKILL, every process of these groups (ours: each was started in a new session)."""
-    for sig, grace in ((signal.SIGTERM, 5.0), (signal.SIGKILL, 5.0)):
-        processes = _group_processes(groups)
-        for process in processes:
-            with contextlib.suppress(psutil.Error):
-                process.send_signal(sig)
-        psutil.wait_procs(processes, timeout=grace)
-
-
-class Cluster:
-    """A head node and worker nodes on this machine, the workers in private mount namespaces."""
-
-    def __init__(self, root: Path, environment: dict[str, str]) -> None:
-        self.root = root
-        self.port = _free_port()
-        self.token = root / "auth_token"
-        self.token.write_text(secrets.token_hex(32))
-        self.groups: list[int] = []
-        self.nodes: dict[str, int] = {}  # name -> process group
-        base = {k: v for k, v in os.environ.items() if not k.startswith("RAY_")}
-        self.env = {
-            **base, **environment,
-            "PYTHONPATH": os.pathsep.join([str(SRC), os.environ.get("PYTHONPATH", "")]),
-            "RAY_AUTH_MODE": "token",
-            "RAY_AUTH_TOKEN_PATH": str(self.token),
-            "RAY_ADDRESS": f"127.0.0.1:{self.port}",  # what --address auto finds (other clusters may run here)
-            "RAY_USAGE_STATS_ENABLED": "0",
-        }  # fmt: skip
-
-    def _start(self, name: str, command: list[str], environment: dict[str, str]) -> int:
-        for attempt in range(4):  # a loaded machine can miss the 30 s Ray gives a raylet to register
-            log = self.root / f"{name}.{attempt}.log"
-            with open(log, "wb") as output:
-                process = subprocess.Popen(command, env=environment, stdout=output, stderr=subprocess.STDOUT,
-                                           stdin=subprocess.DEVNULL, start_new_session=True)  # fmt: skip
-            self.groups.append(process.pid)
-            try:
-                code = process.wait(timeout=240)
-            except subprocess.TimeoutExpired:
-                code = -1
-            if code == 0:
-                self.nodes[name] = process.pid
-                return process.pid
-            _stop([process.pid])
-        raise RuntimeError(f"{name} did not start:\n{log.read_text(errors='replace')[-3000:]}")
-
-    def start_head(self) -> None:
-        self._start("head", [str(RAY), "start", "--head", "--num-cpus=0", f"--port={self.port}",
-                             "--node-ip-address=127.0.0.1", f"--object-store-memory={OBJECT_STORE}",
-                             "--include-dashboard=false", "--disable-usage-stats", f"--temp-dir={self.root}/head",
-                             "--include-log-monitor=false", f"--system-config={HEAD_CONFIG}"], self.env)  # fmt: skip
-
-    def add_worker(self, name: str, cpus: int = 1) -> int:
-        """A worker node in its own mount namespace: /tmp a fresh tmpfs holding its copy of the token."""
-        script = (
-            "set -e; mount -t tmpfs -o size=2g tmpfs /tmp; mkdir -p /tmp/node; "
-            'printf %s "$NODE_TOKEN" > /tmp/node/auth_token; export RAY_AUTH_TOKEN_PATH=/tmp/node/auth_token; '
-            f"exec {RAY} start --address=127.0.0.1:{self.port} --num-cpus={cpus} --node-ip-address=127.0.0.1 "
-            f"--object-store-memory={OBJECT_STORE} --temp-dir=/tmp/node/ray --disable-usage-stats "
-            "--include-log-monitor=false"
-        )
-        environment = {**self.env, "NODE_TOKEN": self.token.read_text()}
-        del environment["RAY_AUTH_TOKEN_PATH"]
-        return self._start(name, ["unshare", "--mount", "--propagation", "private", "sh", "-c", script], environment)
-
-    def processes(self, name: str) -> list:
-        return _group_processes([self.nodes[name]])
-
-    def stop(self) -> None:
-        _stop(self.groups)
 
 
 @pytest.fixture(scope="module")
@@ -179,7 +64,7 @@ def moto(tmp_path_factory):
     pytest.importorskip("s3fs")
     if not server.exists():
         pytest.skip("needs moto[server] (moto_server)")
-    port = _free_port()
+    port = free_port()
     log = open(tmp_path_factory.mktemp("moto") / "moto.log", "wb")  # noqa: SIM115 - closed below
     process = subprocess.Popen([str(server), "-H", "127.0.0.1", "-p", str(port)], stdout=log,
                                stderr=subprocess.STDOUT, start_new_session=True)  # fmt: skip
@@ -201,7 +86,7 @@ def moto(tmp_path_factory):
         fs.mkdir("frustum")
         yield environment
     finally:
-        _stop([process.pid])
+        stop_groups([process.pid])
         log.close()
 
 
@@ -252,7 +137,7 @@ def _finish(process: subprocess.Popen, timeout: float = 600) -> tuple[int, str, 
     try:
         out, err = process.communicate(timeout=timeout)
     except subprocess.TimeoutExpired:
-        _stop([process.pid])
+        stop_groups([process.pid])
         out, err = process.communicate()
         pytest.fail(f"the driver ran past {timeout} s:\n{err.decode(errors='replace')[-3000:]}")
     return process.returncode, out.decode(errors="replace"), err.decode(errors="replace")
@@ -336,7 +221,7 @@ def test_s3_driver_killed_midway_then_rerun_equals_an_uninterrupted_run(cluster,
         if len(fs.glob("frustum/killed/manifest.parts/*.jsonl", refresh=True)) >= 1:
             break
         time.sleep(0.2)
-    _stop([driver.pid])
+    stop_groups([driver.pid])
     driver.communicate()
     fs.invalidate_cache()
     assert not fs.exists("frustum/killed/cameras.json"), "the first run was not stopped midway"
@@ -403,7 +288,7 @@ def test_worker_node_killed_halfway_the_dataset_still_completes(cluster, scene_p
     code, out, err = _finish(driver)
     assert killed_at is not None and killed_at < 100, "node b was not killed midway"
     assert code == 0, err
-    assert "160 views rendered, 0 skipped, 0 failed" in out
+    assert "160 views rendered, 0 skipped" in out and "0 failed" in out
     assert files_of(tmp_path / "ray") == files_of(tmp_path / "serial")
     workers = _workers(log.read_text())
     assert any(w.rsplit(":", 1)[1] in node_b for w in workers)  # both nodes rendered
