@@ -392,7 +392,7 @@ def render_many(
     address: str | None = None,
     collect: str | None = None,
 ) -> list[ViewResult]:
-    """Render many views; workers write the files and return metadata, in the order of `jobs`.
+    """Render many views; workers (or this process, ``collect="driver"``) write the files; metadata in job order.
 
     The same call writes the same bytes with every executor and any number of workers. A view that fails is
     reported in its ``ViewResult.error``; the other views go on. Bad jobs (unknown output kinds, a scene file
