@@ -1,7 +1,7 @@
 """Benchmark: ``render_dataset`` / ``render_many`` on every executor against a bare ``render`` loop.
 
     python benchmarks/bench_batch.py [--views 200] [--size 512] [--repeat 3]
-                                     [--runs serial,process2,ray2,nodes2-driver,nodes2-workers]
+                                     [--runs serial,process2,node1,nodes2-driver,nodes2-workers]
                                      [--mesh PATH] [--out DIR] [--json PATH]
 
 The Stanford bunny (69,451 triangles) at ``--size``² with every buffer (color PNG, metric depth .npy, normals
@@ -19,10 +19,11 @@ The Stanford bunny (69,451 triangles) at ``--size``² with every buffer (color P
 The baseline is a bare loop in this process, ``render(...)`` then the same files written with the same encoders,
 after a warm-up (the first call, kernel compile or cache load, is printed separately). Output bytes per view
 are summed from the files. ``rayN`` runs start a local one-node cluster of ``num_cpus = N`` (``ray.init``, not
-included in the wall clock; starting the actors and loading their kernels is). ``nodes2-driver`` and ``nodes2-workers`` run on a two-node cluster whose nodes share no disk
-(``tests/ray_local_cluster.py``: a head with no CPUs and two worker nodes of one CPU each, each in its own
-mount namespace with a private /tmp; needs root; started once, not included in the wall clock): ``-driver``
-writes a folder on the driver's side (the files come back through the object store), ``-workers`` a
+included in the wall clock; starting the actors and loading their kernels is); ``node1`` is one node of two
+CPUs started once with ``ray start --head``, joined with its address. ``nodes2-driver`` and ``nodes2-workers``
+run on a two-node cluster whose nodes share no disk (``tests/ray_local_cluster.py``: a head with no CPUs and
+two worker nodes of one CPU each, each in its own mount namespace with a private /tmp; needs root; started
+once, not included in the wall clock): ``-driver`` writes a folder on the driver's side (the files come back through the object store), ``-workers`` a
 ``file://`` URL on /dev/shm, which both nodes share, written by the workers. Every run writes under /dev/shm
 (where it exists), so the two write paths write to the same kind of storage.
 
@@ -214,8 +215,9 @@ def median_of(repeats: list[dict]) -> dict:
             for key, value in repeats[0].items()}  # fmt: skip
 
 
-def start_cluster(work: Path):
-    """Head (no CPUs) and two worker nodes of one CPU each, sharing no disk (tests/ray_local_cluster.py)."""
+def start_cluster(work: Path, nodes: int = 2):
+    """Head (no CPUs) and two worker nodes of one CPU each, sharing no disk (tests/ray_local_cluster.py); with
+    `nodes` = 1 a head of two CPUs alone."""
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
     from ray_local_cluster import Cluster, skip_reason
 
@@ -224,9 +226,12 @@ def start_cluster(work: Path):
         raise SystemExit(f"bench_batch: the two-node runs {reason}")
     root = Path(tempfile.mkdtemp(prefix="fr-", dir="/tmp"))  # short: Ray's socket paths
     cluster = Cluster(root, {}, object_store=str(400 * 2**20))
-    cluster.start_head()
-    cluster.add_worker("a")
-    cluster.add_worker("b")
+    if nodes == 1:
+        cluster.start_head(cpus=2)
+    else:
+        cluster.start_head()
+        cluster.add_worker("a")
+        cluster.add_worker("b")
     for key in ("RAY_AUTH_MODE", "RAY_AUTH_TOKEN_PATH"):  # this process is the driver
         os.environ[key] = cluster.env[key]
     return cluster
@@ -236,7 +241,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--views", type=int, default=200)
     parser.add_argument("--size", type=int, default=512)
-    parser.add_argument("--runs", default="serial,process2,ray2,nodes2-driver,nodes2-workers")
+    parser.add_argument("--runs", default="serial,process2,node1,nodes2-driver,nodes2-workers")
     parser.add_argument("--repeat", type=int, default=3, help="runs of each configuration (medians reported)")
     parser.add_argument("--mesh", default="/work/shared/data/bunny/bun_zipper.ply")
     parser.add_argument("--out", default=None, help="folder for the datasets (default: a temporary one, removed)")
@@ -276,11 +281,17 @@ def main() -> None:
         for run in args.runs.split(","):
             address = collect = None
             url = False
-            if run.startswith("nodes2"):
+            if run.startswith(("node1", "nodes2")):  # clusters started once with `ray start`, not counted
+                nodes = 1 if run.startswith("node1") else 2
+                if cluster is not None and cluster.size != nodes:
+                    cluster.stop()
+                    cluster = None
                 if cluster is None:
-                    cluster = start_cluster(work)
+                    cluster = start_cluster(work, nodes)
+                    cluster.size = nodes
                 executor, workers, address = "ray", 2, cluster.env["RAY_ADDRESS"]
-                collect, url = run.split("-")[1], run.endswith("workers")
+                collect = run.split("-")[1] if "-" in run else None
+                url = run.endswith("workers")
             else:
                 executor = run.rstrip("0123456789")
                 workers = int(run[len(executor) :] or 1)

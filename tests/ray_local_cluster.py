@@ -112,8 +112,9 @@ class Cluster:
             stop_groups([process.pid])
         raise RuntimeError(f"{name} did not start:\n{log.read_text(errors='replace')[-3000:]}")
 
-    def start_head(self) -> None:
-        self._start("head", [str(RAY), "start", "--head", "--num-cpus=0", f"--port={self.port}",
+    def start_head(self, cpus: int = 0) -> None:
+        """The head node; with no CPUs (the default) it schedules and holds the driver but renders nothing."""
+        self._start("head", [str(RAY), "start", "--head", f"--num-cpus={cpus}", f"--port={self.port}",
                              "--node-ip-address=127.0.0.1", f"--object-store-memory={self.object_store}",
                              "--include-dashboard=false", "--disable-usage-stats", f"--temp-dir={self.root}/head",
                              "--include-log-monitor=false", f"--system-config={HEAD_CONFIG}"], self.env)  # fmt: skip
