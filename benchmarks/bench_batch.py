@@ -20,12 +20,13 @@ The baseline is a bare loop in this process, ``render(...)`` then the same files
 after a warm-up (the first call, kernel compile or cache load, is printed separately). Output bytes per view
 are summed from the files. ``rayN`` runs start a local one-node cluster of ``num_cpus = N`` (``ray.init``, not
 included in the wall clock; starting the actors and loading their kernels is); ``node1`` is one node of two
-CPUs started once with ``ray start --head``, joined with its address. ``nodes2-driver`` and ``nodes2-workers``
-run on a two-node cluster whose nodes share no disk (``tests/ray_local_cluster.py``: a head with no CPUs and
-two worker nodes of one CPU each, each in its own mount namespace with a private /tmp; needs root; started
-once, not included in the wall clock): ``-driver`` writes a folder on the driver's side (the files come back through the object store), ``-workers`` a
-``file://`` URL on /dev/shm, which both nodes share, written by the workers. Every run writes under /dev/shm
-(where it exists), so the two write paths write to the same kind of storage.
+CPUs started once with ``ray start --head``, joined with its address.
+``nodes2-driver`` and ``nodes2-workers`` run on a two-node cluster whose nodes share no disk
+(``tests/ray_local_cluster.py``: a head with no CPUs and two worker nodes of one CPU each, each in its own mount
+namespace with a private /tmp; needs root; started once, not included in the wall clock): ``-driver`` writes a
+folder on the driver's side (the files come back through the object store), ``-workers`` a ``file://`` URL on
+/dev/shm, which both nodes share, written by the workers. Every run writes under /dev/shm (where it exists), so
+the two write paths write to the same kind of storage.
 
 Each run is repeated ``--repeat`` times; the table gives the median of each column. The machine may be shared
 with other work: the load average is printed with each run, and the numbers are only comparable within a run.
