@@ -37,6 +37,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import secrets
 import shutil
 import statistics
 import sys
@@ -216,6 +217,10 @@ def median_of(repeats: list[dict]) -> dict:
             for key, value in repeats[0].items()}  # fmt: skip
 
 
+TOKEN = secrets.token_hex(32)
+"""One token for every cluster this process joins (Ray keeps the first token a process reads)."""
+
+
 def start_cluster(work: Path, nodes: int = 2):
     """Head (no CPUs) and two worker nodes of one CPU each, sharing no disk (tests/ray_local_cluster.py); with
     `nodes` = 1 a head of two CPUs alone."""
@@ -226,7 +231,7 @@ def start_cluster(work: Path, nodes: int = 2):
     if reason:
         raise SystemExit(f"bench_batch: the two-node runs {reason}")
     root = Path(tempfile.mkdtemp(prefix="fr-", dir="/tmp"))  # short: Ray's socket paths
-    cluster = Cluster(root, {}, object_store=str(400 * 2**20))
+    cluster = Cluster(root, {}, object_store=str(400 * 2**20), token=TOKEN)
     if nodes == 1:
         cluster.start_head(cpus=2)
     else:

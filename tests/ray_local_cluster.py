@@ -78,11 +78,12 @@ def stop_groups(groups: list[int]) -> None:
 class Cluster:
     """A head node and worker nodes on this machine, the workers in private mount namespaces."""
 
-    def __init__(self, root: Path, environment: dict[str, str], object_store: str = OBJECT_STORE) -> None:
+    def __init__(self, root: Path, environment: dict[str, str], object_store: str = OBJECT_STORE,
+                 token: str | None = None) -> None:  # fmt: skip
         self.root, self.object_store = root, object_store
         self.port = free_port()
         self.token = root / "auth_token"
-        self.token.write_text(secrets.token_hex(32))
+        self.token.write_text(token or secrets.token_hex(32))  # a driver process keeps the first token it read
         self.groups: list[int] = []
         self.nodes: dict[str, int] = {}  # name -> process group
         base = {k: v for k, v in os.environ.items() if not k.startswith("RAY_")}
