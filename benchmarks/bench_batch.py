@@ -291,6 +291,7 @@ def main() -> None:
                 nodes = 1 if run.startswith("node1") else 2
                 if cluster is not None and cluster.size != nodes:
                     cluster.stop()
+                    shutil.rmtree(cluster.root, ignore_errors=True)
                     cluster = None
                 if cluster is None:
                     cluster = start_cluster(work, nodes)
@@ -319,6 +320,7 @@ def main() -> None:
     finally:
         if cluster is not None:
             cluster.stop()
+            shutil.rmtree(cluster.root, ignore_errors=True)
     if args.json:
         Path(args.json).write_text(json.dumps(report, indent=2) + "\n")
     if not args.out:
