@@ -124,6 +124,8 @@ class Material:
     over what lies behind it, drawn back to front after the opaque surfaces: the "ghosted" parts of a cutaway),
     ``texture`` an (H, W[, 3|4]) image sampled bilinearly at the mesh's UV coordinates (v up: v = 0 is the
     image's bottom row; uint8 bytes are taken as linear values / 255), multiplied into the base color.
+    ``emission`` (>= 0, default 1) scales ``emissive`` for ``radiosity``: an emitter's radiance is
+    ``emissive · emission``, which may exceed 1 (the local illumination model adds ``emissive`` alone).
     ``hatch`` (vector output only): the spacing of 45° section lines drawn over the faces in filled SVG/PDF,
     in drawing units, as engineering drawings mark cut surfaces (``cutaway`` sets it on section caps).
     Raises ``ShadingError`` for a non-finite or negative coefficient, a color outside [0, 1] or a bad texture.
@@ -138,6 +140,7 @@ class Material:
     opacity: float = 1.0
     texture: NDArray[np.float32] | None = None
     hatch: float | None = None
+    emission: float = 1.0
 
     def __post_init__(self) -> None:
         where = "Material"
@@ -155,6 +158,7 @@ class Material:
             raise ShadingError(f"{where}: opacity = {opacity!r} is above 1; expected 0 <= opacity <= 1")
         object.__setattr__(self, "opacity", opacity)
         object.__setattr__(self, "texture", _texture(self.texture, where))
+        object.__setattr__(self, "emission", _nonnegative(self.emission, "emission", where))
 
     def with_(self, **changes: Any) -> Material:
         """A copy with some fields changed, e.g. ``material.with_(opacity=0.3)``."""
