@@ -149,6 +149,11 @@ def test_a_closed_white_box_with_uniform_emission_converges_to_e_over_one_minus_
 def _mitsuba_wall_means(scene: fr.Scene, spp: int = 64, size: int = 64) -> np.ndarray:
     """(5, 3) mean radiance of the Cornell box's walls by Mitsuba 3's path tracer: an orthographic sensor just in
     front of each wall, looking at it face-on and covering it exactly, so the image mean is the area mean."""
+    return _mitsuba_wall_means_and_errors(scene, spp, size)[0]
+
+
+def _mitsuba_wall_means_and_errors(scene: fr.Scene, spp: int = 64, size: int = 64) -> tuple[np.ndarray, np.ndarray]:
+    """``_mitsuba_wall_means`` and the standard error of each mean (pixel standard deviation / √pixels)."""
     mi = pytest.importorskip("mitsuba")
     mi.set_variant("scalar_rgb")
     transform = mi.ScalarTransform4f
@@ -172,7 +177,7 @@ def _mitsuba_wall_means(scene: fr.Scene, spp: int = 64, size: int = 64) -> np.nd
         if radiance.max() > 0:
             shape["emitter"] = {"type": "area", "radiance": {"type": "rgb", "value": radiance.tolist()}}
         shapes[name] = shape
-    means = []
+    means, errors = [], []
     for item in scene.items[:5]:
         centre, u, w, n = frame(item.mesh)
         m = np.eye(4)
@@ -183,8 +188,10 @@ def _mitsuba_wall_means(scene: fr.Scene, spp: int = 64, size: int = 64) -> np.nd
                   "sampler": {"type": "independent", "sample_count": spp}}  # fmt: skip
         mitsuba_scene = mi.load_dict({"type": "scene", "integrator": {"type": "path", "max_depth": 64},
                                       "sensor": sensor, **shapes})  # fmt: skip
-        means.append(np.asarray(mi.render(mitsuba_scene, spp=spp)).reshape(-1, 3).mean(axis=0))
-    return np.array(means)
+        pixels = np.asarray(mi.render(mitsuba_scene, spp=spp)).reshape(-1, 3)
+        means.append(pixels.mean(axis=0))
+        errors.append(pixels.std(axis=0) / np.sqrt(pixels.shape[0]))
+    return np.array(means), np.array(errors)
 
 
 def test_cornell_box_wall_means_agree_with_mitsuba():
