@@ -225,14 +225,15 @@ class _Rasterizer:
     def codes(self, camera: Camera) -> tuple[np.ndarray, np.ndarray]:
         """(depth, codes) of one view: codes ``2·patch + back`` where drawn, depth 1 elsewhere (no culling:
         a patch seen from behind hides what lies beyond it but receives nothing)."""
-        import importlib
+        from frustum.render.buffers import Scratch
+        from frustum.render.stages import Pixels, draw_item
 
-        driver = importlib.import_module("frustum.render")
         depth = np.ones((camera.height, camera.width), dtype=np.float32)
         codes = np.zeros((camera.height, camera.width), dtype=np.int32)
         bary = np.zeros((camera.height, camera.width, 2), dtype=np.float32)
-        scratch = driver.Scratch()
-        driver._draw_item(self.item, camera, False, 0, depth, codes, bary, scratch)
+        dummy = np.zeros((1, 1, 4), dtype=np.uint8)
+        scratch = Scratch()
+        draw_item(self.item, camera, False, 0, Pixels(depth, codes, bary, dummy, (dummy, dummy)), scratch)
         scratch.release()
         return depth, codes
 

@@ -13,11 +13,12 @@ Both change only the *shading* normal (the geometry stays flat), per pixel, from
   gradient in texture space (central differences on the image, one-sided at its edges, scaled by its size and
   sampled bilinearly as textures are: ``height_gradient``). With a smooth-shaded mesh the interpolated unit
   normal n stands for N/|N| and ``|N| = |P_u × P_v|``.
-* **Normal map**: each texel stores a unit normal in the surface's tangent frame, ``n_t = 2·rgb − 1``, in the
+* **Normal map**: each texel stores a unit normal in the surface's tangent frame, ``n_t = (255·rgb − 128) / 127``
+  clamped to [−1, 1] (8-bit values b as (b − 128)/127: 128 is exactly 0 and 255 is 1, so a "flat" map of
+  (128, 128, 255) is exactly (0, 0, 1); glTF's ``2·b/255 − 1`` differs by at most 0.008), in the
   OpenGL convention (+x along the tangent T = P_u, +y along the bitangent = P_v: "green up", as glTF's
   ``normalTexture``); ``N' = normalize(T̂ n_t.x + B̂ n_t.y + n n_t.z)`` with T̂ made perpendicular to n
-  (Gram–Schmidt) and ``B̂ = ±(n × T̂)``, the sign that of the UV layout's handedness. A map that is (128, 128, 255)
-  everywhere leaves the normal as it is (to within its 8-bit rounding).
+  (Gram–Schmidt) and ``B̂ = ±(n × T̂)``, the sign that of the UV layout's handedness.
 
 The renderer evaluates them per pixel in Phong shading only: flat shading lights each face once and Gouraud
 shading each vertex once, so a per-pixel normal has nowhere to go there (documented as a no-op).
@@ -131,7 +132,7 @@ def mapped_normals(normal: ArrayLike, p_u: ArrayLike, p_v: ArrayLike, texel: Arr
     side = np.cross(n, tangent)
     handed = np.where((side * pv).sum(axis=-1, keepdims=True) < 0.0, -1.0, 1.0)
     bitangent = side * handed
-    t = 2.0 * np.asarray(texel, dtype=np.float64) - 1.0
+    t = np.clip((255.0 * np.asarray(texel, dtype=np.float64) - 128.0) / 127.0, -1.0, 1.0)
     mapped = tangent * t[:, 0:1] + bitangent * t[:, 1:2] + n * t[:, 2:3]
     no_frame = (np.linalg.norm(pu, axis=-1) == 0.0)[:, None]
     return _unit(np.where(no_frame, n, mapped))
