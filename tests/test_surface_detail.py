@@ -100,3 +100,20 @@ def test_bad_maps_are_refused():
         fr.Material(normal_map=np.full((4, 4, 3), np.nan))
     with pytest.raises(ShadingError, match="bump_scale"):
         fr.Material(bump_scale=float("inf"))
+
+
+def test_a_gltf_normal_texture_loads_as_the_parts_normal_map(tmp_path):
+    import trimesh
+    from PIL import Image
+
+    box = trimesh.creation.box()
+    uvs = np.random.default_rng(0).random((len(box.vertices), 2))
+    normals = np.zeros((4, 4, 3), dtype=np.uint8)
+    normals[:] = (140, 120, 250)
+    material = trimesh.visual.material.PBRMaterial(baseColorFactor=[200, 100, 50, 255],
+                                                   normalTexture=Image.fromarray(normals))  # fmt: skip
+    box.visual = trimesh.visual.TextureVisuals(uv=uvs, material=material)
+    box.export(tmp_path / "box.glb")
+    part = fr.load_parts(tmp_path / "box.glb")[0]
+    np.testing.assert_array_equal(part.normal_map, normals)
+    assert fr.Material(normal_map=part.normal_map).normal_map.shape == (4, 4, 4)
