@@ -212,6 +212,10 @@ _LAZY = {
     "over_under": "frustum.output.stereo",
     "release_memory": "frustum.render",
     "render": "frustum.render",
+    "radiosity": "frustum.radiosity",
+    "RadiosityError": "frustum.radiosity",
+    "RadiosityResult": "frustum.radiosity",
+    "EnvironmentMap": "frustum.environment",
     "render_examples": "frustum.scenefile",
     "render_scene_file": "frustum.scenefile",
     "render_stereo": "frustum.output.stereo",
@@ -335,6 +339,7 @@ if TYPE_CHECKING:  # pragma: no cover
         DepthOrder,
         depth_sort,
     )
+    from frustum.environment import EnvironmentMap
     from frustum.geometry.csg import (
         difference,
         intersection,
@@ -435,6 +440,7 @@ if TYPE_CHECKING:  # pragma: no cover
         svg_path_from_bezier,
         svg_path_from_polyline,
     )
+    from frustum.radiosity import RadiosityError, RadiosityResult, radiosity
     from frustum.raster._jit import set_threads
     from frustum.render import RENDER_METHODS, RENDER_MODES, SHADING_MODES, VISIBILITY_METHODS, release_memory, render
     from frustum.scenefile import (
@@ -584,6 +590,7 @@ __all__ = [
     "DirectionalLight",
     "DiskEmitter",
     "Drag",
+    "EnvironmentMap",
     "Frame",
     "Frustum",
     "FrustumError",
@@ -622,6 +629,8 @@ __all__ = [
     "PrincipalVanishingPoints",
     "Projection",
     "Quaternion",
+    "RadiosityError",
+    "RadiosityResult",
     "Ray",
     "RayHits",
     "RenderJob",
@@ -745,6 +754,7 @@ __all__ = [
     "quaternion_julia",
     "quaternion_julia_mesh",
     "quaternion_julia_volume",
+    "radiosity",
     "reflect",
     "region_code",
     "release_memory",
