@@ -41,14 +41,20 @@ from frustum.errors import OutputError
 from frustum.geometry import Mesh, Polyline
 from frustum.hidden_lines import (
     DEFAULT_CREASE_ANGLE,
-    EDGE_BOUNDARY,
-    EDGE_CREASE,
+    EDGE_SILHOUETTE,
     HiddenLines,
-    classify_edges,
     remove_hidden_lines,
-    welded_adjacency,
 )
-from frustum.output.svg import _check_common, _drawing_groups, _escape, _number, _placed_meshes, svg_document
+from frustum.output.svg import (
+    _HIDDEN_GRAY,
+    _check_common,
+    _drawing_groups,
+    _escape,
+    _number,
+    _placed_meshes,
+    svg_document,
+)
+from frustum.output.true_curves import Circle, EllipseArc, circle_arcs, find_circles, svg_arc_elements
 from frustum.projection import ISOMETRIC_ROTATION_X, MULTIVIEWS, Axonometric, Orthographic, multiview
 from frustum.scene import Scene
 
@@ -99,20 +105,10 @@ _ARROW_LENGTH, _ARROW_HALF_WIDTH = 3.0, 0.55  # arrowhead, mm (about 20 degrees 
 _LETTER = 3.5  # dimension and label text height, mm
 _LEADER_RISE = 5.0  # a diameter leader's shoulder sits this far above the view, mm; more leaders stack 6 mm apart
 _LABEL_DROP = 7.0  # view label baseline below everything else of the view, mm
-# circles: closed loops of creases / boundaries with at least this many vertices, planar and round within
-# these fractions of the radius (a tessellated circle's vertices lie on it, up to round-off)
-_CIRCLE_MIN_VERTICES = 10
+# circles (output/true_curves.py): two circles are one cylinder's when radii and axes agree within this fraction
 _CIRCLE_TOLERANCE = 1e-6
 # an end-on circle's plane normal lies within this angle (radians) of the line of sight
 _END_ON_ANGLE = 1e-6
-
-
-@dataclass(frozen=True)
-class _Circle:
-    centre: NDArray[np.float64]  # world
-    normal: NDArray[np.float64]  # unit, world
-    radius: float
-    sides: int  # vertices of the polygon
 
 
 @dataclass
@@ -124,6 +120,8 @@ class _View:
     local: NDArray[np.float64]  # (N, 2) every model vertex in view-local model mm: x right, y down, origin = target
     circles: list[tuple[NDArray[np.float64], float, float]]  # end-on circles: local centre, radius, visible part
     axes: list[tuple[NDArray[np.float64], NDArray[np.float64]]]  # cylinder axes seen side-on: local ends
+    visible_arcs: list[EllipseArc] = field(default_factory=list)  # true curves, window coordinates
+    hidden_arcs: list[EllipseArc] = field(default_factory=list)
 
 
 @dataclass
@@ -197,60 +195,11 @@ def _view_camera(name: str, target: NDArray, radius: float) -> Camera:
     return Camera.multiview(name, Orthographic(height, near, far), target, distance, _PIXELS, _PIXELS)
 
 
-def _circles(meshes: list[tuple[Mesh | Polyline, NDArray]]) -> list[_Circle]:
-    """Circular edge loops of the meshes (world): closed chains of creases and boundaries, planar and round.
-
-    A loop is a connected set of feature edges in which every vertex has two edges; it is a circle when it has
-    at least ``_CIRCLE_MIN_VERTICES`` vertices, all within ``_CIRCLE_TOLERANCE``·r of one plane and of one
-    distance r from their centroid (a regular polygon's centroid is the circle's centre).
-    """
-    found = []
-    for mesh, world_from_model in meshes:
-        if not isinstance(mesh, Mesh) or mesh.face_count == 0:
-            continue
-        points = mesh.vertices @ world_from_model[:3, :3].T + world_from_model[:3, 3]
-        adjacency = welded_adjacency(mesh)
-        kinds = classify_edges(adjacency, points, np.asarray(mesh.faces), None, DEFAULT_CREASE_ANGLE)
-        edges = adjacency.edges[(kinds & (EDGE_BOUNDARY | EDGE_CREASE)) != 0]
-        if edges.shape[0] < _CIRCLE_MIN_VERTICES:
-            continue
-        # connected components of the edge graph (union–find on the few feature vertices)
-        vertices, local = np.unique(edges, return_inverse=True)
-        local = local.reshape(-1, 2)
-        parent = np.arange(vertices.size)
-        changed = True
-        while changed:
-            low = np.minimum(parent[local[:, 0]], parent[local[:, 1]])
-            changed = bool((parent[local[:, 0]] != low).any() or (parent[local[:, 1]] != low).any())
-            np.minimum.at(parent, local[:, 0], low)
-            np.minimum.at(parent, local[:, 1], low)
-            parent = parent[parent]
-        degree = np.bincount(local.reshape(-1), minlength=vertices.size)
-        for root in np.unique(parent):
-            members = np.flatnonzero(parent == root)
-            if members.size < _CIRCLE_MIN_VERTICES or (degree[members] != 2).any():
-                continue
-            ring = points[vertices[members]]
-            centre = ring.mean(axis=0)
-            offsets = ring - centre
-            normal = np.linalg.svd(offsets)[2][2]
-            radii = np.linalg.norm(offsets, axis=1)
-            radius = float(radii.mean())
-            if not radius > 0.0:
-                continue
-            if np.abs(offsets @ normal).max() > _CIRCLE_TOLERANCE * radius:
-                continue
-            if np.abs(radii - radius).max() > _CIRCLE_TOLERANCE * radius:
-                continue
-            found.append(_Circle(centre, normal, radius, int(members.size)))
-    return found
-
-
 def _sheet_views(names: Sequence[str], points_world: NDArray, meshes: list, options: dict) -> list[_View]:
     low, high = points_world.min(axis=0), points_world.max(axis=0)
     target = (low + high) / 2.0
     radius = max(float(np.linalg.norm(high - low)) / 2.0, 1e-9)
-    circles = _circles(meshes)
+    circles = find_circles(meshes, options["crease_angle"])
     views = []
     for name in names:
         camera = _view_camera(name, target, radius)
@@ -259,7 +208,8 @@ def _sheet_views(names: Sequence[str], points_world: NDArray, meshes: list, opti
         local = _to_local(camera.project(points_world)[:, :2], mm_per_pixel)
         end_on = [] if name == "isometric" else _end_on(circles, camera, lines, mm_per_pixel)
         axes = [] if name == "isometric" else _side_on_axes(circles, camera, mm_per_pixel)
-        views.append(_View(name, camera, mm_per_pixel, lines, local, end_on, axes))
+        lines, visible_arcs, hidden_arcs = circle_arcs(lines, circles, camera)
+        views.append(_View(name, camera, mm_per_pixel, lines, local, end_on, axes, visible_arcs, hidden_arcs))
     return views
 
 
@@ -269,7 +219,7 @@ def _to_local(window: NDArray, factor: float) -> NDArray:
     return np.column_stack([(window[:, 0] - half) * factor, -(window[:, 1] - half) * factor])
 
 
-def _side_on_axes(circles: list[_Circle], camera: Camera, mm_per_pixel: float) -> list:
+def _side_on_axes(circles: list[Circle], camera: Camera, mm_per_pixel: float) -> list:
     """Axes of the cylinders `camera` sees from the side, as view-local segments, collinear overlaps merged.
 
     A cylinder (or a coaxial hole) shows as two circles of equal radius whose centres lie on their common normal;
@@ -277,6 +227,7 @@ def _side_on_axes(circles: list[_Circle], camera: Camera, mm_per_pixel: float) -
     """
     direction = np.asarray(camera.frame.direction)
     found: list[tuple[NDArray, NDArray]] = []
+    circles = [circle for circle in circles if circle.kind == "loop"]
     for i, first in enumerate(circles):
         if abs(float(first.normal @ direction)) > math.sin(_END_ON_ANGLE):
             continue
@@ -300,8 +251,10 @@ def _side_on_axes(circles: list[_Circle], camera: Camera, mm_per_pixel: float) -
             along = (d - c) / np.linalg.norm(d - c)
             gap = 1e-6 * max(float(np.linalg.norm(d - c)), float(np.linalg.norm(b - a)))
             offset = a - c
-            if (abs(float(unit[0] * along[1] - unit[1] * along[0])) > 1e-9  # 2D cross products: not parallel,
-                    or abs(float(offset[0] * along[1] - offset[1] * along[0])) > gap):  # or not on one line
+            if (
+                abs(float(unit[0] * along[1] - unit[1] * along[0])) > 1e-9  # 2D cross products: not parallel,
+                or abs(float(offset[0] * along[1] - offset[1] * along[0])) > gap
+            ):  # or not on one line
                 continue
             t = [float((p - c) @ along) for p in (a, b)]
             span = float(np.linalg.norm(d - c))
@@ -315,15 +268,21 @@ def _side_on_axes(circles: list[_Circle], camera: Camera, mm_per_pixel: float) -
     return merged
 
 
-def _end_on(circles: list[_Circle], camera: Camera, lines: HiddenLines, mm_per_pixel: float) -> list:
+def _end_on(circles: list[Circle], camera: Camera, lines: HiddenLines, mm_per_pixel: float) -> list:
     """The circles seen end-on by `camera`, once per projected centre and radius: (local centre, radius,
     visible fraction of the drawn circle)."""
     direction = np.asarray(camera.frame.direction)
     seen: list[tuple[NDArray, float, float]] = []
     for circle in circles:
-        if abs(float(circle.normal @ direction)) < math.cos(_END_ON_ANGLE):
+        if circle.kind == "sphere":  # seen as its silhouette circle from every side
+            circle = Circle(circle.centre, direction, circle.radius, 0, circle.mesh, "sphere")
+        elif abs(float(circle.normal @ direction)) < math.cos(_END_ON_ANGLE):
             continue
         centre = _to_local(camera.project(circle.centre[None, :])[:, :2], mm_per_pixel)[0]
+        if circle.kind == "sphere":
+            visible = _silhouette_visible(lines, circle.mesh)
+            _add_seen(seen, centre, circle.radius, visible)
+            continue
         # drawn pieces of this circle: ends in its plane, between the chord midpoints' and the vertices' radius
         inner = circle.radius * math.cos(math.pi / circle.sides) * (1.0 - 1e-6)
         outer = circle.radius * (1.0 + 1e-6)
@@ -335,18 +294,35 @@ def _end_on(circles: list[_Circle], camera: Camera, lines: HiddenLines, mm_per_p
             on = planar & ((distance >= inner) & (distance <= outer)).all(axis=1)
             lengths.append(float(np.linalg.norm(world[on, 1] - world[on, 0], axis=1).sum()))
         drawn = lengths[0] + lengths[1]
-        visible = lengths[0] / drawn if drawn > 0.0 else 0.0
-        tolerance = 1e-6 * circle.radius
-        same = next(
-            (k for k, (c, r, _) in enumerate(seen)
-             if np.abs(c - centre).max() <= tolerance and abs(r - circle.radius) <= tolerance),
-            None,
-        )  # fmt: skip
-        if same is None:
-            seen.append((centre, circle.radius, visible))
-        elif visible > seen[same][2]:
-            seen[same] = (centre, circle.radius, visible)
+        _add_seen(seen, centre, circle.radius, lengths[0] / drawn if drawn > 0.0 else 0.0)
     return seen
+
+
+def _add_seen(seen: list, centre: NDArray, radius: float, visible: float) -> None:
+    """Add an end-on circle once per projected centre and radius, keeping the larger visible fraction."""
+    tolerance = 1e-6 * radius
+    same = next(
+        (
+            k
+            for k, (c, r, _) in enumerate(seen)
+            if np.abs(c - centre).max() <= tolerance and abs(r - radius) <= tolerance
+        ),
+        None,
+    )
+    if same is None:
+        seen.append((centre, radius, visible))
+    elif visible > seen[same][2]:
+        seen[same] = (centre, radius, visible)
+
+
+def _silhouette_visible(lines: HiddenLines, mesh: int) -> float:
+    """Visible fraction of the drawn silhouette of placed mesh `mesh` (a sphere's outline)."""
+    lengths = []
+    for window, owners in ((lines.visible, lines.visible_edges), (lines.hidden, lines.hidden_edges)):
+        mine = (lines.edge_meshes[owners] == mesh) & ((lines.edge_kinds[owners] & EDGE_SILHOUETTE) != 0)
+        lengths.append(float(np.linalg.norm(window[mine, 1] - window[mine, 0], axis=1).sum()))
+    total = lengths[0] + lengths[1]
+    return lengths[0] / total if total > 0.0 else 0.0
 
 
 # --- annotations in view-local paper millimetres ----------------------------------------------------------
@@ -702,10 +678,35 @@ def _view_group(
         return np.column_stack([centre_x + local[:, 0], centre_y + local[:, 1]])
 
     groups = _drawing_groups(view.lines, placed, to_paper, stroke_width, hidden, False, prefix=f"{view.name}-")
+    groups += _curve_groups(view, to_paper, stroke_width, hidden)
     return (
         f'<g id="view-{view.name}" data-scale="{_number(scale)}" '
         f'data-centre="{_number(centre_x)} {_number(centre_y)}">{"".join(groups)}</g>'
     )
+
+
+def _curve_groups(view: _View, to_paper: Any, stroke_width: float, hidden: str | None) -> list[str]:
+    """The view's true curves: groups ``<view>-hidden-curves`` (styled as the hidden lines) and
+    ``<view>-visible-curves`` of ``<circle>``, ``<ellipse>`` and elliptical-arc ``<path>`` elements."""
+    groups = []
+    if hidden is not None and view.hidden_arcs:
+        thin = _number(0.7 * stroke_width)
+        if hidden == "dashed":
+            dash = f"{_number(4 * stroke_width)} {_number(2.5 * stroke_width)}"
+            style = f'stroke="#000000" stroke-width="{thin}" stroke-dasharray="{dash}"'
+        else:
+            style = f'stroke="{_HIDDEN_GRAY}" stroke-width="{thin}"'
+        elements = svg_arc_elements([arc.mapped(to_paper) for arc in view.hidden_arcs])
+        groups.append(
+            f'<g id="{view.name}-hidden-curves" fill="none" {style} stroke-linecap="butt">{"".join(elements)}</g>'
+        )
+    if view.visible_arcs:
+        elements = svg_arc_elements([arc.mapped(to_paper) for arc in view.visible_arcs])
+        groups.append(
+            f'<g id="{view.name}-visible-curves" fill="none" stroke-linecap="round" stroke-linejoin="round" '
+            f'stroke="#000000" stroke-width="{_number(stroke_width)}">{"".join(elements)}</g>'
+        )
+    return groups
 
 
 def _view_names(views: Any, where: str) -> list[str]:
