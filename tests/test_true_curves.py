@@ -82,8 +82,7 @@ def test_cylinder_seen_at_an_angle_gives_ellipses_with_the_analytic_axes(tilt_de
             assert _group(root, group).get("stroke-dasharray")
         d = paths[0].get("d")
         points = [np.array([float(v) for v in NUMBER.findall(d)[:2]])]
-        sweep = 0.0
-        for rx, ry, rotation, _, _, x, y in ARC.findall(d):
+        for rx, ry, _rotation, _, _, x, y in ARC.findall(d):
             assert float(rx) == pytest.approx(major, abs=1e-9) and float(ry) == pytest.approx(minor, abs=1e-9)
             points.append(np.array([float(x), float(y)]))
         for point in points:  # every end on the ellipse ((x/a)² + (y/b)² = 1 about the far rim's centre)
@@ -99,7 +98,7 @@ def test_block_with_a_drilled_hole_circle_in_plan_dashed_lines_in_elevation():
     drill = Mesh(
         cylinder(radius, 20.0, 48).vertices @ rotate_x(-math.pi / 2)[:3, :3].T, cylinder(radius, 20.0, 48).faces
     )
-    part = difference(box((40.0, 10.0, 30.0)), Mesh(drill.vertices + [8.0, 0.0, 3.0], drill.faces))
+    part = difference(box((40.0, 10.0, 30.0)), Mesh(drill.vertices + np.array([8.0, 0.0, 3.0]), drill.faces))
     scene = Scene()
     scene.add(part)
     root = ET.fromstring(drawing_sheet(scene, views=("front", "top"), scale=scale).encode())
