@@ -155,7 +155,7 @@ def test_scale_labels():
             r"scale = 50.0 does not fit 4 views on A3 \(the largest standard scale that fits is 2:1\)",
         ),
         ({"orientation": "sideways"}, OutputError, r"orientation = 'sideways' is unknown; expected 'landscape'"),
-        ({"dimensions": "yes"}, OutputError, r"dimensions = 'yes' is not a bool"),
+        ({"dimensions": "yes"}, OutputError, r"dimensions = 'yes' is unknown; expected 'overall', 'parts' or False"),
         ({"paper": "B5"}, OutputError, r"paper = 'B5' is unknown"),
         ({"paper": (50, 40)}, OutputError, r"paper = \(50.0, 40.0\) is not a paper name"),
         ({"projection_angle": "second"}, OutputError, r"projection_angle = 'second' is unknown"),
@@ -292,7 +292,9 @@ def _dimension(root: ET.Element, group_id: str) -> tuple[float, str, np.ndarray]
 @pytest.mark.parametrize("scale", [1.0, 2.0])
 def test_dimension_values_are_the_model_extents_and_lines_measure_them_times_scale(scale):
     scene, part = _box_with_cylinder()
-    root = ET.fromstring(drawing_sheet(scene, views=("front", "top", "right"), scale=scale).encode())
+    root = ET.fromstring(
+        drawing_sheet(scene, views=("front", "top", "right"), scale=scale, dimensions="overall").encode()
+    )
     extent = part.bounds[1] - part.bounds[0]  # (60, 40, 40): x, y, z
     # (horizontal, vertical) model axes of each view
     axes = {"front": (0, 1), "top": (0, 2), "right": (2, 1)}
@@ -389,10 +391,14 @@ def test_pdf_and_svg_outputs_read_back_like_the_png(tmp_path):
 def test_a_flat_part_seen_edge_on_gets_no_zero_dimension():
     scene = Scene()
     scene.add(Mesh([[0, 0, 0], [40, 0, 0], [40, 0, 20.0]], [[0, 1, 2]]))  # in the y = 0 plane
-    root = ET.fromstring(drawing_sheet(scene, views=("front", "top")).encode())
+    root = ET.fromstring(drawing_sheet(scene, views=("front", "top"), dimensions="overall").encode())
     values = {g.get("id"): float(g.get("data-value")) for g in root.iter(f"{SVG}g") if g.get("class") == "dimension"}
     assert values == {
         "front-dimension-horizontal": 40.0,
         "top-dimension-horizontal": 40.0,
         "top-dimension-vertical": 20.0,
     }
+    # per part: each size once, none of them zero
+    root = ET.fromstring(drawing_sheet(scene, views=("front", "top"), dimensions="parts").encode())
+    values = {g.get("id"): float(g.get("data-value")) for g in root.iter(f"{SVG}g") if g.get("class") == "dimension"}
+    assert sorted(values.values()) == [20.0, 40.0]

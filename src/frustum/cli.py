@@ -457,7 +457,9 @@ def view_command(
     paper: Annotated[str, typer.Option(help="Sheet size: A4, A3, A2, A1, A0, Letter or Tabloid.")] = "A3",
     orientation: Annotated[str, typer.Option(help="landscape or portrait.")] = "landscape",
     angle: Annotated[str, typer.Option(help="Projection angle: third (US, ISO E) or first (ISO, Europe).")] = "third",
-    dimensions: Annotated[bool, typer.Option(help="Draw overall dimensions and diameters.")] = True,
+    dimensions: Annotated[
+        str, typer.Option(help="parts (each part's sizes), overall (each view's extent) or none.")
+    ] = "parts",
 ) -> None:
     """Draw the scene as an engineering sheet: orthographic views at the largest standard scale that fits, with
     hidden lines, dimensions, title block and scale bar."""
@@ -465,7 +467,8 @@ def view_command(
 
     written = render_view_sheet(
         scene, output, tuple(v.strip() for v in views.split(",") if v.strip()),
-        paper=paper, orientation=orientation, projection_angle=angle, dimensions=dimensions,
+        paper=paper, orientation=orientation, projection_angle=angle,
+        dimensions=False if dimensions == "none" else dimensions,
     )  # fmt: skip
     console.print(f"wrote {written}", markup=False, highlight=False, soft_wrap=True)
 

@@ -59,6 +59,7 @@ from frustum.projection import ISOMETRIC_ROTATION_X, MULTIVIEWS, Axonometric, Or
 from frustum.scene import Scene
 
 __all__ = [
+    "DIMENSION_MODES",
     "ORIENTATIONS",
     "PAPER_SIZES",
     "SHEET_VIEWS",
@@ -83,6 +84,8 @@ ORIENTATIONS = ("landscape", "portrait")
 STANDARD_SCALES = tuple(m * 10.0**k if k >= 0 else m / 10.0**-k for k in range(2, -5, -1) for m in (5.0, 2.0, 1.0))
 """Drawing scales (paper length / model length) ``scale=None`` chooses from, largest first: ISO 5455's
 1, 2, 5 series (500:1 … 1:10000; the standard's table extended by powers of ten, as it allows)."""
+DIMENSION_MODES = ("parts", "overall")
+"""What ``drawing_sheet(dimensions=...)`` dimensions besides False: each part's sizes, or each view's overall extent."""
 SHEET_VIEWS = (*MULTIVIEWS, "isometric")
 """View names ``drawing_sheet`` accepts."""
 
@@ -99,6 +102,7 @@ _PIXELS = 1000  # window size of the view cameras; window → paper is x_p = sca
 # dimensioning (ISO 129-1): thin lines, closed filled arrowheads, 3.5 mm lettering above the dimension line
 _THIN = 0.25  # dimension, extension, leader and centre lines, mm
 _DIMENSION_OFFSET = 10.0  # view outline to dimension line, mm
+_DIMENSION_SPACING = 7.0  # between stacked parallel dimension lines, mm
 _EXTENSION_GAP = 1.0  # extension lines start this far from the feature ...
 _EXTENSION_BEYOND = 2.0  # ... and end this far past the dimension line, mm
 _ARROW_LENGTH, _ARROW_HALF_WIDTH = 3.0, 0.55  # arrowhead, mm (about 20 degrees included)
@@ -122,6 +126,14 @@ class _View:
     axes: list[tuple[NDArray[np.float64], NDArray[np.float64]]]  # cylinder axes seen side-on: local ends
     visible_arcs: list[EllipseArc] = field(default_factory=list)  # true curves, window coordinates
     hidden_arcs: list[EllipseArc] = field(default_factory=list)
+    parts: list[NDArray[np.float64]] = field(default_factory=list)  # (N_p, 2) view-local points of each part
+    # world axis (0, 1, 2) running across / down the view; -1 for a view not aligned with the axes (isometric)
+    across: int = -1
+    down: int = -1
+    # per part: visible share of its drawn edges in this view (how well the view shows it)
+    shown: list[float] = field(default_factory=list)
+    # per end-on circle entry of `circles`: the keys (part, radius, axis) of the circles drawn there
+    circle_keys: list[set] = field(default_factory=list)
 
 
 @dataclass
@@ -134,6 +146,9 @@ class _Mark:
     lines: list[tuple[float, float, float, float]] = field(default_factory=list)
     arrows: list[tuple[float, float, float, float]] = field(default_factory=list)  # tip x, y, unit direction
     texts: list[tuple[float, float, str, str, bool]] = field(default_factory=list)  # x, y, text, anchor, vertical
+    # what the mark measures, for CAD (DXF DIMENSION entities): ("linear", a, b, at, horizontal) or
+    # ("diameter", centre, radius, tip) in the same coordinates, or None
+    definition: tuple | None = None
 
 
 def _box(marks: list[_Mark]) -> NDArray[np.float64]:
@@ -195,11 +210,14 @@ def _view_camera(name: str, target: NDArray, radius: float) -> Camera:
     return Camera.multiview(name, Orthographic(height, near, far), target, distance, _PIXELS, _PIXELS)
 
 
-def _sheet_views(names: Sequence[str], points_world: NDArray, meshes: list, options: dict) -> list[_View]:
+def _sheet_views(
+    names: Sequence[str], points_world: NDArray, meshes: list, options: dict
+) -> tuple[list[_View], list[Circle]]:
     low, high = points_world.min(axis=0), points_world.max(axis=0)
     target = (low + high) / 2.0
     radius = max(float(np.linalg.norm(high - low)) / 2.0, 1e-9)
     circles = find_circles(meshes, options["crease_angle"])
+    parts_world = [_points(mesh) @ m[:3, :3].T + m[:3, 3] for mesh, m in meshes]
     views = []
     for name in names:
         camera = _view_camera(name, target, radius)
@@ -208,9 +226,48 @@ def _sheet_views(names: Sequence[str], points_world: NDArray, meshes: list, opti
         local = _to_local(camera.project(points_world)[:, :2], mm_per_pixel)
         end_on = [] if name == "isometric" else _end_on(circles, camera, lines, mm_per_pixel)
         axes = [] if name == "isometric" else _side_on_axes(circles, camera, mm_per_pixel)
+        shown = [_shown(lines, index) for index in range(len(meshes))]
         lines, visible_arcs, hidden_arcs = circle_arcs(lines, circles, camera)
-        views.append(_View(name, camera, mm_per_pixel, lines, local, end_on, axes, visible_arcs, hidden_arcs))
-    return views
+        view = _View(name, camera, mm_per_pixel, lines, local, end_on, axes, visible_arcs, hidden_arcs)
+        view.parts = [_to_local(camera.project(points)[:, :2], mm_per_pixel) for points in parts_world]
+        view.shown = shown
+        if name != "isometric":
+            u, v = np.asarray(camera.frame.u), np.asarray(camera.frame.v)
+            view.across, view.down = int(np.argmax(np.abs(u))), int(np.argmax(np.abs(v)))
+            view.circle_keys = _circle_keys(end_on, circles, camera, mm_per_pixel, 2.0 * radius)
+        views.append(view)
+    return views, circles
+
+
+def _shown(lines: HiddenLines, mesh: int) -> float:
+    """Visible share of the drawn edges of placed mesh `mesh` (window length), 0 where none is drawn."""
+    lengths = []
+    for window, owners in ((lines.visible, lines.visible_edges), (lines.hidden, lines.hidden_edges)):
+        mine = lines.edge_meshes[owners] == mesh
+        lengths.append(float(np.linalg.norm(window[mine, 1] - window[mine, 0], axis=1).sum()))
+    total = lengths[0] + lengths[1]
+    return lengths[0] / total if total > 0.0 else 0.0
+
+
+def _circle_key(circle: Circle, size: float) -> tuple:
+    """One key for the circles a part's diameter states: (part, radius, axis); a sphere's axis is -1."""
+    axis = -1 if circle.kind == "sphere" else int(np.argmax(np.abs(circle.normal)))
+    return (circle.mesh, round(circle.radius / size, 9), axis)
+
+
+def _circle_keys(end_on: list, circles: list[Circle], camera: Camera, mm_per_pixel: float, size: float) -> list:
+    """For each end-on circle entry (projected centre, radius): the keys of the circles drawn there."""
+    direction = np.asarray(camera.frame.direction)
+    keys: list[set] = [set() for _ in end_on]
+    for circle in circles:
+        if circle.kind != "sphere" and abs(float(circle.normal @ direction)) < math.cos(_END_ON_ANGLE):
+            continue
+        centre = _to_local(camera.project(circle.centre[None, :])[:, :2], mm_per_pixel)[0]
+        tolerance = 1e-6 * circle.radius
+        for k, (c, r, _) in enumerate(end_on):
+            if np.abs(c - centre).max() <= tolerance and abs(r - circle.radius) <= tolerance:
+                keys[k].add(_circle_key(circle, size))
+    return keys
 
 
 def _to_local(window: NDArray, factor: float) -> NDArray:
@@ -328,8 +385,9 @@ def _silhouette_visible(lines: HiddenLines, mesh: int) -> float:
 # --- annotations in view-local paper millimetres ----------------------------------------------------------
 
 
-def _marks(view: _View, scale: float, dimensions: bool) -> list[_Mark]:
-    """Centre lines of end-on circles, dimensions (overall extents, diameters) and the label of one view."""
+def _marks(view: _View, scale: float, dimensions: str | None, plan: _Plan | None = None) -> list[_Mark]:
+    """Centre lines of end-on circles, dimensions (overall extents or each part's sizes, diameters) and the
+    label of one view."""
     marks: list[_Mark] = []
     paper = view.local * scale
     x0, y0 = paper.min(axis=0)
@@ -345,7 +403,10 @@ def _marks(view: _View, scale: float, dimensions: bool) -> list[_Mark]:
             start, end = a * scale - 2.0 * along, b * scale + 2.0 * along
             centres.lines.append((float(start[0]), float(start[1]), float(end[0]), float(end[1])))
         marks.append(centres)
-    if dimensions and orthographic:
+    if dimensions == "parts" and orthographic and plan is not None:
+        marks += _part_dimensions(view, scale, plan.linear[view.name])
+        marks += _diameters(view, scale, min(y0, float(_box(marks)[1])), plan.leaders[view.name])
+    elif dimensions == "overall" and orthographic:
         model = view.local.max(axis=0) - view.local.min(axis=0)
         tolerance = 1e-9 * max(x1 - x0, y1 - y0, 1e-300)
         # horizontal: below the view, extension lines from the lowest point on each extreme vertical
@@ -365,14 +426,21 @@ def _marks(view: _View, scale: float, dimensions: bool) -> list[_Mark]:
     return marks
 
 
-def _linear(name: str, value: float, a: tuple[float, float], b: tuple[float, float], at: float) -> _Mark:
+def _linear(
+    name: str, value: float, a: tuple[float, float], b: tuple[float, float], at: float, *, mark_name: str = "",
+    prefix: str = "", text_side: str = "",
+) -> Any:  # fmt: skip
     """A linear dimension of model length `value` between feature points `a` and `b` (paper): extension lines
     to a dimension line at `at` (y for "horizontal", x for "vertical"), arrowheads at both ends (outside,
-    pointing in, when they do not fit between), the value above the line (vertical: reading from the right)."""
-    mark = _Mark("dimension", f"dimension-{name}", value)
+    pointing in, when they do not fit between), the value above the line (vertical: reading from the right),
+    or past the end of the line when it does not fit between the extension lines (ISO 129-1). `text_side`
+    "fit", "after" (past the high end) or "before" asks for one placement: None when "fit" does not fit;
+    "" chooses (between, else after)."""
+    mark = _Mark("dimension", mark_name or f"dimension-{name}", value)
     horizontal = name == "horizontal"
     axis = 0 if horizontal else 1
     low, high = a[axis], b[axis]
+    mark.definition = ("linear", a, b, at, horizontal)
     for point in (a, b):
         foot = point[1 - axis]
         sign = 1.0 if at >= foot else -1.0
@@ -385,10 +453,28 @@ def _linear(name: str, value: float, a: tuple[float, float], b: tuple[float, flo
     for tip, sign in ((low, outward), (high, -outward)):
         mark.arrows.append((tip, at, sign, 0.0) if horizontal else (at, tip, 0.0, sign))
     middle = (low + high) / 2.0
-    text = dimension_text(value)
-    mark.texts.append(
-        (middle, at - 1.0, text, "middle", False) if horizontal else (at - 1.0, middle, text, "middle", True)
-    )
+    text = prefix + dimension_text(value)
+    run = 0.6 * _LETTER * len(text)
+    fits = run + 2.0 <= high - low
+    if text_side == "fit" and not fits:
+        return None
+    offset = -1.0  # the text 1 mm above the line (left of a vertical one, reading from the right)
+    if fits and text_side in ("", "fit"):
+        mark.texts.append(
+            (middle, at + offset, text, "middle", False) if horizontal else (at + offset, middle, text, "middle", True)
+        )
+    elif text_side in ("", "after"):  # past the high end (right; for a vertical dimension: below, reading up)
+        position = high + reach + 1.5
+        mark.texts.append(
+            (position, at + offset, text, "start", False)
+            if horizontal
+            else (at + offset, position + run, text, "start", True)
+        )
+    else:  # past the low end (left; above)
+        position = low - reach - 1.5
+        mark.texts.append(
+            (position, at + offset, text, "end", False) if horizontal else (at + offset, position, text, "start", True)
+        )
     return mark
 
 
@@ -415,24 +501,224 @@ def _diameter_groups(view: _View) -> list[tuple[float, list[NDArray]]]:
     return [(r, sorted(c, key=lambda p: (float(p[0]), float(p[1])))) for r, c in ordered]
 
 
-def _diameters(view: _View, scale: float, top: float) -> list[_Mark]:
-    """One leader per diameter: from the circle at 45° up and right (arrowhead on the circle, pointing at the
-    centre) to a shoulder above the view, with "⌀d" (or "n× ⌀d" for n equal circles)."""
+def _diameters(
+    view: _View, scale: float, top: float, groups: list[tuple[float, list[NDArray], str]] | None = None
+) -> list[_Mark]:
+    """One leader per diameter: from the circle at 45° (57°, 69°, ...) up and right (arrowhead on the circle,
+    pointing at the centre) to a shoulder above the view, with "⌀d" (or "n× ⌀d" for n equal circles; "S⌀d"
+    for a sphere). `groups` (radius, local centres, symbol) default to every visible end-on circle of the view."""
     marks = []
-    unit = np.array([math.sqrt(0.5), -math.sqrt(0.5)])
-    for index, (radius, centres) in enumerate(_diameter_groups(view)):
+    if groups is None:
+        groups = [(radius, centres, "⌀") for radius, centres in _diameter_groups(view)]
+    for index, (radius, centres, symbol) in enumerate(groups):
+        # each further leader 12° steeper (concentric circles' leaders are rays from one centre: never cross)
+        angle = math.radians(min(45.0 + 12.0 * index, 81.0))
+        unit = np.array([math.cos(angle), -math.sin(angle)])
         mark = _Mark("diameter", f"diameter-{index}", 2.0 * radius)
         tip = centres[-1] * scale + radius * scale * unit
         level = top - _LEADER_RISE - 6.0 * index
-        knee = tip + (float(tip[1]) - level) * np.array([1.0, -1.0])
+        knee = (
+            tip
+            + (float(tip[1]) - level) / math.tan(angle) * np.array([1.0, 0.0])
+            + np.array([0.0, level - float(tip[1])])
+        )
         mark.lines.append((float(tip[0]), float(tip[1]), float(knee[0]), level))
         mark.lines.append((float(knee[0]), level, float(knee[0]) + 3.0, level))
         mark.arrows.append((float(tip[0]), float(tip[1]), -float(unit[0]), -float(unit[1])))
         count = f"{len(centres)}× " if len(centres) > 1 else ""
-        text = f"{count}⌀{dimension_text(2.0 * radius)}"
+        text = f"{count}{symbol}{dimension_text(2.0 * radius)}"
         mark.texts.append((float(knee[0]) + 4.0, level + 1.2, text, "start", False))
+        mark.definition = ("diameter", centres[-1] * scale, radius * scale, tip)
         marks.append(mark)
     return marks
+
+
+# --- dimensions per part (ISO 129-1) ----------------------------------------------------------------------
+
+
+@dataclass
+class _Plan:
+    """Which view states which size of which part: per view, linear dimensions (part, "horizontal" or
+    "vertical", symbol before the value) and diameter leaders (radius, local centres, symbol)."""
+
+    linear: dict[str, list[tuple[int, str, str]]]
+    leaders: dict[str, list[tuple[float, list[NDArray], str]]]
+
+
+def _plan_parts(
+    views: list[_View], circles: list[Circle], parts_world: list[NDArray], meshes_ids: list[int], size: float
+) -> _Plan:
+    """Each part's sizes, each stated once on the sheet, in the view that shows it best.
+
+    A part's sizes are its extents along the world axes. A circle of the part (a rim or a hole, or a sphere)
+    gets a diameter leader in the end-on view where it is most visible; a diameter equal to the part's extents
+    across its axis states those extents (a sphere's: all three). Extents left get a linear dimension in the
+    aligned view that shows them, preferring the view where the most of the part's edges are visible and a
+    view already dimensioning the part. Without an end-on view, a rim's diameter is a linear dimension "⌀d".
+    """
+    ortho = [view for view in views if view.across >= 0]
+    linear: dict[str, list[tuple[int, str, str]]] = {view.name: [] for view in views}
+    leader_groups: dict[str, list[tuple[float, list[NDArray], str]]] = {view.name: [] for view in views}
+    tolerance = 1e-6 * size
+    done: list[tuple[int, NDArray]] = []  # (mesh id, extent) of the parts dimensioned
+    for part, points in enumerate(parts_world):
+        if points.shape[0] == 0:
+            continue
+        extent = points.max(axis=0) - points.min(axis=0)
+        # a copy of a part already dimensioned (equal model geometry, placed alike): its diameters count in the "n×"
+        # of the leaders, its sizes are the first copy's
+        copy = any(m == meshes_ids[part] and np.abs(e - extent).max() <= 1e-9 * size for m, e in done)
+        done.append((meshes_ids[part], extent))
+        needed = {k for k in range(3) if extent[k] > 1e-9 * size}
+        stated: set[tuple] = set()
+        for circle in sorted((c for c in circles if c.mesh == part), key=lambda c: -c.radius):
+            key = _circle_key(circle, size)
+            if key in stated:
+                continue
+            stated.add(key)
+            axis = key[2]
+            across = {0, 1, 2} - {axis}
+            covers = across if all(abs(2.0 * circle.radius - extent[k]) <= tolerance for k in across) else set()
+            best = None  # (visible fraction, -order, view, entry)
+            for order, view in enumerate(ortho):
+                for entry, keys in enumerate(view.circle_keys):
+                    if key in keys:
+                        candidate = (view.circles[entry][2], -order, view, entry)
+                        if best is None or candidate[:2] > best[:2]:
+                            best = candidate
+            symbol = "S⌀" if circle.kind == "sphere" else "⌀"
+            if best is not None:
+                view, entry = best[2], best[3]
+                centre = view.circles[entry][0]
+                groups = leader_groups[view.name]
+                for k, (radius, centres, other) in enumerate(groups):
+                    if other == symbol and abs(radius - circle.radius) <= 1e-6 * circle.radius:
+                        groups[k] = (radius, [*centres, centre], other)
+                        break
+                else:
+                    groups.append((circle.radius, [centre], symbol))
+                needed -= covers
+            elif covers and axis >= 0:  # no end-on view: the rim's diameter as a linear dimension
+                k = min(covers & needed, default=None)
+                view = _best_view(ortho, part, k, linear) if k is not None else None
+                if view is not None:
+                    linear[view.name].append((part, "horizontal" if view.across == k else "vertical", "⌀"))
+                    needed -= covers
+        for k in sorted(needed) if not copy else ():
+            view = _best_view(ortho, part, k, linear)
+            if view is not None:
+                linear[view.name].append((part, "horizontal" if view.across == k else "vertical", ""))
+    leaders = {}
+    for name, groups in leader_groups.items():
+        ordered = sorted(groups, key=lambda group: -group[0])
+        leaders[name] = [(r, sorted(c, key=lambda p: (float(p[0]), float(p[1]))), sym) for r, c, sym in ordered]
+    return _Plan(linear, leaders)
+
+
+def _best_view(ortho: list[_View], part: int, axis: int, linear: dict) -> _View | None:
+    """The aligned view showing world `axis` where the part is most visible (a view that already dimensions
+    the part counts half a view more; earlier views win ties)."""
+    best, best_score = None, -math.inf
+    for view in ortho:
+        if axis not in (view.across, view.down) or view.parts[part].shape[0] == 0:
+            continue
+        score = view.shown[part] + (0.5 if any(entry[0] == part for entry in linear[view.name]) else 0.0)
+        if score > best_score + 1e-12:
+            best, best_score = view, score
+    return best
+
+
+def _part_dimensions(view: _View, scale: float, specs: list[tuple[int, str, str]]) -> list[_Mark]:
+    """The linear dimensions `specs` of one view, stacked outward from the view at ``_DIMENSION_SPACING``
+    (horizontal ones below it, else above; vertical ones right of it, else left): shorter ones first, each on
+    the nearest level where it clashes with no dimension placed before (``_clash``: no extension line across
+    another's dimension line, arrowheads or text, no overlap of those); a value that does not fit between its
+    extension lines goes past one end of the line."""
+    paper = view.local * scale
+    (x0, y0), (x1, y1) = paper.min(axis=0), paper.max(axis=0)
+    items = []
+    for part, orientation, symbol in specs:
+        axis = 0 if orientation == "horizontal" else 1
+        local = view.parts[part]
+        value = float(local[:, axis].max() - local[:, axis].min())
+        items.append((value, orientation, part, symbol, local * scale))
+    items.sort(key=lambda item: (item[0], item[1], item[2]))
+    marks: list[_Mark] = []
+    for value, orientation, part, symbol, points in items:
+        axis = 0 if orientation == "horizontal" else 1
+        # (sign away from the view, first level's position): below / right first, then above / left
+        sides = [(1.0, (y1 if axis == 0 else x1) + _DIMENSION_OFFSET),
+                 (-1.0, (y0 if axis == 0 else x0) - _DIMENSION_OFFSET)]  # fmt: skip
+        low, high = float(points[:, axis].min()), float(points[:, axis].max())
+        tolerance = 1e-9 * max(abs(low), abs(high), 1.0)
+        name = f"dimension-part{part}-{orientation}"
+        chosen = None
+        for level in range(2 * len(items) + 1):
+            for sign, base in sides:
+                ends = []
+                for end in (low, high):  # the foot: the part's outermost point toward that side, at the end
+                    across = points[np.abs(points[:, axis] - end) <= tolerance, 1 - axis]
+                    foot = float(across.max() if sign > 0 else across.min())
+                    ends.append((end, foot) if axis == 0 else (foot, end))
+                at = base + sign * level * _DIMENSION_SPACING
+                for text_side in ("fit", "after", "before"):
+                    mark = _linear(orientation, value, ends[0], ends[1], at, mark_name=name, prefix=symbol,
+                                   text_side=text_side)  # fmt: skip
+                    if mark is not None and not any(_clash(mark, other) for other in marks):
+                        chosen = mark
+                        break
+                if chosen is not None:
+                    break
+            if chosen is not None:
+                break
+        if chosen is None:  # crowded beyond resolving: the next free level below / right
+            level = 2 * len(items) + 1
+            chosen = _linear(orientation, value, ends[0], ends[1], sides[0][1] + level * _DIMENSION_SPACING,
+                             mark_name=name, prefix=symbol)  # fmt: skip
+        marks.append(chosen)
+    return marks
+
+
+def _body(mark: _Mark) -> list[NDArray]:
+    """Rectangles (x0, y0, x1, y1) around a linear dimension's line with its arrowheads, and its text."""
+    x0, y0, x1, y1 = mark.lines[-1]
+    line = np.array([min(x0, x1), min(y0, y1), max(x0, x1), max(y0, y1)])
+    line += np.array([-1.0, -1.0, 1.0, 1.0]) * _ARROW_HALF_WIDTH
+    return [line, _box([_Mark("text", "", texts=mark.texts)])]
+
+
+def _clash(mark: _Mark, other: _Mark) -> bool:
+    """Whether two linear dimensions clash: an extension line of one meets the other's dimension line,
+    arrowheads or text, or those of both overlap (0.5 mm clearance)."""
+    clear = 0.5
+    for a, b in ((mark, other), (other, mark)):
+        for rectangle in _body(b):
+            grown = rectangle + np.array([-clear, -clear, clear, clear])
+            if any(_segment_meets(segment, grown) for segment in a.lines[:-1]):
+                return True
+    return any(_overlap(r + np.array([-clear, -clear, clear, clear]), q) for r in _body(mark) for q in _body(other))
+
+
+def _overlap(a: NDArray, b: NDArray) -> bool:
+    return bool(a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3])
+
+
+def _segment_meets(segment: tuple[float, float, float, float], box: NDArray) -> bool:
+    """Whether the segment meets the open box (x0, y0, x1, y1): Liang–Barsky clipping."""
+    x0, y0, x1, y1 = segment
+    dx, dy = x1 - x0, y1 - y0
+    t0, t1 = 0.0, 1.0
+    for p, q in ((-dx, x0 - box[0]), (dx, box[2] - x0), (-dy, y0 - box[1]), (dy, box[3] - y0)):
+        if p == 0.0:
+            if q <= 0.0:
+                return False
+        else:
+            t = q / p
+            if p < 0.0:
+                t0 = max(t0, t)
+            else:
+                t1 = min(t1, t)
+    return t0 < t1
 
 
 def _mark_svg(mark: _Mark, prefix: str, dx: float, dy: float) -> str:
@@ -522,7 +808,7 @@ def drawing_sheet(
     paper: str | tuple[float, float] = "A3",
     orientation: str = "landscape",
     title: str = "",
-    dimensions: bool = True,
+    dimensions: str | bool = "parts",
     edges: str | Sequence[str] = "feature",
     crease_angle: float = DEFAULT_CREASE_ANGLE,
     hidden: str | None = "dashed",
@@ -560,8 +846,13 @@ def drawing_sheet(
         For a named paper: long side horizontal or vertical. A (width, height) is used as given.
     title : str
         Drawing title for the title block.
-    dimensions : bool
-        False: no dimensions or diameter leaders (centre lines stay).
+    dimensions : {"parts", "overall"} or False
+        "parts" (default): each part (placed mesh, a scene-graph node with geometry) gets its sizes, each
+        stated once in the view that shows it best (``_plan_parts``): a diameter leader (``⌀d``, ``S⌀d`` for a
+        sphere, ``n× ⌀d`` for equal circles in one view) on each of its circles, linear dimensions for the
+        extents the diameters do not state, stacked outward 7 mm apart so that no extension line crosses a
+        dimension line or its text. "overall": each view's overall width and height and a leader for every
+        visible end-on diameter. False: none (centre lines stay). True is "overall".
     edges, crease_angle, hidden, stroke_width
         As in ``render_svg``; `stroke_width` (visible outlines) in paper millimetres.
 
@@ -596,8 +887,14 @@ def drawing_sheet(
         raise OutputError(
             f"{where}: orientation = {describe(orientation)} is unknown; expected 'landscape' or 'portrait'"
         )
-    if not isinstance(dimensions, bool | np.bool_):
-        raise OutputError(f"{where}: dimensions = {describe(dimensions)} is not a bool; give True or False")
+    if dimensions is True or dimensions is False or isinstance(dimensions, np.bool_):
+        mode = "overall" if dimensions else None
+    elif isinstance(dimensions, str) and dimensions in DIMENSION_MODES:
+        mode = dimensions
+    else:
+        raise OutputError(
+            f"{where}: dimensions = {describe(dimensions)} is unknown; expected 'overall', 'parts' or False"
+        )
     paper_width, paper_height = _paper(paper, orientation, where)
     given_scale = None
     if scale is not None:
@@ -618,13 +915,17 @@ def drawing_sheet(
         [_points(item.mesh) @ item.world_from_model[:3, :3].T + item.world_from_model[:3, 3] for item in placed]
     )
     meshes = [(item.mesh, item.world_from_model) for item in placed]
-    sheet_views = _sheet_views(names, points_world, meshes, {"edges": edges, "crease_angle": crease_angle})
+    sheet_views, circles = _sheet_views(names, points_world, meshes, {"edges": edges, "crease_angle": crease_angle})
+    size = max(float(np.linalg.norm(points_world.max(axis=0) - points_world.min(axis=0))), 1e-300)
+    parts_world = [_points(mesh) @ m[:3, :3].T + m[:3, 3] for mesh, m in meshes]
+    ids = [hash((_points(mesh).tobytes(), getattr(mesh, "faces", np.empty(0)).tobytes())) for mesh, _ in meshes]
+    plan = _plan_parts(sheet_views, circles, parts_world, ids, size) if mode == "parts" else None
     cells = _THIRD_ANGLE if projection_angle == "third" else _FIRST_ANGLE
     # the drawing area: inside the border, above the title strip
     area = (_MARGIN, _MARGIN, paper_width - 2 * _MARGIN, paper_height - 2 * _MARGIN - _TITLE_HEIGHT)
 
     def attempt(candidate: float) -> tuple[dict, dict] | None:
-        marks = {view.name: _marks(view, candidate, dimensions) for view in sheet_views}
+        marks = {view.name: _marks(view, candidate, mode, plan) for view in sheet_views}
         places = _layout(sheet_views, marks, cells, candidate, area)
         return None if places is None else (marks, places)
 

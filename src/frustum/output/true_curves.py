@@ -16,7 +16,8 @@ Circular features are found in any mesh, whoever built it (``find_circles``):
   placement), the rims of holes drilled by CSG (``frustum.geometry.csg``: manifold3d keeps the cutter's
   vertices) and circular loops in loaded meshes;
 * **spheres** — a mesh of at least ``SPHERE_MIN_VERTICES`` distinct vertices all at one distance r from their
-  centroid (same tolerance) with no edge longer than r/2 (a polyhedron with few faces is not a sphere): its
+  centroid (same tolerance), no edge longer than 0.75·r and every face normal within 26° of the radius
+  through the face's centroid (a polyhedron with few faces, or a short cylinder, is not a sphere): its
   silhouette under a parallel projection is the great circle perpendicular to the line of sight, drawn as a
   circle of radius r (the faceted silhouette's zigzag lies inside it).
 
@@ -173,7 +174,14 @@ def _sphere(points: NDArray, faces: NDArray, size: float, index: int) -> Circle 
         return None
     corners = points[faces]
     longest = float(np.linalg.norm(corners - corners[:, [1, 2, 0]], axis=2).max())
-    if longest > 0.5 * radius:
+    if longest > 0.75 * radius:
+        return None
+    # every face turned to the centre like a sphere's facets (a short cylinder's vertices also lie on a sphere)
+    normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    radial = corners.mean(axis=1) - centre
+    lengths = np.linalg.norm(normals, axis=1) * np.linalg.norm(radial, axis=1)
+    good = lengths > 0.0
+    if np.any(np.abs((normals[good] * radial[good]).sum(axis=1)) < 0.9 * lengths[good]):
         return None
     return Circle(centre, np.array([0.0, 0.0, 1.0]), radius, 0, index, "sphere")
 
@@ -236,7 +244,9 @@ def circle_arcs(
     """
     if not camera.projection.parallel or not circles:
         return lines, [], []
-    direction = np.asarray(camera.frame.direction, dtype=np.float64)
+    # the line of sight of the projection (an axonometric projection turns it away from the frame's)
+    rows = np.asarray(camera.clip_from_world)[[0, 1, 3]]
+    direction = np.linalg.svd(rows)[2][-1][:3]
     direction = direction / np.linalg.norm(direction)
     edges = lines.edges
     size = (
