@@ -692,11 +692,22 @@ def _clash(mark: _Mark, other: _Mark) -> bool:
     arrowheads or text, or those of both overlap (0.5 mm clearance)."""
     clear = 0.5
     for a, b in ((mark, other), (other, mark)):
-        for rectangle in _body(b):
-            grown = rectangle + np.array([-clear, -clear, clear, clear])
-            if any(_segment_meets(segment, grown) for segment in a.lines[:-1]):
-                return True
+        line, text = _body(b)
+        for segment in a.lines[:-1]:
+            # an extension line on the line of one of b's own (a shared extension line, as in chain
+            # dimensioning) may run through b's arrowhead there, not through its text
+            shared = any(_collinear(segment, own) for own in b.lines[:-1])
+            for rectangle in (text,) if shared else (line, text):
+                if _segment_meets(segment, rectangle + np.array([-clear, -clear, clear, clear])):
+                    return True
     return any(_overlap(r + np.array([-clear, -clear, clear, clear]), q) for r in _body(mark) for q in _body(other))
+
+
+def _collinear(a: tuple[float, float, float, float], b: tuple[float, float, float, float]) -> bool:
+    """Whether two axis-parallel extension lines lie on one line (within 1e-9 mm)."""
+    if a[0] == a[2] and b[0] == b[2]:
+        return abs(a[0] - b[0]) <= 1e-9
+    return a[1] == a[3] and b[1] == b[3] and abs(a[1] - b[1]) <= 1e-9
 
 
 def _overlap(a: NDArray, b: NDArray) -> bool:
