@@ -102,7 +102,8 @@ def test_title_block_labels_and_scale_bar():
     text = drawing_sheet(_block(), scale=2.0, title="Block <A&B>")
     root = ET.fromstring(text.encode())
     texts = [t.text for t in root.iter(f"{SVG}text")]
-    assert "Block <A&B>" in texts and "SCALE 2:1" in texts
+    block = _group(root, "title-block")
+    assert "Block <A&B>" in texts and "SCALE" in texts and "2:1" in texts and block.get("data-scale") == "2:1"
     assert {"FRONT VIEW", "TOP VIEW", "RIGHT VIEW", "ISOMETRIC VIEW"} <= set(texts)
     bar = next(g for g in root.iter(f"{SVG}g") if g.get("id") == "scale-bar")
     length = float(bar.get("data-length"))
@@ -113,8 +114,8 @@ def test_title_block_labels_and_scale_bar():
 
 def test_automatic_scale_is_the_largest_standard_scale_that_fits():
     text = drawing_sheet(_bracket(), paper="A4")
-    chosen = next(t.text for t in ET.fromstring(text.encode()).iter(f"{SVG}text") if t.text.startswith("SCALE"))
-    scale = next(s for s in STANDARD_SCALES if f"SCALE {scale_label(s)}" == chosen)
+    chosen = _group(ET.fromstring(text.encode()), "title-block").get("data-scale")
+    scale = next(s for s in STANDARD_SCALES if scale_label(s) == chosen)
     larger = [s for s in STANDARD_SCALES if s > scale]
     with pytest.raises(OutputError, match=r"does not fit"):
         drawing_sheet(_bracket(), paper="A4", scale=min(larger))
@@ -320,12 +321,14 @@ def test_dimension_values_are_the_model_extents_and_lines_measure_them_times_sca
     for view, axis_paper_x in (("front", 5.0 - (part.bounds[0][0] + part.bounds[1][0]) / 2),
                                ("right", 4.0 + (part.bounds[0][2] + part.bounds[1][2]) / 2)):  # fmt: skip
         group = _group(root, f"{view}-centre-lines")
-        (x0, y0), (x1, y1) = np.array([float(v) for v in NUMBER.findall(group.find(f"{SVG}path").get("d"))]).reshape(
-            2, 2
-        )
+        # a chain line drawn as its dashes (long dashes at both ends: no stray dots)
+        dashes = np.array([float(v) for v in NUMBER.findall(group.find(f"{SVG}path").get("d"))]).reshape(-1, 2, 2)
         centre = [float(v) for v in _group(root, f"view-{view}").get("data-centre").split()]
-        assert x0 == pytest.approx(x1, abs=1e-9) and x0 == pytest.approx(centre[0] + axis_paper_x * scale, abs=1e-9)
-        assert abs(y1 - y0) == pytest.approx(30.0 * scale + 4.0, abs=1e-9)
+        np.testing.assert_allclose(dashes[:, :, 0], centre[0] + axis_paper_x * scale, atol=1e-9)
+        ys = np.sort(dashes[:, :, 1], axis=1)
+        assert ys.max() - ys.min() == pytest.approx(30.0 * scale + 4.0, abs=1e-9)
+        ordered = ys[np.argsort(ys[:, 0])]
+        assert (ordered[[0, -1], 1] - ordered[[0, -1], 0] >= 2.0).all()  # the end dashes are long ones
     arrowheads = [p for p in root.iter(f"{SVG}path") if p.get("class") == "arrowheads"]
     assert len(arrowheads) == 7 and all(p.get("d").count("Z") in (1, 2) for p in arrowheads)
 

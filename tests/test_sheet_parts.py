@@ -18,7 +18,7 @@ import shapely
 from shapely import affinity
 from shapely.geometry import LineString, Point, box
 
-from frustum import Scene, rotate_x, translate
+from frustum import OutputError, Scene, rotate_x, translate
 from frustum.geometry import box as box_mesh
 from frustum.geometry import cylinder, uv_sphere
 from frustum.output.sheet import dimension_text, drawing_sheet
@@ -193,3 +193,75 @@ def test_a_cylinder_without_an_end_on_view_gets_a_linear_diameter():
     root = ET.fromstring(drawing_sheet(scene, views=("front", "top")).encode())
     assert [g.find(f"{SVG}text").text for g in _groups(root, "diameter")] == ["⌀12"]
     assert [g.find(f"{SVG}text").text for g in _groups(root, "dimension")] == ["20"]
+
+
+# --- title block (ISO 7200) and projection symbol (ISO 5456-2) ---------------------------------------------
+
+
+@pytest.mark.parametrize("angle", ["third", "first"])
+def test_title_block_has_every_field_and_the_projection_symbol_of_the_angle(angle):
+    scene = Scene()
+    scene.add(box_mesh((40.0, 20.0, 10.0)))
+    fields = {"title": "Bracket", "drawing_number": "FR-0042", "sheet": (2, 3), "date": "2026-12-02",
+              "author": "A. Drafter", "tolerance": "ISO 2768-f", "units": "mm"}  # fmt: skip
+    root = ET.fromstring(drawing_sheet(scene, projection_angle=angle, paper="A4", title_block=fields).encode())
+    block = next(g for g in root.iter(f"{SVG}g") if g.get("id") == "title-block")
+    texts = [t.text for t in block.iter(f"{SVG}text")]
+    for label in ("TITLE", "DRAWING NO.", "DRAWN BY", "DATE", "SCALE", "SHEET", "UNITS", "GENERAL TOLERANCES",
+                  "SIZE"):  # fmt: skip
+        assert label in texts
+    for value in ("Bracket", "FR-0042", "2/3", "2026-12-02", "A. Drafter", "ISO 2768-f", "mm", "A4",
+                  f"{angle.upper()} ANGLE PROJECTION", block.get("data-scale")):  # fmt: skip
+        assert value in texts, value
+    # the symbol: a trapezoid (the truncated cone, small end left) and two concentric circles (its view from
+    # the small end), those right of the cone in first angle, left of it in third
+    symbol = next(g for g in block.iter(f"{SVG}g") if g.get("id") == f"projection-symbol-{angle}")
+    circles = symbol.findall(f"{SVG}circle")
+    assert len(circles) == 2 and circles[0].get("cx") == circles[1].get("cx")
+    radii = sorted(float(c.get("r")) for c in circles)
+    cone = np.array([float(v) for v in NUMBER.findall(symbol.find(f"{SVG}path").get("d"))]).reshape(-1, 2, 2)
+    xs = cone[:, :, 0]
+    left_side = cone[np.abs(cone[:, 0, 0] - cone[:, 1, 0]) < 1e-9]
+    heights = {float(s[0, 0]): abs(s[1, 1] - s[0, 1]) for s in left_side}
+    assert heights[min(heights)] == pytest.approx(2 * radii[0]) and heights[max(heights)] == pytest.approx(2 * radii[1])
+    circles_x = float(circles[0].get("cx"))
+    assert (circles_x > xs.max()) if angle == "first" else (circles_x < xs.min())
+
+
+@pytest.mark.parametrize(
+    ("title_block", "match"),
+    [
+        ({"drawing_no": "1"}, r"title_block has 'drawing_no', which is unknown; expected keys from"),
+        ({"sheet": (3, 2)}, r"title_block sheet = \(3, 2\) needs 1 <= n <= N"),
+        ({"date": 20261202}, r"title_block date = 20261202 is not text"),
+        ("Bracket", r"title_block = 'Bracket' is not a mapping"),
+    ],
+)
+def test_title_block_rejects_bad_fields(title_block, match):
+    scene = Scene()
+    scene.add(box_mesh((40.0, 20.0, 10.0)))
+    with pytest.raises(OutputError, match=match):
+        drawing_sheet(scene, title_block=title_block)
+
+
+def test_every_circle_gets_a_centre_mark_without_stray_dots():
+    scene = _plate_with_parts()
+    root = ET.fromstring(drawing_sheet(scene, views=("front", "top", "right")).encode())
+    for view in ("front", "top", "right"):
+        group = next(g for g in root.iter(f"{SVG}g") if g.get("id") == f"{view}-centre-lines")
+        dashes = np.array([float(v) for v in NUMBER.findall(group.find(f"{SVG}path").get("d"))]).reshape(-1, 2, 2)
+        lengths = np.linalg.norm(dashes[:, 1] - dashes[:, 0], axis=1)
+        # short dashes of 1 mm only between long ones: every dash that ends a line is >= 2 mm
+        ends = {tuple(np.round(p, 6)) for p in dashes.reshape(-1, 2)}
+        for dash, length in zip(dashes, lengths, strict=True):
+            if length < 2.0:
+                # both neighbours along its line exist (a short dash inside a chain, not at an end)
+                direction = (dash[1] - dash[0]) / length
+                before, after = dash[0] - direction, dash[1] + direction
+                assert tuple(np.round(before, 6)) in ends and tuple(np.round(after, 6)) in ends
+    # the sphere's centre mark in every view (its outline is a circle seen from every side)
+    front_circles = [
+        float(c.get("r"))
+        for c in next(g for g in root.iter(f"{SVG}g") if g.get("id") == "front-visible-curves").iter(f"{SVG}circle")
+    ]
+    assert front_circles == [pytest.approx(5.0)]

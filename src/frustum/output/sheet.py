@@ -28,8 +28,10 @@ Orthogonal Projections"; [seed] "Elevation and Plan View", "engineering and arch
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from html import escape as _html_escape
 from typing import Any
 
 import numpy as np
@@ -52,6 +54,7 @@ from frustum.output.svg import (
     _escape,
     _number,
     _placed_meshes,
+    save_svg,
     svg_document,
 )
 from frustum.output.true_curves import Circle, EllipseArc, circle_arcs, find_circles, svg_arc_elements
@@ -96,7 +99,7 @@ _FIRST_ANGLE = {"front": (0, 0), "top": (0, 1), "bottom": (0, -1), "right": (-1,
                 "rear": (2, 0), "isometric": (1, 1)}  # fmt: skip
 _MARGIN = 10.0  # border to paper edge, mm
 _TITLE_HEIGHT = 36.0  # title block strip at the bottom of the frame, mm
-_TITLE_WIDTH = 170.0
+_TITLE_WIDTH = 180.0  # ISO 7200: at most 180 mm wide
 _MIN_GAP = 8.0  # least space between views (and between views and the border), mm
 _PIXELS = 1000  # window size of the view cameras; window → paper is x_p = scale · (h / _PIXELS) · x_w + ...
 # dimensioning (ISO 129-1): thin lines, closed filled arrowheads, 3.5 mm lettering above the dimension line
@@ -149,6 +152,9 @@ class _Mark:
     # what the mark measures, for CAD (DXF DIMENSION entities): ("linear", a, b, at, horizontal) or
     # ("diameter", centre, radius, tip) in the same coordinates, or None
     definition: tuple | None = None
+    circles: list[tuple[float, float, float]] = field(default_factory=list)  # x, y, radius (projection symbol)
+    text_size: float = _LETTER
+    line_width: float = _THIN
 
 
 def _box(marks: list[_Mark]) -> NDArray[np.float64]:
@@ -401,7 +407,7 @@ def _marks(view: _View, scale: float, dimensions: str | None, plan: _Plan | None
             # the axis, 2 mm past the ends of the cylinder
             along = (b - a) / np.linalg.norm(b - a)
             start, end = a * scale - 2.0 * along, b * scale + 2.0 * along
-            centres.lines.append((float(start[0]), float(start[1]), float(end[0]), float(end[1])))
+            centres.lines += _chain_line((float(start[0]), float(start[1])), (float(end[0]), float(end[1])))
         marks.append(centres)
     if dimensions == "parts" and orthographic and plan is not None:
         marks += _part_dimensions(view, scale, plan.linear[view.name])
@@ -479,10 +485,50 @@ def _linear(
 
 
 def _centre_lines(mark: _Mark, centre: NDArray, radius: float) -> None:
+    """Two centre lines crossing at the centre on their long dashes, 2 mm past the circle (a centre mark)."""
     reach = radius + 2.0
     cx, cy = float(centre[0]), float(centre[1])
-    mark.lines.append((cx - reach, cy, cx + reach, cy))
-    mark.lines.append((cx, cy - reach, cx, cy + reach))
+    mark.lines += _chain_line((cx - reach, cy), (cx + reach, cy))
+    mark.lines += _chain_line((cx, cy - reach), (cx, cy + reach))
+
+
+_CHAIN_LONG, _CHAIN_GAP, _CHAIN_SHORT = 8.0, 1.0, 1.0  # long-dashed dotted narrow line (ISO 128-2 type 04), mm
+
+
+def _chain_line(a: tuple[float, float], b: tuple[float, float]) -> list[tuple[float, float, float, float]]:
+    """A centre line from `a` to `b` as its dashes, symmetric about the middle: a long dash across the middle,
+    then short dash and long dash in turn, and a long dash (never a gap or a short dash) at each end. A line
+    too short for one short dash each side is drawn solid (ISO 128-2: small circles get continuous centre
+    lines)."""
+    ax, ay = a
+    bx, by = b
+    half = math.hypot(bx - ax, by - ay) / 2.0
+    if half <= 0.0:
+        return []
+    ux, uy = (bx - ax) / (2 * half), (by - ay) / (2 * half)
+    mx, my = (ax + bx) / 2.0, (ay + by) / 2.0
+    # pieces along one half, from the middle: [0, L/2] long, then (gap, short, gap, long) repeated
+    pieces: list[list[float]] = [[0.0, _CHAIN_LONG / 2]]
+    position = _CHAIN_LONG / 2
+    while position < half:
+        short = [position + _CHAIN_GAP, position + _CHAIN_GAP + _CHAIN_SHORT]
+        long = [short[1] + _CHAIN_GAP, short[1] + _CHAIN_GAP + _CHAIN_LONG]
+        pieces += [short, long]
+        position = long[1]
+    # cut at the end; an end that is not a long dash of at least 2 mm: extend the last long dash instead
+    kept = [piece for piece in pieces if piece[0] < half]
+    while len(kept) > 1 and (len(kept) % 2 == 0 or half - kept[-1][0] < 2.0):
+        kept.pop()
+    kept[-1][1] = half
+    segments = []
+    for start, end in kept:
+        for sign in (1.0, -1.0):
+            if start == 0.0 and sign < 0.0:  # the middle dash: once, across the middle
+                segments.append((mx - end * ux, my - end * uy, mx + end * ux, my + end * uy))
+            elif start > 0.0:
+                p, q = start * sign, end * sign
+                segments.append((mx + p * ux, my + p * uy, mx + q * ux, my + q * uy))
+    return segments
 
 
 def _diameter_groups(view: _View) -> list[tuple[float, list[NDArray]]]:
@@ -740,9 +786,13 @@ def _mark_svg(mark: _Mark, prefix: str, dx: float, dy: float) -> str:
             f"M{_number(x0 + dx)} {_number(y0 + dy)} L{_number(x1 + dx)} {_number(y1 + dy)}"
             for x0, y0, x1, y1 in mark.lines
         )
-        dash = ' stroke-dasharray="6 1 1 1"' if mark.kind == "centre" else ""
         parts.append(
-            f'<path class="lines" d="{d}" fill="none" stroke="#000000" stroke-width="{_number(_THIN)}"{dash}/>'
+            f'<path class="lines" d="{d}" fill="none" stroke="#000000" stroke-width="{_number(mark.line_width)}"/>'
+        )
+    for x, y, r in mark.circles:
+        parts.append(
+            f'<circle cx="{_number(x + dx)}" cy="{_number(y + dy)}" r="{_number(r)}" fill="none" stroke="#000000" '
+            f'stroke-width="{_number(mark.line_width)}"/>'
         )
     if mark.arrows:
         heads = []
@@ -759,7 +809,7 @@ def _mark_svg(mark: _Mark, prefix: str, dx: float, dy: float) -> str:
         X, Y = _number(x + dx), _number(y + dy)
         turn = f' transform="rotate(-90 {X} {Y})"' if vertical else ""
         parts.append(
-            f'<text x="{X}" y="{Y}" font-family="sans-serif" font-size="{_number(_LETTER)}" '
+            f'<text x="{X}" y="{Y}" font-family="sans-serif" font-size="{_number(mark.text_size)}" '
             f'text-anchor="{anchor}"{turn}>{_escape(text)}</text>'
         )
     value = "" if math.isnan(mark.value) else f' data-value="{_number(mark.value)}"'
@@ -824,6 +874,8 @@ def drawing_sheet(
     crease_angle: float = DEFAULT_CREASE_ANGLE,
     hidden: str | None = "dashed",
     stroke_width: float = 0.5,
+    title_block: dict[str, Any] | None = None,
+    path: str | os.PathLike | None = None,
 ) -> str:
     """An SVG engineering drawing of `scene`: multiview orthographic views, dimensions, title block, scale bar.
 
@@ -907,6 +959,7 @@ def drawing_sheet(
             f"{where}: dimensions = {describe(dimensions)} is unknown; expected 'overall', 'parts' or False"
         )
     paper_width, paper_height = _paper(paper, orientation, where)
+    fields = _title_fields(title_block, title, where)
     given_scale = None
     if scale is not None:
         given_scale = as_scalar(scale, "scale", where=where, error=OutputError)
@@ -969,9 +1022,47 @@ def drawing_sheet(
         view_hidden = None if view.name == "isometric" else hidden
         body.append(_view_group(view, placed, centre_x, centre_y, drawing_scale, view_hidden, width_line))
         body += [_mark_svg(mark, f"{view.name}-", centre_x, centre_y) for mark in marks[view.name]]
-    body.append(_title_block(paper_width, paper_height, title, drawing_scale, projection_angle))
+    paper_name = (
+        paper.upper()
+        if isinstance(paper, str) and paper.lower() != "letter" and paper.lower() != "tabloid"
+        else (paper.capitalize() if isinstance(paper, str) else f"{_number(paper_width)} x {_number(paper_height)}")
+    )
+    title_marks = _title_block(paper_width, paper_height, fields, drawing_scale, projection_angle, paper_name)
+    data = {**fields, "scale": scale_label(drawing_scale), "projection": projection_angle, "size": paper_name}
+    attributes = "".join(f' data-{key.replace("_", "-")}="{_html_escape(value)}"' for key, value in data.items())
+    body.append(f'<g id="title-block"{attributes}>{"".join(_mark_svg(mark, "", 0.0, 0.0) for mark in title_marks)}</g>')
     body.append(_scale_bar(drawing_scale, paper_height))
-    return svg_document(paper_width, paper_height, body, units="mm")
+    text = svg_document(paper_width, paper_height, body, units="mm")
+    if path is not None:
+        if str(path).lower().endswith(".dxf"):
+            from frustum.output.sheet_dxf import save_sheet_dxf
+
+            save_sheet_dxf(
+                _SheetDrawing(paper_width, paper_height, drawing_scale, sheet_views, places, marks, title_marks,
+                              hidden, fields["units"], placed),
+                path,
+            )  # fmt: skip
+        else:
+            save_svg(text, path)
+    return text
+
+
+@dataclass
+class _SheetDrawing:
+    """Everything a sheet draws, for writers other than SVG (``output/sheet_dxf.py``): paper size (mm), scale,
+    the views and their sheet positions, their marks (view-local paper mm), the title block's marks (sheet mm),
+    the hidden-line style, the model units and the placed meshes."""
+
+    width: float
+    height: float
+    scale: float
+    views: list[_View]
+    places: dict[str, tuple[float, float]]
+    marks: dict[str, list[_Mark]]
+    title_marks: list[_Mark]
+    hidden: str | None
+    units: str
+    placed: list
 
 
 def _points(geometry: Mesh | Polyline) -> NDArray[np.float64]:
@@ -1071,22 +1162,102 @@ def _text(x: float, y: float, text: str, size: float, anchor: str = "start") -> 
     )
 
 
-def _title_block(paper_width: float, paper_height: float, title: str, scale: float, angle: str) -> str:
+TITLE_BLOCK_FIELDS = ("title", "drawing_number", "sheet", "date", "author", "tolerance", "units")
+"""Keys of ``drawing_sheet(title_block=...)`` (ISO 7200 data fields): the drawing's title, its identification
+number, sheet "n/N", date of issue, creator, general tolerance note and model units."""
+_TITLE_DEFAULTS = {"drawing_number": "", "sheet": "1/1", "date": "", "author": "", "tolerance": "ISO 2768-m",
+                   "units": "mm"}  # fmt: skip
+# title block cells: (key, label, x, y, width, height) in mm from the block's top left corner; 180 x 32 mm
+_TITLE_CELLS = (
+    ("title", "TITLE", 0.0, 0.0, 120.0, 12.0), ("drawing_number", "DRAWING NO.", 120.0, 0.0, 60.0, 12.0),
+    ("author", "DRAWN BY", 0.0, 12.0, 50.0, 10.0), ("date", "DATE", 50.0, 12.0, 35.0, 10.0),
+    ("scale", "SCALE", 85.0, 12.0, 35.0, 10.0), ("sheet", "SHEET", 120.0, 12.0, 30.0, 10.0),
+    ("units", "UNITS", 150.0, 12.0, 30.0, 10.0), ("tolerance", "GENERAL TOLERANCES", 0.0, 22.0, 85.0, 10.0),
+    ("projection", "", 85.0, 22.0, 65.0, 10.0), ("size", "SIZE", 150.0, 22.0, 30.0, 10.0),
+)  # fmt: skip
+_TITLE_LABEL = 1.8  # label lettering, mm
+
+
+def _title_fields(title_block: Any, title: str, where: str) -> dict[str, str]:
+    """The title block's field texts from ``title_block`` (a mapping of ``TITLE_BLOCK_FIELDS``) and `title`."""
+    if title_block is None:
+        title_block = {}
+    if not isinstance(title_block, dict):
+        raise OutputError(
+            f"{where}: title_block = {describe(title_block)} is not a mapping; give a dict of {TITLE_BLOCK_FIELDS}"
+        )
+    unknown = sorted(str(key) for key in title_block if key not in TITLE_BLOCK_FIELDS)
+    if unknown:
+        raise OutputError(
+            f"{where}: title_block has {', '.join(map(repr, unknown))}, which is unknown; expected keys from "
+            f"{TITLE_BLOCK_FIELDS}"
+        )
+    fields = {**_TITLE_DEFAULTS, "title": title, **title_block}
+    sheet = fields["sheet"]
+    if isinstance(sheet, tuple | list):
+        if len(sheet) != 2 or not all(isinstance(k, int) and not isinstance(k, bool) for k in sheet):
+            raise OutputError(
+                f"{where}: title_block sheet = {describe(sheet)} is not (n, N); give e.g. (1, 2) or '1/2'"
+            )
+        number, count = sheet
+        if not 1 <= number <= count:
+            raise OutputError(f"{where}: title_block sheet = ({number}, {count}) needs 1 <= n <= N; give e.g. (1, 2)")
+        fields["sheet"] = f"{number}/{count}"
+    for key, value in fields.items():
+        if not isinstance(value, str):
+            raise OutputError(f"{where}: title_block {key} = {describe(value)} is not text; give a string")
+    return fields
+
+
+def _title_block(paper_width: float, paper_height: float, fields: dict[str, str], scale: float, angle: str,
+                 paper: str) -> list[_Mark]:  # fmt: skip
+    """The ISO 7200 title block at the lower right corner of the frame, as marks (sheet coordinates): frame and
+    cell lines, each cell's label (small) and value, and the projection symbol of `angle` with its name."""
     x1, y1 = paper_width - _MARGIN, paper_height - _MARGIN
-    x0, y0 = x1 - _TITLE_WIDTH, y1 - _TITLE_HEIGHT + 4.0
-    middle = (y0 + y1) / 2.0
-    column = x0 + 110.0
-    parts = [
-        f'<rect x="{_number(x0)}" y="{_number(y0)}" width="{_number(_TITLE_WIDTH)}" '
-        f'height="{_number(y1 - y0)}" fill="none" stroke="#000000" stroke-width="0.5"/>',
-        f'<path d="M{_number(x0)} {_number(middle)} L{_number(x1)} {_number(middle)} '
-        f'M{_number(column)} {_number(middle)} L{_number(column)} {_number(y1)}" '
-        'fill="none" stroke="#000000" stroke-width="0.35"/>',
-        _text(x0 + 3.0, middle - 5.0, title or "UNTITLED", 6.0),
-        _text(x0 + 3.0, y1 - 5.0, f"{angle.upper()} ANGLE PROJECTION   UNITS: mm", 3.5),
-        _text(column + 3.0, y1 - 5.0, f"SCALE {scale_label(scale)}", 3.5),
-    ]
-    return f'<g id="title-block">{"".join(parts)}</g>'
+    x0, y0 = x1 - _TITLE_WIDTH, y1 - 32.0
+    frame = _Mark("title", "title-block-lines", line_width=0.5)
+    frame.lines += [(x0, y0, x1, y0), (x1, y0, x1, y1), (x1, y1, x0, y1), (x0, y1, x0, y0)]
+    labels = _Mark("title", "title-block-labels", text_size=_TITLE_LABEL)
+    values = _Mark("title", "title-block-values")
+    title = _Mark("title", "title-block-title", text_size=5.0)
+    cells = _Mark("title", "title-block-cells", line_width=0.35)
+    texts = {**fields, "scale": scale_label(scale), "size": paper}
+    for key, label, dx, dy, _width, height in _TITLE_CELLS:
+        cx, cy = x0 + dx, y0 + dy
+        if dx > 0.0:  # the cell's left side
+            cells.lines.append((cx, cy, cx, cy + height))
+        if label:
+            labels.texts.append((cx + 1.5, cy + 1.5 + _TITLE_LABEL, label, "start", False))
+        if key == "projection":
+            continue
+        text = texts[key]
+        target = title if key == "title" else values
+        target.texts.append((cx + 1.5, cy + height - 2.0, text or "—", "start", False))
+    for row in (12.0, 22.0):  # rows between the cells
+        cells.lines.append((x0, y0 + row, x1, y0 + row))
+    symbol = _projection_symbol(x0 + 85.0 + 2.0, y0 + 22.0 + 1.5, angle)
+    symbol.texts.append((x0 + 85.0 + 27.0, y0 + 22.0 + 6.2, f"{angle.upper()} ANGLE PROJECTION", "start", False))
+    symbol.text_size = 2.5
+    return [frame, cells, labels, values, title, symbol]
+
+
+def _projection_symbol(x: float, y: float, angle: str) -> _Mark:
+    """ISO 5456-2's symbol of the projection method, 7 mm tall, its top left at (x, y): a truncated cone with
+    its small end to the left (front view: a trapezoid) and its view from the left (two circles, both rims
+    seen). First angle puts that view on the far side, right of the trapezoid (next to the large end); third
+    angle where it was seen from, left of it (next to the small end). Centre lines through both."""
+    mark = _Mark("symbol", f"projection-symbol-{angle}", line_width=0.35)
+    big, small, length, gap = 3.5, 1.75, 7.0, 4.0  # radii, the cone's length, space between the views, mm
+    circles_x = x + big if angle == "third" else x + length + gap + big
+    cone_x = x + 2 * big + gap if angle == "third" else x
+    cy = y + big
+    mark.lines += [
+        (cone_x, cy - small, cone_x + length, cy - big), (cone_x + length, cy - big, cone_x + length, cy + big),
+        (cone_x + length, cy + big, cone_x, cy + small), (cone_x, cy + small, cone_x, cy - small),
+    ]  # fmt: skip
+    mark.circles += [(circles_x, cy, big), (circles_x, cy, small)]
+    mark.definition = ("symbol", circles_x, cone_x)
+    return mark
 
 
 def _scale_bar(scale: float, paper_height: float) -> str:
