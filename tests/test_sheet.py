@@ -107,7 +107,7 @@ def test_title_block_labels_and_scale_bar():
     assert {"FRONT VIEW", "TOP VIEW", "RIGHT VIEW", "ISOMETRIC VIEW"} <= set(texts)
     bar = next(g for g in root.iter(f"{SVG}g") if g.get("id") == "scale-bar")
     length = float(bar.get("data-length"))
-    line = [float(v) for v in NUMBER.findall(bar.find(f"{SVG}path").get("d"))[:4]]
+    line = [float(v) for v in NUMBER.findall(next(bar.iter(f"{SVG}path")).get("d"))[:4]]
     assert line[2] - line[0] == pytest.approx(length * 2.0, abs=1e-9) and line[1] == line[3]
     assert f"{length:g} mm" in texts
 

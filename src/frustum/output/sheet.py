@@ -1031,7 +1031,9 @@ def drawing_sheet(
     data = {**fields, "scale": scale_label(drawing_scale), "projection": projection_angle, "size": paper_name}
     attributes = "".join(f' data-{key.replace("_", "-")}="{_html_escape(value)}"' for key, value in data.items())
     body.append(f'<g id="title-block"{attributes}>{"".join(_mark_svg(mark, "", 0.0, 0.0) for mark in title_marks)}</g>')
-    body.append(_scale_bar(drawing_scale, paper_height))
+    length, bar = _scale_bar(drawing_scale, paper_height)
+    body.append(f'<g id="scale-bar" data-length="{_number(length)}">{_mark_svg(bar, "", 0.0, 0.0)}</g>')
+    title_marks.append(bar)
     text = svg_document(paper_width, paper_height, body, units="mm")
     if path is not None:
         if str(path).lower().endswith(".dxf"):
@@ -1260,8 +1262,9 @@ def _projection_symbol(x: float, y: float, angle: str) -> _Mark:
     return mark
 
 
-def _scale_bar(scale: float, paper_height: float) -> str:
-    """A bar of a round model length (1, 2 or 5 × 10^k mm) between 20 and 50 mm of paper, with ticks."""
+def _scale_bar(scale: float, paper_height: float) -> tuple[float, _Mark]:
+    """A bar of a round model length (1, 2 or 5 × 10^k mm) between 20 and 50 mm of paper, with ticks: the
+    length and the bar as a mark (sheet coordinates)."""
     target = 40.0 / scale  # model mm that make about 40 mm of paper
     exponent = math.floor(math.log10(target))
     length = max(
@@ -1270,14 +1273,8 @@ def _scale_bar(scale: float, paper_height: float) -> str:
     )
     x0, y = _MARGIN + 8.0, paper_height - _MARGIN - 12.0
     bar = length * scale
-    ticks = " ".join(
-        f"M{_number(x0 + bar * k / 4)} {_number(y - 2.0)} L{_number(x0 + bar * k / 4)} {_number(y + 2.0)}"
-        for k in range(5)
-    )
-    parts = [
-        f'<path id="scale-bar-line" d="M{_number(x0)} {_number(y)} L{_number(x0 + bar)} {_number(y)} {ticks}" '
-        'fill="none" stroke="#000000" stroke-width="0.35"/>',
-        _text(x0, y + 6.0, "0", 3.0, "middle"),
-        _text(x0 + bar, y + 6.0, f"{_number(length)} mm", 3.0, "middle"),
-    ]
-    return f'<g id="scale-bar" data-length="{_number(length)}">{"".join(parts)}</g>'
+    mark = _Mark("title", "scale-bar-line", line_width=0.35, text_size=3.0)
+    mark.lines.append((x0, y, x0 + bar, y))
+    mark.lines += [(x0 + bar * k / 4, y - 2.0, x0 + bar * k / 4, y + 2.0) for k in range(5)]
+    mark.texts += [(x0, y + 6.0, "0", "middle", False), (x0 + bar, y + 6.0, f"{_number(length)} mm", "middle", False)]
+    return length, mark
