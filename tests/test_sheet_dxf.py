@@ -197,3 +197,20 @@ def test_dxf_is_deterministic(tmp_path):
     drawing_sheet(scene, path=first)
     drawing_sheet(scene, path=second)
     assert first.read_bytes() == second.read_bytes()
+
+
+def test_view_command_writes_dxf_and_reads_the_sheet_table(tmp_path):
+    from frustum.cli import main
+
+    dxf, svg = tmp_path / "sheet.dxf", tmp_path / "sheet.svg"
+    arguments = ["view", str(EXAMPLES / "exploded_assembly.toml")]
+    main([*arguments, "-o", str(dxf), "--date", "2026-12-02"])
+    document = ezdxf.readfile(dxf)
+    texts = {e.dxf.text for e in document.modelspace().query("TEXT")}
+    # the file's [sheet] table (drawing number, author) and the command line's date
+    assert {"FR-EX-0001", "frustum examples", "2026-12-02", "Exploded assembly"} <= texts
+    assert len(document.modelspace().query("DIMENSION")) > 0
+    main([*arguments, "-o", str(svg), "--author", "someone else", "--angle", "first"])
+    root = ET.fromstring(svg.read_bytes())
+    block = next(g for g in root.iter(f"{SVG}g") if g.get("id") == "title-block")
+    assert block.get("data-author") == "someone else" and block.get("data-projection") == "first"

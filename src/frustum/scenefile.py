@@ -115,8 +115,12 @@ _DEGREE_PARAMETERS = frozenset({"LSystem.angle", "union.sharp_angle", "differenc
 
 _TOP_LEVEL = (
     "title", "description", "camera", "cameras", "lights", "materials", "nodes", "render", "exploded", "cutaway",
-    "output", "animation", "svg", "particles", "cloth", "volumes",
+    "output", "animation", "svg", "particles", "cloth", "volumes", "sheet",
 )  # fmt: skip
+_SHEET_KEYS = ("views", "paper", "orientation", "angle", "scale", "dimensions", "title", "drawing_number", "sheet",
+               "date", "author", "tolerance", "units")  # fmt: skip
+_SHEET_TEXT = ("paper", "orientation", "angle", "title", "drawing_number", "sheet", "date", "author", "tolerance",
+               "units")  # fmt: skip
 _NODE_KEYS = ("name", "geometry", "material", "transform", "children", "lights")
 _CAMERA_KEYS = (
     "eye", "target", "up", "projection", "fovy_deg", "near", "far", "height", "left", "right", "bottom", "top",
@@ -1904,6 +1908,7 @@ class SceneFile:
     columns: int = 0
     title: str = ""
     path: Path | None = None
+    sheet: dict = field(default_factory=dict)
 
     def resized(self, size: tuple[int, int]) -> SceneFile:
         """The same scene file with every camera's image `size` = (width, height) replaced."""
@@ -2101,9 +2106,54 @@ def _build(report: _Report, data: dict, base: Path) -> SceneFile | None:
         _warm_up(report, scene, animation)
     if report.problems:
         return None
+    sheet = _sheet_options(report, data.get("sheet", {}))
+    if report.problems:
+        return None
     title = data.get("title", "")
     single = cameras[0] if "camera" in data else None
-    return SceneFile(scene, single, options, outputs, tuple(cameras), stereo, animation, svg, size, columns, title)
+    return SceneFile(
+        scene, single, options, outputs, tuple(cameras), stereo, animation, svg, size, columns, title, sheet=sheet
+    )
+
+
+def _sheet_options(report: _Report, value: Any) -> dict:
+    """``[sheet]``: ``drawing_sheet`` keywords for ``frustum view`` (views, paper, orientation, angle, scale,
+    dimensions) and the title block's fields (title, drawing_number, sheet, date, author, tolerance, units)."""
+    path = ("sheet",)
+    params = _table(report, path, value)
+    if params is _BAD:
+        return {}
+    _unknown_keys(report, path, params, _SHEET_KEYS)
+    options: dict[str, Any] = {}
+    fields: dict[str, str] = {}
+    for key in _SHEET_TEXT:
+        if key in params:
+            if not isinstance(params[key], str):
+                report.add((*path, key), params[key], "is not a string", "give text in quotes")
+            elif key in ("paper", "orientation", "angle"):
+                options["projection_angle" if key == "angle" else key] = params[key]
+            else:
+                fields[key] = params[key]
+    if "views" in params:
+        views = params["views"]
+        if not isinstance(views, list) or not views or not all(isinstance(v, str) for v in views):
+            report.add((*path, "views"), views, "is not a list of view names",
+                       "give e.g. [\"front\", \"top\", \"right\", \"iso\"]")  # fmt: skip
+        else:
+            options["views"] = ["isometric" if v == "iso" else v for v in views]
+    if "scale" in params:
+        scale = _number(report, (*path, "scale"), params["scale"], low=0.0, low_open=True)
+        if scale is not _BAD:
+            options["scale"] = float(scale)
+    if "dimensions" in params:
+        dimensions = params["dimensions"]
+        if dimensions not in ("parts", "overall", False):
+            report.add((*path, "dimensions"), dimensions, "is unknown", 'give "parts", "overall" or false')
+        else:
+            options["dimensions"] = dimensions
+    if fields:
+        options["title_block"] = fields
+    return options
 
 
 def load_scene_file(path: str | Path) -> SceneFile:
@@ -2216,11 +2266,13 @@ def render_scene_file(
 
 
 def render_view_sheet(
-    path: str | Path, output: str | Path, views: Sequence[str] = ("front", "top", "right", "isometric"), **options: Any
+    path: str | Path, output: str | Path, views: Sequence[str] | None = None, **options: Any
 ) -> Path:
-    """An engineering drawing sheet (``drawing_sheet``) of the scene file's scene: SVG, or PDF/PNG by suffix.
+    """An engineering drawing sheet (``drawing_sheet``) of the scene file's scene: SVG, or PDF/PNG/DXF by suffix.
 
-    ``views`` accepts "iso" for "isometric". Other keywords go to ``drawing_sheet`` (scale, paper, title, ...).
+    ``views`` accepts "iso" for "isometric" (default: the file's ``[sheet] views``, else front, top, right and
+    isometric). Other keywords go to ``drawing_sheet`` (scale, paper, title, title_block, ...) and override the
+    file's ``[sheet]`` table; ``title_block`` fields are merged over the file's.
     """
     scene_file = load_scene_file(path)
     try:
@@ -2228,11 +2280,18 @@ def render_view_sheet(
         svg = importlib.import_module("frustum.output.svg")
     except ImportError:
         raise OutputError("render_view_sheet: drawing sheets are not available in this version") from None
-    names = ["isometric" if v == "iso" else v for v in views]
-    options.setdefault("title", scene_file.title)
-    text = sheet.drawing_sheet(scene_file.scene, names, **options)
+    settings = dict(scene_file.sheet)
+    file_views = settings.pop("views", ("front", "top", "right", "isometric"))
+    names = ["isometric" if v == "iso" else v for v in (views if views is not None else file_views)]
+    title_block = {**settings.pop("title_block", {}), **(options.pop("title_block", None) or {})}
+    settings.update({key: value for key, value in options.items() if value is not None})
+    settings.setdefault("title", scene_file.title)
     target = Path(output)
     target.parent.mkdir(parents=True, exist_ok=True)
+    if target.suffix.lower() == ".dxf":
+        sheet.drawing_sheet(scene_file.scene, names, title_block=title_block or None, path=target, **settings)
+        return target
+    text = sheet.drawing_sheet(scene_file.scene, names, title_block=title_block or None, **settings)
     return Path(svg.save_svg(text, target))
 
 
