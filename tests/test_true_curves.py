@@ -14,8 +14,10 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pytest
 import trimesh
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
-from frustum import Scene, rotate_x, rotate_y, translate
+from frustum import Scene, rotate_x, rotate_y, rotate_z, translate
 from frustum.geometry import Mesh, box, cylinder, uv_sphere
 from frustum.geometry.csg import difference
 from frustum.output.sheet import drawing_sheet
@@ -175,3 +177,27 @@ def test_ellipse_arc_principal_axes():
     major, minor, _ = arc.principal()
     # conjugate semi-diameters: a² + b² = |A|² + |B|², a·b = |det[A B]|
     assert major**2 + minor**2 == pytest.approx(9 + 1 + 4) and major * minor == pytest.approx(6.0)
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    polar=st.floats(0.05, math.pi / 2 - 0.05),
+    azimuth=st.floats(0.0, 2 * math.pi),
+    radius=st.floats(0.5, 20.0),
+)
+def test_rim_ellipse_axes_follow_the_tilt_for_any_orientation(polar, azimuth, radius):
+    # a disk-like cylinder turned so that its axis makes angle `polar` with the front view's line of sight: the
+    # rims' images have semi-axes r·scale and r·scale·cos(polar) (tolerance: round-off of the paper mapping)
+    scene = Scene()
+    turn = rotate_z(azimuth) @ rotate_x(polar)
+    scene.add(cylinder(radius=radius, height=radius / 4, segments=36), transform=turn)
+    root = ET.fromstring(drawing_sheet(scene, views=("front",), scale=1.0, paper="A0").encode())
+    found = []
+    for group in ("front-visible-curves", "front-hidden-curves"):
+        for element in _elements(root, group, "ellipse"):
+            found.append((float(element.get("rx")), float(element.get("ry"))))
+        for path in _elements(root, group, "path"):
+            found += [(float(rx), float(ry)) for rx, ry, *_ in ARC.findall(path.get("d"))]
+    assert found
+    for rx, ry in found:
+        assert rx == pytest.approx(radius, rel=1e-9) and ry == pytest.approx(radius * math.cos(polar), rel=1e-9)
