@@ -886,12 +886,16 @@ def drawing_sheet(
 
     Only what a drawing shows is drawn: boundaries, creases and silhouettes of the solids (faces adjacent by
     shared vertex positions; never an edge between coplanar triangles, see ``hidden_lines.COPLANAR_ANGLE``),
-    visible solid, hidden dashed (thinner; the isometric view shows visible edges only). Each orthographic
-    view carries its overall horizontal and vertical dimension (extension lines, dimension line, arrowheads,
-    the model length in mm), centre lines through the circles it sees end-on and along the axes of the
-    cylinders it sees from the side, and a leader with the diameter of each visible end-on circle (``n× ⌀d``
-    for n equal circles). Circles are closed loops of creases (over the default 30°) or boundaries with at
-    least 10 vertices, planar and round within 1e-6 of their radius.
+    visible solid, hidden dashed (thinner; the isometric view shows visible edges only). Circular features
+    (``output/true_curves.py``: closed loops of creases or boundaries with at least 10 vertices, planar and
+    round within 1e-6 of radius + model size, and spheres) are drawn as true curves, ``<circle>``,
+    ``<ellipse>`` or elliptical-arc ``<path>`` in groups ``<view>-visible-curves`` / ``<view>-hidden-curves``,
+    instead of their polygons. Each orthographic view carries centre lines (dashes, long ones at the ends)
+    through the circles it sees end-on (a sphere's outline too) and along the axes of the cylinders it sees
+    from the side, and the dimensions `dimensions` asks for (extension lines, dimension line, arrowheads, the
+    model length in model units; leaders with ``⌀d``). The title block (ISO 7200) has the title, drawing number,
+    sheet n/N, scale, the projection symbol of `projection_angle` (ISO 5456-2), units, date, author, general
+    tolerances and paper size; a scale bar sits at the lower left.
 
     Parameters
     ----------
@@ -918,6 +922,12 @@ def drawing_sheet(
         visible end-on diameter. False: none (centre lines stay). True is "overall".
     edges, crease_angle, hidden, stroke_width
         As in ``render_svg``; `stroke_width` (visible outlines) in paper millimetres.
+    title_block : dict, optional
+        Title block fields, keys from ``TITLE_BLOCK_FIELDS``: "title" (else `title`), "drawing_number", "sheet"
+        ("n/N" or (n, N)), "date", "author", "tolerance" (default "ISO 2768-m"), "units" (default "mm"); text.
+    path : str or PathLike, optional
+        Also write the sheet: ``.svg``, ``.pdf``, ``.png`` (``save_svg``) or ``.dxf`` (``output/sheet_dxf.py``:
+        layers, true CIRCLE / ARC / ELLIPSE, DIMENSION entities, in model units at full size; the ``dxf`` extra).
 
     Returns
     -------
@@ -929,7 +939,9 @@ def drawing_sheet(
     FrustumError
         If `scene` is not a Scene.
     OutputError
-        For a scene with volumes (a drawing sheet shows meshes only), an empty scene, an unknown or repeated view,
+        For a bad title block field, a ``.dxf`` path without ezdxf (the message names the extra), a file that
+        cannot be written,
+        a scene with volumes (a drawing sheet shows meshes only), an empty scene, an unknown or repeated view,
         a bad scale, paper, orientation or projection angle, or views that do not fit on the paper at the given
         scale (the message says the largest scale that fits).
 
