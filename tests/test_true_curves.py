@@ -139,7 +139,10 @@ def test_a_faceted_loop_of_any_mesh_is_found_as_a_circle():
     disk = np.vstack([rim, [0.0, 0.0, 0.0]])
     assert len(find_circles([(Mesh(disk, faces), np.eye(4))])) == 1
     disk[5] *= 1.001
-    assert find_circles([(Mesh(disk, faces), np.eye(4))]) == []
+    # no longer a circle: what is left on it is one arc, from vertex 6 round to vertex 4
+    (arc,) = find_circles([(Mesh(disk, faces), np.eye(4))])
+    assert arc.kind == "arc" and arc.radius == pytest.approx(1.0, abs=1e-12)
+    np.testing.assert_allclose(arc.middle, disk[(6 + 22 // 2) % 24], atol=1e-12)
     # and on a sheet the loop is a true circle in the view along its axis
     scene = Scene()
     scene.add(Mesh(part.vertices, part.faces), transform=rotate_x(-math.pi / 2))  # axis along y: the top view
@@ -201,3 +204,48 @@ def test_rim_ellipse_axes_follow_the_tilt_for_any_orientation(polar, azimuth, ra
     assert found
     for rx, ry in found:
         assert rx == pytest.approx(radius, rel=1e-9) and ry == pytest.approx(radius * math.cos(polar), rel=1e-9)
+
+
+def _rounded_plate(width=60.0, depth=40.0, height=8.0, radius=6.0, segments=8) -> Mesh:
+    """A plate with rounded corners (an extruded rounded rectangle), axis y: the caps' outlines are lines and
+    quarter circles."""
+    outline = []
+    x, z = width / 2 - radius, depth / 2 - radius
+    corners = [(x, z, 0.0), (-x, z, 0.5), (-x, -z, 1.0), (x, -z, 1.5)]
+    for cx, cz, start in corners:
+        for k in range(segments + 1):
+            angle = math.pi * (start + 0.5 * k / segments)
+            outline.append((cx + radius * math.cos(angle), cz + radius * math.sin(angle)))
+    outline = np.array(outline)
+    n = len(outline)
+    bottom = np.column_stack([outline[:, 0], np.full(n, -height / 2), outline[:, 1]])
+    top = bottom + np.array([0.0, height, 0.0])
+    vertices = np.vstack([bottom, top, [[0.0, -height / 2, 0.0], [0.0, height / 2, 0.0]]])
+    faces = []
+    for k in range(n):
+        j = (k + 1) % n
+        faces += [[k, n + k, j], [j, n + k, n + j], [2 * n, j, k], [2 * n + 1, n + k, n + j]]
+    return Mesh(vertices, np.array(faces))
+
+
+def test_arcs_of_a_rounded_outline_are_true_arcs_with_a_radius_leader(tmp_path):
+    plate = _rounded_plate()
+    arcs = [c for c in find_circles([(plate, np.eye(4))]) if c.kind == "arc"]
+    assert len(arcs) == 8 and all(abs(c.radius - 6.0) <= 1e-9 for c in arcs)
+    scene = Scene()
+    scene.add(plate)
+    root = ET.fromstring(drawing_sheet(scene, views=("front", "top"), scale=2.0, path=tmp_path / "s.dxf").encode())
+    paths = [p for p in _elements(root, "top-visible-curves", "path") if p.get("class") == "arc"]
+    assert len(paths) == 4  # the corners (each cap's arc once: the lower one is hidden under the upper)
+    for path in paths:
+        for rx, ry, *_ in ARC.findall(path.get("d")):
+            assert float(rx) == pytest.approx(12.0, abs=1e-9) and float(ry) == pytest.approx(12.0, abs=1e-9)
+    radius = [g for g in root.iter(f"{SVG}g") if g.get("class") == "radius"]
+    assert [g.find(f"{SVG}text").text for g in radius] == ["4× R6"]
+    import ezdxf
+
+    document = ezdxf.readfile(tmp_path / "s.dxf")
+    assert not document.audit().has_errors
+    measured = [d.get_measurement() for d in document.modelspace().query("DIMENSION") if d.dimtype == 4]
+    assert measured == [pytest.approx(6.0, abs=1e-9)]
+    assert len(document.modelspace().query("ARC[layer=='VISIBLE']")) == 4

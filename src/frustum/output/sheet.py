@@ -266,6 +266,8 @@ def _circle_keys(end_on: list, circles: list[Circle], camera: Camera, mm_per_pix
     direction = np.asarray(camera.frame.direction)
     keys: list[set] = [set() for _ in end_on]
     for circle in circles:
+        if circle.kind == "arc":
+            continue
         if circle.kind != "sphere" and abs(float(circle.normal @ direction)) < math.cos(_END_ON_ANGLE):
             continue
         centre = _to_local(camera.project(circle.centre[None, :])[:, :2], mm_per_pixel)[0]
@@ -337,6 +339,8 @@ def _end_on(circles: list[Circle], camera: Camera, lines: HiddenLines, mm_per_pi
     direction = np.asarray(camera.frame.direction)
     seen: list[tuple[NDArray, float, float]] = []
     for circle in circles:
+        if circle.kind == "arc":  # arcs get radius leaders (_plan_parts), not centre lines
+            continue
         if circle.kind == "sphere":  # seen as its silhouette circle from every side
             circle = Circle(circle.centre, direction, circle.radius, 0, circle.mesh, "sphere")
         elif abs(float(circle.normal @ direction)) < math.cos(_END_ON_ANGLE):
@@ -412,6 +416,7 @@ def _marks(view: _View, scale: float, dimensions: str | None, plan: _Plan | None
     if dimensions == "parts" and orthographic and plan is not None:
         marks += _part_dimensions(view, scale, plan.linear[view.name])
         marks += _diameters(view, scale, min(y0, float(_box(marks)[1])), plan.leaders[view.name])
+        marks += _radius_leaders(view, scale, plan.radii.get(view.name, []))
     elif dimensions == "overall" and orthographic:
         model = view.local.max(axis=0) - view.local.min(axis=0)
         tolerance = 1e-9 * max(x1 - x0, y1 - y0, 1e-300)
@@ -589,6 +594,7 @@ class _Plan:
 
     linear: dict[str, list[tuple[int, str, str]]]
     leaders: dict[str, list[tuple[float, list[NDArray], str]]]
+    radii: dict[str, list[tuple[float, list[tuple[NDArray, NDArray]]]]] = field(default_factory=dict)
 
 
 def _plan_parts(
@@ -605,6 +611,7 @@ def _plan_parts(
     ortho = [view for view in views if view.across >= 0]
     linear: dict[str, list[tuple[int, str, str]]] = {view.name: [] for view in views}
     leader_groups: dict[str, list[tuple[float, list[NDArray], str]]] = {view.name: [] for view in views}
+    radii: dict[str, list[tuple[float, list[tuple[NDArray, NDArray]]]]] = {view.name: [] for view in views}
     tolerance = 1e-6 * size
     done: list[tuple[int, NDArray]] = []  # (mesh id, extent) of the parts dimensioned
     for part, points in enumerate(parts_world):
@@ -618,6 +625,9 @@ def _plan_parts(
         needed = {k for k in range(3) if extent[k] > 1e-9 * size}
         stated: set[tuple] = set()
         for circle in sorted((c for c in circles if c.mesh == part), key=lambda c: -c.radius):
+            if circle.kind == "arc":
+                _plan_radius(circle, ortho, radii, size)
+                continue
             key = _circle_key(circle, size)
             if key in stated:
                 continue
@@ -658,7 +668,51 @@ def _plan_parts(
     for name, groups in leader_groups.items():
         ordered = sorted(groups, key=lambda group: -group[0])
         leaders[name] = [(r, sorted(c, key=lambda p: (float(p[0]), float(p[1]))), sym) for r, c, sym in ordered]
-    return _Plan(linear, leaders)
+    return _Plan(linear, leaders, radii)
+
+
+def _plan_radius(circle: Circle, ortho: list[_View], radii: dict, size: float) -> None:
+    """An arc's radius goes to the first aligned view that sees it end-on: (local centre, local middle point),
+    with the other arcs of its radius there ("n× R")."""
+    for view in ortho:
+        direction = np.asarray(view.camera.frame.direction)
+        if abs(float(circle.normal @ direction)) < math.cos(_END_ON_ANGLE) or circle.middle is None:
+            continue
+        ends = view.camera.project(np.stack([circle.centre, circle.middle]))[:, :2]
+        local = _to_local(ends, view.model_per_pixel)
+        groups = radii[view.name]
+        for k, (radius, arcs) in enumerate(groups):
+            if abs(radius - circle.radius) <= 1e-6 * max(radius, size * 1e-9):
+                tolerance = 1e-6 * max(radius, size * 1e-9)
+                if not any(np.abs(c - local[0]).max() <= tolerance for c, _ in arcs):  # one arc behind another
+                    groups[k] = (radius, [*arcs, (local[0], local[1])])
+                break
+        else:
+            groups.append((circle.radius, [(local[0], local[1])]))
+        return
+
+
+def _radius_leaders(view: _View, scale: float, groups: list) -> list[_Mark]:
+    """One leader per radius of the view's arcs: arrowhead on the arc's middle, pointing at its centre, a line
+    8 mm outward along the radius, a 3 mm shoulder and "R r" (or "n× R r")."""
+    marks = []
+    for index, (radius, arcs) in enumerate(sorted(groups, key=lambda group: -group[0])):
+        centre, middle = (np.asarray(p) * scale for p in arcs[-1])
+        outward = middle - centre
+        outward = outward / max(float(np.linalg.norm(outward)), 1e-300)
+        knee = middle + 8.0 * outward
+        side = 1.0 if outward[0] >= 0.0 else -1.0
+        mark = _Mark("radius", f"radius-{index}", radius)
+        mark.lines.append((float(middle[0]), float(middle[1]), float(knee[0]), float(knee[1])))
+        mark.lines.append((float(knee[0]), float(knee[1]), float(knee[0]) + 3.0 * side, float(knee[1])))
+        mark.arrows.append((float(middle[0]), float(middle[1]), -float(outward[0]), -float(outward[1])))
+        count = f"{len(arcs)}× " if len(arcs) > 1 else ""
+        text = f"{count}R{dimension_text(radius)}"
+        anchor = "start" if side > 0 else "end"
+        mark.texts.append((float(knee[0]) + 4.0 * side, float(knee[1]) + 1.2, text, anchor, False))
+        mark.definition = ("radius", centre, radius * scale, middle)
+        marks.append(mark)
+    return marks
 
 
 def _best_view(ortho: list[_View], part: int, axis: int, linear: dict) -> _View | None:

@@ -15,7 +15,8 @@ HIDDEN        the same for hidden parts                                DASHED (t
 CENTER        LINE: the dashes of the centre lines (as drawn)          continuous, 0.25 mm
 DIMENSIONS    DIMENSION (linear: horizontal / vertical, with the        continuous, 0.25 mm
               measured value and "⌀" / "S⌀" / "n×" prefixes;
-              diameter), rendered into their blocks by ezdxf
+              diameter; radius "R"), rendered into their blocks by
+              ezdxf
 TITLE         LINE, CIRCLE, TEXT: border, title block, projection       continuous, 0.25–0.7 mm
               symbol, scale bar, view labels
 ============  =======================================================  ==========================================
@@ -166,7 +167,9 @@ def _add_arc(space: Any, arc: EllipseArc, layer: str) -> None:
 
 def _add_mark(space: Any, mark: Any, dx: float, dy: float, to_dxf: Any, scale: float) -> None:
     """A sheet mark: DIMENSION for dimensions and diameters, LINE / CIRCLE / TEXT for the rest."""
-    layer = {"dimension": "DIMENSIONS", "diameter": "DIMENSIONS", "centre": "CENTER"}.get(mark.kind, "TITLE")
+    layer = {"dimension": "DIMENSIONS", "diameter": "DIMENSIONS", "radius": "DIMENSIONS", "centre": "CENTER"}.get(
+        mark.kind, "TITLE"
+    )
     attributes = {"layer": layer}
     definition = mark.definition
     if mark.kind == "dimension" and definition is not None:
@@ -189,6 +192,19 @@ def _add_mark(space: Any, mark: Any, dx: float, dy: float, to_dxf: Any, scale: f
         knee = mark.lines[0][2:]
         location = to_dxf(np.array([[knee[0] + dx, knee[1] + dy]]))[0]
         dimension = space.add_diameter_dim(
+            center=tuple(centre_dxf), radius=radius / scale, angle=angle, location=tuple(location),
+            text=f"{_prefix(mark.texts[0][2])}<>", dimstyle="FRUSTUM",
+            override={"dimdec": _decimals(mark.value), "dimtmove": 0}, dxfattribs=attributes,
+        )  # fmt: skip
+        dimension.render()
+        return
+    if mark.kind == "radius" and definition is not None:
+        _, centre, radius, tip = definition
+        centre_dxf = to_dxf(np.array([[centre[0] + dx, centre[1] + dy]]))[0]
+        angle = math.degrees(math.atan2(-(tip[1] - centre[1]), tip[0] - centre[0]))
+        knee = mark.lines[0][2:]
+        location = to_dxf(np.array([[knee[0] + dx, knee[1] + dy]]))[0]
+        dimension = space.add_radius_dim(
             center=tuple(centre_dxf), radius=radius / scale, angle=angle, location=tuple(location),
             text=f"{_prefix(mark.texts[0][2])}<>", dimstyle="FRUSTUM",
             override={"dimdec": _decimals(mark.value), "dimtmove": 0}, dxfattribs=attributes,

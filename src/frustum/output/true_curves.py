@@ -12,9 +12,12 @@ Circular features are found in any mesh, whoever built it (``find_circles``):
   vertex has two chain edges, with at least ``CIRCLE_MIN_VERTICES`` vertices that lie within a tolerance of one
   plane and of one distance r from their centroid. The tolerance is ``CIRCLE_TOLERANCE`` (1e-6) of
   r + the model size, so float32 mesh files qualify and a polygon with one vertex off by a visible amount does
-  not. This finds the rims of cylinders, cones and disks (``frustum.geometry`` primitives, any rotation or
-  placement), the rims of holes drilled by CSG (``frustum.geometry.csg``: manifold3d keeps the cutter's
-  vertices) and circular loops in loaded meshes;
+  not. A loop or open chain that is not one circle is searched for **arcs**: runs of at least
+  ``ARC_MIN_VERTICES`` consecutive vertices, equally spaced, whose every three consecutive ones have one
+  circumcircle (a rounded rectangle's corners, a slot's ends). This finds the rims of cylinders, cones and
+  disks (``frustum.geometry`` primitives, any rotation or placement), the rims of holes drilled by CSG
+  (``frustum.geometry.csg``: manifold3d keeps the cutter's vertices) and circular loops and arcs in loaded
+  meshes;
 * **spheres** — a mesh of at least ``SPHERE_MIN_VERTICES`` distinct vertices all at one distance r from their
   centroid (same tolerance), no edge longer than 0.75·r and every face normal within 26° of the radius
   through the face's centroid (a polyhedron with few faces, or a short cylinder, is not a sphere): its
@@ -58,6 +61,7 @@ from frustum.hidden_lines import (
 )
 
 __all__ = [
+    "ARC_MIN_VERTICES",
     "CIRCLE_MIN_VERTICES",
     "CIRCLE_TOLERANCE",
     "SPHERE_MIN_VERTICES",
@@ -69,6 +73,8 @@ __all__ = [
 
 CIRCLE_MIN_VERTICES = 10
 """An edge loop with fewer vertices is a polygon, not a circle."""
+ARC_MIN_VERTICES = 4
+"""An arc needs at least this many consecutive chain vertices on one circle (three segments)."""
 CIRCLE_TOLERANCE = 1e-6
 """Vertices lie on the circle (or sphere) within this fraction of (radius + model size)."""
 SPHERE_MIN_VERTICES = 24
@@ -91,7 +97,11 @@ class Circle:
         Vertices of the polygon that stands for it (0 for a sphere).
     mesh : int
         Index of the placed mesh it belongs to (the order given to ``find_circles``).
-    kind : {"loop", "sphere"}
+    middle : (3,) float64 or None
+        An arc's middle vertex (where a radius leader points).
+    kind : {"loop", "arc", "sphere"}
+        A whole circle (a closed loop), an arc of a chain of feature edges (the rest of the chain is not on the
+        circle), or a sphere's outline.
     """
 
     centre: NDArray[np.float64]
@@ -100,6 +110,7 @@ class Circle:
     sides: int
     mesh: int
     kind: str = "loop"
+    middle: NDArray[np.float64] | None = None
 
 
 class EllipseArc(NamedTuple):
@@ -207,7 +218,10 @@ def _loops(mesh: Mesh, points: NDArray, size: float, index: int, crease_angle: f
     found = []
     for root in np.unique(parent):
         members = np.flatnonzero(parent == root)
+        if (degree[members] > 2).any() or members.size < ARC_MIN_VERTICES:
+            continue
         if members.size < CIRCLE_MIN_VERTICES or (degree[members] != 2).any():
+            found += _arcs(_ordered(members, local, degree), points[vertices], size, index)
             continue
         ring = points[vertices[members]]
         centre = ring.mean(axis=0)
@@ -219,8 +233,106 @@ def _loops(mesh: Mesh, points: NDArray, size: float, index: int, crease_angle: f
             continue
         tolerance = _tolerance(radius, size)
         if np.abs(offsets @ normal).max() > tolerance or np.abs(radii - radius).max() > tolerance:
+            found += _arcs(_ordered(members, local, degree), points[vertices], size, index)
             continue
         found.append(Circle(centre, normal, radius, int(members.size), index))
+    return found
+
+
+def _ordered(members: NDArray, local: NDArray, degree: NDArray) -> tuple[list[int], bool]:
+    """The vertices of one chain (every degree <= 2) in order along it, and whether it is closed."""
+    inside = set(members.tolist())
+    neighbours: dict[int, list[int]] = {int(m): [] for m in members}
+    for a, b in local.tolist():
+        if a in inside:
+            neighbours[a].append(b)
+            neighbours[b].append(a)
+    ends = [m for m in neighbours if degree[m] == 1]
+    start = ends[0] if ends else int(members[0])
+    order, previous = [start], -1
+    while True:
+        step = [n for n in neighbours[order[-1]] if n != previous]
+        if not step or step[0] == start:
+            break
+        previous = order[-1]
+        order.append(step[0])
+        if len(order) > len(neighbours):
+            break
+    return order, not ends
+
+
+def _circumcircle(a: NDArray, b: NDArray, c: NDArray) -> tuple[NDArray, float, NDArray] | None:
+    """Centre, radius and unit normal of the circle through three points; None for collinear points."""
+    ab, ac = b - a, c - a
+    normal = np.cross(ab, ac)
+    area2 = float(normal @ normal)
+    if not area2 > (1e-12 * float(ab @ ab) * float(ac @ ac)):
+        return None
+    centre = a + (np.cross(normal, ab) * float(ac @ ac) + np.cross(ac, normal) * float(ab @ ab)) / (2.0 * area2)
+    return centre, float(np.linalg.norm(a - centre)), normal / math.sqrt(area2)
+
+
+def _arcs(chain: tuple[list[int], bool], points: NDArray, size: float, index: int) -> list[Circle]:
+    """Circular arcs along a chain of feature edges (a loop of lines and arcs, such as a rounded rectangle's
+    outline): maximal runs of at least ``ARC_MIN_VERTICES`` consecutive vertices on one circle (every three
+    consecutive ones have the same circumcircle, within the tolerance), each an arc of kind "arc"."""
+    order, closed = chain
+    ring = points[order]
+    count = len(order)
+    if count < 3:
+        return []
+    triples = range(count) if closed else range(1, count - 1)
+    circles = {}
+    for i in triples:
+        circle = _circumcircle(ring[i - 1], ring[i], ring[(i + 1) % count])
+        if circle is not None and circle[1] < 1e3 * max(size, 1e-300):
+            circles[i] = circle
+
+    def same(i: int, j: int) -> bool:
+        if i not in circles or j not in circles:
+            return False
+        (c1, r1, n1), (c2, r2, _) = circles[i], circles[j]
+        tolerance = _tolerance(r1, size)
+        return bool(
+            np.abs(c1 - c2).max() <= tolerance
+            and abs(r1 - r2) <= tolerance
+            and abs(float(n1 @ circles[j][2])) > 1 - 1e-9
+        )
+
+    # runs of consecutive triples on one circle (a closed chain: start after a break)
+    indices = list(triples)
+    if closed:
+        breaks = [k for k in range(count) if not same(indices[k - 1], indices[k])]
+        if not breaks:
+            return []
+        indices = indices[breaks[0] :] + indices[: breaks[0]]
+    runs: list[list[int]] = []
+    for i in indices:
+        if runs and same(runs[-1][-1], i):
+            runs[-1].append(i)
+        elif i in circles:
+            runs.append([i])
+    found = []
+    for run in runs:
+        if len(run) + 2 < ARC_MIN_VERTICES:
+            continue
+        chosen = [run[0] - 1, *run, (run[-1] + 1) % count]
+        arc_points = ring[[k % count for k in chosen]]
+        centre = np.mean([circles[i][0] for i in run], axis=0)
+        normal = circles[run[0]][2]
+        radii = np.linalg.norm(arc_points - centre, axis=1)
+        radius = float(radii.mean())
+        tolerance = _tolerance(radius, size)
+        if np.abs(radii - radius).max() > tolerance or np.abs((arc_points - centre) @ normal).max() > tolerance:
+            continue
+        # a tessellated arc has equal chords; four points of a symmetric outline (two corners' ends and the
+        # straight side between them) lie on a circle too, with unequal ones
+        chords = np.linalg.norm(np.diff(arc_points, axis=0), axis=1)
+        if chords.max() - chords.min() > 1e-6 * chords.max():
+            continue
+        step = 2.0 * math.asin(min(1.0, float(np.linalg.norm(arc_points[1] - arc_points[0])) / (2.0 * radius)))
+        sides = max(3, round(2.0 * math.pi / step)) if step > 0.0 else 0
+        found.append(Circle(centre, normal, radius, sides, index, "arc", arc_points[len(arc_points) // 2].copy()))
     return found
 
 
