@@ -214,3 +214,16 @@ def test_view_command_writes_dxf_and_reads_the_sheet_table(tmp_path):
     root = ET.fromstring(svg.read_bytes())
     block = next(g for g in root.iter(f"{SVG}g") if g.get("id") == "title-block")
     assert block.get("data-author") == "someone else" and block.get("data-projection") == "first"
+
+
+def test_dxf_dimension_texts_read_as_the_svg_ones(tmp_path):
+    root, document, _ = _sheet(tmp_path, load_scene_file(EXAMPLES / "exploded_assembly.toml").scene)
+    svg = sorted(
+        g.find(f"{SVG}text").text for g in root.iter(f"{SVG}g") if g.get("class") in ("dimension", "diameter", "radius")
+    )
+    dxf = []
+    for dimension in document.modelspace().query("DIMENSION"):
+        block = dimension.get_geometry_block()
+        (text,) = [e.dxf.text if e.dxftype() == "TEXT" else e.text for e in block if e.dxftype() in ("TEXT", "MTEXT")]
+        dxf.append(text.replace("%%c", "⌀"))
+    assert sorted(dxf) == svg

@@ -192,10 +192,15 @@ def _add_mark(space: Any, mark: Any, dx: float, dy: float, to_dxf: Any, scale: f
         knee = mark.lines[0][2:]
         location = to_dxf(np.array([[knee[0] + dx, knee[1] + dy]]))[0]
         dimension = space.add_diameter_dim(
-            center=tuple(centre_dxf), radius=radius / scale, angle=angle, location=tuple(location),
-            text=f"{_prefix(mark.texts[0][2])}<>", dimstyle="FRUSTUM",
-            override={"dimdec": _decimals(mark.value), "dimtmove": 0}, dxfattribs=attributes,
-        )  # fmt: skip
+            center=tuple(centre_dxf),
+            radius=radius / scale,
+            angle=angle,
+            location=tuple(location),
+            text=f"{_prefix(mark.texts[0][2]).removesuffix('%%c')}<>",
+            dimstyle="FRUSTUM",
+            override={"dimdec": _decimals(mark.value), "dimtmove": 0, "dimtih": 1, "dimtoh": 1},
+            dxfattribs=attributes,
+        )  # fmt: skip  (a diameter dimension writes its own ⌀ before the measurement)
         dimension.render()
         return
     if mark.kind == "radius" and definition is not None:
@@ -205,10 +210,15 @@ def _add_mark(space: Any, mark: Any, dx: float, dy: float, to_dxf: Any, scale: f
         knee = mark.lines[0][2:]
         location = to_dxf(np.array([[knee[0] + dx, knee[1] + dy]]))[0]
         dimension = space.add_radius_dim(
-            center=tuple(centre_dxf), radius=radius / scale, angle=angle, location=tuple(location),
-            text=f"{_prefix(mark.texts[0][2])}<>", dimstyle="FRUSTUM",
-            override={"dimdec": _decimals(mark.value), "dimtmove": 0}, dxfattribs=attributes,
-        )  # fmt: skip
+            center=tuple(centre_dxf),
+            radius=radius / scale,
+            angle=angle,
+            location=tuple(location),
+            text=f"{_prefix(mark.texts[0][2]).removesuffix('R')}<>",
+            dimstyle="FRUSTUM",
+            override={"dimdec": _decimals(mark.value), "dimtmove": 0, "dimtih": 1, "dimtoh": 1},
+            dxfattribs=attributes,
+        )  # fmt: skip  (a radius dimension writes its own R before the measurement)
         dimension.render()
         return
     weight = {"lineweight": round(mark.line_width * 100)} if layer == "TITLE" else {}
