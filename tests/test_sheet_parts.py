@@ -265,3 +265,20 @@ def test_every_circle_gets_a_centre_mark_without_stray_dots():
         for c in next(g for g in root.iter(f"{SVG}g") if g.get("id") == "front-visible-curves").iter(f"{SVG}circle")
     ]
     assert front_circles == [pytest.approx(5.0)]
+
+
+def test_parts_dimensions_fall_back_to_overall_when_they_crowd_the_paper():
+    rng = np.random.default_rng(1)
+    scene = Scene()
+    for _ in range(14):  # fourteen scattered blocks: some 40 dimensions do not fit an A4 sheet at any scale
+        scene.add(box_mesh(tuple(rng.uniform(2, 20, 3))), transform=translate(*rng.uniform(-60, 60, 3)))
+    root = ET.fromstring(drawing_sheet(scene, views=("front", "top"), paper="A4").encode())
+    block = next(g for g in root.iter(f"{SVG}g") if g.get("id") == "title-block")
+    assert block.get("data-dimensions") == "overall"
+    assert sorted(g.get("id") for g in _groups(root, "dimension")) == [
+        "front-dimension-horizontal", "front-dimension-vertical", "top-dimension-horizontal", "top-dimension-vertical"
+    ]  # fmt: skip
+    # a small assembly keeps its parts' dimensions
+    root = ET.fromstring(drawing_sheet(_plate_with_parts(), paper="A4").encode())
+    block = next(g for g in root.iter(f"{SVG}g") if g.get("id") == "title-block")
+    assert block.get("data-dimensions") == "parts"

@@ -106,6 +106,7 @@ _PIXELS = 1000  # window size of the view cameras; window → paper is x_p = sca
 _THIN = 0.25  # dimension, extension, leader and centre lines, mm
 _DIMENSION_OFFSET = 10.0  # view outline to dimension line, mm
 _DIMENSION_SPACING = 7.0  # between stacked parallel dimension lines, mm
+_PARTS_TRIES = 4  # scales at which the views fit that dimensions="parts" tries before falling back to "overall"
 _EXTENSION_GAP = 1.0  # extension lines start this far from the feature ...
 _EXTENSION_BEYOND = 2.0  # ... and end this far past the dimension line, mm
 _ARROW_LENGTH, _ARROW_HALF_WIDTH = 3.0, 0.55  # arrowhead, mm (about 20 degrees included)
@@ -155,6 +156,7 @@ class _Mark:
     circles: list[tuple[float, float, float]] = field(default_factory=list)  # x, y, radius (projection symbol)
     text_size: float = _LETTER
     line_width: float = _THIN
+    body: list | None = field(default=None, repr=False, compare=False)  # cached by _body
 
 
 def _box(marks: list[_Mark]) -> NDArray[np.float64]:
@@ -744,6 +746,7 @@ def _part_dimensions(view: _View, scale: float, specs: list[tuple[int, str, str]
         items.append((value, orientation, part, symbol, local * scale))
     items.sort(key=lambda item: (item[0], item[1], item[2]))
     marks: list[_Mark] = []
+    deepest: dict[tuple[str, float], int] = {}  # deepest level used per orientation and side
     for value, orientation, part, symbol, points in items:
         axis = 0 if orientation == "horizontal" else 1
         # (sign away from the view, first level's position): below / right first, then above / left
@@ -753,7 +756,7 @@ def _part_dimensions(view: _View, scale: float, specs: list[tuple[int, str, str]
         tolerance = 1e-9 * max(abs(low), abs(high), 1.0)
         name = f"dimension-part{part}-{orientation}"
         chosen = None
-        for level in range(2 * len(items) + 1):
+        for level in range(len(items) + 1):
             for sign, base in sides:
                 ends = []
                 for end in (low, high):  # the foot: the part's outermost point toward that side, at the end
@@ -766,13 +769,19 @@ def _part_dimensions(view: _View, scale: float, specs: list[tuple[int, str, str]
                                    text_side=text_side)  # fmt: skip
                     if mark is not None and not any(_clash(mark, other) for other in marks):
                         chosen = mark
+                        deepest[(orientation, sign)] = max(deepest.get((orientation, sign), -1), level)
                         break
                 if chosen is not None:
                     break
             if chosen is not None:
                 break
-        if chosen is None:  # crowded beyond resolving: the next free level below / right
-            level = 2 * len(items) + 1
+        if chosen is None:  # crowded beyond resolving: the level past the deepest below / right (may clash)
+            level = deepest.get((orientation, 1.0), -1) + 1
+            deepest[(orientation, 1.0)] = level
+            ends = []
+            for end in (low, high):
+                across = points[np.abs(points[:, axis] - end) <= tolerance, 1 - axis]
+                ends.append((end, float(across.max())) if axis == 0 else (float(across.max()), end))
             chosen = _linear(orientation, value, ends[0], ends[1], sides[0][1] + level * _DIMENSION_SPACING,
                              mark_name=name, prefix=symbol)  # fmt: skip
         marks.append(chosen)
@@ -780,7 +789,14 @@ def _part_dimensions(view: _View, scale: float, specs: list[tuple[int, str, str]
 
 
 def _body(mark: _Mark) -> list[NDArray]:
-    """Rectangles (x0, y0, x1, y1) around a linear dimension's line with its arrowheads, and its text."""
+    """Rectangles (x0, y0, x1, y1) around a linear dimension's line with its arrowheads, and its text (computed
+    once per mark)."""
+    if mark.body is None:
+        mark.body = _body_of(mark)
+    return mark.body
+
+
+def _body_of(mark: _Mark) -> list[NDArray]:
     x0, y0, x1, y1 = mark.lines[-1]
     line = np.array([min(x0, x1), min(y0, y1), max(x0, x1), max(y0, y1)])
     line += np.array([-1.0, -1.0, 1.0, 1.0]) * _ARROW_HALF_WIDTH
@@ -972,8 +988,11 @@ def drawing_sheet(
         stated once in the view that shows it best (``_plan_parts``): a diameter leader (``⌀d``, ``S⌀d`` for a
         sphere, ``n× ⌀d`` for equal circles in one view) on each of its circles, linear dimensions for the
         extents the diameters do not state, stacked outward 7 mm apart so that no extension line crosses a
-        dimension line or its text. "overall": each view's overall width and height and a leader for every
-        visible end-on diameter. False: none (centre lines stay). True is "overall".
+        dimension line or its text (radii "R r" on arcs). When the parts' dimensions crowd the paper at the
+        four largest standard scales at which the views fit (or at the given `scale`), the sheet falls back to
+        "overall" (the title block's ``data-dimensions`` says which). "overall": each view's overall width and
+        height and a leader for every visible end-on diameter. False: none (centre lines stay). True is
+        "overall".
     edges, crease_angle, hidden, stroke_width
         As in ``render_svg``; `stroke_width` (visible outlines) in paper millimetres.
     title_block : dict, optional
@@ -1054,13 +1073,37 @@ def drawing_sheet(
     # the drawing area: inside the border, above the title strip
     area = (_MARGIN, _MARGIN, paper_width - 2 * _MARGIN, paper_height - 2 * _MARGIN - _TITLE_HEIGHT)
 
-    def attempt(candidate: float) -> tuple[dict, dict] | None:
-        marks = {view.name: _marks(view, candidate, mode, plan) for view in sheet_views}
+    empty: dict[str, list[_Mark]] = {view.name: [] for view in sheet_views}
+
+    def attempt(candidate: float, use: str | None) -> tuple[dict, dict] | None:
+        if _layout(sheet_views, empty, cells, candidate, area) is None:  # the views alone do not fit
+            return None
+        marks = {view.name: _marks(view, candidate, use, plan) for view in sheet_views}
         places = _layout(sheet_views, marks, cells, candidate, area)
         return None if places is None else (marks, places)
 
-    largest = next(((s, fitted) for s in STANDARD_SCALES if (fitted := attempt(s)) is not None), None)
+    def search(use: str | None, tries: int | None) -> tuple[float, tuple[dict, dict]] | None:
+        """The largest standard scale that fits with `use` dimensions (giving up after `tries` scales at which
+        the views alone fit)."""
+        for candidate in STANDARD_SCALES:
+            if _layout(sheet_views, empty, cells, candidate, area) is None:
+                continue
+            fitted = attempt(candidate, use)
+            if fitted is not None:
+                return candidate, fitted
+            if tries is not None:
+                tries -= 1
+                if tries == 0:
+                    return None
+        return None
+
+    # each part's dimensions stack outward at a constant paper spacing: when they crowd the paper at every
+    # scale that fits the views (many parts), the sheet falls back to each view's overall dimensions
+    used = mode
     if given_scale is None:
+        largest = search(mode, _PARTS_TRIES if mode == "parts" else None)
+        if largest is None and mode == "parts":
+            used, largest = "overall", search("overall", None)
         if largest is None:
             raise OutputError(
                 f"{where}: scale = None found no standard scale down to {scale_label(STANDARD_SCALES[-1])} that "
@@ -1069,8 +1112,11 @@ def drawing_sheet(
         drawing_scale, (marks, places) = largest
     else:
         drawing_scale = given_scale
-        fitted = attempt(drawing_scale)
+        fitted = attempt(drawing_scale, mode)
+        if fitted is None and mode == "parts":
+            used, fitted = "overall", attempt(drawing_scale, "overall")
         if fitted is None:
+            largest = search(used, None)
             hint = f"the largest standard scale that fits is {scale_label(largest[0])}" if largest else "none fits"
             raise OutputError(
                 f"{where}: scale = {drawing_scale!r} does not fit {len(names)} views on {_paper_text(paper)} "
@@ -1094,7 +1140,8 @@ def drawing_sheet(
         else (paper.capitalize() if isinstance(paper, str) else f"{_number(paper_width)} x {_number(paper_height)}")
     )
     title_marks = _title_block(paper_width, paper_height, fields, drawing_scale, projection_angle, paper_name)
-    data = {**fields, "scale": scale_label(drawing_scale), "projection": projection_angle, "size": paper_name}
+    data = {**fields, "scale": scale_label(drawing_scale), "projection": projection_angle, "size": paper_name,
+            "dimensions": str(used).lower()}  # fmt: skip
     attributes = "".join(f' data-{key.replace("_", "-")}="{_html_escape(value)}"' for key, value in data.items())
     body.append(f'<g id="title-block"{attributes}>{"".join(_mark_svg(mark, "", 0.0, 0.0) for mark in title_marks)}</g>')
     length, bar = _scale_bar(drawing_scale, paper_height)
