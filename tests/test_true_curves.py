@@ -249,3 +249,23 @@ def test_arcs_of_a_rounded_outline_are_true_arcs_with_a_radius_leader(tmp_path):
     measured = [d.get_measurement() for d in document.modelspace().query("DIMENSION") if d.dimtype == 4]
     assert measured == [pytest.approx(6.0, abs=1e-9)]
     assert len(document.modelspace().query("ARC[layer=='VISIBLE']")) == 4
+
+
+def test_a_torus_seen_along_its_axis_has_true_circle_outlines():
+    from frustum.geometry import torus
+
+    scene = Scene()
+    scene.add(torus(10.0, 3.0, 48, 24), transform=translate(5.0, 0.0, 0.0) @ rotate_x(-math.pi / 2))  # axis y
+    circles = [c for c in find_circles([(scene.items[0].mesh, scene.items[0].world_from_model)])]
+    assert sorted((c.kind, round(c.radius, 9)) for c in circles) == [("torus", 7.0), ("torus", 13.0)]
+    root = ET.fromstring(drawing_sheet(scene, views=("front", "top"), scale=2.0).encode())
+    top, _ = _view_centre(root, "top")
+    found = sorted(
+        (float(c.get("r")), float(c.get("cx")), float(c.get("cy")))
+        for c in _elements(root, "top-visible-curves", "circle")
+    )
+    np.testing.assert_allclose(found, [[14.0, *top], [26.0, *top]], atol=1e-9)
+    # seen from the side it stays as drawn (no circle), and its diameters are stated in the top view
+    assert not _elements(root, "front-visible-curves", "circle")
+    texts = sorted(g.find(f"{SVG}text").text for g in root.iter(f"{SVG}g") if g.get("class") == "diameter")
+    assert texts == ["⌀14", "⌀26"]

@@ -348,7 +348,7 @@ def _end_on(circles: list[Circle], camera: Camera, lines: HiddenLines, mm_per_pi
         elif abs(float(circle.normal @ direction)) < math.cos(_END_ON_ANGLE):
             continue
         centre = _to_local(camera.project(circle.centre[None, :])[:, :2], mm_per_pixel)[0]
-        if circle.kind == "sphere":
+        if circle.kind in ("sphere", "torus"):  # outlines: the share of the mesh's silhouette that is visible
             visible = _silhouette_visible(lines, circle.mesh)
             _add_seen(seen, centre, circle.radius, visible)
             continue

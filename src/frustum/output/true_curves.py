@@ -22,11 +22,15 @@ Circular features are found in any mesh, whoever built it (``find_circles``):
   centroid (same tolerance), no edge longer than 0.75·r and every face normal within 26° of the radius
   through the face's centroid (a polyhedron with few faces, or a short cylinder, is not a sphere): its
   silhouette under a parallel projection is the great circle perpendicular to the line of sight, drawn as a
-  circle of radius r (the faceted silhouette's zigzag lies inside it).
+  circle of radius r (the faceted silhouette's zigzag lies inside it);
+* **tori** — a mesh whose vertices satisfy ``(ρ − R)² + h² = r²`` about the axis of their smallest second
+  moment (least squares in R and R² − r², same tolerance, r < R, faces turned like the surface): seen along
+  its axis, its silhouette is the outer and inner equator, circles of radii R ± r.
 
 Not converted: a circle seen edge-on (its image is a line; the polygon's pieces are kept), silhouettes of tori
-and cones (not circles in general), anything under a perspective projection (the image of a circle is still a
-conic there, but its arcs are not an affine image of the circle's angles).
+seen other than along the axis and of cones (not circles in general), anything under a perspective
+projection (the image of a circle is still a conic there, but its arcs are not an affine image of the circle's
+angles).
 
 Each piece of a loop's edge maps to the angle interval between the polar angles of its ends (about the centre,
 in the circle's plane); a sphere's silhouette pieces likewise in the view plane. Intervals are merged per circle
@@ -99,7 +103,7 @@ class Circle:
         Index of the placed mesh it belongs to (the order given to ``find_circles``).
     middle : (3,) float64 or None
         An arc's middle vertex (where a radius leader points).
-    kind : {"loop", "arc", "sphere"}
+    kind : {"loop", "arc", "sphere", "torus"}
         A whole circle (a closed loop), an arc of a chain of feature edges (the rest of the chain is not on the
         circle), or a sphere's outline.
     """
@@ -166,6 +170,10 @@ def find_circles(
         if sphere is not None:
             found.append(sphere)
             continue
+        rims = _torus(points, np.asarray(mesh.faces), size, index)
+        if rims:
+            found += rims
+            continue
         found += _loops(mesh, points, size, index, crease_angle)
     return found
 
@@ -195,6 +203,46 @@ def _sphere(points: NDArray, faces: NDArray, size: float, index: int) -> Circle 
     if np.any(np.abs((normals[good] * radial[good]).sum(axis=1)) < 0.9 * lengths[good]):
         return None
     return Circle(centre, np.array([0.0, 0.0, 1.0]), radius, 0, index, "sphere")
+
+
+def _torus(points: NDArray, faces: NDArray, size: float, index: int) -> list[Circle]:
+    """A ring torus's outer and inner equators (kind "torus", radii R ± r, normal = its axis), or []."""
+    distinct = np.unique(points, axis=0)
+    if distinct.shape[0] < SPHERE_MIN_VERTICES:
+        return []
+    centre = distinct.mean(axis=0)
+    offsets = distinct - centre
+    axis = np.linalg.eigh(offsets.T @ offsets)[1][:, 0]  # the smallest second moment: along the axis
+    height = offsets @ axis
+    rho = np.linalg.norm(offsets - height[:, None] * axis, axis=1)
+    # (ρ − R)² + h² = r²  ⇔  2R·ρ − (R² − r²) = ρ² + h²: linear least squares in R and c = R² − r²
+    design = np.column_stack([2.0 * rho, -np.ones_like(rho)])
+    singular = np.linalg.svd(design, compute_uv=False)
+    if not singular[1] > 1e-9 * singular[0]:
+        return []
+    (big, c), *_ = np.linalg.lstsq(design, rho**2 + height**2, rcond=None)
+    if not big**2 > c:
+        return []
+    small = math.sqrt(big**2 - c)
+    if not 0.0 < small < big:
+        return []
+    tolerance = _tolerance(small, size)
+    if np.abs(np.hypot(rho - big, height) - small).max() > tolerance:
+        return []
+    # every face turned like the torus's surface there (its normal from the tube's centre circle)
+    corners = points[faces]
+    middle = corners.mean(axis=1) - centre
+    along = middle @ axis
+    radial = middle - along[:, None] * axis
+    radial /= np.maximum(np.linalg.norm(radial, axis=1, keepdims=True), 1e-300)
+    surface = middle - big * radial  # from the tube's centre circle
+    normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    lengths = np.linalg.norm(normals, axis=1) * np.linalg.norm(surface, axis=1)
+    good = lengths > 0.0
+    if np.any(np.abs((normals[good] * surface[good]).sum(axis=1)) < 0.9 * lengths[good]):
+        return []
+    return [Circle(centre, axis, float(big + small), 0, index, "torus"),
+            Circle(centre, axis, float(big - small), 0, index, "torus")]  # fmt: skip
 
 
 def _loops(mesh: Mesh, points: NDArray, size: float, index: int, crease_angle: float) -> list[Circle]:
@@ -374,6 +422,16 @@ def circle_arcs(
         if circle.kind == "sphere":
             normal = direction
             on_edge = (lines.edge_meshes == circle.mesh) & ((lines.edge_kinds & EDGE_SILHOUETTE) != 0)
+        elif circle.kind == "torus":  # seen along its axis: its silhouette is the outer and the inner equator
+            normal = circle.normal
+            if abs(float(normal @ direction)) < math.cos(1e-6):
+                continue
+            offsets = edges - circle.centre
+            rho = np.linalg.norm(offsets - (offsets @ normal)[..., None] * normal, axis=2)
+            middle = np.mean([c.radius for c in circles if c.kind == "torus" and c.mesh == circle.mesh])
+            side = (rho > middle).all(axis=1) if circle.radius > middle else (rho < middle).all(axis=1)
+            silhouette = (lines.edge_kinds & EDGE_SILHOUETTE) != 0
+            on_edge = (lines.edge_meshes == circle.mesh) & silhouette & side
         else:
             normal = circle.normal
             tolerance = _tolerance(circle.radius, size)
