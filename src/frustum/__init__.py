@@ -289,6 +289,9 @@ _LAZY = {
     "STANDARD_SCALES": "frustum.output.sheet",
     "drawing_sheet": "frustum.output.sheet",
     "scale_label": "frustum.output.sheet",
+    "DIMENSION_MODES": "frustum.output.sheet",
+    "TITLE_BLOCK_FIELDS": "frustum.output.sheet",
+    "find_circles": "frustum.output.true_curves",
     "FILL_ORDERS": "frustum.output.svg",
     "HIDDEN_STYLES": "frustum.output.svg",
     "render_svg": "frustum.output.svg",
@@ -416,9 +419,11 @@ if TYPE_CHECKING:  # pragma: no cover
     )
     from frustum.output.animation import turntable, write_animation
     from frustum.output.sheet import (
+        DIMENSION_MODES,
         PAPER_SIZES,
         SHEET_VIEWS,
         STANDARD_SCALES,
+        TITLE_BLOCK_FIELDS,
         drawing_sheet,
         scale_label,
     )
@@ -440,6 +445,7 @@ if TYPE_CHECKING:  # pragma: no cover
         svg_path_from_bezier,
         svg_path_from_polyline,
     )
+    from frustum.output.true_curves import find_circles
     from frustum.radiosity import RadiosityError, RadiosityResult, radiosity
     from frustum.raster._jit import set_threads
     from frustum.render import RENDER_METHODS, RENDER_MODES, SHADING_MODES, VISIBILITY_METHODS, release_memory, render
@@ -530,6 +536,7 @@ __all__ = [
     "DEFAULT_BYTES",
     "DEFAULT_MAX_BYTES",
     "DEFAULT_OPERATIONS",
+    "DIMENSION_MODES",
     "EDGE_BOUNDARY",
     "EDGE_CREASE",
     "EDGE_KINDS",
@@ -559,6 +566,7 @@ __all__ = [
     "STANDARD_SCALES",
     "STEREO_LAYOUTS",
     "SUPPORTED_SUFFIXES",
+    "TITLE_BLOCK_FIELDS",
     "TRANSFER_PRESETS",
     "VIEW_VOLUME_PLANES",
     "VISIBILITY_METHODS",
@@ -708,6 +716,7 @@ __all__ = [
     "fbm_cloud",
     "fbm_terrain",
     "feature_edges",
+    "find_circles",
     "fractal_coastline",
     "frustum",
     "general_perspective",

@@ -450,22 +450,37 @@ def explain_command(
 @app.command("view")
 def view_command(
     scene: Annotated[Path, typer.Argument(help="A TOML scene file.")],
-    output: Annotated[Path, typer.Option("--output", "-o", help="The sheet: .svg, .pdf or .png.")],
-    views: Annotated[str, typer.Option(help="Comma-separated views: front, top, right, left, rear, bottom, iso.")] = (
-        "front,top,right,iso"
-    ),
-    paper: Annotated[str, typer.Option(help="Sheet size: A4, A3, A2, A1, A0, Letter or Tabloid.")] = "A3",
-    orientation: Annotated[str, typer.Option(help="landscape or portrait.")] = "landscape",
-    angle: Annotated[str, typer.Option(help="Projection angle: third (US, ISO E) or first (ISO, Europe).")] = "third",
-    dimensions: Annotated[bool, typer.Option(help="Draw overall dimensions and diameters.")] = True,
+    output: Annotated[Path, typer.Option("--output", "-o", help="The sheet: .svg, .pdf, .png or .dxf (CAD).")],
+    views: Annotated[
+        str | None, typer.Option(help="Comma-separated views: front, top, right, left, rear, bottom, iso.")
+    ] = None,
+    paper: Annotated[str | None, typer.Option(help="Sheet size: A4, A3, A2, A1, A0, Letter or Tabloid.")] = None,
+    orientation: Annotated[str | None, typer.Option(help="landscape or portrait.")] = None,
+    angle: Annotated[
+        str | None, typer.Option(help="Projection angle: third (US, ISO E) or first (ISO, Europe).")
+    ] = None,
+    dimensions: Annotated[
+        str | None, typer.Option(help="parts (each part's sizes; default), overall (each view's extent) or none.")
+    ] = None,
+    title: Annotated[str | None, typer.Option(help="Title block: the drawing's title.")] = None,
+    drawing_number: Annotated[str | None, typer.Option(help="Title block: drawing number.")] = None,
+    sheet_number: Annotated[str | None, typer.Option("--sheet", help="Title block: sheet n/N, e.g. 1/2.")] = None,
+    date: Annotated[str | None, typer.Option(help="Title block: date of issue.")] = None,
+    author: Annotated[str | None, typer.Option(help="Title block: drawn by.")] = None,
+    tolerance: Annotated[str | None, typer.Option(help="Title block: general tolerances (ISO 2768-m).")] = None,
+    units: Annotated[str | None, typer.Option(help="Title block: model units (mm).")] = None,
 ) -> None:
     """Draw the scene as an engineering sheet: orthographic views at the largest standard scale that fits, with
-    hidden lines, dimensions, title block and scale bar."""
+    hidden lines, dimensions, title block and scale bar (the scene file's [sheet] table sets the defaults)."""
     from frustum.scenefile import render_view_sheet
 
+    fields = {"title": title, "drawing_number": drawing_number, "sheet": sheet_number, "date": date,
+              "author": author, "tolerance": tolerance, "units": units}  # fmt: skip
     written = render_view_sheet(
-        scene, output, tuple(v.strip() for v in views.split(",") if v.strip()),
-        paper=paper, orientation=orientation, projection_angle=angle, dimensions=dimensions,
+        scene, output, tuple(v.strip() for v in views.split(",") if v.strip()) if views is not None else None,
+        paper=paper, orientation=orientation, projection_angle=angle,
+        dimensions=False if dimensions == "none" else dimensions,
+        title_block={key: value for key, value in fields.items() if value is not None},
     )  # fmt: skip
     console.print(f"wrote {written}", markup=False, highlight=False, soft_wrap=True)
 

@@ -25,6 +25,7 @@ from frustum.scenefile.lights_materials import _environment, _lights, _material
 from frustum.scenefile.nodes import _explode_and_cut, _node
 from frustum.scenefile.outputs import _DEFAULT_SIZE, _MAX_PIXELS, _check_image_memory, _outputs, _render_options
 from frustum.scenefile.report import _BAD, _Report
+from frustum.scenefile.sheet import _sheet_options
 from frustum.scenefile.simulation import _simulations, _warm_up
 from frustum.scenefile.volumes import _volume
 from frustum.shading import Material
@@ -43,7 +44,7 @@ _MAX_NESTING = 64
 
 _TOP_LEVEL = (
     "title", "description", "camera", "cameras", "lights", "materials", "nodes", "render", "exploded", "cutaway",
-    "output", "animation", "svg", "particles", "cloth", "volumes", "environment", "radiosity",
+    "output", "animation", "svg", "particles", "cloth", "volumes", "sheet", "environment", "radiosity",
 )  # fmt: skip
 
 RADIOSITY_KEYS = {"patch_size": float, "hemicube": int, "tolerance": float, "max_iterations": int, "shooter": float}
@@ -90,6 +91,7 @@ class SceneFile:
     columns: int = 0
     title: str = ""
     path: Path | None = None
+    sheet: dict = field(default_factory=dict)
     radiosity: dict | None = None
 
     def resized(self, size: tuple[int, int]) -> SceneFile:
@@ -320,10 +322,13 @@ def _build(report: _Report, data: dict, base: Path) -> SceneFile | None:
         _warm_up(report, scene, animation)
     if report.problems:
         return None
+    sheet = _sheet_options(report, data.get("sheet", {}))
+    if report.problems:
+        return None
     title = data.get("title", "")
     single = cameras[0] if "camera" in data else None
     return SceneFile(scene, single, options, outputs, tuple(cameras), stereo, animation, svg, size, columns, title,
-                     radiosity=radiosity)  # fmt: skip
+                     sheet=sheet, radiosity=radiosity)  # fmt: skip
 
 
 def load_scene_file(path: str | Path) -> SceneFile:
