@@ -544,6 +544,14 @@ def serve_command(
         str, typer.Option(help="Interface to listen on; 127.0.0.1 is this machine only, 0.0.0.0 every interface.")
     ] = "127.0.0.1",
     port: Annotated[int, typer.Option(help="TCP port; 0 picks a free one.")] = 8000,
+    allow_origin: Annotated[
+        list[str] | None,
+        typer.Option("--allow-origin", help="Also let pages of this origin (e.g. http://localhost:8888) use the "
+                     "viewer, for deliberate embedding; repeatable. Other pages get 403."),
+    ] = None,
+    no_token: Annotated[
+        bool, typer.Option("--no-token", help="Serve a non-loopback --host without the random URL token.")
+    ] = False,
 ) -> None:
     """Open an interactive viewer of a scene file in the browser (orbit, pan, zoom, the pipeline beside it)."""
     from frustum.viewer.server import serve
@@ -553,9 +561,12 @@ def serve_command(
         if host in ("127.0.0.1", "localhost", "::1"):
             console.print("listening on this machine only; --host 0.0.0.0 serves other machines too; Ctrl-C stops",
                           markup=False, highlight=False, soft_wrap=True)  # fmt: skip
+        elif "?token=" in url:
+            console.print("other machines need the URL with its token; --no-token serves without one; Ctrl-C stops",
+                          markup=False, highlight=False, soft_wrap=True)  # fmt: skip
         console.file.flush()
 
-    serve(scene, host, port, ready=ready)
+    serve(scene, host, port, ready=ready, allow_origins=tuple(allow_origin or ()), token=False if no_token else None)
 
 
 # --- entry point ------------------------------------------------------------------------------------------------
