@@ -10,8 +10,10 @@ import time
 from pathlib import Path
 
 import numpy as np
+import pytest
+from test_hostile_inputs import run_case
 
-from frustum.geometry.io import load_parts
+from frustum.geometry.io import load, load_parts
 
 # --- 5. glTF scene graphs are walked once ------------------------------------------------------------------------
 
@@ -80,3 +82,44 @@ def test_gltf_walk_matches_trimesh_on_a_branching_graph(tmp_path):
         expected, _ = scene.graph[part.name]  # trimesh's own path product, fine at this depth
         np.testing.assert_allclose(part.world_from_model, expected, atol=1e-12)
     assert any(np.allclose(p.world_from_model, _chain_matrix(300), atol=1e-12) for p in parts)
+
+
+# --- 7. text in mesh files: UTF-8, then Latin-1, without optional packages ------------------------------------
+
+_PLY_HEADER = (
+    b"ply\nformat %s 1.0\ncomment caf\xe9 (Latin-1)\nelement vertex 3\nproperty float x\nproperty float y\n"
+    b"property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+)
+_LATIN1_FILES = {
+    "solid.stl": b"solid caf\xe9\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+    b"endloop\nendfacet\nendsolid caf\xe9\n",
+    "comment.off": b"OFF\n# caf\xe9 (Latin-1)\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+    "ascii.ply": _PLY_HEADER % b"ascii" + b"0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+    "binary.ply": _PLY_HEADER % b"binary_little_endian"
+    + np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], "<f4").tobytes()
+    + bytes([3])
+    + np.array([0, 1, 2], "<i4").tobytes(),
+}
+
+
+@pytest.mark.parametrize("name", sorted(_LATIN1_FILES))
+def test_latin1_text_in_stl_off_and_ply_loads_without_a_charset_detector(tmp_path, name):
+    path = tmp_path / name
+    path.write_bytes(_LATIN1_FILES[name])
+    result = run_case(f"""
+        import sys
+        sys.modules["charset_normalizer"] = None  # as if neither detector were installed
+        sys.modules["chardet"] = None
+        import numpy as np
+        from frustum.geometry.io import load
+        mesh = load({str(path)!r})
+        assert mesh.face_count == 1, mesh.face_count
+        assert np.allclose(np.sort(mesh.vertices[mesh.faces[0]], axis=0), [[0, 0, 0], [0, 0, 0], [1, 1, 0]])
+    """)
+    assert result["type"] is None, result
+
+
+def test_utf8_names_still_load_as_before(tmp_path):
+    path = tmp_path / "utf8.stl"
+    path.write_bytes(_LATIN1_FILES["solid.stl"].replace(b"\xe9", "\u00e9".encode()))
+    assert load(path).face_count == 1

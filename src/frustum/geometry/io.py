@@ -114,10 +114,10 @@ def load_parts(path: str | Path, texture: str | Path | None = None) -> list[Mesh
     if file.suffix.lower() == ".stl":
         _check_binary_stl_size(file)
     _check_file_memory(file)
-    text = _obj_text(file) if file.suffix.lower() == ".obj" else None
+    text = _text_bytes(file)
     try:
         if text is not None:
-            scene = trimesh.load_scene(io.BytesIO(text), file_type="obj", process=False,
+            scene = trimesh.load_scene(io.BytesIO(text), file_type=file.suffix.lower()[1:], process=False,
                                        resolver=trimesh.resolvers.FilePathResolver(str(file)))  # fmt: skip
         else:
             scene = trimesh.load_scene(str(file), process=False)
@@ -307,11 +307,43 @@ def _obj_text(file: Path) -> bytes:
             f"load: path = {str(file)!r}, line {line}: face {text!r}... uses vertex index 0; OBJ indices start at 1 "
             "(negative ones count back from the last vertex), so the file is malformed"
         )
+    return _utf8(data)
+
+
+def _utf8(data: bytes) -> bytes:
+    """`data` if it is UTF-8, else its Latin-1 reading (every byte is a character) encoded as UTF-8."""
     try:
         data.decode("utf-8")
         return data
     except UnicodeDecodeError:
         return data.decode("latin-1").encode("utf-8")
+
+
+def _text_bytes(file: Path) -> bytes | None:
+    """The bytes trimesh should parse, when they differ from the file's: OBJ always (see ``_obj_text``); an
+    ASCII STL, an OFF file or a PLY header that is not UTF-8, read as Latin-1 and given as UTF-8, so trimesh
+    never asks an optional charset detector (``charset_normalizer``) and a Latin-1 name or comment loads.
+    None: parse the file itself."""
+    suffix = file.suffix.lower()
+    if suffix == ".obj":
+        return _obj_text(file)
+    if suffix not in (".stl", ".off", ".ply"):
+        return None
+    data = file.read_bytes()
+    if suffix == ".stl":
+        if not (data[:5].lower() == b"solid" and b"facet" in data[:1024]):
+            return None  # binary STL: an 80-byte header trimesh does not decode, then numbers
+        if len(data) >= 84 and len(data) == 84 + 50 * int.from_bytes(data[80:84], "little"):
+            return None  # a binary STL whose header happens to start with "solid"
+    if suffix == ".ply":
+        end = data.find(b"end_header")
+        if end < 0:
+            return None  # no header: trimesh says what is wrong
+        header = data[:end]
+        converted = _utf8(header)
+        return None if converted is header else converted + data[end:]
+    converted = _utf8(data)
+    return None if converted is data else converted
 
 
 def _world_placements(graph: Any) -> dict[Any, tuple[NDArray[np.float64], Any]]:
