@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 from test_hostile_inputs import run_case
 
+from frustum import GeometryError
 from frustum.geometry.io import load, load_parts
 
 # --- 5. glTF scene graphs are walked once ------------------------------------------------------------------------
@@ -123,3 +124,44 @@ def test_utf8_names_still_load_as_before(tmp_path):
     path = tmp_path / "utf8.stl"
     path.write_bytes(_LATIN1_FILES["solid.stl"].replace(b"\xe9", "\u00e9".encode()))
     assert load(path).face_count == 1
+
+
+# --- 8. a GLB chunk longer than the file is corrupt, not too large ---------------------------------------------
+
+
+def _glb_with_chunk_length(tmp_path: Path, chunk: int) -> Path:
+    import trimesh
+
+    data = bytearray(trimesh.creation.icosphere(subdivisions=2).export(file_type="glb"))
+    json_length = int.from_bytes(data[12:16], "little")
+    at = 12 if chunk == 0 else 20 + json_length
+    data[at : at + 4] = (0xFFFFFFF0).to_bytes(4, "little")
+    path = tmp_path / f"chunk{chunk}.glb"
+    path.write_bytes(bytes(data))
+    return path
+
+
+@pytest.mark.parametrize("chunk", [0, 1])
+def test_glb_chunk_length_beyond_the_file_is_corrupt_not_too_large(tmp_path, chunk):
+    path = _glb_with_chunk_length(tmp_path, chunk)
+    result = run_case(f"from frustum.geometry.io import load; load({str(path)!r})")
+    assert result["type"] == "GeometryError", result
+    assert f"chunk {chunk} announces 4294967280 bytes" in result["message"]
+    assert "the file is corrupt or truncated" in result["message"]
+    assert "too large" not in result["message"]
+
+
+def test_memory_error_on_a_small_file_says_corrupt(tmp_path, monkeypatch):
+    import trimesh
+
+    path = tmp_path / "small.off"
+    path.write_bytes(_LATIN1_FILES["comment.off"])
+
+    def exhausted(*args, **kwargs):
+        raise MemoryError("Unable to allocate 16.0 GiB")
+
+    monkeypatch.setattr(trimesh, "load_scene", exhausted)
+    with pytest.raises(GeometryError, match=r"ran out of memory while loading, although a valid file of this size "
+                       r"needs about .*; the file is corrupt") as info:  # fmt: skip
+        load(path)
+    assert "too large" not in str(info.value)

@@ -26,7 +26,7 @@ from numpy.typing import NDArray
 
 from frustum._arrays import describe
 from frustum._files import atomic_path, os_reason
-from frustum.budgets import check_memory, format_bytes
+from frustum.budgets import check_memory, format_bytes, get_budget
 from frustum.errors import GeometryError
 from frustum.geometry.mesh import Mesh
 
@@ -113,6 +113,8 @@ def load_parts(path: str | Path, texture: str | Path | None = None) -> list[Mesh
     explicit = None if texture is None else _read_image(Path(texture), "load")
     if file.suffix.lower() == ".stl":
         _check_binary_stl_size(file)
+    if file.suffix.lower() == ".glb":
+        _check_glb_chunks(file)
     _check_file_memory(file)
     text = _text_bytes(file)
     try:
@@ -122,8 +124,15 @@ def load_parts(path: str | Path, texture: str | Path | None = None) -> list[Mesh
         else:
             scene = trimesh.load_scene(str(file), process=False)
     except MemoryError:
+        size = file.stat().st_size
+        if size * _LOAD_BYTES_PER_FILE_BYTE < get_budget().bytes:  # a file this small should load: a bad count
+            raise GeometryError(
+                f"load: path = {str(file)!r} ({format_bytes(size)}) ran out of memory while loading, although a "
+                f"valid file of this size needs about {format_bytes(size * _LOAD_BYTES_PER_FILE_BYTE)}; the file is "
+                "corrupt (a length or count in it far beyond its data)"
+            ) from None
         raise GeometryError(
-            f"load: path = {str(file)!r} ({format_bytes(file.stat().st_size)}) ran out of memory while loading; "
+            f"load: path = {str(file)!r} ({format_bytes(size)}) ran out of memory while loading; "
             "the file is valid but too large for this machine: free memory or lower the budget with "
             "frustum.set_budget(bytes=...) so such files are refused up front"
         ) from None
@@ -276,6 +285,29 @@ def _check_binary_stl_size(file: Path) -> None:
             f"load: path = {str(file)!r} has {size} bytes but its header announces {count} triangles "
             f"({84 + 50 * count} bytes); the file is truncated"
         )
+
+
+def _check_glb_chunks(file: Path) -> None:
+    """A GLB is a 12-byte header ("glTF", version, length) and chunks of (uint32 length, uint32 type, data):
+    refuse a chunk that announces more bytes than the file holds (trimesh would ask for all of them)."""
+    size = file.stat().st_size
+    with file.open("rb") as stream:
+        head = stream.read(12)
+        if len(head) < 12 or head[:4] != b"glTF":
+            return  # not a binary glTF: trimesh says what it is not
+        offset, index = 12, 0
+        while offset < size:
+            stream.seek(offset)
+            chunk = stream.read(8)
+            if len(chunk) < 8:
+                return  # trimesh reports a chunk header cut short
+            length = int.from_bytes(chunk[:4], "little")
+            if offset + 8 + length > size:
+                raise GeometryError(
+                    f"load: path = {str(file)!r}: GLB chunk {index} announces {length} bytes at byte {offset}, but "
+                    f"the file has {size - offset - 8} more; the file is corrupt or truncated"
+                )
+            offset, index = offset + 8 + length, index + 1
 
 
 _LOAD_BYTES_PER_FILE_BYTE = 12
