@@ -284,7 +284,10 @@ def trace_command(
 def _load_mesh(path: Path, where: str) -> Mesh:
     """A mesh file as one Mesh (``frustum.geometry.io.load``, else trimesh), errors as one-line GeometryErrors."""
     if not path.is_file():
-        raise GeometryError(f"{where}: mesh = {str(path)!r} does not exist or is not a file; give a mesh file path")
+        from frustum._files import file_kind
+
+        problem = "does not exist" if not path.exists() else f"is not a regular file ({file_kind(path)})"
+        raise GeometryError(f"{where}: mesh = {str(path)!r} {problem}; give a mesh file path")
     try:
         from frustum.geometry.io import load
     except ImportError:  # pragma: no cover - the io module ships with frustum; trimesh directly otherwise

@@ -48,6 +48,7 @@ from typing import Any
 import numpy as np
 
 from frustum._arrays import describe, escape_control
+from frustum._files import file_kind
 from frustum.budgets import check_memory
 from frustum.camera import Camera
 from frustum.errors import FrustumError, OutputError, SceneFileError
@@ -430,7 +431,7 @@ class _Report:
 
     def add(self, path: Sequence, value: Any, problem: str, valid: str) -> None:
         """``key = value problem; valid``."""
-        self.problems.append(f"{self._where(path)}: {_path_text(path)} = {describe(value)} {problem}; {valid}")
+        self.problems.append(f"{self._where(path)}: {_path_text(path)} = {_toml_text(value)} {problem}; {valid}")
 
     def missing(self, path: Sequence, valid: str) -> None:
         self.problems.append(f"{self._where(path)}: {_path_text(path)} is missing; {valid}")
@@ -447,7 +448,9 @@ class _Report:
                 if key in value:
                     path, value = (*path, key), value[key]
                     break
-        self.problems.append(f"{self._where(path)}: {_path_text(path)} = {describe(value)} is not accepted: {message}")
+        self.problems.append(
+            f"{self._where(path)}: {_path_text(path)} = {_toml_text(value)} is not accepted: {message}"
+        )
 
     def raise_if_any(self) -> None:
         if self.problems:
@@ -1101,6 +1104,15 @@ def _as_mesh(report: _Report, path: tuple, value: Any, label: str) -> Any:
     return _BAD
 
 
+def _toml_text(value: Any) -> str:
+    """``describe(value)`` with booleans spelled as the scene file wrote them: ``[2.2, 1.6, false]``."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, list) and any(isinstance(v, bool) for v in value) and len(value) <= 16:
+        return "[" + ", ".join(_toml_text(v) for v in value) + "]"
+    return describe(value)
+
+
 def _mesh_file(report: _Report, path: tuple, params: dict, base: Path, loader: Callable) -> Any:
     _unknown_keys(report, path, params, ("path",))
     if "path" not in params:
@@ -1112,7 +1124,8 @@ def _mesh_file(report: _Report, path: tuple, params: dict, base: Path, loader: C
         return _BAD
     file = (base / name).resolve()
     if not file.is_file():
-        report.add((*path, "path"), name, f"does not exist (looked for {file})",
+        problem = f"is not a regular file ({file_kind(file)})" if file.exists() else "does not exist"
+        report.add((*path, "path"), name, f"{problem} (looked for {file})",
                    "give a mesh file relative to the scene file's folder")  # fmt: skip
         return _BAD
     if len(params) > 1:

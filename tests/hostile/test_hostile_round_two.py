@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import base64
 import json
+import re
 import time
 from pathlib import Path
 
@@ -165,3 +166,50 @@ def test_memory_error_on_a_small_file_says_corrupt(tmp_path, monkeypatch):
                        r"needs about .*; the file is corrupt") as info:  # fmt: skip
         load(path)
     assert "too large" not in str(info.value)
+
+
+# --- 10. messages say what is true ------------------------------------------------------------------------------
+
+
+def _scene_text(eye: str = "[2.2, 1.6, 5.0]", mesh: str = "") -> str:
+    geometry = f'geometry = {{ type = "mesh", path = "{mesh}" }}' if mesh else 'geometry = { type = "cube" }'
+    return f'[camera]\neye = {eye}\n\n[[nodes]]\nname = "thing"\n{geometry}\n'
+
+
+def test_false_in_a_vector_is_shown_as_false(tmp_path):
+    from frustum import SceneFileError, load_scene_file
+    from frustum._arrays import describe
+
+    path = tmp_path / "scene.toml"
+    path.write_text(_scene_text(eye="[2.2, 1.6, false]"))
+    with pytest.raises(SceneFileError) as info:
+        load_scene_file(path)
+    assert "scene.toml:2: camera.eye = [2.2, 1.6, false] is not 3 numbers" in str(info.value)
+    assert "0.0" not in str(info.value).split("camera.eye = ")[1].split(" is not")[0]
+    assert describe([2.2, 1.6, False]) == "[2.2, 1.6, False]" and describe([2.2, 1.6, 0]) == "(2.2, 1.6, 0.0)"
+
+
+@pytest.mark.parametrize(
+    ("target", "problem"),
+    [
+        ("/dev/zero", "is not a regular file (a character device)"),
+        ("folder", "is not a regular file (a folder)"),
+        ("missing", "does not exist"),
+    ],
+)
+def test_mesh_path_that_is_a_device_or_folder_is_not_called_missing(tmp_path, target, problem):
+    from frustum import SceneFileError, load_scene_file
+
+    (tmp_path / "folder").mkdir()
+    link = tmp_path / "mesh.obj"
+    link.symlink_to(target if target.startswith("/") else tmp_path / target)
+    for name in ("mesh.obj", target if target.startswith("/") else None):
+        if name is None:
+            continue
+        scene = tmp_path / "scene.toml"
+        scene.write_text(_scene_text(mesh=name))
+        with pytest.raises(SceneFileError) as info:
+            load_scene_file(scene)
+        assert f"nodes[0].geometry.path = {name!r} {problem} (looked for" in str(info.value)
+    with pytest.raises(GeometryError, match=r"path = '.*mesh\.obj' " + re.escape(problem) + ";"):
+        load(link)

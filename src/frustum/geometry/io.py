@@ -25,7 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from frustum._arrays import describe
-from frustum._files import atomic_path, os_reason
+from frustum._files import atomic_path, file_kind, os_reason
 from frustum.budgets import check_memory, format_bytes, get_budget
 from frustum.errors import GeometryError
 from frustum.geometry.mesh import Mesh
@@ -258,7 +258,7 @@ def _checked_path(path: Any, where: str) -> Path:
     file = Path(path)
     _suffix(file, where)
     if not file.is_file():
-        problem = "is a folder" if file.is_dir() else "does not exist"
+        problem = "does not exist" if not file.exists() else f"is not a regular file ({file_kind(file)})"
         raise GeometryError(f"{where}: path = {str(file)!r} {problem}; give the path of an existing mesh file")
     if file.stat().st_size == 0:
         raise GeometryError(f"{where}: path = {str(file)!r} is empty (0 bytes); the file is truncated or not written")
