@@ -213,3 +213,74 @@ def test_mesh_path_that_is_a_device_or_folder_is_not_called_missing(tmp_path, ta
         assert f"nodes[0].geometry.path = {name!r} {problem} (looked for" in str(info.value)
     with pytest.raises(GeometryError, match=r"path = '.*mesh\.obj' " + re.escape(problem) + ";"):
         load(link)
+
+
+# --- 9. no orphans: pool workers and the resource tracker die with their parent ---------------------------------
+
+
+def _process_table() -> dict[int, tuple[int, str, int]]:
+    """pid -> (parent pid, state, start time in clock ticks) of every process, from /proc."""
+    table = {}
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            text = (entry / "stat").read_text()
+        except OSError:
+            continue
+        fields = text[text.rindex(")") + 2 :].split()  # after "pid (command)": state, ppid, ...
+        table[int(entry.name)] = (int(fields[1]), fields[0], int(fields[19]))
+    return table
+
+
+def _descendants(root: int, table: dict[int, tuple[int, str, int]]) -> dict[int, int]:
+    """pid -> start time of every process below `root`."""
+    found, frontier = {}, [root]
+    while frontier:
+        parent = frontier.pop()
+        for pid, (ppid, _, started) in table.items():
+            if ppid == parent and pid not in found:
+                found[pid] = started
+                frontier.append(pid)
+    return found
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="reads the process table from /proc (Linux)")
+def test_sigkill_of_a_process_dataset_leaves_no_workers_or_tracker(tmp_path):
+    import os
+    import signal
+    import subprocess
+    import sys
+
+    root = Path(__file__).resolve().parents[2]
+    out = tmp_path / "data"
+    environment = {**os.environ, "PYTHONPATH": os.pathsep.join([str(root / "src"), os.environ.get("PYTHONPATH", "")])}
+    process = subprocess.Popen(
+        [sys.executable, "-m", "frustum", "dataset", str(root / "examples" / "teapot.toml"), "--out", str(out),
+         "--views", "400", "--size", "160x120", "--format", "files", "--executor", "process", "--workers", "2",
+         "--no-progress"],
+        env=environment, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+    )  # fmt: skip
+    log = out / "manifest.jsonl"
+    try:
+        deadline = time.monotonic() + 180
+        while time.monotonic() < deadline and process.poll() is None:
+            if log.exists() and log.read_text().count("\n") >= 4:  # the configuration and three views
+                break
+            time.sleep(0.01)
+        assert process.poll() is None, "the dataset finished (or failed) before it could be killed"
+        children = _descendants(process.pid, _process_table())
+        assert len(children) >= 3, children  # two workers and the resource tracker
+        process.send_signal(signal.SIGKILL)
+        process.wait()
+        time.sleep(10)
+        table = _process_table()
+        alive = {pid for pid, started in children.items() if pid in table and table[pid][2] == started
+                 and table[pid][1] != "Z"}  # fmt: skip
+        assert not alive, f"still running 10 s after the parent's SIGKILL: {sorted(alive)}"
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.wait()
+    finished = log.read_text().count("\n") - 1
+    assert 3 <= finished < 400
