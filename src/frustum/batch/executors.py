@@ -101,14 +101,18 @@ def _prepare(jobs: Sequence[RenderJob], where: str) -> tuple[list[tuple[Any, Map
 # --- worker side ------------------------------------------------------------------------------------------------
 
 
-def _init_worker(scenes_blob: bytes, threads: int) -> None:
-    """Pool initializer: unpickle the scenes once, set this worker's kernel threads, ignore Ctrl-C."""
+def _init_worker(scenes_blob: bytes, threads: int, parent: int | None = None) -> None:
+    """Pool initializer: watch the parent (its pid `parent`, given by the parent itself: a worker that starts
+    after its parent died must not take its new parent, init, for it), unpickle the scenes once, set this
+    worker's kernel threads, ignore Ctrl-C."""
     import signal
 
     from frustum.raster._jit import set_threads
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    _WORKER["parent"] = os.getppid()
+    _WORKER["parent"] = os.getppid() if parent is None else parent
+    if os.getppid() != _WORKER["parent"]:
+        os._exit(0)  # the parent died while this worker was starting
     threading.Thread(target=_watch_parent, args=(_WORKER["parent"],), name="frustum-parent-watch", daemon=True).start()
     _WORKER["scenes"] = pickle.loads(scenes_blob)
     set_threads(threads)
@@ -180,7 +184,8 @@ def _process(scenes: list, jobs: list[RenderJob], workers: int, on_result: Calla
     blob = pickle.dumps(scenes, protocol=pickle.HIGHEST_PROTOCOL)
     # spawn, not fork: a forked child of a process whose kernel threads are running can deadlock
     context = multiprocessing.get_context("spawn")
-    pool = ProcessPoolExecutor(workers, mp_context=context, initializer=_init_worker, initargs=(blob, threads))
+    pool = ProcessPoolExecutor(workers, mp_context=context, initializer=_init_worker,
+                               initargs=(blob, threads, os.getpid()))  # fmt: skip
     pending = iter(jobs)
     in_flight: set = set()
     try:
