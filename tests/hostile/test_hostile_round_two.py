@@ -246,7 +246,8 @@ def _descendants(root: int, table: dict[int, tuple[int, str, int]]) -> dict[int,
 
 
 @pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="reads the process table from /proc (Linux)")
-def test_sigkill_of_a_process_dataset_leaves_no_workers_or_tracker(tmp_path):
+@pytest.mark.parametrize("when", ["drawing", "starting"])
+def test_sigkill_of_a_process_dataset_leaves_no_workers_or_tracker(tmp_path, when):
     import os
     import signal
     import subprocess
@@ -265,7 +266,9 @@ def test_sigkill_of_a_process_dataset_leaves_no_workers_or_tracker(tmp_path):
     try:
         deadline = time.monotonic() + 180
         while time.monotonic() < deadline and process.poll() is None:
-            if log.exists() and log.read_text().count("\n") >= 4:  # the configuration and three views
+            if when == "drawing" and log.exists() and log.read_text().count("\n") >= 4:  # configuration, 3 views
+                break
+            if when == "starting" and len(_descendants(process.pid, _process_table())) >= 3:  # workers spawned
                 break
             time.sleep(0.01)
         assert process.poll() is None, "the dataset finished (or failed) before it could be killed"
@@ -282,5 +285,29 @@ def test_sigkill_of_a_process_dataset_leaves_no_workers_or_tracker(tmp_path):
         if process.poll() is None:
             process.kill()
             process.wait()
-    finished = log.read_text().count("\n") - 1
-    assert 3 <= finished < 400
+    if when == "drawing":
+        assert 3 <= log.read_text().count("\n") - 1 < 400
+
+
+# --- 6. budgets from real peaks ------------------------------------------------------------------------------------
+
+
+def test_obj_face_line_of_millions_of_indices_is_refused_before_parsing(tmp_path):
+    path = tmp_path / "one_line.obj"
+    count = 4_500_000  # 9 MB: trimesh's reader would take over 1 GB (measured: ~225 bytes an index)
+    path.write_bytes(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf " + b"1 " * count + b"\n")
+    started = time.perf_counter()
+    result = run_case(f"from frustum.geometry.io import load; load({str(path)!r})", env={"FRUSTUM_MAX_BYTES": "512M"})
+    elapsed = time.perf_counter() - started
+    assert result["type"] == "GeometryError", result
+    assert f"with {count} vertex indices in polygons of more than 4 (the longest, line 5, has {count})" in (
+        result["message"]
+    )
+    assert "needs about 1.2 GiB, over the memory budget of 512.0 MiB" in result["message"]
+    assert elapsed < 20  # refused before parsing (parsing took 36 s and a MemoryError)
+
+
+def test_obj_polygons_within_the_budget_still_load(tmp_path):
+    path = tmp_path / "pentagon.obj"
+    path.write_text("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0.5 1.5 0\nv 0 1 0\nf 1 2 3 4 5\nf 1 2 3\n")
+    assert load(path).face_count == 4
