@@ -614,10 +614,15 @@ def serve(
         ) from None
     if isinstance(allow_origins, str):
         allow_origins = (allow_origins,)
-    url_token = choose_token(host, token)
+    choose_token(host, token if isinstance(token, str) else False)  # a bad token string fails before binding
     source = SceneSource(path)
     sock = open_socket(host, port)
     bound = sock.getsockname()
+    url_token = choose_token(bound[0] if is_loopback(bound[0]) else host, token)  # e.g. a name for 127.0.1.1
+    if not logging.getLogger().hasHandlers() and not log.handlers:  # refusals and ignored messages on stderr
+        handler = logging.StreamHandler()
+        handler.setFormatter(logging.Formatter("frustum serve: %(message)s"))
+        log.addHandler(handler)
     shown = f"[{bound[0]}]" if ":" in bound[0] else bound[0]
     access = Access(host, bound[1], bound[0], allow_origins=tuple(allow_origins), token=url_token)
     source.check()
