@@ -300,8 +300,9 @@ def test_obj_face_line_of_millions_of_indices_is_refused_before_parsing(tmp_path
     result = run_case(f"from frustum.geometry.io import load; load({str(path)!r})", env={"FRUSTUM_MAX_BYTES": "512M"})
     elapsed = time.perf_counter() - started
     assert result["type"] == "GeometryError", result
-    assert f"with {count} vertex indices in polygons of more than 4 (the longest, line 5, has {count})" in (
-        result["message"]
+    assert (
+        f"with {count} vertex indices in polygons of more than 4 (the longest, line 5, has {count})"
+        in (result["message"])
     )
     assert "needs about 1.2 GiB, over the memory budget of 512.0 MiB" in result["message"]
     assert elapsed < 20  # refused before parsing (parsing took 36 s and a MemoryError)
