@@ -43,7 +43,7 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
-from frustum._arrays import describe
+from frustum._arrays import describe, escape_control
 from frustum.budgets import format_bytes, get_budget
 from frustum.errors import FrustumError
 from frustum.scenefile import SceneFile, load_scene_file
@@ -405,7 +405,7 @@ class _Connection:
     def ignore(self, why: str) -> None:
         self.ignored += 1
         if self.ignored <= _LOG_LINES_PER_CONNECTION:
-            log.warning("ignored a message from %s: %s", self.client, why)
+            log.warning("ignored a message from %s: %s", self.client, escape_control(why))
             if self.ignored == _LOG_LINES_PER_CONNECTION:
                 log.warning("further ignored messages from %s are not logged", self.client)
 

@@ -42,7 +42,7 @@ from typing import Any
 
 import numpy as np
 
-from frustum._arrays import describe
+from frustum._arrays import describe, escape_control
 from frustum.camera import Camera
 from frustum.clipping import REGION_BOTTOM, REGION_FAR, REGION_LEFT, REGION_NEAR, REGION_RIGHT, REGION_TOP
 from frustum.errors import FrustumError
@@ -333,7 +333,8 @@ class ViewerSession:
                 hello = isinstance(message, Mapping) and message.get("type") == "hello"
                 action = "rest" if hello else self.handle(message)
             except Exception as error:  # the guard: a message that breaks a handler is ignored, not fatal
-                _log.warning("ignored a viewer message (%s: %s)", type(error).__name__, str(error)[:120])
+                reason = escape_control(str(error)[:120])
+                _log.warning("ignored a viewer message (%s: %s)", type(error).__name__, reason)
                 action = None
             if action is None:
                 ignored = True
