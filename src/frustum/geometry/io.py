@@ -412,8 +412,12 @@ def _world_placements(graph: Any) -> dict[Any, tuple[NDArray[np.float64], Any]]:
     identity = np.eye(4)
     placements: dict[Any, tuple[NDArray[np.float64], Any]] = {}
     stack = [(graph.base_frame, identity)]
+    seen = set()
     while stack:
         node, world_from_node = stack.pop()
+        if node in seen:  # a node listed twice (or a cycle in a broken file) is walked once
+            continue
+        seen.add(node)
         geometry = forest.node_data.get(node, {}).get("geometry")
         if geometry is not None:
             matrix = world_from_node
