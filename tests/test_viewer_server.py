@@ -274,8 +274,17 @@ def test_handler_failure_is_ignored_not_raised(monkeypatch, caplog):
     assert "TypeError" in caplog.text
 
 
-def test_picks_are_merged_latest_wins(plain):
+def test_picks_are_merged_latest_wins(plain, monkeypatch):
     port = plain[0]
+    original = ViewerSession.pick
+    picked = []
+
+    def slow_pick(self, x, y):  # a pick costs a full-size render; 50 ms makes that visible on any machine
+        picked.append((x, y))
+        time.sleep(0.05)
+        return original(self, x, y)
+
+    monkeypatch.setattr(ViewerSession, "pick", slow_pick)
     with _connect(port) as ws:
         _greeted(ws)
         started = time.perf_counter()
@@ -291,7 +300,7 @@ def test_picks_are_merged_latest_wins(plain):
                     break
         elapsed = time.perf_counter() - started
     print(f"\n1001 picks: {len(picks)} answered in {elapsed:.2f} s")
-    assert len(picks) <= 20 and elapsed < 30
+    assert len(picks) == len(picked) <= 20 and elapsed < 30  # unmerged: 1001 renders, 50 s at least
     assert picks[-1]["hit"]
 
 
