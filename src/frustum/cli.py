@@ -284,7 +284,10 @@ def trace_command(
 def _load_mesh(path: Path, where: str) -> Mesh:
     """A mesh file as one Mesh (``frustum.geometry.io.load``, else trimesh), errors as one-line GeometryErrors."""
     if not path.is_file():
-        raise GeometryError(f"{where}: mesh = {str(path)!r} does not exist or is not a file; give a mesh file path")
+        from frustum._files import file_kind
+
+        problem = "does not exist" if not path.exists() else f"is not a regular file ({file_kind(path)})"
+        raise GeometryError(f"{where}: mesh = {str(path)!r} {problem}; give a mesh file path")
     try:
         from frustum.geometry.io import load
     except ImportError:  # pragma: no cover - the io module ships with frustum; trimesh directly otherwise
@@ -559,6 +562,14 @@ def serve_command(
         str, typer.Option(help="Interface to listen on; 127.0.0.1 is this machine only, 0.0.0.0 every interface.")
     ] = "127.0.0.1",
     port: Annotated[int, typer.Option(help="TCP port; 0 picks a free one.")] = 8000,
+    allow_origin: Annotated[
+        list[str] | None,
+        typer.Option("--allow-origin", help="Also let pages of this origin (e.g. http://localhost:8888) use the "
+                     "viewer, for deliberate embedding; repeatable. Other pages get 403."),
+    ] = None,
+    no_token: Annotated[
+        bool, typer.Option("--no-token", help="Serve a non-loopback --host without the random URL token.")
+    ] = False,
 ) -> None:
     """Open an interactive viewer of a scene file in the browser (orbit, pan, zoom, the pipeline beside it)."""
     from frustum.viewer.server import serve
@@ -568,9 +579,12 @@ def serve_command(
         if host in ("127.0.0.1", "localhost", "::1"):
             console.print("listening on this machine only; --host 0.0.0.0 serves other machines too; Ctrl-C stops",
                           markup=False, highlight=False, soft_wrap=True)  # fmt: skip
+        elif "?token=" in url:
+            console.print("other machines need the URL with its token; --no-token serves without one; Ctrl-C stops",
+                          markup=False, highlight=False, soft_wrap=True)  # fmt: skip
         console.file.flush()
 
-    serve(scene, host, port, ready=ready)
+    serve(scene, host, port, ready=ready, allow_origins=tuple(allow_origin or ()), token=False if no_token else None)
 
 
 # --- entry point ------------------------------------------------------------------------------------------------
