@@ -1,0 +1,22 @@
+"""Watch the algorithms of the lecture notes work, step by step (the teaching layer).
+
+Each function takes the same inputs as the production function it records and returns a ``Steps``: a sequence
+of ``Step(title, text, values)`` taken from the real computation (a ``record=`` hook of the production
+function, or a recording mode of a kernel's Python twin that is tested equal to it), with ``Steps.result``
+equal to the production result. ``Steps.figure(i)`` draws step i as SVG; ``Steps.save(path)`` writes ``.svg``,
+``.gif``/``.mp4``, ``.html`` (a slider) or ``.md``; in Jupyter a ``Steps`` shows as a slider.
+
+One module per chapter of the notes: ``clipping``.
+"""
+
+from frustum.steps._record import SAVE_FORMATS, Step, Steps
+from frustum.steps.clipping import cohen_sutherland, liang_barsky, sutherland_hodgman
+
+__all__ = [
+    "SAVE_FORMATS",
+    "Step",
+    "Steps",
+    "cohen_sutherland",
+    "liang_barsky",
+    "sutherland_hodgman",
+]
