@@ -11,12 +11,17 @@ One module per chapter of the notes: ``clipping``.
 
 from frustum.steps._record import SAVE_FORMATS, Step, Steps
 from frustum.steps.clipping import cohen_sutherland, liang_barsky, sutherland_hodgman
+from frustum.steps.modeling import rotation_about_axis
+from frustum.steps.viewing import back_faces, viewing_pipeline
 
 __all__ = [
     "SAVE_FORMATS",
     "Step",
     "Steps",
+    "back_faces",
     "cohen_sutherland",
     "liang_barsky",
+    "rotation_about_axis",
     "sutherland_hodgman",
+    "viewing_pipeline",
 ]
