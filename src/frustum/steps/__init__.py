@@ -6,11 +6,13 @@ function, or a recording mode of a kernel's Python twin that is tested equal to 
 equal to the production result. ``Steps.figure(i)`` draws step i as SVG; ``Steps.save(path)`` writes ``.svg``,
 ``.gif``/``.mp4``, ``.html`` (a slider) or ``.md``; in Jupyter a ``Steps`` shows as a slider.
 
-One module per chapter of the notes: ``clipping``.
+One module per chapter of the notes: ``modeling``, ``viewing``, ``clipping``, ``curves``, ``fractals``.
 """
 
 from frustum.steps._record import SAVE_FORMATS, Step, Steps
 from frustum.steps.clipping import cohen_sutherland, liang_barsky, sutherland_hodgman
+from frustum.steps.curves import b_spline_basis, de_casteljau, hermite
+from frustum.steps.fractals import box_counting, koch, midpoint_displacement
 from frustum.steps.modeling import rotation_about_axis
 from frustum.steps.viewing import back_faces, viewing_pipeline
 
@@ -18,9 +20,15 @@ __all__ = [
     "SAVE_FORMATS",
     "Step",
     "Steps",
+    "b_spline_basis",
     "back_faces",
+    "box_counting",
     "cohen_sutherland",
+    "de_casteljau",
+    "hermite",
+    "koch",
     "liang_barsky",
+    "midpoint_displacement",
     "rotation_about_axis",
     "sutherland_hodgman",
     "viewing_pipeline",
