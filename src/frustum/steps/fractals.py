@@ -10,6 +10,8 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from frustum.budgets import check_memory
+from frustum.errors import OutputError
 from frustum.geometry.dimension import box_counting_dimension
 from frustum.geometry.fractals import fractal_coastline, koch_curve
 from frustum.steps._draw import bounds_of
@@ -17,9 +19,24 @@ from frustum.steps._record import Step, Steps, _Canvas
 
 __all__ = ["box_counting", "koch", "midpoint_displacement"]
 
+# a recorded polyline vertex costs its copy (16 bytes) and about 20 characters in each figure that draws it
+# (its own step's and the next one's): the estimate checked against the memory budget before any work
+_BYTES_PER_RECORDED_VERTEX = 16 + 2 * 20
+
+
+def check_recording(vertices: float, where: str, cause: str) -> None:
+    """Refuse a recording whose polylines (all levels together) would exceed the memory budget."""
+    check_memory(vertices * _BYTES_PER_RECORDED_VERTEX, where=where, cause=cause, error=OutputError)
+
 
 def koch(level: int = 4, start: ArrayLike = (0.0, 0.0), end: ArrayLike = (1.0, 0.0)) -> Steps:
-    """The Koch curve, iteration by iteration (``koch_curve(..., record=...)``); ``result`` is its polyline."""
+    """The Koch curve, iteration by iteration (``koch_curve(..., record=...)``); ``result`` is its polyline.
+
+    Raises ``OutputError`` when the recording (every level's polyline and its figures) is over the memory
+    budget (``frustum.set_budget``), with the estimate.
+    """
+    if isinstance(level, int) and level >= 0:
+        check_recording(sum(4.0**k + 1 for k in range(level + 1)), "steps.koch", f"a recording of level = {level}")
     levels: list[NDArray] = []
     result = koch_curve(level, start, end, record=lambda k, points: levels.append(points.copy()))
     first = np.array([np.asarray(start, float)[:2], np.asarray(end, float)[:2]])
@@ -50,7 +67,11 @@ def midpoint_displacement(
     amplitude: float = 0.3,
 ) -> Steps:  # fmt: skip
     """Random midpoint displacement of a polyline (``fractal_coastline(..., record=...)``), step by step;
-    ``result`` is the production polyline."""
+    ``result`` is the production polyline. Over the memory budget: ``OutputError`` with the estimate."""
+    if isinstance(level, int) and level >= 0:
+        segments = max(len(polyline) - 1, 1) if hasattr(polyline, "__len__") else 1
+        check_recording(sum(segments * 2.0**k + 1 for k in range(level + 1)), "steps.midpoint_displacement",
+                        f"a recording of level = {level}")  # fmt: skip
     levels: list[tuple[NDArray, float]] = []
 
     def record(k: int, points: NDArray, sigma: float) -> None:
