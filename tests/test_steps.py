@@ -356,3 +356,49 @@ def test_html_slider_works_in_chromium(tmp_path):
             assert recorded[2].title in title
         finally:
             browser.close()
+
+
+# --- visible surfaces --------------------------------------------------------------------------------------
+
+
+triangle_soups = st.lists(st.tuples(point3, point3, point3), min_size=1, max_size=6)
+
+
+@settings(max_examples=40, deadline=None)
+@given(triangle_soups, point3)
+def test_bsp_steps_end_in_the_trees_back_to_front_order(soup, eye):
+    polygons = np.array(soup, dtype=float)
+    areas = np.linalg.norm(np.cross(polygons[:, 1] - polygons[:, 0], polygons[:, 2] - polygons[:, 0]), axis=1)
+    if (areas < 1e-3).any():
+        return
+    eye = np.add(eye, np.array([0.0, 0.0, 9.0]))
+    recorded = fs.bsp_tree(polygons, eye)
+    expected = frustum.BSPTree(polygons).back_to_front_indices(eye=eye)
+    assert np.array_equal(recorded.result, expected)
+    painted = [s.values["painted so far"] for s in recorded if "painted so far" in s.values]
+    assert painted[-1] == expected.tolist()
+
+
+def test_bsp_worked_example_splits_a_crossing_wall():
+    recorded = fs.bsp_tree()
+    nodes = [s for s in recorded if s.title.startswith("Node")]
+    assert sum(s.values["splits"] for s in nodes) == frustum.BSPTree(fs.visible_surfaces.default_walls()).split_count
+    assert sum(s.values["splits"] for s in nodes) == 2
+
+
+def test_depth_buffer_steps_end_in_the_render_byte_for_byte():
+    scene, camera = fs.visible_surfaces.default_scene()
+    recorded = fs.depth_buffer(scene, camera)
+    frame = frustum.render(scene, camera)
+    assert np.array_equal(recorded.result.color, frame.color)
+    assert np.array_equal(recorded.result.depth, frame.depth)
+    assert len(recorded) == len(scene.root.children) + 1
+    written = [s.values["pixels written"] for s in recorded[1:]]
+    assert all(n > 0 for n in written)
+
+
+def test_depth_buffer_recording_of_a_4k_image_is_refused_with_the_estimate():
+    scene, camera = fs.visible_surfaces.default_scene()
+    big = frustum.Camera(camera.frame, camera.projection, 3840, 2160)
+    with frustum.budget(bytes="256M"), pytest.raises(OutputError, match=r"3 surfaces at 3840x2160 needs about 474"):
+        fs.depth_buffer(scene, big)

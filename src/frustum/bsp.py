@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import bisect
 from collections.abc import Sequence
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -295,7 +295,9 @@ class BSPTree:
     [HB 16] "BSP-Tree Method"; [seed] "BSP Trees".
     """
 
-    def __init__(self, polygons: Sequence[ArrayLike] | NDArray, ids: ArrayLike | None = None) -> None:
+    def __init__(
+        self, polygons: Sequence[ArrayLike] | NDArray, ids: ArrayLike | None = None, *, record: Any = None
+    ) -> None:
         polys, labels = _check_polygons(polygons, ids, "BSPTree")
         self.tolerance = _scene_tolerance(polys)
         self._area_tolerance = self.tolerance**2
@@ -313,7 +315,7 @@ class BSPTree:
         self._back: list[int] = []
         self._members: list[NDArray[np.int64]] = []
         self._cells: list[bool] = []
-        self._build()
+        self._build(record)
         # keep only the fragments the tree holds (a split polygon is replaced by its parts), renumbered
         alive = np.concatenate(self._members) if self._members else np.empty(0, dtype=np.int64)
         alive.sort()
@@ -358,12 +360,14 @@ class BSPTree:
         self._size += count
         return np.arange(self._size - count, self._size)
 
-    def _build(self) -> None:
+    def _build(self, record: Any = None) -> None:
         """Iterative construction (no recursion limit): each stack entry is (parent, side, fragment indices).
 
         A group whose polygons all lie behind (or on) every one of their planes is a convex cell, such as a
         convex polyhedron: it becomes one leaf, painted as "faces turned away, then faces turned toward the
         viewer" (within each half no two overlap on the screen), instead of a chain of one node per face.
+        ``record("node", ...)`` (``frustum.steps``), if given, sees each node as it is made: its plane, the
+        polygons on it, the numbers in front and behind, and each split (the polygon and its two parts).
         """
         eps = self.tolerance
         stack: list[tuple[int, int, NDArray[np.int64]]] = [(-1, 0, np.arange(self._size))] if self._size else []
@@ -373,6 +377,10 @@ class BSPTree:
             if len(group) == 1:  # a leaf: one polygon in its own plane
                 node = self._new_node(self._source_planes[self._owners[group[0]]], parent, side, False)
                 self._members.append(group)
+                if record is not None:
+                    record("node", node=node, parent=parent, side=side, plane=self._planes[node], cell=False,
+                           on=[self._corners[i, : self._counts[i]].copy() for i in group.tolist()],
+                           in_front=0, behind=0, splits=[])  # fmt: skip
                 continue
             plane = self._choose_splitter(group)
             distances = self._corners[group] @ plane[:3] + plane[3]  # (m, 8)
@@ -389,18 +397,29 @@ class BSPTree:
             node = self._new_node(plane, parent, side, cell)
             if cell:
                 self._members.append(group)
+                if record is not None:
+                    record("node", node=node, parent=parent, side=side, plane=plane, cell=True,
+                           on=[self._corners[i, : self._counts[i]].copy() for i in group.tolist()],
+                           in_front=0, behind=0, splits=[])  # fmt: skip
                 continue
             self._members.append(group[on])
             front_parts, back_parts = [group[in_front]], [group[behind]]
+            splits = []
             for index in group[straddle].tolist():
                 owner = int(self._owners[index])
                 front, back = _split(self._corners[index, : self._counts[index]], plane, eps)
                 self.split_count += 1
+                if record is not None:
+                    splits.append((self._corners[index, : self._counts[index]].copy(), front, back))
                 for part, parts in ((front, front_parts), (back, back_parts)):
                     pieces = _pieces(part, self._area_tolerance) if part is not None else []
                     if pieces:
                         parts.append(self._append(pieces, owner))
             back_group, front_group = np.concatenate(back_parts), np.concatenate(front_parts)
+            if record is not None:
+                record("node", node=node, parent=parent, side=side, plane=plane, cell=False,
+                       on=[self._corners[i, : self._counts[i]].copy() for i in group[on].tolist()],
+                       in_front=int(in_front.sum()), behind=int(behind.sum()), splits=splits)  # fmt: skip
             if back_group.size:
                 stack.append((node, -1, back_group))
             if front_group.size:
@@ -486,10 +505,12 @@ class BSPTree:
         return [(corners[i, :count], label) for i, count, label in zip(indices.tolist(), counts, labels, strict=True)]
 
     def back_to_front_indices(
-        self, eye: ArrayLike | None = None, direction: ArrayLike | None = None, *, camera: Camera | None = None
+        self, eye: ArrayLike | None = None, direction: ArrayLike | None = None, *, camera: Camera | None = None,
+        record: Any = None,
     ) -> NDArray[np.int64]:
         """(F,) int64 indices into ``fragments`` (and ``ids``) in painting order: the array form of
-        ``back_to_front``, for drawing many fragments at once."""
+        ``back_to_front``, for drawing many fragments at once. ``record("emit", node=..., fragments=...,
+        viewer_in_front=...)`` (``frustum.steps``), if given, sees each node's fragments as they are emitted."""
         where = "BSPTree.back_to_front"
         if sum(value is not None for value in (eye, direction, camera)) != 1:
             raise CameraError(
@@ -520,11 +541,16 @@ class BSPTree:
             entry = stack.pop()
             if entry < 0:
                 order.append(self._members[-1 - entry])
+                if record is not None:
+                    record("emit", node=-1 - entry, fragments=order[-1], viewer_in_front=bool(
+                        sides[-1 - entry] >= -tolerance))  # fmt: skip
                 continue
             if self._cells[entry]:  # convex cell: faces turned away first, then faces turned toward the viewer
                 members = self._members[entry]
                 toward = self._source_planes[self._owners[members]] @ viewer > tolerance
                 order.extend((members[~toward], members[toward]))
+                if record is not None:
+                    record("emit", node=entry, fragments=np.concatenate(order[-2:]), viewer_in_front=None)
                 continue
             if sides[entry] < -tolerance:  # viewer behind: the front subtree is farther
                 near, far = self._back[entry], self._front[entry]

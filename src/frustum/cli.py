@@ -561,6 +561,8 @@ def serve_command(
 @app.command("steps")
 def steps_command(
     algorithm: Annotated[str | None, typer.Argument(help="Algorithm name (frustum steps --list).")] = None,
+    scene_file: Annotated[Path | None, typer.Argument(help="A TOML scene file (depth-buffer).")] = None,
+    size: Annotated[str | None, typer.Option(help="Image size WxH for a scene file's camera.")] = None,
     output: Annotated[Path | None, typer.Option("-o", "--output", help="Output .svg, .gif, .mp4, .html, .md.")] = None,
     list_algorithms: Annotated[bool, typer.Option("--list", help="List the algorithms and exit.")] = False,
     from_: Annotated[str | None, typer.Option("--from", help="Segment start x,y,z[,w].")] = None,
@@ -585,8 +587,18 @@ def steps_command(
         return
     if algorithm is None or output is None:
         raise UsageError("frustum steps: give an ALGORITHM and -o out.svg|gif|mp4|html|md (or --list)")
-    options = {"from": from_, "to": to, "points": points, "t": t, "level": level, "axis": axis, "point": point,
-               "angle_deg": angle_deg, "knots": knots, "order": order, "u": u, "seed": seed}  # fmt: skip
+    options: dict[str, Any] = {"from": from_, "to": to, "points": points, "t": t, "level": level, "axis": axis,
+                               "point": point, "angle_deg": angle_deg, "knots": knots, "order": order, "u": u,
+                               "seed": seed}  # fmt: skip
+    if scene_file is not None:
+        from frustum.scenefile import load_scene_file
+
+        loaded = load_scene_file(scene_file)
+        camera = loaded.camera or loaded.cameras[0]
+        if size is not None:
+            width, height = _image_size(size)
+            camera = Camera(camera.frame, camera.projection, width, height)
+        options.update(scene=loaded.scene, camera=camera)
     recorded = build(algorithm, options)
     written = recorded.save(output, fps=fps)
     console.print(f"frustum steps: {algorithm}, {len(recorded)} steps -> {', '.join(map(str, written))}",

@@ -6,7 +6,8 @@ function, or a recording mode of a kernel's Python twin that is tested equal to 
 equal to the production result. ``Steps.figure(i)`` draws step i as SVG; ``Steps.save(path)`` writes ``.svg``,
 ``.gif``/``.mp4``, ``.html`` (a slider) or ``.md``; in Jupyter a ``Steps`` shows as a slider.
 
-One module per chapter of the notes: ``modeling``, ``viewing``, ``clipping``, ``curves``, ``fractals``.
+One module per chapter of the notes: ``modeling``, ``viewing``, ``clipping``, ``visible_surfaces``, ``curves``,
+``fractals``.
 """
 
 from frustum.steps._record import SAVE_FORMATS, Step, Steps
@@ -14,7 +15,8 @@ from frustum.steps.clipping import cohen_sutherland, liang_barsky, sutherland_ho
 from frustum.steps.curves import b_spline_basis, de_casteljau, hermite
 from frustum.steps.fractals import box_counting, koch, midpoint_displacement
 from frustum.steps.modeling import rotation_about_axis
-from frustum.steps.viewing import back_faces, viewing_pipeline
+from frustum.steps.viewing import viewing_pipeline
+from frustum.steps.visible_surfaces import back_faces, bsp_tree, depth_buffer
 
 __all__ = [
     "SAVE_FORMATS",
@@ -23,8 +25,10 @@ __all__ = [
     "b_spline_basis",
     "back_faces",
     "box_counting",
+    "bsp_tree",
     "cohen_sutherland",
     "de_casteljau",
+    "depth_buffer",
     "hermite",
     "koch",
     "liang_barsky",

@@ -135,6 +135,23 @@ class _Canvas:
         if label:
             self.label((x + radius + 3, y - radius - 2), label, color=color, world=False)
 
+    def image(self, rgb: np.ndarray, corner0: Sequence[float], corner1: Sequence[float]) -> None:
+        """An (H, W, 3|4) uint8 image as an embedded PNG, stretched over the world box corner0–corner1, pixels kept
+        sharp (a buffer, not a photograph)."""
+        import base64
+
+        from PIL import Image
+
+        buffer = io.BytesIO()
+        Image.fromarray(np.ascontiguousarray(rgb)).save(buffer, format="PNG")
+        data = base64.b64encode(buffer.getvalue()).decode("ascii")
+        (xa, ya), (xb, yb) = self.xy(corner0), self.xy(corner1)
+        self.elements.append(
+            f'<image x="{min(xa, xb):.2f}" y="{min(ya, yb):.2f}" width="{abs(xb - xa):.2f}" '
+            f'height="{abs(yb - ya):.2f}" preserveAspectRatio="none" style="image-rendering:pixelated" '
+            f'href="data:image/png;base64,{data}"/>'
+        )
+
     def label(self, point: Sequence[float], text: str, color: str = "ink", size: float = 13.0,
               world: bool = True, anchor: str = "start") -> None:  # fmt: skip
         x, y = self.xy(point) if world else (float(point[0]), float(point[1]))

@@ -3,7 +3,8 @@ command line's option texts.
 
 Options (each algorithm reads the ones it needs; defaults give the chapter's worked example):
 ``from`` / ``to`` (``x,y,z[,w]``), ``points`` (``x,y[,z];x,y[,z];...``), ``t``, ``level``, ``axis``, ``point``,
-``angle_deg``, ``knots`` (``0,0,0,1,2,2,2``), ``order``, ``u``, ``seed``.
+``angle_deg``, ``knots`` (``0,0,0,1,2,2,2``), ``order``, ``u``, ``seed``; and ``scene``, ``camera`` (objects, from a
+scene file the command loaded).
 """
 
 from __future__ import annotations
@@ -15,12 +16,12 @@ from typing import Any
 import numpy as np
 
 from frustum.errors import FrustumError
-from frustum.steps import clipping, curves, fractals, modeling, viewing
+from frustum.steps import clipping, curves, fractals, modeling, viewing, visible_surfaces
 from frustum.steps._record import Steps
 
 __all__ = ["ALGORITHMS", "build", "describe_algorithms"]
 
-Options = Mapping[str, str | None]
+Options = Mapping[str, Any]  # option texts (str or None); "scene" and "camera" are objects the CLI loaded
 
 
 def _vector(options: Options, name: str, default: Any, widths: tuple[int, ...] = (3,)) -> np.ndarray:
@@ -81,7 +82,12 @@ ALGORITHMS: dict[str, tuple[str, Callable[[Options], Steps]]] = {
                                                         _vector(o, "point", (0.5, 0.0, 0.0)))),
     "viewing-pipeline": ("world → view → projection → normalization → viewport, for a small house",
                          lambda o: viewing.viewing_pipeline()),
-    "back-faces": ("back-face detection by the plane equation, face by face", lambda o: viewing.back_faces()),
+    "back-faces": ("back-face detection by the plane equation, face by face",
+                   lambda o: visible_surfaces.back_faces()),
+    "depth-buffer": ("depth buffer, surface by surface: depth and frame buffers after each (SCENE.toml, --size)",
+                     lambda o: visible_surfaces.depth_buffer(o.get("scene"), o.get("camera"))),
+    "bsp": ("BSP tree: the splits while building, then the back-to-front order from the eye",
+            lambda o: visible_surfaces.bsp_tree()),
     "cohen-sutherland": ("Cohen–Sutherland 3D line clipping: region codes, accept/reject, intersections "
                          "(--from, --to)",
                          lambda o: clipping.cohen_sutherland(_vector(o, "from", (-2.0, 0.5, 0.0), (3, 4)),

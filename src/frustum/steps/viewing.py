@@ -1,11 +1,9 @@
 """Viewing, step by step: the pipeline world → view → projection → normalization → viewport, and back faces.
 
 ``viewing_pipeline`` is ``frustum.trace`` (the renderer's stages, recorded) drawn stage by stage, with the view
-volume's eight corners traced along so that the frustum visibly becomes the canonical cube; ``back_faces``
-records ``backface_mask``'s plane test for every face.
+volume's eight corners traced along so that the frustum visibly becomes the canonical cube.
 
-References: [HB 10] "The Three-Dimensional Viewing Pipeline"; [HB 16] "Back-Face Detection"; [seed]
-"Three-Dimensional Viewing Pipeline", "Back-face detection".
+References: [HB 10] "The Three-Dimensional Viewing Pipeline"; [seed] "Three-Dimensional Viewing Pipeline".
 """
 
 from __future__ import annotations
@@ -16,23 +14,16 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from frustum._arrays import as_faces, as_points
+from frustum._arrays import as_points
 from frustum.camera import Camera
 from frustum.errors import FrustumError, GeometryError
 from frustum.projection import Perspective
-from frustum.steps._draw import CUBE_CORNERS, CUBE_EDGES, bounds_of, cartesian, oblique
-from frustum.steps._record import Step, Steps, _Canvas, format_value
+from frustum.steps._draw import CUBE_CORNERS, CUBE_EDGES, cartesian, oblique
+from frustum.steps._record import Step, Steps, _Canvas
 from frustum.steps.modeling import HOUSE_EDGES, HOUSE_POINTS
 from frustum.trace import trace
-from frustum.visibility import backface_mask
 
-__all__ = ["back_faces", "default_camera", "viewing_pipeline"]
-
-# the house's faces (outward, counter-clockwise seen from outside) for back-face detection
-HOUSE_FACES = np.array(
-    [[0, 3, 2], [0, 2, 1], [4, 5, 6], [4, 6, 7], [0, 1, 5], [0, 5, 4], [1, 2, 6], [1, 6, 5], [3, 0, 4], [3, 4, 7],
-     [2, 3, 8], [6, 9, 7], [2, 8, 9], [2, 9, 6], [3, 7, 9], [3, 9, 8]], dtype=np.int64,
-)  # fmt: skip
+__all__ = ["default_camera", "viewing_pipeline"]
 
 
 def default_camera() -> Camera:
@@ -104,70 +95,3 @@ def viewing_pipeline(points: ArrayLike | None = None, camera: Camera | None = No
                      size=12)  # fmt: skip
 
     return Steps("The viewing pipeline", steps, result, paint, (0.0, 0.0, 1.0, 1.05))
-
-
-def back_faces(
-    vertices: ArrayLike | None = None, faces: ArrayLike | None = None, camera: Camera | None = None
-) -> Steps:
-    """Back-face detection by the plane equation, face by face: ``A·x + B·y + C·z + D·w < 0`` at the viewer.
-
-    Runs ``backface_mask(vertices, faces, camera, record=...)``; ``result`` is its (M,) bool mask (True = back
-    face). Default: the house of ``viewing_pipeline`` and its camera.
-    """
-    where = "steps.back_faces"
-    cam = _camera(camera, where)
-    if vertices is None:
-        points, triangles = HOUSE_POINTS, HOUSE_FACES
-    else:
-        points = as_points(vertices, "vertices", where=where)
-        triangles = as_faces(faces, points.shape[0], where=where, error=GeometryError)
-    events: list[dict[str, Any]] = []
-    result = backface_mask(points, triangles, cam, record=lambda event, **values: events.append(values))
-    tests = events[0]
-    position = tests["position"]
-    steps = [Step(
-        "The viewing position",
-        "Each face's plane A·x + B·y + C·z + D = 0 comes from its corners, N = (P1 − P0) × (P2 − P0) pointing "
-        "out of the object. A face is a back face when the viewing position (x, y, z, w) lies behind its plane.",
-        {"viewer (x, y, z, w)": position, "faces": len(triangles)},
-    )]  # fmt: skip
-    for f, (plane, value) in enumerate(zip(tests["planes"], tests["values"], strict=True)):
-        back = bool(value < 0.0)
-        steps.append(Step(
-            f"Face {f}: {'back face, culled' if back else 'front face, kept'}",
-            "Plane test at the viewing position: A·x + B·y + C·z + D·w "
-            + ("< 0, the viewer is behind the plane." if back else ">= 0, the viewer is in front of it."),
-            {"A, B, C, D": plane, "A·x + B·y + C·z + D·w": value, "back": back},
-        ))  # fmt: skip
-    steps.append(Step(
-        "All faces tested",
-        "The back faces (grey) are removed before any depth test; for a closed convex object the rest is the "
-        "visible surface.",
-        {"back faces": int(result.sum()), "front faces": int((~result).sum())},
-    ))  # fmt: skip
-    window = np.asarray(cam.project(points))[:, :2]
-
-    def paint(index: int, canvas: _Canvas) -> None:
-        done = index - 1  # faces decided so far (step 0 none, the last step all)
-        final = index == len(steps) - 1
-        order = np.argsort(~result, kind="stable") if final else range(len(triangles))  # back faces first
-        for f in order:
-            corners = window[triangles[f]]
-            if not np.isfinite(corners).all():
-                continue
-            if f < done or final:
-                fill = "faint" if result[f] else "accept"
-                canvas.polyline(corners, color="ink", closed=True, fill=fill, opacity=0.35, width=0.8)
-            elif f == done:
-                fill = "reject" if result[f] else "accept"
-                canvas.polyline(corners, color="highlight", closed=True, fill=fill, opacity=0.6, width=2.5)
-            else:
-                canvas.polyline(corners, color="faint", closed=True, width=0.6)
-        if 0 <= done < len(triangles):
-            centre = window[triangles[done]].mean(axis=0)
-            if np.isfinite(centre).all():
-                canvas.label(centre, format_value(float(tests["values"][done])), color="highlight", size=11)
-
-    finite = window[np.isfinite(window).all(axis=1)]
-    bounds = bounds_of(finite) if finite.size else (0.0, 0.0, cam.width, cam.height)
-    return Steps("Back-face detection", steps, result, paint, bounds)

@@ -1,0 +1,297 @@
+"""Visible surfaces, step by step: back-face detection, the BSP tree (splits, then back to front), the depth buffer
+(surface by surface).
+
+References: [HB 16] "Back-Face Detection", "BSP-Tree Method", "Depth-Buffer Method"; [seed] "Back-face
+detection", "BSP trees", "Depth-buffer method".
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from frustum._arrays import as_faces, as_points, as_vector3
+from frustum.bsp import BSPTree
+from frustum.budgets import check_memory, check_operations
+from frustum.camera import Camera
+from frustum.errors import CameraError, FrustumError, GeometryError, OutputError
+from frustum.scene import Scene
+from frustum.steps._draw import bounds_of, oblique
+from frustum.steps._record import Step, Steps, _Canvas, format_value
+from frustum.steps.modeling import HOUSE_POINTS
+from frustum.steps.viewing import _camera
+from frustum.visibility import backface_mask
+
+__all__ = ["HOUSE_FACES", "back_faces", "bsp_tree", "depth_buffer"]
+
+# the house's faces (outward, counter-clockwise seen from outside) for back-face detection
+HOUSE_FACES = np.array(
+    [[0, 3, 2], [0, 2, 1], [4, 5, 6], [4, 6, 7], [0, 1, 5], [0, 5, 4], [1, 2, 6], [1, 6, 5], [3, 0, 4], [3, 4, 7],
+     [2, 3, 8], [6, 9, 7], [2, 8, 9], [2, 9, 6], [3, 7, 9], [3, 9, 8]], dtype=np.int64,
+)  # fmt: skip
+
+
+def back_faces(
+    vertices: ArrayLike | None = None, faces: ArrayLike | None = None, camera: Camera | None = None
+) -> Steps:
+    """Back-face detection by the plane equation, face by face: ``A·x + B·y + C·z + D·w < 0`` at the viewer.
+
+    Runs ``backface_mask(vertices, faces, camera, record=...)``; ``result`` is its (M,) bool mask (True = back
+    face). Default: the house of ``viewing_pipeline`` and its camera.
+    """
+    where = "steps.back_faces"
+    cam = _camera(camera, where)
+    if vertices is None:
+        points, triangles = HOUSE_POINTS, HOUSE_FACES
+    else:
+        points = as_points(vertices, "vertices", where=where)
+        triangles = as_faces(faces, points.shape[0], where=where, error=GeometryError)
+    events: list[dict[str, Any]] = []
+    result = backface_mask(points, triangles, cam, record=lambda event, **values: events.append(values))
+    tests = events[0]
+    position = tests["position"]
+    steps = [Step(
+        "The viewing position",
+        "Each face's plane A·x + B·y + C·z + D = 0 comes from its corners, N = (P1 − P0) × (P2 − P0) pointing "
+        "out of the object. A face is a back face when the viewing position (x, y, z, w) lies behind its plane.",
+        {"viewer (x, y, z, w)": position, "faces": len(triangles)},
+    )]  # fmt: skip
+    for f, (plane, value) in enumerate(zip(tests["planes"], tests["values"], strict=True)):
+        back = bool(value < 0.0)
+        steps.append(Step(
+            f"Face {f}: {'back face, culled' if back else 'front face, kept'}",
+            "Plane test at the viewing position: A·x + B·y + C·z + D·w "
+            + ("< 0, the viewer is behind the plane." if back else ">= 0, the viewer is in front of it."),
+            {"A, B, C, D": plane, "A·x + B·y + C·z + D·w": value, "back": back},
+        ))  # fmt: skip
+    steps.append(Step(
+        "All faces tested",
+        "The back faces (grey) are removed before any depth test; for a closed convex object the rest is the "
+        "visible surface.",
+        {"back faces": int(result.sum()), "front faces": int((~result).sum())},
+    ))  # fmt: skip
+    window = np.asarray(cam.project(points))[:, :2]
+
+    def paint(index: int, canvas: _Canvas) -> None:
+        done = index - 1  # faces decided so far (step 0 none, the last step all)
+        final = index == len(steps) - 1
+        order = np.argsort(~result, kind="stable") if final else range(len(triangles))  # back faces first
+        for f in order:
+            corners = window[triangles[f]]
+            if not np.isfinite(corners).all():
+                continue
+            if f < done or final:
+                fill = "faint" if result[f] else "accept"
+                canvas.polyline(corners, color="ink", closed=True, fill=fill, opacity=0.35, width=0.8)
+            elif f == done:
+                fill = "reject" if result[f] else "accept"
+                canvas.polyline(corners, color="highlight", closed=True, fill=fill, opacity=0.6, width=2.5)
+            else:
+                canvas.polyline(corners, color="faint", closed=True, width=0.6)
+        if 0 <= done < len(triangles):
+            centre = window[triangles[done]].mean(axis=0)
+            if np.isfinite(centre).all():
+                canvas.label(centre, format_value(float(tests["values"][done])), color="highlight", size=11)
+
+    finite = window[np.isfinite(window).all(axis=1)]
+    bounds = bounds_of(finite) if finite.size else (0.0, 0.0, cam.width, cam.height)
+    return Steps("Back-face detection", steps, result, paint, bounds)
+
+
+# --- BSP tree ----------------------------------------------------------------------------------------------
+
+# four walls seen from above (x right, z toward the viewer), two of them crossing: the building splits one
+_WALLS = [((-2.0, 0.0), (2.0, 0.0)), ((-1.0, -2.0), (-1.0, 1.5)), ((0.5, -1.5), (2.5, 1.0)), ((-2.5, 2.0), (1.5, 2.5))]
+
+
+def default_walls() -> NDArray[np.float64]:
+    """(4, 4, 3) vertical rectangles (walls) standing on the xz plane, the BSP example of the chapter."""
+    walls = []
+    for (x0, z0), (x1, z1) in _WALLS:
+        walls.append([(x0, 0.0, z0), (x1, 0.0, z1), (x1, 1.0, z1), (x0, 1.0, z0)])
+    return np.array(walls)
+
+
+def _top_view(points: Any) -> NDArray[np.float64]:
+    p = np.asarray(points, dtype=float).reshape(-1, 3)
+    return np.column_stack([p[:, 0], -p[:, 2]])
+
+
+def bsp_tree(polygons: ArrayLike | None = None, eye: ArrayLike = (0.3, 0.5, 4.0)) -> Steps:
+    """A BSP tree built node by node (partitioning plane, polygons in front and behind, splits), then read back
+    to front from `eye`, fragment by fragment.
+
+    Runs ``BSPTree(polygons, record=...)`` and ``back_to_front_indices(eye=eye, record=...)``; ``result`` is that
+    painting order (indices into the tree's ``fragments``). Walls standing on the xz plane (the default) are
+    drawn from above, as the textbook does; other polygons in an oblique view.
+    """
+    where = "steps.bsp_tree"
+    polys = default_walls() if polygons is None else polygons
+    viewer = as_vector3(eye, "eye", where=where, error=CameraError)
+    nodes: list[dict[str, Any]] = []
+    tree = BSPTree(polys, record=lambda event, **values: nodes.append(values))
+    emitted: list[dict[str, Any]] = []
+    result = tree.back_to_front_indices(eye=viewer, record=lambda event, **values: emitted.append(values))
+    fragments = tree.fragments
+    sources = [np.asarray(p, dtype=float) for p in polys]
+    vertical = all(abs(float(np.cross(p[1] - p[0], p[2] - p[0])[1])) < 1e-9 for p in sources)
+    view = _top_view if vertical else oblique
+    steps = [Step("The polygons and the viewer",
+                  "A BSP tree splits space by the plane of one polygon at each node: polygons in front go to one "
+                  "subtree, those behind to the other, and a polygon crossing the plane is split in two.",
+                  {"polygons": len(sources), "eye": viewer})]  # fmt: skip
+    shown: list[tuple[str, Any]] = [("scene", None)]
+    for node in nodes:
+        kind = "convex cell" if node["cell"] else "partitioning plane"
+        steps.append(Step(f"Node {node['node']}: {kind}",
+                          "The node keeps the polygons lying in its plane; the rest go in front (N·P + D > 0) or "
+                          "behind." + (" Crossing polygons are split at the plane." if node["splits"] else ""),
+                          {"plane (A, B, C, D)": node["plane"], "on the plane": len(node["on"]),
+                           "in front": node["in_front"], "behind": node["behind"],
+                           "splits": len(node["splits"])}))  # fmt: skip
+        shown.append(("node", node))
+    painted: list[int] = []
+    for emit in emitted:
+        ids = [int(i) for i in np.asarray(emit["fragments"]).tolist()]
+        if not ids:
+            continue
+        side = emit["viewer_in_front"]
+        rule = ("the viewer is in front of this node's plane: its back subtree was painted first"
+                if side else "the viewer is behind this node's plane: its front subtree was painted first"
+                if side is not None else "a convex cell: faces turned away first")  # fmt: skip
+        painted = painted + ids
+        steps.append(Step(f"Paint node {emit['node']}'s fragments {ids}", rule[0].upper() + rule[1:] + ".",
+                          {"painted so far": list(painted)}))  # fmt: skip
+        shown.append(("paint", list(painted)))
+    everything = np.vstack([view(p) for p in sources] + [view(viewer)])
+    box = bounds_of(everything, pad=0.15)
+
+    def plane_line(canvas: _Canvas, plane: NDArray) -> None:
+        if not vertical:
+            return
+        a, c, d = plane[0], -plane[2], plane[3]  # in top-view coordinates (x, −z)
+        norm = a * a + c * c
+        if norm == 0:
+            return
+        base = -d * np.array([a, c]) / norm
+        along = np.array([-c, a]) / math.sqrt(norm) * 2 * (box[2] - box[0] + box[3] - box[1])
+        canvas.line(base - along, base + along, color="highlight", dash=True)
+
+    def paint(index: int, canvas: _Canvas) -> None:
+        kind, data = shown[index]
+        canvas.dot(view(viewer)[0], color="ink", label="eye")
+        if kind == "paint":
+            for n, i in enumerate(data):
+                outline = view(fragments[i])
+                canvas.polyline(outline, color="blue", closed=True, fill="blue", opacity=0.25, width=3.0)
+                canvas.label(outline.mean(axis=0), str(n + 1), color="highlight", size=14)
+            return
+        for p in sources:
+            canvas.polyline(view(p), color="faint" if kind == "node" else "ink", closed=True, width=2.0)
+        if kind == "node":
+            plane_line(canvas, data["plane"])
+            for p in data["on"]:
+                canvas.polyline(view(p), color="highlight", closed=True, width=4.0)
+            for _, front, back in data["splits"]:
+                if front is not None:
+                    canvas.polyline(view(front), color="accept", closed=True, width=3.0)
+                if back is not None:
+                    canvas.polyline(view(back), color="purple", closed=True, width=3.0)
+
+    return Steps("BSP tree", steps, result, paint, box)
+
+
+# --- depth buffer ------------------------------------------------------------------------------------------
+
+
+def default_scene() -> tuple[Scene, Camera]:
+    """Three overlapping boxes and a sphere on a small image: the depth-buffer example of the chapter."""
+    from frustum.geometry import box, uv_sphere
+    from frustum.projection import Perspective
+    from frustum.shading import AmbientLight, DirectionalLight, Material
+    from frustum.transforms import translate
+
+    scene = Scene(lights=[DirectionalLight((-0.4, -0.6, -1.0)), AmbientLight(intensity=0.25)])
+    scene.add(box((2.0, 1.0, 0.4)), Material(color=(0.85, 0.3, 0.2)), translate(0.0, 0.0, -0.5), name="back slab")
+    scene.add(uv_sphere(0.7, 16, 8), Material(color=(0.2, 0.5, 0.9)), translate(0.4, 0.2, 0.0), name="sphere")
+    scene.add(box((0.8, 1.6, 0.8)), Material(color=(0.3, 0.75, 0.3)), translate(-0.6, 0.0, 0.3), name="pillar")
+    camera = Camera.look_at((0.0, 0.8, 4.0), (0.0, 0.0, 0.0), projection=Perspective(math.radians(45), 0.1, 20.0),
+                            width=64, height=48)  # fmt: skip
+    return scene, camera
+
+
+def depth_buffer(scene: Scene | None = None, camera: Camera | None = None, **options: Any) -> Steps:
+    """The depth-buffer method surface by surface: the depth and frame buffers after each of the scene's top
+    nodes (in order) has been drawn.
+
+    Each step is ``render`` of the scene's first k surfaces (``options`` passed on): the depth buffer keeps, per
+    pixel, the nearest depth seen so far, so drawing the first k surfaces is exactly the state after k of them.
+    ``result`` is the last render, equal byte for byte to ``render(scene, camera, **options)``.
+
+    Raises
+    ------
+    OutputError
+        A recording over the memory or work budget (k renders of W×H), with the estimate.
+    """
+    from frustum.render import render
+
+    where = "steps.depth_buffer"
+    if scene is None:
+        scene, default_camera = default_scene()
+        camera = default_camera if camera is None else camera
+    if not isinstance(scene, Scene):
+        raise FrustumError(f"{where}: scene = {scene!r} is not a Scene")
+    cam = _camera(camera, where)
+    surfaces = list(scene.root.children)
+    if not surfaces:
+        raise GeometryError(f"{where}: the scene has no surfaces; add a mesh with Scene.add")
+    pixels = cam.width * cam.height
+    cause = f"a recording of {len(surfaces)} surfaces at {cam.width}x{cam.height}"
+    # per surface and pixel: the kept frame's color and depth (8 bytes) and its two pictures in the figure (PNG
+    # in base64, up to about 12 bytes for noisy buffers)
+    check_memory(len(surfaces) * pixels * (8 + 12), where=where, cause=cause, error=OutputError)
+    check_operations(len(surfaces) * pixels * 64, where=where, cause=cause, error=OutputError)
+    frames = []
+    for k in range(1, len(surfaces) + 1):
+        partial = Scene(lights=scene.lights)
+        for node in surfaces[:k]:
+            partial.root.children.append(node)
+        frames.append(render(partial, cam, **options))
+    result = frames[-1]
+    steps = [Step("Empty buffers",
+                  "The depth buffer starts at 1 (the far plane) everywhere, the frame buffer at the background. "
+                  "Each surface is then scan-converted; a pixel is overwritten only where the surface is nearer "
+                  "than the depth stored there.",
+                  {"size": f"{cam.width}x{cam.height}", "surfaces": len(surfaces)})]  # fmt: skip
+    previous = np.ones((cam.height, cam.width), dtype=np.float32)
+    for k, (node, frame) in enumerate(zip(surfaces, frames, strict=True), start=1):
+        depth = np.asarray(frame.depth)
+        changed = int(np.count_nonzero(depth != previous))
+        steps.append(Step(f"Surface {k}: {node.name or 'unnamed'}",
+                          "For each pixel (x, y) of the surface: if its depth z < depth(x, y), store z and the "
+                          "surface's color there; otherwise the pixel keeps what a nearer surface left.",
+                          {"pixels written": changed, "nearest depth": float(depth.min())}))  # fmt: skip
+        previous = depth
+    width, height = float(cam.width), float(cam.height)
+    nearest = float(min(np.asarray(frame.depth).min() for frame in frames))
+
+    def paint(index: int, canvas: _Canvas) -> None:
+        if index == 0:
+            depth = np.ones((cam.height, cam.width), dtype=np.float32)
+            color = np.zeros((cam.height, cam.width, 3), dtype=np.uint8)
+        else:
+            depth, color = np.asarray(frames[index - 1].depth), np.asarray(frames[index - 1].color)[:, :, :3]
+        # depths of the scene crowd near 1: stretch [nearest, 1] over the gray ramp (1 = far = white)
+        shade = np.clip((depth - nearest) / max(1.0 - nearest, 1e-12), 0.0, 1.0)
+        gray = (40 + shade * 215).astype(np.uint8)
+        zoom = max(1, 256 // max(cam.width, 1))  # nearest-neighbour enlargement: buffer pixels stay sharp
+        big = np.repeat(np.repeat(np.repeat(gray[:, :, None], 3, axis=2), zoom, axis=0), zoom, axis=1)
+        canvas.image(big, (0.0, height), (width, 0.0))
+        canvas.image(np.repeat(np.repeat(color, zoom, axis=0), zoom, axis=1), (width * 1.1, height), (width * 2.1, 0.0))
+        canvas.label((0.0, height * 1.04), "depth buffer (white = far)", size=12)
+        canvas.label((width * 1.1, height * 1.04), "frame buffer", size=12)
+
+    return Steps("Depth buffer", steps, result, paint, (0.0, 0.0, width * 2.1, height * 1.1))
