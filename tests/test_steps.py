@@ -402,3 +402,40 @@ def test_depth_buffer_recording_of_a_4k_image_is_refused_with_the_estimate():
     big = frustum.Camera(camera.frame, camera.projection, 3840, 2160)
     with frustum.budget(bytes="256M"), pytest.raises(OutputError, match=r"3 surfaces at 3840x2160 needs about 474"):
         fs.depth_buffer(scene, big)
+
+
+def test_area_subdivision_steps_end_in_the_render_and_log_every_area():
+    scene, camera = fs.visible_surfaces.default_scene()
+    recorded = fs.area_subdivision(scene, camera)
+    frame = frustum.render(scene, camera, method="area-subdivision")
+    counts = frame.stats
+    assert np.array_equal(recorded.result.color, frame.color)
+    assert np.array_equal(recorded.result.depth, frame.depth)
+    per_level = [sum(v for k, v in s.values.items() if not k.startswith("single,")) for s in recorded[1:-1]]
+    assert per_level == counts["areas_per_level"]
+    for step, level in zip(recorded[1:-1], range(len(per_level)), strict=True):
+        assert step.title.startswith(f"Level {level}:")
+    assert recorded[1].values == {"subdivided": 1}  # the whole image is never decided at once here
+
+
+def test_warnock_recording_of_a_4k_image_is_refused_with_the_estimate(tmp_path):
+    scene, camera = fs.visible_surfaces.default_scene()
+    big = frustum.Camera(camera.frame, camera.projection, 3840, 2160)
+    with pytest.raises(OutputError, match=r"recording at 3840x2160 .* needs about .* GiB, over the memory budget"):
+        fs.area_subdivision(scene, big)
+
+
+def test_cli_warnock_of_a_scene_file(tmp_path):
+    env = {"PYTHONPATH": str(ROOT / "src")}
+    out = tmp_path / "warnock.gif"
+    scene_file = ROOT / "examples" / "teapot.toml"
+    done = subprocess.run([sys.executable, "-m", "frustum", "steps", "warnock", str(scene_file), "--size", "64x48",
+                           "-o", str(out)], env=env, capture_output=True, text=True)  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    with Image.open(out) as image:
+        frames = image.n_frames
+    assert f"{frames} steps" in done.stdout
+    command = [sys.executable, "-m", "frustum", "steps", "warnock", str(scene_file), "--size", "3840x2160", "-o",
+               str(tmp_path / "w4k.gif")]  # fmt: skip
+    refused = subprocess.run(command, env=env, capture_output=True, text=True)
+    assert refused.returncode == 1 and "needs about" in refused.stderr and "3840x2160" in refused.stderr

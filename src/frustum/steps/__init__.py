@@ -16,12 +16,13 @@ from frustum.steps.curves import b_spline_basis, de_casteljau, hermite
 from frustum.steps.fractals import box_counting, koch, midpoint_displacement
 from frustum.steps.modeling import rotation_about_axis
 from frustum.steps.viewing import viewing_pipeline
-from frustum.steps.visible_surfaces import back_faces, bsp_tree, depth_buffer
+from frustum.steps.visible_surfaces import area_subdivision, back_faces, bsp_tree, depth_buffer
 
 __all__ = [
     "SAVE_FORMATS",
     "Step",
     "Steps",
+    "area_subdivision",
     "b_spline_basis",
     "back_faces",
     "box_counting",

@@ -86,6 +86,9 @@ ALGORITHMS: dict[str, tuple[str, Callable[[Options], Steps]]] = {
                    lambda o: visible_surfaces.back_faces()),
     "depth-buffer": ("depth buffer, surface by surface: depth and frame buffers after each (SCENE.toml, --size)",
                      lambda o: visible_surfaces.depth_buffer(o.get("scene"), o.get("camera"))),
+    "warnock": ("area subdivision (Warnock): the quadtree of areas level by level and the test that decided each "
+                "(SCENE.toml, --size)",
+                lambda o: visible_surfaces.area_subdivision(o.get("scene"), o.get("camera"))),
     "bsp": ("BSP tree: the splits while building, then the back-to-front order from the eye",
             lambda o: visible_surfaces.bsp_tree()),
     "cohen-sutherland": ("Cohen–Sutherland 3D line clipping: region codes, accept/reject, intersections "

@@ -25,7 +25,7 @@ from frustum.steps.modeling import HOUSE_POINTS
 from frustum.steps.viewing import _camera
 from frustum.visibility import backface_mask
 
-__all__ = ["HOUSE_FACES", "back_faces", "bsp_tree", "depth_buffer"]
+__all__ = ["HOUSE_FACES", "area_subdivision", "back_faces", "bsp_tree", "depth_buffer"]
 
 # the house's faces (outward, counter-clockwise seen from outside) for back-face detection
 HOUSE_FACES = np.array(
@@ -295,3 +295,98 @@ def depth_buffer(scene: Scene | None = None, camera: Camera | None = None, **opt
         canvas.label((width * 1.1, height * 1.04), "frame buffer", size=12)
 
     return Steps("Depth buffer", steps, result, paint, (0.0, 0.0, width * 2.1, height * 1.1))
+
+
+# --- area subdivision (Warnock) ----------------------------------------------------------------------------
+
+_DECISION_COLORS = {0: "#dddddd", 1: "#2b8a3e", 2: "#1c63b7", 3: "#d9480f", 4: "#7048e8"}
+_DECISION_TEXT = {
+    0: "empty: no surface is left in the area, it keeps the background",
+    1: "surrounding: a surrounding surface is nearer than every other one over the whole area and fills it",
+    2: "single: one surface is left (inside, overlapping or surrounding) and is drawn into the area",
+    3: "pixel: the area is one pixel, the nearest surface at its centre is drawn",
+    4: "subdivided: no test decided, the area is cut into four",
+}
+_RELATIONS = ("outside", "surrounding", "inside", "overlapping")
+# a logged area costs its row (9 int64) and, in each figure that draws it, one rectangle of about 170 characters
+_BYTES_PER_AREA_ROW, _BYTES_PER_AREA_RECT = 72, 170
+
+
+def area_subdivision(scene: Scene | None = None, camera: Camera | None = None, **options: Any) -> Steps:
+    """Warnock's area subdivision level by level: every area of the quadtree and the test that decided it.
+
+    Runs ``render(scene, camera, method="area-subdivision", **options)`` with the kernel's recording mode on
+    (``visibility.warnock.recording``: the kernel logs each area it visits); ``result`` is that frame, byte for
+    byte the frame of the same call without recording.
+
+    Raises
+    ------
+    OutputError
+        A recording over the memory budget (at most 2·W·H areas, drawn in every later figure), with the estimate:
+        a 4K image is refused by default.
+    """
+    from frustum.raster.warnock import DECISIONS
+    from frustum.render import render
+    from frustum.visibility.warnock import recording
+
+    where = "steps.area_subdivision"
+    if scene is None:
+        scene, default_camera = default_scene()
+        camera = default_camera if camera is None else camera
+    if not isinstance(scene, Scene):
+        raise FrustumError(f"{where}: scene = {scene!r} is not a Scene")
+    cam = _camera(camera, where)
+    areas_bound = 2 * cam.width * cam.height + 1
+    levels_bound = 2 * max(1, math.ceil(math.log2(max(cam.width, cam.height, 2)))) + 2
+    check_memory(areas_bound * (_BYTES_PER_AREA_ROW + _BYTES_PER_AREA_RECT * levels_bound), where=where,
+                 cause=f"a recording at {cam.width}x{cam.height} (up to {areas_bound} areas, {levels_bound} levels)",
+                 error=OutputError)  # fmt: skip
+    with recording() as logs:
+        frame = render(scene, cam, method="area-subdivision", **options)
+    log = logs[0] if logs else np.zeros((0, 9), dtype=np.int64)
+    result = frame
+    levels = int(log[:, 4].max()) + 1 if len(log) else 0
+    steps = [Step("The whole image is the first area",
+                  "Each area is tested against the surfaces its parent kept: each is surrounding, overlapping, "
+                  "inside or outside it. The area is finished when a test decides (no surface, a surrounding "
+                  "surface hides all others, a single surface, or one pixel); otherwise it is cut into four.",
+                  {"size": f"{cam.width}x{cam.height}", "areas visited": len(log)})]  # fmt: skip
+    for level in range(levels):
+        rows = log[log[:, 4] == level]
+        counts = {DECISIONS[d]: int(np.count_nonzero(rows[:, 5] == d)) for d in range(len(DECISIONS))}
+        decided = [d for d in range(len(DECISIONS)) if counts[DECISIONS[d]]]
+        relations = {}
+        picked = rows[rows[:, 5] == 2]  # the single surface left: the relation it had to the area
+        for r in range(4):
+            n = int(np.count_nonzero(picked[:, 8] == r))
+            if n:
+                relations[f"single, {_RELATIONS[r]}"] = n
+        steps.append(Step(f"Level {level}: {len(rows)} area{'s' if len(rows) != 1 else ''}",
+                          "; ".join(_DECISION_TEXT[d] for d in decided) + ".",
+                          {**{k: v for k, v in counts.items() if v}, **relations}))  # fmt: skip
+    steps.append(Step("The finished image", "Every pixel belongs to exactly one finished area; the surfaces found "
+                      "are shaded as the depth buffer's.", {"areas": len(log), "levels": levels}))  # fmt: skip
+    color = np.asarray(frame.color)[:, :, :3]
+    width, height = float(cam.width), float(cam.height)
+    zoom = max(1, 256 // max(cam.width, 1))
+    picture = np.repeat(np.repeat(color, zoom, axis=0), zoom, axis=1)
+
+    def paint(index: int, canvas: _Canvas) -> None:
+        canvas.image(picture, (0.0, height), (width, 0.0))
+        canvas.rect((0.0, 0.0), (width, height), color="ink", fill="white", opacity=0.55)
+        current = index - 1 if 0 < index <= levels else levels
+        shown = log[log[:, 4] <= current]
+        for row in shown:
+            i0, j0, i1, j1, level, decision = (int(v) for v in row[:6])
+            finished = decision != 4
+            if level < current and not finished:
+                continue
+            paint_color = _DECISION_COLORS[decision]
+            canvas.rect((i0, j0), (i1, j1), color=paint_color, fill=paint_color if finished else None,
+                        opacity=0.45 if level == current else 0.2, width=1.5 if level == current else 0.5)  # fmt: skip
+        for n, d in enumerate(DECISIONS):
+            canvas.rect((width * 1.03, height - n * height / 9), (width * 1.07, height - (n + 0.6) * height / 9),
+                        color=_DECISION_COLORS[n], fill=_DECISION_COLORS[n], opacity=0.6)  # fmt: skip
+            canvas.label((width * 1.09, height - (n + 0.55) * height / 9), d, size=12)
+
+    return Steps("Area subdivision (Warnock)", steps, result, paint, (0.0, 0.0, width * 1.35, height))
