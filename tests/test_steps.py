@@ -439,3 +439,23 @@ def test_cli_warnock_of_a_scene_file(tmp_path):
                str(tmp_path / "w4k.gif")]  # fmt: skip
     refused = subprocess.run(command, env=env, capture_output=True, text=True)
     assert refused.returncode == 1 and "needs about" in refused.stderr and "3840x2160" in refused.stderr
+
+
+def test_scan_line_steps_end_in_the_render_and_spans_cover_the_drawn_pixels():
+    scene, camera = fs.visible_surfaces.default_scene()
+    recorded = fs.scan_line(scene, camera)
+    frame = frustum.render(scene, camera, method="scan-line")
+    assert np.array_equal(recorded.result.color, frame.color)
+    assert np.array_equal(recorded.result.depth, frame.depth)
+    drawn_rows = {camera.height - 1 - r for r in np.flatnonzero((np.asarray(frame.depth) < 1.0).any(axis=1))}
+    rows = {int(s.title.split("y = ")[1].split(":")[0]) for s in recorded if s.title.startswith("Scan line")}
+    assert drawn_rows <= rows
+    for step in recorded:
+        if step.title.startswith("Scan line"):
+            j = int(step.title.split("y = ")[1].split(":")[0])
+            covered = np.zeros(camera.width, bool)
+            for text in step.values["spans"]:
+                x0, x1 = (int(v) for v in text[1 : text.index("]")].split(", "))
+                covered[x0 : x1 + 1] = True
+            row = np.asarray(frame.depth)[camera.height - 1 - j] < 1.0
+            assert not (row & ~covered).any()  # every drawn pixel of the row lies in a recorded span

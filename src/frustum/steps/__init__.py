@@ -16,7 +16,7 @@ from frustum.steps.curves import b_spline_basis, de_casteljau, hermite
 from frustum.steps.fractals import box_counting, koch, midpoint_displacement
 from frustum.steps.modeling import rotation_about_axis
 from frustum.steps.viewing import viewing_pipeline
-from frustum.steps.visible_surfaces import area_subdivision, back_faces, bsp_tree, depth_buffer
+from frustum.steps.visible_surfaces import area_subdivision, back_faces, bsp_tree, depth_buffer, scan_line
 
 __all__ = [
     "SAVE_FORMATS",
@@ -35,6 +35,7 @@ __all__ = [
     "liang_barsky",
     "midpoint_displacement",
     "rotation_about_axis",
+    "scan_line",
     "sutherland_hodgman",
     "viewing_pipeline",
 ]

@@ -86,6 +86,8 @@ ALGORITHMS: dict[str, tuple[str, Callable[[Options], Steps]]] = {
                    lambda o: visible_surfaces.back_faces()),
     "depth-buffer": ("depth buffer, surface by surface: depth and frame buffers after each (SCENE.toml, --size)",
                      lambda o: visible_surfaces.depth_buffer(o.get("scene"), o.get("camera"))),
+    "scan-line": ("scan-line method: the edge table, then per row the active list and the spans (SCENE.toml, --size)",
+                  lambda o: visible_surfaces.scan_line(o.get("scene"), o.get("camera"))),
     "warnock": ("area subdivision (Warnock): the quadtree of areas level by level and the test that decided each "
                 "(SCENE.toml, --size)",
                 lambda o: visible_surfaces.area_subdivision(o.get("scene"), o.get("camera"))),

@@ -25,7 +25,7 @@ from frustum.steps.modeling import HOUSE_POINTS
 from frustum.steps.viewing import _camera
 from frustum.visibility import backface_mask
 
-__all__ = ["HOUSE_FACES", "area_subdivision", "back_faces", "bsp_tree", "depth_buffer"]
+__all__ = ["HOUSE_FACES", "area_subdivision", "back_faces", "bsp_tree", "depth_buffer", "scan_line"]
 
 # the house's faces (outward, counter-clockwise seen from outside) for back-face detection
 HOUSE_FACES = np.array(
@@ -390,3 +390,101 @@ def area_subdivision(scene: Scene | None = None, camera: Camera | None = None, *
             canvas.label((width * 1.09, height - (n + 0.55) * height / 9), d, size=12)
 
     return Steps("Area subdivision (Warnock)", steps, result, paint, (0.0, 0.0, width * 1.35, height))
+
+
+# --- scan line ---------------------------------------------------------------------------------------------
+
+# each scan line's figure embeds the picture (about 12 bytes a pixel as PNG in base64, stretched) and its logs
+_BYTES_PER_PIXEL_PER_FIGURE = 12
+
+
+def _triangle_color(t: int) -> str:
+    hue = (int(t) * 0.618034) % 1.0
+    r, g, b = (int(200 * (0.5 + 0.5 * math.cos(2 * math.pi * (hue + k / 3)))) for k in range(3))
+    return f"#{r:02x}{g:02x}{b:02x}"
+
+
+def scan_line(scene: Scene | None = None, camera: Camera | None = None, **options: Any) -> Steps:
+    """The scan-line method row by row: the edge table, then per scan line the active list (triangles crossing
+    it, sorted by span start) and the spans walked, each with the surface that filled it.
+
+    Runs ``render(scene, camera, method="scan-line", **options)`` with the kernel's recording mode on
+    (``visibility.scanline.recording``); ``result`` is that frame, byte for byte the frame without recording.
+    Rows are window rows (y up from the bottom); rows that no triangle crosses are left out.
+
+    Raises
+    ------
+    OutputError
+        A recording over the memory budget (one figure per row, each with the picture), with the estimate.
+    """
+    from frustum.render import render
+    from frustum.visibility.scanline import recording
+
+    where = "steps.scan_line"
+    if scene is None:
+        scene, default_camera = default_scene()
+        camera = default_camera if camera is None else camera
+    if not isinstance(scene, Scene):
+        raise FrustumError(f"{where}: scene = {scene!r} is not a Scene")
+    cam = _camera(camera, where)
+    zoom = max(1, 256 // max(cam.width, 1))
+    check_memory(cam.height * cam.width * cam.height * zoom * zoom * _BYTES_PER_PIXEL_PER_FIGURE, where=where,
+                 cause=f"a recording of {cam.height} scan lines at {cam.width}x{cam.height}",
+                 error=OutputError)  # fmt: skip
+    with recording() as logs:
+        frame = render(scene, cam, method="scan-line", **options)
+    result = frame
+    height, width = cam.height, cam.width
+    if not logs:  # nothing drawn by the method (an empty scene)
+        logs = [{"order": np.zeros(0, np.int64), "bucket": np.zeros(height + 1, np.int64),
+                 "active": np.full((height, 0, 3), -1), "spans": np.full((height, 1, 4), -1),
+                 "box": np.zeros((0, 4), np.int64), "code": np.zeros(0, np.int64)}]  # fmt: skip
+    log = logs[0]
+    bucket, order = log["bucket"], log["order"]
+    table = {int(j): order[bucket[j] : bucket[j + 1]].tolist() for j in range(height) if bucket[j + 1] > bucket[j]}
+    steps = [Step("The edge table",
+                  "Every triangle is listed under the first scan line it crosses (its lowest row). Going up the "
+                  "image row by row, triangles enter the active list from this table and leave after their last "
+                  "row.", {f"row {j}": ts for j, ts in list(table.items())[:12]})]  # fmt: skip
+    rows: list[int] = []
+    for j in range(height):
+        active = log["active"][j]
+        active = active[active[:, 0] >= 0]
+        if not len(active):
+            continue
+        spans = log["spans"][j]
+        spans = spans[spans[:, 0] >= 0]
+        described = []
+        for x0, x1, t, inside in spans.tolist():
+            who = f"triangle {t}" if t >= 0 else "per pixel"
+            described.append(f"[{x0}, {x1 - 1}] {who}" + (f" ({inside} in)" if inside > 1 else ""))
+        steps.append(Step(f"Scan line y = {j}: {len(active)} active, {len(spans)} spans",
+                          "The active list holds the triangles crossing this row, sorted by the x where their "
+                          "span starts (insertion sort: the order hardly changes from the row below). Walking the "
+                          "row through span starts and ends: one surface in, it fills the span; several, the "
+                          "nearest at both ends fills it; else the nearest is found pixel by pixel.",
+                          {"active list (t, x from, x to)": [tuple(r) for r in active.tolist()],
+                           "spans": described}))  # fmt: skip
+        rows.append(j)
+    steps.append(Step("The finished image", "Every row walked; the surfaces found are shaded as the depth "
+                      "buffer's.", {"rows with surfaces": len(rows)}))  # fmt: skip
+    color = np.asarray(frame.color)[:, :, :3]
+    background = color[0, 0].copy() if np.asarray(frame.depth)[0, 0] >= 1.0 else np.zeros(3, np.uint8)
+
+    def paint(index: int, canvas: _Canvas) -> None:
+        done = height if index == len(steps) - 1 else (rows[index - 1] + 1 if index > 0 else 0)
+        partial = np.empty_like(color)
+        partial[:] = background
+        if done:
+            partial[height - done :] = color[height - done :]  # window rows 0 … done − 1 are the bottom ones
+        canvas.image(np.repeat(np.repeat(partial, zoom, axis=0), zoom, axis=1), (0.0, height), (width, 0.0))
+        canvas.rect((0.0, 0.0), (width, height), color="ink")
+        if 0 < index < len(steps) - 1:
+            j = rows[index - 1]
+            canvas.line((0.0, j + 0.5), (width, j + 0.5), color="faint", width=0.8, dash=True)
+            for x0, x1, t, _inside in log["spans"][j][log["spans"][j][:, 0] >= 0].tolist():
+                canvas.rect((x0, j), (x1, j + 1), color="highlight", fill=_triangle_color(t) if t >= 0 else "white",
+                            opacity=0.9, width=1.2)  # fmt: skip
+            canvas.label((width + 1.0, j + 0.2), f"y = {j}", color="highlight", size=12)
+
+    return Steps("Scan-line method", steps, result, paint, (0.0, 0.0, width * 1.15, float(height)))
