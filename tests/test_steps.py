@@ -459,3 +459,26 @@ def test_scan_line_steps_end_in_the_render_and_spans_cover_the_drawn_pixels():
                 covered[x0 : x1 + 1] = True
             row = np.asarray(frame.depth)[camera.height - 1 - j] < 1.0
             assert not (row & ~covered).any()  # every drawn pixel of the row lies in a recorded span
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.integers(0, 10_000))
+def test_depth_sort_steps_end_in_the_production_order(seed):
+    rng = np.random.default_rng(seed)
+    soup = rng.uniform(-0.8, 0.8, (6, 1, 3)) + rng.uniform(-0.6, 0.6, (6, 3, 3))
+    camera = fs.visible_surfaces.default_depth_sort_scene()[1]
+    recorded = fs.depth_sort(soup, camera)
+    expected = frustum.depth_sort(list(soup), camera)
+    assert len(recorded.result.fragments) == len(expected.fragments)
+    for (a, label_a), (b, label_b) in zip(recorded.result.fragments, expected.fragments, strict=True):
+        assert label_a == label_b and np.array_equal(a, b)
+    paints = [s for s in recorded if s.title.startswith(("Paint", "Unresolved"))]
+    assert len(paints) == len(expected.fragments)
+
+
+def test_depth_sort_worked_example_splits_the_cycle():
+    recorded = fs.depth_sort()
+    titles = [s.title for s in recorded]
+    assert titles[0] == "Sorted by greatest depth"
+    assert sum(t.startswith("Split") for t in titles) == recorded.result.split_count == 1
+    assert sum(t.startswith("Paint") for t in titles) == 4  # three triangles, one cut in two

@@ -505,7 +505,11 @@ class BSPTree:
         return [(corners[i, :count], label) for i, count, label in zip(indices.tolist(), counts, labels, strict=True)]
 
     def back_to_front_indices(
-        self, eye: ArrayLike | None = None, direction: ArrayLike | None = None, *, camera: Camera | None = None,
+        self,
+        eye: ArrayLike | None = None,
+        direction: ArrayLike | None = None,
+        *,
+        camera: Camera | None = None,
         record: Any = None,
     ) -> NDArray[np.int64]:
         """(F,) int64 indices into ``fragments`` (and ``ids``) in painting order: the array form of
@@ -604,7 +608,9 @@ class _SortItem(NamedTuple):
     high: NDArray
 
 
-def depth_sort(polygons: Sequence[ArrayLike], camera: Camera, ids: ArrayLike | None = None) -> DepthOrder:
+def depth_sort(
+    polygons: Sequence[ArrayLike], camera: Camera, ids: ArrayLike | None = None, *, record: Any = None
+) -> DepthOrder:
     """Painter's algorithm: order `polygons` back to front for `camera`, splitting cyclic overlaps.
 
     The polygons are clipped by the near plane, then mapped to normalized device coordinates, where every
@@ -634,6 +640,10 @@ def depth_sort(polygons: Sequence[ArrayLike], camera: Camera, ids: ArrayLike | N
     camera : Camera
     ids : (len(polygons),) array_like of int, optional
         Labels returned with the fragments; default 0, 1, 2, ….
+    record : callable, optional
+        ``record(event, **values)`` (``frustum.steps``): ``"sorted"`` (the list by z_max), ``"test"`` (which of
+        the tests 1–4 showed that P cannot hide Q), ``"hides"``, ``"move"``, ``"split"``, ``"paint"``,
+        ``"unresolved"``; items are numbered as created (a split's parts get new numbers).
 
     Returns
     -------
@@ -672,7 +682,7 @@ def depth_sort(polygons: Sequence[ArrayLike], camera: Camera, ids: ArrayLike | N
             if inside is None or _polygon_area(inside) <= area_tolerance:
                 continue
         kept.append((inside, int(label), _plane(vertices)))
-    sorter = _DepthSorter(clip_from_world, kept, tolerance)
+    sorter = _DepthSorter(clip_from_world, kept, tolerance, record)
     fragments = sorter.run()
     return DepthOrder(fragments, sorter.split_count, degenerate, clipped, sorter.unresolved_count)
 
@@ -680,7 +690,10 @@ def depth_sort(polygons: Sequence[ArrayLike], camera: Camera, ids: ArrayLike | N
 class _DepthSorter:
     """State of one Newell–Newell–Sancha sort in normalized screen space (see ``depth_sort``)."""
 
-    def __init__(self, clip_from_world: NDArray, kept: list[tuple[Polygon, int, NDArray]], tolerance: float) -> None:
+    def __init__(
+        self, clip_from_world: NDArray, kept: list[tuple[Polygon, int, NDArray]], tolerance: float, record: Any = None
+    ) -> None:
+        self.record = record
         self.clip_from_world = clip_from_world
         self.world_tolerance = tolerance
         self.area_tolerance = tolerance**2
@@ -736,6 +749,10 @@ class _DepthSorter:
         order: list[tuple[Polygon, int]] = [(items[i].world, items[i].label) for i in edge_on]  # paint nothing
         z_max = np.array([self._z_max(i) for i in visible])
         main = [visible[i] for i in np.argsort(z_max, kind="stable")]
+        record = self.record
+        if record is not None:
+            record("sorted", order=list(main[::-1]), edge_on=list(edge_on), polygons=[item.world for item in items],
+                   labels=[item.label for item in items])  # fmt: skip
         moved: list[int] = []
         # the chain of moves since the last paint or split: each polygon hides the next, so meeting a member
         # again closes a cycle
@@ -749,12 +766,18 @@ class _DepthSorter:
                 order.append((items[head].world, items[head].label))
                 (moved if moved else main).pop()
                 chain.clear()
+                if record is not None:
+                    record("paint", item=head, label=items[head].label)
                 continue
             q, pierce = conflict
+            if record is not None:
+                record("hides", p=head, q=q, pierce=pierce)
             if not pierce and q not in chain:  # P hides Q, Q does not hide P: paint Q first
                 chain.extend([head, q] if not chain else [q])
                 (moved if q in moved else main).remove(q)
                 moved.append(q)
+                if record is not None:
+                    record("move", p=head, q=q)
                 continue
             # piercing polygons or a cycle: split Q by P's plane, else P by Q's plane, else one member of the
             # cycle by the plane of another
@@ -765,6 +788,8 @@ class _DepthSorter:
             if self._split_cycle(cycle, moved, main):
                 continue
             self.unresolved_count += 1
+            if record is not None:
+                record("unresolved", item=head)
             order.append((items[head].world, items[head].label))
             (moved if moved else main).pop()
         return order
@@ -788,6 +813,8 @@ class _DepthSorter:
         if len(parts) < 2:
             return False
         new = [self._add(self._item(part, item.label, item.world_plane)) for part in parts]
+        if self.record is not None:
+            self.record("split", victim=victim, by=by, parts=new, polygons=[self.items[i].world for i in new])
         if victim in moved:
             position = moved.index(victim)
             moved[position : position + 1] = new
@@ -827,16 +854,26 @@ class _DepthSorter:
         # depth ranges overlap (Q reaches farther than P's nearest point), then test 1: bounding rectangles
         overlap = (high[:, 2] > p.low[2] + eps) & (low[:, :2] < p.high[:2] - eps).all(axis=1)
         overlap &= (high[:, :2] > p.low[:2] + eps).all(axis=1)
+        record = self.record
+        if record is not None:
+            for k in np.flatnonzero(~overlap):
+                record("test", p=head, q=int(rest[k]), passed=1)
         for k in np.flatnonzero(overlap):
             q = items[int(rest[k])]
             # test 2: P wholly behind Q's plane; test 3: Q wholly in front of P's plane
             if (p.screen @ q.plane[:3] + q.plane[3]).max() <= eps:
+                if record is not None:
+                    record("test", p=head, q=int(rest[k]), passed=2)
                 continue
             if (q.screen @ p.plane[:3] + p.plane[3]).min() >= -eps:
+                if record is not None:
+                    record("test", p=head, q=int(rest[k]), passed=3)
                 continue
             # test 4: the common region of the projections, and the depth difference at its corners
             region = _convex_intersection(p.screen[:, :2], q.screen[:, :2], eps)
             if region is None:
+                if record is not None:
+                    record("test", p=head, q=int(rest[k]), passed=4)
                 continue
             depth_p = -(region @ p.plane[:2] + p.plane[3]) / p.plane[2]
             depth_q = -(region @ q.plane[:2] + q.plane[3]) / q.plane[2]
@@ -844,6 +881,8 @@ class _DepthSorter:
             # a plane's depth carries its on-plane tolerance divided by |C| (steep planes amplify round-off)
             depth_eps = eps * (1.0 / abs(p.plane[2]) + 1.0 / abs(q.plane[2]))
             if difference.min() >= -depth_eps:
+                if record is not None:
+                    record("test", p=head, q=int(rest[k]), passed=4)
                 continue
             return int(rest[k]), bool(difference.max() > depth_eps)
         return None

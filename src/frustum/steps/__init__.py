@@ -16,7 +16,14 @@ from frustum.steps.curves import b_spline_basis, de_casteljau, hermite
 from frustum.steps.fractals import box_counting, koch, midpoint_displacement
 from frustum.steps.modeling import rotation_about_axis
 from frustum.steps.viewing import viewing_pipeline
-from frustum.steps.visible_surfaces import area_subdivision, back_faces, bsp_tree, depth_buffer, scan_line
+from frustum.steps.visible_surfaces import (
+    area_subdivision,
+    back_faces,
+    bsp_tree,
+    depth_buffer,
+    depth_sort,
+    scan_line,
+)
 
 __all__ = [
     "SAVE_FORMATS",
@@ -30,6 +37,7 @@ __all__ = [
     "cohen_sutherland",
     "de_casteljau",
     "depth_buffer",
+    "depth_sort",
     "hermite",
     "koch",
     "liang_barsky",

@@ -25,7 +25,7 @@ from frustum.steps.modeling import HOUSE_POINTS
 from frustum.steps.viewing import _camera
 from frustum.visibility import backface_mask
 
-__all__ = ["HOUSE_FACES", "area_subdivision", "back_faces", "bsp_tree", "depth_buffer", "scan_line"]
+__all__ = ["HOUSE_FACES", "area_subdivision", "back_faces", "bsp_tree", "depth_buffer", "depth_sort", "scan_line"]
 
 # the house's faces (outward, counter-clockwise seen from outside) for back-face detection
 HOUSE_FACES = np.array(
@@ -488,3 +488,119 @@ def scan_line(scene: Scene | None = None, camera: Camera | None = None, **option
             canvas.label((width + 1.0, j + 0.2), f"y = {j}", color="highlight", size=12)
 
     return Steps("Scan-line method", steps, result, paint, (0.0, 0.0, width * 1.15, float(height)))
+
+
+# --- depth sort --------------------------------------------------------------------------------------------
+
+_TESTS = {
+    1: "test 1: their bounding rectangles do not overlap (or Q is wholly nearer)",
+    2: "test 2: P lies wholly behind Q's plane",
+    3: "test 3: Q lies wholly in front of P's plane",
+    4: "test 4: their projections do not overlap, or P is behind Q where they do",
+}
+
+
+def default_depth_sort_scene() -> tuple[NDArray[np.float64], Camera]:
+    """Three long triangles that overlap cyclically (each over the next) and a camera looking down at them."""
+    from frustum.projection import Orthographic
+
+    length, half_width, height = 2.0 * math.sqrt(3.0), 0.45, 0.6
+    base = np.array([[-length, -1.0 - half_width, -height], [-length, -1.0 + half_width, -height],
+                     [length, -1.0, height]])  # fmt: skip
+    turns = []
+    for k in range(3):
+        angle = 2 * math.pi * k / 3
+        rotation = np.array([[math.cos(angle), -math.sin(angle), 0], [math.sin(angle), math.cos(angle), 0], [0, 0, 1]])
+        turns.append(base @ rotation.T)
+    camera = Camera.look_at((0.0, 0.0, 6.0), (0.0, 0.0, 0.0), projection=Orthographic(4.0, 0.1, 20.0), width=64,
+                            height=64)  # fmt: skip
+    return np.array(turns) * 0.6, camera
+
+
+def depth_sort(polygons: ArrayLike | None = None, camera: Camera | None = None) -> Steps:
+    """The depth-sorting (painter's) method: the list by greatest depth, the overlap tests 1–4 of each P against
+    the Q it might hide, moves to the head of the list, splits of cyclic overlaps, then each polygon painted.
+
+    Runs ``frustum.bsp.depth_sort(polygons, camera, record=...)``; ``result`` is its ``DepthOrder``. Default: three
+    triangles that overlap cyclically, which only a split can order.
+    """
+    from frustum.bsp import depth_sort as production
+
+    where = "steps.depth_sort"
+    if polygons is None:
+        polygons, default_camera = default_depth_sort_scene()
+        camera = default_camera if camera is None else camera
+    cam = _camera(camera, where)
+    events: list[tuple[str, dict[str, Any]]] = []
+    result = production(polygons, cam, record=lambda event, **values: events.append((event, values)))
+    shapes: dict[int, NDArray] = {}
+    labels: dict[int, int] = {}
+    steps: list[Step] = []
+    shown: list[tuple[list[int], int | None, int | None]] = []  # painted so far, P, Q
+    painted: list[int] = []
+    tests: list[str] = []
+    for event, values in events:
+        if event == "sorted":
+            shapes.update(enumerate(values["polygons"]))
+            labels.update(enumerate(values["labels"]))
+            steps.append(Step("Sorted by greatest depth",
+                              "The polygons are listed by their farthest point z_max, farthest first. The farthest, "
+                              "P, may be painted unless it hides part of a polygon Q whose depth range overlaps "
+                              "its own: tests 1–4, in order of cost, each show that P cannot hide Q.",
+                              {"list (farthest first)": values["order"]}))  # fmt: skip
+            shown.append(([], None, None))
+        elif event == "test":
+            tests.append(f"P{values['p']}/Q{values['q']}: {values['passed']}")
+        elif event == "hides":
+            p, q = values["p"], values["q"]
+            kind = "their depths cross inside the overlap (they pierce)" if values["pierce"] else "P is behind Q"
+            steps.append(Step(f"P = {p} hides part of Q = {q}",
+                              f"Tests 1–4 all fail for Q = {q}: where their projections overlap, {kind}.",
+                              {"tests passed (P/Q: test)": list(tests)}))  # fmt: skip
+            tests = []
+            shown.append((list(painted), p, q))
+        elif event == "move":
+            steps.append(Step(f"Q = {values['q']} moved to the head of the list",
+                              "Q must be painted before P. Q is marked: meeting it again means a cycle.",
+                              {"P": values["p"], "Q": values["q"]}))  # fmt: skip
+            shown.append((list(painted), values["p"], values["q"]))
+        elif event == "split":
+            for index, polygon in zip(values["parts"], values["polygons"], strict=True):
+                shapes[index] = polygon
+                labels[index] = labels[values["victim"]]
+            steps.append(Step(f"Split {values['victim']} by the plane of {values['by']}",
+                              "A cycle (or two polygons piercing each other) cannot be ordered whole: the polygon is "
+                              "cut by the other's plane and its parts take its place in the list.",
+                              {"new parts": values["parts"]}))  # fmt: skip
+            shown.append((list(painted), values["by"], values["victim"]))
+        elif event in ("paint", "unresolved"):
+            item = values["item"]
+            if event == "paint":
+                painted.append(item)
+            steps.append(Step(f"Paint {item} (polygon {labels.get(item, item)})" if event == "paint"
+                              else f"Unresolved: paint {item} as it is",
+                              "No polygon it could hide is left unpainted before it, so it is painted over what is "
+                              "there (back to front).", {"tests passed (P/Q: test)": list(tests),
+                                                          "painted so far": list(painted)}))  # fmt: skip
+            tests = []
+            shown.append((list(painted), item, None))
+    window = {i: np.asarray(cam.project(np.asarray(poly)))[:, :2] for i, poly in shapes.items()}
+    everything = np.vstack(list(window.values())) if window else np.zeros((1, 2))
+    colors = {label: _triangle_color(label + 3) for label in set(labels.values())}
+
+    def paint(index: int, canvas: _Canvas) -> None:
+        done, p, q = shown[index]
+        for i in shapes:
+            if i in window:
+                canvas.polyline(window[i], color="faint", closed=True, width=0.8)
+        for n, i in enumerate(done):
+            canvas.polyline(window[i], color="ink", closed=True, fill=colors[labels[i]], opacity=1.0, width=0.8)
+            canvas.label(window[i].mean(axis=0), str(n + 1), color="ink", size=11)
+        if p is not None:
+            canvas.polyline(window[p], color="highlight", closed=True, width=3.0)
+            canvas.label(window[p][0], f"P {p}", color="highlight", size=12)
+        if q is not None:
+            canvas.polyline(window[q], color="blue", closed=True, width=3.0, dash=True)
+            canvas.label(window[q][-1], f"Q {q}", color="blue", size=12)
+
+    return Steps("Depth sort (painter's algorithm)", steps, result, paint, bounds_of(everything, pad=0.1))
