@@ -482,3 +482,19 @@ def test_depth_sort_worked_example_splits_the_cycle():
     assert titles[0] == "Sorted by greatest depth"
     assert sum(t.startswith("Split") for t in titles) == recorded.result.split_count == 1
     assert sum(t.startswith("Paint") for t in titles) == 4  # three triangles, one cut in two
+
+
+def test_a_buffer_steps_show_the_pixels_fragments_and_end_in_the_render():
+    scene, camera = fs.visible_surfaces.default_transparent_scene()
+    recorded = fs.a_buffer(scene, camera)
+    frame = frustum.render(scene, camera, method="a-buffer")
+    assert np.array_equal(recorded.result.color, frame.color)
+    count = recorded[0].values["fragments"]
+    assert count == frame.stats["max_fragments"]  # the default pixel is the one with the most fragments
+    assert len(recorded) == count + 2
+    x, y = (int(v) for v in recorded[0].title.split("(")[1].split(")")[0].split(", "))
+    assert np.array_equal(recorded[-1].values["color (RGBA bytes)"], frame.color[camera.height - 1 - y, x])
+    for step in recorded[1:-1]:
+        assert step.values["covered"] == step.values["mask (rows top to bottom)"].count("1")
+    with pytest.raises(OutputError, match=r"pixel = \(64, 0\) lies outside the 64x48 image"):
+        fs.a_buffer(scene, camera, pixel=(64, 0))

@@ -17,6 +17,7 @@ from frustum.steps.fractals import box_counting, koch, midpoint_displacement
 from frustum.steps.modeling import rotation_about_axis
 from frustum.steps.viewing import viewing_pipeline
 from frustum.steps.visible_surfaces import (
+    a_buffer,
     area_subdivision,
     back_faces,
     bsp_tree,
@@ -29,6 +30,7 @@ __all__ = [
     "SAVE_FORMATS",
     "Step",
     "Steps",
+    "a_buffer",
     "area_subdivision",
     "b_spline_basis",
     "back_faces",

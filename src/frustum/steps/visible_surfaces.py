@@ -25,7 +25,16 @@ from frustum.steps.modeling import HOUSE_POINTS
 from frustum.steps.viewing import _camera
 from frustum.visibility import backface_mask
 
-__all__ = ["HOUSE_FACES", "area_subdivision", "back_faces", "bsp_tree", "depth_buffer", "depth_sort", "scan_line"]
+__all__ = [
+    "HOUSE_FACES",
+    "a_buffer",
+    "area_subdivision",
+    "back_faces",
+    "bsp_tree",
+    "depth_buffer",
+    "depth_sort",
+    "scan_line",
+]
 
 # the house's faces (outward, counter-clockwise seen from outside) for back-face detection
 HOUSE_FACES = np.array(
@@ -604,3 +613,114 @@ def depth_sort(polygons: ArrayLike | None = None, camera: Camera | None = None) 
             canvas.label(window[q][-1], f"Q {q}", color="blue", size=12)
 
     return Steps("Depth sort (painter's algorithm)", steps, result, paint, bounds_of(everything, pad=0.1))
+
+
+# --- A-buffer ----------------------------------------------------------------------------------------------
+
+
+def default_transparent_scene() -> tuple[Scene, Camera]:
+    """The depth-buffer scene with a half-transparent sphere and pillar: the A-buffer example of the chapter."""
+    from frustum.shading import Material
+
+    scene, camera = default_scene()
+    for node, opacity in zip(scene.root.children, (1.0, 0.5, 0.6), strict=True):
+        node.material = Material(color=node.material.color, opacity=opacity)
+    return scene, camera
+
+
+def _mask_cells(mask: int) -> list[tuple[int, int]]:
+    """The covered subsamples (column a, row b from the bottom) of a 16-bit coverage mask (bit 4·b + a)."""
+    return [(a, b) for b in range(4) for a in range(4) if mask >> (4 * b + a) & 1]
+
+
+def a_buffer(
+    scene: Scene | None = None, camera: Camera | None = None, pixel: tuple[int, int] | None = None, **options: Any
+) -> Steps:
+    """One pixel of the A-buffer: its fragment list (each fragment's 4×4 coverage mask, depth and color), then the
+    resolved color.
+
+    Runs ``render(scene, camera, method="a-buffer", **options)`` with the A-buffer's recording mode on
+    (``visibility.abuffer.recording``: the fragment lists as resolved); ``result`` is that frame, byte for byte
+    the frame without recording. `pixel` is ``(x, y)`` in window coordinates (y up from the bottom); by default
+    the pixel with the most fragments.
+    """
+    from frustum.render import render
+    from frustum.visibility.abuffer import recording
+
+    where = "steps.a_buffer"
+    if scene is None:
+        scene, default_camera = default_transparent_scene()
+        camera = default_camera if camera is None else camera
+    if not isinstance(scene, Scene):
+        raise FrustumError(f"{where}: scene = {scene!r} is not a Scene")
+    cam = _camera(camera, where)
+    with recording() as logs:
+        frame = render(scene, cam, method="a-buffer", **options)
+    result = frame
+    if not logs:
+        raise GeometryError(f"{where}: the A-buffer resolved no fragments; the scene shows no surface")
+    fragments, premultiplied = logs[0]["fragments"], logs[0]["premultiplied"]
+    starts = fragments.starts
+    width, height = cam.width, cam.height
+    if pixel is None:
+        index = int(np.argmax(np.diff(starts)))
+        x, y = index % width, height - 1 - index // width
+    else:
+        x, y = (int(v) for v in pixel)
+        if not (0 <= x < width and 0 <= y < height):
+            raise OutputError(f"{where}: pixel = {pixel!r} lies outside the {width}x{height} image; give 0 <= x < "
+                              f"{width}, 0 <= y < {height}")  # fmt: skip
+        index = (height - 1 - y) * width + x
+    first, last = int(starts[index]), int(starts[index + 1])
+    entries = []
+    for k in range(first, last):
+        rgba = premultiplied[k].astype(float) / 255.0
+        alpha = float(rgba[3])
+        entries.append({"triangle": int(fragments.triangle[k]), "mask": int(fragments.mask[k]),
+                        "depth": float(fragments.depth[k, 0]), "alpha": alpha,
+                        "color": rgba[:3] / alpha if alpha > 0 else rgba[:3]})  # fmt: skip
+    steps = [Step(f"Pixel ({x}, {y}): {len(entries)} fragments",
+                  "The A-buffer keeps, per pixel, a list of fragments: each surface touching the pixel leaves its "
+                  "coverage of the pixel's 4×4 subsamples (a 16-bit mask), its depth and its color with opacity α.",
+                  {"fragments": len(entries)})]  # fmt: skip
+    for n, entry in enumerate(entries):
+        bits = format(entry["mask"], "016b")
+        steps.append(Step(f"Fragment {n + 1}: triangle {entry['triangle']}",
+                          "Its coverage mask marks the subsamples the triangle covers (top-left rule at each); "
+                          "shading was done once, at their centroid.",
+                          {"mask (rows top to bottom)": " ".join(bits[i : i + 4][::-1] for i in range(0, 16, 4)),
+                           "covered": bin(entry["mask"]).count("1"), "depth": entry["depth"],
+                           "alpha": entry["alpha"]}))  # fmt: skip
+    final = np.asarray(frame.color)[height - 1 - y, x]
+    steps.append(Step("Resolved pixel",
+                      "Per subsample, the fragments covering it are composited front to back by their plane's depth "
+                      "there, C = Σ T_k·α_k·c_k + T·background with T_k = Π(1 − α_m) over the nearer ones; the "
+                      "pixel is the mean of its 16 subsamples.", {"color (RGBA bytes)": final}))  # fmt: skip
+    picture = np.asarray(frame.color)[:, :, :3]
+    zoom = max(1, 160 // max(width, 1))
+    big = np.repeat(np.repeat(picture, zoom, axis=0), zoom, axis=1)
+    # the image on the left (width units), the pixel's 4×4 grid on the right, in a box of side `side`
+    side = float(height)
+    grid_x0 = width * 1.15
+
+    def paint(index_: int, canvas: _Canvas) -> None:
+        canvas.image(big, (0.0, height), (width, 0.0))
+        canvas.rect((x, y), (x + 1, y + 1), color="highlight", width=2.0)
+        cell = side / 4.0
+        shown = entries if index_ == len(steps) - 1 else entries[max(0, index_ - 1) : index_]
+        if index_ == len(steps) - 1:
+            r, g, b = (int(v) for v in final[:3])
+            canvas.rect((grid_x0, 0.0), (grid_x0 + side, side), color="ink", fill=f"#{r:02x}{g:02x}{b:02x}")
+        for entry in shown[::-1]:  # the nearest last (on top)
+            r, g, b = (int(np.clip(v, 0.0, 1.0) * 255) for v in entry["color"])
+            for a, b_row in _mask_cells(entry["mask"]):
+                canvas.rect((grid_x0 + a * cell, b_row * cell), (grid_x0 + (a + 1) * cell, (b_row + 1) * cell),
+                            color="ink", fill=f"#{r:02x}{g:02x}{b:02x}",
+                            opacity=0.5 if index_ == len(steps) - 1 else max(entry["alpha"], 0.25),
+                            width=0.5)  # fmt: skip
+        for k in range(5):
+            canvas.line((grid_x0 + k * cell, 0.0), (grid_x0 + k * cell, side), color="faint", width=0.8)
+            canvas.line((grid_x0, k * cell), (grid_x0 + side, k * cell), color="faint", width=0.8)
+        canvas.label((grid_x0, side * 1.03), f"pixel ({x}, {y}): 4×4 subsamples", size=12)
+
+    return Steps("A-buffer", steps, result, paint, (0.0, 0.0, grid_x0 + side, side * 1.08))

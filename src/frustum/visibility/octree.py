@@ -131,5 +131,3 @@ def render_octree(
     faces = octree_face_colors(octree, material, lights, matrix, camera.frame.eye)
     draw_octree_into(octree, camera, matrix, faces, color, depth, written)
     return Frame(color=color, depth=depth)
-
-
