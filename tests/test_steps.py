@@ -498,3 +498,22 @@ def test_a_buffer_steps_show_the_pixels_fragments_and_end_in_the_render():
         assert step.values["covered"] == step.values["mask (rows top to bottom)"].count("1")
     with pytest.raises(OutputError, match=r"pixel = \(64, 0\) lies outside the 64x48 image"):
         fs.a_buffer(scene, camera, pixel=(64, 0))
+
+
+@pytest.mark.parametrize("pixel", [(32, 24), (5, 5), (20, 30)])
+def test_ray_casting_steps_follow_one_ray_and_end_in_the_render(pixel):
+    scene, camera = fs.visible_surfaces.default_scene()
+    recorded = fs.ray_casting(scene, camera, pixel=pixel)
+    frame = frustum.render(scene, camera, method="ray-casting")
+    assert np.array_equal(recorded.result.color, frame.color)
+    assert np.array_equal(recorded.result.depth, frame.depth)
+    titles = [s.title for s in recorded]
+    hits = [t for t in titles if t.startswith("Nearest hit")]
+    x, y = pixel
+    assert bool(hits) == bool(frame.depth[camera.height - 1 - y, x] < 1.0)
+    entered = [t for t in titles if t.startswith("Enter")]
+    if entered:
+        assert entered[0] == "Enter node 0 (level 0)"  # every ray starts at the root
+    # each new nearest hit is nearer than the one before
+    distances = [s.values["t"] for s in recorded if s.title.startswith("Nearest hit")]
+    assert distances == sorted(distances, reverse=True)

@@ -23,6 +23,7 @@ from frustum.steps.visible_surfaces import (
     bsp_tree,
     depth_buffer,
     depth_sort,
+    ray_casting,
     scan_line,
 )
 
@@ -44,6 +45,7 @@ __all__ = [
     "koch",
     "liang_barsky",
     "midpoint_displacement",
+    "ray_casting",
     "rotation_about_axis",
     "scan_line",
     "sutherland_hodgman",

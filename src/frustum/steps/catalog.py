@@ -95,6 +95,8 @@ ALGORITHMS: dict[str, tuple[str, Callable[[Options], Steps]]] = {
                    lambda o: visible_surfaces.depth_sort()),
     "a-buffer": ("A-buffer: one pixel's fragment list with coverage masks, then the resolved color (SCENE.toml, "
                  "--size)", lambda o: visible_surfaces.a_buffer(o.get("scene"), o.get("camera"))),
+    "ray-casting": ("ray casting: one pixel's ray through the bounding-volume hierarchy (SCENE.toml, --size)",
+                    lambda o: visible_surfaces.ray_casting(o.get("scene"), o.get("camera"))),
     "bsp": ("BSP tree: the splits while building, then the back-to-front order from the eye",
             lambda o: visible_surfaces.bsp_tree()),
     "cohen-sutherland": ("Cohen–Sutherland 3D line clipping: region codes, accept/reject, intersections "

@@ -724,3 +724,100 @@ def a_buffer(
         canvas.label((grid_x0, side * 1.03), f"pixel ({x}, {y}): 4×4 subsamples", size=12)
 
     return Steps("A-buffer", steps, result, paint, (0.0, 0.0, grid_x0 + side, side * 1.08))
+
+
+# --- ray casting -------------------------------------------------------------------------------------------
+
+
+def ray_casting(
+    scene: Scene | None = None, camera: Camera | None = None, pixel: tuple[int, int] | None = None, **options: Any
+) -> Steps:
+    """One pixel's ray through the scene's bounding-volume hierarchy: each node entered (nearer child first), each
+    ray–triangle test in the leaves, each new nearest hit, the nodes skipped because they lie beyond it.
+
+    Runs ``render(scene, camera, method="ray-casting", **options)`` with the kernel's recording mode on for that
+    pixel (``visibility.raycast.recording``); ``result`` is that frame, byte for byte the frame without recording.
+    `pixel` is ``(x, y)`` in window coordinates (y up); by default the image centre.
+    """
+    from frustum.raster.bvh import LOG_EVENTS
+    from frustum.render import render
+    from frustum.visibility.raycast import recording
+
+    where = "steps.ray_casting"
+    if scene is None:
+        scene, default_camera = default_scene()
+        camera = default_camera if camera is None else camera
+    if not isinstance(scene, Scene):
+        raise FrustumError(f"{where}: scene = {scene!r} is not a Scene")
+    cam = _camera(camera, where)
+    width, height = cam.width, cam.height
+    x, y = (width // 2, height // 2) if pixel is None else (int(v) for v in pixel)
+    if not (0 <= x < width and 0 <= y < height):
+        raise OutputError(f"{where}: pixel = {pixel!r} lies outside the {width}x{height} image; give 0 <= x < "
+                          f"{width}, 0 <= y < {height}")  # fmt: skip
+    with recording((x, y)) as logs:
+        frame = render(scene, cam, method="ray-casting", **options)
+    result = frame
+    if not logs:
+        raise GeometryError(f"{where}: the scene has no triangles to cast rays at")
+    log, lo, hi = logs[0]["log"], logs[0]["lo"], logs[0]["hi"]
+    leaves = (lo.shape[0] + 1) // 2
+    steps = [Step(f"The ray through pixel ({x}, {y})",
+                  "From the pixel centre on the near plane toward the far plane. Instead of testing every surface, "
+                  "the ray descends the bounding-volume hierarchy: a box it misses hides nothing, and the nearer "
+                  "child is entered first so that a hit found early lets farther boxes be skipped.",
+                  {"nodes": lo.shape[0], "leaves": leaves})]  # fmt: skip
+    shown: list[tuple[int, int]] = [(-1, -1)]
+    for kind, node, t, face in log.tolist():
+        event, node, face = LOG_EVENTS[int(kind)], int(node), int(face)
+        level = (node + 1).bit_length() - 1
+        if event == "visit":
+            what = "leaf" if node >= leaves - 1 else "node"
+            steps.append(Step(f"Enter {what} {node} (level {level})",
+                              "The ray enters its box at parameter t (slab test); " + (
+                                  "its triangles are tested." if what == "leaf"
+                                  else "both children's boxes are tested, the nearer is entered first."),
+                              {"entry t": t}))  # fmt: skip
+        elif event == "skip":
+            steps.append(Step(f"Skip node {node}", "Its box begins beyond the nearest hit found so far: nothing in it "
+                              "can be nearer.", {"entry t": t}))  # fmt: skip
+        elif event == "test":
+            steps.append(Step(f"Test triangle {face}", "Möller–Trumbore: the ray meets the triangle at t"
+                              + (" (a hit)" if math.isfinite(t) else " — it misses"), {"t": t}))  # fmt: skip
+        else:
+            steps.append(Step(f"Nearest hit so far: triangle {face}", "It is nearer than every hit before; boxes "
+                              "entered beyond it will be skipped.", {"t": t}))  # fmt: skip
+        shown.append((node, face))
+    hit = frame.depth[height - 1 - y, x] < 1.0
+    steps.append(Step("The pixel's surface", "The nearest hit is the visible surface: its depth, face and "
+                      "barycentrics are shaded as the depth buffer's." if hit else "The ray meets no surface: "
+                      "the pixel keeps the background.", {"depth": float(frame.depth[height - 1 - y, x])}))  # fmt: skip
+    shown.append((-1, -1))
+    # the boxes drawn on the image: each node's eight corners projected, their bounding rectangle
+    corners = np.array([[i & 1, (i >> 1) & 1, (i >> 2) & 1] for i in range(8)], dtype=float)
+    rectangles: dict[int, tuple[float, float, float, float]] = {}
+    for node in {int(n) for n in log[:, 1].tolist()}:
+        if lo[node, 0] > hi[node, 0]:
+            continue
+        box = lo[node] + corners * (hi[node] - lo[node])
+        window = np.asarray(cam.project(box))[:, :2]
+        if np.isfinite(window).all():
+            rectangles[node] = (*window.min(axis=0), *window.max(axis=0))
+    picture = np.asarray(frame.color)[:, :, :3]
+    zoom = max(1, 256 // max(width, 1))
+    big = np.repeat(np.repeat(picture, zoom, axis=0), zoom, axis=1)
+
+    def paint(index: int, canvas: _Canvas) -> None:
+        canvas.image(big, (0.0, height), (width, 0.0))
+        node, _face = shown[index]
+        visited = {int(n) for kind, n, _t, _f in log[: max(0, index - 1)].tolist() if kind == 0.0}
+        for n in visited:
+            if n in rectangles:
+                x0, y0, x1, y1 = rectangles[n]
+                canvas.rect((x0, y0), (x1, y1), color="faint", width=0.6)
+        if node in rectangles:
+            x0, y0, x1, y1 = rectangles[node]
+            canvas.rect((x0, y0), (x1, y1), color="highlight", width=2.0)
+        canvas.rect((x, y), (x + 1, y + 1), color="blue", fill="blue", width=1.0)
+
+    return Steps("Ray casting through a BVH", steps, result, paint, (0.0, 0.0, float(width), float(height)))

@@ -21,12 +21,34 @@ References
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
+from collections.abc import Iterator
+
 import numpy as np
 
 from frustum.camera import Camera
 from frustum.scene import Scene
 
-__all__ = ["ray_casting"]
+__all__ = ["ray_casting", "recording"]
+
+_RECORDING: contextvars.ContextVar[tuple[tuple[int, int], list[dict]] | None] = contextvars.ContextVar(
+    "ray_casting_log", default=None
+)
+_LOG_ROWS = 1 << 16
+
+
+@contextlib.contextmanager
+def recording(pixel: tuple[int, int]) -> Iterator[list[dict]]:
+    """Recording mode (``frustum.steps``): every ``ray_casting`` inside the block appends to the list the
+    traversal of the ray through window pixel ``(i, j)`` (y up): ``log`` (L, 4) rows ``(kind, node, t, face)``
+    (``raster.bvh.LOG_EVENTS``), the hierarchy's ``lo``/``hi`` boxes and the ray's ``items`` and ``starts``."""
+    logs: list[dict] = []
+    token = _RECORDING.set(((int(pixel[0]), int(pixel[1])), logs))
+    try:
+        yield logs
+    finally:
+        _RECORDING.reset(token)
 
 
 def ray_casting(
@@ -70,8 +92,13 @@ def ray_casting(
     skip = np.repeat(clear, np.diff(starts)).astype(np.uint8) if clear.any() else np.empty(0, dtype=np.uint8)
     window_from_world = np.ascontiguousarray(camera.viewport_matrix @ camera.clip_from_world, dtype=np.float64)
     world_from_window = np.ascontiguousarray(camera.world_from_window, dtype=np.float64)
+    recorder = _RECORDING.get()
+    log = np.full((_LOG_ROWS if recorder is not None else 0, 4), np.nan)
+    log_pixel = np.array(recorder[0] if recorder is not None else (-1, -1), dtype=np.int64)
     bvh.cast_pixels(index.lo, index.hi, index.triangles, index.order, skip, world_from_window, window_from_world,
-                    int(cull), depth, codes, bary, stats)  # fmt: skip
+                    int(cull), depth, codes, bary, stats, log, log_pixel)  # fmt: skip
+    if recorder is not None:
+        recorder[1].append({"log": log[~np.isnan(log[:, 0])], "lo": index.lo, "hi": index.hi, "order": index.order})
     totals = stats.sum(axis=0)
     result = {name: int(value) for name, value in zip(bvh.CAST_STATS, totals, strict=True)}
     result["tests_per_ray"] = round(result["triangle_tests"] / max(1, result["rays"]), 3)
