@@ -517,3 +517,18 @@ def test_ray_casting_steps_follow_one_ray_and_end_in_the_render(pixel):
     # each new nearest hit is nearer than the one before
     distances = [s.values["t"] for s in recorded if s.title.startswith("Nearest hit")]
     assert distances == sorted(distances, reverse=True)
+
+
+def test_octree_steps_show_levels_then_the_traversal_and_end_in_the_render():
+    from frustum.visibility.octree import render_octree
+
+    tree, camera = fs.visible_surfaces.default_octree()
+    recorded = fs.octree(tree, camera)
+    frame = render_octree(tree, camera)
+    assert np.array_equal(recorded.result.color, frame.color)
+    assert np.array_equal(recorded.result.depth, frame.depth)
+    levels = [s for s in recorded if s.title.startswith("Subdivision")]
+    assert [s.values["full cells"] for s in levels] == [len(codes) for codes in tree.full]
+    visits = [s for s in recorded if s.title.startswith("Visit")]
+    assert visits[0].title.startswith("Visit 1: level 0")  # the root first
+    assert sum(s.values["pixels written"] for s in visits) == np.count_nonzero(frame.depth < 1.0)

@@ -23,6 +23,7 @@ from frustum.steps.visible_surfaces import (
     bsp_tree,
     depth_buffer,
     depth_sort,
+    octree,
     ray_casting,
     scan_line,
 )
@@ -45,6 +46,7 @@ __all__ = [
     "koch",
     "liang_barsky",
     "midpoint_displacement",
+    "octree",
     "ray_casting",
     "rotation_about_axis",
     "scan_line",

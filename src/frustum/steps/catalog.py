@@ -97,6 +97,8 @@ ALGORITHMS: dict[str, tuple[str, Callable[[Options], Steps]]] = {
                  "--size)", lambda o: visible_surfaces.a_buffer(o.get("scene"), o.get("camera"))),
     "ray-casting": ("ray casting: one pixel's ray through the bounding-volume hierarchy (SCENE.toml, --size)",
                     lambda o: visible_surfaces.ray_casting(o.get("scene"), o.get("camera"))),
+    "octree": ("octree method: the subdivision by level, then the front-to-back traversal of a ball's octree",
+               lambda o: visible_surfaces.octree()),
     "bsp": ("BSP tree: the splits while building, then the back-to-front order from the eye",
             lambda o: visible_surfaces.bsp_tree()),
     "cohen-sutherland": ("Cohen–Sutherland 3D line clipping: region codes, accept/reject, intersections "
