@@ -500,21 +500,34 @@ def test_a_buffer_steps_show_the_pixels_fragments_and_end_in_the_render():
         fs.a_buffer(scene, camera, pixel=(64, 0))
 
 
-@pytest.mark.parametrize("pixel", [(32, 24), (5, 5), (20, 30)])
+@pytest.mark.parametrize("pixel", [(32, 24), (5, 5), (20, 30), (40, 22)])
 def test_ray_casting_steps_follow_one_ray_and_end_in_the_render(pixel):
+    from frustum.raster import rays
+
     scene, camera = fs.visible_surfaces.default_scene()
     recorded = fs.ray_casting(scene, camera, pixel=pixel)
     frame = frustum.render(scene, camera, method="ray-casting")
     assert np.array_equal(recorded.result.color, frame.color)
     assert np.array_equal(recorded.result.depth, frame.depth)
-    titles = [s.title for s in recorded]
-    hits = [t for t in titles if t.startswith("Nearest hit")]
+    # the traced Python twin returns what the compiled kernel returns for this ray
+    _items, index, _starts = scene._triangle_index()
+    ray = fs.visible_surfaces._pixel_ray(camera, *pixel)
+    twin, events = fs.visible_surfaces.traced_closest(index, np.empty(0, np.uint8), ray, 1)
+    stack, entry = np.empty(index.depth + 2, dtype=np.int64), np.empty(index.depth + 2)
+    compiled = rays._closest(index.boxes, index.links, index.triangles, index.order, np.empty(0, np.uint8), *ray,
+                             0.0, 1.0, 1, stack, entry)  # fmt: skip
+    assert tuple(twin) == tuple(compiled)
+    assert sum(e[0] == "test" for e in events) == compiled[7]  # its triangle tests, counted by the kernel
+    assert sum(e[0] in ("node", "leaf") for e in events) == compiled[6]  # its nodes visited
     x, y = pixel
-    assert bool(hits) == bool(frame.depth[camera.height - 1 - y, x] < 1.0)
-    entered = [t for t in titles if t.startswith("Enter")]
-    if entered:
-        assert entered[0] == "Enter node 0 (level 0)"  # every ray starts at the root
-    # each new nearest hit is nearer than the one before
+    hit = frame.depth[camera.height - 1 - y, x] < 1.0
+    assert (compiled[1] >= 0) == hit
+    if hit:  # the window depth of the traced hit is the frame's
+        t = twin[0]
+        point = np.array(ray[:3]) + t * np.array(ray[3:])
+        w = np.asarray(camera.viewport_matrix @ camera.clip_from_world)
+        z = np.float32((w[2, :3] @ point + w[2, 3]) / (w[3, :3] @ point + w[3, 3]))
+        assert z == frame.depth[camera.height - 1 - y, x]
     distances = [s.values["t"] for s in recorded if s.title.startswith("Nearest hit")]
     assert distances == sorted(distances, reverse=True)
 

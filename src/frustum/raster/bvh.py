@@ -17,7 +17,7 @@ import numpy as np
 
 from frustum.raster._jit import kernel, parallel_kernel
 
-__all__ = ["CAST_STATS", "LEAF_SIZE", "LOG_EVENTS", "Hierarchy", "build", "cast_pixels", "first_hits"]
+__all__ = ["CAST_STATS", "LEAF_SIZE", "Hierarchy", "build", "cast_pixels", "first_hits"]
 
 LEAF_SIZE = 4
 
@@ -107,23 +107,8 @@ def _box_entry(lo, hi, node, ox, oy, oz, ix, iy, iz, t_max):
     return t0
 
 
-LOG_EVENTS = ("visit", "skip", "test", "hit")
-"""Recording mode: the kinds of ``_cast_ray``'s log rows ``(kind, node, t, face)``: a node entered (t its box
-entry), a node popped but farther than the best hit (skipped), a ray–triangle test (t the hit, inf for a miss),
-a new nearest hit."""
-
-
 @kernel
-def _log(log, logged, kind, node, t, face):
-    """Row `logged` of the recording mode's log, if there is room; returns the next row."""
-    if logged < log.shape[0]:
-        log[logged, 0], log[logged, 1], log[logged, 2], log[logged, 3] = kind, node, t, face
-        return logged + 1
-    return logged
-
-
-@kernel
-def _cast_ray(lo, hi, triangles, order, skip, ox, oy, oz, dx, dy, dz, t_max, cull, log):
+def _cast_ray(lo, hi, triangles, order, skip, ox, oy, oz, dx, dy, dz, t_max, cull):
     """First hit of one ray: ``(t, face, u, v, back, box_tests, nodes, tests)``.
 
     The nearest t in [0, t_max) over the triangles (ties: the lower triangle index), skipping those with
@@ -132,12 +117,9 @@ def _cast_ray(lo, hi, triangles, order, skip, ox, oy, oz, dx, dy, dz, t_max, cul
     u, v are the weights of corners 1 and 2 at the hit (world barycentrics: perspective-correct), back = 1 for a
     back face; inf, −1 for a miss. The counts: box (slab) tests, nodes visited (popped and still nearer than the
     best hit so far), ray–triangle tests. A node is entered nearer child first; a node whose box entry is
-    beyond the best hit found since it was pushed is not visited. Recording mode: `log` (L, 4) float64 gets the
-    traversal's events (``LOG_EVENTS``) while rows are left; (0, 4) records nothing.
+    beyond the best hit found since it was pushed is not visited.
     """
     leaves = (lo.shape[0] + 1) // 2
-    recording = log.shape[0] > 0
-    logged = 0
     ix = 1.0 / dx if dx != 0.0 else np.inf
     iy = 1.0 / dy if dy != 0.0 else np.inf
     iz = 1.0 / dz if dz != 0.0 else np.inf
@@ -158,12 +140,8 @@ def _cast_ray(lo, hi, triangles, order, skip, ox, oy, oz, dx, dy, dz, t_max, cul
         top -= 1
         node = stack[top]
         if entry[top] > best:
-            if recording:
-                logged = _log(log, logged, 1.0, node, entry[top], -1.0)
             continue
         nodes += 1
-        if recording:
-            logged = _log(log, logged, 0.0, node, entry[top], -1.0)
         if node >= leaves - 1:
             first = (node - (leaves - 1)) * 4
             for row in range(first, first + 4):
@@ -177,30 +155,20 @@ def _cast_ray(lo, hi, triangles, order, skip, ox, oy, oz, dx, dy, dz, t_max, cul
                 px, py, pz = dy * e2z - dz * e2y, dz * e2x - dx * e2z, dx * e2y - dy * e2x
                 det = e1x * px + e1y * py + e1z * pz
                 if det == 0.0 or (cull != 0 and det < 0.0):
-                    if recording:
-                        logged = _log(log, logged, 2.0, node, np.inf, face)
                     continue
                 inv = 1.0 / det
                 sx, sy, sz = ox - ax, oy - ay, oz - az
                 u = (sx * px + sy * py + sz * pz) * inv
                 if u < 0.0 or u > 1.0:
-                    if recording:
-                        logged = _log(log, logged, 2.0, node, np.inf, face)
                     continue
                 qx, qy, qz = sy * e1z - sz * e1y, sz * e1x - sx * e1z, sx * e1y - sy * e1x
                 v = (dx * qx + dy * qy + dz * qz) * inv
                 if v < 0.0 or u + v > 1.0:
-                    if recording:
-                        logged = _log(log, logged, 2.0, node, np.inf, face)
                     continue
                 t = (e2x * qx + e2y * qy + e2z * qz) * inv
-                if recording:
-                    logged = _log(log, logged, 2.0, node, t, face)
                 if t >= 0.0 and (t < best or (t == best and face < best_face)):
                     best, best_face, best_u, best_v = t, face, u, v
                     best_back = 1 if det < 0.0 else 0
-                    if recording:
-                        logged = _log(log, logged, 3.0, node, t, face)
             continue
         left, right = 2 * node + 1, 2 * node + 2
         t_left = _box_entry(lo, hi, left, ox, oy, oz, ix, iy, iz, best)
@@ -225,8 +193,7 @@ def _cast_ray(lo, hi, triangles, order, skip, ox, oy, oz, dx, dy, dz, t_max, cul
 @kernel
 def _trace_ray(lo, hi, triangles, order, ox, oy, oz, dx, dy, dz):
     """(t, face): nearest t >= 0 over all triangles (inf, −1 if none) of one ray."""
-    hit = _cast_ray(lo, hi, triangles, order, np.empty(0, dtype=np.uint8), ox, oy, oz, dx, dy, dz, np.inf, 0,
-                    np.empty((0, 4)))  # fmt: skip
+    hit = _cast_ray(lo, hi, triangles, order, np.empty(0, dtype=np.uint8), ox, oy, oz, dx, dy, dz, np.inf, 0)
     return hit[0], hit[1]
 
 
@@ -264,7 +231,7 @@ CAST_STATS = ("rays", "hits", "box_tests", "nodes_visited", "triangle_tests")
 @parallel_kernel(lambda lo, hi, triangles, order, skip, world_from_window, window_from_world, cull, depth, *_:
                  depth.shape[0], work=lambda *args: args[8].size, grain=4096)  # fmt: skip
 def cast_pixels(lo, hi, triangles, order, skip, world_from_window, window_from_world, cull, depth, codes, bary,
-                stats, log, log_pixel, start, stop):  # fmt: skip
+                stats, start, stop):  # fmt: skip
     """A ray through the centre of every pixel of window rows [start, stop) (y up); the first hit's window depth,
     face code and barycentrics, as the depth buffer writes them.
 
@@ -276,11 +243,8 @@ def cast_pixels(lo, hi, triangles, order, skip, world_from_window, window_from_w
     depth that rounds to 1 is not written (the depth buffer's test "less" against its clear value). ``stats``
     (H, len(CAST_STATS)) int64 receives each row's counts. `cull` != 0 skips back faces (the ray goes on to
     what lies behind them, as the depth buffer never draws them); `skip` (F,) uint8 marks triangles not drawn.
-    Recording mode: the ray of pixel ``log_pixel`` (2,) int64 ``(i, j)`` logs its traversal into `log` (L, 4)
-    (``_cast_ray``); ``(−1, −1)`` and a (0, 4) log record nothing.
     """
     height, width = depth.shape[0], depth.shape[1]
-    no_log = np.empty((0, 4))
     m = world_from_window
     for j in range(start, stop):
         row = height - 1 - j
@@ -296,9 +260,8 @@ def cast_pixels(lo, hi, triangles, order, skip, world_from_window, window_from_w
             dx = (m[0, 0] * x + m[0, 1] * y + m[0, 2] + m[0, 3]) / fw - ox
             dy = (m[1, 0] * x + m[1, 1] * y + m[1, 2] + m[1, 3]) / fw - oy
             dz = (m[2, 0] * x + m[2, 1] * y + m[2, 2] + m[2, 3]) / fw - oz
-            logged = log if (i == log_pixel[0] and j == log_pixel[1]) else no_log
             t, face, u, v, back, b, n, k = _cast_ray(lo, hi, triangles, order, skip, ox, oy, oz, dx, dy, dz, 1.0,
-                                                     cull, logged)  # fmt: skip
+                                                     cull)  # fmt: skip
             rays += 1
             box_tests += b
             nodes += n

@@ -14,6 +14,7 @@ from numpy.typing import ArrayLike, NDArray
 from frustum._arrays import as_scalar
 from frustum.errors import GeometryError
 from frustum.geometry import curves
+from frustum.geometry.curves import _validation, bezier
 from frustum.steps._draw import bounds_of
 from frustum.steps._record import Step, Steps, _Canvas, format_value
 
@@ -37,7 +38,7 @@ def de_casteljau(control_points: ArrayLike, t: float = 0.5) -> Steps:
         raise GeometryError(f"{where}: t = {s!r} lies outside [0.0, 1.0]; give 0 <= t <= 1")
     points = curve.control_points
     levels: list[NDArray] = [points]
-    left, right = curves._split_batch(points[None], s, record=lambda level: levels.append(level[0].copy()))
+    left, right = bezier._split_batch(points[None], s, record=lambda level: levels.append(level[0].copy()))
     point = levels[-1][0]
     result = (point, (left[0], right[0]))
     steps = [Step(
@@ -93,8 +94,8 @@ def b_spline_basis(knots: ArrayLike, order: int, u: float | None = None, samples
     `order` functions non-zero there are shown.
     """
     where = "steps.b_spline_basis"
-    x = curves._as_knot_vector(knots, "knots", where=where)
-    k_max = curves._as_degree(order, where=where, name="order")
+    x = _validation._as_knot_vector(knots, "knots", where=where)
+    k_max = _validation._as_degree(order, where=where, name="order")
     count = x.size - k_max
     if count < 1:
         raise GeometryError(f"{where}: {x.size} knots leave no basis function of order {k_max}; give at least "

@@ -726,22 +726,88 @@ def a_buffer(
     return Steps("A-buffer", steps, result, paint, (0.0, 0.0, grid_x0 + side, side * 1.08))
 
 
-# --- ray casting -------------------------------------------------------------------------------------------
+# --- ray casting ---------------------------------------------------------------------------------------------
+
+
+def _pixel_ray(camera: Camera, x: int, y: int) -> tuple[float, ...]:
+    """The ray of window pixel (x, y), with ``raster.rays.cast_pixels``' arithmetic: origin on the near plane,
+    direction to the far plane (t in [0, 1))."""
+    m = np.ascontiguousarray(camera.world_from_window, dtype=np.float64)
+    px, py = x + 0.5, y + 0.5
+    nw = m[3, 0] * px + m[3, 1] * py + m[3, 3]
+    ox = (m[0, 0] * px + m[0, 1] * py + m[0, 3]) / nw
+    oy = (m[1, 0] * px + m[1, 1] * py + m[1, 3]) / nw
+    oz = (m[2, 0] * px + m[2, 1] * py + m[2, 3]) / nw
+    fw = nw + m[3, 2]
+    dx = (m[0, 0] * px + m[0, 1] * py + m[0, 2] + m[0, 3]) / fw - ox
+    dy = (m[1, 0] * px + m[1, 1] * py + m[1, 2] + m[1, 3]) / fw - oy
+    dz = (m[2, 0] * px + m[2, 1] * py + m[2, 2] + m[2, 3]) / fw - oz
+    return ox, oy, oz, dx, dy, dz
+
+
+def traced_closest(index: Any, skip: NDArray, ray: tuple[float, ...], cull: int) -> tuple[tuple, list[tuple]]:
+    """Run the ray kernel's Python twin (``raster.rays._closest``'s own source, uncompiled) on one ray under a
+    line tracer: its return value (equal to the compiled kernel's) and the traversal's events in order —
+    ``("node", node, t_left, t_right)`` (an inner node entered and its children's box entries, inf for a miss),
+    ``("leaf", first_row, count)``, ``("test", row, face)``, ``("hit", row, face, t)`` (a new nearest hit)."""
+    import inspect
+    import sys
+
+    from frustum.raster import rays
+
+    function = getattr(rays._closest, "py_func", rays._closest)
+    code = function.__code__
+    lines, first = inspect.getsourcelines(function)
+    children_line = first + next(n for n, text in enumerate(lines) if "left, right = links[node, 0]" in text)
+    leaf_line = first + next(n for n, text in enumerate(lines) if "first = code >> 3" in text)
+    events: list[tuple] = []
+    seen = {"tests": 0, "best_row": -1}
+
+    def local(frame: Any, event: str, arg: Any) -> Any:
+        if event != "line":
+            return local
+        values = frame.f_locals
+        if frame.f_lineno == children_line:
+            events.append(("node", int(values["node"]), float(values["t_near0"]), float(values["t_near1"])))
+        elif frame.f_lineno == leaf_line:
+            events.append(("leaf", int(values["code"]) >> 3, int(values["code"]) & 7))
+        tests = values.get("tests", 0)
+        if tests > seen["tests"]:
+            seen["tests"] = tests
+            events.append(("test", int(values["row"]), int(values["face"])))
+        best_row = values.get("best_row", -1)
+        if best_row != seen["best_row"]:
+            seen["best_row"] = best_row
+            events.append(("hit", int(best_row), int(values["best_face"]), float(values["best"])))
+        return local
+
+    def tracer(frame: Any, event: str, arg: Any) -> Any:
+        return local if frame.f_code is code else None
+
+    stack = np.empty(index.depth + 2, dtype=np.int64)
+    entry = np.empty(index.depth + 2)
+    previous = sys.gettrace()
+    sys.settrace(tracer)
+    try:
+        result = function(index.boxes, index.links, index.triangles, index.order, skip, *ray, 0.0, 1.0, cull, stack,
+                          entry)  # fmt: skip
+    finally:
+        sys.settrace(previous)
+    return result, events
 
 
 def ray_casting(
     scene: Scene | None = None, camera: Camera | None = None, pixel: tuple[int, int] | None = None, **options: Any
 ) -> Steps:
-    """One pixel's ray through the scene's bounding-volume hierarchy: each node entered (nearer child first), each
-    ray–triangle test in the leaves, each new nearest hit, the nodes skipped because they lie beyond it.
+    """One pixel's ray through the scene's bounding-volume hierarchy: each node entered (nearer child first, a
+    child whose box the ray misses left out), each leaf's ray–triangle tests, each new nearest hit.
 
-    Runs ``render(scene, camera, method="ray-casting", **options)`` with the kernel's recording mode on for that
-    pixel (``visibility.raycast.recording``); ``result`` is that frame, byte for byte the frame without recording.
-    `pixel` is ``(x, y)`` in window coordinates (y up); by default the image centre.
+    The frame is ``render(scene, camera, method="ray-casting", **options)`` (``result``); the pixel's traversal is
+    the ray kernel's Python twin (``raster.rays._closest``, the same source uncompiled) run on that pixel's ray
+    under a line tracer (``traced_closest``), whose hit equals the kernel's (a test holds the depth it gives to
+    the frame's). `pixel` is ``(x, y)`` in window coordinates (y up); by default the image centre.
     """
-    from frustum.raster.bvh import LOG_EVENTS
     from frustum.render import render
-    from frustum.visibility.raycast import recording
 
     where = "steps.ray_casting"
     if scene is None:
@@ -755,69 +821,75 @@ def ray_casting(
     if not (0 <= x < width and 0 <= y < height):
         raise OutputError(f"{where}: pixel = {pixel!r} lies outside the {width}x{height} image; give 0 <= x < "
                           f"{width}, 0 <= y < {height}")  # fmt: skip
-    with recording((x, y)) as logs:
-        frame = render(scene, cam, method="ray-casting", **options)
+    frame = render(scene, cam, method="ray-casting", **options)
     result = frame
-    if not logs:
+    found = scene._triangle_index(where=where)
+    if found is None:
         raise GeometryError(f"{where}: the scene has no triangles to cast rays at")
-    log, lo, hi = logs[0]["log"], logs[0]["lo"], logs[0]["hi"]
-    leaves = (lo.shape[0] + 1) // 2
+    items, index, starts = found
+    clear = np.array([item.material.opacity < 1.0 for item in items])
+    skip = np.repeat(clear, np.diff(starts)).astype(np.uint8) if clear.any() else np.empty(0, dtype=np.uint8)
+    ray = _pixel_ray(cam, x, y)
+    cull = int(options.get("cull_back_faces", True))
+    hit, events = traced_closest(index, skip, ray, cull)
     steps = [Step(f"The ray through pixel ({x}, {y})",
                   "From the pixel centre on the near plane toward the far plane. Instead of testing every surface, "
                   "the ray descends the bounding-volume hierarchy: a box it misses hides nothing, and the nearer "
                   "child is entered first so that a hit found early lets farther boxes be skipped.",
-                  {"nodes": lo.shape[0], "leaves": leaves})]  # fmt: skip
-    shown: list[tuple[int, int]] = [(-1, -1)]
-    for kind, node, t, face in log.tolist():
-        event, node, face = LOG_EVENTS[int(kind)], int(node), int(face)
-        level = (node + 1).bit_length() - 1
-        if event == "visit":
-            what = "leaf" if node >= leaves - 1 else "node"
-            steps.append(Step(f"Enter {what} {node} (level {level})",
-                              "The ray enters its box at parameter t (slab test); " + (
-                                  "its triangles are tested." if what == "leaf"
-                                  else "both children's boxes are tested, the nearer is entered first."),
-                              {"entry t": t}))  # fmt: skip
-        elif event == "skip":
-            steps.append(Step(f"Skip node {node}", "Its box begins beyond the nearest hit found so far: nothing in it "
-                              "can be nearer.", {"entry t": t}))  # fmt: skip
-        elif event == "test":
-            steps.append(Step(f"Test triangle {face}", "Möller–Trumbore: the ray meets the triangle at t"
-                              + (" (a hit)" if math.isfinite(t) else " — it misses"), {"t": t}))  # fmt: skip
+                  {"origin": ray[:3], "direction": ray[3:], "inner nodes": index.nodes})]  # fmt: skip
+    shown: list[tuple] = [("start",)]
+    for event in events:
+        if event[0] == "node":
+            _, node, t_left, t_right = event
+            entries = {"left entry t": t_left, "right entry t": t_right}
+            order = "left first" if t_left <= t_right else "right first"
+            missed = [side for side, t in (("left", t_left), ("right", t_right)) if not math.isfinite(t)]
+            steps.append(Step(f"Node {node}: test both children's boxes",
+                              "Slab test of each child box: the entry parameter t where the ray enters it. "
+                              + (f"The ray misses the {' and '.join(missed)} box." if missed else
+                                 f"Both are hit: the nearer is entered first ({order}), the other pushed."),
+                              entries))  # fmt: skip
+        elif event[0] == "leaf":
+            steps.append(Step(f"Leaf: triangles {event[1]}…{event[1] + event[2] - 1}",
+                              "A leaf holds a few triangles; each is tested against the ray (Möller–Trumbore).",
+                              {"triangles": event[2]}))  # fmt: skip
+        elif event[0] == "test":
+            steps.append(Step(f"Test face {event[2]}", "Ray–triangle test: a hit nearer than the best so far "
+                              "replaces it.", {"face": event[2]}))  # fmt: skip
         else:
-            steps.append(Step(f"Nearest hit so far: triangle {face}", "It is nearer than every hit before; boxes "
-                              "entered beyond it will be skipped.", {"t": t}))  # fmt: skip
-        shown.append((node, face))
-    hit = frame.depth[height - 1 - y, x] < 1.0
+            steps.append(Step(f"Nearest hit so far: face {event[2]}", "Boxes entered beyond it will be skipped.",
+                              {"t": event[3]}))  # fmt: skip
+        shown.append(event)
+    row = height - 1 - y
     steps.append(Step("The pixel's surface", "The nearest hit is the visible surface: its depth, face and "
-                      "barycentrics are shaded as the depth buffer's." if hit else "The ray meets no surface: "
-                      "the pixel keeps the background.", {"depth": float(frame.depth[height - 1 - y, x])}))  # fmt: skip
-    shown.append((-1, -1))
-    # the boxes drawn on the image: each node's eight corners projected, their bounding rectangle
-    corners = np.array([[i & 1, (i >> 1) & 1, (i >> 2) & 1] for i in range(8)], dtype=float)
-    rectangles: dict[int, tuple[float, float, float, float]] = {}
-    for node in {int(n) for n in log[:, 1].tolist()}:
-        if lo[node, 0] > hi[node, 0]:
-            continue
-        box = lo[node] + corners * (hi[node] - lo[node])
-        window = np.asarray(cam.project(box))[:, :2]
-        if np.isfinite(window).all():
-            rectangles[node] = (*window.min(axis=0), *window.max(axis=0))
+                      "barycentrics are shaded as the depth buffer's." if hit[1] >= 0 else "The ray meets no "
+                      "surface: the pixel keeps the background.",
+                      {"t": hit[0], "depth": float(frame.depth[row, x])}))  # fmt: skip
+    shown.append(("end",))
+    # draw the boxes of the nodes entered, projected onto the image (their 8 corners' bounding rectangles)
+    corners = np.array([[c & 1, (c >> 1) & 1, (c >> 2) & 1] for c in range(8)], dtype=float)
+
+    def child_rect(node: int, side: int) -> NDArray | None:
+        box = np.asarray(index.boxes[node, 6 * side : 6 * side + 6], dtype=float)
+        lo, hi = box[:3], box[3:]
+        if (lo > hi).any():
+            return None
+        window = np.asarray(cam.project(lo + corners * (hi - lo)))[:, :2]
+        return None if not np.isfinite(window).all() else np.array([window.min(axis=0), window.max(axis=0)])
+
     picture = np.asarray(frame.color)[:, :, :3]
     zoom = max(1, 256 // max(width, 1))
     big = np.repeat(np.repeat(picture, zoom, axis=0), zoom, axis=1)
 
-    def paint(index: int, canvas: _Canvas) -> None:
+    def paint(index_: int, canvas: _Canvas) -> None:
         canvas.image(big, (0.0, height), (width, 0.0))
-        node, _face = shown[index]
-        visited = {int(n) for kind, n, _t, _f in log[: max(0, index - 1)].tolist() if kind == 0.0}
-        for n in visited:
-            if n in rectangles:
-                x0, y0, x1, y1 = rectangles[n]
-                canvas.rect((x0, y0), (x1, y1), color="faint", width=0.6)
-        if node in rectangles:
-            x0, y0, x1, y1 = rectangles[node]
-            canvas.rect((x0, y0), (x1, y1), color="highlight", width=2.0)
+        event = shown[index_]
+        if event[0] == "node":
+            for side, t in ((0, event[2]), (1, event[3])):
+                rect = child_rect(event[1], side)
+                if rect is not None:
+                    canvas.rect(rect[0], rect[1], color="accept" if math.isfinite(t) else "reject",
+                                width=2.0 if math.isfinite(t) else 1.0)  # fmt: skip
         canvas.rect((x, y), (x + 1, y + 1), color="blue", fill="blue", width=1.0)
 
     return Steps("Ray casting through a BVH", steps, result, paint, (0.0, 0.0, float(width), float(height)))
