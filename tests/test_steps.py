@@ -289,8 +289,8 @@ def test_bad_input_is_refused_with_a_clear_message(tmp_path):
         recorded.figure(7)
     with pytest.raises(OutputError, match=r"suffix '.png'.*'.gif'"):
         recorded.save(tmp_path / "koch.png")
-    with pytest.raises(FrustumError, match=r"algorithm = 'warnock' is unknown; expected one of rotation, "):
-        build("warnock", {})
+    with pytest.raises(FrustumError, match=r"algorithm = 'zbuffer' is unknown; expected one of rotation, "):
+        build("zbuffer", {})
     with pytest.raises(FrustumError, match=r"--from = '1,2' is not 3 or 4"):
         build("cohen-sutherland", {"from": "1,2"})
     with pytest.raises(frustum.GeometryError, match=r"t = 1.5 lies outside"):
@@ -306,7 +306,7 @@ def test_cli_lists_writes_and_refuses_unknown_names(tmp_path):
     subprocess.run([*run, "cohen-sutherland", "--from", "-2,0.5,0", "--to", "2,0.3,-3", "-o", str(out)], env=env,
                    check=True, capture_output=True)  # fmt: skip
     ET.parse(out)
-    unknown = subprocess.run([*run, "warnock", "-o", str(tmp_path / "w.gif")], capture_output=True, text=True, env=env)
+    unknown = subprocess.run([*run, "zbuffer", "-o", str(tmp_path / "w.gif")], capture_output=True, text=True, env=env)
     assert unknown.returncode == 1
     assert len(unknown.stderr.strip().splitlines()) == 1 and "expected one of rotation" in unknown.stderr
     refused = subprocess.run([*run, "koch", "--level", "14", "-o", str(tmp_path / "k.gif")], capture_output=True,
