@@ -545,3 +545,16 @@ def test_octree_steps_show_levels_then_the_traversal_and_end_in_the_render():
     visits = [s for s in recorded if s.title.startswith("Visit")]
     assert visits[0].title.startswith("Visit 1: level 0")  # the root first
     assert sum(s.values["pixels written"] for s in visits) == np.count_nonzero(frame.depth < 1.0)
+
+
+def test_mp4_has_one_frame_per_step(tmp_path):
+    pytest.importorskip("imageio_ffmpeg")
+    import imageio
+
+    recorded = fs.koch(3)
+    (path,) = recorded.save(tmp_path / "koch.mp4", fps=2)
+    reader = imageio.get_reader(path)
+    try:
+        assert sum(1 for _ in reader) == len(recorded)
+    finally:
+        reader.close()
