@@ -93,6 +93,12 @@ def _attenuation(value: ArrayLike, where: str) -> Vector3:
     return read_only(coefficients)
 
 
+def _check_cast_shadows(value: Any, where: str) -> None:
+    """``cast_shadows`` (whether surfaces shadow this light where a method draws shadows) must be a bool."""
+    if not isinstance(value, bool | np.bool_):
+        raise ShadingError(f"{where}: cast_shadows = {describe(value)} is not a bool; give True or False")
+
+
 def _texture(value: Any, where: str) -> NDArray[np.float32] | None:
     if value is None:
         return None
@@ -126,6 +132,9 @@ class Material:
     image's bottom row; uint8 bytes are taken as linear values / 255), multiplied into the base color.
     ``hatch`` (vector output only): the spacing of 45° section lines drawn over the faces in filled SVG/PDF,
     in drawing units, as engineering drawings mark cut surfaces (``cutaway`` sets it on section caps).
+    ``reflectivity`` in [0, 1] and ``ior`` (index of refraction, > 0; 1 bends nothing, glass 1.5) are read by
+    ``render(..., method="ray-tracing")`` only: the weight of the mirror-reflected ray, and the bending of the
+    ray transmitted through a surface of opacity < 1 (Snell's law; docs/ray-tracing.md).
     Raises ``ShadingError`` for a non-finite or negative coefficient, a color outside [0, 1] or a bad texture.
     """
 
@@ -138,9 +147,19 @@ class Material:
     opacity: float = 1.0
     texture: NDArray[np.float32] | None = None
     hatch: float | None = None
+    reflectivity: float = 0.0
+    ior: float = 1.0
 
     def __post_init__(self) -> None:
         where = "Material"
+        reflectivity = as_scalar(self.reflectivity, "reflectivity", where=where, error=ShadingError)
+        if not 0.0 <= reflectivity <= 1.0:
+            raise ShadingError(f"{where}: reflectivity = {reflectivity!r} is outside [0, 1]; 0 is matte, 1 a mirror")
+        object.__setattr__(self, "reflectivity", reflectivity)
+        ior = as_scalar(self.ior, "ior", where=where, error=ShadingError)
+        if not (math.isfinite(ior) and ior > 0.0):
+            raise ShadingError(f"{where}: ior = {ior!r} is not a finite index of refraction > 0 (glass: 1.5)")
+        object.__setattr__(self, "ior", ior)
         if self.hatch is not None:
             spacing = as_scalar(self.hatch, "hatch", where=where, error=ShadingError)
             if not spacing > 0.0:
@@ -184,9 +203,11 @@ class DirectionalLight:
     direction: Vector3
     color: Vector3 = (1.0, 1.0, 1.0)  # type: ignore[assignment]
     intensity: float = 1.0
+    cast_shadows: bool = True
 
     def __post_init__(self) -> None:
         where = "DirectionalLight"
+        _check_cast_shadows(self.cast_shadows, where)
         object.__setattr__(
             self, "direction", read_only(as_direction(self.direction, "direction", where=where, error=ShadingError))
         )
@@ -212,9 +233,11 @@ class PointLight:
     color: Vector3 = (1.0, 1.0, 1.0)  # type: ignore[assignment]
     intensity: float = 1.0
     attenuation: Vector3 = (1.0, 0.0, 0.0)  # type: ignore[assignment]
+    cast_shadows: bool = True
 
     def __post_init__(self) -> None:
         where = type(self).__name__
+        _check_cast_shadows(self.cast_shadows, where)
         object.__setattr__(
             self, "position", read_only(as_vector3(self.position, "position", where=where, error=ShadingError))
         )
@@ -240,9 +263,11 @@ class SpotLight:
     inner_angle: float = math.radians(20.0)
     outer_angle: float = math.radians(30.0)
     attenuation: Vector3 = (1.0, 0.0, 0.0)  # type: ignore[assignment]
+    cast_shadows: bool = True
 
     def __post_init__(self) -> None:
         where = "SpotLight"
+        _check_cast_shadows(self.cast_shadows, where)
         object.__setattr__(
             self, "position", read_only(as_vector3(self.position, "position", where=where, error=ShadingError))
         )
