@@ -428,8 +428,8 @@ def test_unknown_method_lists_the_valid_ones() -> None:
     with pytest.raises(FrustumError) as error:
         render(scene, camera, method=3)
     assert all(repr(name) in str(error.value) for name in RENDER_METHODS)
-    with pytest.raises(FrustumError, match=r"method = 'ray-tracing' is unknown; expected one of .*'ray-casting'"):
-        render(scene, camera, method="ray-tracing")
+    with pytest.raises(FrustumError, match=r"method = 'path-tracing' is unknown; expected one of .*'ray-casting'"):
+        render(scene, camera, method="path-tracing")
     with pytest.raises(FrustumError, match="transparency = 'depth-peeling' is unknown; expected one of 'sort'"):
         render(scene, camera, transparency="depth-peeling")
     with pytest.raises(FrustumError, match="mode = 'wireframe' draws lines"):
@@ -505,8 +505,8 @@ def test_scene_file_render_method_and_transparency(tmp_path) -> None:
     assert_same_picture(frame, render(scene_file.scene, scene_file.cameras[0]))
     path.write_text(SCENE_FILE.replace("size = [48, 32]", 'size = [48, 32]\nmethod = "ray-casting"'))
     assert load_scene_file(path).options["method"] == "ray-casting"
-    path.write_text(SCENE_FILE.replace("size = [48, 32]", 'size = [48, 32]\nmethod = "ray-tracing"'))
-    with pytest.raises(SceneFileError, match=r"ball.toml:8: render.method = 'ray-tracing' .*'ray-casting'"):
+    path.write_text(SCENE_FILE.replace("size = [48, 32]", 'size = [48, 32]\nmethod = "path-tracing"'))
+    with pytest.raises(SceneFileError, match=r"ball.toml:8: render.method = 'path-tracing' .*'ray-casting'"):
         load_scene_file(path)
 
 
