@@ -258,3 +258,35 @@ def test_empty_scene_and_background() -> None:
     assert (frame.color == [51, 102, 153, 128]).all() and (frame.depth == 1.0).all()
     path = ray_path(Scene(), camera, 8.0, 6.0)
     assert len(path) == 1 and path[0].t == math.inf and path[0].item == -1
+
+
+def test_scene_file_and_explain(tmp_path, capsys) -> None:
+    from pathlib import Path
+
+    from frustum.cli import main
+    from frustum.errors import SceneFileError
+    from frustum.scenefile import load_scene_file
+
+    example = Path(__file__).parents[1] / "examples" / "ray_tracing.toml"
+    loaded = load_scene_file(example)
+    assert loaded.options["method"] == "ray-tracing" and loaded.options["max_depth"] == 6
+    assert loaded.options["shadows"] is True
+    materials = {item.material.reflectivity for item in loaded.scene.items}
+    assert materials == {0.0, 0.85, 0.08} and {item.material.ior for item in loaded.scene.items} == {1.0, 1.5}
+    text = example.read_text().replace("max_depth = 6", "max_depth = 65")
+    (tmp_path / "checkerboard.ply").write_bytes((example.parent / "checkerboard.ply").read_bytes())
+    bad = tmp_path / "bad.toml"
+    bad.write_text(text)
+    with pytest.raises(SceneFileError, match=r"bad.toml:\d+: render.max_depth = 65"):
+        load_scene_file(bad)
+    bad.write_text(example.read_text().replace("ior = 1.5", "ior = 0.0"))
+    with pytest.raises(SceneFileError, match=r"materials.glass.*ior = 0.0"):
+        load_scene_file(bad)
+    small = tmp_path / "small.toml"
+    small.write_text(example.read_text().replace("size = [480, 360]", "size = [40, 30]").replace("samples = 4", ""))
+    (tmp_path / "checkerboard.ply").write_bytes((example.parent / "checkerboard.ply").read_bytes())
+    main(["explain", str(small), "--method", "ray-tracing"])
+    lines = dict(line.split(None, 1) for line in capsys.readouterr().out.splitlines() if line.strip())
+    assert lines["method"] == "ray-tracing" and int(lines["primary_rays"]) == 40 * 30
+    assert int(lines["shadow_rays"]) > 0 and int(lines["reflected_rays"]) > 0 and int(lines["refracted_rays"]) > 0
+    assert 1 <= int(lines["depth_reached"]) <= 6
