@@ -35,7 +35,8 @@ def still_life(mirror: bool = False) -> Scene:
                           PointLight((2.0, 4.0, 3.0), attenuation=(1.0, 0.05, 0.01)),
                           SpotLight((0.0, 5.0, 0.0), (0.0, -1.0, 0.0))])  # fmt: skip
     scene.add(uv_sphere(1.0, 48, 24), Material(color=(0.9, 0.3, 0.2)), transform=translate(-1.2, 1.0, 0.0))
-    scene.add(uv_sphere(1.0, 48, 24), Material(color=(0.9, 0.9, 0.9), shininess=7.5), transform=translate(1.2, 1.0, 0.0))
+    shiny = Material(color=(0.9, 0.9, 0.9), shininess=7.5)  # a non-integral exponent: libm's pow
+    scene.add(uv_sphere(1.0, 48, 24), shiny, transform=translate(1.2, 1.0, 0.0))
     scene.add(box((1.0, 0.6, 0.8)), Material(color=(0.2, 0.4, 0.9)), transform=translate(0.0, 0.3, 1.5))
     # the ground: z from −2 to 4 (nothing behind the mirror)
     scene.add(plane((8.0, 6.0), (8, 6)), Material(color=(0.4, 0.8, 0.4)), transform=translate(0, 0, 1) @ FLOOR)
@@ -115,8 +116,8 @@ def test_slab_shifts_a_ray_sideways() -> None:
         path = ray_path(scene, camera, 16.5, 16.5, max_depth=3, shadows=False)
         first = path[0]
         assert first.kind == "primary" and first.item == 0
-        inside = [s for s in path if s.kind == "refracted" and s.depth == 1][0]
-        outside = [s for s in path if s.kind == "refracted" and s.depth == 2][0]
+        inside = next(s for s in path if s.kind == "refracted" and s.depth == 1)
+        outside = next(s for s in path if s.kind == "refracted" and s.depth == 2)
         incoming = first.direction / np.linalg.norm(first.direction)
         np.testing.assert_allclose(outside.direction, incoming, atol=1e-12)  # leaves parallel to where it came from
         # Snell inside: sin θ_t = sin θ / n
@@ -140,7 +141,7 @@ def test_ball_lens_focus() -> None:
         crossings = []
         for x in (50.5 + 2.0, 50.5 + 3.0, 50.5 - 2.5):  # heights h = 0.004 … 0.006 R
             path = ray_path(scene, camera, x, 50.5, max_depth=2, shadows=False)
-            out = [s for s in path if s.kind == "refracted" and s.depth == 2][0]
+            out = next(s for s in path if s.kind == "refracted" and s.depth == 2)
             # where the exit ray crosses the axis (x = 0)
             s = -out.origin[0] / out.direction[0]
             crossings.append(-(out.origin[2] + s * out.direction[2]))
@@ -230,7 +231,7 @@ def test_bad_input() -> None:
         with pytest.raises(FrustumError, match=r"max_depth = .* is not an integer in \[0, 64\]"):
             render(scene, camera, method="ray-tracing", max_depth=depth)
     for ior in (0.0, -1.5, float("nan"), float("inf")):
-        with pytest.raises(ShadingError, match="ior = .* is not (a )?finite"):
+        with pytest.raises(ShadingError, match=r"ior = .* is not (a )?finite"):
             Material(ior=ior)
     for reflectivity in (-0.1, 1.5):
         with pytest.raises(ShadingError, match=r"reflectivity = .* is outside \[0, 1\]"):
