@@ -28,9 +28,9 @@ only what it reflects, and a transparent surface of ``ior = 1`` the depth buffer
 Rays that leave the scene see the ``background`` color, or the scene's environment map (``Scene(environment=)``)
 along their direction for reflected and refracted rays (primary rays that miss show it as the depth buffer
 does). After ``max_depth`` levels of reflected and refracted rays no more are spawned (their share of the color
-is black), and rays whose weight is below ``MIN_WEIGHT`` are not traced. The normal used to reflect and refract is the interpolated (shading) normal; rays start ``ε`` (1e-9 of
-the scene's size) off the surface along the geometric normal, on the side they leave to, so that they do not meet
-it again.
+is black), and rays whose weight is below ``MIN_WEIGHT`` are not traced. The normal used to reflect and refract
+is the interpolated (shading) normal; rays start ``ε`` (1e-9 of the scene's size) off the surface along the
+geometric normal, on the side they leave to, so that they do not meet it again.
 
 The depth buffer receives the window depth of each primary hit, so volumes and particles are composited along
 the primary rays exactly as with ``method="ray-casting"``; ``buffers=("normals", "object_id")`` show the primary
