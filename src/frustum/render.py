@@ -88,7 +88,7 @@ HIDDEN_STYLES = (None, "dimmed", "dashed")
 EDGE_SETS = ("all", "feature")
 FILTERS = ("box", "tent")
 COLOR_SPACES = ("linear", "srgb")
-BUFFERS = ("normals", "object_id")
+BUFFERS = ("normals", "object_id", "position", "shadow")
 TILE_BITS = 5
 TILE_SIZE = 1 << TILE_BITS
 ONE_PASS_CLIPPING = 16384
@@ -122,6 +122,8 @@ class _Options:
     method: str = "depth-buffer"
     transparency: str = "sort"
     counts: dict | None = None  # the method's counts (Frame.stats), filled while drawing
+    shadow: Any = None  # shadow_pass.ShadowOptions, or None: no shadows
+    outputs: dict | None = None  # "position", "seen" (shadow_pass), filled while drawing where asked for
 
 
 class Scratch:
@@ -207,6 +209,9 @@ def render(
     method: str = "depth-buffer",
     transparency: str = "sort",
     stats: bool = False,
+    shadows: bool | str | None = None,
+    shadow_map_size: int = 2048,
+    shadow_softness: float = 1.0,
 ) -> Frame:
     """Render `scene` seen by `camera` into a ``Frame`` (color (H, W, 4) uint8 and depth (H, W) float32).
 
@@ -258,9 +263,11 @@ def render(
         are drawn √samples times as wide, so they come out anti-aliased. Depth keeps each block's nearest.
     color_space : {"linear", "srgb"}
         Output encoding; "srgb" applies the sRGB transfer curve to the linear result.
-    buffers : tuple of {"normals", "object_id"}
-        Extra per-pixel outputs on the Frame: unit world normals (0 on background) and the index of the item
-        in ``scene.items`` (−1 on background).
+    buffers : tuple of {"normals", "object_id", "position", "shadow"}
+        Extra per-pixel outputs on the Frame: unit world normals (0 on background), the index of the item
+        in ``scene.items`` (−1 on background), the world point of the nearest opaque surface ((H, W, 3) float32,
+        NaN on background) and, with `shadows` on, the fraction of each shadow-casting light reaching it ((H, W,
+        L) float32, NaN on background; lights in ``Scene.world_lights`` order, ``frustum.shadow_pass``).
     method : str
         The visible-surface method (``RENDER_METHODS``, docs/visibility.md). For the meshes
         (``VISIBILITY_METHODS``): ``"depth-buffer"`` (the default), ``"scan-line"``, ``"area-subdivision"``
@@ -277,6 +284,17 @@ def render(
         per subsample through an A-buffer (exact whatever the order, anti-aliased edges; costs fragment memory).
     stats : bool
         ``method="depth-buffer"`` only: also count its depth tests (an extra counting pass) into ``Frame.stats``.
+    shadows : None, False, True or "ray"
+        None: the method's own (off for the depth buffer and every method here, so pictures of today do not
+        change); False: off; True: shadow maps (the depth-buffer method from each light); ``"ray"``: exact
+        shadow rays through the scene's BVH (``method="ray-casting"`` always uses rays). Lights with
+        ``cast_shadows=False`` and ambient light cast none. Surface modes only; not with ``method="octree"`` or
+        ``"a-buffer"``. What casts, what receives and how each shading mode uses the result:
+        ``frustum.shadow_pass``.
+    shadow_map_size : int
+        Texels on a side of each shadow map, a power of two in [64, 16384] (a point light has six).
+    shadow_softness : float
+        Percentage-closer filter radius in texels, in [0, 16]; 0: hard edges.
 
     Raises
     ------
@@ -299,6 +317,7 @@ def render(
     )  # fmt: skip
     factor = _supersampling(samples, where)
     options = _method_options(options, method, transparency, stats, where)
+    options = _shadow_options(options, shadows, shadow_map_size, shadow_softness, where)
     _choice(filter, FILTERS, "filter", where)
     _choice(color_space, COLOR_SPACES, "color_space", where)
     _check_image_budget(camera, factor, options.buffers, filter, color_space, where)
@@ -318,6 +337,10 @@ def render(
         middle = factor // 2
         normals = None if normals is None else np.ascontiguousarray(normals[middle::factor, middle::factor])
         ids = None if ids is None else np.ascontiguousarray(ids[middle::factor, middle::factor])
+        if options.outputs:
+            for key in ("position", "seen"):  # the middle sample of each block, as for normals
+                if key in options.outputs:
+                    options.outputs[key] = np.ascontiguousarray(options.outputs[key][middle::factor, middle::factor])
     if color_space == "srgb":
         values = color.astype(np.float64) / 255.0 if linear is None else linear
         values[..., :3] = np.where(
@@ -326,7 +349,9 @@ def render(
         linear = values
     if linear is not None:
         color = np.floor(np.clip(linear, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
-    return Frame(color=color, depth=depth, normals=normals, object_id=ids, stats=options.counts)
+    position, shadow = _shadow_buffers(options)
+    return Frame(color=color, depth=depth, normals=normals, object_id=ids, stats=options.counts, position=position,
+                 shadow=shadow)  # fmt: skip
 
 
 def _render_octrees(scene: Scene, camera: Camera, *, background: Any) -> Frame:
@@ -452,6 +477,9 @@ def _draw_surfaces(
             world, normals, rows = _draw_item(items[index], camera, options.cull, int(offsets[index]), depth,
                                               codes, bary, scratch)  # fmt: skip
             drawn.append((index, world, normals, rows))
+        if options.outputs is not None:
+            _shadow_pass(scene, items, [(i, w, int(offsets[i])) for i, w, _, _ in drawn], camera, options, lights,
+                         depth, codes, bary)  # fmt: skip
         for index, world, normals, rows in drawn:
             _shade_item(items[index], index, int(offsets[index]), camera, options, ambient, lights, world, normals,
                         depth, codes, bary, color, extra, rows, blend=False)  # fmt: skip
@@ -541,7 +569,7 @@ def _directional(item: SceneItem, options: _Options, lights: np.ndarray) -> bool
         and options.shade_mode == shade.SHADE_PHONG and options.specular_model == shade.SPECULAR_BLINN
         and bool((lights[:, 0] == 0.0).all()) and getattr(mesh, "vertex_colors", None) is None
         and (item.material.texture is None or getattr(mesh, "uvs", None) is None)
-        and options.depth_cue is None and not options.buffers
+        and options.depth_cue is None and not options.buffers and options.shadow is None
     )  # fmt: skip
 
 
@@ -585,6 +613,23 @@ def _shade_item(
     params = _shading_parameters(item, camera, options, ambient)
     mode = options.shade_mode
     faces = _world_faces(item) if mesh.face_count else np.empty((0, 3), dtype=np.int64)
+    seen = None if options.outputs is None else options.outputs.get("seen")
+    if seen is not None and not blend and seen[band].shape[:2] == codes.shape and mode in _SHADOWED_MODES:
+        from frustum.raster import shadow
+
+        world, normals = np.asarray(world, dtype=np.float64), np.asarray(normals, dtype=np.float64)
+        lit = _lit_per_light(mesh, faces, world, normals, params, lights, options)
+        vertex_colors = getattr(mesh, "vertex_colors", None)
+        vertex_colors = np.empty((0, 3)) if vertex_colors is None else np.ascontiguousarray(vertex_colors[:, :3], float)
+        uvs, texture = getattr(mesh, "uvs", None), material.texture
+        if texture is None or uvs is None:
+            texture, uvs = np.empty((0, 0, 4), dtype=np.float32), np.empty((0, 2))
+        else:
+            uvs = np.ascontiguousarray(uvs, dtype=np.float64)
+        flags = _item_flags(index, face_offset, options, blend, write_normals, write_ids)
+        shadow.shade_pixels_shadowed(depth, codes, bary, faces, world, normals, lit, vertex_colors, uvs, texture,
+                                     params, lights, flags, seen[band], color, extra[0], extra[1])  # fmt: skip
+        return
     if not blend and _directional(item, options, lights):  # the same bytes without the general branches
         flags = _item_flags(index, face_offset, options, blend, False, False)
         shade.shade_pixels_directional(depth, codes, bary, faces, world, normals, params, lights, flags, color)
@@ -1317,8 +1362,12 @@ def _draw_surfaces_by_method(
         else:
             tris = window_triangles(items, opaque, offsets, camera, options.cull)
             counts.update(draw(tris, depth, codes, bary))
+        attributes = {index: _world_attributes(items[index], scratch) for index in opaque}
+        if options.outputs is not None:
+            _shadow_pass(scene, items, [(i, attributes[i][0], offsets[i]) for i in opaque], camera, options, lights,
+                         depth, codes, bary)  # fmt: skip
         for index in opaque:
-            world, normals = _world_attributes(items[index], scratch)
+            world, normals = attributes[index]
             _shade_item(items[index], index, offsets[index], camera, options, ambient, lights, world, normals,
                         depth, codes, bary, color, extra, (0, height), blend=False)  # fmt: skip
         _draw_volumes_over_surfaces(scene, camera, options, depth, color)  # (_draw_surfaces casts them itself)
@@ -1377,3 +1426,94 @@ def _composite(
     if under_depth is None:
         under_depth = np.ones(depth.shape, dtype=np.float32)
     return abuffer.resolve_fragments(fragments, premultiplied, tris, color, under_depth, color, depth)
+
+
+# --- shadows (frustum.shadow_pass) ---------------------------------------------------------------------------
+
+_SHADOWED_MODES = (shade.SHADE_PHONG, shade.SHADE_GOURAUD, shade.SHADE_FLAT)
+
+
+def _shadow_options(options: _Options, shadows: Any, map_size: Any, softness: Any, where: str) -> _Options:
+    """Check the shadow arguments; the options with the shadow settings and an outputs dict where needed."""
+    from frustum.shadow_pass import check_shadows
+
+    shadow = check_shadows(shadows, map_size, softness, options.method, options.mode, where)
+    if "shadow" in options.buffers and shadow is None:
+        raise FrustumError(
+            f"{where}: buffers = {describe(options.buffers)} asks for 'shadow' with shadows = {describe(shadows)}; "
+            "give shadows=True or 'ray'"
+        )
+    if "position" in options.buffers and options.mode in ("wireframe", "points"):
+        raise FrustumError(
+            f"{where}: buffers = {describe(options.buffers)} asks for 'position' with mode = {options.mode!r}; "
+            "positions are those of surfaces: use a surface mode"
+        )
+    wanted = shadow is not None or "position" in options.buffers
+    return dataclasses.replace(options, shadow=shadow, outputs={} if wanted else None)
+
+
+def _draw_depth(item: SceneItem, camera: Camera, depth: np.ndarray, codes: np.ndarray, bary: np.ndarray) -> None:
+    """Stages 1–4 of one item, both sides, into `depth` alone (codes and weights are scratch): a shadow map."""
+    binned = bin_item(item, camera, False)
+    tiling = np.array([TILE_SIZE, binned.tiles_x, 0, depth.shape[1], depth.shape[0]], dtype=np.int64)
+    triangles.rasterize_tiles(
+        binned.faces, binned.win_int, binned.win_float, binned.tri_int, binned.tri_float, binned.tri_weights,
+        binned.tile_starts, binned.tile_entries, tiling, depth, codes, bary,
+    )  # fmt: skip
+
+
+def _shadow_pass(
+    scene: Scene, items: list[SceneItem], drawn: list[tuple[int, np.ndarray, int]], camera: Camera,
+    options: _Options, lights: np.ndarray, depth: np.ndarray, codes: np.ndarray, bary: np.ndarray,
+) -> None:  # fmt: skip
+    """World points of the drawn opaque pixels and, with shadows on, each light's fraction reaching them, into
+    ``options.outputs`` ("position", "seen")."""
+    from frustum import shadow_pass
+
+    assert options.outputs is not None
+    points, facing = shadow_pass.surface_points(items, drawn, depth, codes, bary)
+    options.outputs["position"] = points
+    if options.shadow is not None:
+        options.outputs["seen"] = shadow_pass.light_fractions(
+            scene, items, camera, options.shadow, lights, depth, points, facing, _draw_depth, "render"
+        )
+        options.outputs["casting"] = np.array(shadow_pass.shadow_lights(scene)[0], dtype=np.int64)
+
+
+def _lit_per_light(
+    mesh: Mesh, faces: np.ndarray, world: np.ndarray, normals: np.ndarray, params: np.ndarray, lights: np.ndarray,
+    options: _Options,
+) -> np.ndarray:  # fmt: skip
+    """Gouraud (per vertex) or flat (per face) terms kept apart per light: (rows, 3 + 6·K) with the ambient term
+    first, then each light's (D, S) without ambient (``raster.shadow.shade_pixels_shadowed``); empty for Phong."""
+    mode = options.shade_mode
+    if mode == shade.SHADE_PHONG or mesh.face_count == 0:
+        return np.empty((0, 3 + 6 * lights.shape[0]))
+    count = mesh.vertex_count if mode == shade.SHADE_GOURAUD else mesh.face_count
+    lit = np.empty((count, 3 + 6 * lights.shape[0]))
+    lit[:, :3] = params[shade.P_AMBIENT] * params[shade.P_LIGHT_AMBIENT : shade.P_LIGHT_AMBIENT + 3]
+    unlit = params.copy()
+    unlit[shade.P_LIGHT_AMBIENT : shade.P_LIGHT_AMBIENT + 3] = 0.0
+    terms = np.empty((count, 6))
+    for k in range(lights.shape[0]):
+        one = np.ascontiguousarray(lights[k : k + 1])
+        if mode == shade.SHADE_GOURAUD:
+            shade.light_vertices(world, normals, unlit, one, options.specular_model, terms)
+        else:
+            shade.light_faces(world, faces, unlit, one, options.specular_model, terms)
+        lit[:, 3 + 6 * k : 9 + 6 * k] = terms
+    return lit
+
+
+def _shadow_buffers(options: _Options) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """``Frame.position`` and ``Frame.shadow`` where asked for (float32, NaN where nothing is drawn)."""
+    if options.outputs is None:
+        return None, None
+    position = shadow = None
+    points = options.outputs.get("position")
+    if "position" in options.buffers and points is not None:
+        position = points.astype(np.float32)
+    if "shadow" in options.buffers and points is not None:
+        seen = options.outputs["seen"][..., options.outputs["casting"]]
+        shadow = np.where(np.isnan(points[..., :1]), np.float32(np.nan), seen).astype(np.float32)
+    return position, shadow

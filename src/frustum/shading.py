@@ -93,6 +93,12 @@ def _attenuation(value: ArrayLike, where: str) -> Vector3:
     return read_only(coefficients)
 
 
+def _check_cast_shadows(value: Any, where: str) -> None:
+    """``cast_shadows`` must be a bool (``render(..., shadows=...)`` reads it)."""
+    if not isinstance(value, bool | np.bool_):
+        raise ShadingError(f"{where}: cast_shadows = {describe(value)} is not a bool; give True or False")
+
+
 def _texture(value: Any, where: str) -> NDArray[np.float32] | None:
     if value is None:
         return None
@@ -184,9 +190,11 @@ class DirectionalLight:
     direction: Vector3
     color: Vector3 = (1.0, 1.0, 1.0)  # type: ignore[assignment]
     intensity: float = 1.0
+    cast_shadows: bool = True
 
     def __post_init__(self) -> None:
         where = "DirectionalLight"
+        _check_cast_shadows(self.cast_shadows, where)
         object.__setattr__(
             self, "direction", read_only(as_direction(self.direction, "direction", where=where, error=ShadingError))
         )
@@ -212,9 +220,11 @@ class PointLight:
     color: Vector3 = (1.0, 1.0, 1.0)  # type: ignore[assignment]
     intensity: float = 1.0
     attenuation: Vector3 = (1.0, 0.0, 0.0)  # type: ignore[assignment]
+    cast_shadows: bool = True
 
     def __post_init__(self) -> None:
         where = type(self).__name__
+        _check_cast_shadows(self.cast_shadows, where)
         object.__setattr__(
             self, "position", read_only(as_vector3(self.position, "position", where=where, error=ShadingError))
         )
@@ -240,9 +250,11 @@ class SpotLight:
     inner_angle: float = math.radians(20.0)
     outer_angle: float = math.radians(30.0)
     attenuation: Vector3 = (1.0, 0.0, 0.0)  # type: ignore[assignment]
+    cast_shadows: bool = True
 
     def __post_init__(self) -> None:
         where = "SpotLight"
+        _check_cast_shadows(self.cast_shadows, where)
         object.__setattr__(
             self, "position", read_only(as_vector3(self.position, "position", where=where, error=ShadingError))
         )
