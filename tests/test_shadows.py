@@ -8,6 +8,7 @@ shadow), shadow rays on >= 99.9 %.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -153,3 +154,161 @@ def test_shadow_rays_agree_with_embree(kind, light_name):
     agreement, _ = _agreement(frame, oracle, light)
     print(f"{kind}/{light_name}: shadow rays agree with Embree on {agreement:.5%}")
     assert agreement >= 0.999
+
+
+def test_no_acne_on_a_plane_lit_at_80_degrees():
+    """A lit plane facing the light at 80° from its normal has no shadowed pixel (slope-scaled bias)."""
+    for light in (
+        fr.DirectionalLight((math.sin(math.radians(80.0)), -math.cos(math.radians(80.0)), 0.0)),
+        fr.SpotLight((-11.0, 2.0, 0.0), (math.sin(math.radians(80.0)), -math.cos(math.radians(80.0)), 0.0),
+                     inner_angle=0.5, outer_angle=0.6),
+    ):  # fmt: skip
+        scene = fr.Scene(lights=[light])
+        _ground(scene)
+        for softness in (0.0, 1.0, 3.0):
+            frame = fr.render(scene, CAMERA, shadows=True, shadow_softness=softness, buffers=("shadow",))
+            values = frame.shadow[..., 0][np.isfinite(frame.shadow[..., 0])]
+            assert values.size > 10000
+            assert (values == 1.0).all(), (type(light).__name__, softness, (values < 1.0).sum())
+
+
+def test_box_on_plane_shadow_touches_its_base():
+    """Contact: no gap between a box resting on the plane and its shadow (no peter-panning): every ground pixel
+    that the exact shadow rays put in shadow and that the map calls lit lies within one pixel of the box's base
+    (or within 2 pixels of the shadow's edges on the ground, where the filter blurs)."""
+    light = fr.DirectionalLight((1.0, -0.6, 0.4))
+    scene = fr.Scene(lights=[light])
+    _ground(scene)
+    scene.add(box((1, 1, 1), center=(0, 0.5, 0)), fr.Material())
+    camera = fr.Camera.look_at((3.0, 2.5, 4.0), (0.5, 0.0, 0.0), (0.0, 1.0, 0.0), width=400, height=300)
+    exact = fr.render(scene, camera, shadows="ray", buffers=("shadow", "position"))
+    mapped = fr.render(scene, camera, shadows=True, buffers=("shadow",))
+    ground = np.abs(exact.position[..., 1]) < 1e-6
+    exact_lit = exact.shadow[..., 0] >= 0.5
+    # where the map calls lit what the rays shadow, away from the shadow's edges on the ground (filtered there)
+    gap = ground & ~exact_lit & (mapped.shadow[..., 0] >= 0.5) & ~_near_oracle_edge(exact_lit, ground)
+    # image distance of each gap pixel to the box's base square (its four edges projected)
+    corners = np.array([[-0.5, 0, -0.5], [0.5, 0, -0.5], [0.5, 0, 0.5], [-0.5, 0, 0.5]])
+    window = camera.project(corners)[:, :2]
+    rows, cols = np.nonzero(gap)
+    centres = np.stack([cols + 0.5, camera.height - 1 - rows + 0.5], axis=1)
+    distance = np.full(centres.shape[0], np.inf)
+    for k in range(4):
+        a, b = window[k], window[(k + 1) % 4]
+        t = np.clip(((centres - a) @ (b - a)) / ((b - a) @ (b - a)), 0.0, 1.0)
+        distance = np.minimum(distance, np.linalg.norm(centres - (a + t[:, None] * (b - a)), axis=1))
+    shadowed = (ground & (exact.shadow[..., 0] < 0.5)).sum()
+    assert shadowed > 1000
+    assert (distance <= 1.0 + 0.5 * math.sqrt(2)).all(), np.sort(distance)[-5:]  # within one pixel (centre to edge)
+
+
+def test_shadows_off_changes_no_byte():
+    scene = _sphere_and_box(LIGHTS["directional"])
+    plain = fr.render(scene, CAMERA)
+    for shadows in (None, False):
+        frame = fr.render(scene, CAMERA, shadows=shadows, shadow_map_size=256, shadow_softness=3.0)
+        assert np.array_equal(frame.color, plain.color) and np.array_equal(frame.depth, plain.depth)
+        assert frame.shadow is None and frame.position is None
+
+
+@pytest.mark.parametrize("light_name", list(LIGHTS))
+def test_lights_that_cast_no_shadow_give_the_unshadowed_bytes(light_name):
+    """Phong with every light's cast_shadows False: the shadowed shading kernel gives the plain picture's bytes."""
+    light = dataclasses.replace(LIGHTS[light_name], cast_shadows=False)
+    scene = _sphere_and_box(light)
+    plain = fr.render(scene, CAMERA)
+    for shadows in (True, "ray"):
+        frame = fr.render(scene, CAMERA, shadows=shadows, buffers=("shadow",))
+        assert frame.shadow.shape == (*plain.depth.shape, 0)
+        assert np.array_equal(frame.color, plain.color)
+
+
+@pytest.mark.parametrize("shading", ["phong", "gouraud", "flat"])
+def test_shadowed_ground_is_darker_in_every_shading_mode(shading):
+    scene = _sphere_and_box(LIGHTS["directional"])
+    lit = fr.render(scene, CAMERA, shading=shading, buffers=("object_id",))
+    frame = fr.render(scene, CAMERA, shading=shading, shadows=True, buffers=("shadow", "object_id"))
+    ground = frame.object_id == 0
+    shadowed = ground & (frame.shadow[..., 0] == 0.0)
+    sunny = ground & (frame.shadow[..., 0] == 1.0)
+    assert shadowed.sum() > 300
+    # in shadow only the ambient term is left; in the sun the picture equals the unshadowed one within a level
+    assert (frame.color[shadowed][:, :3].astype(int) < lit.color[shadowed][:, :3].astype(int) - 40).all()
+    assert np.abs(frame.color[sunny].astype(int) - lit.color[sunny].astype(int)).max() <= 1
+
+
+def test_position_buffer_is_the_unprojected_depth():
+    scene = _sphere_and_box(LIGHTS["point"])
+    frame = fr.render(scene, CAMERA, buffers=("position",))
+    drawn = frame.depth < 1.0
+    assert np.isnan(frame.position[~drawn]).all() and np.isfinite(frame.position[drawn]).all()
+    rows, cols = np.nonzero(drawn)
+    window = np.stack([cols + 0.5, CAMERA.height - 1 - rows + 0.5, frame.depth[drawn]], axis=1)
+    expected = CAMERA.unproject(window)
+    # float32 window depth: its round-off (~6e-8) times dz/d(depth) of a perspective camera at ~8 units
+    assert np.abs(frame.position[drawn] - expected).max() < 2e-3
+    assert frame.position.dtype == np.float32 and not frame.position.flags.writeable
+
+
+def test_shadows_with_other_methods_and_supersampling():
+    scene = _sphere_and_box(LIGHTS["directional"])
+    reference = fr.render(scene, CAMERA, shadows="ray", buffers=("shadow",))
+    for method in ("scan-line", "ray-casting"):
+        frame = fr.render(scene, CAMERA, method=method, shadows=True, buffers=("shadow",))
+        both = np.isfinite(frame.shadow) & np.isfinite(reference.shadow)
+        assert ((frame.shadow[both] >= 0.5) == (reference.shadow[both] >= 0.5)).mean() > 0.995
+    big = fr.render(scene, CAMERA, shadows=True, samples=4, buffers=("shadow", "position"))
+    assert big.shadow.shape == (CAMERA.height, CAMERA.width, 1) and big.position.shape == (CAMERA.height, CAMERA.width, 3)
+
+
+def test_light_order_of_the_shadow_buffer():
+    """Channels follow Scene.world_lights: the root's lights first, then lights riding nodes; lights with
+    cast_shadows=False and ambient lights have none."""
+    left = fr.DirectionalLight((1.0, -0.8, -0.3))
+    unshadowing = fr.DirectionalLight((0.0, -1.0, 0.0), cast_shadows=False)
+    scene = _sphere_and_box(left)
+    scene.root.lights.append(unshadowing)
+    rider = fr.Node("lamp", translate(0.0, 0.0, 0.0))
+    rider.add_light(fr.PointLight((3.0, 3.0, -2.0)))
+    scene.add(rider)
+    frame = fr.render(scene, CAMERA, shadows="ray", buffers=("shadow",))
+    assert frame.shadow.shape[2] == 2
+    alone = fr.render(_sphere_and_box(left), CAMERA, shadows="ray", buffers=("shadow",))
+    assert np.array_equal(frame.shadow[..., 0], alone.shadow[..., 0], equal_nan=True)
+
+
+@pytest.mark.parametrize(
+    ("options", "message"),
+    [
+        ({"shadows": True, "shadow_map_size": 100}, r"shadow_map_size = 100 is not a power of two in \[64, 16384\]"),
+        ({"shadows": True, "shadow_map_size": 32}, r"shadow_map_size = 32 is not a power of two"),
+        ({"shadows": True, "shadow_map_size": 32768}, r"shadow_map_size = 32768 is not a power of two"),
+        ({"shadows": True, "shadow_map_size": 2048.0}, r"shadow_map_size = 2048.0 is not an integer"),
+        ({"shadows": True, "shadow_softness": -1}, r"shadow_softness = -1 is not a number in \[0, 16\]"),
+        ({"shadows": True, "shadow_softness": "soft"}, r"shadow_softness = 'soft' is not a number"),
+        ({"shadows": "maps"}, r"shadows = 'maps' is unknown; expected None"),
+        ({"shadows": True, "mode": "wireframe"}, r"shadows = True with mode = 'wireframe'"),
+        ({"shadows": True, "mode": "hidden-line"}, r"mode = 'hidden-line'"),
+        ({"shadows": True, "method": "a-buffer"}, r"not available with method = 'a-buffer'"),
+        ({"buffers": ("shadow",)}, r"asks for 'shadow' with shadows = None; give shadows=True or 'ray'"),
+        ({"buffers": ("position",), "mode": "points"}, r"asks for 'position' with mode = 'points'"),
+    ],
+)
+def test_bad_shadow_arguments(options, message):
+    scene = _sphere_and_box(LIGHTS["point"])
+    with pytest.raises(fr.FrustumError, match=message):
+        fr.render(scene, CAMERA, **options)
+
+
+def test_cube_maps_over_the_memory_budget():
+    scene = _sphere_and_box(LIGHTS["point"])
+    with fr.budget(bytes=2**30), pytest.raises(fr.FrustumError, match=r"shadow_map_size = 8192 .* point light.*budget"):
+        fr.render(scene, CAMERA, shadows=True, shadow_map_size=8192)
+
+
+def test_cast_shadows_must_be_a_bool():
+    with pytest.raises(fr.FrustumError, match=r"PointLight: cast_shadows = 'yes' is not a bool"):
+        fr.PointLight((0, 1, 0), cast_shadows="yes")
+    with pytest.raises(fr.FrustumError, match=r"SpotLight: cast_shadows = 1 is not a bool"):
+        fr.SpotLight((0, 1, 0), (0, -1, 0), cast_shadows=1)
+    assert fr.DirectionalLight((0, -1, 0)).cast_shadows is True
