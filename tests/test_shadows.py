@@ -258,7 +258,8 @@ def test_shadows_with_other_methods_and_supersampling():
         both = np.isfinite(frame.shadow) & np.isfinite(reference.shadow)
         assert ((frame.shadow[both] >= 0.5) == (reference.shadow[both] >= 0.5)).mean() > 0.995
     big = fr.render(scene, CAMERA, shadows=True, samples=4, buffers=("shadow", "position"))
-    assert big.shadow.shape == (CAMERA.height, CAMERA.width, 1) and big.position.shape == (CAMERA.height, CAMERA.width, 3)
+    assert big.shadow.shape == (CAMERA.height, CAMERA.width, 1)
+    assert big.position.shape == (CAMERA.height, CAMERA.width, 3)
 
 
 def test_light_order_of_the_shadow_buffer():

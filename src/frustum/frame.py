@@ -27,9 +27,9 @@ class Frame:
     scene item seen at each pixel (−1 for background); ``position`` (H, W, 3) float32 world points of the nearest
     opaque surface (NaN where nothing was drawn) and ``shadow`` (H, W, L) float32, the fraction of each of the L
     shadow-casting lights reaching the pixel (1 lit, 0 in shadow, NaN where nothing was drawn; lights in
-    ``Scene.world_lights`` order: the root's first, then those on nodes). All arrays are read-only. ``stats``: the visible-surface
-    method's counts (``render(..., method=...)``; spans, areas per level, depth tests, fragments per pixel …),
-    with ``stats["method"]`` its name, or None where none were asked for.
+    ``Scene.world_lights`` order: the root's first, then those on nodes). All arrays are read-only. ``stats``:
+    the visible-surface method's counts (``render(..., method=...)``; spans, areas per level, depth tests,
+    fragments per pixel …), with ``stats["method"]`` its name, or None where none were asked for.
     """
 
     color: NDArray[np.uint8]
@@ -54,7 +54,8 @@ class Frame:
         lights = None if self.shadow is None else np.shape(self.shadow)[2:3]
         for name, dtype, shape in (
             ("normals", np.float32, (*depth.shape, 3)), ("object_id", np.int32, depth.shape),
-            ("position", np.float32, (*depth.shape, 3)), ("shadow", np.float32, (*depth.shape, *(lights or (-1,)))),
+            ("position", np.float32, (*depth.shape, 3)),
+            ("shadow", np.float32, (*depth.shape, *(lights or (-1,)))),
         ):  # fmt: skip
             value = getattr(self, name)
             if value is None:

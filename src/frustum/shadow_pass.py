@@ -194,8 +194,12 @@ def light_fractions(
     size = options.map_size
     cube_count = sum(isinstance(light, PointLight) for light in casting)
     nbytes = (6 * cube_count + len(casting) - cube_count) * size * size * 4 + size * size * 12
-    check_memory(nbytes, where=where, cause=f"shadow_map_size = {size} with {len(casting)} shadow-casting light(s), "
-                 f"{cube_count} of them point lights (a cube of six maps each, {format_bytes(6 * size * size * 4)})")
+    check_memory(
+        nbytes,
+        where=where,
+        cause=f"shadow_map_size = {size} with {len(casting)} shadow-casting light(s), "
+        f"{cube_count} of them point lights (a cube of six maps each, {format_bytes(6 * size * size * 4)})",
+    )
     codes = np.empty((size, size), dtype=np.int32 if 2 * sum(i.mesh.face_count for i in items) < 2**31 else np.int64)
     bary = np.empty((size, size, 2), dtype=np.float32)
     for channel, light in zip(rows, casting, strict=True):
@@ -223,6 +227,9 @@ def occluded(scene: Scene, origins: np.ndarray, directions: np.ndarray, t_max: n
     t_max = np.ascontiguousarray(t_max, dtype=np.float64)
     if origins.shape[0] == 0:
         return np.zeros(0, dtype=bool)
+    query = getattr(scene, "occluded", None)
+    if callable(query):  # the scene's own ray queries (Scene.occluded), where this version has them
+        return np.asarray(query(origins, directions, t_max), dtype=bool)
     from frustum.raster import shadow
 
     found = scene._triangle_index(where="render")

@@ -25,10 +25,34 @@ import numpy as np
 from frustum.raster._jit import kernel, parallel_kernel
 from frustum.raster.bvh import _box_entry
 from frustum.raster.shade import (
-    I_BLEND, I_FACE_OFFSET, I_MODE, I_OBJECT_ID, I_SPECULAR_MODEL, I_WRITE_IDS, I_WRITE_NORMALS, P_AMBIENT,
-    P_COLOR, P_CUE_ON, P_DIFFUSE, P_EMISSIVE, P_EYE, P_LIGHT_AMBIENT, P_OPACITY, P_SHININESS, P_SPECULAR,
-    P_VIEW_AXIS, SHADE_FLAT, SHADE_NONE, SHADE_PHONG, SPECULAR_PHONG, _cue, _interpolate, _sample, _surface,
-    _to_byte, power,
+    I_BLEND,
+    I_FACE_OFFSET,
+    I_MODE,
+    I_OBJECT_ID,
+    I_SPECULAR_MODEL,
+    I_WRITE_IDS,
+    I_WRITE_NORMALS,
+    P_AMBIENT,
+    P_COLOR,
+    P_CUE_ON,
+    P_DIFFUSE,
+    P_EMISSIVE,
+    P_EYE,
+    P_LIGHT_AMBIENT,
+    P_OPACITY,
+    P_SHININESS,
+    P_SPECULAR,
+    P_VIEW_AXIS,
+    SHADE_FLAT,
+    SHADE_NONE,
+    SHADE_PHONG,
+    SPECULAR_PHONG,
+    _cue,
+    _interpolate,
+    _sample,
+    _surface,
+    _to_byte,
+    power,
 )  # fmt: skip
 
 __all__ = [
@@ -85,7 +109,8 @@ def surface_points(
 
 @kernel
 def _linear_depth(view: np.ndarray, z: float) -> float:
-    """Distance along the light's axis of window depth z (orthographic: linear; perspective: 2nf/((f+n) − z_ndc(f−n)))."""
+    """Distance along the light's axis of window depth z (orthographic: linear; perspective:
+    ``2nf/((f + n) − z_ndc·(f − n))``)."""
     near, far = view[M_NEAR], view[M_FAR]
     if view[M_KIND] == KIND_ORTHOGRAPHIC:
         return near + z * (far - near)
@@ -106,9 +131,11 @@ def _lookup(
     """
     size = shadow_map.shape[0]
     cos_theta = min(abs((nx * lx + ny * ly) + nz * lz), 1.0)
-    tan_theta = SLOPE_LIMIT if cos_theta * SLOPE_LIMIT <= math.sqrt(1.0 - cos_theta * cos_theta) else math.sqrt(
-        1.0 - cos_theta * cos_theta
-    ) / cos_theta
+    tan_theta = (
+        SLOPE_LIMIT
+        if cos_theta * SLOPE_LIMIT <= math.sqrt(1.0 - cos_theta * cos_theta)
+        else math.sqrt(1.0 - cos_theta * cos_theta) / cos_theta
+    )
     m = view
     texel = m[M_TEXEL]
     if m[M_KIND] != KIND_ORTHOGRAPHIC:  # texel size grows with the distance along the axis
@@ -126,15 +153,15 @@ def _lookup(
         return -1.0
     receiver = _linear_depth(view, min(max(z, 0.0), 1.0))
     bias = texel * (1.0 + (1.0 + softness) * tan_theta)
-    steps = int(math.ceil(softness))
+    steps = int(math.ceil(softness))  # noqa: RUF046 (an int in Python, a float's type for Numba's typing)
     step = softness / steps if steps > 0 else 0.0
     lit, taps = 0, 0
     for j in range(-steps, steps + 1):
         ty = y + j * step
-        row = size - 1 - int(math.floor(ty))
+        row = size - 1 - int(math.floor(ty))  # noqa: RUF046
         for i in range(-steps, steps + 1):
             tx = x + i * step
-            col = int(math.floor(tx))
+            col = int(math.floor(tx))  # noqa: RUF046
             taps += 1
             if row < 0 or row >= size or col < 0 or col >= size:
                 lit += 1
