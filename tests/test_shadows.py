@@ -313,3 +313,94 @@ def test_cast_shadows_must_be_a_bool():
     with pytest.raises(fr.FrustumError, match=r"SpotLight: cast_shadows = 1 is not a bool"):
         fr.SpotLight((0, 1, 0), (0, -1, 0), cast_shadows=1)
     assert fr.DirectionalLight((0, -1, 0)).cast_shadows is True
+
+
+# --- scene files and the CLI ------------------------------------------------------------------------------
+
+SCENE_TOML = """
+[render]
+size = [96, 72]
+{render}
+
+[camera]
+eye = [4.0, 5.0, 7.0]
+target = [0.0, 0.0, 0.0]
+
+[[lights]]
+type = "directional"
+direction = [1.0, -0.8, -0.3]
+{light}
+
+[[nodes]]
+geometry = {{ type = "plane", size = [10.0, 10.0] }}
+transform = [{{ rotate_x_deg = -90 }}]
+
+[[nodes]]
+geometry = {{ type = "box", center = [0.0, 0.5, 0.0] }}
+"""
+
+
+def _scene_file(tmp_path, render="", light=""):
+    path = tmp_path / "shadows.toml"
+    path.write_text(SCENE_TOML.format(render=render, light=light))
+    return path
+
+
+@pytest.mark.parametrize("value", ["true", '"ray"'])
+def test_scene_file_shadows(tmp_path, value):
+    from frustum.scenefile import load_scene_file, render_scene_file
+
+    loaded = load_scene_file(_scene_file(tmp_path, f"shadows = {value}\nshadow_map_size = 512\nshadow_softness = 0"))
+    assert loaded.options["shadows"] == (True if value == "true" else "ray")
+    assert loaded.options["shadow_map_size"] == 512 and loaded.options["shadow_softness"] == 0
+    shadowed = fr.render(loaded.scene, loaded.camera, **loaded.options)
+    plain = fr.render(loaded.scene, loaded.camera, **{**loaded.options, "shadows": False})
+    assert (shadowed.color[..., :3].astype(int).sum(axis=2) < plain.color[..., :3].astype(int).sum(axis=2)).sum() > 50
+    written = render_scene_file(_scene_file(tmp_path, f"shadows = {value}"), tmp_path / "out.png")
+    assert written.is_file()
+
+
+def test_scene_file_light_without_shadows(tmp_path):
+    from frustum.scenefile import load_scene_file
+
+    loaded = load_scene_file(_scene_file(tmp_path, "shadows = true", "cast_shadows = false"))
+    assert [light.cast_shadows for light in loaded.scene.world_lights()] == [False]
+    frame = fr.render(loaded.scene, loaded.camera, **loaded.options)
+    plain = fr.render(loaded.scene, loaded.camera, **{**loaded.options, "shadows": False})
+    assert np.array_equal(frame.color, plain.color)
+
+
+@pytest.mark.parametrize(
+    ("render", "light", "message"),
+    [
+        ('shadows = "maps"', "", r"shadows.* is not a shadow method"),
+        ("shadow_map_size = 32", "", r"shadow_map_size"),
+        ("", 'cast_shadows = "yes"', r"cast_shadows"),
+    ],
+)
+def test_scene_file_bad_shadows(tmp_path, render, light, message):
+    from frustum.scenefile import load_scene_file
+
+    with pytest.raises(fr.FrustumError, match=message):
+        load_scene_file(_scene_file(tmp_path, render, light))
+
+
+def test_cli_shadows_option(tmp_path):
+    import subprocess
+    import sys
+
+    path = _scene_file(tmp_path)
+    command = [sys.executable, "-m", "frustum", "render", str(path), "-o"]
+    plain = subprocess.run([*command, str(tmp_path / "plain.png")], capture_output=True, text=True, timeout=600)
+    shadowed = subprocess.run([*command, str(tmp_path / "ray.png"), "--shadows", "ray"], capture_output=True, text=True,
+                              timeout=600)  # fmt: skip
+    assert plain.returncode == 0 and shadowed.returncode == 0, shadowed.stderr
+    from PIL import Image
+
+    a = np.asarray(Image.open(tmp_path / "plain.png")).astype(int)
+    b = np.asarray(Image.open(tmp_path / "ray.png")).astype(int)
+    assert (b[..., :3].sum(axis=2) < a[..., :3].sum(axis=2)).sum() > 50
+    bad = subprocess.run([*command, str(tmp_path / "x.png"), "--shadows", "maybe"], capture_output=True, text=True,
+                         timeout=600)  # fmt: skip
+    assert bad.returncode != 0 and "--shadows 'maybe' is unknown; expected on, off or ray" in bad.stderr
+    assert len(bad.stderr.strip().splitlines()) == 1

@@ -127,7 +127,7 @@ _STEREO_KEYS = ("eye_separation", "convergence_distance", "layout", "anaglyph_me
 _RENDER_KEYS = (
     "size", "shading", "specular", "background", "cull_back_faces", "mode", "edges", "crease_angle_deg", "edge_color",
     "hidden", "hidden_color", "line_width", "depth_cue", "samples", "filter", "color_space", "columns", "method",
-    "transparency",
+    "transparency", "shadows", "shadow_map_size", "shadow_softness",
 )  # fmt: skip
 _DEPTH_CUE_KEYS = ("near", "far", "min_intensity", "max_intensity", "color")
 _LIGHT_TYPES = {"ambient": AmbientLight, "directional": DirectionalLight, "point": PointLight, "spot": SpotLight}
@@ -1453,6 +1453,14 @@ class _Stereo:
 # --- render options, exploded/cutaway, outputs -------------------------------------------------------------
 
 
+def _shadows(report: _Report, path: tuple, value: Any) -> Any:
+    """``[render] shadows``: true (shadow maps), false, or "ray" (shadow rays)."""
+    if isinstance(value, bool) or value == "ray":
+        return value
+    report.add(path, value, "is not a shadow method", 'give true (shadow maps), false or "ray" (shadow rays)')
+    return _BAD
+
+
 def _render_options(report: _Report, path: tuple, value: Any) -> tuple[dict, tuple[int, int], int]:
     params = _table(report, path, value)
     if params is _BAD:
@@ -1483,6 +1491,9 @@ def _render_options(report: _Report, path: tuple, value: Any) -> tuple[dict, tup
         "color_space": lambda p, v: _choice(report, p, v, ("linear", "srgb")),
         "method": lambda p, v: _choice(report, p, v, tuple(RENDER_METHODS)),
         "transparency": lambda p, v: _choice(report, p, v, TRANSPARENCY_MODES),
+        "shadows": lambda p, v: _shadows(report, p, v),
+        "shadow_map_size": lambda p, v: _number(report, p, v, low=64, high=16384, integer=True),
+        "shadow_softness": lambda p, v: _number(report, p, v, low=0.0, high=16.0),
     }
     for key, check in simple.items():
         if key in params:
@@ -2175,8 +2186,9 @@ def _write(scene_file: SceneFile, target: Path) -> Path:
 
 
 def render_scene_file(
-    path: str | Path, output: str | Path | Sequence[str | Path] | None = None, *, size: tuple[int, int] | None = None
-) -> Path | list[Path]:
+    path: str | Path, output: str | Path | Sequence[str | Path] | None = None, *, size: tuple[int, int] | None = None,
+    shadows: bool | str | None = None,
+) -> Path | list[Path]:  # fmt: skip
     """Render the scene file at `path` and write it by suffix: PNG, SVG or PDF (line drawing), GIF or MP4 (turntable).
 
     Parameters
@@ -2187,6 +2199,8 @@ def render_scene_file(
         Where to write. None: the file's ``[output].files``, or ``out/<stem>.png`` next to the scene file.
     size : (int, int), optional
         Image width and height, replacing ``[render].size``.
+    shadows : True, False, "ray" or None
+        Replaces ``[render].shadows`` (None: the file's).
 
     Returns
     -------
@@ -2204,6 +2218,8 @@ def render_scene_file(
     scene_file = load_scene_file(path)
     if size is not None:
         scene_file = scene_file.resized(tuple(size))  # type: ignore[arg-type]
+    if shadows is not None:
+        scene_file = dataclasses.replace(scene_file, options={**scene_file.options, "shadows": shadows})
     if output is None:
         targets = list(scene_file.outputs) or [Path(path).parent / "out" / (Path(path).stem + ".png")]
         single = not scene_file.outputs
