@@ -404,3 +404,89 @@ def test_cli_shadows_option(tmp_path):
                          timeout=600)  # fmt: skip
     assert bad.returncode != 0 and "--shadows 'maybe' is unknown; expected on, off or ray" in bad.stderr
     assert len(bad.stderr.strip().splitlines()) == 1
+
+
+# --- exact shadow polygons in vector drawings -------------------------------------------------------------
+
+shapely = pytest.importorskip("shapely")
+
+
+def _box_on_plane(light) -> fr.Scene:
+    scene = fr.Scene(lights=[light])
+    scene.add(plane((10, 10)), fr.Material(), transform=rotate_x(-math.pi / 2))
+    scene.add(box((1, 1, 1), center=(0, 0.5, 0)), fr.Material())
+    return scene
+
+
+SVG_LIGHTS = {"directional": fr.DirectionalLight((1.0, -1.0, -0.5)), "point": fr.PointLight((-2.0, 3.0, 1.5))}
+
+
+def _analytic_ground_shadow(light):
+    """The box's shadow on the ground, (x, z): hull of its corners projected from the light, and its base."""
+    corners = np.array([[x, y, z] for x in (-0.5, 0.5) for y in (0.0, 1.0) for z in (-0.5, 0.5)])
+    if isinstance(light, fr.DirectionalLight):
+        d = np.asarray(light.direction)
+        projected = corners - (corners[:, 1] / d[1])[:, None] * d
+    else:
+        p = np.asarray(light.position)
+        projected = p + (p[1] / (p[1] - corners[:, 1]))[:, None] * (corners - p)
+    hull = shapely.MultiPoint([tuple(q) for q in projected[:, [0, 2]]]).convex_hull
+    base = shapely.Polygon([(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)])
+    return hull, base
+
+
+@pytest.mark.parametrize("light_name", list(SVG_LIGHTS))
+def test_shadow_polygon_vertices_are_the_projected_silhouette(light_name):
+    """Seen from above (orthographic), the ground's shadow polygon is the projection of the box's silhouette from
+    the light less the base the box stands on: the same vertices to 1e-9."""
+    light = SVG_LIGHTS[light_name]
+    scene = _box_on_plane(light)
+    camera = fr.Camera(fr.ViewFrame((0.0, 10.0, 0.0), target=(0.0, 0.0, 0.0), up=(0.0, 0.0, -1.0)),
+                       fr.Orthographic(8.0, 0.1, 20.0), 400, 400)  # fmt: skip
+    polygons = [p for p in fr.shadow_polygons(scene, camera) if p.item == 0]
+    assert len(polygons) == 1 and polygons[0].kind == "cast" and len(polygons[0].loops) == 1
+    loop = polygons[0].loops[0]
+    hull, base = _analytic_ground_shadow(light)
+    expected_xz = np.array(hull.difference(base).exterior.coords)[:-1]
+    expected = camera.project(np.column_stack([expected_xz[:, 0], np.zeros(len(expected_xz)), expected_xz[:, 1]]))
+    expected = expected[:, :2]
+    assert loop.shape == expected.shape, (loop, expected)
+    distances = np.linalg.norm(loop[:, None, :] - expected[None, :, :], axis=2)
+    assert distances.min(axis=1).max() < 1e-9 and distances.min(axis=0).max() < 1e-9
+    assert polygons[0].area == pytest.approx(hull.difference(base).area * (400 / 8.0) ** 2, rel=1e-9)
+
+
+@pytest.mark.parametrize("light_name", list(SVG_LIGHTS))
+def test_shadow_polygon_area_equals_the_rasterized_shadow(light_name):
+    """Perspective view (the box hides part of its shadow): the polygons' area equals the area of the exact
+    shadow rays' Frame.shadow, 16x supersampled, within 1 %."""
+    light = SVG_LIGHTS[light_name]
+    scene = _box_on_plane(light)
+    eye, target = (3.0, 6.0, 5.0), (0.5, 0.0, 0.0)
+    camera = fr.Camera.look_at(eye, target, (0.0, 1.0, 0.0), width=300, height=225)
+    area = sum(p.area for p in fr.shadow_polygons(scene, camera))
+    fine = fr.Camera.look_at(eye, target, (0.0, 1.0, 0.0), width=1200, height=900)
+    frame = fr.render(scene, fine, shadows="ray", buffers=("shadow",))
+    raster = float((frame.shadow[..., 0] < 0.5).sum()) / 16.0
+    print(f"{light_name}: polygons {area:.2f} px², rasterized {raster:.2f} px²")
+    assert raster > 300
+    assert area == pytest.approx(raster, rel=0.01)
+
+
+def test_render_svg_and_drawing_sheet_draw_the_shadows():
+    scene = _box_on_plane(fr.sun_45())
+    assert np.allclose(fr.sun_45().direction, np.array([1.0, -1.0, -1.0]) / math.sqrt(3.0))
+    camera = fr.Camera.look_at((3.0, 6.0, 5.0), (0.5, 0.0, 0.0), (0.0, 1.0, 0.0), width=300, height=225)
+    plain = fr.render_svg(scene, camera)
+    assert 'id="shadows"' not in plain
+    filled = fr.render_svg(scene, camera, fill=True, shadows=True)
+    hatched = fr.render_svg(scene, camera, shadows=True)
+    assert '<g id="shadows" fill="#000000" fill-opacity="0.35"' in filled
+    assert 'fill="url(#shadow-hatch)"' in hatched and "<pattern id=\"shadow-hatch\"" in hatched
+    assert hatched.count('class="cast"') >= 1 and hatched.count('class="attached"') >= 1
+    # the shadows lie under the lines: their group comes before the edges
+    assert hatched.index('id="shadows"') < hatched.index('id="visible"')
+    sheet = fr.drawing_sheet(scene, ("front", "top"), shadows=True)
+    assert 'id="top-shadows"' in sheet and 'id="front-shadows"' in sheet
+    with pytest.raises(fr.FrustumError, match=r"shadows = 'yes' is not a bool"):
+        fr.render_svg(scene, camera, shadows="yes")

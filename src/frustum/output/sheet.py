@@ -551,6 +551,7 @@ def drawing_sheet(
     crease_angle: float = DEFAULT_CREASE_ANGLE,
     hidden: str | None = "dashed",
     stroke_width: float = 0.5,
+    shadows: bool = False,
 ) -> str:
     """An SVG engineering drawing of `scene`: multiview orthographic views, dimensions, title block, scale bar.
 
@@ -680,6 +681,8 @@ def drawing_sheet(
         # a pictorial view shows visible edges only (hidden lines are for the orthographic views)
         view_hidden = None if view.name == "isometric" else hidden
         body.append(_view_group(view, placed, centre_x, centre_y, drawing_scale, view_hidden, width_line))
+        if shadows:  # sciagraphy: the exact shadow polygons of the scene's lights in each view, hatched
+            body.append(_view_shadows(scene, view, centre_x, centre_y, drawing_scale))
         body += [_mark_svg(mark, f"{view.name}-", centre_x, centre_y) for mark in marks[view.name]]
     body.append(_title_block(paper_width, paper_height, title, drawing_scale, projection_angle))
     body.append(_scale_bar(drawing_scale, paper_height))
@@ -705,6 +708,26 @@ def _view_group(
     return (
         f'<g id="view-{view.name}" data-scale="{_number(scale)}" '
         f'data-centre="{_number(centre_x)} {_number(centre_y)}">{"".join(groups)}</g>'
+    )
+
+
+def _view_shadows(scene: Scene, view: _View, centre_x: float, centre_y: float, scale: float) -> str:
+    """The view's ``<g id="<view>-shadows">``: hatched shadow paths (``svg_shadows.shadow_polygons``) on paper."""
+    from frustum.output.svg_shadows import shadow_polygons
+
+    factor = scale * view.model_per_pixel
+    paths = []
+    for polygon in shadow_polygons(scene, view.camera):
+        loops = []
+        for loop in polygon.loops:
+            local = _to_local(loop, factor)
+            loops.append("M " + " L ".join(f"{_number(centre_x + x)} {_number(centre_y + y)}" for x, y in local) + " Z")
+        paths.append(f'<path d="{" ".join(loops)}" class="{polygon.kind}"/>')
+    return (
+        f'<g id="{view.name}-shadows" fill="url(#shadow-hatch)" fill-rule="evenodd" stroke="#000000" '
+        f'stroke-width="0.18"><defs><pattern id="shadow-hatch" patternUnits="userSpaceOnUse" width="1.5" '
+        'height="1.5" patternTransform="rotate(45)"><line x1="0" y1="0" x2="0" y2="1.5" stroke="#000000" '
+        f'stroke-width="0.18"/></pattern></defs>{"".join(paths)}</g>'
     )
 
 
