@@ -482,7 +482,7 @@ def test_render_svg_and_drawing_sheet_draw_the_shadows():
     filled = fr.render_svg(scene, camera, fill=True, shadows=True)
     hatched = fr.render_svg(scene, camera, shadows=True)
     assert '<g id="shadows" fill="#000000" fill-opacity="0.35"' in filled
-    assert 'fill="url(#shadow-hatch)"' in hatched and "<pattern id=\"shadow-hatch\"" in hatched
+    assert 'fill="url(#shadow-hatch)"' in hatched and '<pattern id="shadow-hatch"' in hatched
     assert hatched.count('class="cast"') >= 1 and hatched.count('class="attached"') >= 1
     # the shadows lie under the lines: their group comes before the edges
     assert hatched.index('id="shadows"') < hatched.index('id="visible"')

@@ -238,9 +238,7 @@ def _scene_faces(scene: Scene, camera: Camera) -> _Faces:
     offset = -(normal * tri[:, 0]).sum(axis=1)
     # the side toward the camera: a perspective eye, or the direction toward the viewer of a parallel camera
     eye = np.asarray(camera.frame.eye, dtype=np.float64)
-    toward = (
-        (normal @ eye + offset) if not camera.projection.parallel else (normal @ np.asarray(camera.frame.n, float))
-    )
+    toward = (normal @ eye + offset) if not camera.projection.parallel else (normal @ np.asarray(camera.frame.n, float))
     flip = np.where(toward < 0.0, -1.0, 1.0)
     return _Faces(tri, item, normal * flip[:, None], offset * flip)
 
@@ -405,9 +403,7 @@ def shadow_group(scene: Scene, camera: Camera, fill: bool) -> str:
         d = " ".join(
             "M " + " L ".join(f"{_number(x)} {_number(height - y)}" for x, y in loop) + " Z" for loop in polygon.loops
         )
-        paths.append(
-            f'<path d="{d}" class="{polygon.kind}" data-light="{polygon.light}" data-item="{polygon.item}"/>'
-        )
+        paths.append(f'<path d="{d}" class="{polygon.kind}" data-light="{polygon.light}" data-item="{polygon.item}"/>')
     if fill:
         style = 'fill="#000000" fill-opacity="0.35" fill-rule="evenodd" stroke="none"'
         defs = ""
