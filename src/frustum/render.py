@@ -183,6 +183,8 @@ def release_memory() -> int:
     with Scratch._lock:
         released = sum(a.nbytes for arrays in Scratch._pool.values() for a in arrays)
         Scratch._pool = {}
+    if "frustum.shadow_pass" in sys.modules:  # the shadow maps and per-pixel arrays of the shadow pass
+        released += sys.modules["frustum.shadow_pass"].release_memory()
     return released + FrameBuffers.release()
 
 
@@ -1478,6 +1480,7 @@ def _shadow_pass(
             scene, items, camera, options.shadow, lights, depth, points, facing, _draw_depth, "render"
         )
         options.outputs["casting"] = np.array(shadow_pass.shadow_lights(scene)[0], dtype=np.int64)
+    shadow_pass.give_back(facing)
 
 
 def _lit_per_light(
@@ -1516,4 +1519,8 @@ def _shadow_buffers(options: _Options) -> tuple[np.ndarray | None, np.ndarray | 
     if "shadow" in options.buffers and points is not None:
         seen = options.outputs["seen"][..., options.outputs["casting"]]
         shadow = np.where(np.isnan(points[..., :1]), np.float32(np.nan), seen).astype(np.float32)
+    if points is not None:  # copied out above: the next frame may have it
+        from frustum.shadow_pass import give_back
+
+        give_back(points)
     return position, shadow

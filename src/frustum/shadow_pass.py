@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import threading
 from collections.abc import Callable
 from typing import Any
 
@@ -52,8 +53,8 @@ from frustum.scene import Scene, SceneItem
 from frustum.shading import AmbientLight, DirectionalLight, PointLight, SpotLight
 
 __all__ = [
-    "SHADOW_METHODS", "ShadowOptions", "check_shadows", "light_fractions", "occluded", "shadow_lights",
-    "surface_points",
+    "SHADOW_METHODS", "ShadowOptions", "check_shadows", "give_back", "light_fractions", "occluded",
+    "release_memory", "shadow_lights", "surface_points",
 ]  # fmt: skip
 
 SHADOW_METHODS = (None, False, True, "ray")
@@ -63,6 +64,34 @@ RAY_EPSILON = 1e-6
 """Shadow rays start this far off the surface along its face normal, relative to the scene's size (its box's
 diagonal): well above the float64 round-off of a hit point, far below a pixel."""
 _MARGIN_TEXELS = 3.0
+_POOL: dict[tuple, list[np.ndarray]] = {}
+_POOL_LOCK = threading.Lock()
+
+
+def _take(shape: tuple[int, ...], dtype: Any) -> np.ndarray:
+    """An uninitialized work array, one a previous frame gave back where shape and dtype match (no first-touch
+    page faults for the maps and per-pixel arrays of an animation's every frame)."""
+    key = (tuple(shape), np.dtype(dtype).str)
+    with _POOL_LOCK:
+        arrays = _POOL.get(key)
+        if arrays:
+            return arrays.pop()
+    return np.empty(shape, dtype=dtype)
+
+
+def give_back(*arrays: np.ndarray) -> None:
+    """Keep `arrays` for the next frame (only the last frame's: the pool holds one array per shape)."""
+    with _POOL_LOCK:
+        for array in arrays:
+            _POOL[(array.shape, array.dtype.str)] = [array]
+
+
+def release_memory() -> int:
+    """Free the work arrays the shadow pass keeps between frames; return their bytes."""
+    with _POOL_LOCK:
+        released = sum(a.nbytes for arrays in _POOL.values() for a in arrays)
+        _POOL.clear()
+    return released
 
 
 @dataclasses.dataclass(frozen=True)
@@ -140,8 +169,9 @@ def surface_points(
     from frustum.raster import shadow
 
     height, width = depth.shape
-    points = np.full((height, width, 3), np.nan)
-    facing = np.zeros((height, width, 3))
+    points = _take((height, width, 3), np.float64)
+    points.fill(np.nan)
+    facing = _take((height, width, 3), np.float64)
     for index, world, offset in drawn:
         item = items[index]
         if item.mesh.face_count == 0:
@@ -200,13 +230,15 @@ def light_fractions(
         cause=f"shadow_map_size = {size} with {len(casting)} shadow-casting light(s), "
         f"{cube_count} of them point lights (a cube of six maps each, {format_bytes(6 * size * size * 4)})",
     )
-    codes = np.empty((size, size), dtype=np.int32 if 2 * sum(i.mesh.face_count for i in items) < 2**31 else np.int64)
-    bary = np.empty((size, size, 2), dtype=np.float32)
+    codes = _take((size, size), np.int32 if 2 * sum(i.mesh.face_count for i in items) < 2**31 else np.int64)
+    bary = _take((size, size, 2), np.float32)
+    seen_points = points[drawn]
     for channel, light in zip(rows, casting, strict=True):
-        cameras = _light_cameras(light, points[drawn], box, size, options.softness)
+        cameras = _light_cameras(light, seen_points, box, size, options.softness)
         if not cameras:
             continue
-        maps = np.ones((len(cameras), size, size), dtype=np.float32)
+        maps = _take((len(cameras), size, size), np.float32)
+        maps.fill(1.0)
         views = np.zeros((len(cameras), shadow.MAP_FIELDS))
         for face, (light_camera, texel) in enumerate(cameras):
             for item in casters:
@@ -214,6 +246,8 @@ def light_fractions(
             views[face] = _map_record(light_camera, texel, light)
         shadow.map_visibility(depth, points, facing, maps, views, np.ascontiguousarray(lights[channel]),
                               float(options.softness), seen, channel)  # fmt: skip
+        give_back(maps)
+    give_back(codes, bary)
     return seen
 
 
@@ -283,8 +317,10 @@ def _light_cameras(
         to_light = -np.asarray(light.direction, dtype=np.float64)
         frame = ViewFrame(np.zeros(3), normal=to_light, up=_up_for(to_light))
         view = frame.matrix[:3, :3]
-        seen = seen_points @ view.T
-        low, high = seen.min(axis=0), seen.max(axis=0)
+        # light-view coordinates of the seen points, row by row (no BLAS call: its threads fight the kernels')
+        seen = [(seen_points[:, 0] * r[0] + seen_points[:, 1] * r[1]) + seen_points[:, 2] * r[2] for r in view]
+        low = np.array([axis.min() for axis in seen])
+        high = np.array([axis.max() for axis in seen])
         side = float(max(high[0] - low[0], high[1] - low[1]))
         span = float(np.linalg.norm(box[1] - box[0]))
         side = max(side, 1e-9 * max(span, 1.0)) * (1.0 + 2.0 * reach)
