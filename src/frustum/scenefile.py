@@ -1619,7 +1619,7 @@ def _transfer_function(report: _Report, path: tuple, value: Any, module: Any) ->
 
 
 def _check_image_memory(report: _Report, options: dict, size: tuple[int, int], cameras: int) -> None:
-    """The image budget (``render._check_image_budget``'s estimate) at load time, so the error has file:line:
+    """The image budget (``render.options.check_image_budget``'s estimate) at load time, so the error has file:line:
     one camera's supersampled buffers (12 bytes a rendered pixel, more for extra buffers and filters) plus
     every camera's finished 8-byte pixels (a contact sheet keeps them all)."""
     width, height = size
