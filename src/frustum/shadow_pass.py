@@ -16,8 +16,8 @@ shadow-casting light in one of two ways.
   faces show no acne while shadows stay attached at contact. Percentage-closer filtering averages the test over
   a (2m + 1)² grid of taps spanning ±``shadow_softness`` texels (m = ⌈softness⌉; 0: one tap, hard edges).
 - **Shadow rays** (``shadows="ray"``): a ray from each point (moved off its face by a small epsilon along the face
-  normal) toward the light, any hit before the light ends it (``occluded``: ``Scene.occluded`` where the scene
-  has it, else the any-hit traversal of the scene's BVH, ``raster.shadow.any_hits``). Exact up to the epsilon.
+  normal) toward the light, any hit before the light ends it (``occluded``: ``Scene.occluded``, the any-hit
+  query through the scene's BVH, ``raster.rays``). Exact up to the epsilon.
 
 Either way a point whose drawn side faces away from the light gets 0 (the surface itself is in the way). What
 casts and receives: opaque meshes cast and receive; transparent items (``Material.opacity < 1``) cast no shadow
@@ -252,29 +252,22 @@ def light_fractions(
 
 
 def occluded(scene: Scene, origins: np.ndarray, directions: np.ndarray, t_max: np.ndarray) -> np.ndarray:
-    """(N,) bool: whether an opaque surface of `scene` meets each ray ``origin + t·direction``, 0 < t < t_max.
+    """(N,) bool: whether an opaque surface of `scene` meets each ray ``origin + t·direction``, 0 <= t < t_max.
 
-    ``Scene.occluded`` where the scene has it; else the any-hit traversal of the scene's BVH (the index of
-    ``Scene.pick``; transparent items are passed through: they cast no shadow)."""
+    ``Scene.occluded`` (the any-hit query through the scene's BVH). Transparent items cast no shadow: where the
+    scene has any, the rays go through a scene of its opaque items alone (whose index is built for the call)."""
     origins = np.ascontiguousarray(origins, dtype=np.float64)
     directions = np.ascontiguousarray(directions, dtype=np.float64)
     t_max = np.ascontiguousarray(t_max, dtype=np.float64)
     if origins.shape[0] == 0:
         return np.zeros(0, dtype=bool)
-    query = getattr(scene, "occluded", None)
-    if callable(query):  # the scene's own ray queries (Scene.occluded), where this version has them
-        return np.asarray(query(origins, directions, t_max), dtype=bool)
-    from frustum.raster import shadow
-
-    found = scene._triangle_index(where="render")
-    if found is None:
-        return np.zeros(origins.shape[0], dtype=bool)
-    items, index, starts = found
-    clear = np.array([item.material.opacity < 1.0 for item in items])
-    skip = np.repeat(clear, np.diff(starts)).astype(np.uint8) if clear.any() else np.empty(0, dtype=np.uint8)
-    hit = np.zeros(origins.shape[0], dtype=np.uint8)
-    shadow.any_hits(index.lo, index.hi, index.triangles, index.order, skip, origins, directions, t_max, hit)
-    return hit.astype(bool)
+    if any(item.material.opacity < 1.0 for item in scene.items):
+        opaque = Scene()
+        for item in scene.items:
+            if item.material.opacity >= 1.0:
+                opaque.add(item.mesh, item.material, transform=item.world_from_model)
+        scene = opaque
+    return np.asarray(scene.occluded(origins, directions, t_max), dtype=bool)
 
 
 def _to_light(light: Any, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -1,5 +1,5 @@
-"""Shadow kernels: surface points per pixel, shadow-map lookups with percentage-closer filtering, shadow rays
-through the scene's BVH (any hit), and the shading of pixels with a visibility factor per light.
+"""Shadow kernels: surface points per pixel, shadow-map lookups with percentage-closer filtering, and the shading of
+pixels with a visibility factor per light (shadow rays go through ``Scene.occluded``, ``raster.rays``).
 
 None of these runs on an ordinary render: they compile only when ``render(..., shadows=...)`` or the
 ``"position"``/``"shadow"`` buffers ask for them (``frustum.shadow_pass`` drives them).
@@ -23,7 +23,6 @@ import math
 import numpy as np
 
 from frustum.raster._jit import kernel, parallel_kernel
-from frustum.raster.bvh import _box_entry
 from frustum.raster.shade import (
     I_BLEND,
     I_FACE_OFFSET,
@@ -56,7 +55,7 @@ from frustum.raster.shade import (
 )  # fmt: skip
 
 __all__ = [
-    "MAP_FIELDS", "any_hits", "map_visibility", "shade_pixels_shadowed", "surface_points",
+    "MAP_FIELDS", "map_visibility", "shade_pixels_shadowed", "surface_points",
 ]  # fmt: skip
 
 # map record layout
@@ -211,69 +210,6 @@ def map_visibility(
                     face = 4 if -lz > 0.0 else 5
             found = _lookup(maps[face], views[face], px, py, pz, nx, ny, nz, lx, ly, lz, softness)
             visibility[row, col, channel] = 1.0 if found < 0.0 else found
-
-
-@kernel
-def _occluded(lo, hi, triangles, order, skip, ox, oy, oz, dx, dy, dz, t_max):
-    """Whether any triangle meets the ray ``o + t·d`` for t in (0, t_max) (any hit: the first one found ends the
-    search; both sides count; triangles with ``skip[face] != 0`` are passed through, `skip` empty: none). The
-    traversal of ``raster.bvh._cast_ray`` without the nearest-hit bookkeeping."""
-    masked = skip.shape[0] > 0
-    leaves = (lo.shape[0] + 1) // 2
-    ix = 1.0 / dx if dx != 0.0 else np.inf
-    iy = 1.0 / dy if dy != 0.0 else np.inf
-    iz = 1.0 / dz if dz != 0.0 else np.inf
-    stack = np.empty(64, dtype=np.int64)
-    if _box_entry(lo, hi, 0, ox, oy, oz, ix, iy, iz, t_max) == np.inf:
-        return False
-    stack[0] = 0
-    top = 1
-    while top > 0:
-        top -= 1
-        node = stack[top]
-        if node >= leaves - 1:
-            first = (node - (leaves - 1)) * 4
-            for r in range(first, first + 4):
-                if order[r] < 0 or (masked and skip[order[r]] != 0):
-                    continue
-                ax, ay, az = triangles[r, 0, 0], triangles[r, 0, 1], triangles[r, 0, 2]
-                e1x, e1y, e1z = triangles[r, 1, 0] - ax, triangles[r, 1, 1] - ay, triangles[r, 1, 2] - az
-                e2x, e2y, e2z = triangles[r, 2, 0] - ax, triangles[r, 2, 1] - ay, triangles[r, 2, 2] - az
-                qx, qy, qz = dy * e2z - dz * e2y, dz * e2x - dx * e2z, dx * e2y - dy * e2x
-                det = e1x * qx + e1y * qy + e1z * qz
-                if det == 0.0:
-                    continue
-                inv = 1.0 / det
-                sx, sy, sz = ox - ax, oy - ay, oz - az
-                u = (sx * qx + sy * qy + sz * qz) * inv
-                if u < 0.0 or u > 1.0:
-                    continue
-                cx, cy, cz = sy * e1z - sz * e1y, sz * e1x - sx * e1z, sx * e1y - sy * e1x
-                v = (dx * cx + dy * cy + dz * cz) * inv
-                if v < 0.0 or u + v > 1.0:
-                    continue
-                t = (e2x * cx + e2y * cy + e2z * cz) * inv
-                if 0.0 < t < t_max:
-                    return True
-            continue
-        for child in (2 * node + 1, 2 * node + 2):
-            if _box_entry(lo, hi, child, ox, oy, oz, ix, iy, iz, t_max) < np.inf:
-                stack[top] = child
-                top += 1
-    return False
-
-
-@parallel_kernel(lambda lo, hi, triangles, order, skip, origins, *_: origins.shape[0], grain=1024)
-def any_hits(
-    lo: np.ndarray, hi: np.ndarray, triangles: np.ndarray, order: np.ndarray, skip: np.ndarray, origins: np.ndarray,
-    directions: np.ndarray, t_max: np.ndarray, hit: np.ndarray,
-    start: int, stop: int,
-) -> None:  # fmt: skip
-    """hit[r] = 1 where ray r (origin, direction (N, 3) float64) meets a triangle of the hierarchy at t in
-    (0, t_max[r]), else 0 (``raster.bvh.Hierarchy`` arrays; skip (F,) uint8 or empty, as in ``_occluded``)."""
-    for r in range(start, stop):
-        hit[r] = _occluded(lo, hi, triangles, order, skip, origins[r, 0], origins[r, 1], origins[r, 2],
-                           directions[r, 0], directions[r, 1], directions[r, 2], t_max[r])  # fmt: skip
 
 
 @kernel
