@@ -490,3 +490,54 @@ def test_render_svg_and_drawing_sheet_draw_the_shadows():
     assert 'id="top-shadows"' in sheet and 'id="front-shadows"' in sheet
     with pytest.raises(fr.FrustumError, match=r"shadows = 'yes' is not a bool"):
         fr.render_svg(scene, camera, shadows="yes")
+
+
+# --- the polygon operations of the vector shadows (properties) --------------------------------------------
+
+from hypothesis import given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+from frustum.output import svg_shadows  # noqa: E402
+
+_coordinates = st.floats(-10.0, 10.0, allow_nan=False, allow_infinity=False)
+_point_sets = st.lists(st.tuples(_coordinates, _coordinates), min_size=3, max_size=8)
+
+
+def _convex(points):
+    from scipy.spatial import ConvexHull, QhullError
+
+    array = np.array(points, dtype=np.float64)
+    try:
+        hull = ConvexHull(array)
+    except (QhullError, ValueError):
+        return None
+    polygon = array[hull.vertices]
+    return polygon if hull.volume > 1e-3 else None  # counter-clockwise (Qhull's 2-D order)
+
+
+@settings(max_examples=60, deadline=None)
+@given(_point_sets, _point_sets)
+def test_convex_difference_and_intersection_partition_the_polygon(a_points, b_points):
+    a, b = _convex(a_points), _convex(b_points)
+    if a is None or b is None:
+        return
+    tiny = 1e-18
+    inside = svg_shadows._intersect(a, b)
+    outside = svg_shadows._subtract(a, b, tiny)
+    area = lambda p: abs(svg_shadows._signed_area(p)) if p.shape[0] >= 3 else 0.0  # noqa: E731
+    # round-off of a few clipped corners of coordinates up to 10: 1e-9 of the area scale
+    assert area(inside) + sum(area(p) for p in outside) == pytest.approx(area(a), abs=1e-9 * max(1.0, area(a)))
+    for piece in outside:  # disjoint from B
+        assert area(svg_shadows._intersect(svg_shadows._ccw(piece), b)) < 1e-9 * max(1.0, area(a))
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.lists(_point_sets, min_size=1, max_size=4))
+def test_outline_of_the_union_has_the_union_area(point_sets):
+    polygons = [p for p in (_convex(points) for points in point_sets) if p is not None]
+    if not polygons:
+        return
+    pieces = svg_shadows._disjoint_union(polygons, 1e-18)
+    loops = svg_shadows._outline(pieces, 20.0)
+    union = shapely.union_all([shapely.Polygon(p) for p in polygons])
+    assert sum(svg_shadows._signed_area(loop) for loop in loops) == pytest.approx(union.area, abs=1e-6)

@@ -82,7 +82,16 @@ def _clip_half_plane(polygon: NDArray, normal: NDArray, offset: float) -> NDArra
             out.append(p)
         if (sp > 0.0 > sq) or (sp < 0.0 < sq):
             out.append(p + (sp / (sp - sq)) * (q - p))
-    return np.array(out).reshape(-1, 2)
+    return _distinct(np.array(out).reshape(-1, 2))
+
+
+def _distinct(polygon: NDArray) -> NDArray:
+    """The polygon without repeated consecutive corners (a clip through a corner adds it twice)."""
+    if polygon.shape[0] < 2:
+        return polygon
+    scale = max(1.0, float(np.abs(polygon).max()))
+    keep = np.abs(polygon - np.roll(polygon, 1, axis=0)).max(axis=1) > _EPSILON * scale
+    return polygon[keep] if keep.any() else polygon[:1]
 
 
 def _edge_lines(polygon: NDArray) -> list[tuple[NDArray, float]]:
@@ -92,7 +101,8 @@ def _edge_lines(polygon: NDArray) -> list[tuple[NDArray, float]]:
     for i in range(count):
         p, q = polygon[i], polygon[(i + 1) % count]
         normal = np.array([-(q[1] - p[1]), q[0] - p[0]])
-        lines.append((normal, -float(normal @ p)))
+        if abs(normal[0]) + abs(normal[1]) > _EPSILON * max(1.0, abs(p[0]) + abs(p[1])):  # a repeated corner: no edge
+            lines.append((normal, -float(normal @ p)))
     return lines
 
 
