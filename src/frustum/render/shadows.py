@@ -30,8 +30,10 @@ SHADOWED_MODES = (shade.SHADE_PHONG, shade.SHADE_GOURAUD, shade.SHADE_FLAT)
 
 
 def draw_depth(item: SceneItem, camera: Camera, depth: np.ndarray, codes: np.ndarray, bary: np.ndarray) -> None:
-    """Stages 1–4 of one item, both sides, into `depth` alone (codes and weights are scratch): a shadow map."""
-    binned = bin_item(item, camera, False)
+    """Stages 1–4 of one item into `depth` alone (codes and weights are scratch): a shadow map. Both sides of an
+    open surface; the front faces alone of a closed one (``Mesh.is_watertight``: along any ray from outside the
+    first surface met is a front face, so the map is the same, for half the fill)."""
+    binned = bin_item(item, camera, bool(item.mesh.is_watertight))
     tiling = np.array([TILE_SIZE, binned.tiles_x, 0, depth.shape[1], depth.shape[0]], dtype=np.int64)
     triangles.rasterize_tiles(
         binned.faces, binned.win_int, binned.win_float, binned.tri_int, binned.tri_float, binned.tri_weights,
