@@ -541,3 +541,23 @@ def test_outline_of_the_union_has_the_union_area(point_sets):
     loops = svg_shadows._outline(pieces, 20.0)
     union = shapely.union_all([shapely.Polygon(p) for p in polygons])
     assert sum(svg_shadows._signed_area(loop) for loop in loops) == pytest.approx(union.area, abs=1e-6)
+
+
+@pytest.mark.parametrize("format", ["nerf", "webdataset"])
+def test_dataset_writes_position_and_shadow_for_a_scene_with_shadows(tmp_path, format):
+    from frustum.batch import render_dataset
+
+    path = _scene_file(tmp_path, "shadows = true")
+    result = render_dataset(path, tmp_path / "out", views=2, format=format, executor="serial", progress=False)
+    assert result.ok and len(result.rendered) == 2
+    if format == "nerf":
+        positions = sorted((tmp_path / "out" / "position").glob("*.npy"))
+        shadows = sorted((tmp_path / "out" / "shadow").glob("*.npy"))
+        assert len(positions) == 2 and len(shadows) == 2
+        position, shadow = np.load(positions[0]), np.load(shadows[0])
+        assert position.shape == (72, 96, 3) and shadow.shape == (72, 96, 1)
+        assert np.array_equal(np.isnan(position[..., 0]), np.isnan(shadow[..., 0]))
+        assert (shadow[np.isfinite(shadow)] == 0.0).any()
+    plain = _scene_file(tmp_path, "")
+    render_dataset(plain, tmp_path / "plain", views=1, format="nerf", executor="serial", progress=False)
+    assert not (tmp_path / "plain" / "shadow").exists()
