@@ -212,6 +212,10 @@ _LAZY = {
     "over_under": "frustum.output.stereo",
     "release_memory": "frustum.render",
     "render": "frustum.render",
+    "radiosity": "frustum.radiosity",
+    "RadiosityError": "frustum.radiosity",
+    "RadiosityResult": "frustum.radiosity",
+    "EnvironmentMap": "frustum.environment",
     "render_examples": "frustum.scenefile",
     "render_scene_file": "frustum.scenefile",
     "render_stereo": "frustum.output.stereo",
@@ -285,6 +289,9 @@ _LAZY = {
     "STANDARD_SCALES": "frustum.output.sheet",
     "drawing_sheet": "frustum.output.sheet",
     "scale_label": "frustum.output.sheet",
+    "DIMENSION_MODES": "frustum.output.sheet",
+    "TITLE_BLOCK_FIELDS": "frustum.output.sheet",
+    "find_circles": "frustum.output.true_curves",
     "FILL_ORDERS": "frustum.output.svg",
     "HIDDEN_STYLES": "frustum.output.svg",
     "render_svg": "frustum.output.svg",
@@ -338,6 +345,7 @@ if TYPE_CHECKING:  # pragma: no cover
         DepthOrder,
         depth_sort,
     )
+    from frustum.environment import EnvironmentMap
     from frustum.geometry.csg import (
         difference,
         intersection,
@@ -414,9 +422,11 @@ if TYPE_CHECKING:  # pragma: no cover
     )
     from frustum.output.animation import turntable, write_animation
     from frustum.output.sheet import (
+        DIMENSION_MODES,
         PAPER_SIZES,
         SHEET_VIEWS,
         STANDARD_SCALES,
+        TITLE_BLOCK_FIELDS,
         drawing_sheet,
         scale_label,
     )
@@ -438,6 +448,8 @@ if TYPE_CHECKING:  # pragma: no cover
         svg_path_from_bezier,
         svg_path_from_polyline,
     )
+    from frustum.output.true_curves import find_circles
+    from frustum.radiosity import RadiosityError, RadiosityResult, radiosity
     from frustum.raster._jit import set_threads
     from frustum.render import RENDER_METHODS, RENDER_MODES, SHADING_MODES, VISIBILITY_METHODS, release_memory, render
     from frustum.scenefile import (
@@ -527,6 +539,7 @@ __all__ = [
     "DEFAULT_BYTES",
     "DEFAULT_MAX_BYTES",
     "DEFAULT_OPERATIONS",
+    "DIMENSION_MODES",
     "EDGE_BOUNDARY",
     "EDGE_CREASE",
     "EDGE_KINDS",
@@ -556,6 +569,7 @@ __all__ = [
     "STANDARD_SCALES",
     "STEREO_LAYOUTS",
     "SUPPORTED_SUFFIXES",
+    "TITLE_BLOCK_FIELDS",
     "TRANSFER_PRESETS",
     "VIEW_VOLUME_PLANES",
     "VISIBILITY_METHODS",
@@ -587,6 +601,7 @@ __all__ = [
     "DirectionalLight",
     "DiskEmitter",
     "Drag",
+    "EnvironmentMap",
     "Frame",
     "Frustum",
     "FrustumError",
@@ -625,6 +640,8 @@ __all__ = [
     "PrincipalVanishingPoints",
     "Projection",
     "Quaternion",
+    "RadiosityError",
+    "RadiosityResult",
     "Ray",
     "RayHits",
     "RenderJob",
@@ -703,6 +720,7 @@ __all__ = [
     "fbm_cloud",
     "fbm_terrain",
     "feature_edges",
+    "find_circles",
     "fractal_coastline",
     "frustum",
     "general_perspective",
@@ -749,6 +767,7 @@ __all__ = [
     "quaternion_julia",
     "quaternion_julia_mesh",
     "quaternion_julia_volume",
+    "radiosity",
     "reflect",
     "region_code",
     "release_memory",

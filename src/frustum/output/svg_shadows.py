@@ -154,6 +154,15 @@ def _outline(pieces: list[NDArray], scale: float) -> list[NDArray]:
     if not pieces:
         return []
     tolerance = _EPSILON * scale * 1e3
+
+    def thickness(piece: NDArray) -> float:
+        perimeter = float(np.linalg.norm(np.roll(piece, -1, axis=0) - piece, axis=1).sum())
+        return 2.0 * abs(_signed_area(piece)) / perimeter if perimeter > 0.0 else 0.0
+
+    # slivers thinner than the tolerance that merges corners would chain into inconsistent loops: left out
+    pieces = [piece for piece in pieces if thickness(piece) > tolerance]
+    if not pieces:
+        return []
     vertices = np.concatenate(pieces)
     segments = []
     for piece in pieces:
