@@ -17,6 +17,7 @@ from frustum.render.stages import (
     TILE_SIZE,
     Lighting,
     Pixels,
+    _plain_surface,
     bin_item,
     item_flags,
     shading_parameters,
@@ -68,9 +69,11 @@ def shade_item(
 ) -> None:  # fmt: skip
     """``stages.shade_item`` with shadows: an opaque item in a shadowed mode goes through
     ``raster.shadow.shade_pixels_shadowed`` with the fractions ``prepare`` found; anything else is shaded as
-    without shadows (transparent items receive none)."""
+    without shadows (transparent items receive none, nor items with a bump or normal map or an environment to
+    reflect: their kernels take no shadow fractions yet)."""
     seen = None if options.outputs is None else options.outputs.get("seen")
-    if seen is None or blend or options.shade_mode not in SHADOWED_MODES or seen.shape[:2] != pixels.codes.shape:
+    plain = seen is None or blend or options.shade_mode not in SHADOWED_MODES or seen.shape[:2] != pixels.codes.shape
+    if plain or not _plain_surface(item, options):  # bump, normal maps and reflections shade their own way
         shade_item_plainly(item, index, face_offset, camera, options, lighting, attributes, pixels, band, blend)
         return
     from frustum.raster import shadow
