@@ -93,6 +93,12 @@ def _attenuation(value: ArrayLike, where: str) -> Vector3:
     return read_only(coefficients)
 
 
+def _check_cast_shadows(value: Any, where: str) -> None:
+    """``cast_shadows`` (whether surfaces shadow this light where a method draws shadows) must be a bool."""
+    if not isinstance(value, bool | np.bool_):
+        raise ShadingError(f"{where}: cast_shadows = {describe(value)} is not a bool; give True or False")
+
+
 def _texture(value: Any, where: str) -> NDArray[np.float32] | None:
     if value is None:
         return None
@@ -124,8 +130,19 @@ class Material:
     over what lies behind it, drawn back to front after the opaque surfaces: the "ghosted" parts of a cutaway),
     ``texture`` an (H, W[, 3|4]) image sampled bilinearly at the mesh's UV coordinates (v up: v = 0 is the
     image's bottom row; uint8 bytes are taken as linear values / 255), multiplied into the base color.
+    ``emission`` (>= 0, default 1) scales ``emissive`` for ``radiosity``: an emitter's radiance is
+    ``emissive · emission``, which may exceed 1 (the local illumination model adds ``emissive`` alone).
+    ``reflectivity`` in [0, 1]: the share of the color that is the mirror reflection of the surroundings (the
+    scene's environment map in the depth-buffer pipeline: ``(1 − r)·I + r·env(R)``).
+    ``bump`` an (H, W[, 3|4]) height image (gray, in [0, 1], times ``bump_scale`` world units) and ``normal_map``
+    an (H, W, 3|4) tangent-space normal image (OpenGL convention, +y up): both perturb the shading normal per pixel
+    in Phong shading, from the mesh's UVs (``frustum.surface_detail``; flat and Gouraud shading ignore them).
     ``hatch`` (vector output only): the spacing of 45° section lines drawn over the faces in filled SVG/PDF,
     in drawing units, as engineering drawings mark cut surfaces (``cutaway`` sets it on section caps).
+    With ``render(..., method="ray-tracing")`` ``reflectivity`` is the weight of the traced mirror-reflected ray
+    (the same ``(1 − r)·I + r·reflected``), and ``ior`` (index of refraction, > 0; 1 bends nothing, glass 1.5;
+    read by that method only) bends the ray transmitted through a surface of opacity < 1 (Snell's law;
+    docs/ray-tracing.md).
     Raises ``ShadingError`` for a non-finite or negative coefficient, a color outside [0, 1] or a bad texture.
     """
 
@@ -138,9 +155,19 @@ class Material:
     opacity: float = 1.0
     texture: NDArray[np.float32] | None = None
     hatch: float | None = None
+    emission: float = 1.0
+    reflectivity: float = 0.0
+    bump: NDArray[np.float32] | None = None
+    bump_scale: float = 1.0
+    normal_map: NDArray[np.float32] | None = None
+    ior: float = 1.0
 
     def __post_init__(self) -> None:
         where = "Material"
+        ior = as_scalar(self.ior, "ior", where=where, error=ShadingError)
+        if not (math.isfinite(ior) and ior > 0.0):
+            raise ShadingError(f"{where}: ior = {ior!r} is not a finite index of refraction > 0 (glass: 1.5)")
+        object.__setattr__(self, "ior", ior)
         if self.hatch is not None:
             spacing = as_scalar(self.hatch, "hatch", where=where, error=ShadingError)
             if not spacing > 0.0:
@@ -155,6 +182,15 @@ class Material:
             raise ShadingError(f"{where}: opacity = {opacity!r} is above 1; expected 0 <= opacity <= 1")
         object.__setattr__(self, "opacity", opacity)
         object.__setattr__(self, "texture", _texture(self.texture, where))
+        object.__setattr__(self, "emission", _nonnegative(self.emission, "emission", where))
+        reflectivity = _nonnegative(self.reflectivity, "reflectivity", where)
+        if reflectivity > 1.0:
+            raise ShadingError(f"{where}: reflectivity = {reflectivity!r} is above 1; expected 0 <= reflectivity <= 1")
+        object.__setattr__(self, "reflectivity", reflectivity)
+        object.__setattr__(self, "bump", _texture(self.bump, f"{where} bump"))
+        bump_scale = as_scalar(self.bump_scale, "bump_scale", where=where, error=ShadingError)
+        object.__setattr__(self, "bump_scale", bump_scale)
+        object.__setattr__(self, "normal_map", _texture(self.normal_map, f"{where} normal_map"))
 
     def with_(self, **changes: Any) -> Material:
         """A copy with some fields changed, e.g. ``material.with_(opacity=0.3)``."""
@@ -184,9 +220,11 @@ class DirectionalLight:
     direction: Vector3
     color: Vector3 = (1.0, 1.0, 1.0)  # type: ignore[assignment]
     intensity: float = 1.0
+    cast_shadows: bool = True
 
     def __post_init__(self) -> None:
         where = "DirectionalLight"
+        _check_cast_shadows(self.cast_shadows, where)
         object.__setattr__(
             self, "direction", read_only(as_direction(self.direction, "direction", where=where, error=ShadingError))
         )
@@ -212,9 +250,11 @@ class PointLight:
     color: Vector3 = (1.0, 1.0, 1.0)  # type: ignore[assignment]
     intensity: float = 1.0
     attenuation: Vector3 = (1.0, 0.0, 0.0)  # type: ignore[assignment]
+    cast_shadows: bool = True
 
     def __post_init__(self) -> None:
         where = type(self).__name__
+        _check_cast_shadows(self.cast_shadows, where)
         object.__setattr__(
             self, "position", read_only(as_vector3(self.position, "position", where=where, error=ShadingError))
         )
@@ -240,9 +280,11 @@ class SpotLight:
     inner_angle: float = math.radians(20.0)
     outer_angle: float = math.radians(30.0)
     attenuation: Vector3 = (1.0, 0.0, 0.0)  # type: ignore[assignment]
+    cast_shadows: bool = True
 
     def __post_init__(self) -> None:
         where = "SpotLight"
+        _check_cast_shadows(self.cast_shadows, where)
         object.__setattr__(
             self, "position", read_only(as_vector3(self.position, "position", where=where, error=ShadingError))
         )
@@ -267,6 +309,13 @@ class SpotLight:
         position = apply(world_from_model, self.position[None, :])[0]
         direction = apply_to_directions(world_from_model, self.direction[None, :])[0]
         return replace(self, position=position, direction=direction)
+
+
+def sun_45(intensity: float = 1.0, color: Any = (1.0, 1.0, 1.0), cast_shadows: bool = True) -> DirectionalLight:
+    """The sciagraphy sun: rays along the diagonal of a cube from the upper left front, ``direction ∝ (1, −1, −1)``
+    (y up, the front elevation seen along −z), so in the front elevation and in the plan every ray and every
+    shadow edge runs at 45°, and a shadow's width equals the depth of what casts it (architects' convention)."""
+    return DirectionalLight((1.0, -1.0, -1.0), color=color, intensity=intensity, cast_shadows=cast_shadows)
 
 
 Light = AmbientLight | DirectionalLight | PointLight | SpotLight

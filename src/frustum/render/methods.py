@@ -6,6 +6,7 @@ counts (``stats=True``)."""
 
 from __future__ import annotations
 
+import dataclasses
 import importlib
 from collections.abc import Callable
 from typing import Any
@@ -15,6 +16,7 @@ import numpy as np
 from frustum.camera import Camera
 from frustum.frame import Frame, background_bytes
 from frustum.geometry import Mesh
+from frustum.render import shadows
 from frustum.render.buffers import Buffers, Scratch, clear_buffers
 from frustum.render.options import METHOD_NAMES, RenderOptions, check_arguments
 from frustum.render.stages import (
@@ -144,10 +146,12 @@ def draw_surfaces_by_method(
     else:
         tris = window_triangles(items, opaque, offsets, camera, options.cull)
         counts.update(draw(tris, depth, pixels.codes, pixels.bary))
+    attributes = {index: world_attributes(items[index], scratch) for index in opaque}
+    shadows.prepare(scene, items, [(i, attributes[i][0], offsets[i]) for i in opaque], camera, options, lighting,
+                    pixels)  # fmt: skip
     for index in opaque:
-        attributes = world_attributes(items[index], scratch)
-        shade_item(items[index], index, offsets[index], camera, options, lighting, attributes, pixels, (0, height),
-                   blend=False)  # fmt: skip
+        shadows.shade_item(items[index], index, offsets[index], camera, options, lighting, attributes[index], pixels,
+                           (0, height), blend=False)  # fmt: skip
     between()
     if not clear_items:
         return
@@ -194,6 +198,7 @@ def _composite(
     dummy = (np.zeros((1, 1, 3), dtype=np.float32), np.zeros((1, 1), dtype=np.int32))
     owner = tris.item[fragments.triangle]
     columns = 256
+    flat_options = dataclasses.replace(options, environment=None)  # fragment images have no pixel rays to reflect
     for index in sorted(set(tris.item.tolist())):
         # the item's fragments as a (rows, 256) image, padded with depth 1 (nothing drawn), shaded by the one kernel:
         # opaque items as the depth buffer shades them, transparent ones blended over transparent black
@@ -209,7 +214,7 @@ def _composite(
         attributes = world_attributes(items[index], scratch)
         image = Pixels(depth_image.reshape(rows, columns), code_image.reshape(rows, columns),
                        bary_image.reshape(rows, columns, 2), color_image, dummy)  # fmt: skip
-        shade_item(items[index], index, offsets[index], camera, options, lighting, attributes, image, (0, rows),
+        shade_item(items[index], index, offsets[index], camera, flat_options, lighting, attributes, image, (0, rows),
                    blend=items[index].material.opacity < 1.0)  # fmt: skip
         premultiplied[chosen] = color_image.reshape(-1, 4)[: chosen.shape[0]]
     if under_depth is None:

@@ -4,6 +4,7 @@ counts (``explain_method``), and the example gallery (``render_examples``)."""
 
 from __future__ import annotations
 
+import dataclasses
 import importlib
 from collections.abc import Sequence
 from pathlib import Path
@@ -63,8 +64,9 @@ def _write(scene_file: SceneFile, target: Path) -> Path:
 
 
 def render_scene_file(
-    path: str | Path, output: str | Path | Sequence[str | Path] | None = None, *, size: tuple[int, int] | None = None
-) -> Path | list[Path]:
+    path: str | Path, output: str | Path | Sequence[str | Path] | None = None, *, size: tuple[int, int] | None = None,
+    shadows: bool | str | None = None,
+) -> Path | list[Path]:  # fmt: skip
     """Render the scene file at `path` and write it by suffix: PNG, SVG or PDF (line drawing), GIF or MP4 (turntable).
 
     Parameters
@@ -75,6 +77,8 @@ def render_scene_file(
         Where to write. None: the file's ``[output].files``, or ``out/<stem>.png`` next to the scene file.
     size : (int, int), optional
         Image width and height, replacing ``[render].size``.
+    shadows : True, False, "ray" or None
+        Replaces ``[render].shadows`` (None: the file's).
 
     Returns
     -------
@@ -92,6 +96,8 @@ def render_scene_file(
     scene_file = load_scene_file(path)
     if size is not None:
         scene_file = scene_file.resized(tuple(size))  # type: ignore[arg-type]
+    if shadows is not None:
+        scene_file = dataclasses.replace(scene_file, options={**scene_file.options, "shadows": shadows})
     if output is None:
         targets = list(scene_file.outputs) or [Path(path).parent / "out" / (Path(path).stem + ".png")]
         single = not scene_file.outputs
@@ -103,12 +109,12 @@ def render_scene_file(
     return written[0] if single else written
 
 
-def render_view_sheet(
-    path: str | Path, output: str | Path, views: Sequence[str] = ("front", "top", "right", "isometric"), **options: Any
-) -> Path:
-    """An engineering drawing sheet (``drawing_sheet``) of the scene file's scene: SVG, or PDF/PNG by suffix.
+def render_view_sheet(path: str | Path, output: str | Path, views: Sequence[str] | None = None, **options: Any) -> Path:
+    """An engineering drawing sheet (``drawing_sheet``) of the scene file's scene: SVG, or PDF/PNG/DXF by suffix.
 
-    ``views`` accepts "iso" for "isometric". Other keywords go to ``drawing_sheet`` (scale, paper, title, ...).
+    ``views`` accepts "iso" for "isometric" (default: the file's ``[sheet] views``, else front, top, right and
+    isometric). Other keywords go to ``drawing_sheet`` (scale, paper, title, title_block, ...) and override the
+    file's ``[sheet]`` table; ``title_block`` fields are merged over the file's.
     """
     scene_file = load_scene_file(path)
     try:
@@ -116,11 +122,18 @@ def render_view_sheet(
         svg = importlib.import_module("frustum.output.svg")
     except ImportError:
         raise OutputError("render_view_sheet: drawing sheets are not available in this version") from None
-    names = ["isometric" if v == "iso" else v for v in views]
-    options.setdefault("title", scene_file.title)
-    text = sheet.drawing_sheet(scene_file.scene, names, **options)
+    settings = dict(scene_file.sheet)
+    file_views = settings.pop("views", ("front", "top", "right", "isometric"))
+    names = ["isometric" if v == "iso" else v for v in (views if views is not None else file_views)]
+    title_block = {**settings.pop("title_block", {}), **(options.pop("title_block", None) or {})}
+    settings.update({key: value for key, value in options.items() if value is not None})
+    settings.setdefault("title", scene_file.title)
     target = Path(output)
     target.parent.mkdir(parents=True, exist_ok=True)
+    if target.suffix.lower() == ".dxf":
+        sheet.drawing_sheet(scene_file.scene, names, title_block=title_block or None, path=target, **settings)
+        return target
+    text = sheet.drawing_sheet(scene_file.scene, names, title_block=title_block or None, **settings)
     return Path(svg.save_svg(text, target))
 
 
