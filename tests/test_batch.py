@@ -646,9 +646,11 @@ def test_url_datasets_equal_a_folder_and_resume_and_refuse_like_one(scene_path, 
 
 
 def test_url_resume_after_sigkill_reads_the_parts_of_the_run_log(scene_path, tmp_path) -> None:
-    """A URL's run log is written in parts every few seconds: a killed run leaves them, the next run reads them."""
+    """A URL's run log is written in parts every few seconds: a killed run leaves them, the next run reads them.
+
+    300 views: the run must outlast the first part (``URL_LOG_SECONDS`` = 2 s) on a fast machine too."""
     pytest.importorskip("fsspec")
-    arguments = ["--views", "60", "--layout", "sphere", "--format", "files", "--size", "320x240", "--no-progress",
+    arguments = ["--views", "300", "--layout", "sphere", "--format", "files", "--size", "200x150", "--no-progress",
                  "--executor", "serial"]  # fmt: skip
     url = f"file://{tmp_path}/killed"
     environment = {**os.environ, "PYTHONPATH": os.pathsep.join([str(SRC), os.environ.get("PYTHONPATH", "")])}
@@ -665,11 +667,11 @@ def test_url_resume_after_sigkill_reads_the_parts_of_the_run_log(scene_path, tmp
     process.wait()
     assert not (tmp_path / "killed/cameras.json").exists(), "the first run was not stopped midway"
     logged = sum(p.read_text().count("\n") for p in parts.glob("*.jsonl"))
-    result = render_dataset(scene_path, url, views=60, layout="sphere", format="files", size=(320, 240),
+    result = render_dataset(scene_path, url, views=300, layout="sphere", format="files", size=(200, 150),
                             executor="serial", progress=False)  # fmt: skip
-    assert len(result.skipped) == logged > 0 and len(result.rendered) == 60 - logged
+    assert len(result.skipped) == logged > 0 and len(result.rendered) == 300 - logged
     assert not parts.exists() or not any(parts.iterdir())
-    render_dataset(scene_path, tmp_path / "reference", views=60, layout="sphere", format="files", size=(320, 240),
+    render_dataset(scene_path, tmp_path / "reference", views=300, layout="sphere", format="files", size=(200, 150),
                    executor="serial", progress=False)  # fmt: skip
     assert files_of(tmp_path / "killed") == files_of(tmp_path / "reference")
 
