@@ -7,6 +7,8 @@
 import importlib.util
 import inspect
 import json
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -65,3 +67,43 @@ def test_render_is_the_function_and_the_package_imports():
     assert inspect.isfunction(frustum.render)
     assert frustum.render is render
     assert str(inspect.signature(frustum.render)) == SNAPSHOT["frustum"]["render"]["signature"]
+
+
+@pytest.mark.parametrize("package", ["frustum", "frustum.geometry"])
+def test_the_stub_lists_every_public_name_once(package):
+    """SPEC 1: ``__init__.pyi`` is the one list of public names (``lazy_loader.attach_stub`` reads it)."""
+    import ast
+
+    module = importlib.import_module(package)
+    stub = Path(module.__file__).with_suffix(".pyi")
+    listed = [alias.name for node in ast.parse(stub.read_text()).body if isinstance(node, ast.ImportFrom)
+              for alias in node.names]  # fmt: skip
+    assert len(listed) == len(set(listed)), sorted(n for n in listed if listed.count(n) > 1)
+    public = set(module.__all__) - {"__version__"} | ({"Viewer"} if package == "frustum" else set())
+    assert public - set(listed) == set()
+    assert set(listed) - public == set(module._SUBMODULES)
+
+
+@pytest.mark.parametrize(
+    "first",
+    ["import frustum.render", "import frustum.trace", "import frustum.warmup", "import frustum.geometry.teapot",
+     "from frustum.render import surfaces", "import frustum"],
+)  # fmt: skip
+def test_a_submodule_import_never_hides_the_function_of_its_name(first):
+    """``frustum.render``, ``trace``, ``warmup`` and ``geometry.teapot`` are functions, whatever was imported first."""
+    code = (
+        f"{first}\n"
+        "import inspect, frustum, frustum.render, frustum.trace, frustum.warmup, frustum.geometry.teapot\n"
+        "names = [frustum.render, frustum.trace, frustum.warmup, frustum.teapot, frustum.geometry.teapot]\n"
+        "assert all(inspect.isfunction(f) for f in names), names\n"
+        "assert frustum.render.__module__ == 'frustum.render' and frustum.geometry.teapot is frustum.teapot\n"
+        "print('ok')\n"
+    )
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert proc.stdout.strip() == "ok", proc.stderr
+
+
+def test_import_frustum_imports_no_module_of_the_package():
+    code = "import sys, frustum; print(sorted(m for m in sys.modules if m.startswith(('frustum.', 'numpy', 'numba'))))"
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert proc.stdout.strip() == "[]", proc.stderr
