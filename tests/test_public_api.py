@@ -1,8 +1,9 @@
 """The public API is the same as before the house was split into packages (issue 35): every name of ``frustum`` and
 ``frustum.geometry``, what ``dir`` shows, every public signature, and every public class's members.
 
-``tests/data/public_api.json`` was captured from the code before the split by ``tests/data/capture_public_api.py``
-(run it again only for a deliberate change of the public API)."""
+``tests/data/public_api.json`` was captured from the code before the split (commit d8bb076) by
+``tests/data/capture_public_api.py``. Later issues may add names, members and keyword parameters with defaults;
+nothing of the snapshot may go or change (a deliberate break: capture the snapshot again)."""
 
 import importlib.util
 import inspect
@@ -29,9 +30,33 @@ def _describe(module, names):
     return capture.describe(module, names)
 
 
-def test_all_lists_the_same_names():
-    assert sorted(frustum.__all__) == SNAPSHOT["frustum.__all__"]
-    assert sorted(frustum.geometry.__all__) == SNAPSHOT["frustum.geometry.__all__"]
+def test_all_still_lists_every_name():
+    assert set(SNAPSHOT["frustum.__all__"]) - set(frustum.__all__) == set()
+    assert set(SNAPSHOT["frustum.geometry.__all__"]) - set(frustum.geometry.__all__) == set()
+    assert "Viewer" not in frustum.__all__  # (it needs the viewer extra: `from frustum import *` works without it)
+
+
+def _compatible(before, now):
+    """Whether `now` (a ``describe`` entry) keeps everything of `before`: the kind, every parameter in order with its
+    kind and default (added parameters need a default), every member (added members are fine)."""
+    if before is None or now is None or before.keys() - now.keys() or before["kind"] != now["kind"]:
+        return before == now
+    if "signature" in before and not _compatible_signature(before["signature"], now["signature"]):
+        return False
+    members = before.get("members", {})
+    return all(
+        name in now["members"] and (value == now["members"][name] or _compatible_signature(value, now["members"][name]))
+        for name, value in members.items()
+    )
+
+
+def _compatible_signature(before, now):
+    if not isinstance(before, dict) or not isinstance(now, dict):
+        return before == now
+    old, new = before["parameters"], now["parameters"]
+    kept = [p for p in new if p[0] in {q[0] for q in old}]
+    added = [p for p in new if p[0] not in {q[0] for q in old}]
+    return kept == old and all(p[2] is not None or p[1] in ("VAR_POSITIONAL", "VAR_KEYWORD") for p in added)
 
 
 @pytest.mark.parametrize("module_name", ["frustum", "frustum.geometry"])
@@ -52,8 +77,23 @@ def test_every_public_signature_is_unchanged(module_name):
     if module_name == "frustum" and importlib.util.find_spec("anywidget") is None:
         names.remove("Viewer")
     now = _describe(module, names)
-    changed = {name: (before[name], now[name]) for name in names if before[name] != now[name]}
+    changed = {name: (before[name], now[name]) for name in names if not _compatible(before[name], now[name])}
     assert changed == {}
+
+
+def test_a_changed_default_or_a_dropped_parameter_is_caught():
+    """The comparison itself: adding keywords with defaults is compatible, changing or dropping one is not."""
+    before = {"kind": "function", "signature": {"text": "", "parameters": [["a", "POSITIONAL_OR_KEYWORD", None],
+                                                                           ["b", "KEYWORD_ONLY", "1"]]}}  # fmt: skip
+    added = {"kind": "function", "signature": {"text": "", "parameters": [*before["signature"]["parameters"],
+                                                                          ["c", "KEYWORD_ONLY", "None"]]}}  # fmt: skip
+    changed = {"kind": "function", "signature": {"text": "", "parameters": [["a", "POSITIONAL_OR_KEYWORD", None],
+                                                                            ["b", "KEYWORD_ONLY", "2"]]}}  # fmt: skip
+    dropped = {"kind": "function", "signature": {"text": "", "parameters": [["a", "POSITIONAL_OR_KEYWORD", None]]}}
+    required = {"kind": "function", "signature": {"text": "", "parameters": [*before["signature"]["parameters"],
+                                                                             ["c", "KEYWORD_ONLY", None]]}}  # fmt: skip
+    assert _compatible(before, added)
+    assert not any(_compatible(before, other) for other in (changed, dropped, required))
 
 
 def test_render_is_the_function_and_the_package_imports():
@@ -66,7 +106,6 @@ def test_render_is_the_function_and_the_package_imports():
 
     assert inspect.isfunction(frustum.render)
     assert frustum.render is render
-    assert str(inspect.signature(frustum.render)) == SNAPSHOT["frustum"]["render"]["signature"]
 
 
 @pytest.mark.parametrize("package", ["frustum", "frustum.geometry"])
