@@ -280,6 +280,7 @@ from .scene import (
     ParticleLayer as ParticleLayer,
     Pick as Pick,
     Placed as Placed,
+    RayHits as RayHits,
     Scene as Scene,
     SceneItem as SceneItem,
     cutaway as cutaway,
