@@ -70,6 +70,9 @@ from .clipping import (
     trivially_accepted as trivially_accepted,
     trivially_rejected as trivially_rejected,
 )
+from .environment import (
+    EnvironmentMap as EnvironmentMap,
+)
 from .errors import (
     CameraError as CameraError,
     ClippingError as ClippingError,
@@ -207,9 +210,11 @@ from .output.animation import (
     write_animation as write_animation,
 )
 from .output.sheet import (
+    DIMENSION_MODES as DIMENSION_MODES,
     PAPER_SIZES as PAPER_SIZES,
     SHEET_VIEWS as SHEET_VIEWS,
     STANDARD_SCALES as STANDARD_SCALES,
+    TITLE_BLOCK_FIELDS as TITLE_BLOCK_FIELDS,
     drawing_sheet as drawing_sheet,
     scale_label as scale_label,
 )
@@ -232,6 +237,9 @@ from .output.svg import (
     svg_document as svg_document,
     svg_path_from_bezier as svg_path_from_bezier,
     svg_path_from_polyline as svg_path_from_polyline,
+)
+from .output.true_curves import (
+    find_circles as find_circles,
 )
 from .projection import (
     MULTIVIEWS as MULTIVIEWS,
@@ -263,6 +271,11 @@ from .projection import (
 from .quaternion import (
     Quaternion as Quaternion,
     slerp as slerp,
+)
+from .radiosity import (
+    RadiosityError as RadiosityError,
+    RadiosityResult as RadiosityResult,
+    radiosity as radiosity,
 )
 from .raster._jit import (
     set_threads as set_threads,

@@ -50,6 +50,8 @@ class MeshPart(NamedTuple):
         The texture image the part's UVs index, row 0 at the top of the image (so v = 1 is row 0).
     color : tuple of 4 floats in [0, 1] or None
         The material's base (diffuse) RGBA color, when the file gives one.
+    normal_map : (H, W, 3) uint8 ndarray or None
+        A glTF material's ``normalTexture`` (tangent-space normals, OpenGL convention): ``Material(normal_map=)``.
     """
 
     name: str
@@ -57,6 +59,7 @@ class MeshPart(NamedTuple):
     world_from_model: NDArray[np.float64]
     texture: NDArray[np.uint8] | None
     color: tuple[float, float, float, float] | None
+    normal_map: NDArray[np.uint8] | None = None
 
 
 def load(path: str | Path, texture: str | Path | None = None) -> Mesh:
@@ -138,7 +141,7 @@ def load_parts(path: str | Path, texture: str | Path | None = None) -> list[Mesh
             if image is None and mesh.uvs is not None:
                 image = explicit if explicit is not None else _sibling_texture(file)
             matrix = np.array(world_from_model, dtype=np.float64)
-            parts.append(MeshPart(str(node), mesh, matrix, image, color))
+            parts.append(MeshPart(str(node), mesh, matrix, image, color, _normal_texture(geometry)))
     except GeometryError as error:
         raise GeometryError(f"load: path = {str(file)!r} holds invalid geometry ({error}); check the file") from None
     except Exception as error:
@@ -285,6 +288,14 @@ def _from_trimesh(geometry: Any, file: Path) -> tuple[Mesh, NDArray[np.uint8] | 
     elif kind == "face":
         base = None  # per-face colors have no per-vertex form without splitting vertices; dropped
     return Mesh(vertices, faces, normals, uvs, colors), image, base
+
+
+def _normal_texture(geometry: Any) -> NDArray[np.uint8] | None:
+    """The glTF material's ``normalTexture`` as (H, W, 3) bytes, or None."""
+    image = getattr(getattr(geometry.visual, "material", None), "normalTexture", None)
+    if image is None or getattr(geometry.visual, "uv", None) is None:
+        return None
+    return np.asarray(image.convert("RGB"), dtype=np.uint8)
 
 
 def _material_image(material: Any) -> NDArray[np.uint8] | None:

@@ -225,6 +225,7 @@ class _Report:
         self._lines = lines  # TOML text: scanned for key lines only when a problem needs one
         self.problems: list[str] = []
         self.built: dict[tuple, Any] = {}  # (builder, arguments) -> result, for deterministic builders
+        self.base: Any = "."  # the scene file's folder: relative image paths resolve against it
 
     @property
     def lines(self) -> dict[tuple, int] | None:
