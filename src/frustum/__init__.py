@@ -15,8 +15,9 @@ import lazy_loader as _lazy
 _getattr, _dir, _names = _lazy.attach_stub(__name__, __file__)
 
 _SUBMODULES = frozenset({"budgets", "camera", "clipping", "errors", "frame", "geometry", "projection", "quaternion",
-                         "scene", "shading", "transforms"})  # fmt: skip
-"""The submodules the stub lists (``frustum.geometry`` works after ``import frustum``): not in ``__all__``."""
+                         "scene", "shading", "steps", "transforms"})  # fmt: skip
+"""The submodules the stub lists (``frustum.geometry`` works after ``import frustum``; ``frustum.steps``, the
+teaching layer, loads on first use): not in ``__all__``."""
 
 __all__ = [name for name in _names if name not in _SUBMODULES and name != "Viewer"] + ["__version__"]
 """Every public name but ``Viewer`` (it needs the viewer extra, anywidget), so ``from frustum import *`` works

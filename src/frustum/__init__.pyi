@@ -14,6 +14,7 @@ from . import (
     quaternion as quaternion,
     scene as scene,
     shading as shading,
+    steps as steps,
     transforms as transforms,
 )
 from .batch import (
