@@ -8,7 +8,7 @@ take a ``seed`` (``numpy.random.default_rng``): same seed, same bytes.
 
 Curves are returned as (N, 3) float64 polylines (2D curves lie in the plane z = 0); solids as a ``Mesh``.
 
-Why one module of ~920 lines: the chapter's generators are short and share the budget check and the polyline helpers.
+Why one module: the chapter's generators are short and share the budget check and the polyline helpers.
 
 References
 ----------
