@@ -289,6 +289,10 @@ from .render import (
     release_memory as release_memory,
     render as render,
 )
+from .render.raytrace import (
+    RaySegment as RaySegment,
+    ray_path as ray_path,
+)
 from .scene import (
     Node as Node,
     ParticleLayer as ParticleLayer,
