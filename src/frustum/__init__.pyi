@@ -239,6 +239,10 @@ from .output.svg import (
     svg_path_from_bezier as svg_path_from_bezier,
     svg_path_from_polyline as svg_path_from_polyline,
 )
+from .output.svg_shadows import (
+    ShadowPolygon as ShadowPolygon,
+    shadow_polygons as shadow_polygons,
+)
 from .output.true_curves import (
     find_circles as find_circles,
 )
@@ -326,6 +330,7 @@ from .shading import (
     blinn_phong as blinn_phong,
     illuminate as illuminate,
     pack_lights as pack_lights,
+    sun_45 as sun_45,
 )
 from .simulation import (
     INTEGRATORS as INTEGRATORS,
