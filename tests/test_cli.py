@@ -14,8 +14,9 @@ import trimesh
 from frustum import Camera, Perspective, __version__, compose, rotate_z, translate
 from frustum.cli import main, parse_step
 from frustum.trace import trace
+from testdata import DATA
 
-BUNNY = Path("/work/shared/data/bunny")
+BUNNY = DATA / "bunny"
 
 
 def run(*arguments: str) -> subprocess.CompletedProcess[str]:

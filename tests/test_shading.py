@@ -29,6 +29,7 @@ from frustum.shading import (
     illuminate,
 )
 from frustum.transforms import rotate_x, translate
+from testdata import DATA
 
 SIZE = 33  # odd: the centre pixel's centre is the world origin under ``ortho_camera``
 BLACK = (0.0, 0.0, 0.0, 1.0)
@@ -410,10 +411,9 @@ def test_translate_keeps_flat_quads_unchanged():
     assert frame.color[SIZE - 1 - int(y), int(x), 0] == 255
 
 
-SPOT = "/work/shared/data/spot/spot_triangulated.obj"
+SPOT = DATA / "spot" / "spot_triangulated.obj"
 
 
-@pytest.mark.skipif(not __import__("os").path.exists(SPOT), reason="shared data not present")
 def test_spot_renders_with_its_texture_black_and_white_patches():
     from frustum.geometry import load_parts
 
