@@ -1050,3 +1050,16 @@ def test_the_format_sample_in_the_docs_loads() -> None:
     assert sample is not None
     scene_file = load_scene(sample.group(1))
     assert scene_file.stereo is not None and scene_file.outputs
+
+
+def test_outputs_outside_the_folder_are_refused_only_when_they_would_be_written(tmp_path):
+    data = {"camera": {"eye": [0, 0, 5], "target": [0, 0, 0]}, "nodes": [{"geometry": {"type": "uv_sphere"}}],
+            "output": {"files": ["../out.png", "inside.png", "/tmp/frustum-absolute.png"]}}  # fmt: skip
+    with pytest.raises(SceneFileError) as info:
+        load_scene(data, base_dir=tmp_path)
+    assert str(info.value).count("is outside the scene file's folder") == 2
+    loaded = load_scene(data, base_dir=tmp_path, check_outputs=False)  # the caller writes elsewhere (-o)
+    assert loaded.outputs == (tmp_path / "inside.png",)
+    data["output"]["files"].append("bad.xyz")  # a malformed entry stays an error either way
+    with pytest.raises(SceneFileError, match="has an unknown suffix"):
+        load_scene(data, base_dir=tmp_path, check_outputs=False)

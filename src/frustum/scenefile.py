@@ -1791,7 +1791,7 @@ def _warm_up(report: _Report, scene: Scene, animation: dict) -> None:
         report.refused(("animation", "warmup"), warmup, error)
 
 
-def _outputs(report: _Report, data: dict, base: Path) -> tuple[tuple[Path, ...], dict, dict]:
+def _outputs(report: _Report, data: dict, base: Path, check: bool = True) -> tuple[tuple[Path, ...], dict, dict]:
     outputs: list[Path] = []
     if "output" in data:
         params = _table(report, ("output",), data["output"])
@@ -1806,6 +1806,8 @@ def _outputs(report: _Report, data: dict, base: Path) -> tuple[tuple[Path, ...],
                         report.add(("output", "files", i), name, "has an unknown suffix",
                                    f"expected one of {', '.join(OUTPUT_SUFFIXES)}")  # fmt: skip
                     elif not _inside(base, name):
+                        if not check:  # not written (the caller writes elsewhere): not refused either
+                            continue
                         report.add(("output", "files", i), name, "is outside the scene file's folder",
                                    "outputs named in a scene file must stay in its folder (no '..', no absolute "
                                    "path, no symlink pointing out); give a relative path, or use -o on the "
@@ -1952,7 +1954,9 @@ def _tile(frames: list[Frame], columns: int, background: Sequence[float]) -> Fra
     return Frame(color, depth)
 
 
-def load_scene(data: Mapping[str, Any] | str, *, source: str = "<scene>", base_dir: str | Path = ".") -> SceneFile:
+def load_scene(
+    data: Mapping[str, Any] | str, *, source: str = "<scene>", base_dir: str | Path = ".", check_outputs: bool = True
+) -> SceneFile:
     """Validate and build a scene from TOML text or an already parsed dictionary.
 
     Every problem is collected first; then one ``SceneFileError`` lists them all, one per line, as
@@ -1966,6 +1970,9 @@ def load_scene(data: Mapping[str, Any] | str, *, source: str = "<scene>", base_d
         The name errors start with (the file name).
     base_dir : str or Path
         Folder that relative paths (mesh files, outputs) are resolved against.
+    check_outputs : bool
+        True (default): ``[output].files`` outside `base_dir` are refused. False, for a caller that writes
+        elsewhere (``frustum render FILE -o ...``): they are not written, so they are left out of ``outputs``.
 
     Raises
     ------
@@ -1992,7 +1999,7 @@ def load_scene(data: Mapping[str, Any] | str, *, source: str = "<scene>", base_d
     else:
         raise SceneFileError(f"{source}: data = {describe(data)} is not TOML text or a table; give a str or a dict")
     report = _Report(source, lines)
-    scene_file = _build(report, parsed, Path(base_dir))
+    scene_file = _build(report, parsed, Path(base_dir), check_outputs)
     report.raise_if_any()
     assert scene_file is not None
     return dataclasses.replace(scene_file, path=None)
@@ -2048,7 +2055,7 @@ def _check_shape(text: str, source: str) -> None:
                              f"{_MAX_NESTING} levels of tables")  # fmt: skip
 
 
-def _build(report: _Report, data: dict, base: Path) -> SceneFile | None:
+def _build(report: _Report, data: dict, base: Path, check_outputs: bool = True) -> SceneFile | None:
     _unknown_keys(report, (), data, _TOP_LEVEL)
     for key in ("title", "description"):
         if key in data and not isinstance(data[key], str):
@@ -2095,7 +2102,7 @@ def _build(report: _Report, data: dict, base: Path) -> SceneFile | None:
             cameras.append(camera)
     else:
         report.missing(("camera",), "add a [camera] table with eye and target (or [[cameras]])")
-    outputs, animation, svg = _outputs(report, data, base)
+    outputs, animation, svg = _outputs(report, data, base, check_outputs)
     _check_image_memory(report, options, size, max(len(cameras), 1))
     if not report.problems:
         _warm_up(report, scene, animation)
@@ -2106,8 +2113,10 @@ def _build(report: _Report, data: dict, base: Path) -> SceneFile | None:
     return SceneFile(scene, single, options, outputs, tuple(cameras), stereo, animation, svg, size, columns, title)
 
 
-def load_scene_file(path: str | Path) -> SceneFile:
+def load_scene_file(path: str | Path, *, check_outputs: bool = True) -> SceneFile:
     """Read, validate and build the TOML scene file at `path` (relative paths inside resolve against its folder).
+
+    ``check_outputs=False``: ``[output].files`` outside the file's folder are not refused (see ``load_scene``).
 
     Raises
     ------
@@ -2127,7 +2136,7 @@ def load_scene_file(path: str | Path) -> SceneFile:
     except (OSError, UnicodeDecodeError) as error:
         reason = getattr(error, "strerror", None) or str(error)
         raise SceneFileError(f"{shown}: cannot be read ({reason}); give an existing UTF-8 TOML scene file") from None
-    scene_file = load_scene(text, source=str(file), base_dir=file.parent)
+    scene_file = load_scene(text, source=str(file), base_dir=file.parent, check_outputs=check_outputs)
     return dataclasses.replace(scene_file, path=file)
 
 
@@ -2201,7 +2210,7 @@ def render_scene_file(
         For an unknown output suffix or an unwritable path; ``FrustumError`` from the renderer for options it
         refuses.
     """
-    scene_file = load_scene_file(path)
+    scene_file = load_scene_file(path, check_outputs=output is None)  # with `output` the file's are not written
     if size is not None:
         scene_file = scene_file.resized(tuple(size))  # type: ignore[arg-type]
     if output is None:
