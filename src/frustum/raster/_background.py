@@ -12,8 +12,8 @@ same options), so every output byte is the same.
 Nothing depends on the child: if it cannot start, fails on a kernel, dies or hangs (no report within
 ``WAIT_LIMIT_S`` of waiting), the waiting call goes on and compiles the kernel itself. The child is started only
 when at least two cores are usable and some planned kernel is missing from the cache (a warm start starts
-nothing), never with ``NUMBA_DISABLE_JIT=1`` or ``FRUSTUM_BACKGROUND_COMPILE=0``, and it is ended when this process
-exits.
+nothing), never with ``NUMBA_DISABLE_JIT=1`` or ``FRUSTUM_BACKGROUND_COMPILE=0``, and it ends when this process
+exits (killed at exit; it also ends itself within 0.2 s of finding its parent gone).
 """
 
 from __future__ import annotations
@@ -27,22 +27,27 @@ import sys
 import threading
 import time
 from collections.abc import Sequence
+from functools import cache
 from typing import Any
-
-import numba
-from numba.core import types
 
 __all__ = ["BackgroundCompile", "start"]
 
 WAIT_LIMIT_S = 120.0
 """Longest a kernel call waits for the child's report before compiling the kernel itself."""
 
-_NAMES = {name: getattr(types, name) for name in dir(types) if not name.startswith("_")}
+# Numba is imported on first use, not with this module: the child starts watching for its parent's end first
+
+
+@cache
+def _type_names() -> dict[str, Any]:
+    from numba.core import types
+
+    return {name: getattr(types, name) for name in dir(types) if not name.startswith("_")}
 
 
 def parse_signature(text: str) -> tuple:
     """Argument types from their ``repr`` (``"(Array(float64, 2, 'C', True, aligned=True), int64)"``)."""
-    value = eval(text, {"__builtins__": {}}, _NAMES)  # only numba.types names, from frustum's own plan
+    value = eval(text, {"__builtins__": {}}, _type_names())  # only numba.types names, from frustum's own plan
     return tuple(value) if isinstance(value, tuple) else (value,)
 
 
@@ -82,7 +87,7 @@ class BackgroundCompile:
         package_root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
         path = os.pathsep.join(p for p in (package_root, os.environ.get("PYTHONPATH", "")) if p)
         self.process = subprocess.Popen(
-            [sys.executable, "-m", "frustum.raster._background", plan], stdin=subprocess.DEVNULL,
+            [sys.executable, "-m", "frustum.raster._background", plan, str(os.getpid())], stdin=subprocess.DEVNULL,
             stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, env={**os.environ, "PYTHONPATH": path},
         )  # fmt: skip
         atexit.register(self.stop)
@@ -146,6 +151,8 @@ def start(plan: Sequence[tuple[str, str, str]]) -> BackgroundCompile | None:
     with _start_lock:
         if _started is not None:
             return _started
+        import numba
+
         if numba.config.DISABLE_JIT or os.environ.get("FRUSTUM_BACKGROUND_COMPILE", "1") == "0":
             return None
         if _usable_cores() < 2:
@@ -165,8 +172,18 @@ def start(plan: Sequence[tuple[str, str, str]]) -> BackgroundCompile | None:
         return _started
 
 
-def _child(plan: list[list[str]]) -> None:
-    """The child: compile each planned kernel for its types (into the cache); one report line each."""
+def _orphan_watch(parent: int) -> None:
+    """End the child once its parent is gone (killed, or ``os._exit`` on Ctrl-C, where ``atexit`` does not run)."""
+    while os.getppid() == parent:
+        time.sleep(0.2)
+    os._exit(0)
+
+
+def _child(plan: list[list[str]], parent: int | None = None) -> None:
+    """The child: compile each planned kernel for its types (into the cache); one report line each. `parent`: the
+    process that started it (when given, the child ends once that process is gone)."""
+    if parent is not None:
+        threading.Thread(target=_orphan_watch, args=(parent,), daemon=True).start()
     for index, (module, name, text) in enumerate(plan):
         try:
             dispatcher(module, name).compile(parse_signature(text))
@@ -177,4 +194,4 @@ def _child(plan: list[list[str]]) -> None:
 
 
 if __name__ == "__main__":
-    _child(json.loads(sys.argv[1]))
+    _child(json.loads(sys.argv[1]), int(sys.argv[2]) if len(sys.argv) > 2 else None)
