@@ -220,10 +220,7 @@ def test_texture_is_sampled_perspective_correctly():
     texture[0, 1] = 255  # top-right texel white
     vertices = [[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [1.0, 1.0, 0.0], [-1.0, 1.0, 0.0]]
     uvs = [[0, 0], [1, 0], [1, 1], [0, 1]]
-    try:
-        mesh = Mesh(vertices, [[0, 1, 2], [0, 2, 3]], uvs=uvs)
-    except TypeError:
-        pytest.skip("Mesh has no uvs in this build")
+    mesh = Mesh(vertices, [[0, 1, 2], [0, 2, 3]], uvs=uvs)
     camera = Camera.look_at((0, -2.5, 2.5), (0, 0, 0), (0, 1, 0), projection=Perspective(0.9, 0.5, 20), width=64,
                             height=64)  # fmt: skip
     frame = render(placed(Scene(), mesh, Material(color=(1, 1, 1), texture=texture)), camera, shading="none")
