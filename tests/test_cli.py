@@ -271,7 +271,7 @@ def test_scene_file_errors_are_one_line_without_traceback(tmp_path):
 
 
 
-@pytest.mark.parametrize("outside", ["../escaped.png", "/tmp/frustum-escaped-absolute.png"])
+@pytest.mark.parametrize("outside", ["../escaped.png", "/tmp/frustum-escaped-absolute.png"])  # outside: refused
 def test_output_outside_the_folder_is_refused_without_o_and_ignored_with_o(tmp_path, outside):
     folder = tmp_path / "scenes"
     folder.mkdir()

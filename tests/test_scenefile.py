@@ -1053,8 +1053,9 @@ def test_the_format_sample_in_the_docs_loads() -> None:
 
 
 def test_outputs_outside_the_folder_are_refused_only_when_they_would_be_written(tmp_path):
+    outside = ["../out.png", "/tmp/frustum-absolute.png"]  # outside: refused (test_self_contained)
     data = {"camera": {"eye": [0, 0, 5], "target": [0, 0, 0]}, "nodes": [{"geometry": {"type": "uv_sphere"}}],
-            "output": {"files": ["../out.png", "inside.png", "/tmp/frustum-absolute.png"]}}  # fmt: skip
+            "output": {"files": [outside[0], "inside.png", outside[1]]}}  # fmt: skip
     with pytest.raises(SceneFileError) as info:
         load_scene(data, base_dir=tmp_path)
     assert str(info.value).count("is outside the scene file's folder") == 2

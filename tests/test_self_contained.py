@@ -21,8 +21,10 @@ SCANNED = [path for path in SOURCES if path != Path(__file__).resolve()]  # this
 
 # Absolute paths a test may name: ones that are deliberately missing or special, never data to read.
 ALLOWED_ABSOLUTE = ("/dev/null", "/dev/zero", "/nonexistent/", "/tmp/frustum-")
-# `../` in a string is allowed only in the hostile-input tests, which check that such output paths are refused.
+# `../` in a string is allowed only in the hostile-input tests, which check that such output paths are refused, and
+# on a line marked with this comment (a test that such a path is refused, never read)
 PARENT_ALLOWED_UNDER = TESTS / "hostile"
+REFUSED_MARK = "# outside: refused"
 
 
 def _mentions_file(node: ast.AST) -> bool:
@@ -31,7 +33,9 @@ def _mentions_file(node: ast.AST) -> bool:
 
 def _offences(path: Path, root: Path = ROOT) -> list[str]:
     """The places in one test module (somewhere below `root`) that name a path outside the repository."""
-    tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+    source = path.read_text(encoding="utf-8")
+    tree = ast.parse(source, filename=str(path))
+    lines = source.splitlines()
     depth = len(path.relative_to(root).parts) - 1  # parents[depth] of this file is the repository root
     docstring = tree.body[0].value if tree.body and isinstance(tree.body[0], ast.Expr) else None
     found, chained = [], set()
@@ -43,7 +47,11 @@ def _offences(path: Path, root: Path = ROOT) -> list[str]:
                 found.append(f"{where}: absolute path {text!r}")
             elif "/work/" in text or "shared/data" in text or "shared/bench" in text or text == "shared":
                 found.append(f"{where}: a folder outside the repository in {text!r}")
-            elif ("../" in text or text == "..") and not path.is_relative_to(PARENT_ALLOWED_UNDER):
+            elif (
+                ("../" in text or text == "..")
+                and not path.is_relative_to(PARENT_ALLOWED_UNDER)
+                and REFUSED_MARK not in lines[node.lineno - 1]
+            ):
                 found.append(f"{where}: parent-folder path {text!r}")
         elif (
             isinstance(node, ast.Subscript)
@@ -79,6 +87,7 @@ def test_the_scan_finds_paths_outside_the_repository(tmp_path):
         "C = Path(__file__).parent.parent.parent\n"
         "D = '../shared/data/teapot_n10.obj'\n"
         "E = Path(__file__).resolve().parents[1] / 'examples'\n"
+        "F = '../refused.png'  # outside: refused\n"
     )
     offences = _offences(module, root=tmp_path)
     assert sorted(line.split(":")[1] for line in offences) == ["2", "3", "3", "4", "5"], offences
