@@ -45,7 +45,8 @@ def main() -> None:
     background = tuple(float(c) for c in sc["background"])
 
     timings: dict[str, float] = {}
-    pipeline = importlib.import_module("frustum.render")  # the module (``frustum.render`` is the function)
+    stages = importlib.import_module("frustum.render.stages")  # the per-item stages (vertex, binning)
+    surfaces = importlib.import_module("frustum.render.surfaces")  # the surface pass (clears the buffers)
 
     def timed(module, name: str) -> None:
         function = getattr(module, name)
@@ -58,10 +59,9 @@ def main() -> None:
 
         setattr(module, name, wrapper)
 
-    for name in ("project_vertices", "world_points", "transform_normals"):
-        timed(pipeline, name)
-    for name in ("clear_buffers", "tile_offsets"):
-        timed(pipeline, name)
+    for name in ("project_vertices", "world_points", "transform_normals", "tile_offsets"):
+        timed(stages, name)
+    timed(surfaces, "clear_buffers")
     for name in ("count_tiles", "add_record_tiles", "fill_tiles"):
         timed(tiles, name)
     for name in ("clip_faces", "rasterize_tiles"):

@@ -1,4 +1,4 @@
-"""geometry/curves.py against bezier, SciPy (BPoly, BSpline, CubicSpline, CubicHermiteSpline) and geomdl, the seed's
+"""geometry/curves/ against bezier, SciPy (BPoly, BSpline, CubicSpline, CubicHermiteSpline) and geomdl, the seed's
 curve properties as Hypothesis properties, and bad input."""
 
 from __future__ import annotations

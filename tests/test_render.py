@@ -19,7 +19,10 @@ from frustum.errors import ShadingError
 from frustum.frame import Frame
 from frustum.geometry import Mesh
 from frustum.raster.vertices import transform_vertices
-from frustum.render import _block_min, _item_matrices, bin_item, render, resolve_color
+from frustum.render import bin_item, render
+from frustum.render.buffers import block_min as _block_min
+from frustum.render.buffers import resolve_color
+from frustum.render.stages import item_matrices as _item_matrices
 from frustum.scene import Scene, SceneItem
 from frustum.shading import DirectionalLight, Material
 from frustum.transforms import apply_homogeneous, rotate_y, translate
@@ -277,18 +280,15 @@ def test_fast_path_window_coordinates_and_culling_equal_the_textbook_path():
 @pytest.mark.parametrize("dtype", [np.float64, np.float32])
 def test_line_path_vertex_stage_in_numpy_equals_the_kernel_bit_for_bit(dtype):
     """Lines and edges take their clip coordinates, world points and region codes from NumPy
-    (``render._clip_vertices``, no kernel to compile): the kernel's operations in its order, so the same bits."""
-    import importlib
-
+    (``render.lines.clip_vertices``, no kernel to compile): the kernel's operations in its order, so the same bits."""
     from frustum.clipping import VIEW_VOLUME_PLANES
-
-    pipeline = importlib.import_module("frustum.render")
+    from frustum.render import lines as pipeline
     points = (np.random.default_rng(1).normal(size=(2000, 3)) * 3).astype(dtype)
     world_from_model = np.array([[0.9, 0.1, 0.0, 0.3], [-0.1, 0.9, 0.2, -0.4], [0.0, -0.2, 1.1, 0.5], [0, 0, 0, 1.0]])
     camera = Camera.look_at(
         (0.3, 0.5, 3.0), (0, 0, 0), (0, 1, 0), projection=Perspective(0.9, 0.5, 10.0), width=64, height=48
     )
-    clip, world, codes = pipeline._clip_vertices(points, world_from_model, camera)
+    clip, world, codes = pipeline.clip_vertices(points, world_from_model, camera)
     expected = np.empty((2000, 4)), np.empty((2000, 3)), np.empty((2000, 3)), np.empty(2000, dtype=np.int64)
     item = SceneItem(None, None, world_from_model)
     transform_vertices(points, np.ones((2000, 3)), _item_matrices(item, camera), VIEW_VOLUME_PLANES, expected[0],
@@ -656,11 +656,11 @@ def test_tile_pipeline_of_a_fine_mesh_equals_reference_byte_for_byte(cull):
 
 
 def test_clipping_in_one_pass_or_two_gives_the_same_frame(monkeypatch):
-    """Faces crossing the view volume are clipped once into ``FAN_MAX`` slots each (``render.ONE_PASS_CLIPPING``
+    """Faces crossing the view volume are clipped once into ``FAN_MAX`` slots each (``render.stages.ONE_PASS_CLIPPING``
     or fewer of them) or counted first and then written: the same records, the same bytes as the reference."""
     import importlib
 
-    pipeline = importlib.import_module("frustum.render")  # the module (``frustum.render`` is the function)
+    pipeline = importlib.import_module("frustum.render.stages")  # binning reads ONE_PASS_CLIPPING there
     scene, camera = small_scene()  # its ground crosses the near plane
     binned = pipeline.bin_item(scene.items[2], camera, cull=True)
     assert binned.crossing.size and binned.tri_int.shape[0] > binned.crossing.size
@@ -677,18 +677,18 @@ def test_clipping_in_one_pass_or_two_gives_the_same_frame(monkeypatch):
 
 
 def test_world_attributes_from_numpy_or_the_kernels_give_the_same_frame(monkeypatch):
-    """Meshes under ``render.KERNEL_MIN_VERTICES`` vertices get world points and normals from NumPy (no kernel to
+    """Meshes under ``render.stages.KERNEL_MIN_VERTICES`` vertices get world points and normals from NumPy (no kernel to
     compile), larger ones from ``raster.vertices``: the same operations in order, the same bits."""
     import importlib
 
-    pipeline = importlib.import_module("frustum.render")
+    pipeline = importlib.import_module("frustum.render.stages")
     scene, camera = small_scene()  # its tube is moved and turned: world points and normals are transformed
     item = scene.items[1]
-    numpy_world, numpy_normals = pipeline._world_attributes(item, pipeline.Scratch())
+    numpy_world, numpy_normals = pipeline.world_attributes(item, pipeline.Scratch())
     assert item.mesh.vertex_count < pipeline.KERNEL_MIN_VERTICES
     first = render(scene, camera, background=BACKGROUND, shading="phong")
     monkeypatch.setattr(pipeline, "KERNEL_MIN_VERTICES", 0)
-    kernel_world, kernel_normals = pipeline._world_attributes(item, pipeline.Scratch())
+    kernel_world, kernel_normals = pipeline.world_attributes(item, pipeline.Scratch())
     np.testing.assert_array_equal(numpy_world, kernel_world)
     np.testing.assert_array_equal(numpy_normals, kernel_normals)
     again = render(scene, camera, background=BACKGROUND, shading="phong")

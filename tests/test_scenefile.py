@@ -23,13 +23,13 @@ from frustum.scenefile import (
     PROJECTIONS,
     SCHEMA_PATH,
     TRANSFORM_STEPS,
-    _key_lines,
     explain_scene_file,
     load_scene,
     load_scene_file,
     render_examples,
     render_scene_file,
 )
+from frustum.scenefile.report import _key_lines
 
 EXAMPLES = sorted(EXAMPLES_DIR.glob("*.toml"))
 SMALL = (48, 36)

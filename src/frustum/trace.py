@@ -1,6 +1,6 @@
 """``trace``: every stage of the viewing pipeline for a few points (or a scene), with its matrix and coordinates.
 
-The seed's pipeline, stage by stage, as the renderer runs it (``render.py``)::
+The seed's pipeline, stage by stage, as the renderer runs it (``render/``)::
 
     modeling ──world_from_model──▶ world ──T(−P0)──▶ ──R(u, v, n)──▶ view ──projection──▶ ──normalization──▶ clip
       ──region codes (clipping)──▶ ──divide by w──▶ NDC ──window_from_ndc──▶ window (pixel x, y up; depth)

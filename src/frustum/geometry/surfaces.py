@@ -26,19 +26,9 @@ from numpy.typing import ArrayLike, NDArray
 from frustum._arrays import as_count, as_scalar, describe, read_only
 from frustum.budgets import check_memory
 from frustum.errors import GeometryError
-from frustum.geometry.curves import (
-    MIN_RELATIVE_TOLERANCE,
-    BezierCurve,
-    NURBSCurve,
-    _as_degree,
-    _as_parameters,
-    _as_weights,
-    _basis_matrix,
-    _checked_knots,
-    _de_casteljau,
-    _knots_for,
-    _split_batch,
-)
+from frustum.geometry.curves._validation import _as_degree, _as_parameters
+from frustum.geometry.curves.bezier import MIN_RELATIVE_TOLERANCE, BezierCurve, _de_casteljau, _split_batch
+from frustum.geometry.curves.bspline import NURBSCurve, _as_weights, _basis_matrix, _checked_knots, _knots_for
 from frustum.geometry.mesh import Mesh, _normalize_rows
 
 __all__ = ["BSplineSurface", "BezierSurface", "NURBSSurface"]

@@ -1,7 +1,7 @@
 """Vertex stage kernels: model → clip coordinates and region codes, window coordinates, world positions and normals.
 
 ``transform_vertices`` is the whole vertex stage in one pass (the readable reference of the others; the line and
-point paths do the same operations in NumPy, ``render._clip_vertices``, and the tests check both against it). The
+point paths do the same operations in NumPy, ``render.lines.clip_vertices``, and the tests check both against it). The
 surface path splits it by what each later stage reads, so nothing is written that
 is not read: ``project_vertices`` (clip coordinates straight to region codes and snapped window coordinates,
 the clip coordinates themselves not stored), ``world_points`` and ``transform_normals`` (for shading, and skipped

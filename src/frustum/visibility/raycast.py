@@ -4,15 +4,16 @@ Image space, one pixel at a time [HB 16 "Ray-Casting Method"]: from the centre o
 line of sight (``Camera.ray``: from the near plane toward the far plane; for a parallel projection along the
 projection direction) and the nearest surface it meets is the visible one. Testing every surface per ray is the
 notes' "consider an object many times"; the scene's bounding-volume hierarchy (``Scene._triangle_index``, the
-index ``Scene.pick`` uses: world-space triangles of every item, Morton-ordered leaves, boxes from the leaves up)
-cuts a ray's tests to the boxes it enters, nearer child first, so the time grows with the pixels and only
-logarithmically with the faces (object coherence through the hierarchy; no coherence between pixels).
+index ``Scene.pick`` and ``Scene.intersect`` use: world-space triangles of every item, split by the surface
+area heuristic, ``raster.rays``) cuts a ray's tests to the boxes it enters, nearer child first, so the time grows
+with the pixels and only logarithmically with the faces (object coherence through the hierarchy; no coherence
+between pixels).
 
 The hit is taken within the view volume (t in [0, 1) between the near and far planes: the side planes hold
 every pixel centre's ray), back faces are skipped when culling (the ray goes on to what lies behind, as the depth
 buffer never draws them) and otherwise hit with the two-sided code ``2·face + 1``. Each pixel gets the depth
 buffer's window depth, face code and the hit's barycentrics (world barycentrics are the perspective-correct
-ones), and the one shading kernel colors them. Kernel: ``raster.bvh.cast_pixels``.
+ones), and the one shading kernel colors them. Kernel: ``raster.rays.cast_pixels``.
 
 References
 ----------
@@ -52,10 +53,11 @@ def ray_casting(
     -------
     dict
         ``rays`` (one per pixel), ``hits``, ``box_tests`` (ray–box slab tests), ``nodes_visited`` (BVH nodes
-        entered), ``triangle_tests`` (ray–triangle intersection tests), ``tests_per_ray``, ``indexed_triangles``
-        (opaque triangles in the index), ``bvh_nodes``.
+        entered: inner nodes and leaves), ``triangle_tests`` (ray–triangle intersection tests), ``tests_per_ray``,
+        ``indexed_triangles`` (opaque triangles in the index), ``bvh_nodes``
+        (inner nodes; each holds its children's boxes).
     """
-    from frustum.raster import bvh
+    from frustum.raster import rays as bvh
 
     height, width = depth.shape
     stats = np.zeros((height, len(bvh.CAST_STATS)), dtype=np.int64)
@@ -70,11 +72,11 @@ def ray_casting(
     skip = np.repeat(clear, np.diff(starts)).astype(np.uint8) if clear.any() else np.empty(0, dtype=np.uint8)
     window_from_world = np.ascontiguousarray(camera.viewport_matrix @ camera.clip_from_world, dtype=np.float64)
     world_from_window = np.ascontiguousarray(camera.world_from_window, dtype=np.float64)
-    bvh.cast_pixels(index.lo, index.hi, index.triangles, index.order, skip, world_from_window, window_from_world,
-                    int(cull), depth, codes, bary, stats)  # fmt: skip
+    bvh.cast_pixels(index.boxes, index.links, index.triangles, index.order, index.depth, skip, world_from_window,
+                    window_from_world, int(cull), depth, codes, bary, stats)  # fmt: skip
     totals = stats.sum(axis=0)
     result = {name: int(value) for name, value in zip(bvh.CAST_STATS, totals, strict=True)}
     result["tests_per_ray"] = round(result["triangle_tests"] / max(1, result["rays"]), 3)
     result["indexed_triangles"] = int(starts[-1]) - int(skip.sum())
-    result["bvh_nodes"] = int(index.lo.shape[0])
+    result["bvh_nodes"] = index.nodes
     return result

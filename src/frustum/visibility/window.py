@@ -62,7 +62,7 @@ class WindowTriangles:
 
 
 def _faces(item: SceneItem) -> np.ndarray:
-    """The item's faces counter-clockwise after its modeling transform (as ``render._world_faces``)."""
+    """The item's faces counter-clockwise after its modeling transform (as ``render.stages.world_faces``)."""
     faces = np.ascontiguousarray(item.mesh.faces, dtype=np.int64)
     if np.linalg.det(np.asarray(item.world_from_model)[:3, :3]) < 0.0:
         return np.ascontiguousarray(faces[:, [0, 2, 1]])

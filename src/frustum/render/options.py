@@ -1,0 +1,291 @@
+"""The options of one ``render`` call, checked once: ``RenderOptions.from_keywords`` turns ``render``'s keyword
+arguments (or a scene file's ``[render]`` table, the same names) into one frozen object that every pass reads.
+
+Every check names the bad value and lists what would be valid (``FrustumError``); the order of the checks is the
+order in which ``render`` has always made them, so the first error a call gets is the same.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Any
+
+import numpy as np
+
+from frustum._arrays import as_scalar, describe
+from frustum.budgets import check_memory
+from frustum.camera import Camera
+from frustum.errors import FrustumError
+from frustum.frame import background_bytes
+from frustum.raster import shade
+from frustum.scene import Scene
+from frustum.shading import SPECULAR_MODELS, DepthCue
+
+SHADING_MODES = {
+    "phong": shade.SHADE_PHONG,
+    "gouraud": shade.SHADE_GOURAUD,
+    "flat": shade.SHADE_FLAT,
+    "normals": shade.SHADE_NORMALS,
+    "depth": shade.SHADE_DEPTH,
+    "none": shade.SHADE_NONE,
+}
+"""Shading names ``render`` accepts (``None`` means ``"none"``)."""
+RENDER_MODES = ("surface", "wireframe", "points", "hidden-line", "surface+edges")
+"""What ``render`` draws: filled surfaces, edges as lines, vertices as pixels, visible edges only, or both."""
+LINE_MODES = ("wireframe", "points")
+"""Modes that draw no surfaces: lines or points straight into the depth buffer (``render.lines``)."""
+EDGE_MODES = ("hidden-line", "surface+edges")
+"""Modes that draw surfaces, then their visible edges against the finished depth buffer."""
+HIDDEN_STYLES = (None, "dimmed", "dashed")
+"""How ``mode="hidden-line"`` draws the hidden parts of edges: not at all, solid in `hidden_color`, or dashed."""
+EDGE_SETS = ("all", "feature")
+FILTERS = ("box", "tent")
+COLOR_SPACES = ("linear", "srgb")
+BUFFERS = ("normals", "object_id")
+TRANSPARENCY_MODES = ("sort", "a-buffer")
+METHOD_NAMES = ("depth-buffer", "scan-line", "area-subdivision", "depth-sort", "bsp", "a-buffer", "octree",
+                "ray-casting")  # fmt: skip
+"""``render(..., method=...)``, in the order error messages list them (``render.methods.RENDER_METHODS``)."""
+PLANNED_METHODS: dict[str, str] = {}
+"""Methods of the visible-surface chapter that this version does not draw yet."""
+MAX_LINE_WIDTH = 256.0
+"""Widest line (and largest point) ``render`` draws, in output pixels."""
+
+DEFAULTS: dict[str, Any] = {
+    "shading": "phong",
+    "specular": "blinn-phong",
+    "background": (0.0, 0.0, 0.0, 1.0),
+    "cull_back_faces": True,
+    "mode": "surface",
+    "edges": None,
+    "crease_angle": math.radians(30.0),
+    "edge_color": None,
+    "hidden": None,
+    "hidden_color": (0.6, 0.6, 0.6),
+    "line_width": 1.0,
+    "depth_cue": None,
+    "samples": 1,
+    "filter": "box",
+    "color_space": "linear",
+    "buffers": (),
+    "method": "depth-buffer",
+    "transparency": "sort",
+    "stats": False,
+}
+"""``render``'s keyword arguments and their defaults (a test holds them equal to ``render``'s signature)."""
+
+
+@dataclasses.dataclass(frozen=True)
+class RenderOptions:
+    """``render``'s options, checked and in the form the passes use (kernel codes, color bytes).
+
+    ``counts`` is the method's counts dict (``Frame.stats``), filled while drawing, or None where nothing is
+    counted; ``factor`` is √samples (the supersampling factor).
+    """
+
+    shade_mode: int
+    specular_model: int
+    background: np.ndarray  # (4,) uint8
+    cull: bool
+    mode: str
+    edges: str
+    crease_angle: float
+    edge_color: np.ndarray | None  # (4,) bytes as float, or None for the material color
+    hidden: str | None
+    hidden_color: np.ndarray
+    line_width: float
+    depth_cue: DepthCue | None
+    buffers: tuple[str, ...]
+    method: str = "depth-buffer"
+    transparency: str = "sort"
+    counts: dict | None = None
+    factor: int = 1
+    filter: str = "box"
+    color_space: str = "linear"
+
+    @classmethod
+    def from_keywords(cls, scene: Any, camera: Any, where: str = "render", **keywords: Any) -> RenderOptions:
+        """Check `keywords` (``render``'s, missing ones at their ``DEFAULTS``) and build the options; a
+        FrustumError (prefixed by `where`) for the first bad one. The image budget is checked last, before any
+        buffer is allocated."""
+        unknown = sorted(set(keywords) - set(DEFAULTS))
+        if unknown:
+            raise FrustumError(
+                f"{where}: unknown option {', '.join(map(repr, unknown))}; expected one of " + ", ".join(DEFAULTS)
+            )
+        k = {**DEFAULTS, **keywords}
+        check_method(k["method"], where)
+        options = check_arguments(
+            scene, camera, k["shading"], k["specular"], k["background"], k["cull_back_faces"], k["mode"], k["edges"],
+            k["crease_angle"], k["edge_color"], k["hidden"], k["hidden_color"], k["line_width"], k["depth_cue"],
+            k["buffers"], where,
+        )  # fmt: skip
+        factor = supersampling(k["samples"], where)
+        options = method_options(options, k["method"], k["transparency"], k["stats"], where)
+        choice(k["filter"], FILTERS, "filter", where)
+        choice(k["color_space"], COLOR_SPACES, "color_space", where)
+        check_image_budget(camera, factor, options.buffers, k["filter"], k["color_space"], where)
+        return dataclasses.replace(options, factor=factor, filter=k["filter"], color_space=k["color_space"])
+
+    def supersampled(self) -> RenderOptions:
+        """The options for the √samples-times larger image: lines √samples times as wide (the same counts dict)."""
+        return dataclasses.replace(self, line_width=self.line_width * self.factor)
+
+    @property
+    def volumes_with_surfaces(self) -> bool:
+        """Whether the volumes are ray cast right after the opaque surfaces (``"surface"``, ``"surface+edges"``:
+        before transparent items) rather than after the lines (``"wireframe"``, ``"points"``, ``"hidden-line"``)."""
+        return self.mode in ("surface", "surface+edges")
+
+
+def choice(value: Any, valid: tuple, name: str, where: str) -> Any:
+    if not isinstance(value, str | type(None)) or value not in valid:
+        raise FrustumError(
+            f"{where}: {name} = {describe(value)} is unknown; expected one of " + ", ".join(repr(v) for v in valid)
+        )
+    return value
+
+
+def supersampling(samples: Any, where: str) -> int:
+    """√samples for a perfect square samples >= 1, else a FrustumError."""
+    if isinstance(samples, bool) or not isinstance(samples, int | np.integer) or samples < 1:
+        raise FrustumError(f"{where}: samples = {describe(samples)} is not a positive integer; use 1, 4, 9 or 16")
+    factor = math.isqrt(int(samples))
+    if factor * factor != samples:
+        raise FrustumError(f"{where}: samples = {samples} is not a perfect square; use 1, 4, 9 or 16")
+    return factor
+
+
+def color_bytes(value: Any, name: str, where: str) -> np.ndarray:
+    """(4,) float64 bytes of an RGB or RGBA color in [0, 1] (alpha 1 if not given)."""
+    try:
+        array = np.asarray(value, dtype=np.float64).ravel()
+    except (TypeError, ValueError):
+        array = np.array([np.nan])
+    if array.shape not in ((3,), (4,)) or not np.isfinite(array).all() or (array < 0).any() or (array > 1).any():
+        raise FrustumError(
+            f"{where}: {name} = {describe(value)} is not an RGB(A) color; expected 3 or 4 numbers in [0, 1]"
+        )
+    if array.shape == (3,):
+        array = np.append(array, 1.0)
+    return np.floor(array * 255.0 + 0.5)
+
+
+def check_image_budget(camera: Camera, factor: int, buffers: tuple[str, ...], filter: str, color_space: str,
+                       where: str) -> None:  # fmt: skip
+    """Refuse, before any buffer is allocated, an image whose buffers exceed the memory budget (``frustum.budgets``).
+
+    Per rendered pixel (``width·height·samples`` of them): color 4 + depth 4 bytes, about 4 bytes of the
+    renderer's work arrays (measured with tracemalloc: 12 bytes a pixel at 1024², surface mode), 12 for a
+    ``normals`` buffer and 4 for ``object_id``; a float64 copy for the tent filter or sRGB (2 × 32 bytes).
+    """
+    pixels = camera.width * camera.height * factor * factor
+    per_pixel = 12 + 12 * ("normals" in buffers) + 4 * ("object_id" in buffers)
+    if filter != "box" or color_space != "linear":
+        per_pixel += 64
+    cause = f"a {camera.width} x {camera.height} image x samples = {factor * factor}"
+    check_memory(pixels * per_pixel, where=where, cause=cause, error=FrustumError)
+
+
+def check_arguments(
+    scene: Any, camera: Any, shading: Any, specular: Any, background: Any, cull_back_faces: Any, mode: Any,
+    edges: Any, crease_angle: Any, edge_color: Any, hidden: Any, hidden_color: Any, line_width: Any,
+    depth_cue: Any, buffers: Any, where: str,
+) -> RenderOptions:  # fmt: skip
+    """The scene, the camera and the drawing options (everything but the method, samples and the resolve)."""
+    if not isinstance(scene, Scene):
+        raise FrustumError(f"{where}: scene = {describe(scene)} is not a Scene; build one with Scene(lights=[...])")
+    if not isinstance(camera, Camera):
+        raise FrustumError(
+            f"{where}: camera = {describe(camera)} is not a Camera; build one with Camera.look_at(eye, target, up)"
+        )
+    name = "none" if shading is None else shading
+    if not isinstance(name, str) or name not in SHADING_MODES:
+        raise FrustumError(
+            f"{where}: shading = {describe(shading)} is unknown; expected one of "
+            + ", ".join(repr(n) for n in SHADING_MODES)
+            + " or None"
+        )
+    choice(specular, SPECULAR_MODELS, "specular", where)
+    choice(mode, RENDER_MODES, "mode", where)
+    if not isinstance(cull_back_faces, bool | np.bool_):
+        raise FrustumError(f"{where}: cull_back_faces = {describe(cull_back_faces)} is not a bool; give True or False")
+    if edges is None:
+        edges = "all" if mode in LINE_MODES else "feature"
+    choice(edges, EDGE_SETS, "edges", where)
+    angle = as_scalar(crease_angle, "crease_angle", where=where, error=FrustumError)
+    if not 0.0 <= angle <= math.pi:
+        raise FrustumError(f"{where}: crease_angle = {angle!r} is outside [0, pi] radians")
+    choice(hidden, HIDDEN_STYLES, "hidden", where)
+    width = as_scalar(line_width, "line_width", where=where, error=FrustumError)
+    if width < 1.0:
+        raise FrustumError(f"{where}: line_width = {width!r} is below 1; give a width in pixels >= 1")
+    if width > MAX_LINE_WIDTH:
+        raise FrustumError(
+            f"{where}: line_width = {width!r} is above {MAX_LINE_WIDTH:g}; give a width in pixels in [1, "
+            f"{MAX_LINE_WIDTH:g}]"
+        )
+    if depth_cue is not None and not isinstance(depth_cue, DepthCue):
+        raise FrustumError(
+            f"{where}: depth_cue = {describe(depth_cue)} is not a DepthCue; build one with DepthCue(near, far)"
+        )
+    if isinstance(buffers, str) or not all(isinstance(b, str) and b in BUFFERS for b in buffers):
+        raise FrustumError(
+            f"{where}: buffers = {describe(buffers)} is not a tuple of buffer names; valid names: "
+            + ", ".join(repr(b) for b in BUFFERS)
+        )
+    background_rgba = background_bytes(background, where)
+    if edge_color is None:  # material colors for wireframes; black on light backgrounds, white on dark ones
+        light = background_rgba[:3].astype(float) @ (0.2126, 0.7152, 0.0722) > 127.5
+        edge = None if mode in LINE_MODES else np.array([0.0, 0.0, 0.0, 255.0]) * light + 255.0 * (not light)
+    else:
+        edge = color_bytes(edge_color, "edge_color", where)
+    return RenderOptions(
+        shade_mode=SHADING_MODES[name],
+        specular_model=shade.SPECULAR_PHONG if specular == "phong" else shade.SPECULAR_BLINN,
+        background=background_rgba,
+        cull=bool(cull_back_faces),
+        mode=mode,
+        edges=edges,
+        crease_angle=angle,
+        edge_color=edge,
+        hidden=hidden,
+        hidden_color=color_bytes(hidden_color, "hidden_color", where),
+        line_width=width,
+        depth_cue=depth_cue,
+        buffers=tuple(buffers),
+    )
+
+
+def check_method(method: Any, where: str) -> None:
+    """A FrustumError listing the available methods for an unknown or not yet available `method`."""
+    valid = ", ".join(repr(name) for name in METHOD_NAMES)
+    if isinstance(method, str) and method in PLANNED_METHODS:
+        raise FrustumError(
+            f"{where}: method = {method!r} is not available yet ({PLANNED_METHODS[method]}); available: {valid}"
+        )
+    if not isinstance(method, str) or method not in METHOD_NAMES:
+        raise FrustumError(f"{where}: method = {describe(method)} is unknown; expected one of {valid}")
+
+
+def method_options(options: RenderOptions, method: Any, transparency: Any, stats: Any, where: str) -> RenderOptions:
+    """Check `transparency` and `stats`; the options with the method (a mesh pipeline one, ``check_method``
+    first), the transparency and a counts dict where counted."""
+    choice(transparency, TRANSPARENCY_MODES, "transparency", where)
+    if not isinstance(stats, bool | np.bool_):
+        raise FrustumError(f"{where}: stats = {describe(stats)} is not a bool; give True or False")
+    if (method != "depth-buffer" or transparency != "sort") and options.mode in LINE_MODES:
+        raise FrustumError(
+            f"{where}: method = {method!r} with transparency = {transparency!r} draws surfaces; mode = "
+            f"{options.mode!r} draws lines or points with the depth buffer: use mode 'surface', 'hidden-line' or "
+            "'surface+edges', or method 'depth-buffer'"
+        )
+    if method == "a-buffer" and options.buffers:
+        raise FrustumError(
+            f"{where}: buffers = {describe(options.buffers)} are not available with method 'a-buffer' (a pixel "
+            "holds several surfaces); use another method for per-pixel normals or object ids"
+        )
+    counted = method != "depth-buffer" or transparency != "sort" or bool(stats)
+    counts = {"method": method} if counted else None
+    return dataclasses.replace(options, method=method, transparency=transparency, counts=counts)
