@@ -29,6 +29,7 @@ from frustum.scenefile import (
     render_examples,
     render_scene_file,
 )
+from frustum.scenefile.loader import _load_scene
 from frustum.scenefile.report import _key_lines
 
 EXAMPLES = sorted(EXAMPLES_DIR.glob("*.toml"))
@@ -1059,8 +1060,8 @@ def test_outputs_outside_the_folder_are_refused_only_when_they_would_be_written(
     with pytest.raises(SceneFileError) as info:
         load_scene(data, base_dir=tmp_path)
     assert str(info.value).count("is outside the scene file's folder") == 2
-    loaded = load_scene(data, base_dir=tmp_path, check_outputs=False)  # the caller writes elsewhere (-o)
+    loaded = _load_scene(data, base_dir=tmp_path, check_outputs=False)  # the caller writes elsewhere (-o)
     assert loaded.outputs == (tmp_path / "inside.png",)
     data["output"]["files"].append("bad.xyz")  # a malformed entry stays an error either way
     with pytest.raises(SceneFileError, match="has an unknown suffix"):
-        load_scene(data, base_dir=tmp_path, check_outputs=False)
+        _load_scene(data, base_dir=tmp_path, check_outputs=False)
