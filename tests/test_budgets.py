@@ -42,8 +42,13 @@ def test_bad_budget_values(bad):
 
 def test_environment_variables():
     code = "import frustum as fr; b = fr.get_budget(); print(b.bytes, b.operations)"
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
-                         env={"FRUSTUM_MAX_BYTES": "512M", "FRUSTUM_MAX_OPERATIONS": "2e3", "PATH": ""})
+    out = subprocess.run(
+        [sys.executable, "-c", code],
+        capture_output=True,
+        text=True,
+        check=True,
+        env={"FRUSTUM_MAX_BYTES": "512M", "FRUSTUM_MAX_OPERATIONS": "2e3", "PATH": ""},
+    )
     assert out.stdout.split() == [str(512 * 2**20), "2000"]
 
 

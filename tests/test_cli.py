@@ -246,7 +246,7 @@ def test_render_explain_and_view_commands(tmp_path, capsys):
 def test_view_command_sheet_options(tmp_path, capsys):
     sheet = tmp_path / "sheet.svg"
     arguments = ["view", str(EXAMPLES / "exploded_assembly.toml"), "-o", str(sheet), "--views", "front,top"]
-    main([*arguments, "--paper", "a4", "--orientation", "portrait", "--angle", "first", "--no-dimensions"])
+    main([*arguments, "--paper", "a4", "--orientation", "portrait", "--angle", "first", "--dimensions", "none"])
     text = sheet.read_text()
     assert 'width="210mm" height="297mm"' in text and "FIRST ANGLE PROJECTION" in text
     assert 'class="dimension"' not in text

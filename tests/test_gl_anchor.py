@@ -89,8 +89,14 @@ LIGHTS = [
     AmbientLight(color=(0.3, 0.3, 0.5), intensity=0.6),
     DirectionalLight(direction=(-0.3, -0.6, -0.7), color=(1.0, 0.95, 0.8), intensity=0.7),
     PointLight(position=(1.5, 1.2, 1.5), color=(0.3, 0.6, 1.0), intensity=1.5, attenuation=(1.0, 0.1, 0.05)),
-    SpotLight(position=(-1.5, 2.0, 1.0), direction=(0.5, -1.0, -0.3), color=(1.0, 0.3, 0.2), intensity=2.0,
-              inner_angle=math.radians(15), outer_angle=math.radians(35)),
+    SpotLight(
+        position=(-1.5, 2.0, 1.0),
+        direction=(0.5, -1.0, -0.3),
+        color=(1.0, 0.3, 0.2),
+        intensity=2.0,
+        inner_angle=math.radians(15),
+        outer_angle=math.radians(35),
+    ),
 ]
 MATERIAL = Material(color=(0.75, 0.6, 0.45), ambient=0.15, diffuse=0.8, specular=0.5, shininess=24)
 

@@ -190,7 +190,7 @@ def test_span_of_an_edge_along_a_row_is_exact_where_the_float_estimate_rounds_wr
 
     columns = np.arange(40)
     rounding = [-75, -77, -91, -93, -99, -105, 75, 91]  # m·step·fl(1/step) lands above m (m = 7, 3): ceil/floor off
-    for step in [*range(-300 * 256, 301 * 256, 37 * 256 + 3), *rounding, -768, 768, -2**20 - 256, 2**20 + 256, 0]:
+    for step in [*range(-300 * 256, 301 * 256, 37 * 256 + 3), *rounding, -768, 768, -(2**20) - 256, 2**20 + 256, 0]:
         for bias in (0, 1):
             for m in (-3, 0, 1, 3, 7, 17, 39, 45):
                 for e in {m * step + d for d in (-1, 0, 1)}:

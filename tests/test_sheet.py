@@ -102,19 +102,20 @@ def test_title_block_labels_and_scale_bar():
     text = drawing_sheet(_block(), scale=2.0, title="Block <A&B>")
     root = ET.fromstring(text.encode())
     texts = [t.text for t in root.iter(f"{SVG}text")]
-    assert "Block <A&B>" in texts and "SCALE 2:1" in texts
+    block = _group(root, "title-block")
+    assert "Block <A&B>" in texts and "SCALE" in texts and "2:1" in texts and block.get("data-scale") == "2:1"
     assert {"FRONT VIEW", "TOP VIEW", "RIGHT VIEW", "ISOMETRIC VIEW"} <= set(texts)
     bar = next(g for g in root.iter(f"{SVG}g") if g.get("id") == "scale-bar")
     length = float(bar.get("data-length"))
-    line = [float(v) for v in NUMBER.findall(bar.find(f"{SVG}path").get("d"))[:4]]
+    line = [float(v) for v in NUMBER.findall(next(bar.iter(f"{SVG}path")).get("d"))[:4]]
     assert line[2] - line[0] == pytest.approx(length * 2.0, abs=1e-9) and line[1] == line[3]
     assert f"{length:g} mm" in texts
 
 
 def test_automatic_scale_is_the_largest_standard_scale_that_fits():
     text = drawing_sheet(_bracket(), paper="A4")
-    chosen = next(t.text for t in ET.fromstring(text.encode()).iter(f"{SVG}text") if t.text.startswith("SCALE"))
-    scale = next(s for s in STANDARD_SCALES if f"SCALE {scale_label(s)}" == chosen)
+    chosen = _group(ET.fromstring(text.encode()), "title-block").get("data-scale")
+    scale = next(s for s in STANDARD_SCALES if scale_label(s) == chosen)
     larger = [s for s in STANDARD_SCALES if s > scale]
     with pytest.raises(OutputError, match=r"does not fit"):
         drawing_sheet(_bracket(), paper="A4", scale=min(larger))
@@ -155,7 +156,7 @@ def test_scale_labels():
             r"scale = 50.0 does not fit 4 views on A3 \(the largest standard scale that fits is 2:1\)",
         ),
         ({"orientation": "sideways"}, OutputError, r"orientation = 'sideways' is unknown; expected 'landscape'"),
-        ({"dimensions": "yes"}, OutputError, r"dimensions = 'yes' is not a bool"),
+        ({"dimensions": "yes"}, OutputError, r"dimensions = 'yes' is unknown; expected 'overall', 'parts' or False"),
         ({"paper": "B5"}, OutputError, r"paper = 'B5' is unknown"),
         ({"paper": (50, 40)}, OutputError, r"paper = \(50.0, 40.0\) is not a paper name"),
         ({"projection_angle": "second"}, OutputError, r"projection_angle = 'second' is unknown"),
@@ -235,10 +236,13 @@ def test_top_view_draws_only_feature_edges_of_the_solid():
     corners = centre + scale * np.array([[-30.0, -20.0], [30.0, -20.0], [30.0, 20.0], [-30.0, 20.0]])
     along = np.linspace(0.0, 1.0, 25)[:, None]
     outline = [corners[k] + along * (corners[(k + 1) % 4] - corners[k]) for k in range(4)]
-    angles = 2 * math.pi * np.arange(48) / 48
+    assert all(drawn_at(point) for point in np.concatenate(outline))
+    # the post's rim is a true circle (output/true_curves.py), not its 48-gon
     axis = centre + scale * (np.array([5.0, -4.0]) - middle[[0, 2]])
-    rim = axis + scale * 10.0 * np.column_stack([np.cos(angles), np.sin(angles)])
-    assert all(drawn_at(point) for point in np.concatenate([*outline, rim]))
+    circles = _group(root, "top-visible-curves").findall(f"{SVG}circle")
+    assert len(circles) == 1
+    found = [float(circles[0].get(k)) for k in ("cx", "cy", "r")]
+    np.testing.assert_allclose(found, [*axis, scale * 10.0], rtol=0, atol=1e-9)
 
 
 @pytest.mark.parametrize(
@@ -265,6 +269,7 @@ def test_views_fill_the_drawing_area_at_the_largest_standard_scale(paper, orient
             for g in root.iter(f"{SVG}g")
             if g.get("id", "").startswith(tuple(f"{view}-" for view in views))
             for path in g.iter(f"{SVG}path")
+            if path.get("class") != "arc"  # true curves (elliptical arcs) lie inside the views' outlines
             for v in NUMBER.findall(path.get("d"))
         ]
     ).reshape(-1, 2)
@@ -288,7 +293,9 @@ def _dimension(root: ET.Element, group_id: str) -> tuple[float, str, np.ndarray]
 @pytest.mark.parametrize("scale", [1.0, 2.0])
 def test_dimension_values_are_the_model_extents_and_lines_measure_them_times_scale(scale):
     scene, part = _box_with_cylinder()
-    root = ET.fromstring(drawing_sheet(scene, views=("front", "top", "right"), scale=scale).encode())
+    root = ET.fromstring(
+        drawing_sheet(scene, views=("front", "top", "right"), scale=scale, dimensions="overall").encode()
+    )
     extent = part.bounds[1] - part.bounds[0]  # (60, 40, 40): x, y, z
     # (horizontal, vertical) model axes of each view
     axes = {"front": (0, 1), "top": (0, 2), "right": (2, 1)}
@@ -314,12 +321,14 @@ def test_dimension_values_are_the_model_extents_and_lines_measure_them_times_sca
     for view, axis_paper_x in (("front", 5.0 - (part.bounds[0][0] + part.bounds[1][0]) / 2),
                                ("right", 4.0 + (part.bounds[0][2] + part.bounds[1][2]) / 2)):  # fmt: skip
         group = _group(root, f"{view}-centre-lines")
-        (x0, y0), (x1, y1) = np.array([float(v) for v in NUMBER.findall(group.find(f"{SVG}path").get("d"))]).reshape(
-            2, 2
-        )
+        # a chain line drawn as its dashes (long dashes at both ends: no stray dots)
+        dashes = np.array([float(v) for v in NUMBER.findall(group.find(f"{SVG}path").get("d"))]).reshape(-1, 2, 2)
         centre = [float(v) for v in _group(root, f"view-{view}").get("data-centre").split()]
-        assert x0 == pytest.approx(x1, abs=1e-9) and x0 == pytest.approx(centre[0] + axis_paper_x * scale, abs=1e-9)
-        assert abs(y1 - y0) == pytest.approx(30.0 * scale + 4.0, abs=1e-9)
+        np.testing.assert_allclose(dashes[:, :, 0], centre[0] + axis_paper_x * scale, atol=1e-9)
+        ys = np.sort(dashes[:, :, 1], axis=1)
+        assert ys.max() - ys.min() == pytest.approx(30.0 * scale + 4.0, abs=1e-9)
+        ordered = ys[np.argsort(ys[:, 0])]
+        assert (ordered[[0, -1], 1] - ordered[[0, -1], 0] >= 2.0).all()  # the end dashes are long ones
     arrowheads = [p for p in root.iter(f"{SVG}path") if p.get("class") == "arrowheads"]
     assert len(arrowheads) == 7 and all(p.get("d").count("Z") in (1, 2) for p in arrowheads)
 
@@ -385,10 +394,14 @@ def test_pdf_and_svg_outputs_read_back_like_the_png(tmp_path):
 def test_a_flat_part_seen_edge_on_gets_no_zero_dimension():
     scene = Scene()
     scene.add(Mesh([[0, 0, 0], [40, 0, 0], [40, 0, 20.0]], [[0, 1, 2]]))  # in the y = 0 plane
-    root = ET.fromstring(drawing_sheet(scene, views=("front", "top")).encode())
+    root = ET.fromstring(drawing_sheet(scene, views=("front", "top"), dimensions="overall").encode())
     values = {g.get("id"): float(g.get("data-value")) for g in root.iter(f"{SVG}g") if g.get("class") == "dimension"}
     assert values == {
         "front-dimension-horizontal": 40.0,
         "top-dimension-horizontal": 40.0,
         "top-dimension-vertical": 20.0,
     }
+    # per part: each size once, none of them zero
+    root = ET.fromstring(drawing_sheet(scene, views=("front", "top"), dimensions="parts").encode())
+    values = {g.get("id"): float(g.get("data-value")) for g in root.iter(f"{SVG}g") if g.get("class") == "dimension"}
+    assert sorted(values.values()) == [20.0, 40.0]

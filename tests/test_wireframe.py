@@ -158,9 +158,12 @@ def scenes() -> dict[str, Scene]:
         "three items": placed(
             placed(
                 placed(Scene(), cube(), material=Material(color=(0.9, 0.6, 0.2))),
-                tetrahedron(), material=Material(color=(0.2, 0.8, 0.4)), transform=np.diag([1.2, 1.2, 1.2, 1.0]),
+                tetrahedron(),
+                material=Material(color=(0.2, 0.8, 0.4)),
+                transform=np.diag([1.2, 1.2, 1.2, 1.0]),
             ),
-            ground(), material=Material(color=(0.5, 0.5, 1.0)),
+            ground(),
+            material=Material(color=(0.5, 0.5, 1.0)),
         ),
     }
 

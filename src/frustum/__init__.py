@@ -212,6 +212,10 @@ _LAZY = {
     "over_under": "frustum.output.stereo",
     "release_memory": "frustum.render",
     "render": "frustum.render",
+    "radiosity": "frustum.radiosity",
+    "RadiosityError": "frustum.radiosity",
+    "RadiosityResult": "frustum.radiosity",
+    "EnvironmentMap": "frustum.environment",
     "render_examples": "frustum.scenefile",
     "render_scene_file": "frustum.scenefile",
     "render_stereo": "frustum.output.stereo",
@@ -285,6 +289,9 @@ _LAZY = {
     "STANDARD_SCALES": "frustum.output.sheet",
     "drawing_sheet": "frustum.output.sheet",
     "scale_label": "frustum.output.sheet",
+    "DIMENSION_MODES": "frustum.output.sheet",
+    "TITLE_BLOCK_FIELDS": "frustum.output.sheet",
+    "find_circles": "frustum.output.true_curves",
     "FILL_ORDERS": "frustum.output.svg",
     "HIDDEN_STYLES": "frustum.output.svg",
     "render_svg": "frustum.output.svg",
@@ -335,6 +342,7 @@ if TYPE_CHECKING:  # pragma: no cover
         DepthOrder,
         depth_sort,
     )
+    from frustum.environment import EnvironmentMap
     from frustum.geometry.csg import (
         difference,
         intersection,
@@ -411,9 +419,11 @@ if TYPE_CHECKING:  # pragma: no cover
     )
     from frustum.output.animation import turntable, write_animation
     from frustum.output.sheet import (
+        DIMENSION_MODES,
         PAPER_SIZES,
         SHEET_VIEWS,
         STANDARD_SCALES,
+        TITLE_BLOCK_FIELDS,
         drawing_sheet,
         scale_label,
     )
@@ -435,6 +445,8 @@ if TYPE_CHECKING:  # pragma: no cover
         svg_path_from_bezier,
         svg_path_from_polyline,
     )
+    from frustum.output.true_curves import find_circles
+    from frustum.radiosity import RadiosityError, RadiosityResult, radiosity
     from frustum.raster._jit import set_threads
     from frustum.render import RENDER_METHODS, RENDER_MODES, SHADING_MODES, VISIBILITY_METHODS, release_memory, render
     from frustum.scenefile import (
@@ -493,6 +505,8 @@ if TYPE_CHECKING:  # pragma: no cover
 
 
 def __getattr__(name: str) -> Any:
+    if name == "steps":  # the teaching layer (frustum.steps), a subpackage loaded on first use
+        return importlib.import_module("frustum.steps")
     module = _LAZY.get(name)
     if module is None:
         raise AttributeError(f"module 'frustum' has no attribute {name!r}")
@@ -524,6 +538,7 @@ __all__ = [
     "DEFAULT_BYTES",
     "DEFAULT_MAX_BYTES",
     "DEFAULT_OPERATIONS",
+    "DIMENSION_MODES",
     "EDGE_BOUNDARY",
     "EDGE_CREASE",
     "EDGE_KINDS",
@@ -553,6 +568,7 @@ __all__ = [
     "STANDARD_SCALES",
     "STEREO_LAYOUTS",
     "SUPPORTED_SUFFIXES",
+    "TITLE_BLOCK_FIELDS",
     "TRANSFER_PRESETS",
     "VIEW_VOLUME_PLANES",
     "VISIBILITY_METHODS",
@@ -584,6 +600,7 @@ __all__ = [
     "DirectionalLight",
     "DiskEmitter",
     "Drag",
+    "EnvironmentMap",
     "Frame",
     "Frustum",
     "FrustumError",
@@ -622,6 +639,8 @@ __all__ = [
     "PrincipalVanishingPoints",
     "Projection",
     "Quaternion",
+    "RadiosityError",
+    "RadiosityResult",
     "Ray",
     "RayHits",
     "RenderJob",
@@ -699,6 +718,7 @@ __all__ = [
     "fbm_cloud",
     "fbm_terrain",
     "feature_edges",
+    "find_circles",
     "fractal_coastline",
     "frustum",
     "general_perspective",
@@ -745,6 +765,7 @@ __all__ = [
     "quaternion_julia",
     "quaternion_julia_mesh",
     "quaternion_julia_volume",
+    "radiosity",
     "reflect",
     "region_code",
     "release_memory",

@@ -32,7 +32,7 @@ import frustum.raster
 from frustum import __version__
 from frustum._arrays import escape_control
 from frustum.camera import Camera
-from frustum.errors import FrustumError, GeometryError
+from frustum.errors import FrustumError, GeometryError, OutputError
 from frustum.geometry import Mesh
 from frustum.projection import Orthographic, Perspective
 from frustum.quaternion import Quaternion
@@ -284,7 +284,10 @@ def trace_command(
 def _load_mesh(path: Path, where: str) -> Mesh:
     """A mesh file as one Mesh (``frustum.geometry.io.load``, else trimesh), errors as one-line GeometryErrors."""
     if not path.is_file():
-        raise GeometryError(f"{where}: mesh = {str(path)!r} does not exist or is not a file; give a mesh file path")
+        from frustum._files import file_kind
+
+        problem = "does not exist" if not path.exists() else f"is not a regular file ({file_kind(path)})"
+        raise GeometryError(f"{where}: mesh = {str(path)!r} {problem}; give a mesh file path")
     try:
         from frustum.geometry.io import load
     except ImportError:  # pragma: no cover - the io module ships with frustum; trimesh directly otherwise
@@ -453,22 +456,37 @@ def explain_command(
 @app.command("view")
 def view_command(
     scene: Annotated[Path, typer.Argument(help="A TOML scene file.")],
-    output: Annotated[Path, typer.Option("--output", "-o", help="The sheet: .svg, .pdf or .png.")],
-    views: Annotated[str, typer.Option(help="Comma-separated views: front, top, right, left, rear, bottom, iso.")] = (
-        "front,top,right,iso"
-    ),
-    paper: Annotated[str, typer.Option(help="Sheet size: A4, A3, A2, A1, A0, Letter or Tabloid.")] = "A3",
-    orientation: Annotated[str, typer.Option(help="landscape or portrait.")] = "landscape",
-    angle: Annotated[str, typer.Option(help="Projection angle: third (US, ISO E) or first (ISO, Europe).")] = "third",
-    dimensions: Annotated[bool, typer.Option(help="Draw overall dimensions and diameters.")] = True,
+    output: Annotated[Path, typer.Option("--output", "-o", help="The sheet: .svg, .pdf, .png or .dxf (CAD).")],
+    views: Annotated[
+        str | None, typer.Option(help="Comma-separated views: front, top, right, left, rear, bottom, iso.")
+    ] = None,
+    paper: Annotated[str | None, typer.Option(help="Sheet size: A4, A3, A2, A1, A0, Letter or Tabloid.")] = None,
+    orientation: Annotated[str | None, typer.Option(help="landscape or portrait.")] = None,
+    angle: Annotated[
+        str | None, typer.Option(help="Projection angle: third (US, ISO E) or first (ISO, Europe).")
+    ] = None,
+    dimensions: Annotated[
+        str | None, typer.Option(help="parts (each part's sizes; default), overall (each view's extent) or none.")
+    ] = None,
+    title: Annotated[str | None, typer.Option(help="Title block: the drawing's title.")] = None,
+    drawing_number: Annotated[str | None, typer.Option(help="Title block: drawing number.")] = None,
+    sheet_number: Annotated[str | None, typer.Option("--sheet", help="Title block: sheet n/N, e.g. 1/2.")] = None,
+    date: Annotated[str | None, typer.Option(help="Title block: date of issue.")] = None,
+    author: Annotated[str | None, typer.Option(help="Title block: drawn by.")] = None,
+    tolerance: Annotated[str | None, typer.Option(help="Title block: general tolerances (ISO 2768-m).")] = None,
+    units: Annotated[str | None, typer.Option(help="Title block: model units (mm).")] = None,
 ) -> None:
     """Draw the scene as an engineering sheet: orthographic views at the largest standard scale that fits, with
-    hidden lines, dimensions, title block and scale bar."""
+    hidden lines, dimensions, title block and scale bar (the scene file's [sheet] table sets the defaults)."""
     from frustum.scenefile import render_view_sheet
 
+    fields = {"title": title, "drawing_number": drawing_number, "sheet": sheet_number, "date": date,
+              "author": author, "tolerance": tolerance, "units": units}  # fmt: skip
     written = render_view_sheet(
-        scene, output, tuple(v.strip() for v in views.split(",") if v.strip()),
-        paper=paper, orientation=orientation, projection_angle=angle, dimensions=dimensions,
+        scene, output, tuple(v.strip() for v in views.split(",") if v.strip()) if views is not None else None,
+        paper=paper, orientation=orientation, projection_angle=angle,
+        dimensions=False if dimensions == "none" else dimensions,
+        title_block={key: value for key, value in fields.items() if value is not None},
     )  # fmt: skip
     console.print(f"wrote {written}", markup=False, highlight=False, soft_wrap=True)
 
@@ -547,6 +565,14 @@ def serve_command(
         str, typer.Option(help="Interface to listen on; 127.0.0.1 is this machine only, 0.0.0.0 every interface.")
     ] = "127.0.0.1",
     port: Annotated[int, typer.Option(help="TCP port; 0 picks a free one.")] = 8000,
+    allow_origin: Annotated[
+        list[str] | None,
+        typer.Option("--allow-origin", help="Also let pages of this origin (e.g. http://localhost:8888) use the "
+                     "viewer, for deliberate embedding; repeatable. Other pages get 403."),
+    ] = None,
+    no_token: Annotated[
+        bool, typer.Option("--no-token", help="Serve a non-loopback --host without the random URL token.")
+    ] = False,
 ) -> None:
     """Open an interactive viewer of a scene file in the browser (orbit, pan, zoom, the pipeline beside it)."""
     from frustum.viewer.server import serve
@@ -556,12 +582,109 @@ def serve_command(
         if host in ("127.0.0.1", "localhost", "::1"):
             console.print("listening on this machine only; --host 0.0.0.0 serves other machines too; Ctrl-C stops",
                           markup=False, highlight=False, soft_wrap=True)  # fmt: skip
+        elif "?token=" in url:
+            console.print("other machines need the URL with its token; --no-token serves without one; Ctrl-C stops",
+                          markup=False, highlight=False, soft_wrap=True)  # fmt: skip
         console.file.flush()
 
-    serve(scene, host, port, ready=ready)
+    serve(scene, host, port, ready=ready, allow_origins=tuple(allow_origin or ()), token=False if no_token else None)
+
+
+@app.command("steps")
+def steps_command(
+    algorithm: Annotated[str | None, typer.Argument(help="Algorithm name (frustum steps --list).")] = None,
+    scene_file: Annotated[Path | None, typer.Argument(help="A TOML scene file (depth-buffer).")] = None,
+    size: Annotated[str | None, typer.Option(help="Image size WxH for a scene file's camera.")] = None,
+    output: Annotated[Path | None, typer.Option("-o", "--output", help="Output .svg, .gif, .mp4, .html, .md.")] = None,
+    list_algorithms: Annotated[bool, typer.Option("--list", help="List the algorithms and exit.")] = False,
+    from_: Annotated[str | None, typer.Option("--from", help="Segment start x,y,z[,w].")] = None,
+    to: Annotated[str | None, typer.Option("--to", help="Segment end x,y,z[,w].")] = None,
+    points: Annotated[str | None, typer.Option(help="Points x,y[,z];x,y[,z];...")] = None,
+    t: Annotated[str | None, typer.Option("--t", help="Curve parameter in [0, 1].")] = None,
+    level: Annotated[str | None, typer.Option(help="Fractal iterations.")] = None,
+    axis: Annotated[str | None, typer.Option(help="Rotation axis x,y,z.")] = None,
+    point: Annotated[str | None, typer.Option(help="A point on the rotation axis x,y,z.")] = None,
+    angle_deg: Annotated[str | None, typer.Option(help="Rotation angle in degrees.")] = None,
+    knots: Annotated[str | None, typer.Option(help="Knot vector, comma-separated.")] = None,
+    order: Annotated[str | None, typer.Option(help="B-spline order k (degree k - 1).")] = None,
+    u: Annotated[str | None, typer.Option("--u", help="B-spline parameter whose knot span is shown.")] = None,
+    seed: Annotated[str | None, typer.Option(help="Random seed.")] = None,
+    fps: Annotated[float, typer.Option(help="Animation frames (steps) per second.")] = 1.0,
+) -> None:
+    """Record an algorithm of the lecture notes step by step and write its figures, animation, page or table."""
+    from frustum.steps.catalog import build, describe_algorithms
+
+    if list_algorithms:
+        console.print(describe_algorithms(), markup=False, highlight=False, soft_wrap=True)
+        return
+    if algorithm is None or output is None:
+        raise UsageError("frustum steps: give an ALGORITHM and -o out.svg|gif|mp4|html|md (or --list)")
+    options: dict[str, Any] = {"from": from_, "to": to, "points": points, "t": t, "level": level, "axis": axis,
+                               "point": point, "angle_deg": angle_deg, "knots": knots, "order": order, "u": u,
+                               "seed": seed}  # fmt: skip
+    if scene_file is not None:
+        from frustum.scenefile import load_scene_file
+
+        loaded = load_scene_file(scene_file)
+        camera = loaded.camera or loaded.cameras[0]
+        if size is not None:
+            width, height = _image_size(size)
+            camera = Camera(camera.frame, camera.projection, width, height)
+        options.update(scene=loaded.scene, camera=camera)
+    recorded = build(algorithm, options)
+    written = recorded.save(output, fps=fps)
+    console.print(f"frustum steps: {algorithm}, {len(recorded)} steps -> {', '.join(map(str, written))}",
+                  markup=False, highlight=False, soft_wrap=True)  # fmt: skip
 
 
 # --- entry point ------------------------------------------------------------------------------------------------
+
+
+@app.command("radiosity")
+def radiosity_command(
+    scene: Annotated[Path, typer.Argument(help="A TOML scene file (emissive materials and/or lights).")],
+    output: Annotated[Path, typer.Option("--output", "-o", help="The picture to write (.png).")],
+    patch_size: Annotated[
+        float | None, typer.Option(help="Longest patch edge in world units (default: the [radiosity] table's, or a "
+                                        "twentieth of the scene's diagonal).")
+    ] = None,
+    hemicube: Annotated[int | None, typer.Option(help="Hemicube pixels a side (default 128).")] = None,
+    tolerance: Annotated[float | None, typer.Option(help="Stop at this unshot / emitted power (default 1e-3).")] = None,
+    size: Annotated[str | None, typer.Option(help="Image size WIDTHxHEIGHT, overriding the file's.")] = None,
+) -> None:
+    """Light a scene file by radiosity (diffuse light bouncing between surfaces, hemicube form factors, progressive
+    refinement) and render the lit scene from the file's camera: each pixel the interpolated radiosity."""
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+    from frustum.radiosity import radiosity
+    from frustum.render import render
+    from frustum.scenefile import load_scene_file
+
+    if output.suffix.lower() != ".png":
+        raise OutputError(f"radiosity: output = {str(output)!r} is not a .png file; radiosity writes a PNG picture")
+    scene_file = load_scene_file(scene)
+    if size:
+        scene_file = scene_file.resized(_image_size(size))
+    settings = dict(getattr(scene_file, "radiosity", None) or {})
+    for name, value in (("patch_size", patch_size), ("hemicube", hemicube), ("tolerance", tolerance)):
+        if value is not None:
+            settings[name] = value
+    goal = -math.log10(float(settings.get("tolerance", 1e-3)))
+    columns = (TextColumn("radiosity"), BarColumn(), TextColumn("{task.fields[shots]} shots, residual "
+               "{task.fields[residual]:.1e}"), TimeElapsedColumn())  # fmt: skip
+    with Progress(*columns, console=error_console, transient=True) as bar:
+        task = bar.add_task("radiosity", total=goal, shots=0, residual=1.0)
+
+        def progress(shots: int, residual: float) -> None:
+            done = min(-math.log10(max(residual, 1e-300)), goal)
+            bar.update(task, completed=done, shots=shots, residual=residual)
+
+        result = _run_interruptible(lambda: radiosity(scene_file.scene, progress=progress, **settings))
+    keep = {k: v for k, v in scene_file.options.items() if k in ("background", "samples", "color_space", "filter")}
+    output.parent.mkdir(parents=True, exist_ok=True)
+    render(result.scene, scene_file.cameras[0], shading="none", **keep).save(output)
+    console.print(f"wrote {output} ({result.patches} patches, {result.iterations} shots, residual "
+                  f"{result.residual:.1e})", markup=False, highlight=False, soft_wrap=True)  # fmt: skip
 
 
 def _click_exception(name: str) -> type[Exception]:

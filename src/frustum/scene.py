@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from frustum._arrays import Matrix4, as_matrix, as_scalar, as_vector3, describe
+from frustum.environment import EnvironmentMap
 from frustum.errors import FrustumError, GeometryError
 from frustum.geometry import Mesh, Polyline
 from frustum.shading import LIGHT_TYPES, Light, Material
@@ -292,9 +293,17 @@ class Scene:
 
     ``scene.items`` lists the placed meshes in drawing order (depth-first). The depth buffer makes the image
     independent of that order except for exactly equal depths (the first drawn wins under the "less" test).
+    ``environment`` (an ``EnvironmentMap`` or None): the surroundings, shown where nothing is drawn (when
+    ``render`` is given no background) and reflected by materials with ``reflectivity > 0``.
     """
 
-    def __init__(self, lights: Iterable[Light] = ()) -> None:
+    def __init__(self, lights: Iterable[Light] = (), *, environment: EnvironmentMap | None = None) -> None:
+        if environment is not None and not isinstance(environment, EnvironmentMap):
+            raise FrustumError(
+                f"Scene: environment = {describe(environment)} is not an EnvironmentMap; build one with "
+                "EnvironmentMap(image) or EnvironmentMap.load(path)"
+            )
+        self.environment = environment
         self.root = Node("")
         self.particle_layers: list[ParticleLayer] = []
         self.mass_springs: list[tuple[Node, MassSpringSystem]] = []
@@ -676,6 +685,7 @@ class Scene:
         scene.root = root
         scene.particle_layers = list(self.particle_layers)
         scene.volumes = list(self.volumes)
+        scene.environment = self.environment
         return scene
 
 

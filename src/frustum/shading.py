@@ -124,6 +124,13 @@ class Material:
     over what lies behind it, drawn back to front after the opaque surfaces: the "ghosted" parts of a cutaway),
     ``texture`` an (H, W[, 3|4]) image sampled bilinearly at the mesh's UV coordinates (v up: v = 0 is the
     image's bottom row; uint8 bytes are taken as linear values / 255), multiplied into the base color.
+    ``emission`` (>= 0, default 1) scales ``emissive`` for ``radiosity``: an emitter's radiance is
+    ``emissive · emission``, which may exceed 1 (the local illumination model adds ``emissive`` alone).
+    ``reflectivity`` in [0, 1]: the share of the color that is the mirror reflection of the surroundings (the
+    scene's environment map in the depth-buffer pipeline: ``(1 − r)·I + r·env(R)``).
+    ``bump`` an (H, W[, 3|4]) height image (gray, in [0, 1], times ``bump_scale`` world units) and ``normal_map``
+    an (H, W, 3|4) tangent-space normal image (OpenGL convention, +y up): both perturb the shading normal per pixel
+    in Phong shading, from the mesh's UVs (``frustum.surface_detail``; flat and Gouraud shading ignore them).
     ``hatch`` (vector output only): the spacing of 45° section lines drawn over the faces in filled SVG/PDF,
     in drawing units, as engineering drawings mark cut surfaces (``cutaway`` sets it on section caps).
     Raises ``ShadingError`` for a non-finite or negative coefficient, a color outside [0, 1] or a bad texture.
@@ -138,6 +145,11 @@ class Material:
     opacity: float = 1.0
     texture: NDArray[np.float32] | None = None
     hatch: float | None = None
+    emission: float = 1.0
+    reflectivity: float = 0.0
+    bump: NDArray[np.float32] | None = None
+    bump_scale: float = 1.0
+    normal_map: NDArray[np.float32] | None = None
 
     def __post_init__(self) -> None:
         where = "Material"
@@ -155,6 +167,15 @@ class Material:
             raise ShadingError(f"{where}: opacity = {opacity!r} is above 1; expected 0 <= opacity <= 1")
         object.__setattr__(self, "opacity", opacity)
         object.__setattr__(self, "texture", _texture(self.texture, where))
+        object.__setattr__(self, "emission", _nonnegative(self.emission, "emission", where))
+        reflectivity = _nonnegative(self.reflectivity, "reflectivity", where)
+        if reflectivity > 1.0:
+            raise ShadingError(f"{where}: reflectivity = {reflectivity!r} is above 1; expected 0 <= reflectivity <= 1")
+        object.__setattr__(self, "reflectivity", reflectivity)
+        object.__setattr__(self, "bump", _texture(self.bump, f"{where} bump"))
+        bump_scale = as_scalar(self.bump_scale, "bump_scale", where=where, error=ShadingError)
+        object.__setattr__(self, "bump_scale", bump_scale)
+        object.__setattr__(self, "normal_map", _texture(self.normal_map, f"{where} normal_map"))
 
     def with_(self, **changes: Any) -> Material:
         """A copy with some fields changed, e.g. ``material.with_(opacity=0.3)``."""

@@ -59,11 +59,13 @@ def run_cli(*arguments: str, env: dict[str, str] | None = None, cwd: Path | None
 API_CASES = {
     "uv_sphere_7GB": (
         "import frustum as fr; fr.geometry.uv_sphere(1.0, 100000, 1000)",
-        "GeometryError", "uv_sphere: segments = 100000, rings = 1000 (100101001 vertices) needs about",
+        "GeometryError",
+        "uv_sphere: segments = 100000, rings = 1000 (100101001 vertices) needs about",
     ),
     "camera_100000_pixels": (
         "import frustum as fr; fr.Camera.look_at((0, 0, 5), (0, 0, 0), width=100000, height=100000)",
-        "CameraError", "width = 100000 is above the limit of 65536 pixels a side",
+        "CameraError",
+        "width = 100000 is above the limit of 65536 pixels a side",
     ),
     "render_86GB_image": (
         """
@@ -71,11 +73,13 @@ API_CASES = {
         scene = fr.Scene(); scene.add(fr.geometry.uv_sphere())
         fr.render(scene, fr.Camera.look_at((0, 0, 5), (0, 0, 0), width=8192, height=8192), samples=64)
         """,
-        "FrustumError", "render: a 8192 x 8192 image x samples = 64 needs about 48.0 GiB, over the memory budget",
+        "FrustumError",
+        "render: a 8192 x 8192 image x samples = 64 needs about 48.0 GiB, over the memory budget",
     ),
     "mandelbrot_1e12_iterations": (
         "import frustum as fr; fr.mandelbrot(width=64, height=64, max_iter=10**12)",
-        "GeometryError", "64 x 64 pixels x max_iter = 1000000000000 needs about 4.1e+15 operations, over the work",
+        "GeometryError",
+        "64 x 64 pixels x max_iter = 1000000000000 needs about 4.1e+15 operations, over the work",
     ),
     "wireframe_line_width_1e8": (
         """
@@ -84,41 +88,48 @@ API_CASES = {
         fr.render(scene, fr.Camera.look_at((0, 0, 5), (0, 0, 0), width=64, height=64), mode="wireframe",
                   line_width=1e8)
         """,
-        "FrustumError", "line_width = 100000000.0 is above 256",
+        "FrustumError",
+        "line_width = 100000000.0 is above 256",
     ),
     "flatness_resolution_1e-300": (
         """
         import numpy as np, frustum as fr
         fr.geometry.BezierSurface(np.random.default_rng(0).random((4, 4, 3))).flatness_resolution(1e-300)
         """,
-        "GeometryError", "tolerance = 1e-300 is below 1e-10 of the surface's extent",
+        "GeometryError",
+        "tolerance = 1e-300 is below 1e-10 of the surface's extent",
     ),
     "curve_flatten_1e-300": (
         """
         import frustum as fr
         fr.geometry.BezierCurve([[0, 0, 0], [1, 2, 0], [3, -1, 0], [4, 0, 0]]).flatten(1e-300)
         """,
-        "GeometryError", "BezierCurve.flatten: tolerance = 1e-300 is below 1e-10 of the curve's extent",
+        "GeometryError",
+        "BezierCurve.flatten: tolerance = 1e-300 is below 1e-10 of the curve's extent",
     ),
     "tessellate_adaptive_1e-9": (
         """
         import numpy as np, frustum as fr
         fr.geometry.BezierSurface(np.random.default_rng(0).random((4, 4, 3))).tessellate_adaptive(1e-9)
         """,
-        "GeometryError", "BezierSurface.tessellate: nu = ",
+        "GeometryError",
+        "BezierSurface.tessellate: nu = ",
     ),
     "fractal_default_budget": (
         "import frustum as fr; fr.geometry.menger_sponge(9)",
-        "GeometryError", "menger_sponge: level = 9 needs about",
+        "GeometryError",
+        "menger_sponge: level = 9 needs about",
     ),
     "fractal_max_bytes_override": (
         "import frustum as fr; fr.geometry.koch_curve(3, max_bytes=1000)",
-        "GeometryError", "level = 3 would need 4680 bytes (4.6 KiB), over the memory budget max_bytes = 1000",
+        "GeometryError",
+        "level = 3 would need 4680 bytes (4.6 KiB), over the memory budget max_bytes = 1000",
     ),
     # --- 4. honest, safe error messages -----------------------------------------------------------------------
     "singular_modeling_transform": (
         "import frustum as fr; fr.Scene().add(fr.geometry.uv_sphere(), transform=fr.scale(0, 0, 0))",
-        "FrustumError", "is singular (determinant 0)",
+        "FrustumError",
+        "is singular (determinant 0)",
     ),
     "polyline_negative_samples": (
         """
@@ -126,15 +137,18 @@ API_CASES = {
         curve = fr.geometry.BezierCurve([[0, 0, 0], [1, 1, 0], [2, 0, 0]])
         fr.geometry.Polyline.from_curve(curve, samples=-3)
         """,
-        "GeometryError", "Polyline.from_curve: samples = -3 is below 2",
+        "GeometryError",
+        "Polyline.from_curve: samples = -3 is below 2",
     ),
     "complex_vertices": (
         "import numpy as np, frustum as fr; fr.geometry.Mesh(np.eye(3) * (1 + 2j), [[0, 1, 2]])",
-        "GeometryError", "Mesh: vertices = ",
+        "GeometryError",
+        "Mesh: vertices = ",
     ),
     "complex_eye": (
         "import frustum as fr; fr.Camera.look_at((0, 0, 5 + 1j), (0, 0, 0))",
-        "CameraError", "is complex",
+        "CameraError",
+        "is complex",
     ),
 }
 
@@ -167,12 +181,11 @@ def test_budget_from_the_environment_and_the_cli(tmp_path):
 
 SCENE_CASES = {
     "quaternion_julia_forever.toml": "quaternion_julia_forever.toml:7: nodes[0].geometry.resolution = 300 is not "
-                                     "accepted: quaternion_julia: resolution = 300",
+    "accepted: quaternion_julia: resolution = 300",
     "huge_sphere.toml": "huge_sphere.toml:6: nodes[0].geometry",
     "huge_image.toml": "huge_image.toml:3: render.samples = 64 is over the memory budget",
     "escape_parent.toml": "escape_parent.toml:9: output.files[0] = '../../escaped.png' is outside the scene file's",
-    "escape_absolute.toml": "escape_absolute.toml:9: output.files[0] = '/tmp/frustum-hostile-absolute.png' is "
-                            "outside",
+    "escape_absolute.toml": "escape_absolute.toml:9: output.files[0] = '/tmp/frustum-hostile-absolute.png' is outside",
 }
 
 
@@ -194,7 +207,7 @@ def test_forged_key_cannot_forge_lines_or_colors():
 
 def test_deep_nesting_and_long_dotted_keys_are_refused_early(tmp_path):
     deep = tmp_path / "deep.toml"
-    deep.write_text('[camera]\neye = [0, 0, 5]\n\nx = ' + "[" * 100_000 + "\n")
+    deep.write_text("[camera]\neye = [0, 0, 5]\n\nx = " + "[" * 100_000 + "\n")
     result = run_cli("render", str(deep))
     assert result.returncode == 1
     assert "deep.toml:4: arrays or tables nest more than 64 deep here" in result.stderr
@@ -267,12 +280,15 @@ def test_mp4_on_a_full_disk_is_one_line_without_the_ffmpeg_command(tmp_path):
     pytest.importorskip("imageio_ffmpeg")
     target = tmp_path / "spin.mp4"
     target.write_bytes(b"old")
-    result = run_case(_FULL_DISK + f"""
+    result = run_case(
+        _FULL_DISK
+        + f"""
 import numpy as np
 from frustum.output.animation import write_animation
 rng = np.random.default_rng(0)
 write_animation((rng.integers(0, 255, (256, 256, 3), dtype=np.uint8) for _ in range(30)), {str(target)!r})
-""")
+"""
+    )
     assert result["type"] == "OutputError", result
     assert "write_animation: path = " in result["message"] and "cannot be written" in result["message"]
     assert "FFMPEG" not in result["message"].upper() or "imageio-ffmpeg" in result["message"]
@@ -284,11 +300,14 @@ write_animation((rng.integers(0, 255, (256, 256, 3), dtype=np.uint8) for _ in ra
 def test_pdf_failure_names_the_cause_not_a_status_number(tmp_path):
     pytest.importorskip("cairosvg")
     target = tmp_path / "sheet.pdf"
-    result = run_case(_FULL_DISK + f"""
+    result = run_case(
+        _FULL_DISK
+        + f"""
 from frustum.output.svg import save_svg
 body = "".join(f'<path d="M {{i % 50}} {{i // 50}} L {{i % 37}} {{i % 23}}" stroke="black"/>' for i in range(5000))
 save_svg('<svg xmlns="http://www.w3.org/2000/svg" width="100" height="100">' + body + '</svg>', {str(target)!r})
-""")
+"""
+    )
     assert result["type"] == "OutputError", result
     assert "save_svg: path = " in result["message"]
     assert "cannot be written (cairo could not write it: the disk is full" in result["message"]
@@ -337,11 +356,13 @@ def test_gif_frames_are_streamed_to_the_file(tmp_path):
 def test_many_large_cameras_count_in_the_image_budget(tmp_path):
     cameras = "".join(f"[[cameras]]\neye = [0, 0, {5 + k}]\ntarget = [0, 0, 0]\n\n" for k in range(64))
     scene = tmp_path / "wall.toml"
-    scene.write_text('[render]\nsize = [8192, 8192]\n\n' + cameras + '[[nodes]]\ngeometry = { type = "uv_sphere" }\n')
+    scene.write_text("[render]\nsize = [8192, 8192]\n\n" + cameras + '[[nodes]]\ngeometry = { type = "uv_sphere" }\n')
     result = run_cli("render", str(scene), cwd=tmp_path)
     assert result.returncode == 1
-    expected = ("wall.toml:2: render.size = (8192.0, 8192.0) is over the memory budget; 8192 x 8192 pixels x "
-                "samples = 1 x 64 cameras needs about 32.8 GiB")
+    expected = (
+        "wall.toml:2: render.size = (8192.0, 8192.0) is over the memory budget; 8192 x 8192 pixels x "
+        "samples = 1 x 64 cameras needs about 32.8 GiB"
+    )
     assert expected in result.stderr, result.stderr
 
 

@@ -28,8 +28,10 @@ Orthogonal Projections"; [seed] "Elevation and Plan View", "engineering and arch
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from html import escape as _html_escape
 from typing import Any
 
 import numpy as np
@@ -41,18 +43,26 @@ from frustum.errors import OutputError
 from frustum.geometry import Mesh, Polyline
 from frustum.hidden_lines import (
     DEFAULT_CREASE_ANGLE,
-    EDGE_BOUNDARY,
-    EDGE_CREASE,
+    EDGE_SILHOUETTE,
     HiddenLines,
-    classify_edges,
     remove_hidden_lines,
-    welded_adjacency,
 )
-from frustum.output.svg import _check_common, _drawing_groups, _escape, _number, _placed_meshes, svg_document
+from frustum.output.svg import (
+    _HIDDEN_GRAY,
+    _check_common,
+    _drawing_groups,
+    _escape,
+    _number,
+    _placed_meshes,
+    save_svg,
+    svg_document,
+)
+from frustum.output.true_curves import Circle, EllipseArc, circle_arcs, find_circles, svg_arc_elements
 from frustum.projection import ISOMETRIC_ROTATION_X, MULTIVIEWS, Axonometric, Orthographic, multiview
 from frustum.scene import Scene
 
 __all__ = [
+    "DIMENSION_MODES",
     "ORIENTATIONS",
     "PAPER_SIZES",
     "SHEET_VIEWS",
@@ -77,6 +87,8 @@ ORIENTATIONS = ("landscape", "portrait")
 STANDARD_SCALES = tuple(m * 10.0**k if k >= 0 else m / 10.0**-k for k in range(2, -5, -1) for m in (5.0, 2.0, 1.0))
 """Drawing scales (paper length / model length) ``scale=None`` chooses from, largest first: ISO 5455's
 1, 2, 5 series (500:1 … 1:10000; the standard's table extended by powers of ten, as it allows)."""
+DIMENSION_MODES = ("parts", "overall")
+"""What ``drawing_sheet(dimensions=...)`` dimensions besides False: each part's sizes, or each view's overall extent."""
 SHEET_VIEWS = (*MULTIVIEWS, "isometric")
 """View names ``drawing_sheet`` accepts."""
 
@@ -87,32 +99,24 @@ _FIRST_ANGLE = {"front": (0, 0), "top": (0, 1), "bottom": (0, -1), "right": (-1,
                 "rear": (2, 0), "isometric": (1, 1)}  # fmt: skip
 _MARGIN = 10.0  # border to paper edge, mm
 _TITLE_HEIGHT = 36.0  # title block strip at the bottom of the frame, mm
-_TITLE_WIDTH = 170.0
+_TITLE_WIDTH = 180.0  # ISO 7200: at most 180 mm wide
 _MIN_GAP = 8.0  # least space between views (and between views and the border), mm
 _PIXELS = 1000  # window size of the view cameras; window → paper is x_p = scale · (h / _PIXELS) · x_w + ...
 # dimensioning (ISO 129-1): thin lines, closed filled arrowheads, 3.5 mm lettering above the dimension line
 _THIN = 0.25  # dimension, extension, leader and centre lines, mm
 _DIMENSION_OFFSET = 10.0  # view outline to dimension line, mm
+_DIMENSION_SPACING = 7.0  # between stacked parallel dimension lines, mm
+_PARTS_TRIES = 4  # scales at which the views fit that dimensions="parts" tries before falling back to "overall"
 _EXTENSION_GAP = 1.0  # extension lines start this far from the feature ...
 _EXTENSION_BEYOND = 2.0  # ... and end this far past the dimension line, mm
 _ARROW_LENGTH, _ARROW_HALF_WIDTH = 3.0, 0.55  # arrowhead, mm (about 20 degrees included)
 _LETTER = 3.5  # dimension and label text height, mm
 _LEADER_RISE = 5.0  # a diameter leader's shoulder sits this far above the view, mm; more leaders stack 6 mm apart
 _LABEL_DROP = 7.0  # view label baseline below everything else of the view, mm
-# circles: closed loops of creases / boundaries with at least this many vertices, planar and round within
-# these fractions of the radius (a tessellated circle's vertices lie on it, up to round-off)
-_CIRCLE_MIN_VERTICES = 10
+# circles (output/true_curves.py): two circles are one cylinder's when radii and axes agree within this fraction
 _CIRCLE_TOLERANCE = 1e-6
 # an end-on circle's plane normal lies within this angle (radians) of the line of sight
 _END_ON_ANGLE = 1e-6
-
-
-@dataclass(frozen=True)
-class _Circle:
-    centre: NDArray[np.float64]  # world
-    normal: NDArray[np.float64]  # unit, world
-    radius: float
-    sides: int  # vertices of the polygon
 
 
 @dataclass
@@ -124,6 +128,16 @@ class _View:
     local: NDArray[np.float64]  # (N, 2) every model vertex in view-local model mm: x right, y down, origin = target
     circles: list[tuple[NDArray[np.float64], float, float]]  # end-on circles: local centre, radius, visible part
     axes: list[tuple[NDArray[np.float64], NDArray[np.float64]]]  # cylinder axes seen side-on: local ends
+    visible_arcs: list[EllipseArc] = field(default_factory=list)  # true curves, window coordinates
+    hidden_arcs: list[EllipseArc] = field(default_factory=list)
+    parts: list[NDArray[np.float64]] = field(default_factory=list)  # (N_p, 2) view-local points of each part
+    # world axis (0, 1, 2) running across / down the view; -1 for a view not aligned with the axes (isometric)
+    across: int = -1
+    down: int = -1
+    # per part: visible share of its drawn edges in this view (how well the view shows it)
+    shown: list[float] = field(default_factory=list)
+    # per end-on circle entry of `circles`: the keys (part, radius, axis) of the circles drawn there
+    circle_keys: list[set] = field(default_factory=list)
 
 
 @dataclass
@@ -136,6 +150,13 @@ class _Mark:
     lines: list[tuple[float, float, float, float]] = field(default_factory=list)
     arrows: list[tuple[float, float, float, float]] = field(default_factory=list)  # tip x, y, unit direction
     texts: list[tuple[float, float, str, str, bool]] = field(default_factory=list)  # x, y, text, anchor, vertical
+    # what the mark measures, for CAD (DXF DIMENSION entities): ("linear", a, b, at, horizontal) or
+    # ("diameter", centre, radius, tip) in the same coordinates, or None
+    definition: tuple | None = None
+    circles: list[tuple[float, float, float]] = field(default_factory=list)  # x, y, radius (projection symbol)
+    text_size: float = _LETTER
+    line_width: float = _THIN
+    body: list | None = field(default=None, repr=False, compare=False)  # cached by _body
 
 
 def _box(marks: list[_Mark]) -> NDArray[np.float64]:
@@ -197,60 +218,14 @@ def _view_camera(name: str, target: NDArray, radius: float) -> Camera:
     return Camera.multiview(name, Orthographic(height, near, far), target, distance, _PIXELS, _PIXELS)
 
 
-def _circles(meshes: list[tuple[Mesh | Polyline, NDArray]]) -> list[_Circle]:
-    """Circular edge loops of the meshes (world): closed chains of creases and boundaries, planar and round.
-
-    A loop is a connected set of feature edges in which every vertex has two edges; it is a circle when it has
-    at least ``_CIRCLE_MIN_VERTICES`` vertices, all within ``_CIRCLE_TOLERANCE``·r of one plane and of one
-    distance r from their centroid (a regular polygon's centroid is the circle's centre).
-    """
-    found = []
-    for mesh, world_from_model in meshes:
-        if not isinstance(mesh, Mesh) or mesh.face_count == 0:
-            continue
-        points = mesh.vertices @ world_from_model[:3, :3].T + world_from_model[:3, 3]
-        adjacency = welded_adjacency(mesh)
-        kinds = classify_edges(adjacency, points, np.asarray(mesh.faces), None, DEFAULT_CREASE_ANGLE)
-        edges = adjacency.edges[(kinds & (EDGE_BOUNDARY | EDGE_CREASE)) != 0]
-        if edges.shape[0] < _CIRCLE_MIN_VERTICES:
-            continue
-        # connected components of the edge graph (union–find on the few feature vertices)
-        vertices, local = np.unique(edges, return_inverse=True)
-        local = local.reshape(-1, 2)
-        parent = np.arange(vertices.size)
-        changed = True
-        while changed:
-            low = np.minimum(parent[local[:, 0]], parent[local[:, 1]])
-            changed = bool((parent[local[:, 0]] != low).any() or (parent[local[:, 1]] != low).any())
-            np.minimum.at(parent, local[:, 0], low)
-            np.minimum.at(parent, local[:, 1], low)
-            parent = parent[parent]
-        degree = np.bincount(local.reshape(-1), minlength=vertices.size)
-        for root in np.unique(parent):
-            members = np.flatnonzero(parent == root)
-            if members.size < _CIRCLE_MIN_VERTICES or (degree[members] != 2).any():
-                continue
-            ring = points[vertices[members]]
-            centre = ring.mean(axis=0)
-            offsets = ring - centre
-            normal = np.linalg.svd(offsets)[2][2]
-            radii = np.linalg.norm(offsets, axis=1)
-            radius = float(radii.mean())
-            if not radius > 0.0:
-                continue
-            if np.abs(offsets @ normal).max() > _CIRCLE_TOLERANCE * radius:
-                continue
-            if np.abs(radii - radius).max() > _CIRCLE_TOLERANCE * radius:
-                continue
-            found.append(_Circle(centre, normal, radius, int(members.size)))
-    return found
-
-
-def _sheet_views(names: Sequence[str], points_world: NDArray, meshes: list, options: dict) -> list[_View]:
+def _sheet_views(
+    names: Sequence[str], points_world: NDArray, meshes: list, options: dict
+) -> tuple[list[_View], list[Circle]]:
     low, high = points_world.min(axis=0), points_world.max(axis=0)
     target = (low + high) / 2.0
     radius = max(float(np.linalg.norm(high - low)) / 2.0, 1e-9)
-    circles = _circles(meshes)
+    circles = find_circles(meshes, options["crease_angle"])
+    parts_world = [_points(mesh) @ m[:3, :3].T + m[:3, 3] for mesh, m in meshes]
     views = []
     for name in names:
         camera = _view_camera(name, target, radius)
@@ -259,8 +234,50 @@ def _sheet_views(names: Sequence[str], points_world: NDArray, meshes: list, opti
         local = _to_local(camera.project(points_world)[:, :2], mm_per_pixel)
         end_on = [] if name == "isometric" else _end_on(circles, camera, lines, mm_per_pixel)
         axes = [] if name == "isometric" else _side_on_axes(circles, camera, mm_per_pixel)
-        views.append(_View(name, camera, mm_per_pixel, lines, local, end_on, axes))
-    return views
+        shown = [_shown(lines, index) for index in range(len(meshes))]
+        lines, visible_arcs, hidden_arcs = circle_arcs(lines, circles, camera)
+        view = _View(name, camera, mm_per_pixel, lines, local, end_on, axes, visible_arcs, hidden_arcs)
+        view.parts = [_to_local(camera.project(points)[:, :2], mm_per_pixel) for points in parts_world]
+        view.shown = shown
+        if name != "isometric":
+            u, v = np.asarray(camera.frame.u), np.asarray(camera.frame.v)
+            view.across, view.down = int(np.argmax(np.abs(u))), int(np.argmax(np.abs(v)))
+            view.circle_keys = _circle_keys(end_on, circles, camera, mm_per_pixel, 2.0 * radius)
+        views.append(view)
+    return views, circles
+
+
+def _shown(lines: HiddenLines, mesh: int) -> float:
+    """Visible share of the drawn edges of placed mesh `mesh` (window length), 0 where none is drawn."""
+    lengths = []
+    for window, owners in ((lines.visible, lines.visible_edges), (lines.hidden, lines.hidden_edges)):
+        mine = lines.edge_meshes[owners] == mesh
+        lengths.append(float(np.linalg.norm(window[mine, 1] - window[mine, 0], axis=1).sum()))
+    total = lengths[0] + lengths[1]
+    return lengths[0] / total if total > 0.0 else 0.0
+
+
+def _circle_key(circle: Circle, size: float) -> tuple:
+    """One key for the circles a part's diameter states: (part, radius, axis); a sphere's axis is -1."""
+    axis = -1 if circle.kind == "sphere" else int(np.argmax(np.abs(circle.normal)))
+    return (circle.mesh, round(circle.radius / size, 9), axis)
+
+
+def _circle_keys(end_on: list, circles: list[Circle], camera: Camera, mm_per_pixel: float, size: float) -> list:
+    """For each end-on circle entry (projected centre, radius): the keys of the circles drawn there."""
+    direction = np.asarray(camera.frame.direction)
+    keys: list[set] = [set() for _ in end_on]
+    for circle in circles:
+        if circle.kind == "arc":
+            continue
+        if circle.kind != "sphere" and abs(float(circle.normal @ direction)) < math.cos(_END_ON_ANGLE):
+            continue
+        centre = _to_local(camera.project(circle.centre[None, :])[:, :2], mm_per_pixel)[0]
+        tolerance = 1e-6 * circle.radius
+        for k, (c, r, _) in enumerate(end_on):
+            if np.abs(c - centre).max() <= tolerance and abs(r - circle.radius) <= tolerance:
+                keys[k].add(_circle_key(circle, size))
+    return keys
 
 
 def _to_local(window: NDArray, factor: float) -> NDArray:
@@ -269,7 +286,7 @@ def _to_local(window: NDArray, factor: float) -> NDArray:
     return np.column_stack([(window[:, 0] - half) * factor, -(window[:, 1] - half) * factor])
 
 
-def _side_on_axes(circles: list[_Circle], camera: Camera, mm_per_pixel: float) -> list:
+def _side_on_axes(circles: list[Circle], camera: Camera, mm_per_pixel: float) -> list:
     """Axes of the cylinders `camera` sees from the side, as view-local segments, collinear overlaps merged.
 
     A cylinder (or a coaxial hole) shows as two circles of equal radius whose centres lie on their common normal;
@@ -277,6 +294,7 @@ def _side_on_axes(circles: list[_Circle], camera: Camera, mm_per_pixel: float) -
     """
     direction = np.asarray(camera.frame.direction)
     found: list[tuple[NDArray, NDArray]] = []
+    circles = [circle for circle in circles if circle.kind == "loop"]
     for i, first in enumerate(circles):
         if abs(float(first.normal @ direction)) > math.sin(_END_ON_ANGLE):
             continue
@@ -300,8 +318,10 @@ def _side_on_axes(circles: list[_Circle], camera: Camera, mm_per_pixel: float) -
             along = (d - c) / np.linalg.norm(d - c)
             gap = 1e-6 * max(float(np.linalg.norm(d - c)), float(np.linalg.norm(b - a)))
             offset = a - c
-            if (abs(float(unit[0] * along[1] - unit[1] * along[0])) > 1e-9  # 2D cross products: not parallel,
-                    or abs(float(offset[0] * along[1] - offset[1] * along[0])) > gap):  # or not on one line
+            if (
+                abs(float(unit[0] * along[1] - unit[1] * along[0])) > 1e-9  # 2D cross products: not parallel,
+                or abs(float(offset[0] * along[1] - offset[1] * along[0])) > gap
+            ):  # or not on one line
                 continue
             t = [float((p - c) @ along) for p in (a, b)]
             span = float(np.linalg.norm(d - c))
@@ -315,15 +335,23 @@ def _side_on_axes(circles: list[_Circle], camera: Camera, mm_per_pixel: float) -
     return merged
 
 
-def _end_on(circles: list[_Circle], camera: Camera, lines: HiddenLines, mm_per_pixel: float) -> list:
+def _end_on(circles: list[Circle], camera: Camera, lines: HiddenLines, mm_per_pixel: float) -> list:
     """The circles seen end-on by `camera`, once per projected centre and radius: (local centre, radius,
     visible fraction of the drawn circle)."""
     direction = np.asarray(camera.frame.direction)
     seen: list[tuple[NDArray, float, float]] = []
     for circle in circles:
-        if abs(float(circle.normal @ direction)) < math.cos(_END_ON_ANGLE):
+        if circle.kind == "arc":  # arcs get radius leaders (_plan_parts), not centre lines
+            continue
+        if circle.kind == "sphere":  # seen as its silhouette circle from every side
+            circle = Circle(circle.centre, direction, circle.radius, 0, circle.mesh, "sphere")
+        elif abs(float(circle.normal @ direction)) < math.cos(_END_ON_ANGLE):
             continue
         centre = _to_local(camera.project(circle.centre[None, :])[:, :2], mm_per_pixel)[0]
+        if circle.kind in ("sphere", "torus"):  # outlines: the share of the mesh's silhouette that is visible
+            visible = _silhouette_visible(lines, circle.mesh)
+            _add_seen(seen, centre, circle.radius, visible)
+            continue
         # drawn pieces of this circle: ends in its plane, between the chord midpoints' and the vertices' radius
         inner = circle.radius * math.cos(math.pi / circle.sides) * (1.0 - 1e-6)
         outer = circle.radius * (1.0 + 1e-6)
@@ -335,25 +363,43 @@ def _end_on(circles: list[_Circle], camera: Camera, lines: HiddenLines, mm_per_p
             on = planar & ((distance >= inner) & (distance <= outer)).all(axis=1)
             lengths.append(float(np.linalg.norm(world[on, 1] - world[on, 0], axis=1).sum()))
         drawn = lengths[0] + lengths[1]
-        visible = lengths[0] / drawn if drawn > 0.0 else 0.0
-        tolerance = 1e-6 * circle.radius
-        same = next(
-            (k for k, (c, r, _) in enumerate(seen)
-             if np.abs(c - centre).max() <= tolerance and abs(r - circle.radius) <= tolerance),
-            None,
-        )  # fmt: skip
-        if same is None:
-            seen.append((centre, circle.radius, visible))
-        elif visible > seen[same][2]:
-            seen[same] = (centre, circle.radius, visible)
+        _add_seen(seen, centre, circle.radius, lengths[0] / drawn if drawn > 0.0 else 0.0)
     return seen
+
+
+def _add_seen(seen: list, centre: NDArray, radius: float, visible: float) -> None:
+    """Add an end-on circle once per projected centre and radius, keeping the larger visible fraction."""
+    tolerance = 1e-6 * radius
+    same = next(
+        (
+            k
+            for k, (c, r, _) in enumerate(seen)
+            if np.abs(c - centre).max() <= tolerance and abs(r - radius) <= tolerance
+        ),
+        None,
+    )
+    if same is None:
+        seen.append((centre, radius, visible))
+    elif visible > seen[same][2]:
+        seen[same] = (centre, radius, visible)
+
+
+def _silhouette_visible(lines: HiddenLines, mesh: int) -> float:
+    """Visible fraction of the drawn silhouette of placed mesh `mesh` (a sphere's outline)."""
+    lengths = []
+    for window, owners in ((lines.visible, lines.visible_edges), (lines.hidden, lines.hidden_edges)):
+        mine = (lines.edge_meshes[owners] == mesh) & ((lines.edge_kinds[owners] & EDGE_SILHOUETTE) != 0)
+        lengths.append(float(np.linalg.norm(window[mine, 1] - window[mine, 0], axis=1).sum()))
+    total = lengths[0] + lengths[1]
+    return lengths[0] / total if total > 0.0 else 0.0
 
 
 # --- annotations in view-local paper millimetres ----------------------------------------------------------
 
 
-def _marks(view: _View, scale: float, dimensions: bool) -> list[_Mark]:
-    """Centre lines of end-on circles, dimensions (overall extents, diameters) and the label of one view."""
+def _marks(view: _View, scale: float, dimensions: str | None, plan: _Plan | None = None) -> list[_Mark]:
+    """Centre lines of end-on circles, dimensions (overall extents or each part's sizes, diameters) and the
+    label of one view."""
     marks: list[_Mark] = []
     paper = view.local * scale
     x0, y0 = paper.min(axis=0)
@@ -367,9 +413,13 @@ def _marks(view: _View, scale: float, dimensions: bool) -> list[_Mark]:
             # the axis, 2 mm past the ends of the cylinder
             along = (b - a) / np.linalg.norm(b - a)
             start, end = a * scale - 2.0 * along, b * scale + 2.0 * along
-            centres.lines.append((float(start[0]), float(start[1]), float(end[0]), float(end[1])))
+            centres.lines += _chain_line((float(start[0]), float(start[1])), (float(end[0]), float(end[1])))
         marks.append(centres)
-    if dimensions and orthographic:
+    if dimensions == "parts" and orthographic and plan is not None:
+        marks += _part_dimensions(view, scale, plan.linear[view.name])
+        marks += _diameters(view, scale, min(y0, float(_box(marks)[1])), plan.leaders[view.name])
+        marks += _radius_leaders(view, scale, plan.radii.get(view.name, []))
+    elif dimensions == "overall" and orthographic:
         model = view.local.max(axis=0) - view.local.min(axis=0)
         tolerance = 1e-9 * max(x1 - x0, y1 - y0, 1e-300)
         # horizontal: below the view, extension lines from the lowest point on each extreme vertical
@@ -389,14 +439,21 @@ def _marks(view: _View, scale: float, dimensions: bool) -> list[_Mark]:
     return marks
 
 
-def _linear(name: str, value: float, a: tuple[float, float], b: tuple[float, float], at: float) -> _Mark:
+def _linear(
+    name: str, value: float, a: tuple[float, float], b: tuple[float, float], at: float, *, mark_name: str = "",
+    prefix: str = "", text_side: str = "",
+) -> Any:  # fmt: skip
     """A linear dimension of model length `value` between feature points `a` and `b` (paper): extension lines
     to a dimension line at `at` (y for "horizontal", x for "vertical"), arrowheads at both ends (outside,
-    pointing in, when they do not fit between), the value above the line (vertical: reading from the right)."""
-    mark = _Mark("dimension", f"dimension-{name}", value)
+    pointing in, when they do not fit between), the value above the line (vertical: reading from the right),
+    or past the end of the line when it does not fit between the extension lines (ISO 129-1). `text_side`
+    "fit", "after" (past the high end) or "before" asks for one placement: None when "fit" does not fit;
+    "" chooses (between, else after)."""
+    mark = _Mark("dimension", mark_name or f"dimension-{name}", value)
     horizontal = name == "horizontal"
     axis = 0 if horizontal else 1
     low, high = a[axis], b[axis]
+    mark.definition = ("linear", a, b, at, horizontal)
     for point in (a, b):
         foot = point[1 - axis]
         sign = 1.0 if at >= foot else -1.0
@@ -409,18 +466,76 @@ def _linear(name: str, value: float, a: tuple[float, float], b: tuple[float, flo
     for tip, sign in ((low, outward), (high, -outward)):
         mark.arrows.append((tip, at, sign, 0.0) if horizontal else (at, tip, 0.0, sign))
     middle = (low + high) / 2.0
-    text = dimension_text(value)
-    mark.texts.append(
-        (middle, at - 1.0, text, "middle", False) if horizontal else (at - 1.0, middle, text, "middle", True)
-    )
+    text = prefix + dimension_text(value)
+    run = 0.6 * _LETTER * len(text)
+    fits = run + 2.0 <= high - low
+    if text_side == "fit" and not fits:
+        return None
+    offset = -1.0  # the text 1 mm above the line (left of a vertical one, reading from the right)
+    if fits and text_side in ("", "fit"):
+        mark.texts.append(
+            (middle, at + offset, text, "middle", False) if horizontal else (at + offset, middle, text, "middle", True)
+        )
+    elif text_side in ("", "after"):  # past the high end (right; for a vertical dimension: below, reading up)
+        position = high + reach + 1.5
+        mark.texts.append(
+            (position, at + offset, text, "start", False)
+            if horizontal
+            else (at + offset, position + run, text, "start", True)
+        )
+    else:  # past the low end (left; above)
+        position = low - reach - 1.5
+        mark.texts.append(
+            (position, at + offset, text, "end", False) if horizontal else (at + offset, position, text, "start", True)
+        )
     return mark
 
 
 def _centre_lines(mark: _Mark, centre: NDArray, radius: float) -> None:
+    """Two centre lines crossing at the centre on their long dashes, 2 mm past the circle (a centre mark)."""
     reach = radius + 2.0
     cx, cy = float(centre[0]), float(centre[1])
-    mark.lines.append((cx - reach, cy, cx + reach, cy))
-    mark.lines.append((cx, cy - reach, cx, cy + reach))
+    mark.lines += _chain_line((cx - reach, cy), (cx + reach, cy))
+    mark.lines += _chain_line((cx, cy - reach), (cx, cy + reach))
+
+
+_CHAIN_LONG, _CHAIN_GAP, _CHAIN_SHORT = 8.0, 1.0, 1.0  # long-dashed dotted narrow line (ISO 128-2 type 04), mm
+
+
+def _chain_line(a: tuple[float, float], b: tuple[float, float]) -> list[tuple[float, float, float, float]]:
+    """A centre line from `a` to `b` as its dashes, symmetric about the middle: a long dash across the middle,
+    then short dash and long dash in turn, and a long dash (never a gap or a short dash) at each end. A line
+    too short for one short dash each side is drawn solid (ISO 128-2: small circles get continuous centre
+    lines)."""
+    ax, ay = a
+    bx, by = b
+    half = math.hypot(bx - ax, by - ay) / 2.0
+    if half <= 0.0:
+        return []
+    ux, uy = (bx - ax) / (2 * half), (by - ay) / (2 * half)
+    mx, my = (ax + bx) / 2.0, (ay + by) / 2.0
+    # pieces along one half, from the middle: [0, L/2] long, then (gap, short, gap, long) repeated
+    pieces: list[list[float]] = [[0.0, _CHAIN_LONG / 2]]
+    position = _CHAIN_LONG / 2
+    while position < half:
+        short = [position + _CHAIN_GAP, position + _CHAIN_GAP + _CHAIN_SHORT]
+        long = [short[1] + _CHAIN_GAP, short[1] + _CHAIN_GAP + _CHAIN_LONG]
+        pieces += [short, long]
+        position = long[1]
+    # cut at the end; an end that is not a long dash of at least 2 mm: extend the last long dash instead
+    kept = [piece for piece in pieces if piece[0] < half]
+    while len(kept) > 1 and (len(kept) % 2 == 0 or half - kept[-1][0] < 2.0):
+        kept.pop()
+    kept[-1][1] = half
+    segments = []
+    for start, end in kept:
+        for sign in (1.0, -1.0):
+            if start == 0.0 and sign < 0.0:  # the middle dash: once, across the middle
+                segments.append((mx - end * ux, my - end * uy, mx + end * ux, my + end * uy))
+            elif start > 0.0:
+                p, q = start * sign, end * sign
+                segments.append((mx + p * ux, my + p * uy, mx + q * ux, my + q * uy))
+    return segments
 
 
 def _diameter_groups(view: _View) -> list[tuple[float, list[NDArray]]]:
@@ -439,24 +554,298 @@ def _diameter_groups(view: _View) -> list[tuple[float, list[NDArray]]]:
     return [(r, sorted(c, key=lambda p: (float(p[0]), float(p[1])))) for r, c in ordered]
 
 
-def _diameters(view: _View, scale: float, top: float) -> list[_Mark]:
-    """One leader per diameter: from the circle at 45° up and right (arrowhead on the circle, pointing at the
-    centre) to a shoulder above the view, with "⌀d" (or "n× ⌀d" for n equal circles)."""
+def _diameters(
+    view: _View, scale: float, top: float, groups: list[tuple[float, list[NDArray], str]] | None = None
+) -> list[_Mark]:
+    """One leader per diameter: from the circle at 45° (57°, 69°, ...) up and right (arrowhead on the circle,
+    pointing at the centre) to a shoulder above the view, with "⌀d" (or "n× ⌀d" for n equal circles; "S⌀d"
+    for a sphere). `groups` (radius, local centres, symbol) default to every visible end-on circle of the view."""
     marks = []
-    unit = np.array([math.sqrt(0.5), -math.sqrt(0.5)])
-    for index, (radius, centres) in enumerate(_diameter_groups(view)):
+    if groups is None:
+        groups = [(radius, centres, "⌀") for radius, centres in _diameter_groups(view)]
+    for index, (radius, centres, symbol) in enumerate(groups):
+        # each further leader 12° steeper (concentric circles' leaders are rays from one centre: never cross)
+        angle = math.radians(min(45.0 + 12.0 * index, 81.0))
+        unit = np.array([math.cos(angle), -math.sin(angle)])
         mark = _Mark("diameter", f"diameter-{index}", 2.0 * radius)
         tip = centres[-1] * scale + radius * scale * unit
         level = top - _LEADER_RISE - 6.0 * index
-        knee = tip + (float(tip[1]) - level) * np.array([1.0, -1.0])
+        knee = (
+            tip
+            + (float(tip[1]) - level) / math.tan(angle) * np.array([1.0, 0.0])
+            + np.array([0.0, level - float(tip[1])])
+        )
         mark.lines.append((float(tip[0]), float(tip[1]), float(knee[0]), level))
         mark.lines.append((float(knee[0]), level, float(knee[0]) + 3.0, level))
         mark.arrows.append((float(tip[0]), float(tip[1]), -float(unit[0]), -float(unit[1])))
         count = f"{len(centres)}× " if len(centres) > 1 else ""
-        text = f"{count}⌀{dimension_text(2.0 * radius)}"
+        text = f"{count}{symbol}{dimension_text(2.0 * radius)}"
         mark.texts.append((float(knee[0]) + 4.0, level + 1.2, text, "start", False))
+        mark.definition = ("diameter", centres[-1] * scale, radius * scale, tip)
         marks.append(mark)
     return marks
+
+
+# --- dimensions per part (ISO 129-1) ----------------------------------------------------------------------
+
+
+@dataclass
+class _Plan:
+    """Which view states which size of which part: per view, linear dimensions (part, "horizontal" or
+    "vertical", symbol before the value) and diameter leaders (radius, local centres, symbol)."""
+
+    linear: dict[str, list[tuple[int, str, str]]]
+    leaders: dict[str, list[tuple[float, list[NDArray], str]]]
+    radii: dict[str, list[tuple[float, list[tuple[NDArray, NDArray]]]]] = field(default_factory=dict)
+
+
+def _plan_parts(
+    views: list[_View], circles: list[Circle], parts_world: list[NDArray], meshes_ids: list[int], size: float
+) -> _Plan:
+    """Each part's sizes, each stated once on the sheet, in the view that shows it best.
+
+    A part's sizes are its extents along the world axes. A circle of the part (a rim or a hole, or a sphere)
+    gets a diameter leader in the end-on view where it is most visible; a diameter equal to the part's extents
+    across its axis states those extents (a sphere's: all three). Extents left get a linear dimension in the
+    aligned view that shows them, preferring the view where the most of the part's edges are visible and a
+    view already dimensioning the part. Without an end-on view, a rim's diameter is a linear dimension "⌀d".
+    """
+    ortho = [view for view in views if view.across >= 0]
+    linear: dict[str, list[tuple[int, str, str]]] = {view.name: [] for view in views}
+    leader_groups: dict[str, list[tuple[float, list[NDArray], str]]] = {view.name: [] for view in views}
+    radii: dict[str, list[tuple[float, list[tuple[NDArray, NDArray]]]]] = {view.name: [] for view in views}
+    tolerance = 1e-6 * size
+    done: list[tuple[int, NDArray]] = []  # (mesh id, extent) of the parts dimensioned
+    for part, points in enumerate(parts_world):
+        if points.shape[0] == 0:
+            continue
+        extent = points.max(axis=0) - points.min(axis=0)
+        # a copy of a part already dimensioned (equal model geometry, placed alike): its diameters count in the "n×"
+        # of the leaders, its sizes are the first copy's
+        copy = any(m == meshes_ids[part] and np.abs(e - extent).max() <= 1e-9 * size for m, e in done)
+        done.append((meshes_ids[part], extent))
+        needed = {k for k in range(3) if extent[k] > 1e-9 * size}
+        stated: set[tuple] = set()
+        for circle in sorted((c for c in circles if c.mesh == part), key=lambda c: -c.radius):
+            if circle.kind == "arc":
+                _plan_radius(circle, ortho, radii, size)
+                continue
+            key = _circle_key(circle, size)
+            if key in stated:
+                continue
+            stated.add(key)
+            axis = key[2]
+            across = {0, 1, 2} - {axis}
+            covers = across if all(abs(2.0 * circle.radius - extent[k]) <= tolerance for k in across) else set()
+            best = None  # (visible fraction, -order, view, entry)
+            for order, view in enumerate(ortho):
+                for entry, keys in enumerate(view.circle_keys):
+                    if key in keys:
+                        candidate = (view.circles[entry][2], -order, view, entry)
+                        if best is None or candidate[:2] > best[:2]:
+                            best = candidate
+            symbol = "S⌀" if circle.kind == "sphere" else "⌀"
+            if best is not None:
+                view, entry = best[2], best[3]
+                centre = view.circles[entry][0]
+                groups = leader_groups[view.name]
+                for k, (radius, centres, other) in enumerate(groups):
+                    if other == symbol and abs(radius - circle.radius) <= 1e-6 * circle.radius:
+                        groups[k] = (radius, [*centres, centre], other)
+                        break
+                else:
+                    groups.append((circle.radius, [centre], symbol))
+                needed -= covers
+            elif covers and axis >= 0:  # no end-on view: the rim's diameter as a linear dimension
+                k = min(covers & needed, default=None)
+                view = _best_view(ortho, part, k, linear) if k is not None else None
+                if view is not None:
+                    linear[view.name].append((part, "horizontal" if view.across == k else "vertical", "⌀"))
+                    needed -= covers
+        for k in sorted(needed) if not copy else ():
+            view = _best_view(ortho, part, k, linear)
+            if view is not None:
+                linear[view.name].append((part, "horizontal" if view.across == k else "vertical", ""))
+    leaders = {}
+    for name, groups in leader_groups.items():
+        ordered = sorted(groups, key=lambda group: -group[0])
+        leaders[name] = [(r, sorted(c, key=lambda p: (float(p[0]), float(p[1]))), sym) for r, c, sym in ordered]
+    return _Plan(linear, leaders, radii)
+
+
+def _plan_radius(circle: Circle, ortho: list[_View], radii: dict, size: float) -> None:
+    """An arc's radius goes to the first aligned view that sees it end-on: (local centre, local middle point),
+    with the other arcs of its radius there ("n× R")."""
+    for view in ortho:
+        direction = np.asarray(view.camera.frame.direction)
+        if abs(float(circle.normal @ direction)) < math.cos(_END_ON_ANGLE) or circle.middle is None:
+            continue
+        ends = view.camera.project(np.stack([circle.centre, circle.middle]))[:, :2]
+        local = _to_local(ends, view.model_per_pixel)
+        groups = radii[view.name]
+        for k, (radius, arcs) in enumerate(groups):
+            if abs(radius - circle.radius) <= 1e-6 * max(radius, size * 1e-9):
+                tolerance = 1e-6 * max(radius, size * 1e-9)
+                if not any(np.abs(c - local[0]).max() <= tolerance for c, _ in arcs):  # one arc behind another
+                    groups[k] = (radius, [*arcs, (local[0], local[1])])
+                break
+        else:
+            groups.append((circle.radius, [(local[0], local[1])]))
+        return
+
+
+def _radius_leaders(view: _View, scale: float, groups: list) -> list[_Mark]:
+    """One leader per radius of the view's arcs: arrowhead on the arc's middle, pointing at its centre, a line
+    8 mm outward along the radius, a 3 mm shoulder and "R r" (or "n× R r")."""
+    marks = []
+    for index, (radius, arcs) in enumerate(sorted(groups, key=lambda group: -group[0])):
+        centre, middle = (np.asarray(p) * scale for p in arcs[-1])
+        outward = middle - centre
+        outward = outward / max(float(np.linalg.norm(outward)), 1e-300)
+        knee = middle + 8.0 * outward
+        side = 1.0 if outward[0] >= 0.0 else -1.0
+        mark = _Mark("radius", f"radius-{index}", radius)
+        mark.lines.append((float(middle[0]), float(middle[1]), float(knee[0]), float(knee[1])))
+        mark.lines.append((float(knee[0]), float(knee[1]), float(knee[0]) + 3.0 * side, float(knee[1])))
+        mark.arrows.append((float(middle[0]), float(middle[1]), -float(outward[0]), -float(outward[1])))
+        count = f"{len(arcs)}× " if len(arcs) > 1 else ""
+        text = f"{count}R{dimension_text(radius)}"
+        anchor = "start" if side > 0 else "end"
+        mark.texts.append((float(knee[0]) + 4.0 * side, float(knee[1]) + 1.2, text, anchor, False))
+        mark.definition = ("radius", centre, radius * scale, middle)
+        marks.append(mark)
+    return marks
+
+
+def _best_view(ortho: list[_View], part: int, axis: int, linear: dict) -> _View | None:
+    """The aligned view showing world `axis` where the part is most visible (a view that already dimensions
+    the part counts half a view more; earlier views win ties)."""
+    best, best_score = None, -math.inf
+    for view in ortho:
+        if axis not in (view.across, view.down) or view.parts[part].shape[0] == 0:
+            continue
+        score = view.shown[part] + (0.5 if any(entry[0] == part for entry in linear[view.name]) else 0.0)
+        if score > best_score + 1e-12:
+            best, best_score = view, score
+    return best
+
+
+def _part_dimensions(view: _View, scale: float, specs: list[tuple[int, str, str]]) -> list[_Mark]:
+    """The linear dimensions `specs` of one view, stacked outward from the view at ``_DIMENSION_SPACING``
+    (horizontal ones below it, else above; vertical ones right of it, else left): shorter ones first, each on
+    the nearest level where it clashes with no dimension placed before (``_clash``: no extension line across
+    another's dimension line, arrowheads or text, no overlap of those); a value that does not fit between its
+    extension lines goes past one end of the line."""
+    paper = view.local * scale
+    (x0, y0), (x1, y1) = paper.min(axis=0), paper.max(axis=0)
+    items = []
+    for part, orientation, symbol in specs:
+        axis = 0 if orientation == "horizontal" else 1
+        local = view.parts[part]
+        value = float(local[:, axis].max() - local[:, axis].min())
+        items.append((value, orientation, part, symbol, local * scale))
+    items.sort(key=lambda item: (item[0], item[1], item[2]))
+    marks: list[_Mark] = []
+    deepest: dict[tuple[str, float], int] = {}  # deepest level used per orientation and side
+    for value, orientation, part, symbol, points in items:
+        axis = 0 if orientation == "horizontal" else 1
+        # (sign away from the view, first level's position): below / right first, then above / left
+        sides = [(1.0, (y1 if axis == 0 else x1) + _DIMENSION_OFFSET),
+                 (-1.0, (y0 if axis == 0 else x0) - _DIMENSION_OFFSET)]  # fmt: skip
+        low, high = float(points[:, axis].min()), float(points[:, axis].max())
+        tolerance = 1e-9 * max(abs(low), abs(high), 1.0)
+        name = f"dimension-part{part}-{orientation}"
+        chosen = None
+        for level in range(len(items) + 1):
+            for sign, base in sides:
+                ends = []
+                for end in (low, high):  # the foot: the part's outermost point toward that side, at the end
+                    across = points[np.abs(points[:, axis] - end) <= tolerance, 1 - axis]
+                    foot = float(across.max() if sign > 0 else across.min())
+                    ends.append((end, foot) if axis == 0 else (foot, end))
+                at = base + sign * level * _DIMENSION_SPACING
+                for text_side in ("fit", "after", "before"):
+                    mark = _linear(orientation, value, ends[0], ends[1], at, mark_name=name, prefix=symbol,
+                                   text_side=text_side)  # fmt: skip
+                    if mark is not None and not any(_clash(mark, other) for other in marks):
+                        chosen = mark
+                        deepest[(orientation, sign)] = max(deepest.get((orientation, sign), -1), level)
+                        break
+                if chosen is not None:
+                    break
+            if chosen is not None:
+                break
+        if chosen is None:  # crowded beyond resolving: the level past the deepest below / right (may clash)
+            level = deepest.get((orientation, 1.0), -1) + 1
+            deepest[(orientation, 1.0)] = level
+            ends = []
+            for end in (low, high):
+                across = points[np.abs(points[:, axis] - end) <= tolerance, 1 - axis]
+                ends.append((end, float(across.max())) if axis == 0 else (float(across.max()), end))
+            chosen = _linear(orientation, value, ends[0], ends[1], sides[0][1] + level * _DIMENSION_SPACING,
+                             mark_name=name, prefix=symbol)  # fmt: skip
+        marks.append(chosen)
+    return marks
+
+
+def _body(mark: _Mark) -> list[NDArray]:
+    """Rectangles (x0, y0, x1, y1) around a linear dimension's line with its arrowheads, and its text (computed
+    once per mark)."""
+    if mark.body is None:
+        mark.body = _body_of(mark)
+    return mark.body
+
+
+def _body_of(mark: _Mark) -> list[NDArray]:
+    x0, y0, x1, y1 = mark.lines[-1]
+    line = np.array([min(x0, x1), min(y0, y1), max(x0, x1), max(y0, y1)])
+    line += np.array([-1.0, -1.0, 1.0, 1.0]) * _ARROW_HALF_WIDTH
+    return [line, _box([_Mark("text", "", texts=mark.texts)])]
+
+
+def _clash(mark: _Mark, other: _Mark) -> bool:
+    """Whether two linear dimensions clash: an extension line of one meets the other's dimension line,
+    arrowheads or text, or those of both overlap (0.5 mm clearance)."""
+    clear = 0.5
+    for a, b in ((mark, other), (other, mark)):
+        line, text = _body(b)
+        for segment in a.lines[:-1]:
+            # an extension line on the line of one of b's own (a shared extension line, as in chain
+            # dimensioning) may run through b's arrowhead there, not through its text
+            shared = any(_collinear(segment, own) for own in b.lines[:-1])
+            for rectangle in (text,) if shared else (line, text):
+                if _segment_meets(segment, rectangle + np.array([-clear, -clear, clear, clear])):
+                    return True
+    return any(_overlap(r + np.array([-clear, -clear, clear, clear]), q) for r in _body(mark) for q in _body(other))
+
+
+def _collinear(a: tuple[float, float, float, float], b: tuple[float, float, float, float]) -> bool:
+    """Whether two axis-parallel extension lines lie on one line (within 1e-9 mm)."""
+    if a[0] == a[2] and b[0] == b[2]:
+        return abs(a[0] - b[0]) <= 1e-9
+    return a[1] == a[3] and b[1] == b[3] and abs(a[1] - b[1]) <= 1e-9
+
+
+def _overlap(a: NDArray, b: NDArray) -> bool:
+    return bool(a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3])
+
+
+def _segment_meets(segment: tuple[float, float, float, float], box: NDArray) -> bool:
+    """Whether the segment meets the open box (x0, y0, x1, y1): Liang–Barsky clipping."""
+    x0, y0, x1, y1 = segment
+    dx, dy = x1 - x0, y1 - y0
+    t0, t1 = 0.0, 1.0
+    for p, q in ((-dx, x0 - box[0]), (dx, box[2] - x0), (-dy, y0 - box[1]), (dy, box[3] - y0)):
+        if p == 0.0:
+            if q <= 0.0:
+                return False
+        else:
+            t = q / p
+            if p < 0.0:
+                t0 = max(t0, t)
+            else:
+                t1 = min(t1, t)
+    return t0 < t1
 
 
 def _mark_svg(mark: _Mark, prefix: str, dx: float, dy: float) -> str:
@@ -467,9 +856,13 @@ def _mark_svg(mark: _Mark, prefix: str, dx: float, dy: float) -> str:
             f"M{_number(x0 + dx)} {_number(y0 + dy)} L{_number(x1 + dx)} {_number(y1 + dy)}"
             for x0, y0, x1, y1 in mark.lines
         )
-        dash = ' stroke-dasharray="6 1 1 1"' if mark.kind == "centre" else ""
         parts.append(
-            f'<path class="lines" d="{d}" fill="none" stroke="#000000" stroke-width="{_number(_THIN)}"{dash}/>'
+            f'<path class="lines" d="{d}" fill="none" stroke="#000000" stroke-width="{_number(mark.line_width)}"/>'
+        )
+    for x, y, r in mark.circles:
+        parts.append(
+            f'<circle cx="{_number(x + dx)}" cy="{_number(y + dy)}" r="{_number(r)}" fill="none" stroke="#000000" '
+            f'stroke-width="{_number(mark.line_width)}"/>'
         )
     if mark.arrows:
         heads = []
@@ -486,7 +879,7 @@ def _mark_svg(mark: _Mark, prefix: str, dx: float, dy: float) -> str:
         X, Y = _number(x + dx), _number(y + dy)
         turn = f' transform="rotate(-90 {X} {Y})"' if vertical else ""
         parts.append(
-            f'<text x="{X}" y="{Y}" font-family="sans-serif" font-size="{_number(_LETTER)}" '
+            f'<text x="{X}" y="{Y}" font-family="sans-serif" font-size="{_number(mark.text_size)}" '
             f'text-anchor="{anchor}"{turn}>{_escape(text)}</text>'
         )
     value = "" if math.isnan(mark.value) else f' data-value="{_number(mark.value)}"'
@@ -546,11 +939,13 @@ def drawing_sheet(
     paper: str | tuple[float, float] = "A3",
     orientation: str = "landscape",
     title: str = "",
-    dimensions: bool = True,
+    dimensions: str | bool = "parts",
     edges: str | Sequence[str] = "feature",
     crease_angle: float = DEFAULT_CREASE_ANGLE,
     hidden: str | None = "dashed",
     stroke_width: float = 0.5,
+    title_block: dict[str, Any] | None = None,
+    path: str | os.PathLike | None = None,
 ) -> str:
     """An SVG engineering drawing of `scene`: multiview orthographic views, dimensions, title block, scale bar.
 
@@ -561,12 +956,16 @@ def drawing_sheet(
 
     Only what a drawing shows is drawn: boundaries, creases and silhouettes of the solids (faces adjacent by
     shared vertex positions; never an edge between coplanar triangles, see ``hidden_lines.COPLANAR_ANGLE``),
-    visible solid, hidden dashed (thinner; the isometric view shows visible edges only). Each orthographic
-    view carries its overall horizontal and vertical dimension (extension lines, dimension line, arrowheads,
-    the model length in mm), centre lines through the circles it sees end-on and along the axes of the
-    cylinders it sees from the side, and a leader with the diameter of each visible end-on circle (``n× ⌀d``
-    for n equal circles). Circles are closed loops of creases (over the default 30°) or boundaries with at
-    least 10 vertices, planar and round within 1e-6 of their radius.
+    visible solid, hidden dashed (thinner; the isometric view shows visible edges only). Circular features
+    (``output/true_curves.py``: closed loops of creases or boundaries with at least 10 vertices, planar and
+    round within 1e-6 of radius + model size, and spheres) are drawn as true curves, ``<circle>``,
+    ``<ellipse>`` or elliptical-arc ``<path>`` in groups ``<view>-visible-curves`` / ``<view>-hidden-curves``,
+    instead of their polygons. Each orthographic view carries centre lines (dashes, long ones at the ends)
+    through the circles it sees end-on (a sphere's outline too) and along the axes of the cylinders it sees
+    from the side, and the dimensions `dimensions` asks for (extension lines, dimension line, arrowheads, the
+    model length in model units; leaders with ``⌀d``). The title block (ISO 7200) has the title, drawing number,
+    sheet n/N, scale, the projection symbol of `projection_angle` (ISO 5456-2), units, date, author, general
+    tolerances and paper size; a scale bar sits at the lower left.
 
     Parameters
     ----------
@@ -584,10 +983,24 @@ def drawing_sheet(
         For a named paper: long side horizontal or vertical. A (width, height) is used as given.
     title : str
         Drawing title for the title block.
-    dimensions : bool
-        False: no dimensions or diameter leaders (centre lines stay).
+    dimensions : {"parts", "overall"} or False
+        "parts" (default): each part (placed mesh, a scene-graph node with geometry) gets its sizes, each
+        stated once in the view that shows it best (``_plan_parts``): a diameter leader (``⌀d``, ``S⌀d`` for a
+        sphere, ``n× ⌀d`` for equal circles in one view) on each of its circles, linear dimensions for the
+        extents the diameters do not state, stacked outward 7 mm apart so that no extension line crosses a
+        dimension line or its text (radii "R r" on arcs). When the parts' dimensions crowd the paper at the
+        four largest standard scales at which the views fit (or at the given `scale`), the sheet falls back to
+        "overall" (the title block's ``data-dimensions`` says which). "overall": each view's overall width and
+        height and a leader for every visible end-on diameter. False: none (centre lines stay). True is
+        "overall".
     edges, crease_angle, hidden, stroke_width
         As in ``render_svg``; `stroke_width` (visible outlines) in paper millimetres.
+    title_block : dict, optional
+        Title block fields, keys from ``TITLE_BLOCK_FIELDS``: "title" (else `title`), "drawing_number", "sheet"
+        ("n/N" or (n, N)), "date", "author", "tolerance" (default "ISO 2768-m"), "units" (default "mm"); text.
+    path : str or PathLike, optional
+        Also write the sheet: ``.svg``, ``.pdf``, ``.png`` (``save_svg``) or ``.dxf`` (``output/sheet_dxf.py``:
+        layers, true CIRCLE / ARC / ELLIPSE, DIMENSION entities, in model units at full size; the ``dxf`` extra).
 
     Returns
     -------
@@ -599,7 +1012,9 @@ def drawing_sheet(
     FrustumError
         If `scene` is not a Scene.
     OutputError
-        For a scene with volumes (a drawing sheet shows meshes only), an empty scene, an unknown or repeated view,
+        For a bad title block field, a ``.dxf`` path without ezdxf (the message names the extra), a file that
+        cannot be written,
+        a scene with volumes (a drawing sheet shows meshes only), an empty scene, an unknown or repeated view,
         a bad scale, paper, orientation or projection angle, or views that do not fit on the paper at the given
         scale (the message says the largest scale that fits).
 
@@ -620,9 +1035,16 @@ def drawing_sheet(
         raise OutputError(
             f"{where}: orientation = {describe(orientation)} is unknown; expected 'landscape' or 'portrait'"
         )
-    if not isinstance(dimensions, bool | np.bool_):
-        raise OutputError(f"{where}: dimensions = {describe(dimensions)} is not a bool; give True or False")
+    if dimensions is True or dimensions is False or isinstance(dimensions, np.bool_):
+        mode = "overall" if dimensions else None
+    elif isinstance(dimensions, str) and dimensions in DIMENSION_MODES:
+        mode = dimensions
+    else:
+        raise OutputError(
+            f"{where}: dimensions = {describe(dimensions)} is unknown; expected 'overall', 'parts' or False"
+        )
     paper_width, paper_height = _paper(paper, orientation, where)
+    fields = _title_fields(title_block, title, where)
     given_scale = None
     if scale is not None:
         given_scale = as_scalar(scale, "scale", where=where, error=OutputError)
@@ -642,18 +1064,46 @@ def drawing_sheet(
         [_points(item.mesh) @ item.world_from_model[:3, :3].T + item.world_from_model[:3, 3] for item in placed]
     )
     meshes = [(item.mesh, item.world_from_model) for item in placed]
-    sheet_views = _sheet_views(names, points_world, meshes, {"edges": edges, "crease_angle": crease_angle})
+    sheet_views, circles = _sheet_views(names, points_world, meshes, {"edges": edges, "crease_angle": crease_angle})
+    size = max(float(np.linalg.norm(points_world.max(axis=0) - points_world.min(axis=0))), 1e-300)
+    parts_world = [_points(mesh) @ m[:3, :3].T + m[:3, 3] for mesh, m in meshes]
+    ids = [hash((_points(mesh).tobytes(), getattr(mesh, "faces", np.empty(0)).tobytes())) for mesh, _ in meshes]
+    plan = _plan_parts(sheet_views, circles, parts_world, ids, size) if mode == "parts" else None
     cells = _THIRD_ANGLE if projection_angle == "third" else _FIRST_ANGLE
     # the drawing area: inside the border, above the title strip
     area = (_MARGIN, _MARGIN, paper_width - 2 * _MARGIN, paper_height - 2 * _MARGIN - _TITLE_HEIGHT)
 
-    def attempt(candidate: float) -> tuple[dict, dict] | None:
-        marks = {view.name: _marks(view, candidate, dimensions) for view in sheet_views}
+    empty: dict[str, list[_Mark]] = {view.name: [] for view in sheet_views}
+
+    def attempt(candidate: float, use: str | None) -> tuple[dict, dict] | None:
+        if _layout(sheet_views, empty, cells, candidate, area) is None:  # the views alone do not fit
+            return None
+        marks = {view.name: _marks(view, candidate, use, plan) for view in sheet_views}
         places = _layout(sheet_views, marks, cells, candidate, area)
         return None if places is None else (marks, places)
 
-    largest = next(((s, fitted) for s in STANDARD_SCALES if (fitted := attempt(s)) is not None), None)
+    def search(use: str | None, tries: int | None) -> tuple[float, tuple[dict, dict]] | None:
+        """The largest standard scale that fits with `use` dimensions (giving up after `tries` scales at which
+        the views alone fit)."""
+        for candidate in STANDARD_SCALES:
+            if _layout(sheet_views, empty, cells, candidate, area) is None:
+                continue
+            fitted = attempt(candidate, use)
+            if fitted is not None:
+                return candidate, fitted
+            if tries is not None:
+                tries -= 1
+                if tries == 0:
+                    return None
+        return None
+
+    # each part's dimensions stack outward at a constant paper spacing: when they crowd the paper at every
+    # scale that fits the views (many parts), the sheet falls back to each view's overall dimensions
+    used = mode
     if given_scale is None:
+        largest = search(mode, _PARTS_TRIES if mode == "parts" else None)
+        if largest is None and mode == "parts":
+            used, largest = "overall", search("overall", None)
         if largest is None:
             raise OutputError(
                 f"{where}: scale = None found no standard scale down to {scale_label(STANDARD_SCALES[-1])} that "
@@ -662,8 +1112,11 @@ def drawing_sheet(
         drawing_scale, (marks, places) = largest
     else:
         drawing_scale = given_scale
-        fitted = attempt(drawing_scale)
+        fitted = attempt(drawing_scale, mode)
+        if fitted is None and mode == "parts":
+            used, fitted = "overall", attempt(drawing_scale, "overall")
         if fitted is None:
+            largest = search(used, None)
             hint = f"the largest standard scale that fits is {scale_label(largest[0])}" if largest else "none fits"
             raise OutputError(
                 f"{where}: scale = {drawing_scale!r} does not fit {len(names)} views on {_paper_text(paper)} "
@@ -681,9 +1134,50 @@ def drawing_sheet(
         view_hidden = None if view.name == "isometric" else hidden
         body.append(_view_group(view, placed, centre_x, centre_y, drawing_scale, view_hidden, width_line))
         body += [_mark_svg(mark, f"{view.name}-", centre_x, centre_y) for mark in marks[view.name]]
-    body.append(_title_block(paper_width, paper_height, title, drawing_scale, projection_angle))
-    body.append(_scale_bar(drawing_scale, paper_height))
-    return svg_document(paper_width, paper_height, body, units="mm")
+    paper_name = (
+        paper.upper()
+        if isinstance(paper, str) and paper.lower() != "letter" and paper.lower() != "tabloid"
+        else (paper.capitalize() if isinstance(paper, str) else f"{_number(paper_width)} x {_number(paper_height)}")
+    )
+    title_marks = _title_block(paper_width, paper_height, fields, drawing_scale, projection_angle, paper_name)
+    data = {**fields, "scale": scale_label(drawing_scale), "projection": projection_angle, "size": paper_name,
+            "dimensions": str(used).lower()}  # fmt: skip
+    attributes = "".join(f' data-{key.replace("_", "-")}="{_html_escape(value)}"' for key, value in data.items())
+    body.append(f'<g id="title-block"{attributes}>{"".join(_mark_svg(mark, "", 0.0, 0.0) for mark in title_marks)}</g>')
+    length, bar = _scale_bar(drawing_scale, paper_height)
+    body.append(f'<g id="scale-bar" data-length="{_number(length)}">{_mark_svg(bar, "", 0.0, 0.0)}</g>')
+    title_marks.append(bar)
+    text = svg_document(paper_width, paper_height, body, units="mm")
+    if path is not None:
+        if str(path).lower().endswith(".dxf"):
+            from frustum.output.sheet_dxf import save_sheet_dxf
+
+            save_sheet_dxf(
+                _SheetDrawing(paper_width, paper_height, drawing_scale, sheet_views, places, marks, title_marks,
+                              hidden, fields["units"], placed),
+                path,
+            )  # fmt: skip
+        else:
+            save_svg(text, path)
+    return text
+
+
+@dataclass
+class _SheetDrawing:
+    """Everything a sheet draws, for writers other than SVG (``output/sheet_dxf.py``): paper size (mm), scale,
+    the views and their sheet positions, their marks (view-local paper mm), the title block's marks (sheet mm),
+    the hidden-line style, the model units and the placed meshes."""
+
+    width: float
+    height: float
+    scale: float
+    views: list[_View]
+    places: dict[str, tuple[float, float]]
+    marks: dict[str, list[_Mark]]
+    title_marks: list[_Mark]
+    hidden: str | None
+    units: str
+    placed: list
 
 
 def _points(geometry: Mesh | Polyline) -> NDArray[np.float64]:
@@ -702,10 +1196,35 @@ def _view_group(
         return np.column_stack([centre_x + local[:, 0], centre_y + local[:, 1]])
 
     groups = _drawing_groups(view.lines, placed, to_paper, stroke_width, hidden, False, prefix=f"{view.name}-")
+    groups += _curve_groups(view, to_paper, stroke_width, hidden)
     return (
         f'<g id="view-{view.name}" data-scale="{_number(scale)}" '
         f'data-centre="{_number(centre_x)} {_number(centre_y)}">{"".join(groups)}</g>'
     )
+
+
+def _curve_groups(view: _View, to_paper: Any, stroke_width: float, hidden: str | None) -> list[str]:
+    """The view's true curves: groups ``<view>-hidden-curves`` (styled as the hidden lines) and
+    ``<view>-visible-curves`` of ``<circle>``, ``<ellipse>`` and elliptical-arc ``<path>`` elements."""
+    groups = []
+    if hidden is not None and view.hidden_arcs:
+        thin = _number(0.7 * stroke_width)
+        if hidden == "dashed":
+            dash = f"{_number(4 * stroke_width)} {_number(2.5 * stroke_width)}"
+            style = f'stroke="#000000" stroke-width="{thin}" stroke-dasharray="{dash}"'
+        else:
+            style = f'stroke="{_HIDDEN_GRAY}" stroke-width="{thin}"'
+        elements = svg_arc_elements([arc.mapped(to_paper) for arc in view.hidden_arcs])
+        groups.append(
+            f'<g id="{view.name}-hidden-curves" fill="none" {style} stroke-linecap="butt">{"".join(elements)}</g>'
+        )
+    if view.visible_arcs:
+        elements = svg_arc_elements([arc.mapped(to_paper) for arc in view.visible_arcs])
+        groups.append(
+            f'<g id="{view.name}-visible-curves" fill="none" stroke-linecap="round" stroke-linejoin="round" '
+            f'stroke="#000000" stroke-width="{_number(stroke_width)}">{"".join(elements)}</g>'
+        )
+    return groups
 
 
 def _view_names(views: Any, where: str) -> list[str]:
@@ -758,26 +1277,107 @@ def _text(x: float, y: float, text: str, size: float, anchor: str = "start") -> 
     )
 
 
-def _title_block(paper_width: float, paper_height: float, title: str, scale: float, angle: str) -> str:
+TITLE_BLOCK_FIELDS = ("title", "drawing_number", "sheet", "date", "author", "tolerance", "units")
+"""Keys of ``drawing_sheet(title_block=...)`` (ISO 7200 data fields): the drawing's title, its identification
+number, sheet "n/N", date of issue, creator, general tolerance note and model units."""
+_TITLE_DEFAULTS = {"drawing_number": "", "sheet": "1/1", "date": "", "author": "", "tolerance": "ISO 2768-m",
+                   "units": "mm"}  # fmt: skip
+# title block cells: (key, label, x, y, width, height) in mm from the block's top left corner; 180 x 32 mm
+_TITLE_CELLS = (
+    ("title", "TITLE", 0.0, 0.0, 120.0, 12.0), ("drawing_number", "DRAWING NO.", 120.0, 0.0, 60.0, 12.0),
+    ("author", "DRAWN BY", 0.0, 12.0, 50.0, 10.0), ("date", "DATE", 50.0, 12.0, 35.0, 10.0),
+    ("scale", "SCALE", 85.0, 12.0, 35.0, 10.0), ("sheet", "SHEET", 120.0, 12.0, 30.0, 10.0),
+    ("units", "UNITS", 150.0, 12.0, 30.0, 10.0), ("tolerance", "GENERAL TOLERANCES", 0.0, 22.0, 85.0, 10.0),
+    ("projection", "", 85.0, 22.0, 65.0, 10.0), ("size", "SIZE", 150.0, 22.0, 30.0, 10.0),
+)  # fmt: skip
+_TITLE_LABEL = 1.8  # label lettering, mm
+
+
+def _title_fields(title_block: Any, title: str, where: str) -> dict[str, str]:
+    """The title block's field texts from ``title_block`` (a mapping of ``TITLE_BLOCK_FIELDS``) and `title`."""
+    if title_block is None:
+        title_block = {}
+    if not isinstance(title_block, dict):
+        raise OutputError(
+            f"{where}: title_block = {describe(title_block)} is not a mapping; give a dict of {TITLE_BLOCK_FIELDS}"
+        )
+    unknown = sorted(str(key) for key in title_block if key not in TITLE_BLOCK_FIELDS)
+    if unknown:
+        raise OutputError(
+            f"{where}: title_block has {', '.join(map(repr, unknown))}, which is unknown; expected keys from "
+            f"{TITLE_BLOCK_FIELDS}"
+        )
+    fields = {**_TITLE_DEFAULTS, "title": title, **title_block}
+    sheet = fields["sheet"]
+    if isinstance(sheet, tuple | list):
+        if len(sheet) != 2 or not all(isinstance(k, int) and not isinstance(k, bool) for k in sheet):
+            raise OutputError(
+                f"{where}: title_block sheet = {describe(sheet)} is not (n, N); give e.g. (1, 2) or '1/2'"
+            )
+        number, count = sheet
+        if not 1 <= number <= count:
+            raise OutputError(f"{where}: title_block sheet = ({number}, {count}) needs 1 <= n <= N; give e.g. (1, 2)")
+        fields["sheet"] = f"{number}/{count}"
+    for key, value in fields.items():
+        if not isinstance(value, str):
+            raise OutputError(f"{where}: title_block {key} = {describe(value)} is not text; give a string")
+    return fields
+
+
+def _title_block(paper_width: float, paper_height: float, fields: dict[str, str], scale: float, angle: str,
+                 paper: str) -> list[_Mark]:  # fmt: skip
+    """The ISO 7200 title block at the lower right corner of the frame, as marks (sheet coordinates): frame and
+    cell lines, each cell's label (small) and value, and the projection symbol of `angle` with its name."""
     x1, y1 = paper_width - _MARGIN, paper_height - _MARGIN
-    x0, y0 = x1 - _TITLE_WIDTH, y1 - _TITLE_HEIGHT + 4.0
-    middle = (y0 + y1) / 2.0
-    column = x0 + 110.0
-    parts = [
-        f'<rect x="{_number(x0)}" y="{_number(y0)}" width="{_number(_TITLE_WIDTH)}" '
-        f'height="{_number(y1 - y0)}" fill="none" stroke="#000000" stroke-width="0.5"/>',
-        f'<path d="M{_number(x0)} {_number(middle)} L{_number(x1)} {_number(middle)} '
-        f'M{_number(column)} {_number(middle)} L{_number(column)} {_number(y1)}" '
-        'fill="none" stroke="#000000" stroke-width="0.35"/>',
-        _text(x0 + 3.0, middle - 5.0, title or "UNTITLED", 6.0),
-        _text(x0 + 3.0, y1 - 5.0, f"{angle.upper()} ANGLE PROJECTION   UNITS: mm", 3.5),
-        _text(column + 3.0, y1 - 5.0, f"SCALE {scale_label(scale)}", 3.5),
-    ]
-    return f'<g id="title-block">{"".join(parts)}</g>'
+    x0, y0 = x1 - _TITLE_WIDTH, y1 - 32.0
+    frame = _Mark("title", "title-block-lines", line_width=0.5)
+    frame.lines += [(x0, y0, x1, y0), (x1, y0, x1, y1), (x1, y1, x0, y1), (x0, y1, x0, y0)]
+    labels = _Mark("title", "title-block-labels", text_size=_TITLE_LABEL)
+    values = _Mark("title", "title-block-values")
+    title = _Mark("title", "title-block-title", text_size=5.0)
+    cells = _Mark("title", "title-block-cells", line_width=0.35)
+    texts = {**fields, "scale": scale_label(scale), "size": paper}
+    for key, label, dx, dy, _width, height in _TITLE_CELLS:
+        cx, cy = x0 + dx, y0 + dy
+        if dx > 0.0:  # the cell's left side
+            cells.lines.append((cx, cy, cx, cy + height))
+        if label:
+            labels.texts.append((cx + 1.5, cy + 1.5 + _TITLE_LABEL, label, "start", False))
+        if key == "projection":
+            continue
+        text = texts[key]
+        target = title if key == "title" else values
+        target.texts.append((cx + 1.5, cy + height - 2.0, text or "—", "start", False))
+    for row in (12.0, 22.0):  # rows between the cells
+        cells.lines.append((x0, y0 + row, x1, y0 + row))
+    symbol = _projection_symbol(x0 + 85.0 + 2.0, y0 + 22.0 + 1.5, angle)
+    symbol.texts.append((x0 + 85.0 + 27.0, y0 + 22.0 + 6.2, f"{angle.upper()} ANGLE PROJECTION", "start", False))
+    symbol.text_size = 2.5
+    return [frame, cells, labels, values, title, symbol]
 
 
-def _scale_bar(scale: float, paper_height: float) -> str:
-    """A bar of a round model length (1, 2 or 5 × 10^k mm) between 20 and 50 mm of paper, with ticks."""
+def _projection_symbol(x: float, y: float, angle: str) -> _Mark:
+    """ISO 5456-2's symbol of the projection method, 7 mm tall, its top left at (x, y): a truncated cone with
+    its small end to the left (front view: a trapezoid) and its view from the left (two circles, both rims
+    seen). First angle puts that view on the far side, right of the trapezoid (next to the large end); third
+    angle where it was seen from, left of it (next to the small end). Centre lines through both."""
+    mark = _Mark("symbol", f"projection-symbol-{angle}", line_width=0.35)
+    big, small, length, gap = 3.5, 1.75, 7.0, 4.0  # radii, the cone's length, space between the views, mm
+    circles_x = x + big if angle == "third" else x + length + gap + big
+    cone_x = x + 2 * big + gap if angle == "third" else x
+    cy = y + big
+    mark.lines += [
+        (cone_x, cy - small, cone_x + length, cy - big), (cone_x + length, cy - big, cone_x + length, cy + big),
+        (cone_x + length, cy + big, cone_x, cy + small), (cone_x, cy + small, cone_x, cy - small),
+    ]  # fmt: skip
+    mark.circles += [(circles_x, cy, big), (circles_x, cy, small)]
+    mark.definition = ("symbol", circles_x, cone_x)
+    return mark
+
+
+def _scale_bar(scale: float, paper_height: float) -> tuple[float, _Mark]:
+    """A bar of a round model length (1, 2 or 5 × 10^k mm) between 20 and 50 mm of paper, with ticks: the
+    length and the bar as a mark (sheet coordinates)."""
     target = 40.0 / scale  # model mm that make about 40 mm of paper
     exponent = math.floor(math.log10(target))
     length = max(
@@ -786,14 +1386,8 @@ def _scale_bar(scale: float, paper_height: float) -> str:
     )
     x0, y = _MARGIN + 8.0, paper_height - _MARGIN - 12.0
     bar = length * scale
-    ticks = " ".join(
-        f"M{_number(x0 + bar * k / 4)} {_number(y - 2.0)} L{_number(x0 + bar * k / 4)} {_number(y + 2.0)}"
-        for k in range(5)
-    )
-    parts = [
-        f'<path id="scale-bar-line" d="M{_number(x0)} {_number(y)} L{_number(x0 + bar)} {_number(y)} {ticks}" '
-        'fill="none" stroke="#000000" stroke-width="0.35"/>',
-        _text(x0, y + 6.0, "0", 3.0, "middle"),
-        _text(x0 + bar, y + 6.0, f"{_number(length)} mm", 3.0, "middle"),
-    ]
-    return f'<g id="scale-bar" data-length="{_number(length)}">{"".join(parts)}</g>'
+    mark = _Mark("title", "scale-bar-line", line_width=0.35, text_size=3.0)
+    mark.lines.append((x0, y, x0 + bar, y))
+    mark.lines += [(x0 + bar * k / 4, y - 2.0, x0 + bar * k / 4, y + 2.0) for k in range(5)]
+    mark.texts += [(x0, y + 6.0, "0", "middle", False), (x0 + bar, y + 6.0, f"{_number(length)} mm", "middle", False)]
+    return length, mark

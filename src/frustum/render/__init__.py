@@ -56,7 +56,7 @@ from typing import Any
 
 from frustum.camera import Camera
 from frustum.frame import Frame
-from frustum.render import composite, lines, methods, surfaces
+from frustum.render import composite, lines, methods, reflection, surfaces
 from frustum.render.buffers import Buffers, resolve
 from frustum.render.buffers import FrameBuffers as FrameBuffers
 from frustum.render.buffers import Scratch as Scratch
@@ -66,7 +66,7 @@ from frustum.render.buffers import resolve_color as resolve_color
 from frustum.render.lines import mesh_edges as mesh_edges
 from frustum.render.methods import RENDER_METHODS as RENDER_METHODS
 from frustum.render.methods import VISIBILITY_METHODS as VISIBILITY_METHODS
-from frustum.render.options import EDGE_MODES, LINE_MODES, RenderOptions, check_method
+from frustum.render.options import DEFAULT_BACKGROUND, EDGE_MODES, LINE_MODES, RenderOptions, check_method
 from frustum.render.options import HIDDEN_STYLES as HIDDEN_STYLES
 from frustum.render.options import RENDER_MODES as RENDER_MODES
 from frustum.render.options import SHADING_MODES as SHADING_MODES
@@ -101,7 +101,7 @@ def render(
     *,
     shading: str | None = "phong",
     specular: str = "blinn-phong",
-    background: Any = (0.0, 0.0, 0.0, 1.0),
+    background: Any = DEFAULT_BACKGROUND,
     cull_back_faces: bool = True,
     mode: str = "surface",
     edges: str | None = None,
@@ -134,7 +134,8 @@ def render(
     specular : {"blinn-phong", "phong"}
         The specular term: (N·H)^n or (R·V)^n.
     background : (4,) array_like
-        RGBA in [0, 1] for pixels nothing covers; stored as ``round(255·value)``.
+        RGBA in [0, 1] for pixels nothing covers; stored as ``round(255·value)``. Not given, a scene with an
+        ``environment`` map shows the map there (``render.reflection``), else opaque black.
     cull_back_faces : bool
         True: drop triangles that are clockwise (or of zero area) in window coordinates. False: draw both
         sides, lighting a back face with its normal flipped toward the viewer (two-sided lighting, for open
@@ -222,6 +223,7 @@ def _draw(scene: Scene, camera: Camera, options: RenderOptions) -> Buffers:
         buffers.start(camera, options)
         lines.draw_edges(scene.items, camera, options, buffers)
         lines.draw_polylines(scene.polylines, camera, options, buffers)
+        reflection.paint_background(camera, options, buffers)
         composite.draw_volumes(scene, camera, buffers)  # each ray stopped at the depth the lines wrote
         composite.draw_particles(scene, camera, buffers)
         return buffers
@@ -245,6 +247,7 @@ def _draw_surfaces(scene: Scene, camera: Camera, options: RenderOptions, buffers
     over them, then the transparent items."""
 
     def between() -> None:
+        reflection.paint_background(camera, options, buffers)  # the environment where no opaque surface is
         # every volume ray cast after the opaque surfaces (rays stop at their depth), before the transparent items;
         # the edges and polylines first, so the part of a cloud in front of a line covers it (polylines write
         # depth, so they stop the rays too)

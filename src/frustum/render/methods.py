@@ -6,6 +6,7 @@ counts (``stats=True``)."""
 
 from __future__ import annotations
 
+import dataclasses
 import importlib
 from collections.abc import Callable
 from typing import Any
@@ -194,6 +195,7 @@ def _composite(
     dummy = (np.zeros((1, 1, 3), dtype=np.float32), np.zeros((1, 1), dtype=np.int32))
     owner = tris.item[fragments.triangle]
     columns = 256
+    flat_options = dataclasses.replace(options, environment=None)  # fragment images have no pixel rays to reflect
     for index in sorted(set(tris.item.tolist())):
         # the item's fragments as a (rows, 256) image, padded with depth 1 (nothing drawn), shaded by the one kernel:
         # opaque items as the depth buffer shades them, transparent ones blended over transparent black
@@ -209,7 +211,7 @@ def _composite(
         attributes = world_attributes(items[index], scratch)
         image = Pixels(depth_image.reshape(rows, columns), code_image.reshape(rows, columns),
                        bary_image.reshape(rows, columns, 2), color_image, dummy)  # fmt: skip
-        shade_item(items[index], index, offsets[index], camera, options, lighting, attributes, image, (0, rows),
+        shade_item(items[index], index, offsets[index], camera, flat_options, lighting, attributes, image, (0, rows),
                    blend=items[index].material.opacity < 1.0)  # fmt: skip
         premultiplied[chosen] = color_image.reshape(-1, 4)[: chosen.shape[0]]
     if under_depth is None:

@@ -52,10 +52,14 @@ PLANNED_METHODS: dict[str, str] = {}
 MAX_LINE_WIDTH = 256.0
 """Widest line (and largest point) ``render`` draws, in output pixels."""
 
+DEFAULT_BACKGROUND = (0.0, 0.0, 0.0, 1.0)
+"""``render``'s default background (opaque black). Left at this very object, a scene's environment map is shown
+instead (``frustum.render.reflection``)."""
+
 DEFAULTS: dict[str, Any] = {
     "shading": "phong",
     "specular": "blinn-phong",
-    "background": (0.0, 0.0, 0.0, 1.0),
+    "background": DEFAULT_BACKGROUND,
     "cull_back_faces": True,
     "mode": "surface",
     "edges": None,
@@ -103,6 +107,8 @@ class RenderOptions:
     factor: int = 1
     filter: str = "box"
     color_space: str = "linear"
+    environment: Any = None  # the scene's EnvironmentMap, for reflections (and the background, below)
+    environment_background: bool = False  # no background given: the environment map is the background
 
     @classmethod
     def from_keywords(cls, scene: Any, camera: Any, where: str = "render", **keywords: Any) -> RenderOptions:
@@ -126,7 +132,11 @@ class RenderOptions:
         choice(k["filter"], FILTERS, "filter", where)
         choice(k["color_space"], COLOR_SPACES, "color_space", where)
         check_image_budget(camera, factor, options.buffers, k["filter"], k["color_space"], where)
-        return dataclasses.replace(options, factor=factor, filter=k["filter"], color_space=k["color_space"])
+        environment = getattr(scene, "environment", None)
+        return dataclasses.replace(options, factor=factor, filter=k["filter"], color_space=k["color_space"],
+                                   environment=environment,
+                                   environment_background=environment is not None
+                                   and k["background"] is DEFAULT_BACKGROUND)  # fmt: skip
 
     def supersampled(self) -> RenderOptions:
         """The options for the √samples-times larger image: lines √samples times as wide (the same counts dict)."""

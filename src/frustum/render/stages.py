@@ -15,6 +15,7 @@ from frustum.clipping import VIEW_VOLUME_PLANES
 from frustum.raster import shade, tiles, triangles
 from frustum.raster._jit import threads
 from frustum.raster.vertices import project_vertices, transform_normals, world_points
+from frustum.render import bumps, reflection
 from frustum.render.buffers import Scratch
 from frustum.render.options import RenderOptions
 from frustum.scene import Scene, SceneItem
@@ -287,8 +288,16 @@ def directional(item: SceneItem, options: RenderOptions, lights: np.ndarray) -> 
         and options.shade_mode == shade.SHADE_PHONG and options.specular_model == shade.SPECULAR_BLINN
         and bool((lights[:, 0] == 0.0).all()) and getattr(mesh, "vertex_colors", None) is None
         and (item.material.texture is None or getattr(mesh, "uvs", None) is None)
-        and options.depth_cue is None and not options.buffers
+        and options.depth_cue is None and not options.buffers and _plain_surface(item, options)
     )  # fmt: skip
+
+
+def _plain_surface(item: SceneItem, options: RenderOptions) -> bool:
+    """No bump or normal map to shade per pixel, and no environment to reflect."""
+    material = item.material
+    return material.bump is None and material.normal_map is None and (
+        options.environment is None or material.reflectivity == 0.0
+    )
 
 
 def _plain_phong(item: SceneItem, options: RenderOptions) -> bool:
@@ -299,7 +308,7 @@ def _plain_phong(item: SceneItem, options: RenderOptions) -> bool:
         item.material.opacity >= 1.0 and options.shade_mode == shade.SHADE_PHONG
         and getattr(mesh, "vertex_colors", None) is None
         and (item.material.texture is None or getattr(mesh, "uvs", None) is None)
-        and options.depth_cue is None and not options.buffers
+        and options.depth_cue is None and not options.buffers and _plain_surface(item, options)
     )  # fmt: skip
 
 
@@ -333,8 +342,26 @@ def shade_item(
     extra = (pixels.extra[0][rows_] if write_normals else pixels.extra[0],
              pixels.extra[1][rows_] if write_ids else pixels.extra[1])  # fmt: skip
     params = shading_parameters(item, camera, options, ambient)
-    mode = options.shade_mode
     faces = world_faces(item) if mesh.face_count else np.empty((0, 3), dtype=np.int64)
+    if options.shade_mode == shade.SHADE_PHONG and bumps.has_detail(item):  # per-pixel normals from the maps
+        flags = item_flags(index, face_offset, options, blend, write_normals, write_ids)
+        bumps.shade_detailed(item, faces, world, normals, params, lights, flags, depth, codes, bary, color, extra)
+    else:
+        _shade_pixels(item, index, face_offset, options, lights, params, faces, world, normals, depth, codes, bary,
+                      color, extra, blend, write_normals, write_ids)  # fmt: skip
+    if options.environment is not None and material.reflectivity > 0.0:
+        reflection.reflect(faces, face_offset, material.reflectivity, camera, options, np.asarray(normals, float),
+                           depth, codes, bary, color, band[0])  # fmt: skip
+
+
+def _shade_pixels(
+    item: SceneItem, index: int, face_offset: int, options: RenderOptions, lights: np.ndarray, params: np.ndarray,
+    faces: np.ndarray, world: np.ndarray, normals: np.ndarray, depth: np.ndarray, codes: np.ndarray, bary: np.ndarray,
+    color: np.ndarray, extra: tuple[np.ndarray, np.ndarray], blend: bool, write_normals: bool, write_ids: bool,
+) -> None:  # fmt: skip
+    """The shading kernel for the item's pixels: the directional or plain Phong fast paths where they apply."""
+    mesh, material = item.mesh, item.material
+    mode = options.shade_mode
     if not blend and directional(item, options, lights):  # the same bytes without the general branches
         flags = item_flags(index, face_offset, options, blend, False, False)
         shade.shade_pixels_directional(depth, codes, bary, faces, world, normals, params, lights, flags, color)

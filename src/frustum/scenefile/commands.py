@@ -103,12 +103,12 @@ def render_scene_file(
     return written[0] if single else written
 
 
-def render_view_sheet(
-    path: str | Path, output: str | Path, views: Sequence[str] = ("front", "top", "right", "isometric"), **options: Any
-) -> Path:
-    """An engineering drawing sheet (``drawing_sheet``) of the scene file's scene: SVG, or PDF/PNG by suffix.
+def render_view_sheet(path: str | Path, output: str | Path, views: Sequence[str] | None = None, **options: Any) -> Path:
+    """An engineering drawing sheet (``drawing_sheet``) of the scene file's scene: SVG, or PDF/PNG/DXF by suffix.
 
-    ``views`` accepts "iso" for "isometric". Other keywords go to ``drawing_sheet`` (scale, paper, title, ...).
+    ``views`` accepts "iso" for "isometric" (default: the file's ``[sheet] views``, else front, top, right and
+    isometric). Other keywords go to ``drawing_sheet`` (scale, paper, title, title_block, ...) and override the
+    file's ``[sheet]`` table; ``title_block`` fields are merged over the file's.
     """
     scene_file = load_scene_file(path)
     try:
@@ -116,11 +116,18 @@ def render_view_sheet(
         svg = importlib.import_module("frustum.output.svg")
     except ImportError:
         raise OutputError("render_view_sheet: drawing sheets are not available in this version") from None
-    names = ["isometric" if v == "iso" else v for v in views]
-    options.setdefault("title", scene_file.title)
-    text = sheet.drawing_sheet(scene_file.scene, names, **options)
+    settings = dict(scene_file.sheet)
+    file_views = settings.pop("views", ("front", "top", "right", "isometric"))
+    names = ["isometric" if v == "iso" else v for v in (views if views is not None else file_views)]
+    title_block = {**settings.pop("title_block", {}), **(options.pop("title_block", None) or {})}
+    settings.update({key: value for key, value in options.items() if value is not None})
+    settings.setdefault("title", scene_file.title)
     target = Path(output)
     target.parent.mkdir(parents=True, exist_ok=True)
+    if target.suffix.lower() == ".dxf":
+        sheet.drawing_sheet(scene_file.scene, names, title_block=title_block or None, path=target, **settings)
+        return target
+    text = sheet.drawing_sheet(scene_file.scene, names, title_block=title_block or None, **settings)
     return Path(svg.save_svg(text, target))
 
 

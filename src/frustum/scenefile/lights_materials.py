@@ -1,12 +1,21 @@
-"""``[materials]``, material references and ``[[lights]]`` (and a node's lights)."""
+"""``[materials]``, material references, ``[[lights]]`` (and a node's lights) and ``[environment]``."""
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any
 
-from frustum.scenefile.checks import _call, _choice, _table, _table_list
+import numpy as np
+
+from frustum.budgets import format_bytes, get_budget
+from frustum.environment import ENVIRONMENT_KINDS, EnvironmentMap
+from frustum.errors import FrustumError
+from frustum.scenefile.checks import _call, _choice, _table, _table_list, _unknown_keys
 from frustum.scenefile.report import _BAD, _Report
 from frustum.shading import AmbientLight, DirectionalLight, Material, PointLight, SpotLight
+
+IMAGE_KEYS = ("texture", "bump", "normal_map")
+"""Material keys that name an image file (relative to the scene file's folder): PNG, JPEG, anything Pillow reads."""
 
 _LIGHT_TYPES = {"ambient": AmbientLight, "directional": DirectionalLight, "point": PointLight, "spot": SpotLight}
 
@@ -15,11 +24,65 @@ def _material(report: _Report, path: tuple, value: Any) -> Any:
     params = _table(report, path, value)
     if params is _BAD:
         return _BAD
-    if "texture" in params:
-        report.add((*path, "texture"), params.pop("texture"), "is not supported in scene files",
-                   "textures come with mesh files (OBJ/glTF) or from the Python API")  # fmt: skip
-        return _BAD
+    for key in IMAGE_KEYS:
+        if key in params:
+            image = _image(report, (*path, key), params[key])
+            if image is _BAD:
+                return _BAD
+            params[key] = image
     return _call(report, path, Material, params, label="Material")
+
+
+def _image(report: _Report, path: tuple, value: Any) -> Any:
+    """The image file `value` names (relative to the scene file's folder) as an (H, W, 3|4) uint8 array."""
+    from PIL import Image
+
+    if not isinstance(value, str) or not value:
+        report.add(path, value, "is not a file name", "give the path of a PNG or JPEG image, relative to the file")
+        return _BAD
+    file = Path(getattr(report, "base", ".")) / value
+    if not file.is_file():
+        problem = "does not exist" if not file.exists() else "is not a regular file"
+        report.add(path, value, problem, f"give an image file (looked for {str(file)!r})")
+        return _BAD
+    try:
+        with Image.open(file) as image:
+            width, height = image.size
+            budget = get_budget().bytes
+            if width * height * 24 > budget:
+                report.add(path, value, f"is a {width} x {height} image, over the memory budget of "
+                           f"{format_bytes(budget)}", "give a smaller image or raise the budget")  # fmt: skip
+                return _BAD
+            return np.asarray(image.convert("RGBA" if "A" in image.mode else "RGB"), dtype=np.uint8)
+    except Exception as error:  # Pillow raises many types for unreadable or hostile files
+        report.add(path, value, f"could not be read as an image ({type(error).__name__})",
+                   "give a PNG or JPEG image")  # fmt: skip
+        return _BAD
+
+
+def _environment(report: _Report, path: tuple, value: Any) -> Any:
+    """``[environment]``: ``image`` (an equirect PNG/JPEG/.hdr, or six cube faces side by side), ``kind``,
+    ``intensity``."""
+    params = _table(report, path, value)
+    if params is _BAD:
+        return _BAD
+    _unknown_keys(report, path, params, ("image", "kind", "intensity"))
+    if "image" not in params:
+        report.missing((*path, "image"), "give the image file of the surroundings (equirect 2:1, or .hdr)")
+        return _BAD
+    kind = _choice(report, (*path, "kind"), params.get("kind", "equirect"), ENVIRONMENT_KINDS)
+    image = params["image"]
+    file = Path(getattr(report, "base", ".")) / image if isinstance(image, str) else None
+    if file is None or not file.is_file():
+        report.add((*path, "image"), image, "is not an image file", "give the path of an image, relative to the file")
+        return _BAD
+    if kind is _BAD:
+        return _BAD
+    try:
+        return EnvironmentMap.load(file, kind=kind, intensity=params.get("intensity", 1.0))
+    except FrustumError as error:
+        report.refused(path, params, error)
+        return _BAD
 
 
 def _material_reference(report: _Report, path: tuple, value: Any, materials: dict) -> Any:

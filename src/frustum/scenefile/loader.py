@@ -21,10 +21,11 @@ from frustum.render import render
 from frustum.scene import Scene
 from frustum.scenefile.camera import _camera, _Stereo, _stereo_modules
 from frustum.scenefile.checks import _table, _table_list, _unknown_keys
-from frustum.scenefile.lights_materials import _lights, _material
+from frustum.scenefile.lights_materials import _environment, _lights, _material
 from frustum.scenefile.nodes import _explode_and_cut, _node
 from frustum.scenefile.outputs import _DEFAULT_SIZE, _MAX_PIXELS, _check_image_memory, _outputs, _render_options
 from frustum.scenefile.report import _BAD, _Report
+from frustum.scenefile.sheet import _sheet_options
 from frustum.scenefile.simulation import _simulations, _warm_up
 from frustum.scenefile.volumes import _volume
 from frustum.shading import Material
@@ -43,8 +44,11 @@ _MAX_NESTING = 64
 
 _TOP_LEVEL = (
     "title", "description", "camera", "cameras", "lights", "materials", "nodes", "render", "exploded", "cutaway",
-    "output", "animation", "svg", "particles", "cloth", "volumes",
+    "output", "animation", "svg", "particles", "cloth", "volumes", "sheet", "environment", "radiosity",
 )  # fmt: skip
+
+RADIOSITY_KEYS = {"patch_size": float, "hemicube": int, "tolerance": float, "max_iterations": int, "shooter": float}
+"""``[radiosity]``: the keywords of ``frustum.radiosity`` a scene file may set."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -70,6 +74,9 @@ class SceneFile:
         ``[animation]`` (frames, fps, axis) and ``[svg]`` (``render_svg`` keywords) settings.
     size : (int, int)
         Image width and height of each camera.
+    radiosity : dict or None
+        ``[radiosity]`` (``frustum.radiosity`` keywords): when given, ``render`` lights the scene by radiosity first
+        and draws the lit scene with ``shading="none"``.
     """
 
     scene: Scene
@@ -84,6 +91,8 @@ class SceneFile:
     columns: int = 0
     title: str = ""
     path: Path | None = None
+    sheet: dict = field(default_factory=dict)
+    radiosity: dict | None = None
 
     def resized(self, size: tuple[int, int]) -> SceneFile:
         """The same scene file with every camera's image `size` = (width, height) replaced."""
@@ -111,7 +120,12 @@ class SceneFile:
             return render_stereo(self.scene, self.stereo.camera, self.stereo.layout,
                                  anaglyph_method=self.stereo.anaglyph_method, cross_eyed=self.stereo.cross_eyed,
                                  **self.options)  # fmt: skip
-        frames = [render(self.scene, camera, **self.options) for camera in self.cameras]
+        scene, options = self.scene, self.options
+        if self.radiosity is not None:
+            from frustum.radiosity import radiosity
+
+            scene, options = radiosity(self.scene, **self.radiosity).scene, {**self.options, "shading": "none"}
+        frames = [render(scene, camera, **options) for camera in self.cameras]
         if len(frames) == 1:
             return frames[0]
         return _tile(frames, self.columns or len(frames), self.options.get("background", (0.0, 0.0, 0.0, 1.0)))
@@ -239,7 +253,27 @@ def _check_shape(text: str, source: str) -> None:
                              f"{_MAX_NESTING} levels of tables")  # fmt: skip
 
 
+def _radiosity(report: _Report, path: tuple, value: Any) -> dict | None:
+    params = _table(report, path, value)
+    if params is _BAD:
+        return None
+    _unknown_keys(report, path, params, tuple(RADIOSITY_KEYS))
+    settings = {}
+    for key, kind in RADIOSITY_KEYS.items():
+        if key not in params:
+            continue
+        number = params[key]
+        ok = not isinstance(number, bool) and isinstance(number, int | float if kind is float else int)
+        if not ok or (not number > 0 and key != "max_iterations") or (kind is int and number < 0):
+            report.add((*path, key), number, "is not a positive number" if kind is float else "is not a count",
+                       "see frustum.radiosity: patch_size > 0, hemicube even 8…2048, 0 < tolerance < 1")  # fmt: skip
+            continue
+        settings[key] = number
+    return settings
+
+
 def _build(report: _Report, data: dict, base: Path, check_outputs: bool = True) -> SceneFile | None:
+    report.base = base  # image files of materials and the environment are read relative to it
     _unknown_keys(report, (), data, _TOP_LEVEL)
     for key in ("title", "description"):
         if key in data and not isinstance(data[key], str):
@@ -253,6 +287,11 @@ def _build(report: _Report, data: dict, base: Path, check_outputs: bool = True) 
             if material is not _BAD:
                 materials[name] = material
     scene = Scene(_lights(report, ("lights",), data.get("lights", [])))
+    if "environment" in data:
+        environment = _environment(report, ("environment",), data["environment"])
+        if environment is not _BAD:
+            scene.environment = environment
+    radiosity = _radiosity(report, ("radiosity",), data["radiosity"]) if "radiosity" in data else None
     names: set[str] = set()
     for i, value in enumerate(_table_list(report, ("nodes",), data.get("nodes", []))):
         node = _node(report, ("nodes", i), dict(value), base, materials, names)
@@ -292,9 +331,13 @@ def _build(report: _Report, data: dict, base: Path, check_outputs: bool = True) 
         _warm_up(report, scene, animation)
     if report.problems:
         return None
+    sheet = _sheet_options(report, data.get("sheet", {}))
+    if report.problems:
+        return None
     title = data.get("title", "")
     single = cameras[0] if "camera" in data else None
-    return SceneFile(scene, single, options, outputs, tuple(cameras), stereo, animation, svg, size, columns, title)
+    return SceneFile(scene, single, options, outputs, tuple(cameras), stereo, animation, svg, size, columns, title,
+                     sheet=sheet, radiosity=radiosity)  # fmt: skip
 
 
 def load_scene_file(path: str | Path) -> SceneFile:
