@@ -19,8 +19,10 @@ ROOT = TESTS.parent
 SOURCES = sorted(TESTS.rglob("*.py"))
 SCANNED = [path for path in SOURCES if path != Path(__file__).resolve()]  # this file names such paths as examples
 
-# Absolute paths a test may name: ones that are deliberately missing or special, never data to read.
-ALLOWED_ABSOLUTE = ("/dev/null", "/dev/zero", "/nonexistent/", "/tmp/frustum-")
+# An absolute path is flagged when its first folder exists at the file system's root (so a deliberately missing
+# '/nonexistent/x.ply' or a URL path '/ws' is not), except these: devices and process information, and the
+# temporary folder (outputs of the hostile-path tests, never data to read).
+SYSTEM_ROOTS = ("dev", "proc", "sys", "tmp")
 # `../` in a string is allowed only in the hostile-input tests, which check that such output paths are refused, and
 # on a line marked with this comment (a test that such a path is refused, never read)
 PARENT_ALLOWED_UNDER = TESTS / "hostile"
@@ -43,7 +45,14 @@ def _offences(path: Path, root: Path = ROOT) -> list[str]:
         where = f"{path.relative_to(root)}:{getattr(node, 'lineno', '?')}"
         if isinstance(node, ast.Constant) and isinstance(node.value, str) and node is not docstring:
             text = node.value
-            if text.startswith("/") and len(text) > 1 and not text.startswith(ALLOWED_ABSOLUTE):
+            first = text[1:].split("/", 1)[0]
+            if (
+                text.startswith("/")
+                and first
+                and first not in SYSTEM_ROOTS
+                and Path("/", first).is_dir()
+                and not text.startswith("//")
+            ):
                 found.append(f"{where}: absolute path {text!r}")
             elif "/work/" in text or "shared/data" in text or "shared/bench" in text or text == "shared":
                 found.append(f"{where}: a folder outside the repository in {text!r}")
