@@ -153,7 +153,7 @@ def _inside(base: Path, name: str) -> bool:
     return target != folder and target.is_relative_to(folder)
 
 
-def _outputs(report: _Report, data: dict, base: Path) -> tuple[tuple[Path, ...], dict, dict]:
+def _outputs(report: _Report, data: dict, base: Path, check: bool = True) -> tuple[tuple[Path, ...], dict, dict]:
     outputs: list[Path] = []
     if "output" in data:
         params = _table(report, ("output",), data["output"])
@@ -168,6 +168,8 @@ def _outputs(report: _Report, data: dict, base: Path) -> tuple[tuple[Path, ...],
                         report.add(("output", "files", i), name, "has an unknown suffix",
                                    f"expected one of {', '.join(OUTPUT_SUFFIXES)}")  # fmt: skip
                     elif not _inside(base, name):
+                        if not check:  # not written (the caller writes elsewhere: -o), so not refused either
+                            continue
                         report.add(("output", "files", i), name, "is outside the scene file's folder",
                                    "outputs named in a scene file must stay in its folder (no '..', no absolute "
                                    "path, no symlink pointing out); give a relative path, or use -o on the "
