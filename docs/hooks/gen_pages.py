@@ -200,7 +200,7 @@ def _properties_table(node: dict) -> list[str]:
     for key, sub in props.items():
         desc = " ".join(str(sub.get("description", "")).split()).replace("|", "\\|")
         lines.append(f"| `{key}` | {_type_of(sub)} | {'yes' if key in required else ''} | {desc} |")
-    return lines + [""]
+    return [*lines, ""]
 
 
 def scene_file_page() -> str:
@@ -223,7 +223,7 @@ def scene_file_page() -> str:
             lines += _properties_table(sub)
             for inner_key, inner in sub["properties"].items():
                 if inner.get("type") == "object" and inner.get("properties"):
-                    lines += [f"#### `[{key}.{inner_key}]`", ""] + _properties_table(inner)
+                    lines += [f"#### `[{key}.{inner_key}]`", "", *_properties_table(inner)]
     lines += ["## Definitions", ""]
     for name, sub in schema.get("$defs", {}).items():
         lines += [f"### {name} {{ #def-{name} }}", ""]
@@ -237,7 +237,6 @@ def scene_file_page() -> str:
 # --- command line ----------------------------------------------------------------------------------------------
 
 def cli_page() -> str:
-    import click
     import typer
 
     _frustum()
@@ -253,13 +252,13 @@ def cli_page() -> str:
     runner = CliRunner()
     env = {"NO_COLOR": "1", "TERMINAL_WIDTH": "100", "COLUMNS": "100", "_TYPER_FORCE_DISABLE_TERMINAL": "1"}
 
-    def walk(cmd: click.Command, path: list[str]) -> None:
+    def walk(cmd, path: list[str]) -> None:
         result = runner.invoke(app, [*path[1:], "--help"], env=env, terminal_width=100)
         if result.exit_code != 0:  # pragma: no cover
             log.warning("`%s --help` failed: %s", " ".join(path), result.output)
         lines.extend([f"## `{' '.join(path)}`", "", "```text", result.output.rstrip(), "```", ""])
-        if isinstance(cmd, click.Group):
-            ctx = click.Context(cmd, info_name=path[-1])
+        if hasattr(cmd, "list_commands"):  # a group (Typer vendors its own click: no isinstance)
+            ctx = cmd.context_class(cmd, info_name=path[-1])
             for sub_name in cmd.list_commands(ctx):
                 walk(cmd.get_command(ctx, sub_name), [*path, sub_name])
 
@@ -334,7 +333,8 @@ def on_config(config, **kwargs):
     groups = api_entries()
     _STATE["groups"] = groups
     api_nav = [{"Index": "reference/api/index.md"}]
-    api_nav += [{GROUP_TITLES.get(g, g): f"reference/api/{g}.md"} for g in sorted(groups, key=lambda g: GROUP_TITLES.get(g, g))]
+    ordered = sorted(groups, key=lambda g: GROUP_TITLES.get(g, g))
+    api_nav += [{GROUP_TITLES.get(g, g): f"reference/api/{g}.md"} for g in ordered]
     _STATE["notebooks"] = notebook_pages()
     for item in config["nav"] or []:
         if isinstance(item, dict) and "Tutorials" in item:
