@@ -505,6 +505,8 @@ if TYPE_CHECKING:  # pragma: no cover
 
 
 def __getattr__(name: str) -> Any:
+    if name == "steps":  # the teaching layer (frustum.steps), a subpackage loaded on first use
+        return importlib.import_module("frustum.steps")
     module = _LAZY.get(name)
     if module is None:
         raise AttributeError(f"module 'frustum' has no attribute {name!r}")
