@@ -5,6 +5,7 @@
   function or class without a docstring is logged as a warning, so ``mkdocs build --strict`` fails.
 - ``reference/scene-file.md``: the scene-file format, from ``src/frustum/scene.schema.json``.
 - ``reference/cli.md``: the command line, from the Typer app's ``--help`` of every command.
+- ``tutorials/notebooks/<stem>.md``, ``lessons/<stem>.md``: the notebooks of ``notebooks/`` and ``docs/lessons/``.
 - ``gallery.md``: every ``examples/*.toml`` with its picture ``docs/gallery/<name>.png`` (when one is there)
   and the scene file itself.
 
@@ -297,11 +298,16 @@ def gallery_page(docs_dir: Path) -> str:
 
 # --- notebooks -----------------------------------------------------------------------------------------------
 
-def notebook_pages() -> dict[str, tuple[str, str]]:
-    """{page path: (title, Markdown)} for every ``notebooks/*.ipynb``: its Markdown cells as they are, its code
-    cells as Python blocks (the notebooks are executed by ``tests/test_notebook.py``, not by the build)."""
+NOTEBOOK_FOLDERS = (("notebooks", "tutorials/notebooks"), ("docs/lessons", "lessons"))
+
+
+def notebook_pages(source: str = "notebooks", target: str = "tutorials/notebooks") -> dict[str, tuple[str, str]]:
+    """{page path: (title, Markdown)} for every notebook in `source` (relative to the repository): its Markdown
+    cells as they are, its code cells as Python blocks (the notebooks are executed by the tests, not by the
+    build). The page goes to `target`/<stem>.md (for ``docs/lessons`` beside the notebook, so its relative links
+    hold)."""
     pages = {}
-    for path in sorted((ROOT / "notebooks").glob("*.ipynb")):
+    for path in sorted((ROOT / source).glob("*.ipynb")):
         notebook = json.loads(path.read_text(encoding="utf-8"))
         chunks, title = [], path.stem.replace("_", " ")
         for cell in notebook.get("cells", []):
@@ -312,7 +318,7 @@ def notebook_pages() -> dict[str, tuple[str, str]]:
                 chunks.append(source)
             elif cell.get("cell_type") == "code" and source.strip():
                 chunks.append("```python\n" + source.rstrip() + "\n```")
-        note = (f"*From the notebook `notebooks/{path.name}` (open it in Jupyter to run it; the tests execute "
+        note = (f"*From the notebook `{source}/{path.name}` (open it in Jupyter to run it; the tests execute "
                 "it).*")
         text = "\n\n".join(chunks) + "\n"
         if text.startswith("# "):
@@ -320,7 +326,7 @@ def notebook_pages() -> dict[str, tuple[str, str]]:
             text = first + "\n\n" + note + "\n" + rest
         else:
             text = f"# {title}\n\n{note}\n\n" + text
-        pages[f"tutorials/notebooks/{path.stem}.md"] = (title, text)
+        pages[f"{target}/{path.stem}.md"] = (title, text)
     return pages
 
 
@@ -335,12 +341,15 @@ def on_config(config, **kwargs):
     api_nav = [{"Index": "reference/api/index.md"}]
     ordered = sorted(groups, key=lambda g: GROUP_TITLES.get(g, g))
     api_nav += [{GROUP_TITLES.get(g, g): f"reference/api/{g}.md"} for g in ordered]
-    _STATE["notebooks"] = notebook_pages()
+    _STATE["notebooks"] = {source: notebook_pages(source, target) for source, target in NOTEBOOK_FOLDERS}
     for item in config["nav"] or []:
         if isinstance(item, dict) and "Tutorials" in item:
-            item["Tutorials"] = list(item["Tutorials"]) + [
-                {title: page} for page, (title, _) in _STATE["notebooks"].items()
-            ]
+            entries = list(item["Tutorials"])
+            entries += [{title: page} for page, (title, _) in _STATE["notebooks"]["notebooks"].items()]
+            lessons = [{title: page} for page, (title, _) in _STATE["notebooks"]["docs/lessons"].items()]
+            if lessons:
+                entries.append({"Lessons, step by step": lessons})
+            item["Tutorials"] = entries
         if isinstance(item, dict) and "Reference" in item:
             item["Reference"] = [
                 "reference/index.md",
@@ -358,8 +367,10 @@ def on_files(files, config, **kwargs):
              "reference/scene-file.md": scene_file_page(),
              "reference/cli.md": cli_page(),
              "gallery.md": gallery_page(docs_dir)}
-    for page, (_, text) in (_STATE.get("notebooks") or notebook_pages()).items():
-        pages[page] = text
+    notebooks = _STATE.get("notebooks") or {src: notebook_pages(src, dst) for src, dst in NOTEBOOK_FOLDERS}
+    for found in notebooks.values():
+        for page, (_, text) in found.items():
+            pages[page] = text
     for group, entries in groups.items():
         pages[f"reference/api/{group}.md"] = _api_page(group, entries)
     for path, content in pages.items():
