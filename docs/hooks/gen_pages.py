@@ -60,7 +60,11 @@ def public_names(module: types.ModuleType) -> list[str]:
     for name in sorted(names):
         if name.startswith("_") or name == "TYPE_CHECKING":
             continue
-        obj = getattr(module, name)
+        try:
+            obj = getattr(module, name)
+        except ImportError:  # a lazy name whose extra is missing: still public
+            out.append(name)
+            continue
         if isinstance(obj, types.ModuleType) and not obj.__name__.startswith("frustum"):
             continue
         owner = getattr(obj, "__module__", None)
@@ -112,7 +116,12 @@ def api_entries() -> dict[str, list[tuple[str, str, str]]]:
     fr = _frustum()
     groups: dict[str, list[tuple[str, str, str]]] = {}
     for name in public_names(fr):
-        obj = getattr(fr, name)
+        try:
+            obj = getattr(fr, name)
+        except ImportError:  # a lazy name whose extra is missing (Viewer without anywidget): read statically
+            module = fr._LAZY[name]
+            groups.setdefault(module.split(".")[1], []).append((name, f"{module}.{name}", "lazy"))
+            continue
         module = _defining_module(name, obj, fr)
         if isinstance(obj, types.ModuleType):
             kind, ident = "module", module
@@ -127,6 +136,16 @@ def api_entries() -> dict[str, list[tuple[str, str, str]]]:
         if kind in ("class", "function") and not inspect.getdoc(obj):
             log.warning("frustum.%s (%s) has no docstring: every public name needs one", name, ident)
     return groups
+
+
+# Public subpackages whose names are used as ``frustum.<module>.<name>`` rather than re-exported: documented whole
+# (module docstring and every public member) on a page of their own, when they exist.
+EXTRA_MODULES = {"steps": "Step by step (frustum.steps)"}
+
+
+def _module_page(module: str, title: str) -> str:
+    return "\n".join([f"# {title}", "", "Generated at build time from the docstrings.", "", f"::: frustum.{module}",
+                       "    options:", "      show_root_heading: false", "      show_submodules: true", ""])
 
 
 def _api_page(group: str, entries: list[tuple[str, str, str]]) -> str:
@@ -146,6 +165,11 @@ def _api_page(group: str, entries: list[tuple[str, str, str]]) -> str:
         lines += [f"::: {ident}", "    options:", "      show_root_heading: true",
                   "      show_root_full_path: false", f"      heading: \"{name}\"" if kind == "constant" else "", ""]
     return "\n".join(lines)
+
+
+def _extra_modules() -> dict[str, str]:
+    return {m: t for m, t in EXTRA_MODULES.items()
+            if (SRC / "frustum" / m).is_dir() or (SRC / "frustum" / f"{m}.py").is_file()}
 
 
 def _api_index(groups: dict[str, list[tuple[str, str, str]]]) -> str:
@@ -341,6 +365,7 @@ def on_config(config, **kwargs):
     api_nav = [{"Index": "reference/api/index.md"}]
     ordered = sorted(groups, key=lambda g: GROUP_TITLES.get(g, g))
     api_nav += [{GROUP_TITLES.get(g, g): f"reference/api/{g}.md"} for g in ordered]
+    api_nav += [{title: f"reference/api/{m}.md"} for m, title in _extra_modules().items()]
     _STATE["notebooks"] = {source: notebook_pages(source, target) for source, target in NOTEBOOK_FOLDERS}
     for item in config["nav"] or []:
         if isinstance(item, dict) and "Tutorials" in item:
@@ -371,6 +396,8 @@ def on_files(files, config, **kwargs):
     for found in notebooks.values():
         for page, (_, text) in found.items():
             pages[page] = text
+    for module, title in _extra_modules().items():
+        pages[f"reference/api/{module}.md"] = _module_page(module, title)
     for group, entries in groups.items():
         pages[f"reference/api/{group}.md"] = _api_page(group, entries)
     for path, content in pages.items():
