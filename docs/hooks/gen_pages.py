@@ -16,10 +16,12 @@ schema key or example added to the code shows up at the next build with no edit 
 from __future__ import annotations
 
 import ast
+import contextlib
 import importlib
 import inspect
 import json
 import logging
+import pkgutil
 import sys
 import types
 from pathlib import Path
@@ -115,7 +117,14 @@ def api_entries() -> dict[str, list[tuple[str, str, str]]]:
     """{group: [(name, identifier for mkdocstrings, kind)]} for every public name of frustum."""
     fr = _frustum()
     groups: dict[str, list[tuple[str, str, str]]] = {}
+    for name in getattr(fr, "_LAZY", {}):  # load the lazy names first: their modules become attributes too
+        with contextlib.suppress(ImportError):
+            getattr(fr, name)
+    # every public top-level module, imported or not: which of them dir(frustum) lists depends on what ran before
+    modules = {m.name for m in pkgutil.iter_modules(fr.__path__) if not m.name.startswith("_")}
+    listed = set()
     for name in public_names(fr):
+        listed.add(name)
         try:
             obj = getattr(fr, name)
         except ImportError:  # a lazy name whose extra is missing (Viewer without anywidget): read statically
@@ -135,7 +144,13 @@ def api_entries() -> dict[str, list[tuple[str, str, str]]]:
         groups.setdefault(group, []).append((name, ident, kind))
         if kind in ("class", "function") and not inspect.getdoc(obj):
             log.warning("frustum.%s (%s) has no docstring: every public name needs one", name, ident)
-    return groups
+    for name in sorted(modules - listed):
+        groups.setdefault(name, []).append((name, f"frustum.{name}", "module"))
+    for name in EXTRA_MODULES:  # documented whole on their own page
+        groups.pop(name, None)
+    for entries in groups.values():
+        entries[:] = [e for e in entries if not (e[2] == "module" and e[0] in EXTRA_MODULES)]
+    return {group: entries for group, entries in groups.items() if entries}
 
 
 # Public subpackages whose names are used as ``frustum.<module>.<name>`` rather than re-exported: documented whole
@@ -145,7 +160,7 @@ EXTRA_MODULES = {"steps": "Step by step (frustum.steps)"}
 
 def _module_page(module: str, title: str) -> str:
     return "\n".join([f"# {title}", "", "Generated at build time from the docstrings.", "", f"::: frustum.{module}",
-                       "    options:", "      show_root_heading: false", "      show_submodules: true", ""])
+                       "    options:", "      show_root_heading: true", "      show_submodules: true", ""])
 
 
 def _api_page(group: str, entries: list[tuple[str, str, str]]) -> str:
