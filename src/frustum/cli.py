@@ -414,11 +414,18 @@ def render_command(
         list[Path] | None, typer.Option("--output", "-o", help="Output file(s): .png .svg .pdf .gif .mp4.")
     ] = None,
     size: Annotated[str | None, typer.Option(help="Image size WIDTHxHEIGHT, overriding the file's.")] = None,
+    shadows: Annotated[
+        str | None, typer.Option(help="Shadows, overriding the file's: on (shadow maps), off, or ray (shadow rays).")
+    ] = None,
 ) -> None:
     """Render a scene file; without -o, the outputs the file names (or out/<name>.png beside it)."""
     from frustum.scenefile import render_scene_file
 
-    written = render_scene_file(scene, output or None, size=_image_size(size) if size else None)
+    choices = {None: None, "on": True, "off": False, "ray": "ray"}
+    if shadows not in choices:
+        raise FrustumError(f"render: --shadows {shadows!r} is unknown; expected on, off or ray")
+    written = render_scene_file(scene, output or None, size=_image_size(size) if size else None,
+                                shadows=choices[shadows])  # fmt: skip
     for path in written if isinstance(written, list) else [written]:
         console.print(f"wrote {path}", markup=False, highlight=False, soft_wrap=True)
 

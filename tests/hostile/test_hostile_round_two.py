@@ -305,7 +305,9 @@ def test_obj_face_line_of_millions_of_indices_is_refused_before_parsing(tmp_path
         in (result["message"])
     )
     assert "needs about 1.2 GiB, over the memory budget of 512.0 MiB" in result["message"]
-    assert elapsed < 20  # refused before parsing (parsing took 36 s and a MemoryError)
+    # refused before parsing: the message counts the line's indices, which only the scan before parsing does (parsing
+    # took 36 s and a MemoryError). The time is a hang guard only: a child Python on a loaded machine takes ~20 s.
+    assert elapsed < 120
 
 
 def test_obj_polygons_within_the_budget_still_load(tmp_path):

@@ -52,6 +52,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import sys
 from typing import Any
 
 from frustum.camera import Camera
@@ -92,7 +93,10 @@ def release_memory() -> int:
     The next ``render`` allocates (and first-touches) them anew. Call it when a program that rendered large
     frames goes on to other work.
     """
-    return Scratch.release_pool() + FrameBuffers.release()
+    released = Scratch.release_pool() + FrameBuffers.release()
+    if "frustum.shadow_pass" in sys.modules:  # the shadow maps and per-pixel arrays of the shadow pass
+        released += sys.modules["frustum.shadow_pass"].release_memory()
+    return released
 
 
 def render(
@@ -118,6 +122,10 @@ def render(
     method: str = "depth-buffer",
     transparency: str = "sort",
     stats: bool = False,
+    max_depth: int = 5,
+    shadows: bool | str | None = None,
+    shadow_map_size: int = 2048,
+    shadow_softness: float = 1.0,
 ) -> Frame:
     """Render `scene` seen by `camera` into a ``Frame`` (color (H, W, 4) uint8 and depth (H, W) float32).
 
@@ -170,14 +178,18 @@ def render(
         are drawn √samples times as wide, so they come out anti-aliased. Depth keeps each block's nearest.
     color_space : {"linear", "srgb"}
         Output encoding; "srgb" applies the sRGB transfer curve to the linear result.
-    buffers : tuple of {"normals", "object_id"}
-        Extra per-pixel outputs on the Frame: unit world normals (0 on background) and the index of the item
-        in ``scene.items`` (−1 on background).
+    buffers : tuple of {"normals", "object_id", "position", "shadow"}
+        Extra per-pixel outputs on the Frame: unit world normals (0 on background), the index of the item
+        in ``scene.items`` (−1 on background), the world point of the nearest opaque surface ((H, W, 3) float32,
+        NaN on background) and, with `shadows` on, the fraction of each shadow-casting light reaching it ((H, W,
+        L) float32, NaN on background; lights in ``Scene.world_lights`` order, ``frustum.shadow_pass``).
     method : str
         The visible-surface method (``RENDER_METHODS``, docs/visibility.md). For the meshes
         (``VISIBILITY_METHODS``): ``"depth-buffer"`` (the default), ``"scan-line"``, ``"area-subdivision"``
         (Warnock), ``"depth-sort"``, ``"bsp"``, ``"ray-casting"`` (a ray per pixel through the scene's BVH) or
-        ``"a-buffer"`` (anti-aliased edges, exact transparency). All
+        ``"a-buffer"`` (anti-aliased edges, exact transparency). ``"ray-tracing"``: Whitted ray tracing (shadow
+        rays, mirror reflection by ``Material.reflectivity``, refraction through surfaces of opacity < 1 by
+        ``Material.ior``, to `max_depth` levels; ``frustum.render.raytrace``, docs/ray-tracing.md). All
         shade with the same model, so where they find the same surface they give the same bytes. Surface modes
         only; each returns its counts in ``Frame.stats``. ``"octree"``: the scene's octrees (``Scene.octrees``)
         by ``visibility.octree.render_octree``, front to back, each face orientation shaded once with the
@@ -189,6 +201,21 @@ def render(
         per subsample through an A-buffer (exact whatever the order, anti-aliased edges; costs fragment memory).
     stats : bool
         ``method="depth-buffer"`` only: also count its depth tests (an extra counting pass) into ``Frame.stats``.
+    max_depth : int
+        ``method="ray-tracing"``: levels of reflected and refracted rays after the primary ray, 0 … 64
+        (0: primary rays and shadow rays only).
+    shadows : None, False, True or "ray"
+        None: the method's own (on for ``method="ray-tracing"``, which casts shadow rays; off for the depth buffer
+        and the other methods, so pictures of today do not change); False: off; True: shadow maps (the
+        depth-buffer method from each light; ``"ray-tracing"`` always uses its shadow rays); ``"ray"``: exact
+        shadow rays through the scene's BVH (``method="ray-casting"`` always uses rays). Lights with
+        ``cast_shadows=False`` and ambient light cast none. Surface modes only; not with ``method="octree"`` or
+        ``"a-buffer"``. What casts, what receives and how each shading mode uses the result:
+        ``frustum.shadow_pass`` (pass: ``render.shadows``).
+    shadow_map_size : int
+        Texels on a side of each shadow map, a power of two in [64, 16384] (a point light has six).
+    shadow_softness : float
+        Percentage-closer filter radius in texels, in [0, 16]; 0: hard edges.
 
     Raises
     ------
@@ -209,6 +236,7 @@ def render(
         mode=mode, edges=edges, crease_angle=crease_angle, edge_color=edge_color, hidden=hidden,
         hidden_color=hidden_color, line_width=line_width, depth_cue=depth_cue, samples=samples, filter=filter,
         color_space=color_space, buffers=buffers, method=method, transparency=transparency, stats=stats,
+        max_depth=max_depth, shadows=shadows, shadow_map_size=shadow_map_size, shadow_softness=shadow_softness,
     )  # fmt: skip
     if options.factor == 1:
         return resolve(_draw(scene, camera, options), options)
@@ -257,7 +285,11 @@ def _draw_surfaces(scene: Scene, camera: Camera, options: RenderOptions, buffers
             lines.draw_polylines(scene.polylines, camera, options, buffers)
             composite.draw_volumes(scene, camera, buffers)
 
-    if options.method == "depth-buffer" and options.transparency == "sort":
+    if options.method == "ray-tracing":
+        from frustum.render import raytrace
+
+        raytrace.draw_surfaces(scene, camera, options, buffers, between)
+    elif options.method == "depth-buffer" and options.transparency == "sort":
         surfaces.draw_surfaces(scene, scene.items, camera, options, buffers, between)
         if options.counts is not None:
             methods.count_depth_tests(scene.items, camera, options)

@@ -42,13 +42,15 @@ HIDDEN_STYLES = (None, "dimmed", "dashed")
 EDGE_SETS = ("all", "feature")
 FILTERS = ("box", "tent")
 COLOR_SPACES = ("linear", "srgb")
-BUFFERS = ("normals", "object_id")
+BUFFERS = ("normals", "object_id", "position", "shadow")
 TRANSPARENCY_MODES = ("sort", "a-buffer")
 METHOD_NAMES = ("depth-buffer", "scan-line", "area-subdivision", "depth-sort", "bsp", "a-buffer", "octree",
-                "ray-casting")  # fmt: skip
+                "ray-casting", "ray-tracing")  # fmt: skip
 """``render(..., method=...)``, in the order error messages list them (``render.methods.RENDER_METHODS``)."""
 PLANNED_METHODS: dict[str, str] = {}
 """Methods of the visible-surface chapter that this version does not draw yet."""
+MAX_DEPTH = 64
+"""Largest ``max_depth`` (reflection and refraction levels) of ``method="ray-tracing"``."""
 MAX_LINE_WIDTH = 256.0
 """Widest line (and largest point) ``render`` draws, in output pixels."""
 
@@ -76,6 +78,10 @@ DEFAULTS: dict[str, Any] = {
     "method": "depth-buffer",
     "transparency": "sort",
     "stats": False,
+    "max_depth": 5,
+    "shadows": None,
+    "shadow_map_size": 2048,
+    "shadow_softness": 1.0,
 }
 """``render``'s keyword arguments and their defaults (a test holds them equal to ``render``'s signature)."""
 
@@ -107,8 +113,12 @@ class RenderOptions:
     factor: int = 1
     filter: str = "box"
     color_space: str = "linear"
+    shadow: Any = None  # shadow_pass.ShadowOptions, or None: no shadows
+    outputs: dict | None = None  # "position", "seen", "casting" (render.shadows), filled while drawing
     environment: Any = None  # the scene's EnvironmentMap, for reflections (and the background, below)
     environment_background: bool = False  # no background given: the environment map is the background
+    max_depth: int = 5
+    shadows: bool = False  # method="ray-tracing": cast shadow rays (the other methods: ``shadow`` above)
 
     @classmethod
     def from_keywords(cls, scene: Any, camera: Any, where: str = "render", **keywords: Any) -> RenderOptions:
@@ -129,14 +139,19 @@ class RenderOptions:
         )  # fmt: skip
         factor = supersampling(k["samples"], where)
         options = method_options(options, k["method"], k["transparency"], k["stats"], where)
+        tracing = options.method == "ray-tracing"  # shadow rays of its own (ray_options), never shadow maps
+        options = shadow_options(options, None if tracing else k["shadows"], k["shadow_map_size"],
+                                 k["shadow_softness"], where)  # fmt: skip
         choice(k["filter"], FILTERS, "filter", where)
         choice(k["color_space"], COLOR_SPACES, "color_space", where)
+        depth, shadows = ray_options(options, k["max_depth"], k["shadows"], k["depth_cue"], k["shading"], where)
         check_image_budget(camera, factor, options.buffers, k["filter"], k["color_space"], where)
         environment = getattr(scene, "environment", None)
         return dataclasses.replace(options, factor=factor, filter=k["filter"], color_space=k["color_space"],
                                    environment=environment,
                                    environment_background=environment is not None
-                                   and k["background"] is DEFAULT_BACKGROUND)  # fmt: skip
+                                   and k["background"] is DEFAULT_BACKGROUND,
+                                   max_depth=depth, shadows=shadows)  # fmt: skip
 
     def supersampled(self) -> RenderOptions:
         """The options for the √samples-times larger image: lines √samples times as wide (the same counts dict)."""
@@ -147,6 +162,26 @@ class RenderOptions:
         """Whether the volumes are ray cast right after the opaque surfaces (``"surface"``, ``"surface+edges"``:
         before transparent items) rather than after the lines (``"wireframe"``, ``"points"``, ``"hidden-line"``)."""
         return self.mode in ("surface", "surface+edges")
+
+
+def shadow_options(options: RenderOptions, shadows: Any, map_size: Any, softness: Any, where: str) -> RenderOptions:
+    """Check the shadow arguments (``frustum.shadow_pass.check_shadows``); the options with the shadow settings and
+    an outputs dict where the shadow pass runs (shadows on, or the "position" buffer asked for)."""
+    from frustum.shadow_pass import check_shadows
+
+    shadow = check_shadows(shadows, map_size, softness, options.method, options.mode, where)
+    if "shadow" in options.buffers and shadow is None:
+        raise FrustumError(
+            f"{where}: buffers = {describe(options.buffers)} asks for 'shadow' with shadows = {describe(shadows)}; "
+            "give shadows=True or 'ray'"
+        )
+    if "position" in options.buffers and options.mode in LINE_MODES:
+        raise FrustumError(
+            f"{where}: buffers = {describe(options.buffers)} asks for 'position' with mode = {options.mode!r}; "
+            "positions are those of surfaces: use a surface mode"
+        )
+    wanted = shadow is not None or "position" in options.buffers
+    return dataclasses.replace(options, shadow=shadow, outputs={} if wanted else None)
 
 
 def choice(value: Any, valid: tuple, name: str, where: str) -> Any:
@@ -299,3 +334,29 @@ def method_options(options: RenderOptions, method: Any, transparency: Any, stats
     counted = method != "depth-buffer" or transparency != "sort" or bool(stats)
     counts = {"method": method} if counted else None
     return dataclasses.replace(options, method=method, transparency=transparency, counts=counts)
+
+
+def ray_options(options: RenderOptions, max_depth: Any, shadows: Any, depth_cue: Any, shading: Any,
+                where: str) -> tuple[int, bool]:  # fmt: skip
+    """``max_depth`` (0 … MAX_DEPTH) and whether ``method="ray-tracing"`` casts shadow rays (``shadows`` None, True
+    or "ray": yes; False: no; False for the other methods, whose shadows are the shadow pass's); what
+    ``"ray-tracing"`` does not draw (other modes, shading models, depth cueing, A-buffer transparency)."""
+    if isinstance(max_depth, bool) or not isinstance(max_depth, int | np.integer) or not 0 <= max_depth <= MAX_DEPTH:
+        raise FrustumError(
+            f"{where}: max_depth = {describe(max_depth)} is not an integer in [0, {MAX_DEPTH}] (levels of reflected "
+            "and refracted rays)"
+        )
+    tracing = options.method == "ray-tracing"
+    if not tracing:  # shadow maps or rays of the shadow pass: checked by shadow_options
+        return int(max_depth), False
+    if shadows is not None and not isinstance(shadows, bool | np.bool_) and shadows != "ray":
+        raise FrustumError(f"{where}: shadows = {describe(shadows)} is not None, False, True or 'ray'")
+    if tracing:
+        name = "none" if shading is None else shading
+        if options.mode != "surface" or name != "phong" or depth_cue is not None or options.transparency != "sort":
+            raise FrustumError(
+                f"{where}: method 'ray-tracing' draws mode 'surface' with shading 'phong', no depth_cue and "
+                f"transparency 'sort' (transparent surfaces refract); got mode = {options.mode!r}, shading = "
+                f"{shading!r}, depth_cue = {describe(depth_cue)}, transparency = {options.transparency!r}"
+            )
+    return int(max_depth), bool(tracing if shadows is None else shadows)

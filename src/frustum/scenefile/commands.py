@@ -4,6 +4,7 @@ counts (``explain_method``), and the example gallery (``render_examples``)."""
 
 from __future__ import annotations
 
+import dataclasses
 import importlib
 from collections.abc import Sequence
 from pathlib import Path
@@ -63,8 +64,9 @@ def _write(scene_file: SceneFile, target: Path) -> Path:
 
 
 def render_scene_file(
-    path: str | Path, output: str | Path | Sequence[str | Path] | None = None, *, size: tuple[int, int] | None = None
-) -> Path | list[Path]:
+    path: str | Path, output: str | Path | Sequence[str | Path] | None = None, *, size: tuple[int, int] | None = None,
+    shadows: bool | str | None = None,
+) -> Path | list[Path]:  # fmt: skip
     """Render the scene file at `path` and write it by suffix: PNG, SVG or PDF (line drawing), GIF or MP4 (turntable).
 
     Parameters
@@ -75,6 +77,8 @@ def render_scene_file(
         Where to write. None: the file's ``[output].files``, or ``out/<stem>.png`` next to the scene file.
     size : (int, int), optional
         Image width and height, replacing ``[render].size``.
+    shadows : True, False, "ray" or None
+        Replaces ``[render].shadows`` (None: the file's).
 
     Returns
     -------
@@ -92,6 +96,8 @@ def render_scene_file(
     scene_file = load_scene_file(path)
     if size is not None:
         scene_file = scene_file.resized(tuple(size))  # type: ignore[arg-type]
+    if shadows is not None:
+        scene_file = dataclasses.replace(scene_file, options={**scene_file.options, "shadows": shadows})
     if output is None:
         targets = list(scene_file.outputs) or [Path(path).parent / "out" / (Path(path).stem + ".png")]
         single = not scene_file.outputs
