@@ -9,8 +9,9 @@
 - ``gallery.md``: every ``examples/*.toml`` with its picture ``docs/gallery/<name>.png`` (when one is there)
   and the scene file itself.
 
-The Reference and Gallery entries of the navigation are filled in here too (``on_config``), so a name, command,
-schema key or example added to the code shows up at the next build with no edit to ``mkdocs.yml``.
+The Reference entries of the navigation are filled in here too (``on_config``), and the notebooks and any topic
+page ``docs/*.md`` that ``mkdocs.yml`` does not list (under Explanation), so a name, command, schema key, example,
+notebook or topic page added to the code shows up at the next build with no edit to ``mkdocs.yml``.
 """
 
 from __future__ import annotations
@@ -374,6 +375,17 @@ def notebook_pages(source: str = "notebooks", target: str = "tutorials/notebooks
 _STATE: dict = {}
 
 
+def _nav_files(nav) -> list[str]:
+    out = []
+    for item in nav:
+        if isinstance(item, str):
+            out.append(item)
+        elif isinstance(item, dict):
+            for value in item.values():
+                out += _nav_files(value) if isinstance(value, list) else [value]
+    return out
+
+
 def on_config(config, **kwargs):
     groups = api_entries()
     _STATE["groups"] = groups
@@ -382,7 +394,15 @@ def on_config(config, **kwargs):
     api_nav += [{GROUP_TITLES.get(g, g): f"reference/api/{g}.md"} for g in ordered]
     api_nav += [{title: f"reference/api/{m}.md"} for m, title in _extra_modules().items()]
     _STATE["notebooks"] = {source: notebook_pages(source, target) for source, target in NOTEBOOK_FOLDERS}
+    listed = set(_nav_files(config["nav"] or []))
     for item in config["nav"] or []:
+        if isinstance(item, dict) and "Explanation" in item:
+            # a topic page added to docs/ (another engineer's feature) joins the Explanation part by itself
+            for page in sorted(Path(config["docs_dir"]).glob("*.md")):
+                if page.name not in listed and page.name != "index.md":
+                    first = page.read_text(encoding="utf-8").splitlines()[:1] or [page.stem]
+                    title = first[0].lstrip("# ").strip() or page.stem
+                    item["Explanation"] = [*item["Explanation"], {title: page.name}]
         if isinstance(item, dict) and "Tutorials" in item:
             entries = list(item["Tutorials"])
             entries += [{title: page} for page, (title, _) in _STATE["notebooks"]["notebooks"].items()]
