@@ -249,7 +249,8 @@ def main() -> None:
     parser.add_argument("--size", type=int, default=512)
     parser.add_argument("--runs", default="serial,process2,node1,nodes2-driver,nodes2-workers")
     parser.add_argument("--repeat", type=int, default=3, help="runs of each configuration (medians reported)")
-    parser.add_argument("--mesh", default="/work/shared/data/bunny/bun_zipper.ply")
+    bunny = Path(__file__).resolve().parents[1] / "tests" / "data" / "bunny" / "bun_zipper.ply"
+    parser.add_argument("--mesh", default=str(bunny))
     parser.add_argument("--out", default=None, help="folder for the datasets (default: a temporary one, removed)")
     parser.add_argument("--json", default=None)
     args = parser.parse_args()

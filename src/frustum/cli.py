@@ -420,6 +420,9 @@ def render_command(
 ) -> None:
     """Render a scene file; without -o, the outputs the file names (or out/<name>.png beside it)."""
     from frustum.scenefile import render_scene_file
+    from frustum.warmup import compile_in_background
+
+    compile_in_background()  # a cold cache: a second process compiles part of the kernels meanwhile
 
     choices = {None: None, "on": True, "off": False, "ray": "ray"}
     if shadows not in choices:

@@ -166,6 +166,15 @@ def load_scene(data: Mapping[str, Any] | str, *, source: str = "<scene>", base_d
     SceneFileError
         Malformed TOML (tomllib's own line and column), or any invalid key or value.
     """
+    return _load_scene(data, source=source, base_dir=base_dir)
+
+
+def _load_scene(
+    data: Mapping[str, Any] | str, *, source: str = "<scene>", base_dir: str | Path = ".", check_outputs: bool = True
+) -> SceneFile:
+    """``load_scene``. ``check_outputs=False`` for a caller that writes elsewhere (``render_scene_file`` with an
+    output, ``frustum render FILE -o``): ``[output].files`` outside `base_dir` are not written, so not refused;
+    they are left out of ``outputs``."""
     lines: dict[tuple, int] | str | None = None
     if isinstance(data, str):
         _check_shape(data, source)
@@ -186,7 +195,7 @@ def load_scene(data: Mapping[str, Any] | str, *, source: str = "<scene>", base_d
     else:
         raise SceneFileError(f"{source}: data = {describe(data)} is not TOML text or a table; give a str or a dict")
     report = _Report(source, lines)
-    scene_file = _build(report, parsed, Path(base_dir))
+    scene_file = _build(report, parsed, Path(base_dir), check_outputs)
     report.raise_if_any()
     assert scene_file is not None
     return dataclasses.replace(scene_file, path=None)
@@ -263,7 +272,7 @@ def _radiosity(report: _Report, path: tuple, value: Any) -> dict | None:
     return settings
 
 
-def _build(report: _Report, data: dict, base: Path) -> SceneFile | None:
+def _build(report: _Report, data: dict, base: Path, check_outputs: bool = True) -> SceneFile | None:
     report.base = base  # image files of materials and the environment are read relative to it
     _unknown_keys(report, (), data, _TOP_LEVEL)
     for key in ("title", "description"):
@@ -316,7 +325,7 @@ def _build(report: _Report, data: dict, base: Path) -> SceneFile | None:
             cameras.append(camera)
     else:
         report.missing(("camera",), "add a [camera] table with eye and target (or [[cameras]])")
-    outputs, animation, svg = _outputs(report, data, base)
+    outputs, animation, svg = _outputs(report, data, base, check_outputs)
     _check_image_memory(report, options, size, max(len(cameras), 1))
     if not report.problems:
         _warm_up(report, scene, animation)
@@ -340,6 +349,11 @@ def load_scene_file(path: str | Path) -> SceneFile:
         If the file cannot be read, is not valid TOML, or has invalid keys or values; the message lists every
         problem as ``file:line: key = value problem; what is valid``.
     """
+    return _load_scene_file(path)
+
+
+def _load_scene_file(path: str | Path, check_outputs: bool = True) -> SceneFile:
+    """``load_scene_file``; ``check_outputs`` as for ``_load_scene``."""
     file = Path(path)
     shown = escape_control(str(file))
     try:
@@ -352,5 +366,5 @@ def load_scene_file(path: str | Path) -> SceneFile:
     except (OSError, UnicodeDecodeError) as error:
         reason = getattr(error, "strerror", None) or str(error)
         raise SceneFileError(f"{shown}: cannot be read ({reason}); give an existing UTF-8 TOML scene file") from None
-    scene_file = load_scene(text, source=str(file), base_dir=file.parent)
+    scene_file = _load_scene(text, source=str(file), base_dir=file.parent, check_outputs=check_outputs)
     return dataclasses.replace(scene_file, path=file)
