@@ -1,6 +1,7 @@
 """Benchmark: ``render_dataset`` / ``render_many`` on every executor against a bare ``render`` loop.
 
-    python benchmarks/bench_batch.py [--views 200] [--size 512] [--runs serial,process1,process2,ray2]
+    python benchmarks/bench_batch.py [--views 200] [--size 512] [--repeat 3]
+                                     [--runs serial,process2,node1,nodes2-driver,nodes2-workers]
                                      [--mesh PATH] [--out DIR] [--json PATH]
 
 The Stanford bunny (69,451 triangles) at ``--size``² with every buffer (color PNG, metric depth .npy, normals
@@ -17,7 +18,18 @@ The Stanford bunny (69,451 triangles) at ``--size``² with every buffer (color P
 
 The baseline is a bare loop in this process, ``render(...)`` then the same files written with the same encoders,
 after a warm-up (the first call, kernel compile or cache load, is printed separately). Output bytes per view
-are summed from the files. Ray runs start a local cluster of ``num_cpus = workers`` (its start is included).
+are summed from the files. ``rayN`` runs start a local one-node cluster of ``num_cpus = N`` (``ray.init``, not
+included in the wall clock; starting the actors and loading their kernels is); ``node1`` is one node of two
+CPUs started once with ``ray start --head``, joined with its address.
+``nodes2-driver`` and ``nodes2-workers`` run on a two-node cluster whose nodes share no disk
+(``tests/ray_local_cluster.py``: a head with no CPUs and two worker nodes of one CPU each, each in its own mount
+namespace with a private /tmp; needs root; started once, not included in the wall clock): ``-driver`` writes a
+folder on the driver's side (the files come back through the object store), ``-workers`` a ``file://`` URL on
+/dev/shm, which both nodes share, written by the workers. Every run writes under /dev/shm (where it exists), so
+the two write paths write to the same kind of storage.
+
+Each run is repeated ``--repeat`` times; the table gives the median of each column. The machine may be shared
+with other work: the load average is printed with each run, and the numbers are only comparable within a run.
 """
 
 from __future__ import annotations
@@ -25,6 +37,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import secrets
 import shutil
 import statistics
 import sys
@@ -131,7 +144,8 @@ def bare_loop(scene_file, cameras, out: Path) -> dict:
     }
 
 
-def dataset_run(scene_path: Path, out: Path, views: int, executor: str, workers: int) -> dict:
+def dataset_run(scene_path: Path, out: Path, views: int, executor: str, workers: int, address: str | None = None,
+                collect: str | None = None, url: bool = False) -> dict:  # fmt: skip
     import frustum.batch.progress as progress_module
     from frustum.batch import render_dataset
 
@@ -150,12 +164,26 @@ def dataset_run(scene_path: Path, out: Path, views: int, executor: str, workers:
         if executor == "ray":
             import ray
 
-            ray.init(num_cpus=workers, include_dashboard=False, log_to_driver=False, configure_logging=False)
+            if address is None:
+                for attempt in range(3):  # a loaded machine can miss the 30 s Ray gives its raylet to register
+                    try:
+                        ray.init(num_cpus=workers, include_dashboard=False, log_to_driver=False,
+                                 configure_logging=False)  # fmt: skip
+                        break
+                    except Exception:
+                        ray.shutdown()
+                        if attempt == 2:
+                            raise
+                start = time.perf_counter()  # a failed start is not counted
+            else:
+                ray.init(address=address, include_dashboard=False, log_to_driver=False, configure_logging=False)
+                start = time.perf_counter()  # the cluster was started before: its start is not counted
             started_ray = True
         kind = "serial" if executor == "serial" else executor
         with PeakMemory(kind) as memory:
-            result = render_dataset(scene_path, out, views=views, layout="orbit", format="files", executor=executor,
-                                    workers=workers, progress=False)  # fmt: skip
+            result = render_dataset(scene_path, f"file://{out}" if url else out, views=views, layout="orbit",
+                                    format="files", executor=executor, workers=workers, progress=False,
+                                    collect=collect)  # fmt: skip
         wall = time.perf_counter() - start
     finally:
         progress_module.ViewProgress.advance = original
@@ -182,11 +210,45 @@ def dataset_run(scene_path: Path, out: Path, views: int, executor: str, workers:
     }
 
 
+def median_of(repeats: list[dict]) -> dict:
+    """The median of every number over the repeats (lists: those of the median run by views/s)."""
+    middle = sorted(repeats, key=lambda r: r["views_per_s"])[len(repeats) // 2]
+    return {key: statistics.median(r[key] for r in repeats) if isinstance(value, int | float) else middle[key]
+            for key, value in repeats[0].items()}  # fmt: skip
+
+
+TOKEN = secrets.token_hex(32)
+"""One token for every cluster this process joins (Ray keeps the first token a process reads)."""
+
+
+def start_cluster(work: Path, nodes: int = 2):
+    """Head (no CPUs) and two worker nodes of one CPU each, sharing no disk (tests/ray_local_cluster.py); with
+    `nodes` = 1 a head of two CPUs alone."""
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+    from ray_local_cluster import Cluster, skip_reason
+
+    reason = skip_reason()
+    if reason:
+        raise SystemExit(f"bench_batch: the two-node runs {reason}")
+    root = Path(tempfile.mkdtemp(prefix="fr-", dir="/tmp"))  # short: Ray's socket paths
+    cluster = Cluster(root, {}, object_store=str(400 * 2**20), token=TOKEN)
+    if nodes == 1:
+        cluster.start_head(cpus=2)
+    else:
+        cluster.start_head()
+        cluster.add_worker("a")
+        cluster.add_worker("b")
+    for key in ("RAY_AUTH_MODE", "RAY_AUTH_TOKEN_PATH"):  # this process is the driver
+        os.environ[key] = cluster.env[key]
+    return cluster
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--views", type=int, default=200)
     parser.add_argument("--size", type=int, default=512)
-    parser.add_argument("--runs", default="serial,process1,process2,ray2")
+    parser.add_argument("--runs", default="serial,process2,node1,nodes2-driver,nodes2-workers")
+    parser.add_argument("--repeat", type=int, default=3, help="runs of each configuration (medians reported)")
     bunny = Path(__file__).resolve().parents[1] / "tests" / "data" / "bunny" / "bun_zipper.ply"
     parser.add_argument("--mesh", default=str(bunny))
     parser.add_argument("--out", default=None, help="folder for the datasets (default: a temporary one, removed)")
@@ -196,7 +258,8 @@ def main() -> None:
     from frustum.batch import dataset_cameras
     from frustum.scenefile import load_scene_file
 
-    work = Path(args.out) if args.out else Path(tempfile.mkdtemp(prefix="bench_batch_"))
+    shm = "/dev/shm" if os.path.isdir("/dev/shm") else None  # the same storage for every write path
+    work = Path(args.out) if args.out else Path(tempfile.mkdtemp(prefix="bench_batch_", dir=shm))
     work.mkdir(parents=True, exist_ok=True)
     scene_path = work / "bunny.toml"
     scene_path.write_text(SCENE.format(size=args.size, mesh=Path(args.mesh).resolve()))
@@ -220,19 +283,45 @@ def main() -> None:
     print("  output per view: " + ", ".join(f"{k} {v / 1024:.0f} KiB" for k, v in sorted(per_view.items()))
           + f"; total {sum(per_view.values()) / 2**20:.2f} MiB")  # fmt: skip
     shutil.rmtree(work / "bare")
-    for run in args.runs.split(","):
-        executor = run.rstrip("0123456789")
-        workers = int(run[len(executor) :] or 1)
-        out = work / run
-        shutil.rmtree(out, ignore_errors=True)
-        result = dataset_run(scene_path, out, args.views, executor, workers)
-        report[run] = result
-        print(f"  {run:<16} {result['views_per_s']:6.2f} views/s   render {result['render_ms_per_view']:6.1f} ms  "
-              f"write {result['write_ms_per_view']:6.1f} ms  overhead {result['overhead_ms_per_view']:6.1f} ms "
-              f"(worker time per view)   first result {result['first_result_s']:.1f} s   "
-              f"peak RSS/worker {result['peak_rss_mib_per_worker']} MiB   "
-              f"load {result['load_average_1min_after']:.1f}")  # fmt: skip
-        shutil.rmtree(out, ignore_errors=True)
+    cluster = None
+    try:
+        for run in args.runs.split(","):
+            address = collect = None
+            url = False
+            if run.startswith(("node1", "nodes2")):  # clusters started once with `ray start`, not counted
+                nodes = 1 if run.startswith("node1") else 2
+                if cluster is not None and cluster.size != nodes:
+                    cluster.stop()
+                    shutil.rmtree(cluster.root, ignore_errors=True)
+                    cluster = None
+                if cluster is None:
+                    cluster = start_cluster(work, nodes)
+                    cluster.size = nodes
+                executor, workers, address = "ray", 2, cluster.env["RAY_ADDRESS"]
+                collect = run.split("-")[1] if "-" in run else None
+                url = run.endswith("workers")
+            else:
+                executor = run.rstrip("0123456789")
+                workers = int(run[len(executor) :] or 1)
+            repeats = []
+            for _ in range(args.repeat):
+                out = work / run
+                shutil.rmtree(out, ignore_errors=True)
+                repeats.append(dataset_run(scene_path, out, args.views, executor, workers, address, collect, url))
+                shutil.rmtree(out, ignore_errors=True)
+            result = median_of(repeats)
+            result["repeats"] = repeats
+            report[run] = result
+            print(f"  {run:<16} {result['views_per_s']:6.2f} views/s   render {result['render_ms_per_view']:6.1f} ms  "
+                  f"write {result['write_ms_per_view']:6.1f} ms  overhead {result['overhead_ms_per_view']:6.1f} ms "
+                  f"(worker time per view)   first result {result['first_result_s']:.1f} s   "
+                  f"peak RSS/worker {result['peak_rss_mib_per_worker']} MiB   "
+                  f"load {result['load_average_1min_after']:.1f}   (median of {len(repeats)}; views/s "
+                  f"{', '.join(format(r['views_per_s'], '.2f') for r in repeats)})", flush=True)  # fmt: skip
+    finally:
+        if cluster is not None:
+            cluster.stop()
+            shutil.rmtree(cluster.root, ignore_errors=True)
     if args.json:
         Path(args.json).write_text(json.dumps(report, indent=2) + "\n")
     if not args.out:

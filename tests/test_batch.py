@@ -389,7 +389,14 @@ def test_failed_views_are_retried_then_listed_and_the_cli_exits_3(scene_path, tm
 @pytest.fixture(scope="session")
 def ray_cluster():
     ray = pytest.importorskip("ray")
-    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False, configure_logging=False)
+    for attempt in range(3):  # a loaded machine can miss the 30 s Ray gives its raylet to register
+        try:
+            ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False, configure_logging=False)
+            break
+        except Exception:
+            ray.shutdown()
+            if attempt == 2:
+                raise
     yield ray
     ray.shutdown()
 
@@ -405,6 +412,32 @@ def test_ray_executor_writes_the_same_bytes(ray_cluster, scene_path, tmp_path) -
     lines = (tmp_path / "ray/manifest.jsonl").read_text().splitlines()[1:]
     workers = {json.loads(line)["worker"] for line in lines}
     assert 1 <= len(workers) <= 2 and f"{os.uname().nodename}:{os.getpid()}" not in workers  # in the actors
+
+
+def test_ray_driver_collect_writes_the_same_bytes_and_memory_urls_go_through_the_driver(
+    ray_cluster, scene_path, tmp_path
+) -> None:
+    """collect="driver": the actors return encoded bytes, this process writes them (what a cluster whose nodes
+    share no disk needs; tests/test_batch_cluster.py runs it on two nodes)."""
+    import fsspec
+
+    render_dataset(scene_path, tmp_path / "serial", views=7, format="colmap", executor="serial", progress=False)
+    result = render_dataset(scene_path, tmp_path / "driver", views=7, format="colmap", executor="ray",
+                            progress=False, collect="driver")  # fmt: skip
+    assert result.ok and files_of(tmp_path / "driver") == files_of(tmp_path / "serial")
+    lines = (tmp_path / "driver/manifest.jsonl").read_text().splitlines()[1:]
+    assert f"{os.uname().nodename}:{os.getpid()}" not in {json.loads(line)["worker"] for line in lines}
+    # memory:// lives in this process: the default collect mode sends the bytes here, "workers" is refused
+    result = render_dataset(scene_path, "memory://collect/ds", views=7, format="colmap", executor="ray",
+                            progress=False)  # fmt: skip
+    assert result.ok and result.out == "memory://collect/ds"
+    fs = fsspec.filesystem("memory")
+    written = {p[len("/collect/ds/") :]: fs.cat_file(p) for p in fs.find("/collect/ds")}
+    written.pop("manifest.jsonl")
+    assert written == files_of(tmp_path / "serial")
+    with pytest.raises(FrustumError, match="memory:// lives in one process"):
+        render_dataset(scene_path, "memory://collect/other", views=2, executor="ray", progress=False,
+                       collect="workers")  # fmt: skip
 
 
 # --- resume and safety ----------------------------------------------------------------------------------------
@@ -568,6 +601,79 @@ def test_render_many_rejects_repeated_keys_and_bad_workers(tmp_path) -> None:
         render_many(jobs, executor="serial", progress=False)
     with pytest.raises(FrustumError, match="workers = 0 must be a positive integer"):
         render_many(jobs[:1], workers=0, progress=False)
+
+
+def test_render_many_rejects_unknown_collect_modes_and_memory_urls_in_a_pool(tmp_path) -> None:
+    scene = Scene()
+    camera = Camera.look_at((0, 0, 4), (0, 0, 0), width=8, height=8)
+    with pytest.raises(FrustumError, match="collect = 'nodes' is unknown; expected one of driver, workers or None"):
+        render_many([RenderJob("a", scene, camera, {})], executor="serial", progress=False, collect="nodes")
+    with pytest.raises(FrustumError, match=r"'memory://x/a\.png' with executor = 'process': memory:// lives in one"):
+        render_many([RenderJob("a", scene, camera, {"color": "memory://x/a.png"})], progress=False)
+
+
+# --- URL outputs (fsspec) -------------------------------------------------------------------------------------
+
+
+def _url_files(url: str) -> dict[str, bytes]:
+    import fsspec
+
+    fs, root = fsspec.core.url_to_fs(url)
+    return {p[len(root) + 1 :]: fs.cat_file(p) for p in sorted(fs.find(root)) if not p.endswith("manifest.jsonl")}
+
+
+def test_url_datasets_equal_a_folder_and_resume_and_refuse_like_one(scene_path, tmp_path) -> None:
+    pytest.importorskip("fsspec")
+    render_dataset(scene_path, tmp_path / "folder", views=4, format="webdataset", executor="serial", progress=False)
+    reference = files_of(tmp_path / "folder")
+    for url in ("memory://urls/ds", f"file://{tmp_path}/url"):
+        result = render_dataset(scene_path, url, views=4, format="webdataset", executor="serial", progress=False)
+        assert result.ok and result.out == url and result.camera_files[0] == f"{url}/cameras.json"
+        assert _url_files(url) == reference
+        import fsspec
+
+        fs, root = fsspec.core.url_to_fs(url)
+        fs.rm_file(f"{root}/depth/view_00002.npy")  # a lost file: that view again
+        again = render_dataset(scene_path, url, views=4, format="webdataset", executor="serial", progress=False)
+        assert again.rendered == ("view_00002",) and len(again.skipped) == 3
+        assert _url_files(url) == reference
+        assert not fs.exists(f"{root}/manifest.parts")  # the run log's parts were merged at the end
+        with pytest.raises(OutputError, match=r"another configuration \(format = 'webdataset' → 'nerf'\)"):
+            render_dataset(scene_path, url, views=4, format="nerf", executor="serial", progress=False)
+    with pytest.raises(OutputError, match=r"out = 'file://.*' is a file"):
+        render_dataset(scene_path, f"file://{tmp_path}/folder/cameras.json", views=2, executor="serial",
+                       progress=False)  # fmt: skip
+
+
+def test_url_resume_after_sigkill_reads_the_parts_of_the_run_log(scene_path, tmp_path) -> None:
+    """A URL's run log is written in parts every few seconds: a killed run leaves them, the next run reads them.
+
+    300 views: the run must outlast the first part (``URL_LOG_SECONDS`` = 2 s) on a fast machine too."""
+    pytest.importorskip("fsspec")
+    arguments = ["--views", "300", "--layout", "sphere", "--format", "files", "--size", "200x150", "--no-progress",
+                 "--executor", "serial"]  # fmt: skip
+    url = f"file://{tmp_path}/killed"
+    environment = {**os.environ, "PYTHONPATH": os.pathsep.join([str(SRC), os.environ.get("PYTHONPATH", "")])}
+    process = subprocess.Popen([sys.executable, "-m", "frustum", "dataset", str(scene_path), "--out", url,
+                                *arguments], env=environment, stdout=subprocess.DEVNULL,
+                               stderr=subprocess.DEVNULL)  # fmt: skip
+    parts = tmp_path / "killed/manifest.parts"
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and process.poll() is None:
+        if parts.is_dir() and any(parts.glob("*.jsonl")):
+            break
+        time.sleep(0.01)
+    process.send_signal(signal.SIGKILL)
+    process.wait()
+    assert not (tmp_path / "killed/cameras.json").exists(), "the first run was not stopped midway"
+    logged = sum(p.read_text().count("\n") for p in parts.glob("*.jsonl"))
+    result = render_dataset(scene_path, url, views=300, layout="sphere", format="files", size=(200, 150),
+                            executor="serial", progress=False)  # fmt: skip
+    assert len(result.skipped) == logged > 0 and len(result.rendered) == 300 - logged
+    assert not parts.exists() or not any(parts.iterdir())
+    render_dataset(scene_path, tmp_path / "reference", views=300, layout="sphere", format="files", size=(200, 150),
+                   executor="serial", progress=False)  # fmt: skip
+    assert files_of(tmp_path / "killed") == files_of(tmp_path / "reference")
 
 
 def test_import_frustum_loads_neither_ray_nor_a_process_pool() -> None:

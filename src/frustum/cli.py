@@ -527,7 +527,7 @@ def examples_command(
 @app.command("dataset")
 def dataset_command(
     scene: Annotated[Path, typer.Argument(help="A TOML scene file (its camera sets projection, size and distance).")],
-    out: Annotated[Path, typer.Option("--out", help="Output folder (created; rerun the command to resume).")],
+    out: Annotated[str, typer.Option("--out", help="Output folder or URL (s3://bucket/prefix); rerun to resume.")],
     views: Annotated[int | None, typer.Option(help="Number of views (default 100; --layout file: the file's).")] = None,
     layout: Annotated[str, typer.Option(help="orbit, sphere, random or file.")] = "orbit",
     format_: Annotated[str, typer.Option("--format", help="nerf, nerfstudio, colmap, files or webdataset.")] = "nerf",
@@ -538,6 +538,7 @@ def dataset_command(
     executor: Annotated[str, typer.Option(help="serial, process or ray.")] = "process",
     workers: Annotated[int | None, typer.Option(help="Worker processes or Ray actors (default: all cores).")] = None,
     address: Annotated[str | None, typer.Option(help="Ray cluster address (e.g. auto) for --executor ray.")] = None,
+    collect: Annotated[str | None, typer.Option(help="Ray: driver or workers write the files (see docs).")] = None,
     overwrite: Annotated[bool, typer.Option("--overwrite", help="Start again over a different configuration.")] = False,
     retries: Annotated[int, typer.Option(help="Tries again for failed views before listing them.")] = 1,
     progress: Annotated[bool, typer.Option("--progress/--no-progress", help="Show the progress bar.")] = True,
@@ -552,7 +553,7 @@ def dataset_command(
         scene, out, views=views if views is not None or layout == "file" else 100, layout=layout, format=format_,
         size=_image_size(size) if size else None, seed=seed, cameras_file=cameras, depth_format=depth_format,
         executor=executor, workers=workers, progress=progress, overwrite=overwrite, retries=retries,
-        address=address,
+        address=address, collect=collect,
     )  # fmt: skip
     for key, error in sorted(result.failed.items()):
         error_console.print(f"failed {key}: {error}", markup=False)

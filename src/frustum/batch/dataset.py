@@ -16,6 +16,12 @@ Safety: every file is written under a temporary name and renamed; a run that sto
 is resumed by running the same command again, which skips the views the manifest lists whose files exist.
 A different configuration is refused (saying what changed) unless ``overwrite=True``. Views that fail are
 retried, then listed with their errors.
+
+`out` may be an fsspec URL (``s3://bucket/prefix``, ``gs://…``, ``file://…``, ``memory://…``;
+``frustum.batch.storage``): the same files, each written whole or not at all. An object cannot be appended
+to, so there the run log goes in parts (``manifest.parts/*.jsonl``, one every ``URL_LOG_SECONDS`` while views
+finish) that the end of the run merges into ``manifest.jsonl``; resuming reads both, so a killed driver
+loses at most the last few seconds of its log (those views are rendered again, to the same bytes).
 """
 
 from __future__ import annotations
@@ -25,6 +31,7 @@ import hashlib
 import json
 import math
 import os
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -37,6 +44,7 @@ from frustum.batch.executors import EXECUTORS, render_many
 from frustum.batch.formats import CAMERA_WRITERS, SHARD_SIZE, check_format_camera
 from frustum.batch.jobs import TEMPORARY_MARK, RenderJob, write_atomically
 from frustum.batch.progress import ViewProgress
+from frustum.batch.storage import RemotePath, to_location
 from frustum.camera import Camera
 from frustum.errors import CameraError, FrustumError, OutputError
 
@@ -52,6 +60,10 @@ _FOLDERS = {"color": "images", "depth": "depth", "normals": "normals", "object_i
             "position": "position", "shadow": "shadow"}  # fmt: skip
 _SUFFIXES = {"color": ".png", "depth": ".npy", "normals": ".npy", "object_id": ".png", "mask": ".png"}
 _MANIFEST = "manifest.jsonl"
+_MANIFEST_PARTS = "manifest.parts"
+URL_LOG_SECONDS = 2.0
+"""A URL output's run log is written as a new part at most this often (and when 1000 views are waiting)."""
+_URL_LOG_LINES = 1000
 _SHARED_FILES = ("cameras.json", "README.txt", "transforms.json", "sparse/0/cameras.txt", "sparse/0/images.txt",
                  "sparse/0/points3D.txt")  # fmt: skip
 _BYTES_PER_PIXEL = 64
@@ -66,11 +78,11 @@ _POLE = 0.999
 class DatasetResult:
     """What ``render_dataset`` did: views rendered now, skipped (done before), failed (key → error), files."""
 
-    out: Path
+    out: Path | str
     rendered: tuple[str, ...]
     skipped: tuple[str, ...]
     failed: dict[str, str] = field(default_factory=dict)
-    camera_files: tuple[Path, ...] = ()
+    camera_files: tuple[Path | str, ...] = ()
 
     @property
     def ok(self) -> bool:
@@ -184,12 +196,19 @@ def dataset_cameras(
 # --- manifest ---------------------------------------------------------------------------------------------------
 
 
-def _read_manifest(path: Path) -> tuple[dict | None, dict[str, dict]]:
-    """The configuration line and the finished views of a run log; a torn last line (a killed run) is ignored."""
+def _read_manifest(out: Any) -> tuple[dict | None, dict[str, dict]]:
+    """The configuration line and the finished views of a run log; a torn last line (a killed run) is ignored.
+
+    At a URL, the parts of runs that did not reach their end (``manifest.parts/``) are read after the log.
+    """
+    path = out / _MANIFEST
     if not path.exists():
         return None, {}
+    text = path.read_text(encoding="utf-8", errors="replace")
+    if isinstance(out, RemotePath):
+        text += "\n" + "\n".join(part.read_text(errors="replace") for part in _log_parts(out))
     config, views = None, {}
-    for line in path.read_text(encoding="utf-8", errors="replace").splitlines():
+    for line in text.splitlines():
         try:
             entry = json.loads(line)
         except json.JSONDecodeError:
@@ -199,6 +218,59 @@ def _read_manifest(path: Path) -> tuple[dict | None, dict[str, dict]]:
         elif "view" in entry:
             views[entry["view"]] = entry
     return config, views
+
+
+def _log_parts(out: RemotePath) -> list[RemotePath]:
+    folder = out / _MANIFEST_PARTS
+    return folder.glob("*.jsonl") if folder.exists() else []
+
+
+class _RunLog:
+    """The run log, one line per finished view. A folder: appended and flushed line by line. A URL: new parts
+    every `URL_LOG_SECONDS` (an object cannot be appended to), merged into ``manifest.jsonl`` by ``close``."""
+
+    def __init__(self, out: Any, config: dict | None) -> None:
+        self.out, self.remote = out, isinstance(out, RemotePath)
+        self.lines: list[str] = []
+        self.flushed = time.monotonic()
+        self.run = f"{time.time_ns():020d}-{os.getpid()}"
+        self.parts = 0
+        if not self.remote:
+            self.file: Any = open(out / _MANIFEST, "a", encoding="utf-8")  # noqa: SIM115 - closed by close()
+            if config is not None:
+                self.write(json.dumps({"config": config}))
+        elif config is not None:
+            (out / _MANIFEST).write_bytes((json.dumps({"config": config}) + "\n").encode("utf-8"))
+
+    def write(self, line: str) -> None:
+        if not self.remote:
+            self.file.write(line + "\n")
+            self.file.flush()
+            return
+        self.lines.append(line)
+        if len(self.lines) >= _URL_LOG_LINES or time.monotonic() - self.flushed >= URL_LOG_SECONDS:
+            self.flush()
+
+    def flush(self) -> None:
+        if self.remote and self.lines:
+            part = self.out / _MANIFEST_PARTS / f"{self.run}-{self.parts:06d}.jsonl"
+            part.write_bytes(("\n".join(self.lines) + "\n").encode("utf-8"))
+            self.parts += 1
+            self.lines = []
+        self.flushed = time.monotonic()
+
+    def close(self) -> None:
+        if not self.remote:
+            self.file.close()
+            return
+        self.flush()
+        parts = _log_parts(self.out)
+        if parts:  # merge: the new log first, then the parts go (a stop between leaves repeated lines, harmless)
+            text = "\n".join(p.read_text(errors="replace").rstrip("\n") for p in [self.out / _MANIFEST, *parts])
+            (self.out / _MANIFEST).write_bytes((text + "\n").encode("utf-8"))
+            for part in parts:
+                part.unlink(missing_ok=True)
+            (self.out / _MANIFEST_PARTS).rmdir()
 
 
 def _changes(old: dict, new: dict) -> list[str]:
@@ -221,21 +293,29 @@ def _check_budget(scene_file: Any, camera: Camera, executor: str, workers: int |
     check_memory(concurrent * (per_view + scene_bytes), where=where, cause=cause, error=OutputError)
 
 
-def _check_folder(out: Path, where: str) -> None:
-    if out.exists() and not out.is_dir():
-        raise OutputError(f"{where}: out = {str(out)!r} is a file; give a folder (it is created if missing)")
+def _check_folder(out: Any, where: str) -> None:
+    remote = isinstance(out, RemotePath)
     try:
+        if out.is_file():
+            raise OutputError(f"{where}: out = {str(out)!r} is a file; give a folder (it is created if missing)")
         out.mkdir(parents=True, exist_ok=True)
         write_atomically(out / ".write-test", lambda file: file.write(b"frustum"))
-        os.remove(out / ".write-test")
-    except OSError as error:
+        (out / ".write-test").unlink()
+    except OutputError:
+        raise
+    except Exception as error:  # OSError locally; fsspec back ends (s3fs, gcsfs) raise their own types too
+        if not remote and not isinstance(error, OSError):
+            raise
+        reason = getattr(error, "strerror", None) or " ".join(str(error).split()) or type(error).__name__
         raise OutputError(
-            f"{where}: out = {str(out)!r} is not writable ({error.strerror or error}); give a folder you can write"
+            f"{where}: out = {str(out)!r} is not writable ({reason}); give a folder or URL you can write"
         ) from None
 
 
-def _remove_partial_files(out: Path) -> None:
+def _remove_partial_files(out: Any) -> None:
     """Temporary files of a run that was killed: never finished outputs."""
+    if isinstance(out, RemotePath) and out.atomic_put:
+        return  # an object store has no temporary files: each object is one PUT
     for sub in (*_FOLDERS.values(), "shards", "sparse/0", "."):
         folder = out / sub
         if folder.is_dir():
@@ -248,17 +328,16 @@ def _remove_partial_files(out: Path) -> None:
 class _LoggedProgress(ViewProgress):
     """The progress bar that also appends each finished view to the run log, flushed at once."""
 
-    def __init__(self, total: int, enabled: bool, log: Any, out: Path) -> None:
+    def __init__(self, total: int, enabled: bool, log: _RunLog, out: Any) -> None:
         super().__init__(total, enabled=enabled, description="dataset")
         self.log, self.out = log, out
 
     def advance(self, result: Any) -> None:
         if result.ok:
-            files = {kind: Path(path).relative_to(self.out).as_posix() for kind, path in result.files.items()}
+            files = {kind: _relative(path, self.out) for kind, path in result.files.items()}
             entry = {"view": result.key, "files": files, "render_seconds": round(result.render_seconds, 4),
                      "write_seconds": round(result.write_seconds, 4), "worker": result.worker}  # fmt: skip
-            self.log.write(json.dumps(entry) + "\n")
-            self.log.flush()
+            self.log.write(json.dumps(entry))
         super().advance(result)
 
     def retrying(self, count: int) -> None:
@@ -266,7 +345,14 @@ class _LoggedProgress(ViewProgress):
         self._refresh(-count)
 
 
-def _paths(out: Path, files: dict[str, str]) -> dict[str, Path]:
+def _relative(path: str, out: Any) -> str:
+    """A written file's path relative to the dataset (POSIX), for the run log."""
+    if isinstance(out, RemotePath):
+        return RemotePath(path).relative_to(out)
+    return Path(path).relative_to(out).as_posix()
+
+
+def _paths(out: Any, files: dict[str, str]) -> dict[str, Any]:
     return {kind: out / relative for kind, relative in files.items()}
 
 
@@ -347,8 +433,9 @@ def render_dataset(
     overwrite: bool = False,
     retries: int = 1,
     address: str | None = None,
+    collect: str | None = None,
 ) -> DatasetResult:
-    """Render a multi-view dataset of a scene file into the folder `out` (see the module docstring).
+    """Render a multi-view dataset of a scene file into the folder or URL `out` (see the module docstring).
 
     Parameters
     ----------
@@ -362,8 +449,11 @@ def render_dataset(
     depth_format : {"npy", "png16"}
         png16 stores ``round(depth / scale)`` with ``scale = far / 65535``, written in README.txt (and as
         nerfstudio's ``depth_unit_scale_factor``).
-    executor, workers, progress, address
-        ``render_many``.
+    out : str or Path
+        A folder (created), or an fsspec URL (``s3://bucket/prefix``, ``gs://…``, ``file://…``, ``memory://…``).
+    executor, workers, progress, address, collect
+        ``render_many``. On a Ray cluster of several nodes a folder is written by this process from the
+        workers' bytes, a URL by the workers themselves.
     overwrite : bool
         Start again in a folder that holds a dataset made with another configuration.
     retries : int
@@ -416,7 +506,8 @@ def render_dataset(
         target = np.hstack(corners).mean(axis=1) if corners else np.zeros(3)
     cameras = dataset_cameras(base, views, layout, seed=seed, target=target, cameras_file=cameras_file)
     _check_budget(scene_file, base, executor, workers, where)
-    out = Path(out)
+    out = to_location(out)
+    remote = isinstance(out, RemotePath)
     _check_folder(out, where)
     extra: dict[str, Any] = {}
     depth_scale = 1e-3
@@ -437,7 +528,7 @@ def render_dataset(
         "cameras_sha256": _sha256(Path(cameras_file)) if layout == "file" and cameras_file else None,
     }
     manifest = out / _MANIFEST
-    old_config, finished = _read_manifest(manifest)
+    old_config, finished = _read_manifest(out)
     if old_config is not None and old_config != config and not overwrite:
         raise OutputError(
             f"{where}: out = {str(out)!r} holds a dataset made with another configuration ("
@@ -449,7 +540,8 @@ def render_dataset(
             for relative in entry.get("files", {}).values():
                 with contextlib.suppress(OSError):
                     (out / relative).unlink()
-        for path in [*(out / name for name in _SHARED_FILES), *out.glob("shards/shard-*.tar")]:
+        parts = _log_parts(out) if remote else []
+        for path in [*(out / name for name in _SHARED_FILES), *out.glob("shards/shard-*.tar"), *parts]:
             with contextlib.suppress(OSError):
                 path.unlink()
         manifest.unlink()
@@ -464,9 +556,10 @@ def render_dataset(
     def files_of(key: str) -> dict[str, str]:
         return {kind: f"{_FOLDERS[kind]}/{key}{suffix}" for kind, suffix in kinds.items()}
 
+    existing = out.files() if remote else None  # one listing of a bucket, not a request per file
     done = {key for key, _ in cameras
             if key in finished and finished[key].get("files") == files_of(key)
-            and all((out / p).is_file() for p in files_of(key).values())}  # fmt: skip
+            and all(p in existing if remote else (out / p).is_file() for p in files_of(key).values())}  # fmt: skip
     jobs = [
         RenderJob(key, scene_file.scene, camera, _paths(out, files_of(key)), scene_file.options, depth_scale)
         for key, camera in cameras
@@ -474,10 +567,8 @@ def render_dataset(
     ]
     failed: dict[str, str] = {}
     rendered: list[str] = []
-    with open(manifest, "a", encoding="utf-8") as log:
-        if old_config is None:
-            log.write(json.dumps({"config": config}) + "\n")
-            log.flush()
+    log = _RunLog(out, config if old_config is None else None)
+    try:
         bar = _LoggedProgress(len(cameras), bool(progress), log, out)
         with bar:
             bar.skip(len(done))
@@ -485,15 +576,20 @@ def render_dataset(
             for attempt in range(retries + 1):
                 if attempt:
                     bar.retrying(len(remaining))
-                results = render_many(remaining, executor=executor, workers=workers, progress=bar, address=address)
+                results = render_many(remaining, executor=executor, workers=workers, progress=bar, address=address,
+                                      collect=collect)  # fmt: skip
                 rendered += [r.key for r in results if r.ok]
                 failed = {r.key: r.error for r in results if not r.ok}
                 remaining = [job for job in remaining if job.key in failed]
                 if not remaining:
                     break
+    finally:
+        log.close()
     complete = [(key, camera, files_of(key)) for key, camera in cameras if key not in failed]
     records = {key: camera_record(camera) for key, camera, _ in complete}
     write_atomically(out / "cameras.json", lambda file: file.write((json.dumps(records, indent=2) + "\n").encode()))
     written = [out / "cameras.json", *CAMERA_WRITERS[format](out, complete, extra)]
     write_atomically(out / "README.txt", lambda file: file.write(_readme(config, base, extra).encode("utf-8")))
-    return DatasetResult(out, tuple(sorted(rendered)), tuple(sorted(done)), failed, (*written, out / "README.txt"))
+    written = [str(path) if remote else path for path in (*written, out / "README.txt")]  # URLs as strings
+    return DatasetResult(str(out) if remote else out, tuple(sorted(rendered)), tuple(sorted(done)), failed,
+                         tuple(written))  # fmt: skip

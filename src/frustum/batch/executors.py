@@ -10,6 +10,16 @@ writes the same files.
 Ctrl-C: workers ignore SIGINT; the caller stops handing out jobs, lets the views in flight finish (so no file
 is left half written) and re-raises KeyboardInterrupt.
 
+Ray clusters whose nodes share no disk: where the files go is the ``collect`` mode. ``"workers"``: each actor
+writes its views' files itself (a URL every node reaches, or a folder on a one-node cluster). ``"driver"``: each
+actor renders and *encodes* its views and returns the files' bytes through Ray's object store; the driver
+writes them (atomically, as a worker would) before it counts the view, so a view in the run log is a view on
+the driver's disk. The driver keeps at most ``RAY_BYTES_IN_FLIGHT`` bytes of views handed out and not yet
+written, so its memory stays flat whatever the number of views. The default picks ``"driver"`` for a local
+folder on a cluster of more than one node (and for ``memory://``, which lives in one process), ``"workers"``
+otherwise. A worker or a node lost mid-run (its actor dies) hands its batches to the actors left, up to
+``RAY_TASK_RETRIES`` times each.
+
 A killed caller (SIGKILL, an out-of-memory kill) leaves no orphans: each pool worker checks every
 ``PARENT_CHECK_SECONDS`` whether its parent is still the process that started it and exits when it is not,
 at once when idle, after the view it is drawing otherwise (that view's files are completed, never cut short).
@@ -18,6 +28,8 @@ The multiprocessing resource tracker exits with the last of them (its pipe close
 
 from __future__ import annotations
 
+import contextlib
+import functools
 import os
 import pickle
 import threading
@@ -27,17 +39,28 @@ from dataclasses import replace
 from typing import Any
 
 from frustum._arrays import describe
-from frustum.batch.jobs import RenderJob, ViewResult, check_job, render_view
+from frustum.batch.jobs import RenderJob, ViewResult, check_job, encode_view, render_view, write_view
 from frustum.batch.progress import ViewProgress
+from frustum.batch.storage import is_url
 from frustum.errors import FrustumError
 
-__all__ = ["EXECUTORS", "RAY_BATCH", "render_many"]
+__all__ = ["COLLECT", "EXECUTORS", "RAY_BATCH", "RAY_BYTES_IN_FLIGHT", "RAY_TASK_RETRIES", "render_many"]
 
 EXECUTORS = ("serial", "process", "ray")
 """Executors ``render_many`` accepts."""
 
 RAY_BATCH = 16
 """Most views per Ray task: one task per view would make the driver's loop the limit on a large cluster."""
+COLLECT = ("driver", "workers")
+"""Where a Ray run's files are written: by the driver (bytes through the object store) or by the workers."""
+RAY_BYTES_IN_FLIGHT = 256 * 2**20
+"""collect="driver": most bytes of encoded views handed out and not yet written (an upper bound per view:
+4 + 4 + 12 + 2 + 1 bytes per pixel for color, depth, normals, ids, mask), and a task's views at most 1/8 of it."""
+RAY_TASK_RETRIES = 3
+"""How often a batch whose actor was lost (a dead worker or node) is handed to another actor."""
+RAY_NO_WORKER_SECONDS = 120.0
+"""How long a run whose every actor was lost waits for a free CPU on the cluster before it gives up."""
+_ENCODED_BYTES_PER_PIXEL = {"color": 4, "depth": 4, "normals": 12, "object_id": 2, "mask": 1}
 
 PARENT_CHECK_SECONDS = 0.5
 """How often a pool worker checks that its parent process is alive."""
@@ -154,11 +177,12 @@ class _RayRenderer:
         self.scenes = scenes
         set_threads(threads)
 
-    def render(self, jobs: list[RenderJob]) -> list[ViewResult]:
-        results = []
+    def render(self, jobs: list[RenderJob], collect: bool = False) -> list[Any]:
+        """ViewResults (files written here), or with `collect` (ViewResult, {kind: bytes}) pairs to write."""
+        results: list[Any] = []
         for job in jobs:
             scene, options = self.scenes[job.scene]
-            results.append(render_view(scene, job, options))
+            results.append(encode_view(scene, job, options) if collect else render_view(scene, job, options))
         return results
 
 
@@ -212,7 +236,44 @@ def _process(scenes: list, jobs: list[RenderJob], workers: int, on_result: Calla
         pool.shutdown(wait=True, cancel_futures=True)
 
 
-def _ray(scenes: list, jobs: list[RenderJob], workers: int | None, on_result: Callable, address: Any) -> None:
+def _encoded_bytes(job: RenderJob) -> int:
+    """An upper bound of a view's encoded files (raw pixels; PNG and .npy headers are small)."""
+    pixels = job.camera.width * job.camera.height
+    return 1024 + pixels * sum(_ENCODED_BYTES_PER_PIXEL.get(kind, 4) for kind in job.outputs)
+
+
+def _collect_mode(ray: Any, collect: str | None, jobs: Sequence[RenderJob]) -> str:
+    """The collect mode, "driver" or "workers", for this cluster and outputs; refuses workers that cannot write."""
+    outputs = [path for job in jobs for path in job.outputs.values()]
+    local = next((path for path in outputs if not is_url(path)), None)
+    memory = next((path for path in outputs if str(path).startswith("memory://")), None)
+    nodes = [node for node in ray.nodes() if node.get("Alive")]
+    try:
+        client = bool(ray.util.client.ray.is_connected())
+    except AttributeError:  # pragma: no cover - a Ray without the client
+        client = False
+    apart = len(nodes) > 1 or client  # workers may run where the driver's disk is not
+    if collect is None:
+        return "driver" if (local is not None and apart) or memory is not None else "workers"
+    if collect == "workers" and local is not None and apart:
+        where = "a Ray Client connection" if client else f"a Ray cluster of {len(nodes)} nodes"
+        raise FrustumError(
+            f"render_many: collect = 'workers' with the local path {str(local)!r} on {where}: each node would "
+            "write to its own disk and the driver would miss their files; use collect='driver' (--collect driver, "
+            "the default here) or a URL every node reaches (s3://, gs://, file:// on a shared file system)"
+        )
+    if collect == "workers" and memory is not None:
+        raise FrustumError(
+            f"render_many: collect = 'workers' with {str(memory)!r}: memory:// lives in one process, so the "
+            "workers' files would never reach this one; use collect='driver'"
+        )
+    return collect
+
+
+def _ray(
+    scenes: list, jobs: list[RenderJob], workers: int | None, on_result: Callable, address: Any,
+    collect: str | None = None,
+) -> None:  # fmt: skip
     try:
         import ray
     except ImportError:
@@ -225,42 +286,137 @@ def _ray(scenes: list, jobs: list[RenderJob], workers: int | None, on_result: Ca
         ray.init(address=address, include_dashboard=False, log_to_driver=False, configure_logging=False)
         started = True
     try:
-        # one CPU per actor: more actors than free CPUs would wait for ever, holding their views
-        free = max(1, int(ray.available_resources().get("CPU", 1)))
-        workers = free if workers is None else min(workers, free)
-        actor_type = ray.remote(num_cpus=1)(_RayRenderer)
-        scenes_ref = ray.put(scenes)  # once into the object store; each actor fetches it once
-        actors = [actor_type.remote(scenes_ref, 1) for _ in range(min(workers, max(1, len(jobs))))]
-        size = _batch_size(len(jobs), len(actors))
-        batches = iter([jobs[i : i + size] for i in range(0, len(jobs), size)])
-        in_flight: dict = {}
-        try:
-            for actor in actors:  # two batches queued per actor: the next is ready when one finishes
-                for _ in range(2):
-                    batch = next(batches, None)
-                    if batch is not None:
-                        in_flight[actor.render.remote(batch)] = actor
-            while in_flight:
-                ready, _ = ray.wait(list(in_flight), num_returns=1)
-                for ref in ready:
-                    actor = in_flight.pop(ref)
-                    for result in ray.get(ref):
-                        on_result(result)
-                    batch = next(batches, None)
-                    if batch is not None:
-                        in_flight[actor.render.remote(batch)] = actor
-        except KeyboardInterrupt:
-            ready, _ = ray.wait(list(in_flight), num_returns=len(in_flight))
-            for results in ray.get(ready):
-                for result in results:
-                    on_result(result)
-            raise
-        finally:
-            for actor in actors:
-                ray.kill(actor)
+        _RayRun(ray, scenes, jobs, workers, on_result, _collect_mode(ray, collect, jobs)).run()
     finally:
         if started:
             ray.shutdown()
+
+
+class _RayRun:
+    """One ``render_many`` on Ray: actors, batches handed out and collected, lost actors replaced."""
+
+    def __init__(self, ray: Any, scenes: list, jobs: list[RenderJob], workers: int | None, on_result: Callable,
+                 collect: str) -> None:  # fmt: skip
+        from collections import deque
+
+        self.ray, self.on_result, self.to_driver = ray, on_result, collect == "driver"
+        self.jobs = {job.key: job for job in jobs}
+        # one CPU per actor: more actors than free CPUs would wait for ever, holding their views
+        free = max(1, int(ray.available_resources().get("CPU", 1)))
+        self.wanted = free if workers is None else min(workers, free)
+        size = _batch_size(len(jobs), self.wanted)
+        self.view_limit = len(jobs)
+        if self.to_driver:  # a bounded number of views handed out and not yet written
+            per_view = _encoded_bytes(jobs[0])
+            size = max(1, min(size, RAY_BYTES_IN_FLIGHT // (8 * per_view)))
+            self.view_limit = max(size, RAY_BYTES_IN_FLIGHT // per_view)
+        self.wanted = max(1, min(self.wanted, -(-len(jobs) // size), -(-self.view_limit // size)))
+        self.pending = deque(jobs[i : i + size] for i in range(0, len(jobs), size))
+        self.tries: dict[str, int] = {}
+        self.actor_type = ray.remote(num_cpus=1, max_restarts=0)(_RayRenderer)
+        self.scenes_ref = ray.put(scenes)  # once into the object store; each actor fetches it once
+        self.actors: list = []
+        self.load: dict = {}
+        self.in_flight: dict = {}  # ref -> (actor, batch)
+        self.views_in_flight = 0
+
+    def _add_actors(self, count: int) -> None:
+        for _ in range(count):
+            actor = self.actor_type.remote(self.scenes_ref, 1)
+            self.actors.append(actor)
+            self.load[actor] = 0
+
+    def _drop(self, actor: Any) -> None:
+        if actor in self.load:
+            self.actors.remove(actor)
+            del self.load[actor]
+            with contextlib.suppress(Exception):
+                self.ray.kill(actor, no_restart=True)
+
+    def _submit(self) -> None:
+        """Hand out batches: at most two per actor (the next is ready when one ends) and `view_limit` views."""
+        while self.pending and self.actors:
+            actor = min(self.actors, key=self.load.__getitem__)
+            batch = self.pending[0]
+            over = self.views_in_flight + len(batch) > self.view_limit and self.in_flight
+            if self.load[actor] >= 2 or over:
+                return
+            self.pending.popleft()
+            self.in_flight[actor.render.remote(batch, self.to_driver)] = (actor, batch)
+            self.load[actor] += 1
+            self.views_in_flight += len(batch)
+
+    def _finish(self, ref: Any) -> None:
+        """Collect one batch: write (driver mode) and count its views, or hand it on when its actor was lost."""
+        ray = self.ray
+        actor, batch = self.in_flight.pop(ref)
+        self.views_in_flight -= len(batch)
+        if actor in self.load:
+            self.load[actor] -= 1
+        try:
+            results = ray.get(ref)
+        except ray.exceptions.RayTaskError as error:  # the batch itself raised (not a view: those are caught)
+            message = " ".join(str(error).split())[:500]
+            for job in batch:
+                self.on_result(ViewResult(job.key, {}, f"{type(error).__name__}: {message}"))
+            return
+        except ray.exceptions.RayError as error:  # the actor (its process or its node) was lost
+            self._drop(actor)
+            tries = self.tries[batch[0].key] = self.tries.get(batch[0].key, 0) + 1
+            if tries > RAY_TASK_RETRIES:
+                for job in batch:
+                    self.on_result(ViewResult(job.key, {}, f"{type(error).__name__}: lost {tries} workers"))
+            else:
+                self.pending.appendleft(batch)
+            return
+        for item in results:
+            if self.to_driver:
+                result, encoded = item
+                item = write_view(self.jobs[result.key], result, encoded)
+            self.on_result(item)
+
+    def _replace_lost(self) -> None:
+        """Every actor was lost: start new ones on the CPUs free now, or wait for one a while.
+
+        Only then: while some actors live they take the lost batches, and a CPU the cluster still lists just
+        after its node died (the head notices a dead node after a few seconds) would hold an actor for ever.
+        """
+        ray = self.ray
+        deadline = time.monotonic() + RAY_NO_WORKER_SECONDS
+        while True:
+            free = int(ray.available_resources().get("CPU", 0))
+            missing = min(free, self.wanted, len(self.pending))
+            if missing > 0:
+                self._add_actors(missing)
+            if self.actors or not self.pending:
+                return
+            if time.monotonic() > deadline:
+                raise FrustumError(
+                    f"render_many: every Ray worker was lost and no CPU came free in {RAY_NO_WORKER_SECONDS:.0f} s; "
+                    f"{sum(len(b) for b in self.pending)} views were not rendered (rerun to resume a dataset)"
+                )
+            time.sleep(1.0)
+
+    def run(self) -> None:
+        ray = self.ray
+        self._add_actors(self.wanted)
+        try:
+            while self.pending or self.in_flight:
+                if not self.actors and self.pending:
+                    self._replace_lost()
+                self._submit()
+                ready, _ = ray.wait(list(self.in_flight), num_returns=1)
+                for ref in ready:
+                    self._finish(ref)
+        except KeyboardInterrupt:
+            self.pending.clear()
+            ready, _ = ray.wait(list(self.in_flight), num_returns=len(self.in_flight))
+            for ref in ready:
+                self._finish(ref)
+            raise
+        finally:
+            for actor in list(self.actors):
+                self._drop(actor)
 
 
 _RUNNERS = {"serial": _serial, "process": _process, "ray": _ray}
@@ -273,8 +429,9 @@ def render_many(
     workers: int | None = None,
     progress: bool | ViewProgress = True,
     address: str | None = None,
+    collect: str | None = None,
 ) -> list[ViewResult]:
-    """Render many views; workers write the files and return metadata, in the order of `jobs`.
+    """Render many views; workers (or this process, ``collect="driver"``) write the files; metadata in job order.
 
     The same call writes the same bytes with every executor and any number of workers. A view that fails is
     reported in its ``ViewResult.error``; the other views go on. Bad jobs (unknown output kinds, a scene file
@@ -288,14 +445,21 @@ def render_many(
         ``"serial"``: in this process. ``"process"``: a local pool of spawned processes, each given the scenes
         once through its initializer and ``cores // workers`` kernel threads. ``"ray"``: long-lived Ray actors
         (one CPU each, one kernel thread, up to ``RAY_BATCH`` views per task) on the cluster at `address`, or
-        a local one started (and stopped) here unless Ray is already initialized; the files must go to a path
-        every node can reach.
+        a local one started (and stopped) here unless Ray is already initialized; a lost actor or node hands
+        its views to the actors left.
     workers : int or None
         Processes or actors; None: the number of cores (the cluster's free CPUs for Ray, which also caps it).
     progress : bool or ViewProgress
         Show a Rich progress bar on stderr (True), nothing (False), or count on the given bar.
     address : str or None
         ``ray.init(address=...)`` for an existing cluster (e.g. ``"auto"``).
+    collect : {"driver", "workers"} or None
+        Ray only: who writes the files (module docstring). ``"driver"``: the workers return the encoded bytes
+        through the object store and this process writes them, at most ``RAY_BYTES_IN_FLIGHT`` bytes of views
+        outstanding. ``"workers"``: each worker writes its own (refused for a local path on a cluster of more
+        than one node, whose nodes do not see each other's disks). None: ``"driver"`` for local paths on more
+        than one node and for ``memory://``, else ``"workers"``. The serial and process executors write in this
+        machine either way.
 
     Returns
     -------
@@ -304,7 +468,8 @@ def render_many(
     Raises
     ------
     FrustumError
-        Unknown executor, workers < 1, a bad job, or Ray missing (``pip install 'frustum[ray]'``).
+        Unknown executor or collect mode, workers < 1, a bad job, Ray missing (``pip install 'frustum[ray]'``),
+        collect = "workers" where the workers cannot reach the outputs, every Ray worker lost for good.
     KeyboardInterrupt
         After the views in flight have finished writing.
     """
@@ -313,8 +478,15 @@ def render_many(
         raise FrustumError(f"{where}: executor = {executor!r} is unknown; expected one of {', '.join(EXECUTORS)}")
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise FrustumError(f"{where}: workers = {describe(workers)} must be a positive integer or None")
+    if collect is not None and collect not in COLLECT:
+        raise FrustumError(f"{where}: collect = {collect!r} is unknown; expected one of {', '.join(COLLECT)} or None")
     job_list = list(jobs)
     scenes, plain = _prepare(job_list, where)
+    if executor == "process":
+        memory = next((p for job in plain for p in job.outputs.values() if str(p).startswith("memory://")), None)
+        if memory is not None:
+            raise FrustumError(f"{where}: {str(memory)!r} with executor = 'process': memory:// lives in one process, "
+                               "so the pool's files would never reach this one; use 'serial' or 'ray'")  # fmt: skip
     count = workers
     if executor == "process":
         count = min(workers or _cpu_count(), max(1, len(plain)))
@@ -325,10 +497,13 @@ def render_many(
         results[result.key] = result
         bar.advance(result)
 
+    runner = _RUNNERS[executor]
+    if executor == "ray":
+        runner = functools.partial(_ray, collect=collect)
     if plain:
         if isinstance(progress, ViewProgress):
-            _RUNNERS[executor](scenes, plain, count, on_result, address)
+            runner(scenes, plain, count, on_result, address)
         else:
             with bar:
-                _RUNNERS[executor](scenes, plain, count, on_result, address)
+                runner(scenes, plain, count, on_result, address)
     return [results[job.key] for job in plain]

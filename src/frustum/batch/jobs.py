@@ -1,9 +1,11 @@
 """One view as plain data (``RenderJob``), what comes back (``ViewResult``), and the worker side that renders it.
 
-A job names a scene, one camera, ``render`` options and the files to write; a worker renders the view, writes
-every file under a temporary name in the target folder and renames it into place (``os.replace``, atomic on one
-file system), and returns only metadata: paths, timings and an error message. Frames never travel between
-processes (a 1024² frame with its buffers is about 25 MB; moving it costs more than rendering it).
+A job names a scene, one camera, ``render`` options and the files to write; a worker renders the view and
+encodes each file (``encode_view``), then either writes every file under a temporary name in the target folder
+and renames it into place (``os.replace``, atomic on one file system; a URL: ``frustum.batch.storage``) and
+returns only metadata (``render_view``), or returns the encoded bytes for the caller to write
+(``write_view``: a Ray driver collecting the files of workers whose disks it cannot see). Frames never travel
+between processes (a 1024² frame with its buffers is about 25 MB; the encoded files are a sixth of that).
 
 Output kinds (``RenderJob.outputs`` keys):
 
@@ -20,6 +22,7 @@ Output kinds (``RenderJob.outputs`` keys):
 from __future__ import annotations
 
 import contextlib
+import io
 import os
 import time
 from collections.abc import Mapping
@@ -30,9 +33,10 @@ from typing import Any
 import numpy as np
 
 from frustum._arrays import describe
+from frustum.batch.storage import TEMPORARY_MARK, RemotePath, is_url
 from frustum.errors import FrustumError, OutputError
 
-__all__ = ["OUTPUT_KINDS", "RenderJob", "ViewResult", "render_view", "write_atomically"]
+__all__ = ["OUTPUT_KINDS", "RenderJob", "ViewResult", "encode_view", "render_view", "write_atomically", "write_view"]
 
 OUTPUT_KINDS = {
     "color": (".png",),
@@ -44,8 +48,6 @@ OUTPUT_KINDS = {
     "shadow": (".npy",),
 }
 """Output kinds a job may ask for, with the file suffixes each accepts."""
-TEMPORARY_MARK = ".partial-"
-"""Infix of temporary file names (``.<name>.partial-<pid>``): a file with it is never a finished output."""
 _MAX_UINT16 = 65535
 PNG_COMPRESS_LEVEL = 1
 """zlib level of the PNGs: measured on the bunny at 512², level 1 encodes the color image in 15 ms against 70 ms at
@@ -114,7 +116,7 @@ def check_job(job: Any, index: int, where: str) -> None:
             raise OutputError(
                 f"{where}: jobs[{index}].outputs has kind {kind!r}; expected one of {', '.join(sorted(OUTPUT_KINDS))}"
             )
-        suffix = Path(path).suffix.lower()
+        suffix = Path(str(path)).suffix.lower()
         if suffix not in OUTPUT_KINDS[kind]:
             raise OutputError(
                 f"{where}: jobs[{index}].outputs[{kind!r}] = {str(path)!r} has suffix {suffix!r}; expected "
@@ -128,8 +130,14 @@ def write_atomically(path: str | os.PathLike, write: Any) -> None:
     """Call ``write(file)`` on a temporary file beside `path`, then rename it to `path`.
 
     Readers never see a partly written `path`: it appears whole or not at all (``os.replace`` is atomic on
-    one file system). On any exception, Ctrl-C included, the temporary file is removed.
+    one file system). On any exception, Ctrl-C included, the temporary file is removed. A URL (a string with
+    ``scheme://`` or a ``RemotePath``) is written through fsspec, whole or not at all (``RemotePath.write_bytes``).
     """
+    if is_url(path):
+        buffer = io.BytesIO()
+        write(buffer)
+        (path if isinstance(path, RemotePath) else RemotePath(path)).write_bytes(buffer.getbuffer())
+        return
     target = Path(path)
     target.parent.mkdir(parents=True, exist_ok=True)
     temporary = target.with_name(f".{target.name}{TEMPORARY_MARK}{os.getpid()}")
@@ -185,11 +193,18 @@ def _encoded(kind: str, suffix: str, frame: Any, camera: Any, depth_scale: float
     return _png_writer(np.where(drawn, 255, 0).astype(np.uint8))
 
 
-def render_view(scene: Any, job: RenderJob, options: Mapping[str, Any] | None = None) -> ViewResult:
-    """Render one job's view of `scene` and write its files; errors come back in the result, not raised.
+def _path_text(path: Any) -> str:
+    return str(path) if is_url(path) else os.fspath(path)
 
-    `options` are defaults (a scene file's ``[render]`` table) under ``job.options``. KeyboardInterrupt and
-    SystemExit pass through (the temporary file is removed first).
+
+def encode_view(
+    scene: Any, job: RenderJob, options: Mapping[str, Any] | None = None
+) -> tuple[ViewResult, dict[str, bytes]]:
+    """Render one job's view of `scene` and encode its files in memory: the result and ``{kind: bytes}``.
+
+    Nothing is written. ``ViewResult.files`` names the paths the bytes belong to and ``write_seconds`` is the
+    encoding time (``write_view`` adds the writing). Errors come back in the result (and no bytes), not raised;
+    KeyboardInterrupt and SystemExit pass through.
     """
     import socket
 
@@ -203,13 +218,49 @@ def render_view(scene: Any, job: RenderJob, options: Mapping[str, Any] | None = 
         merged = {**(options or {}), **job.options, "buffers": buffers}
         frame = render(scene, job.camera, **merged)
         render_seconds = time.perf_counter() - start
-        written = time.perf_counter()
+        encoding = time.perf_counter()
         files: dict[str, str] = {}
+        encoded: dict[str, bytes] = {}
         for kind, path in job.outputs.items():
-            suffix = Path(path).suffix.lower()
-            write_atomically(path, _encoded(kind, suffix, frame, job.camera, job.depth_scale))
-            files[kind] = os.fspath(path)
-        return ViewResult(job.key, files, None, render_seconds, time.perf_counter() - written, worker)
+            suffix = Path(str(path)).suffix.lower()
+            buffer = io.BytesIO()
+            _encoded(kind, suffix, frame, job.camera, job.depth_scale)(buffer)
+            encoded[kind] = buffer.getvalue()
+            files[kind] = _path_text(path)
+        return ViewResult(job.key, files, None, render_seconds, time.perf_counter() - encoding, worker), encoded
     except Exception as error:  # every failure of one view is reported with the view, not raised
-        message = " ".join(str(error).split()) or "no details"
-        return ViewResult(job.key, {}, f"{type(error).__name__}: {message}", render_seconds, 0.0, worker)
+        return _failed(job, error, render_seconds, worker), {}
+
+
+def _failed(job: RenderJob, error: Exception, render_seconds: float, worker: str) -> ViewResult:
+    message = " ".join(str(error).split()) or "no details"
+    return ViewResult(job.key, {}, f"{type(error).__name__}: {message}", render_seconds, 0.0, worker)
+
+
+def write_view(job: RenderJob, result: ViewResult, encoded: Mapping[str, bytes]) -> ViewResult:
+    """Write the bytes ``encode_view`` returned to the job's outputs, each atomically; the result, timed.
+
+    A failed write (a full disk, a refused URL) comes back as the view's error, not raised.
+    """
+    if not result.ok:
+        return result
+    from dataclasses import replace
+
+    start = time.perf_counter()
+    try:
+        for kind, path in job.outputs.items():
+            data = encoded[kind]
+            write_atomically(path, lambda file, data=data: file.write(data))
+    except Exception as error:  # reported with the view, as a rendering failure is
+        return _failed(job, error, result.render_seconds, result.worker)
+    return replace(result, write_seconds=result.write_seconds + time.perf_counter() - start)
+
+
+def render_view(scene: Any, job: RenderJob, options: Mapping[str, Any] | None = None) -> ViewResult:
+    """Render one job's view of `scene` and write its files; errors come back in the result, not raised.
+
+    `options` are defaults (a scene file's ``[render]`` table) under ``job.options``. KeyboardInterrupt and
+    SystemExit pass through (a temporary file is removed first). ``write_seconds`` is encoding plus writing.
+    """
+    result, encoded = encode_view(scene, job, options)
+    return write_view(job, result, encoded)
