@@ -146,16 +146,19 @@ def _tile(frames: list[Frame], columns: int, background: Sequence[float]) -> Fra
     return Frame(color, depth)
 
 
-def load_scene(data: Mapping[str, Any] | str, *, source: str = "<scene>", base_dir: str | Path = ".") -> SceneFile:
-    """Validate and build a scene from TOML text or an already parsed dictionary.
+def load_scene(
+    data: Mapping[str, Any] | str | Path, *, source: str = "<scene>", base_dir: str | Path = "."
+) -> SceneFile:
+    """Validate and build a scene from TOML text or an already parsed dictionary; or load a file: a ``Path``, or a
+    one-line string ending in ``.toml`` or a mesh suffix (``MODEL_SUFFIXES``), goes to ``load_scene_file``.
 
     Every problem is collected first; then one ``SceneFileError`` lists them all, one per line, as
     ``source:line: key = value problem; what is valid`` (no line numbers for a dictionary).
 
     Parameters
     ----------
-    data : str or mapping
-        TOML text, or the dictionary ``tomllib.loads`` would return.
+    data : str, Path or mapping
+        TOML text, or the dictionary ``tomllib.loads`` would return, or the path of a scene or mesh file.
     source : str
         The name errors start with (the file name).
     base_dir : str or Path
@@ -166,6 +169,10 @@ def load_scene(data: Mapping[str, Any] | str, *, source: str = "<scene>", base_d
     SceneFileError
         Malformed TOML (tomllib's own line and column), or any invalid key or value.
     """
+    if isinstance(data, Path) or (
+        isinstance(data, str) and "\n" not in data and data.lower().endswith((".toml", *MODEL_SUFFIXES))
+    ):
+        return load_scene_file(data)
     lines: dict[tuple, int] | str | None = None
     if isinstance(data, str):
         _check_shape(data, source)
@@ -331,16 +338,25 @@ def _build(report: _Report, data: dict, base: Path) -> SceneFile | None:
                      sheet=sheet, radiosity=radiosity)  # fmt: skip
 
 
-def load_scene_file(path: str | Path) -> SceneFile:
-    """Read, validate and build the TOML scene file at `path` (relative paths inside resolve against its folder).
+def load_scene_file(path: str | Path, *, up: str = "y") -> SceneFile:
+    """Read, validate and build the TOML scene file at `path` (relative paths inside resolve against its folder),
+    or the scene of a mesh file (.obj .stl .ply .off .gltf .glb).
+
+    A mesh file gives the scene a file with only ``[[nodes]] geometry = { type = "mesh", path = ... }`` would,
+    with the file's materials and textures, a camera framing it from a 3/4 view (``Camera.fit``) and the default
+    lights (``frustum.scenefile.models``); `up` = "z" stands a z-up model upright (glTF is y-up and ignores it).
 
     Raises
     ------
     SceneFileError
         If the file cannot be read, is not valid TOML, or has invalid keys or values; the message lists every
         problem as ``file:line: key = value problem; what is valid``.
+    GeometryError
+        If a mesh file cannot be read.
     """
     file = Path(path)
+    if file.suffix.lower() in MODEL_SUFFIXES:
+        return _model_scene_file(file, up)
     shown = escape_control(str(file))
     try:
         with open(file, "rb") as handle:
@@ -354,3 +370,14 @@ def load_scene_file(path: str | Path) -> SceneFile:
         raise SceneFileError(f"{shown}: cannot be read ({reason}); give an existing UTF-8 TOML scene file") from None
     scene_file = load_scene(text, source=str(file), base_dir=file.parent)
     return dataclasses.replace(scene_file, path=file)
+
+
+MODEL_SUFFIXES = (".obj", ".stl", ".ply", ".off", ".gltf", ".glb")
+"""Suffixes ``load_scene_file`` reads as a mesh file (a model) instead of a TOML scene file."""
+
+
+def _model_scene_file(file: Path, up: str) -> SceneFile:
+    from frustum.scenefile.models import model_scene
+
+    scene, camera = model_scene(file, up=up, size=_DEFAULT_SIZE)
+    return SceneFile(scene, camera, {}, (), (camera,), size=_DEFAULT_SIZE, title=file.stem, path=file)
