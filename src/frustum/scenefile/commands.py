@@ -63,7 +63,11 @@ def _write(scene_file: SceneFile, target: Path) -> Path:
 
 
 def render_scene_file(
-    path: str | Path, output: str | Path | Sequence[str | Path] | None = None, *, size: tuple[int, int] | None = None
+    path: str | Path,
+    output: str | Path | Sequence[str | Path] | None = None,
+    *,
+    size: tuple[int, int] | None = None,
+    up: str = "y",
 ) -> Path | list[Path]:
     """Render the scene file at `path` and write it by suffix: PNG, SVG or PDF (line drawing), GIF or MP4 (turntable).
 
@@ -89,7 +93,7 @@ def render_scene_file(
         For an unknown output suffix or an unwritable path; ``FrustumError`` from the renderer for options it
         refuses.
     """
-    scene_file = load_scene_file(path)
+    scene_file = load_scene_file(path, up=up)
     if size is not None:
         scene_file = scene_file.resized(tuple(size))  # type: ignore[arg-type]
     if output is None:

@@ -105,6 +105,8 @@ class SceneFile:
             raise OutputError(f"{where}: size = {describe(size)} is not (width, height); give two positive integers")
         width, height = int(size[0]), int(size[1])
         cameras = tuple(dataclasses.replace(c, width=width, height=height) for c in self.cameras)
+        if self.path is not None and self.path.suffix.lower() in MODEL_SUFFIXES and self.camera is not None:
+            cameras = (Camera.fit(self.scene, -self.camera.frame.n, width=width, height=height),)  # keep it framed
         stereo = self.stereo
         if stereo is not None:
             centre = dataclasses.replace(stereo.camera.camera, width=width, height=height)
