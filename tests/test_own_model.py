@@ -93,8 +93,6 @@ def test_textured_cube_shows_both_checker_colours_on_every_visible_face(tmp_path
     checker = np.zeros((64, 64, 3), dtype=np.uint8)
     checker[:32, :32] = checker[32:, 32:] = (230, 40, 40)
     checker[:32, 32:] = checker[32:, :32] = (40, 40, 230)
-    box = trimesh.creation.box()
-    box = box.unwrap() if hasattr(box, "unwrap") and False else box
     # a cube of 6 separate quads, each face mapped to the whole checker image
     faces_v, faces_uv, tris = [], [], []
     for axis in range(3):
@@ -111,11 +109,8 @@ def test_textured_cube_shows_both_checker_colours_on_every_visible_face(tmp_path
             quad = [[base, base + 1, base + 2], [base, base + 2, base + 3]]
             if sign < 0:
                 quad = [q[::-1] for q in quad]
-            if axis == 1:
-                quad = [q[::-1] for q in quad]
             tris.extend(quad)
     mesh = trimesh.Trimesh(np.array(faces_v), np.array(tris), process=False)
-    mesh.fix_normals()
     material = trimesh.visual.material.PBRMaterial(baseColorTexture=Image.fromarray(checker),
                                                    baseColorFactor=[255, 255, 255, 255])  # fmt: skip
     mesh.visual = trimesh.visual.TextureVisuals(uv=np.array(faces_uv, dtype=float), material=material)
