@@ -130,8 +130,8 @@ def test_textured_cube_shows_both_checker_colours_on_every_visible_face(tmp_path
                 x, y, _ = camera.project(p)
                 samples.append(rgb[frame.height - 1 - int(y), int(x)])
         samples = np.array(samples)
-        reds = ((samples[:, 0] > samples[:, 2] + 30)).sum()
-        blues = ((samples[:, 2] > samples[:, 0] + 30)).sum()
+        reds = (samples[:, 0] > samples[:, 2] + 30).sum()
+        blues = (samples[:, 2] > samples[:, 0] + 30).sum()
         assert reds >= 20 and blues >= 20, (axis, reds, blues)
 
 
@@ -167,7 +167,8 @@ def test_camera_fit_touches_the_image_edge_at_the_margin(low, extent, direction,
     low = np.array(low)
     high = low + np.array(extent)
     camera = Camera.fit([low, high], direction, math.radians(fovy_deg), margin,
-                        projection="perspective" if perspective else "orthographic", width=width, height=height)  # fmt: skip
+                        projection="perspective" if perspective else "orthographic",
+                        width=width, height=height)  # fmt: skip
     window = _silhouette(camera, (low + high) / 2, float(np.linalg.norm(high - low)) / 2, perspective)
     gaps = [window[:, 0].min(), width - window[:, 0].max(), window[:, 1].min(), height - window[:, 1].max()]
     expected = margin * min(width, height)
@@ -248,3 +249,27 @@ def test_cli_render_a_missing_or_broken_mesh_file_is_one_line_and_non_zero(tmp_p
         with pytest.raises(SystemExit) as stopped:
             main(["render", str(path), "-o", str(tmp_path / "x.png")])
         assert stopped.value.code != 0
+
+
+def test_scene_file_camera_fit_view_iso_and_default_lights(tmp_path):
+    node = f'[[nodes]]\ngeometry = {{ type = "mesh", path = "{BUNNY.resolve()}" }}\n'
+    fitted = load_scene("[camera]\nfit = true\n" + node)
+    assert len(fitted.scene.world_lights()) == 4  # key, fill, rim and ambient when the file names none
+    model = load_scene_file(BUNNY)
+    assert np.allclose(fitted.camera.frame.eye, model.camera.frame.eye)
+    iso = load_scene('[camera]\nfit = true\nview = "iso"\n' + node)
+    assert type(iso.camera.projection).__name__ == "Orthographic"
+    eye = iso.camera.frame.eye - iso.camera.frame.target
+    assert np.allclose(eye / np.linalg.norm(eye), np.ones(3) / math.sqrt(3))
+    turned = load_scene("[camera]\nfit = true\nazimuth_deg = 0\nelevation_deg = 0\nmargin = 0.2\n" + node)
+    assert abs(turned.camera.frame.n[2] - 1.0) < 1e-9
+    placed = load_scene('[camera]\nview = "iso"\ndistance = 5\n' + node)  # iso also without fit
+    assert np.allclose(placed.camera.frame.eye, np.full(3, 5 / math.sqrt(3)))
+    lit = load_scene('[camera]\nfit = true\n[[lights]]\ntype = "ambient"\n' + node)
+    assert len(lit.scene.world_lights()) == 1
+    with pytest.raises(SceneFileError, match=r"eye = .* does not apply to fit"):
+        load_scene("[camera]\nfit = true\neye = [0, 0, 5]\n" + node)
+    with pytest.raises(SceneFileError, match="nothing to frame"):
+        load_scene("[camera]\nfit = true\n")
+    with pytest.raises(SceneFileError, match="margin"):
+        load_scene("[camera]\nfit = true\nmargin = 0.7\n" + node)

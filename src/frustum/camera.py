@@ -415,7 +415,8 @@ class Camera:
         edges `margin` in from them.
 
         The sphere is centred on the axis-aligned bounding box (centre ``(low + high)/2``) with the radius of the
-        farthest point (for bounds ``[low, high]``: half the box's diagonal). Perspective: ``distance = r / sin(atan((1 − 2·margin)·tan(half_fov)))`` where ``half_fov`` is the
+        farthest point (for bounds ``[low, high]``: half the box's diagonal). Perspective:
+        ``distance = r / sin(atan((1 − 2·margin)·tan(half_fov)))`` where ``half_fov`` is the
         smaller of the vertical and horizontal half angles, so the sphere's image circle — the cone tangent to the
         sphere — spans ``1 − 2·margin`` of the smaller image side. Orthographic: the view height is
         ``2r / ((1 − 2·margin)·min(1, width/height))`` and the eye stands 3r back.

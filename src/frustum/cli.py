@@ -515,7 +515,9 @@ def examples_command(
 
 @app.command("dataset")
 def dataset_command(
-    scene: Annotated[Path, typer.Argument(help="A TOML scene file (its camera sets projection, size and distance) or a mesh file.")],
+    scene: Annotated[
+        Path, typer.Argument(help="A TOML scene file (its camera sets projection, size and distance) or a mesh file.")
+    ],
     out: Annotated[Path, typer.Option("--out", help="Output folder (created; rerun the command to resume).")],
     views: Annotated[int | None, typer.Option(help="Number of views (default 100; --layout file: the file's).")] = None,
     layout: Annotated[str, typer.Option(help="orbit, sphere, random or file.")] = "orbit",

@@ -22,6 +22,7 @@ from frustum.scene import Scene
 from frustum.scenefile.camera import _camera, _Stereo, _stereo_modules
 from frustum.scenefile.checks import _table, _table_list, _unknown_keys
 from frustum.scenefile.lights_materials import _environment, _lights, _material
+from frustum.scenefile.models import default_lights
 from frustum.scenefile.nodes import _explode_and_cut, _node
 from frustum.scenefile.outputs import _DEFAULT_SIZE, _MAX_PIXELS, _check_image_memory, _outputs, _render_options
 from frustum.scenefile.report import _BAD, _Report
@@ -314,17 +315,20 @@ def _build(report: _Report, data: dict, base: Path) -> SceneFile | None:
                 report.add(("cameras", i, "stereo"), entry["stereo"], "is not allowed in [[cameras]]",
                            "stereo goes with a single [camera]")  # fmt: skip
                 continue
-            camera = _camera(report, ("cameras", i), entry, size)
+            camera = _camera(report, ("cameras", i), entry, size, scene)
             if camera is not _BAD:
                 cameras.append(camera)
     elif "camera" in data:
-        camera = _camera(report, ("camera",), data["camera"], size)
+        camera = _camera(report, ("camera",), data["camera"], size, scene)
         if isinstance(camera, _Stereo):
             stereo, camera = camera, camera.camera.camera
         if camera is not _BAD:
             cameras.append(camera)
     else:
         report.missing(("camera",), "add a [camera] table with eye and target (or [[cameras]])")
+    if cameras and _fits(data) and not scene.world_lights() and "environment" not in data and "radiosity" not in data:
+        for light in default_lights(cameras[0]):  # a fitted camera and no lights named: the default three-point set
+            scene.root.add_light(light)
     outputs, animation, svg = _outputs(report, data, base)
     _check_image_memory(report, options, size, max(len(cameras), 1))
     if not report.problems:
@@ -338,6 +342,12 @@ def _build(report: _Report, data: dict, base: Path) -> SceneFile | None:
     single = cameras[0] if "camera" in data else None
     return SceneFile(scene, single, options, outputs, tuple(cameras), stereo, animation, svg, size, columns, title,
                      sheet=sheet, radiosity=radiosity)  # fmt: skip
+
+
+def _fits(data: dict) -> bool:
+    """Whether the file's camera (or first camera) is placed by ``fit = true``."""
+    camera = data.get("camera", (data.get("cameras") or [None])[0] if isinstance(data.get("cameras"), list) else None)
+    return isinstance(camera, dict) and camera.get("fit") is True
 
 
 def load_scene_file(path: str | Path, *, up: str = "y") -> SceneFile:
