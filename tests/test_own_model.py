@@ -273,3 +273,19 @@ def test_scene_file_camera_fit_view_iso_and_default_lights(tmp_path):
         load_scene("[camera]\nfit = true\n")
     with pytest.raises(SceneFileError, match="margin"):
         load_scene("[camera]\nfit = true\nmargin = 0.7\n" + node)
+
+
+def test_scene_file_meshes_bring_their_materials_and_textures(tmp_path):
+    obj = _spot_with_mtl(tmp_path)
+    glb = _spot_glb(tmp_path)
+    for path in (obj, glb):
+        scene_file = load_scene(f'[camera]\nfit = true\n[[nodes]]\ngeometry = {{ type = "mesh", path = "{path}" }}\n')
+        item = scene_file.scene.items[0]
+        assert item.material.texture is not None and item.material.texture.shape[:2] == (1024, 1024)
+        mask, luminance = _model_pixels(scene_file.render())
+        assert (luminance[mask] < 0.12).mean() > 0.03 and (luminance[mask] > 0.55).mean() > 0.1
+    mine = load_scene(f'[camera]\nfit = true\n[[nodes]]\nmaterial = {{ color = [1, 0, 0] }}\n'
+                      f'geometry = {{ type = "mesh", path = "{obj}" }}\n')  # fmt: skip
+    assert mine.scene.items[0].material.texture is None  # the node's own material wins
+    plain = load_scene(f'[camera]\nfit = true\n[[nodes]]\ngeometry = {{ type = "mesh", path = "{BUNNY}" }}\n')
+    assert plain.scene.root.children[0].material is None  # nothing in the file: the default Material, as before
