@@ -12,8 +12,8 @@ from frustum.errors import FrustumError
 from frustum.scene import Node, Scene, cutaway, exploded
 from frustum.scenefile.checks import _boolean, _number, _table, _table_list, _unknown_keys, _vector
 from frustum.scenefile.geometry import _geometry, _mesh_file
-from frustum.scenefile.models import part_material, part_nodes
 from frustum.scenefile.lights_materials import _lights, _material_reference
+from frustum.scenefile.models import part_material, part_nodes
 from frustum.scenefile.report import _BAD, _bad, _Report
 from frustum.scenefile.transforms import _transform
 
