@@ -289,3 +289,36 @@ def test_scene_file_meshes_bring_their_materials_and_textures(tmp_path):
     assert mine.scene.items[0].material.texture is None  # the node's own material wins
     plain = load_scene(f'[camera]\nfit = true\n[[nodes]]\ngeometry = {{ type = "mesh", path = "{BUNNY}" }}\n')
     assert plain.scene.root.children[0].material is None  # nothing in the file: the default Material, as before
+
+
+def test_short_reprs_of_array_holders():
+    from frustum.geometry.io import load_parts
+
+    part = load_parts(SPOT)[0]
+    assert part.texture.shape == (1024, 1024, 3)
+    assert len(repr(part)) < 400 and "<1024x1024x3 image>" in repr(part)
+    material = frustum.Material(texture=part.texture, normal_map=np.zeros((8, 8, 3), np.uint8))
+    assert len(repr(material)) < 400 and "normal_map=<8x8x" in repr(material)
+
+
+def test_random_stl_bytes_are_reported_truncated_not_as_a_memory_need(tmp_path):
+    noise = tmp_path / "noise.stl"
+    noise.write_bytes(np.random.default_rng(5).integers(0, 256, 5000, dtype=np.uint8).tobytes())
+    with pytest.raises(frustum.GeometryError, match="truncated") as caught:
+        frustum.load(noise)
+    assert "GiB" not in str(caught.value)
+
+
+def test_gltf_emissive_factor_and_alpha_mode_reach_the_material(tmp_path):
+    box = trimesh.creation.box()
+    box.visual = trimesh.visual.TextureVisuals(
+        uv=np.zeros((len(box.vertices), 2)),
+        material=trimesh.visual.material.PBRMaterial(baseColorFactor=[255, 0, 0, 128], emissiveFactor=[0, 0.5, 0],
+                                                     alphaMode="OPAQUE"),  # fmt: skip
+    )
+    path = tmp_path / "glow.glb"
+    box.export(path)
+    material = load_scene_file(path).scene.items[0].material
+    assert np.allclose(material.emissive, [0, 0.5, 0], atol=0.01)
+    assert material.opacity == 1.0  # alphaMode OPAQUE ignores alpha
+    assert np.allclose(material.color, [1, 0, 0], atol=0.01)

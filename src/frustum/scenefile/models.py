@@ -46,7 +46,8 @@ def default_lights(camera: Camera) -> list[Any]:
 
 def part_material(part: Any) -> Material:
     """The ``Material`` a loaded ``MeshPart`` carries: its base colour (white under a texture, which it multiplies),
-    its texture, its normal map; a part with none of them gets a light neutral gray."""
+    its texture, its normal map, glTF's emissive factor, its alpha as opacity (not for glTF's alphaMode OPAQUE);
+    a part with none of them gets a light neutral gray."""
     color = part.color
     texture = part.texture
     normal_map = getattr(part, "normal_map", None)
@@ -54,7 +55,11 @@ def part_material(part: Any) -> Material:
         rgb, opacity = ((1.0, 1.0, 1.0) if texture is not None else (0.8, 0.8, 0.78)), 1.0
     else:
         rgb, opacity = tuple(float(c) for c in color[:3]), float(color[3]) if len(color) > 3 else 1.0
-    return Material(color=rgb, texture=texture, normal_map=normal_map, opacity=opacity, specular=0.2)
+    if getattr(part, "alpha_mode", None) == "OPAQUE":  # glTF: alpha is ignored unless the mode is BLEND (or MASK)
+        opacity = 1.0
+    emissive = getattr(part, "emissive", None) or (0.0, 0.0, 0.0)
+    return Material(color=rgb, texture=texture, normal_map=normal_map, opacity=opacity, specular=0.2,
+                    emissive=emissive)  # fmt: skip
 
 
 def part_nodes(parts: list[Any], transform: np.ndarray | None = None) -> list[Node]:

@@ -68,7 +68,7 @@ def _mesh_file_parts(report: _Report, path: tuple, table: dict, base: Path) -> t
         return _BAD, [], None
     if len(parts) == 1 and np.allclose(parts[0].world_from_model, np.eye(4)):
         part = parts[0]
-        has_own = part.texture is not None or part.color is not None or part.normal_map is not None
+        has_own = any(x is not None for x in (part.texture, part.color, part.normal_map, part.emissive))
         return part.mesh, [], part_material(part) if has_own else None
     return None, part_nodes(parts), None
 
