@@ -313,8 +313,9 @@ def test_gltf_emissive_factor_and_alpha_mode_reach_the_material(tmp_path):
     box = trimesh.creation.box()
     box.visual = trimesh.visual.TextureVisuals(
         uv=np.zeros((len(box.vertices), 2)),
-        material=trimesh.visual.material.PBRMaterial(baseColorFactor=[255, 0, 0, 128], emissiveFactor=[0, 0.5, 0],
-                                                     alphaMode="OPAQUE"),  # fmt: skip
+        material=trimesh.visual.material.PBRMaterial(
+            baseColorFactor=[255, 0, 0, 128], emissiveFactor=[0, 0.5, 0], alphaMode="OPAQUE"
+        ),
     )
     path = tmp_path / "glow.glb"
     box.export(path)
@@ -322,3 +323,30 @@ def test_gltf_emissive_factor_and_alpha_mode_reach_the_material(tmp_path):
     assert np.allclose(material.emissive, [0, 0.5, 0], atol=0.01)
     assert material.opacity == 1.0  # alphaMode OPAQUE ignores alpha
     assert np.allclose(material.color, [1, 0, 0], atol=0.01)
+
+
+def test_library_compile_notice_once_and_silenced(monkeypatch, capsys):
+    import frustum.raster as raster
+    from frustum.raster import _jit
+
+    monkeypatch.setattr(raster, "_noticed", [False])
+    monkeypatch.setattr(raster, "compile_notice", raster._library_notice)
+    monkeypatch.setattr(_jit, "NOTICE_AFTER", 0.05)
+    watch = _jit._CompileWatch()
+    watch.on_start(None)  # a compilation that goes on past NOTICE_AFTER
+    import time
+
+    time.sleep(0.3)
+    watch.on_end(None)
+    watch.on_start(None)
+    watch.on_end(None)
+    raster.compile_notice()  # once per process, however often asked
+    lines = [line for line in capsys.readouterr().err.splitlines() if "compiling render kernels" in line]
+    assert len(lines) == 1
+    monkeypatch.setattr(raster, "_noticed", [False])
+    frustum.set_compile_notice(False)
+    assert raster.compile_notice is None
+    frustum.set_compile_notice(True)
+    monkeypatch.setenv("FRUSTUM_COMPILE_NOTICE", "0")
+    raster.compile_notice()
+    assert "compiling" not in capsys.readouterr().err

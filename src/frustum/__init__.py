@@ -209,6 +209,7 @@ _LAZY = {
     "explain_scene_file": "frustum.scenefile",
     "load_scene": "frustum.scenefile",
     "load_scene_file": "frustum.scenefile",
+    "set_compile_notice": "frustum.raster",
     "over_under": "frustum.output.stereo",
     "release_memory": "frustum.render",
     "render": "frustum.render",
@@ -447,6 +448,7 @@ if TYPE_CHECKING:  # pragma: no cover
     )
     from frustum.output.true_curves import find_circles
     from frustum.radiosity import RadiosityError, RadiosityResult, radiosity
+    from frustum.raster import set_compile_notice
     from frustum.raster._jit import set_threads
     from frustum.render import RENDER_METHODS, RENDER_MODES, SHADING_MODES, VISIBILITY_METHODS, release_memory, render
     from frustum.scenefile import (
@@ -787,6 +789,7 @@ __all__ = [
     "scale",
     "scale_label",
     "set_budget",
+    "set_compile_notice",
     "set_threads",
     "shear",
     "side_by_side",
