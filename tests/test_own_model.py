@@ -350,3 +350,25 @@ def test_library_compile_notice_once_and_silenced(monkeypatch, capsys):
     monkeypatch.setenv("FRUSTUM_COMPILE_NOTICE", "0")
     raster.compile_notice()
     assert "compiling" not in capsys.readouterr().err
+
+
+def test_examples_render_what_they_can_and_list_what_needs_an_extra(tmp_path, monkeypatch, capsys):
+    import sys
+
+    gallery = tmp_path / "examples"
+    gallery.mkdir()
+    root = Path(__file__).parents[1] / "examples"
+    shutil.copy(root / "volume_julia.toml", gallery / "a_volume_julia.toml")
+    (gallery / "b_box.toml").write_text('[camera]\nfit = true\n[[nodes]]\ngeometry = { type = "box" }\n')
+    monkeypatch.setitem(sys.modules, "matplotlib", None)  # the colormaps extra is not installed
+    from frustum.scenefile import render_examples
+
+    skipped: list = []
+    written = render_examples(tmp_path / "out", (64, 48), examples_dir=gallery, skipped=skipped)
+    assert [p.name for p in written] == ["b_box.png"] and skipped[0][0] == "a_volume_julia.toml"
+    with pytest.raises(frustum.FrustumError, match="pip install"):
+        render_examples(tmp_path / "out", (64, 48), examples_dir=gallery)  # without `skipped`: as before
+    monkeypatch.setattr("frustum.scenefile.commands.EXAMPLES_DIR", gallery)
+    main(["examples", "--out", str(tmp_path / "cli"), "--size", "64x48"])  # exit 0: no SystemExit
+    out = capsys.readouterr().out
+    assert "skipped a_volume_julia.toml" in out and "pip install 'frustum[colormaps]'" in out

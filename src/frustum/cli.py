@@ -503,11 +503,18 @@ def examples_command(
     out: Annotated[Path, typer.Option(help="Folder for the pictures.")] = Path("examples/out"),
     size: Annotated[str, typer.Option(help="Image size WIDTHxHEIGHT.")] = "320x240",
 ) -> None:
-    """Render the example gallery (examples/*.toml) into a folder."""
+    """Render the example gallery (examples/*.toml) into a folder; examples that need an optional extra which is
+    not installed are listed with the pip command (exit 0)."""
     from frustum.scenefile import render_examples
+    from frustum.scenefile.commands import extra_install_command
 
-    for path in render_examples(out, _image_size(size)):
+    skipped: list[tuple[str, str]] = []
+    for path in render_examples(out, _image_size(size), skipped=skipped):
         console.print(f"wrote {path}", markup=False, highlight=False, soft_wrap=True)
+    for name, message in skipped:  # exit 0: only optional extras are missing
+        command = extra_install_command(message)
+        console.print(f"skipped {name}: needs an optional extra ({command or message})",
+                      markup=False, highlight=False, soft_wrap=True)  # fmt: skip
 
 
 # --- datasets ---------------------------------------------------------------------------------------------------

@@ -5,13 +5,14 @@ counts (``explain_method``), and the example gallery (``render_examples``)."""
 from __future__ import annotations
 
 import importlib
+import re
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from frustum.errors import OutputError, SceneFileError
+from frustum.errors import FrustumError, OutputError, SceneFileError
 from frustum.scenefile.loader import SceneFile, load_scene_file
 from frustum.scenefile.outputs import OUTPUT_SUFFIXES
 
@@ -183,8 +184,12 @@ def render_examples(
     size: tuple[int, int] | None = (320, 240),
     *,
     examples_dir: str | Path | None = None,
+    skipped: list[tuple[str, str]] | None = None,
 ) -> list[Path]:
     """Render every ``*.toml`` of the example gallery to ``out_dir/<stem>.png`` (at `size`; None: each file's own).
+
+    With a `skipped` list, an example that needs an optional extra which is not installed (its error names a
+    ``pip install`` command) is appended as ``(file name, message)`` and the rest are still rendered.
 
     Raises
     ------
@@ -196,4 +201,18 @@ def render_examples(
     if not files:
         raise OutputError(f"render_examples: examples_dir = {str(folder)!r} holds no *.toml scene files")
     out = Path(out_dir)
-    return [render_scene_file(file, out / (file.stem + ".png"), size=size) for file in files]  # type: ignore[misc]
+    written = []
+    for file in files:
+        try:
+            written.append(render_scene_file(file, out / (file.stem + ".png"), size=size))
+        except FrustumError as error:
+            if skipped is None or "pip install" not in str(error):
+                raise
+            skipped.append((file.name, str(error)))
+    return written  # type: ignore[return-value]
+
+
+def extra_install_command(message: str) -> str:
+    """The ``pip install ...`` command an extra-missing error message names ("" when none)."""
+    found = re.search(r"pip install ('[^']+'|\S+)", message)
+    return found.group(0).rstrip(";,.") if found else ""
