@@ -372,3 +372,11 @@ def test_examples_render_what_they_can_and_list_what_needs_an_extra(tmp_path, mo
     main(["examples", "--out", str(tmp_path / "cli"), "--size", "64x48"])  # exit 0: no SystemExit
     out = capsys.readouterr().out
     assert "skipped a_volume_julia.toml" in out and "pip install 'frustum[colormaps]'" in out
+
+
+def test_the_image_size_message_names_the_limit():
+    with pytest.raises(SceneFileError, match="over the limit of 8192 pixels a side") as caught:
+        load_scene('[render]\nsize = [100000, 100000]\n[camera]\neye = [0, 0, 5]\n')
+    assert "not two positive integer" not in str(caught.value)
+    with pytest.raises(SceneFileError, match="is not two positive integer pixel counts"):
+        load_scene('[render]\nsize = [-3, 10]\n[camera]\neye = [0, 0, 5]\n')
