@@ -380,3 +380,14 @@ def test_the_image_size_message_names_the_limit():
     assert "not two positive integer" not in str(caught.value)
     with pytest.raises(SceneFileError, match="is not two positive integer pixel counts"):
         load_scene('[render]\nsize = [-3, 10]\n[camera]\neye = [0, 0, 5]\n')
+
+
+def test_turntable_estimates_its_work_before_the_first_frame(tmp_path):
+    with pytest.raises(SystemExit) as stopped:
+        main(["turntable", str(BUNNY), "-o", str(tmp_path / "t.gif"), "--frames", "100000000"])
+    assert stopped.value.code != 0
+    assert not (tmp_path / "t.gif").exists()
+    from frustum.output.animation import turntable
+
+    with pytest.raises(frustum.OutputError, match=r"frames = 100000000 .* over the work budget"):
+        turntable(load_scene_file(BUNNY).scene, frames=100_000_000, size=(480, 480))
