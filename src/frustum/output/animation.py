@@ -446,8 +446,8 @@ def turntable(
     count = int(frames)
     # the whole turn's work, estimated before the first frame: each frame touches every pixel and every triangle
     triangles = sum(item.mesh.face_count for item in scene.items)
-    check_operations(count * (camera.width * camera.height + triangles), where=where, error=OutputError,
-                     cause=f"frames = {count} of {camera.width}x{camera.height} pixels and {triangles} triangles")  # fmt: skip
+    cause = f"frames = {count} of {camera.width}x{camera.height} pixels and {triangles} triangles"
+    check_operations(count * (camera.width * camera.height + triangles), where=where, cause=cause, error=OutputError)
     turns = _turns(_axis(axis, camera, where), camera.frame.target, count)
 
     def jobs() -> Iterator[tuple[Scene, Camera]]:  # one frame's scene and camera at a time: none are kept
