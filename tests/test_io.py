@@ -199,7 +199,7 @@ def _write(path: Path, data: bytes) -> Path:
     [
         (lambda d: d / "missing.obj", "does not exist"),
         (lambda d: d, "has suffix '\\(none\\)'"),
-        (lambda d: (d / "folder.obj").mkdir() or d / "folder.obj", "is a folder"),
+        (lambda d: (d / "folder.obj").mkdir() or d / "folder.obj", r"is not a regular file \(a folder\)"),
         (lambda d: _write(d / "empty.ply", b""), r"is empty \(0 bytes\)"),
         (lambda d: _write(d / "short.stl", b"\0" * 40), "fewer than the 84-byte binary STL header"),
         (

@@ -166,6 +166,9 @@ def test_control_rejects_bad_construction():
         {"type": "control", "name": "depth_cue", "value": 1},
         {"type": "control", "name": "shading", "value": True},
         {"type": "control", "name": "samples", "value": 16},
+        {"type": "control", "name": {}, "value": 1},  # unhashable name: ignored, not a TypeError (issue 38)
+        {"type": "control", "name": ["mode"], "value": "wireframe"},
+        {"type": {}, "key": []},
         {"type": "pick", "x": 160, "y": 5},
         {"type": "pick", "x": 5},
         {"type": "teleport"},
@@ -278,6 +281,15 @@ def test_pick_unprojects_the_depth_buffer_onto_the_surface_and_matches_trace(tea
 
 
 STAGE_INDEX = {name: k for k, name in enumerate(frustum.STAGE_NAMES)}
+
+
+def test_picks_in_one_list_are_merged_the_latest_wins(teapot_session, monkeypatch):
+    calls = []
+    original = teapot_session.pick
+    monkeypatch.setattr(teapot_session, "pick", lambda x, y: calls.append((x, y)) or original(x, y))
+    replies = teapot_session.replies([{"type": "pick", "x": 10 + k, "y": 60} for k in range(50)])
+    assert calls == [(59, 60)]
+    assert [header["type"] for header, _ in replies] == ["pick"] and replies[0][0]["pixel"] == [59, 60]
 
 
 def test_pick_on_background_is_a_miss(teapot_session):

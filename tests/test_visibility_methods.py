@@ -160,12 +160,13 @@ def test_one_quad_counts_are_exact() -> None:
     assert cut > 0
     assert buffer.stats["fragments"] == 24 + cut  # every pixel once, those the diagonal cuts twice
     assert buffer.stats["pixels_with_fragments"] == 24
-    # ray casting: the index is one inner node (the root) whose left child is a leaf holding both triangles and
-    # whose right child is empty; every ray visits the root and tests its two child boxes, the 24 whose centre
-    # lies over the quad enter the leaf (256 + 24 nodes visited), test both triangles, and hit one
+    # ray casting: the index is one inner node (the root) whose children are two leaves of one triangle each
+    # (both boxes are the quad's box); every ray visits the root and tests the two child boxes, the 24 whose
+    # centre lies over the quad enter both leaves (the quad is flat: the second leaf's entry equals the hit's
+    # t, a possible tie), 256 + 48 nodes visited, test both triangles, and hit one
     rays = render(scene, camera, method="ray-casting")
     assert rays.stats == {
-        "method": "ray-casting", "rays": 256, "hits": 24, "box_tests": 512, "nodes_visited": 280,
+        "method": "ray-casting", "rays": 256, "hits": 24, "box_tests": 512, "nodes_visited": 304,
         "triangle_tests": 48, "tests_per_ray": 0.188, "indexed_triangles": 2, "bvh_nodes": 1,
     }  # fmt: skip
     assert_same_picture(rays, reference, 1.0)
@@ -428,8 +429,8 @@ def test_unknown_method_lists_the_valid_ones() -> None:
     with pytest.raises(FrustumError) as error:
         render(scene, camera, method=3)
     assert all(repr(name) in str(error.value) for name in RENDER_METHODS)
-    with pytest.raises(FrustumError, match=r"method = 'ray-tracing' is unknown; expected one of .*'ray-casting'"):
-        render(scene, camera, method="ray-tracing")
+    with pytest.raises(FrustumError, match=r"method = 'path-tracing' is unknown; expected one of .*'ray-casting'"):
+        render(scene, camera, method="path-tracing")
     with pytest.raises(FrustumError, match="transparency = 'depth-peeling' is unknown; expected one of 'sort'"):
         render(scene, camera, transparency="depth-peeling")
     with pytest.raises(FrustumError, match="mode = 'wireframe' draws lines"):
@@ -505,8 +506,8 @@ def test_scene_file_render_method_and_transparency(tmp_path) -> None:
     assert_same_picture(frame, render(scene_file.scene, scene_file.cameras[0]))
     path.write_text(SCENE_FILE.replace("size = [48, 32]", 'size = [48, 32]\nmethod = "ray-casting"'))
     assert load_scene_file(path).options["method"] == "ray-casting"
-    path.write_text(SCENE_FILE.replace("size = [48, 32]", 'size = [48, 32]\nmethod = "ray-tracing"'))
-    with pytest.raises(SceneFileError, match=r"ball.toml:8: render.method = 'ray-tracing' .*'ray-casting'"):
+    path.write_text(SCENE_FILE.replace("size = [48, 32]", 'size = [48, 32]\nmethod = "path-tracing"'))
+    with pytest.raises(SceneFileError, match=r"ball.toml:8: render.method = 'path-tracing' .*'ray-casting'"):
         load_scene_file(path)
 
 

@@ -199,6 +199,8 @@ _LAZY = {
     "warmup": "frustum.warmup",
     "ANAGLYPH_METHODS": "frustum.output.stereo",
     "RENDER_METHODS": "frustum.render",
+    "RaySegment": "frustum.render.raytrace",
+    "ray_path": "frustum.render.raytrace",
     "RENDER_MODES": "frustum.render",
     "SHADING_MODES": "frustum.render",
     "STEREO_LAYOUTS": "frustum.output.stereo",
@@ -507,6 +509,8 @@ if TYPE_CHECKING:  # pragma: no cover
 
 
 def __getattr__(name: str) -> Any:
+    if name == "steps":  # the teaching layer (frustum.steps), a subpackage loaded on first use
+        return importlib.import_module("frustum.steps")
     module = _LAZY.get(name)
     if module is None:
         raise AttributeError(f"module 'frustum' has no attribute {name!r}")
@@ -643,6 +647,7 @@ __all__ = [
     "RadiosityResult",
     "Ray",
     "RayHits",
+    "RaySegment",
     "RenderJob",
     "Scene",
     "SceneFile",
@@ -766,6 +771,7 @@ __all__ = [
     "quaternion_julia_mesh",
     "quaternion_julia_volume",
     "radiosity",
+    "ray_path",
     "reflect",
     "region_code",
     "release_memory",

@@ -65,8 +65,11 @@ def describe(value: Any, *, limit: int = 80) -> str:
     control characters escaped."""
     if isinstance(value, np.ndarray):
         value = (value.ravel()[:limit] if value.size > limit else value).tolist()  # a huge array is never listed
-    if isinstance(value, list | tuple) and len(value) <= limit and all(isinstance(v, int | float | np.number)
-                                                                       for v in value):  # fmt: skip
+    if (
+        isinstance(value, list | tuple)
+        and len(value) <= limit
+        and all(isinstance(v, int | float | np.number) and not isinstance(v, bool | np.bool_) for v in value)
+    ):  # a boolean among numbers is shown as itself (False), not as 0.0
         text = "(" + ", ".join(repr(float(v)) for v in value) + ("," if len(value) == 1 else "") + ")"
     elif isinstance(value, np.number):
         text = repr(value.item())

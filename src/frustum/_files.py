@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import stat
 import tempfile
 import threading
 from collections.abc import Iterator
@@ -39,6 +40,21 @@ def _file_mode() -> int:
             _umask = os.umask(0o022)
             os.umask(_umask)
     return 0o666 & ~_umask
+
+
+def file_kind(path: str | os.PathLike) -> str:
+    """What an existing path that is not a regular file is: "a folder", "a character device" (``/dev/zero``),
+    "a block device", "a named pipe", "a socket"; "missing" if nothing is there."""
+    try:
+        mode = os.stat(path).st_mode
+    except OSError:
+        return "missing"
+    for test, name in ((stat.S_ISDIR, "a folder"), (stat.S_ISCHR, "a character device"),
+                       (stat.S_ISBLK, "a block device"), (stat.S_ISFIFO, "a named pipe"),
+                       (stat.S_ISSOCK, "a socket"), (stat.S_ISREG, "a regular file")):  # fmt: skip
+        if test(mode):
+            return name
+    return "not a regular file"
 
 
 def os_reason(error: BaseException) -> str:

@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import bisect
 from collections.abc import Sequence
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -295,7 +295,9 @@ class BSPTree:
     [HB 16] "BSP-Tree Method"; [seed] "BSP Trees".
     """
 
-    def __init__(self, polygons: Sequence[ArrayLike] | NDArray, ids: ArrayLike | None = None) -> None:
+    def __init__(
+        self, polygons: Sequence[ArrayLike] | NDArray, ids: ArrayLike | None = None, *, record: Any = None
+    ) -> None:
         polys, labels = _check_polygons(polygons, ids, "BSPTree")
         self.tolerance = _scene_tolerance(polys)
         self._area_tolerance = self.tolerance**2
@@ -313,7 +315,7 @@ class BSPTree:
         self._back: list[int] = []
         self._members: list[NDArray[np.int64]] = []
         self._cells: list[bool] = []
-        self._build()
+        self._build(record)
         # keep only the fragments the tree holds (a split polygon is replaced by its parts), renumbered
         alive = np.concatenate(self._members) if self._members else np.empty(0, dtype=np.int64)
         alive.sort()
@@ -358,12 +360,14 @@ class BSPTree:
         self._size += count
         return np.arange(self._size - count, self._size)
 
-    def _build(self) -> None:
+    def _build(self, record: Any = None) -> None:
         """Iterative construction (no recursion limit): each stack entry is (parent, side, fragment indices).
 
         A group whose polygons all lie behind (or on) every one of their planes is a convex cell, such as a
         convex polyhedron: it becomes one leaf, painted as "faces turned away, then faces turned toward the
         viewer" (within each half no two overlap on the screen), instead of a chain of one node per face.
+        ``record("node", ...)`` (``frustum.steps``), if given, sees each node as it is made: its plane, the
+        polygons on it, the numbers in front and behind, and each split (the polygon and its two parts).
         """
         eps = self.tolerance
         stack: list[tuple[int, int, NDArray[np.int64]]] = [(-1, 0, np.arange(self._size))] if self._size else []
@@ -373,6 +377,10 @@ class BSPTree:
             if len(group) == 1:  # a leaf: one polygon in its own plane
                 node = self._new_node(self._source_planes[self._owners[group[0]]], parent, side, False)
                 self._members.append(group)
+                if record is not None:
+                    record("node", node=node, parent=parent, side=side, plane=self._planes[node], cell=False,
+                           on=[self._corners[i, : self._counts[i]].copy() for i in group.tolist()],
+                           in_front=0, behind=0, splits=[])  # fmt: skip
                 continue
             plane = self._choose_splitter(group)
             distances = self._corners[group] @ plane[:3] + plane[3]  # (m, 8)
@@ -389,18 +397,29 @@ class BSPTree:
             node = self._new_node(plane, parent, side, cell)
             if cell:
                 self._members.append(group)
+                if record is not None:
+                    record("node", node=node, parent=parent, side=side, plane=plane, cell=True,
+                           on=[self._corners[i, : self._counts[i]].copy() for i in group.tolist()],
+                           in_front=0, behind=0, splits=[])  # fmt: skip
                 continue
             self._members.append(group[on])
             front_parts, back_parts = [group[in_front]], [group[behind]]
+            splits = []
             for index in group[straddle].tolist():
                 owner = int(self._owners[index])
                 front, back = _split(self._corners[index, : self._counts[index]], plane, eps)
                 self.split_count += 1
+                if record is not None:
+                    splits.append((self._corners[index, : self._counts[index]].copy(), front, back))
                 for part, parts in ((front, front_parts), (back, back_parts)):
                     pieces = _pieces(part, self._area_tolerance) if part is not None else []
                     if pieces:
                         parts.append(self._append(pieces, owner))
             back_group, front_group = np.concatenate(back_parts), np.concatenate(front_parts)
+            if record is not None:
+                record("node", node=node, parent=parent, side=side, plane=plane, cell=False,
+                       on=[self._corners[i, : self._counts[i]].copy() for i in group[on].tolist()],
+                       in_front=int(in_front.sum()), behind=int(behind.sum()), splits=splits)  # fmt: skip
             if back_group.size:
                 stack.append((node, -1, back_group))
             if front_group.size:
@@ -486,10 +505,16 @@ class BSPTree:
         return [(corners[i, :count], label) for i, count, label in zip(indices.tolist(), counts, labels, strict=True)]
 
     def back_to_front_indices(
-        self, eye: ArrayLike | None = None, direction: ArrayLike | None = None, *, camera: Camera | None = None
+        self,
+        eye: ArrayLike | None = None,
+        direction: ArrayLike | None = None,
+        *,
+        camera: Camera | None = None,
+        record: Any = None,
     ) -> NDArray[np.int64]:
         """(F,) int64 indices into ``fragments`` (and ``ids``) in painting order: the array form of
-        ``back_to_front``, for drawing many fragments at once."""
+        ``back_to_front``, for drawing many fragments at once. ``record("emit", node=..., fragments=...,
+        viewer_in_front=...)`` (``frustum.steps``), if given, sees each node's fragments as they are emitted."""
         where = "BSPTree.back_to_front"
         if sum(value is not None for value in (eye, direction, camera)) != 1:
             raise CameraError(
@@ -520,11 +545,16 @@ class BSPTree:
             entry = stack.pop()
             if entry < 0:
                 order.append(self._members[-1 - entry])
+                if record is not None:
+                    record("emit", node=-1 - entry, fragments=order[-1], viewer_in_front=bool(
+                        sides[-1 - entry] >= -tolerance))  # fmt: skip
                 continue
             if self._cells[entry]:  # convex cell: faces turned away first, then faces turned toward the viewer
                 members = self._members[entry]
                 toward = self._source_planes[self._owners[members]] @ viewer > tolerance
                 order.extend((members[~toward], members[toward]))
+                if record is not None:
+                    record("emit", node=entry, fragments=np.concatenate(order[-2:]), viewer_in_front=None)
                 continue
             if sides[entry] < -tolerance:  # viewer behind: the front subtree is farther
                 near, far = self._back[entry], self._front[entry]
@@ -578,7 +608,9 @@ class _SortItem(NamedTuple):
     high: NDArray
 
 
-def depth_sort(polygons: Sequence[ArrayLike], camera: Camera, ids: ArrayLike | None = None) -> DepthOrder:
+def depth_sort(
+    polygons: Sequence[ArrayLike], camera: Camera, ids: ArrayLike | None = None, *, record: Any = None
+) -> DepthOrder:
     """Painter's algorithm: order `polygons` back to front for `camera`, splitting cyclic overlaps.
 
     The polygons are clipped by the near plane, then mapped to normalized device coordinates, where every
@@ -608,6 +640,10 @@ def depth_sort(polygons: Sequence[ArrayLike], camera: Camera, ids: ArrayLike | N
     camera : Camera
     ids : (len(polygons),) array_like of int, optional
         Labels returned with the fragments; default 0, 1, 2, ….
+    record : callable, optional
+        ``record(event, **values)`` (``frustum.steps``): ``"sorted"`` (the list by z_max), ``"test"`` (which of
+        the tests 1–4 showed that P cannot hide Q), ``"hides"``, ``"move"``, ``"split"``, ``"paint"``,
+        ``"unresolved"``; items are numbered as created (a split's parts get new numbers).
 
     Returns
     -------
@@ -646,7 +682,7 @@ def depth_sort(polygons: Sequence[ArrayLike], camera: Camera, ids: ArrayLike | N
             if inside is None or _polygon_area(inside) <= area_tolerance:
                 continue
         kept.append((inside, int(label), _plane(vertices)))
-    sorter = _DepthSorter(clip_from_world, kept, tolerance)
+    sorter = _DepthSorter(clip_from_world, kept, tolerance, record)
     fragments = sorter.run()
     return DepthOrder(fragments, sorter.split_count, degenerate, clipped, sorter.unresolved_count)
 
@@ -654,7 +690,10 @@ def depth_sort(polygons: Sequence[ArrayLike], camera: Camera, ids: ArrayLike | N
 class _DepthSorter:
     """State of one Newell–Newell–Sancha sort in normalized screen space (see ``depth_sort``)."""
 
-    def __init__(self, clip_from_world: NDArray, kept: list[tuple[Polygon, int, NDArray]], tolerance: float) -> None:
+    def __init__(
+        self, clip_from_world: NDArray, kept: list[tuple[Polygon, int, NDArray]], tolerance: float, record: Any = None
+    ) -> None:
+        self.record = record
         self.clip_from_world = clip_from_world
         self.world_tolerance = tolerance
         self.area_tolerance = tolerance**2
@@ -710,6 +749,10 @@ class _DepthSorter:
         order: list[tuple[Polygon, int]] = [(items[i].world, items[i].label) for i in edge_on]  # paint nothing
         z_max = np.array([self._z_max(i) for i in visible])
         main = [visible[i] for i in np.argsort(z_max, kind="stable")]
+        record = self.record
+        if record is not None:
+            record("sorted", order=list(main[::-1]), edge_on=list(edge_on), polygons=[item.world for item in items],
+                   labels=[item.label for item in items])  # fmt: skip
         moved: list[int] = []
         # the chain of moves since the last paint or split: each polygon hides the next, so meeting a member
         # again closes a cycle
@@ -723,12 +766,18 @@ class _DepthSorter:
                 order.append((items[head].world, items[head].label))
                 (moved if moved else main).pop()
                 chain.clear()
+                if record is not None:
+                    record("paint", item=head, label=items[head].label)
                 continue
             q, pierce = conflict
+            if record is not None:
+                record("hides", p=head, q=q, pierce=pierce)
             if not pierce and q not in chain:  # P hides Q, Q does not hide P: paint Q first
                 chain.extend([head, q] if not chain else [q])
                 (moved if q in moved else main).remove(q)
                 moved.append(q)
+                if record is not None:
+                    record("move", p=head, q=q)
                 continue
             # piercing polygons or a cycle: split Q by P's plane, else P by Q's plane, else one member of the
             # cycle by the plane of another
@@ -739,6 +788,8 @@ class _DepthSorter:
             if self._split_cycle(cycle, moved, main):
                 continue
             self.unresolved_count += 1
+            if record is not None:
+                record("unresolved", item=head)
             order.append((items[head].world, items[head].label))
             (moved if moved else main).pop()
         return order
@@ -762,6 +813,8 @@ class _DepthSorter:
         if len(parts) < 2:
             return False
         new = [self._add(self._item(part, item.label, item.world_plane)) for part in parts]
+        if self.record is not None:
+            self.record("split", victim=victim, by=by, parts=new, polygons=[self.items[i].world for i in new])
         if victim in moved:
             position = moved.index(victim)
             moved[position : position + 1] = new
@@ -801,16 +854,26 @@ class _DepthSorter:
         # depth ranges overlap (Q reaches farther than P's nearest point), then test 1: bounding rectangles
         overlap = (high[:, 2] > p.low[2] + eps) & (low[:, :2] < p.high[:2] - eps).all(axis=1)
         overlap &= (high[:, :2] > p.low[:2] + eps).all(axis=1)
+        record = self.record
+        if record is not None:
+            for k in np.flatnonzero(~overlap):
+                record("test", p=head, q=int(rest[k]), passed=1)
         for k in np.flatnonzero(overlap):
             q = items[int(rest[k])]
             # test 2: P wholly behind Q's plane; test 3: Q wholly in front of P's plane
             if (p.screen @ q.plane[:3] + q.plane[3]).max() <= eps:
+                if record is not None:
+                    record("test", p=head, q=int(rest[k]), passed=2)
                 continue
             if (q.screen @ p.plane[:3] + p.plane[3]).min() >= -eps:
+                if record is not None:
+                    record("test", p=head, q=int(rest[k]), passed=3)
                 continue
             # test 4: the common region of the projections, and the depth difference at its corners
             region = _convex_intersection(p.screen[:, :2], q.screen[:, :2], eps)
             if region is None:
+                if record is not None:
+                    record("test", p=head, q=int(rest[k]), passed=4)
                 continue
             depth_p = -(region @ p.plane[:2] + p.plane[3]) / p.plane[2]
             depth_q = -(region @ q.plane[:2] + q.plane[3]) / q.plane[2]
@@ -818,6 +881,8 @@ class _DepthSorter:
             # a plane's depth carries its on-plane tolerance divided by |C| (steep planes amplify round-off)
             depth_eps = eps * (1.0 / abs(p.plane[2]) + 1.0 / abs(q.plane[2]))
             if difference.min() >= -depth_eps:
+                if record is not None:
+                    record("test", p=head, q=int(rest[k]), passed=4)
                 continue
             return int(rest[k]), bool(difference.max() > depth_eps)
         return None

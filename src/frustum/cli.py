@@ -284,7 +284,10 @@ def trace_command(
 def _load_mesh(path: Path, where: str) -> Mesh:
     """A mesh file as one Mesh (``frustum.geometry.io.load``, else trimesh), errors as one-line GeometryErrors."""
     if not path.is_file():
-        raise GeometryError(f"{where}: mesh = {str(path)!r} does not exist or is not a file; give a mesh file path")
+        from frustum._files import file_kind
+
+        problem = "does not exist" if not path.exists() else f"is not a regular file ({file_kind(path)})"
+        raise GeometryError(f"{where}: mesh = {str(path)!r} {problem}; give a mesh file path")
     try:
         from frustum.geometry.io import load
     except ImportError:  # pragma: no cover - the io module ships with frustum; trimesh directly otherwise
@@ -570,6 +573,14 @@ def serve_command(
         str, typer.Option(help="Interface to listen on; 127.0.0.1 is this machine only, 0.0.0.0 every interface.")
     ] = "127.0.0.1",
     port: Annotated[int, typer.Option(help="TCP port; 0 picks a free one.")] = 8000,
+    allow_origin: Annotated[
+        list[str] | None,
+        typer.Option("--allow-origin", help="Also let pages of this origin (e.g. http://localhost:8888) use the "
+                     "viewer, for deliberate embedding; repeatable. Other pages get 403."),
+    ] = None,
+    no_token: Annotated[
+        bool, typer.Option("--no-token", help="Serve a non-loopback --host without the random URL token.")
+    ] = False,
 ) -> None:
     """Open an interactive viewer of a scene file in the browser (orbit, pan, zoom, the pipeline beside it)."""
     from frustum.viewer.server import serve
@@ -579,9 +590,59 @@ def serve_command(
         if host in ("127.0.0.1", "localhost", "::1"):
             console.print("listening on this machine only; --host 0.0.0.0 serves other machines too; Ctrl-C stops",
                           markup=False, highlight=False, soft_wrap=True)  # fmt: skip
+        elif "?token=" in url:
+            console.print("other machines need the URL with its token; --no-token serves without one; Ctrl-C stops",
+                          markup=False, highlight=False, soft_wrap=True)  # fmt: skip
         console.file.flush()
 
-    serve(scene, host, port, ready=ready)
+    serve(scene, host, port, ready=ready, allow_origins=tuple(allow_origin or ()), token=False if no_token else None)
+
+
+@app.command("steps")
+def steps_command(
+    algorithm: Annotated[str | None, typer.Argument(help="Algorithm name (frustum steps --list).")] = None,
+    scene_file: Annotated[Path | None, typer.Argument(help="A TOML scene file (depth-buffer).")] = None,
+    size: Annotated[str | None, typer.Option(help="Image size WxH for a scene file's camera.")] = None,
+    output: Annotated[Path | None, typer.Option("-o", "--output", help="Output .svg, .gif, .mp4, .html, .md.")] = None,
+    list_algorithms: Annotated[bool, typer.Option("--list", help="List the algorithms and exit.")] = False,
+    from_: Annotated[str | None, typer.Option("--from", help="Segment start x,y,z[,w].")] = None,
+    to: Annotated[str | None, typer.Option("--to", help="Segment end x,y,z[,w].")] = None,
+    points: Annotated[str | None, typer.Option(help="Points x,y[,z];x,y[,z];...")] = None,
+    t: Annotated[str | None, typer.Option("--t", help="Curve parameter in [0, 1].")] = None,
+    level: Annotated[str | None, typer.Option(help="Fractal iterations.")] = None,
+    axis: Annotated[str | None, typer.Option(help="Rotation axis x,y,z.")] = None,
+    point: Annotated[str | None, typer.Option(help="A point on the rotation axis x,y,z.")] = None,
+    angle_deg: Annotated[str | None, typer.Option(help="Rotation angle in degrees.")] = None,
+    knots: Annotated[str | None, typer.Option(help="Knot vector, comma-separated.")] = None,
+    order: Annotated[str | None, typer.Option(help="B-spline order k (degree k - 1).")] = None,
+    u: Annotated[str | None, typer.Option("--u", help="B-spline parameter whose knot span is shown.")] = None,
+    seed: Annotated[str | None, typer.Option(help="Random seed.")] = None,
+    fps: Annotated[float, typer.Option(help="Animation frames (steps) per second.")] = 1.0,
+) -> None:
+    """Record an algorithm of the lecture notes step by step and write its figures, animation, page or table."""
+    from frustum.steps.catalog import build, describe_algorithms
+
+    if list_algorithms:
+        console.print(describe_algorithms(), markup=False, highlight=False, soft_wrap=True)
+        return
+    if algorithm is None or output is None:
+        raise UsageError("frustum steps: give an ALGORITHM and -o out.svg|gif|mp4|html|md (or --list)")
+    options: dict[str, Any] = {"from": from_, "to": to, "points": points, "t": t, "level": level, "axis": axis,
+                               "point": point, "angle_deg": angle_deg, "knots": knots, "order": order, "u": u,
+                               "seed": seed}  # fmt: skip
+    if scene_file is not None:
+        from frustum.scenefile import load_scene_file
+
+        loaded = load_scene_file(scene_file)
+        camera = loaded.camera or loaded.cameras[0]
+        if size is not None:
+            width, height = _image_size(size)
+            camera = Camera(camera.frame, camera.projection, width, height)
+        options.update(scene=loaded.scene, camera=camera)
+    recorded = build(algorithm, options)
+    written = recorded.save(output, fps=fps)
+    console.print(f"frustum steps: {algorithm}, {len(recorded)} steps -> {', '.join(map(str, written))}",
+                  markup=False, highlight=False, soft_wrap=True)  # fmt: skip
 
 
 # --- entry point ------------------------------------------------------------------------------------------------

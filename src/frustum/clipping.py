@@ -42,8 +42,9 @@ Viewing", which holds 3D clipping; [seed] is the lecture notes.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from types import ModuleType
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -85,6 +86,7 @@ def _kernels() -> ModuleType:
 
     return clip
 
+
 REGION_LEFT = 1
 """Region-code bit 1: ``w + x < 0`` (x < −w)."""
 REGION_RIGHT = 2
@@ -115,6 +117,9 @@ MAX_KERNEL_PLANES = 63
 """Planes (the cube's six included) that ``clip_lines`` and ``clip_triangles`` accept: one int64 code bit each."""
 
 _METHODS = ("liang-barsky", "cohen-sutherland", "cyrus-beck")
+
+Recorder = Callable[..., Any]
+"""A ``record=`` hook: called as ``record(event, **values)`` at each step of an algorithm (``frustum.steps``)."""
 
 
 # --- region codes and point clipping ----------------------------------------------------------------------
@@ -312,7 +317,12 @@ class ClippedLines(NamedTuple):
 
 
 def clip_line(
-    p0: ArrayLike, p1: ArrayLike, method: str = "liang-barsky", planes: ArrayLike | None = None
+    p0: ArrayLike,
+    p1: ArrayLike,
+    method: str = "liang-barsky",
+    planes: ArrayLike | None = None,
+    *,
+    record: Recorder | None = None,
 ) -> ClippedSegment | None:
     """The part of the clip-space segment p0 → p1 inside the view volume (and any user planes), or None.
 
@@ -334,6 +344,9 @@ def clip_line(
     method : {"liang-barsky", "cohen-sutherland", "cyrus-beck"}
     planes : (K, 4) or (4,) array_like, optional
         Extra clip-space planes (inside ``a·x + b·y + c·z + d·w >= 0``), applied after the cube's six.
+    record : callable, optional
+        Called as ``record(event, **values)`` at each step (``frustum.steps`` builds its record from it).
+        Liang–Barsky then runs in the Python twin of its kernel (``_liang_barsky``, tested equal bit for bit).
 
     Returns
     -------
@@ -355,10 +368,13 @@ def clip_line(
         raise ClippingError(f"clip_line: method = {method!r} is unknown; expected one of {', '.join(_METHODS)}")
     all_planes = _with_view_volume(planes, "clip_line")
     if method == "cohen-sutherland":
-        return _cohen_sutherland(start, end, all_planes)
+        return _cohen_sutherland(start, end, all_planes, record)
     if method == "cyrus-beck":
         return _cyrus_beck(start, end, all_planes)
-    u0, u1 = _kernels().clip_segment(start, end, all_planes)
+    if record is not None:
+        u0, u1 = _liang_barsky(start, end, all_planes, record)
+    else:
+        u0, u1 = _kernels().clip_segment(start, end, all_planes)
     return _segment(start, end, u0, u1)
 
 
@@ -443,26 +459,67 @@ def clip_line_convex(p0: ArrayLike, p1: ArrayLike, planes: ArrayLike) -> Clipped
     return clipped._replace(start=clipped.start[:3], end=clipped.end[:3])
 
 
-def _cohen_sutherland(start: NDArray, end: NDArray, planes: NDArray) -> ClippedSegment | None:
+def _cohen_sutherland(
+    start: NDArray, end: NDArray, planes: NDArray, record: Recorder | None = None
+) -> ClippedSegment | None:
     ends = [start.copy(), end.copy()]
     u = [0.0, 1.0]
     done = [0, 0]  # planes an end was already moved onto: on it up to round-off, so inside from then on
     codes = [_plane_code(ends[0], planes), _plane_code(ends[1], planes)]
     while True:
+        if record is not None:
+            record("codes", ends=(ends[0].copy(), ends[1].copy()), codes=tuple(codes), u=tuple(u))
         if codes[0] | codes[1] == 0:  # trivial accept
+            if record is not None:
+                record("accept", codes=tuple(codes))
             return ClippedSegment(ends[0], ends[1], float(u[0]), float(u[1]))
         if codes[0] & codes[1]:  # trivial reject: both ends outside one plane
+            if record is not None:
+                record("reject", codes=tuple(codes), common=codes[0] & codes[1])
             return None
         i = 0 if codes[0] else 1  # an end outside some plane
         k = (codes[i] & -codes[i]).bit_length() - 1  # its lowest-order set bit
         d_out, d_in = planes[k] @ ends[i], planes[k] @ ends[1 - i]
         if d_out == d_in:  # parallel to the plane and outside it
+            if record is not None:
+                record("parallel", end=i, plane=k)
             return None
         t = d_out / (d_out - d_in)
         ends[i] = ends[i] + (ends[1 - i] - ends[i]) * t
         u[i] = u[i] + (u[1 - i] - u[i]) * t
         done[i] |= 1 << k
         codes[i] = _plane_code(ends[i], planes) & ~done[i]
+        if record is not None:
+            record("intersect", end=i, plane=k, d_out=float(d_out), d_in=float(d_in), t=float(t),
+                   point=ends[i].copy(), u=float(u[i]))  # fmt: skip
+
+
+def _liang_barsky(start: NDArray, end: NDArray, planes: NDArray, record: Recorder) -> tuple[float, float]:
+    """The Python twin of the kernel ``raster.clip.clip_segment`` (same operations, same order; a test holds
+    them equal bit for bit), calling ``record`` for each plane's ``p_k``, ``q_k`` and the narrowed ``[u0, u1]``."""
+    u0, u1 = 0.0, 1.0
+    for k in range(planes.shape[0]):
+        plane = planes[k]
+        q = plane[0] * start[0] + plane[1] * start[1] + plane[2] * start[2] + plane[3] * start[3]
+        p = q - (plane[0] * end[0] + plane[1] * end[1] + plane[2] * end[2] + plane[3] * end[3])
+        if p == 0.0:
+            if q < 0.0:
+                record("plane", plane=k, p=float(p), q=float(q), u0=u0, u1=u1, case="parallel, outside")
+                record("reject", plane=k)
+                return 1.0, 0.0
+            case = "parallel, inside"
+        elif p < 0.0:
+            u0 = max(u0, q / p)
+            case = "entering"
+        else:
+            u1 = min(u1, q / p)
+            case = "leaving"
+        record("plane", plane=k, p=float(p), q=float(q), u0=float(u0), u1=float(u1), case=case)
+        if u0 > u1:
+            record("reject", plane=k)
+            return 1.0, 0.0
+    record("accept", u0=float(u0), u1=float(u1))
+    return u0, u1
 
 
 def _cyrus_beck(start: NDArray, end: NDArray, planes: NDArray) -> ClippedSegment | None:
@@ -507,7 +564,11 @@ class ClippedPolygon(NamedTuple):
 
 
 def clip_polygon(
-    vertices_h: ArrayLike, attributes: ArrayLike | None = None, planes: ArrayLike | None = None
+    vertices_h: ArrayLike,
+    attributes: ArrayLike | None = None,
+    planes: ArrayLike | None = None,
+    *,
+    record: Recorder | None = None,
 ) -> ClippedPolygon:
     """Sutherland–Hodgman: the polygon cut by the cube's six planes (and any user planes), in clip space.
 
@@ -526,6 +587,8 @@ def clip_polygon(
         Per-vertex values to interpolate (colors, normals, uv, ...).
     planes : (K, 4) or (4,) array_like, optional
         Extra clip-space planes, applied after the cube's six.
+    record : callable, optional
+        Called as ``record(event, **values)``: the polygon after each plane (``frustum.steps``).
 
     Returns
     -------
@@ -551,10 +614,16 @@ def clip_polygon(
             f"clip_polygon: vertices_h has {vertices.shape[0]} rows; a polygon needs at least 3 vertices"
         )
     values = _with_attributes(vertices, attributes)
-    for plane in _with_view_volume(planes, "clip_polygon"):
+    if record is not None:
+        record("start", polygon=values[:, :4].copy())
+    for k, plane in enumerate(_with_view_volume(planes, "clip_polygon")):
         if values.shape[0] == 0:
             break
+        before = values
         values = _clip_against_plane(values, plane)
+        if record is not None:
+            record("plane", plane=k, distances=before[:, :4] @ plane, before=before[:, :4].copy(),
+                   polygon=values[:, :4].copy())  # fmt: skip
     # touching a plane at a point or along an edge leaves no area; and a polygon with no vertex of w > 0 is
     # collapsed onto the clip-space origin (0, 0, 0, 0), the one code-0 point that is no visible position
     if values.shape[0] < 3 or not (values[:, 3] > 0).any():

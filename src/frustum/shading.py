@@ -93,6 +93,12 @@ def _attenuation(value: ArrayLike, where: str) -> Vector3:
     return read_only(coefficients)
 
 
+def _check_cast_shadows(value: Any, where: str) -> None:
+    """``cast_shadows`` (whether surfaces shadow this light where a method draws shadows) must be a bool."""
+    if not isinstance(value, bool | np.bool_):
+        raise ShadingError(f"{where}: cast_shadows = {describe(value)} is not a bool; give True or False")
+
+
 def _texture(value: Any, where: str) -> NDArray[np.float32] | None:
     if value is None:
         return None
@@ -133,6 +139,10 @@ class Material:
     in Phong shading, from the mesh's UVs (``frustum.surface_detail``; flat and Gouraud shading ignore them).
     ``hatch`` (vector output only): the spacing of 45° section lines drawn over the faces in filled SVG/PDF,
     in drawing units, as engineering drawings mark cut surfaces (``cutaway`` sets it on section caps).
+    With ``render(..., method="ray-tracing")`` ``reflectivity`` is the weight of the traced mirror-reflected ray
+    (the same ``(1 − r)·I + r·reflected``), and ``ior`` (index of refraction, > 0; 1 bends nothing, glass 1.5;
+    read by that method only) bends the ray transmitted through a surface of opacity < 1 (Snell's law;
+    docs/ray-tracing.md).
     Raises ``ShadingError`` for a non-finite or negative coefficient, a color outside [0, 1] or a bad texture.
     """
 
@@ -150,9 +160,14 @@ class Material:
     bump: NDArray[np.float32] | None = None
     bump_scale: float = 1.0
     normal_map: NDArray[np.float32] | None = None
+    ior: float = 1.0
 
     def __post_init__(self) -> None:
         where = "Material"
+        ior = as_scalar(self.ior, "ior", where=where, error=ShadingError)
+        if not (math.isfinite(ior) and ior > 0.0):
+            raise ShadingError(f"{where}: ior = {ior!r} is not a finite index of refraction > 0 (glass: 1.5)")
+        object.__setattr__(self, "ior", ior)
         if self.hatch is not None:
             spacing = as_scalar(self.hatch, "hatch", where=where, error=ShadingError)
             if not spacing > 0.0:
@@ -218,9 +233,11 @@ class DirectionalLight:
     direction: Vector3
     color: Vector3 = (1.0, 1.0, 1.0)  # type: ignore[assignment]
     intensity: float = 1.0
+    cast_shadows: bool = True
 
     def __post_init__(self) -> None:
         where = "DirectionalLight"
+        _check_cast_shadows(self.cast_shadows, where)
         object.__setattr__(
             self, "direction", read_only(as_direction(self.direction, "direction", where=where, error=ShadingError))
         )
@@ -246,9 +263,11 @@ class PointLight:
     color: Vector3 = (1.0, 1.0, 1.0)  # type: ignore[assignment]
     intensity: float = 1.0
     attenuation: Vector3 = (1.0, 0.0, 0.0)  # type: ignore[assignment]
+    cast_shadows: bool = True
 
     def __post_init__(self) -> None:
         where = type(self).__name__
+        _check_cast_shadows(self.cast_shadows, where)
         object.__setattr__(
             self, "position", read_only(as_vector3(self.position, "position", where=where, error=ShadingError))
         )
@@ -274,9 +293,11 @@ class SpotLight:
     inner_angle: float = math.radians(20.0)
     outer_angle: float = math.radians(30.0)
     attenuation: Vector3 = (1.0, 0.0, 0.0)  # type: ignore[assignment]
+    cast_shadows: bool = True
 
     def __post_init__(self) -> None:
         where = "SpotLight"
+        _check_cast_shadows(self.cast_shadows, where)
         object.__setattr__(
             self, "position", read_only(as_vector3(self.position, "position", where=where, error=ShadingError))
         )

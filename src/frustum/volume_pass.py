@@ -13,11 +13,12 @@ min/max/empty flags of empty-space skipping.
 
 from __future__ import annotations
 
+import math
 import weakref
 
 import numpy as np
 
-from frustum.budgets import check_operations
+from frustum.budgets import check_memory, check_operations
 from frustum.camera import Camera
 from frustum.errors import FrustumError
 from frustum.geometry.volume import Volume
@@ -34,6 +35,9 @@ TERMINATE = 1.0 - 1.0 / 512.0
 """Early ray termination: a composite ray stops once its accumulated opacity reaches this (what is left behind
 could change a pixel by under half a level)."""
 BISECTIONS = 16
+_BYTES_PER_BLOCK = 84
+"""Work memory per empty-space block of ``volume_arrays``: the cached min/max/flag (12 bytes), this frame's copy
+(12) and the composite mode's float64 temporaries (four of 8 bytes, the index arrays 2 × 8, the flags 4)."""
 _block_cache: weakref.WeakKeyDictionary[Volume, np.ndarray] = weakref.WeakKeyDictionary()
 
 
@@ -64,6 +68,9 @@ def volume_arrays(item: VolumeItem, camera: Camera, lights_packed: tuple[np.ndar
     check_operations(camera.width * camera.height * samples, where="render",
                      cause=f"a volume of shape {volume.shape} with step = {item.step!r} ({samples:.3g} samples per "
                            f"ray) at {camera.width}x{camera.height} pixels", error=FrustumError)  # fmt: skip
+    block_count = math.prod(-(-(n - 1) // kernels.BLOCK) for n in volume.shape)
+    check_memory(block_count * _BYTES_PER_BLOCK, where="render", error=FrustumError,
+                 cause=f"the empty-space blocks of a volume of shape {volume.shape}")  # fmt: skip
     world_from_grid = np.asarray(item.world_from_model) @ volume.model_from_grid
     window_from_grid = camera.viewport_matrix @ camera.clip_from_world @ world_from_grid
     matrices = np.zeros((5, 4, 4))

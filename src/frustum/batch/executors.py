@@ -9,12 +9,19 @@ writes the same files.
 
 Ctrl-C: workers ignore SIGINT; the caller stops handing out jobs, lets the views in flight finish (so no file
 is left half written) and re-raises KeyboardInterrupt.
+
+A killed caller (SIGKILL, an out-of-memory kill) leaves no orphans: each pool worker checks every
+``PARENT_CHECK_SECONDS`` whether its parent is still the process that started it and exits when it is not,
+at once when idle, after the view it is drawing otherwise (that view's files are completed, never cut short).
+The multiprocessing resource tracker exits with the last of them (its pipe closes).
 """
 
 from __future__ import annotations
 
 import os
 import pickle
+import threading
+import time
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import replace
 from typing import Any
@@ -32,7 +39,11 @@ EXECUTORS = ("serial", "process", "ray")
 RAY_BATCH = 16
 """Most views per Ray task: one task per view would make the driver's loop the limit on a large cluster."""
 
-_WORKER: dict[str, Any] = {"scenes": None}
+PARENT_CHECK_SECONDS = 0.5
+"""How often a pool worker checks that its parent process is alive."""
+
+_WORKER: dict[str, Any] = {"scenes": None, "parent": None, "busy": False, "orphaned": False}
+_WORKER_LOCK = threading.Lock()
 
 
 def _cpu_count() -> int:
@@ -90,20 +101,48 @@ def _prepare(jobs: Sequence[RenderJob], where: str) -> tuple[list[tuple[Any, Map
 # --- worker side ------------------------------------------------------------------------------------------------
 
 
-def _init_worker(scenes_blob: bytes, threads: int) -> None:
-    """Pool initializer: unpickle the scenes once, set this worker's kernel threads, ignore Ctrl-C."""
+def _init_worker(scenes_blob: bytes, threads: int, parent: int | None = None) -> None:
+    """Pool initializer: watch the parent (its pid `parent`, given by the parent itself: a worker that starts
+    after its parent died must not take its new parent, init, for it), unpickle the scenes once, set this
+    worker's kernel threads, ignore Ctrl-C."""
     import signal
 
     from frustum.raster._jit import set_threads
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    _WORKER["parent"] = os.getppid() if parent is None else parent
+    if os.getppid() != _WORKER["parent"]:
+        os._exit(0)  # the parent died while this worker was starting
+    threading.Thread(target=_watch_parent, args=(_WORKER["parent"],), name="frustum-parent-watch", daemon=True).start()
     _WORKER["scenes"] = pickle.loads(scenes_blob)
     set_threads(threads)
 
 
+def _watch_parent(parent: int) -> None:
+    """A worker's watchdog: when the parent that started it is gone (the worker has been re-parented), exit
+    now if idle, else mark it so ``_run_in_worker`` exits after the view being drawn."""
+    while True:
+        time.sleep(PARENT_CHECK_SECONDS)
+        if os.getppid() != parent:
+            with _WORKER_LOCK:
+                _WORKER["orphaned"] = True
+                if not _WORKER["busy"]:
+                    os._exit(0)
+
+
 def _run_in_worker(job: RenderJob) -> ViewResult:
-    scene, options = _WORKER["scenes"][job.scene]
-    return render_view(scene, job, options)
+    with _WORKER_LOCK:
+        if _WORKER["orphaned"] or (_WORKER["parent"] is not None and os.getppid() != _WORKER["parent"]):
+            os._exit(0)  # the caller is gone: nobody would receive this view
+        _WORKER["busy"] = True
+    try:
+        scene, options = _WORKER["scenes"][job.scene]
+        return render_view(scene, job, options)
+    finally:
+        with _WORKER_LOCK:
+            _WORKER["busy"] = False
+            if _WORKER["orphaned"]:
+                os._exit(0)  # the view's files are written; its result has no reader
 
 
 class _RayRenderer:
@@ -145,7 +184,8 @@ def _process(scenes: list, jobs: list[RenderJob], workers: int, on_result: Calla
     blob = pickle.dumps(scenes, protocol=pickle.HIGHEST_PROTOCOL)
     # spawn, not fork: a forked child of a process whose kernel threads are running can deadlock
     context = multiprocessing.get_context("spawn")
-    pool = ProcessPoolExecutor(workers, mp_context=context, initializer=_init_worker, initargs=(blob, threads))
+    pool = ProcessPoolExecutor(workers, mp_context=context, initializer=_init_worker,
+                               initargs=(blob, threads, os.getpid()))  # fmt: skip
     pending = iter(jobs)
     in_flight: set = set()
     try:

@@ -186,11 +186,12 @@ def _koch_refine(points: NDArray[np.float64]) -> NDArray[np.float64]:
 
 
 def koch_curve(level: int, start: ArrayLike = (0.0, 0.0), end: ArrayLike = (1.0, 0.0), *,
-               max_bytes: int | None = None) -> Points:  # fmt: skip
+               max_bytes: int | None = None, record: Any = None) -> Points:  # fmt: skip
     """Koch curve from `start` to `end`: a polyline of 4^level segments in the plane z = 0.
 
     Each segment is replaced by four of a third of its length, the middle third raised into an equilateral
-    bump on the left of the direction of travel. D = log 4 / log 3 ≈ 1.2619.
+    bump on the left of the direction of travel. D = log 4 / log 3 ≈ 1.2619. ``record(k, points)``
+    (``frustum.steps``), if given, sees the (M, 2) polyline after each iteration k = 1 … level.
 
     Returns
     -------
@@ -204,8 +205,10 @@ def koch_curve(level: int, start: ArrayLike = (0.0, 0.0), end: ArrayLike = (1.0,
     n = _level(level, where)
     _check_memory((4**n + 1) * 3 * 8 * 3, _budget(max_bytes, where), where=where, name="level", value=n)
     points = np.stack([_point2(start, "start", where), _point2(end, "end", where)])
-    for _ in range(n):
+    for k in range(n):
         points = _koch_refine(points)
+        if record is not None:
+            record(k + 1, points)
     return _with_z(points)
 
 
@@ -874,13 +877,14 @@ def heightfield_mesh(heights: ArrayLike, size: float = 1.0, *, max_bytes: int | 
 
 
 def fractal_coastline(polyline: ArrayLike, level: int, *, seed: int, hurst: float = 0.5, amplitude: float = 0.3,
-                      max_bytes: int | None = None) -> Points:  # fmt: skip
+                      max_bytes: int | None = None, record: Any = None) -> Points:  # fmt: skip
     """Fractal coastline: midpoint displacement of a polyline in the xy plane, `level` times.
 
     Each segment p→q gains the midpoint (p + q)/2 + g·σ_k·n̂, with n̂ the unit normal of p→q in the xy plane,
     g ~ N(0, 1) and σ_k = amplitude·L̄·2^(−k·H) at step k (L̄ the mean initial segment length); z is
     interpolated. Endpoints stay fixed; for a closed outline repeat the first point at the end. The curve's
-    dimension is about 2 − H.
+    dimension is about 2 − H. ``record(k, points, sigma)`` (``frustum.steps``), if given, sees the polyline
+    after each step k = 1 … level and that step's σ_k.
 
     Returns
     -------
@@ -916,4 +920,6 @@ def fractal_coastline(polyline: ArrayLike, level: int, *, seed: int, hurst: floa
         out[1::2] = mid
         out[-1] = points[-1]
         points = out
+        if record is not None:
+            record(k + 1, points, sigma)
     return points

@@ -25,8 +25,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from frustum._arrays import describe
-from frustum._files import atomic_path, os_reason
-from frustum.budgets import check_memory, format_bytes
+from frustum._files import atomic_path, file_kind, os_reason
+from frustum.budgets import check_memory, format_bytes, get_budget
 from frustum.errors import GeometryError
 from frustum.geometry.mesh import Mesh
 
@@ -128,27 +128,26 @@ def load_parts(path: str | Path, texture: str | Path | None = None) -> list[Mesh
     explicit = None if texture is None else _read_image(Path(texture), "load")
     if file.suffix.lower() == ".stl":
         _check_binary_stl_size(file)
+    if file.suffix.lower() == ".glb":
+        _check_glb_chunks(file)
     _check_file_memory(file)
-    text = _obj_text(file) if file.suffix.lower() == ".obj" else None
+    text = _text_bytes(file)
     try:
         if text is not None:
-            scene = trimesh.load_scene(io.BytesIO(text), file_type="obj", process=False,
+            scene = trimesh.load_scene(io.BytesIO(text), file_type=file.suffix.lower()[1:], process=False,
                                        resolver=trimesh.resolvers.FilePathResolver(str(file)))  # fmt: skip
         else:
             scene = trimesh.load_scene(str(file), process=False)
     except MemoryError:
-        raise GeometryError(
-            f"load: path = {str(file)!r} ({format_bytes(file.stat().st_size)}) ran out of memory while loading; "
-            "the file is valid but too large for this machine: free memory or lower the budget with "
-            "frustum.set_budget(bytes=...) so such files are refused up front"
-        ) from None
+        raise _memory_error(file) from None
     except Exception as error:  # trimesh raises many types (ValueError, KeyError, struct.error, ...)
         raise _read_error(file, error) from None
     parts: list[MeshPart] = []
     try:
+        placements = _world_placements(scene.graph)
         nodes = sorted(scene.graph.nodes_geometry)
         for node in nodes:
-            world_from_model, geometry_name = scene.graph[node]
+            world_from_model, geometry_name = placements[node] if node in placements else scene.graph[node]
             geometry = scene.geometry.get(geometry_name)
             if not isinstance(geometry, trimesh.Trimesh) or len(geometry.faces) == 0:
                 continue
@@ -161,6 +160,8 @@ def load_parts(path: str | Path, texture: str | Path | None = None) -> list[Mesh
                                   alpha_mode))  # fmt: skip
     except GeometryError as error:
         raise GeometryError(f"load: path = {str(file)!r} holds invalid geometry ({error}); check the file") from None
+    except MemoryError:
+        raise _memory_error(file) from None
     except Exception as error:
         raise _read_error(file, error) from None
     if not parts:
@@ -265,7 +266,7 @@ def _checked_path(path: Any, where: str) -> Path:
     file = Path(path)
     _suffix(file, where)
     if not file.is_file():
-        problem = "is a folder" if file.is_dir() else "does not exist"
+        problem = "does not exist" if not file.exists() else f"is not a regular file ({file_kind(file)})"
         raise GeometryError(f"{where}: path = {str(file)!r} {problem}; give the path of an existing mesh file")
     if file.stat().st_size == 0:
         raise GeometryError(f"{where}: path = {str(file)!r} is empty (0 bytes); the file is truncated or not written")
@@ -294,6 +295,29 @@ def _check_binary_stl_size(file: Path) -> None:
                  cause=f"path = {str(file)!r} with {count} triangles", error=GeometryError)  # fmt: skip
 
 
+def _check_glb_chunks(file: Path) -> None:
+    """A GLB is a 12-byte header ("glTF", version, length) and chunks of (uint32 length, uint32 type, data):
+    refuse a chunk that announces more bytes than the file holds (trimesh would ask for all of them)."""
+    size = file.stat().st_size
+    with file.open("rb") as stream:
+        head = stream.read(12)
+        if len(head) < 12 or head[:4] != b"glTF":
+            return  # not a binary glTF: trimesh says what it is not
+        offset, index = 12, 0
+        while offset < size:
+            stream.seek(offset)
+            chunk = stream.read(8)
+            if len(chunk) < 8:
+                return  # trimesh reports a chunk header cut short
+            length = int.from_bytes(chunk[:4], "little")
+            if offset + 8 + length > size:
+                raise GeometryError(
+                    f"load: path = {str(file)!r}: GLB chunk {index} announces {length} bytes at byte {offset}, but "
+                    f"the file has {size - offset - 8} more; the file is corrupt or truncated"
+                )
+            offset, index = offset + 8 + length, index + 1
+
+
 _LOAD_BYTES_PER_FILE_BYTE = 12
 """Peak memory of trimesh's loaders per byte of a text mesh file (OBJ, PLY, OFF), a generous estimate."""
 _LOAD_BYTES_PER_TRIANGLE = 400
@@ -307,6 +331,33 @@ def _check_file_memory(file: Path) -> None:
                  cause=f"path = {str(file)!r} ({format_bytes(size)})", error=GeometryError)  # fmt: skip
 
 
+_OBJ_BYTES_PER_FILE_BYTE = 20
+"""Peak memory of trimesh's OBJ reader per byte of the file (measured: 18.4–19.2 for triangle lines)."""
+_OBJ_BYTES_PER_POLYGON_INDEX = 240
+"""Peak memory per vertex index of a face line of more than four (measured: 209–225 bytes beyond the file's
+own, whatever the index text: such lines are split and fan-triangulated in Python lists)."""
+_OBJ_POLYGON_LINE = re.compile(rb"^[ \t]*f(?:[ \t]+\S+){5,}", re.MULTILINE)
+
+
+def _check_obj_memory(file: Path, data: bytes) -> None:
+    """Refuse, through the work budget and before parsing, an OBJ whose reading would take more memory than
+    allowed: the file's bytes and the vertex indices of every polygon line (counted line by line)."""
+    indices, longest, longest_at = 0, 0, 0
+    for match in _OBJ_POLYGON_LINE.finditer(data):
+        end = data.find(b"\n", match.start())
+        count = len(data[match.start() : end if end >= 0 else len(data)].split()) - 1
+        indices += count
+        if count > longest:
+            longest, longest_at = count, match.start()
+    estimate = len(data) * _OBJ_BYTES_PER_FILE_BYTE + indices * _OBJ_BYTES_PER_POLYGON_INDEX
+    cause = f"path = {str(file)!r} ({format_bytes(len(data))})"
+    if longest:
+        line = data.count(b"\n", 0, longest_at) + 1
+        cause += (f" with {indices} vertex indices in polygons of more than 4 (the longest, line {line}, has "
+                  f"{longest})")  # fmt: skip
+    check_memory(estimate, where="load", cause=cause, error=GeometryError)
+
+
 _OBJ_ZERO_INDEX = re.compile(rb"^[ \t]*f[ \t].*?(?<![\w./+-])[+]?0+(?=[/\s]|$)", re.MULTILINE)
 
 
@@ -315,6 +366,7 @@ def _obj_text(file: Path) -> bytes:
     comments are all an OBJ keeps as text), so no charset detector is needed. Face index 0 is refused: OBJ
     indices start at 1 (negative ones count back from the last vertex)."""
     data = file.read_bytes()
+    _check_obj_memory(file, data)
     zero = _OBJ_ZERO_INDEX.search(data)
     if zero:
         line = data.count(b"\n", 0, zero.start()) + 1
@@ -323,11 +375,95 @@ def _obj_text(file: Path) -> bytes:
             f"load: path = {str(file)!r}, line {line}: face {text!r}... uses vertex index 0; OBJ indices start at 1 "
             "(negative ones count back from the last vertex), so the file is malformed"
         )
+    return _utf8(data)
+
+
+def _utf8(data: bytes) -> bytes:
+    """`data` if it is UTF-8, else its Latin-1 reading (every byte is a character) encoded as UTF-8."""
     try:
         data.decode("utf-8")
         return data
     except UnicodeDecodeError:
         return data.decode("latin-1").encode("utf-8")
+
+
+def _text_bytes(file: Path) -> bytes | None:
+    """The bytes trimesh should parse, when they differ from the file's: OBJ always (see ``_obj_text``); an
+    ASCII STL, an OFF file or a PLY header that is not UTF-8, read as Latin-1 and given as UTF-8, so trimesh
+    never asks an optional charset detector (``charset_normalizer``) and a Latin-1 name or comment loads.
+    None: parse the file itself."""
+    suffix = file.suffix.lower()
+    if suffix == ".obj":
+        return _obj_text(file)
+    if suffix not in (".stl", ".off", ".ply"):
+        return None
+    data = file.read_bytes()
+    if suffix == ".stl":
+        if not (data[:5].lower() == b"solid" and b"facet" in data[:1024]):
+            return None  # binary STL: an 80-byte header trimesh does not decode, then numbers
+        if len(data) >= 84 and len(data) == 84 + 50 * int.from_bytes(data[80:84], "little"):
+            return None  # a binary STL whose header happens to start with "solid"
+    if suffix == ".ply":
+        end = data.find(b"end_header")
+        if end < 0:
+            return None  # no header: trimesh says what is wrong
+        header = data[:end]
+        converted = _utf8(header)
+        return None if converted is header else converted + data[end:]
+    converted = _utf8(data)
+    return None if converted is data else converted
+
+
+def _world_placements(graph: Any) -> dict[Any, tuple[NDArray[np.float64], Any]]:
+    """(world_from_model, geometry name) of every node of a trimesh scene graph that holds a geometry, in one
+    walk from the root.
+
+    ``world_from_child = world_from_node · node_from_child`` down each edge, so the walk is linear in the node
+    count (trimesh's ``graph[node]`` finds each node's path and multiplies it with ``multi_dot``, whose
+    matrix-chain ordering is cubic in the depth: 3,000 chained glTF nodes took minutes). As trimesh does,
+    identity edges are skipped and the result is repaired to a rigid transform within ``graph.repair_rigid``.
+    """
+    from trimesh.scene.transforms import fix_rigid
+
+    forest = graph.transforms
+    identity = np.eye(4)
+    placements: dict[Any, tuple[NDArray[np.float64], Any]] = {}
+    stack = [(graph.base_frame, identity)]
+    seen = set()
+    while stack:
+        node, world_from_node = stack.pop()
+        if node in seen:  # a node listed twice (or a cycle in a broken file) is walked once
+            continue
+        seen.add(node)
+        geometry = forest.node_data.get(node, {}).get("geometry")
+        if geometry is not None:
+            matrix = world_from_node
+            if graph.repair_rigid is not None:
+                matrix = fix_rigid(matrix, max_deviance=graph.repair_rigid)
+            placements[node] = (matrix, geometry)
+        for child in forest.children.get(node, ()):
+            node_from_child = forest.edge_data.get((node, child), {}).get("matrix")
+            world_from_child = world_from_node
+            if node_from_child is not None and np.abs(node_from_child - identity).max() > 1e-8:
+                world_from_child = node_from_child if world_from_node is identity else world_from_node @ node_from_child
+            stack.append((child, world_from_child))
+    return placements
+
+
+def _memory_error(file: Path) -> GeometryError:
+    """A MemoryError while loading `file`, said truthfully: corrupt if a valid file of its size fits the budget."""
+    size = file.stat().st_size
+    if size * _LOAD_BYTES_PER_FILE_BYTE < get_budget().bytes:  # a file this small should load: a bad count
+        return GeometryError(
+            f"load: path = {str(file)!r} ({format_bytes(size)}) ran out of memory while loading, although a "
+            f"valid file of this size needs about {format_bytes(size * _LOAD_BYTES_PER_FILE_BYTE)}; the file is "
+            "corrupt (a length or count in it far beyond its data)"
+        )
+    return GeometryError(
+        f"load: path = {str(file)!r} ({format_bytes(size)}) ran out of memory while loading; "
+        "the file is valid but too large for this machine: free memory or lower the budget with "
+        "frustum.set_budget(bytes=...) so such files are refused up front"
+    )
 
 
 def _read_error(file: Path, error: BaseException) -> GeometryError:

@@ -53,6 +53,78 @@ __all__ = [
 TRANSFER_PRESETS = ("grayscale", "bone", "fire")
 """Names ``TransferFunction.preset`` knows (any Matplotlib colormap name works through ``.colormap``)."""
 
+_SLAB_VOXELS = 1 << 20
+"""Voxels per slab of the work done in pieces (finiteness check, reading a .npy): 4 MiB of float32."""
+
+
+def volume_bytes(shape: Any) -> float:
+    """Peak memory of making a ``Volume`` of `shape` beside its source: the float32 copy (4 bytes a voxel) and
+    one slab of work (``_SLAB_VOXELS``: a slab's finiteness flags, or a slab read from a file and converted)."""
+    voxels = math.prod(int(n) for n in shape)
+    return voxels * 4.0 + min(voxels, _SLAB_VOXELS) * 9.0
+
+
+class _Owned:
+    """A float32 C-ordered array a loader has just made: ``Volume`` keeps it instead of copying it."""
+
+    def __init__(self, array: np.ndarray) -> None:
+        self.array = array
+
+
+def _slabs(shape: tuple[int, ...]) -> Any:
+    """(start, stop) along axis 0 covering it in slabs of about ``_SLAB_VOXELS`` voxels."""
+    per_row = max(1, math.prod(shape[1:]))
+    step = max(1, _SLAB_VOXELS // per_row)
+    return ((start, min(start + step, shape[0])) for start in range(0, shape[0], step))
+
+
+def _check_finite(array: np.ndarray, where: str) -> None:
+    """GeometryError naming the first voxel that is NaN or infinite; checked slab by slab (no full-size flags)."""
+    for start, stop in _slabs(array.shape):
+        finite = np.isfinite(array[start:stop])
+        if not finite.all():
+            index = tuple(int(i) for i in np.argwhere(~finite)[0])
+            index = (index[0] + start, *index[1:])
+            count = sum(int(np.count_nonzero(~np.isfinite(array[a:b]))) for a, b in _slabs(array.shape))
+            raise GeometryError(f"{where}: data[{', '.join(map(str, index))}] = {float(array[index])!r} is not "
+                                f"finite ({count} such voxels); voxels must be finite numbers, replace them first, "
+                                "e.g. np.nan_to_num(data, nan=0.0)")  # fmt: skip
+
+
+def _read_npy(name: str, where: str) -> np.ndarray:
+    """A .npy file's 3D array as float32, read slab by slab into its one float32 array (no full-size copy of
+    the file's data in memory: a float32 file is read straight into place)."""
+    from numpy.lib import format as npy
+
+    with open(name, "rb") as stream:
+        try:
+            version = npy.read_magic(stream)
+            read_header = npy.read_array_header_1_0 if version == (1, 0) else npy.read_array_header_2_0
+            shape, fortran, dtype = read_header(stream)
+        except (ValueError, OSError, SyntaxError, UnicodeError) as error:
+            raise GeometryError(f"{where}: path = {name!r} is not a readable .npy array ({error})") from None
+        if len(shape) != 3 or fortran or dtype.hasobject or dtype.kind not in "biuf":
+            return np.load(name, allow_pickle=False, mmap_mode="r")  # Volume says what is wrong, or copies it
+        check_memory(volume_bytes(shape), where=where, cause=f"path = {name!r} with data of shape {shape}",
+                     error=GeometryError)  # fmt: skip
+        array = np.empty(shape, dtype=np.float32)
+        for start, stop in _slabs(shape):
+            count = (stop - start) * math.prod(shape[1:])
+            if dtype == np.dtype("<f4") or (dtype == np.dtype("=f4") and np.little_endian):
+                target = memoryview(array[start:stop].reshape(-1)).cast("B")
+                read = stream.readinto(target)
+                if read != target.nbytes:
+                    raise GeometryError(f"{where}: path = {name!r} ends after {read} of the {target.nbytes} bytes of "
+                                        f"rows {start}..{stop - 1}; the file is truncated")  # fmt: skip
+            else:
+                raw = stream.read(count * dtype.itemsize)
+                if len(raw) != count * dtype.itemsize:
+                    raise GeometryError(f"{where}: path = {name!r} ends inside rows {start}..{stop - 1}; the file is "
+                                        "truncated")  # fmt: skip
+                array[start:stop] = np.frombuffer(raw, dtype=dtype).reshape((stop - start, *shape[1:]))
+    return array
+
+
 _PRESET_COLORS = {
     "grayscale": ((0.0, 0.0, 0.0, 0.0), (1.0, 1.0, 1.0, 1.0)),
     # bone: black through blue-gray to white, as Matplotlib's "bone" (gray with a cold tint)
@@ -278,25 +350,23 @@ class Volume:
     def __init__(self, data: ArrayLike, spacing: ArrayLike = (1.0, 1.0, 1.0), origin: ArrayLike = (0.0, 0.0, 0.0),
                  *, direction: ArrayLike | None = None) -> None:  # fmt: skip
         where = "Volume"
-        if isinstance(data, np.ndarray):
-            check_memory(data.size * 4.0, where=where, cause=f"data of shape {data.shape}", error=GeometryError)
-        try:
-            array = np.array(data, dtype=np.float32, order="C")
-        except (TypeError, ValueError):
-            raise GeometryError(f"{where}: data = {describe(data)} is not numeric; expected a 3D array of "
-                                "numbers") from None  # fmt: skip
+        if isinstance(data, _Owned):  # a float32 array Volume.load has just read: kept, not copied
+            array = data.array
+        else:
+            if isinstance(data, np.ndarray):
+                check_memory(volume_bytes(data.shape), where=where, cause=f"data of shape {data.shape}",
+                             error=GeometryError)  # fmt: skip
+            try:
+                array = np.array(data, dtype=np.float32, order="C")
+            except (TypeError, ValueError):
+                raise GeometryError(f"{where}: data = {describe(data)} is not numeric; expected a 3D array of "
+                                    "numbers") from None  # fmt: skip
         if array.ndim != 3:
             raise GeometryError(f"{where}: data has shape {array.shape} ({array.ndim}D); expected a 3D array "
                                 "(nx, ny, nz)")  # fmt: skip
         if min(array.shape) < 2:
             raise GeometryError(f"{where}: data has shape {array.shape}; every axis needs at least 2 grid points")
-        finite = np.isfinite(array)
-        if not finite.all():
-            index = tuple(int(i) for i in np.argwhere(~finite)[0])
-            count = int(array.size - np.count_nonzero(finite))
-            raise GeometryError(f"{where}: data[{', '.join(map(str, index))}] = {float(array[index])!r} is not "
-                                f"finite ({count} such voxels); voxels must be finite numbers, replace them first, "
-                                "e.g. np.nan_to_num(data, nan=0.0)")  # fmt: skip
+        _check_finite(array, where)
         self.spacing = read_only(as_vector3(spacing, "spacing", where=where, error=GeometryError))
         if not (self.spacing > 0.0).all():
             raise GeometryError(f"{where}: spacing = {describe(self.spacing)} is not positive; give three "
@@ -359,10 +429,10 @@ class Volume:
             raise GeometryError(f"{where}: path = {name!r} is not a file; give an existing .npy, .nii or .nii.gz")
         if lower.endswith(".npy"):
             try:
-                array = np.load(name, allow_pickle=False, mmap_mode="r")
+                array = _read_npy(name, where)
             except (ValueError, OSError) as error:
                 raise GeometryError(f"{where}: path = {name!r} is not a readable .npy array ({error})") from None
-            return cls(array)
+            return cls(_Owned(array) if array.dtype == np.float32 and array.flags.writeable else array)
         if lower.endswith((".nii", ".nii.gz")):
             try:
                 import nibabel

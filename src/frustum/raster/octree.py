@@ -108,7 +108,7 @@ def _covered(tile_counts, written, i0, i1, j0, j1, height, width):
 
 @kernel
 def draw_octree(full_codes, full_offsets, partial_codes, partial_offsets, params, face_rgba, color, depth, written,
-                tile_counts):  # fmt: skip
+                tile_counts, log):  # fmt: skip
     """Draw the full cells of an octree front to back; returns the number of nodes visited.
 
     params (27,): model cube origin (3), side, depth, clip_from_model row-major (16), viewing position in model
@@ -117,7 +117,12 @@ def draw_octree(full_codes, full_offsets, partial_codes, partial_offsets, params
     `tile_counts` (⌈H/8⌉, ⌈W/8⌉) int32 are read and updated (a pixel already written is never changed).
     Children are visited in the order ``mask XOR c``, c = 0 … 7, where bit a of `mask` says the eye lies on
     the high side of the node's centre along axis a: a child never hides one visited before it.
+    Recording mode: `log` (L, 4) int64 gets a row per node visited while rows are left, ``(level, Morton code,
+    outcome, pixels drawn)`` with outcome 0 outside the view volume, 1 on no pixel centre, 2 hidden (every pixel
+    under it already written), 3 drawn (a full cell's faces), 4 its children visited, 5 a finest cell crossing
+    the near plane (not drawn); (0, 4) records nothing.
     """
+    logged = 0
     ox, oy, oz, side = params[0], params[1], params[2], params[3]
     max_level = int(params[4])
     m = params[5:21]
@@ -143,6 +148,10 @@ def draw_octree(full_codes, full_offsets, partial_codes, partial_offsets, params
         top -= 1
         level, code, full = stack_level[top], stack_code[top], stack_full[top]  # full, else partial
         visited += 1
+        log_row = logged
+        if logged < log.shape[0]:
+            log[log_row, 0], log[log_row, 1], log[log_row, 2], log[log_row, 3] = level, np.int64(code), 4, 0
+            logged += 1
         # integer coordinates from the Morton code
         i = j = k = np.uint64(0)
         for bit in range(level):
@@ -169,6 +178,8 @@ def draw_octree(full_codes, full_offsets, partial_codes, partial_offsets, params
                 outside = True
                 break
         if outside:
+            if log_row < log.shape[0]:
+                log[log_row, 2] = 0
             continue
         in_front = True
         for c in range(8):
@@ -189,10 +200,15 @@ def draw_octree(full_codes, full_offsets, partial_codes, partial_offsets, params
             j0 = max(int(np.ceil(ymin - 0.5)), 0)
             j1 = min(int(np.floor(ymax - 0.5)), height - 1)
             if i0 > i1 or j0 > j1:
+                if log_row < log.shape[0]:
+                    log[log_row, 2] = 1
                 continue  # covers no pixel centre
             if _covered(tile_counts, written, i0, i1, j0, j1, height, width):
+                if log_row < log.shape[0]:
+                    log[log_row, 2] = 2
                 continue  # every pixel under it is already written by nearer cells
             if full:
+                before = drawn
                 for axis in range(3):
                     lo = lo_x if axis == 0 else (lo_y if axis == 1 else lo_z)
                     e = ex if axis == 0 else (ey if axis == 1 else ez)
@@ -209,8 +225,12 @@ def draw_octree(full_codes, full_offsets, partial_codes, partial_offsets, params
                         quad[3] = base | (1 << v)
                         drawn += _fill_face(window, quad, face_rgba[2 * axis + (1 - high)], color, depth, written,
                                             tile_counts)  # fmt: skip
+                if log_row < log.shape[0]:
+                    log[log_row, 2], log[log_row, 3] = 3, drawn - before
                 continue
         elif full and level == max_level:
+            if log_row < log.shape[0]:
+                log[log_row, 2] = 5
             continue  # a finest cell crossing the near plane is not drawn
         # a partial node (or a full one crossing the near plane): its non-empty children, front to back
         if full:

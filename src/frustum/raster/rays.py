@@ -3,8 +3,8 @@
 Build (``build``): a binary bounding-volume hierarchy by the binned surface area heuristic [Wald 2007]: at each
 node the triangles' box centres are put into ``BINS`` bins along each of the three axes, and the plane between
 two bins with the least ``A_left·N_left + A_right·N_right`` (A: surface area of the side's bounding box, N: its
-triangle count) splits them; a range of at most ``LEAF_SIZE`` triangles is a leaf (shallow leaves: few
-triangle tests per leaf), a range whose centres coincide is cut in the middle. Nodes hold the boxes of their
+triangle count) splits them; a range of at most ``LEAF_SIZE`` triangles is a leaf (shallow leaves: one
+triangle test per leaf), a range whose centres coincide is cut in the middle. Nodes hold the boxes of their
 two children (one node's boxes are one cache line: float32, rounded outward, so a box never shrinks), and a
 node over triangles ``[s, e)`` numbered ``k`` has its left child at ``k + 1`` and its right child at
 ``k + (m − s)`` (m: the split), so every subtree owns a fixed range of node numbers: the top of the tree is
@@ -41,8 +41,9 @@ from frustum.raster._jit import kernel, parallel_kernel
 
 __all__ = ["BINS", "CAST_STATS", "LEAF_SIZE", "Index", "any_hits", "build", "cast_pixels", "closest_hits"]
 
-LEAF_SIZE = 4
-"""Most triangles in a leaf."""
+LEAF_SIZE = 1
+"""Most triangles in a leaf: one (measured on the bunny against Embree in the same run: first-hit 1.44×, occlusion
+1.62× Embree's time with 1, 1.8–2.0× and 2.0–2.3× with 2, 2.3× and 2.4× with 4; the build pays some 15 % more)."""
 BINS = 16
 """Bins per axis of the binned SAH."""
 PARALLEL_CUTOFF = 16384

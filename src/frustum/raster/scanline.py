@@ -21,6 +21,11 @@ drawn first, as in the depth buffer's test "less".
 
 Counts per row (``stats[j]``): spans drawn, edge updates (non-horizontal edges of active triangles whose
 y range holds the row), depth tests, spans resolved per pixel.
+
+Recording mode (``frustum.steps``): ``active_log`` (H, capacity, 3) gets each row's active list in span order
+(triangle, span start, span end), ``span_log`` (H, 2·capacity + 1, 4) its spans (first pixel, end, the
+triangle that filled it or −1 where it was resolved pixel by pixel, the number of surfaces in); unused entries
+keep the caller's fill. With a first dimension of 0 nothing is written.
 """
 
 from __future__ import annotations
@@ -91,14 +96,16 @@ def _fill(
 def scan_lines(
     xy: np.ndarray, zq: np.ndarray, weights: np.ndarray, code: np.ndarray, box: np.ndarray, order: np.ndarray,
     bucket: np.ndarray, capacity: int, depth: np.ndarray, codes: np.ndarray, bary: np.ndarray, stats: np.ndarray,
-    start: int, stop: int,
+    active_log: np.ndarray, span_log: np.ndarray, start: int, stop: int,
 ) -> None:  # fmt: skip
     """Rows [start, stop) of the image (window row j is array row H − 1 − j).
 
     order (T,) int64: triangles sorted by first row (stable), the edge table; bucket (H + 1,) int64: the
     triangles whose first row is j are ``order[bucket[j]:bucket[j + 1]]``; capacity: the most triangles active
-    on one row. depth, codes, bary: the buffers (depth cleared to 1); stats (H, 4) int64, written per row.
+    on one row. depth, codes, bary: the buffers (depth cleared to 1); stats (H, 4) int64, written per row;
+    active_log, span_log: the recording mode's logs (module docstring), (0, …) when off.
     """
+    recording = active_log.shape[0] > 0
     width = depth.shape[1]
     active = np.empty(capacity, dtype=np.int64)  # triangle indices, sorted by span start
     by_end = np.empty(capacity, dtype=np.int64)  # slots sorted by span end
@@ -156,6 +163,9 @@ def scan_lines(
                 active[m + 1], low[m + 1], high[m + 1] = active[m], low[m], high[m]
                 m -= 1
             active[m + 1], low[m + 1], high[m + 1] = t, lo, hi
+        if recording:
+            for n in range(count):
+                active_log[j, n, 0], active_log[j, n, 1], active_log[j, n, 2] = active[n], low[n], high[n]
         for n in range(count):
             by_end[n] = n
         for n in range(1, count):
@@ -182,14 +192,21 @@ def scan_lines(
             event = min(start_x, end_x)
             if inside > 0 and event > x:
                 spans += 1
+                if recording:
+                    span_log[j, spans - 1, 0], span_log[j, spans - 1, 1] = x, event
+                    span_log[j, spans - 1, 2], span_log[j, spans - 1, 3] = -1, inside
                 if inside == 1:
                     _fill(xy, zq, weights, code, current[0], j, x, event, depth, codes, bary)
+                    if recording:
+                        span_log[j, spans - 1, 2] = current[0]
                 else:
                     left = _nearest(xy, zq, current, inside, x, py)
                     right = _nearest(xy, zq, current, inside, event - 1, py)
                     tests += 2 * inside
                     if left == right:
                         _fill(xy, zq, weights, code, left, j, x, event, depth, codes, bary)
+                        if recording:
+                            span_log[j, spans - 1, 2] = left
                     else:
                         split += 1
                         for i in range(x, event):

@@ -30,7 +30,7 @@ from frustum.raster._jit import kernel
 from frustum.raster.fixed_point import HALF_SUBPIXEL, SUBPIXEL
 from frustum.raster.window import edge_setup, pixel_values, plane_depth
 
-__all__ = ["LEVELS", "STATS", "subdivide"]
+__all__ = ["DECISIONS", "LEVELS", "LOG_COLUMNS", "STATS", "subdivide"]
 
 LEVELS = 32
 STATS = (
@@ -38,6 +38,11 @@ STATS = (
     "outside", "surrounding", "inside", "overlapping", "depth_tests",
 )  # fmt: skip
 OUTSIDE, SURROUNDING, INSIDE, OVERLAPPING = 0, 1, 2, 3
+DECISIONS = ("empty", "surrounding", "single", "pixel", "subdivided")
+"""What finished an area (the log's ``decision`` column): exits 0–3 as in ``STATS``, or 4, quartered."""
+LOG_COLUMNS = ("i0", "j0", "i1", "j1", "level", "decision", "surfaces", "triangle", "relation")
+"""The recording mode's log: one row per area visited, in visiting order (``triangle`` the one drawn or −1;
+``relation`` that triangle's relation to the area, or −1)."""
 
 
 @kernel
@@ -112,10 +117,11 @@ def _draw(
 @kernel
 def subdivide(
     xy: np.ndarray, zq: np.ndarray, weights: np.ndarray, code: np.ndarray, box: np.ndarray, lists: np.ndarray,
-    depth: np.ndarray, codes: np.ndarray, bary: np.ndarray, stats: np.ndarray,
+    depth: np.ndarray, codes: np.ndarray, bary: np.ndarray, stats: np.ndarray, log: np.ndarray,
 ) -> None:  # fmt: skip
     """Warnock's recursion over the whole image (module docstring). lists: int array of at least
-    T·(levels + 2) entries; stats (LEVELS + len(STATS),) int64, added to."""
+    T·(levels + 2) entries; stats (LEVELS + len(STATS),) int64, added to. Recording mode: `log` (A, 9) int64
+    gets one row per area visited (``LOG_COLUMNS``) while rows are left; (0, 9) records nothing."""
     height, width = depth.shape[0], depth.shape[1]
     count = xy.shape[0]
     for t in range(count):
@@ -125,6 +131,7 @@ def subdivide(
     stack[0, 4], stack[0, 5], stack[0, 6], stack[0, 7] = 0, 0, count, count
     size = 1
     s = LEVELS
+    logged = 0
     while size > 0:
         size -= 1
         i0, j0, i1, j1 = stack[size, 0], stack[size, 1], stack[size, 2], stack[size, 3]
@@ -132,6 +139,10 @@ def subdivide(
         stats[min(level, LEVELS - 1)] += 1
         n = 0
         best, best_far = -1, np.inf
+        last_relation = -1
+        if logged < log.shape[0]:
+            log[logged, 0], log[logged, 1], log[logged, 2], log[logged, 3], log[logged, 4] = i0, j0, i1, j1, level
+            log[logged, 5], log[logged, 6], log[logged, 7], log[logged, 8] = 4, 0, -1, -1
         for m in range(parent, parent + length):
             t = np.int64(lists[m])  # one compiled version of the helpers, whatever the list type
             relation = _relation(xy, box, t, i0, j0, i1, j1)
@@ -140,12 +151,19 @@ def subdivide(
                 continue
             lists[top + n] = t
             n += 1
+            last_relation = relation
             if relation == SURROUNDING:
                 near, far = _plane_range(xy, zq, t, i0, j0, i1, j1)
                 if far < best_far:
                     best, best_far = t, far
+        row = logged
+        if logged < log.shape[0]:
+            log[row, 6] = n
+            logged += 1
         if n == 0:
             stats[s + 0] += 1
+            if row < log.shape[0]:
+                log[row, 5] = 0
             continue
         if best >= 0:  # does the nearest surrounding surface hide all others?
             hides = True
@@ -161,10 +179,14 @@ def subdivide(
                     break
             if hides:
                 stats[s + 1] += 1
+                if row < log.shape[0]:
+                    log[row, 5], log[row, 7], log[row, 8] = 1, best, SURROUNDING
                 _draw(xy, zq, weights, code, best, i0, j0, i1, j1, False, depth, codes, bary)
                 continue
         if n == 1:
             stats[s + 2] += 1
+            if row < log.shape[0]:
+                log[row, 5], log[row, 7], log[row, 8] = 2, lists[top], last_relation
             _draw(xy, zq, weights, code, np.int64(lists[top]), i0, j0, i1, j1, True, depth, codes, bary)
             continue
         if i1 - i0 == 1 and j1 - j0 == 1:
@@ -182,6 +204,8 @@ def subdivide(
                     z, _u1, _u2 = pixel_values(xy, zq, weights, t, e0, e1, e2, px, py)
                     if z < chosen_z:
                         chosen, chosen_z = t, z
+            if row < log.shape[0]:
+                log[row, 5], log[row, 7] = 3, chosen
             if chosen >= 0:
                 _draw(xy, zq, weights, code, chosen, i0, j0, i1, j1, False, depth, codes, bary)
             continue

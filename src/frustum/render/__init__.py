@@ -118,6 +118,8 @@ def render(
     method: str = "depth-buffer",
     transparency: str = "sort",
     stats: bool = False,
+    max_depth: int = 5,
+    shadows: bool | str | None = None,
 ) -> Frame:
     """Render `scene` seen by `camera` into a ``Frame`` (color (H, W, 4) uint8 and depth (H, W) float32).
 
@@ -177,7 +179,9 @@ def render(
         The visible-surface method (``RENDER_METHODS``, docs/visibility.md). For the meshes
         (``VISIBILITY_METHODS``): ``"depth-buffer"`` (the default), ``"scan-line"``, ``"area-subdivision"``
         (Warnock), ``"depth-sort"``, ``"bsp"``, ``"ray-casting"`` (a ray per pixel through the scene's BVH) or
-        ``"a-buffer"`` (anti-aliased edges, exact transparency). All
+        ``"a-buffer"`` (anti-aliased edges, exact transparency). ``"ray-tracing"``: Whitted ray tracing (shadow
+        rays, mirror reflection by ``Material.reflectivity``, refraction through surfaces of opacity < 1 by
+        ``Material.ior``, to `max_depth` levels; ``frustum.render.raytrace``, docs/ray-tracing.md). All
         shade with the same model, so where they find the same surface they give the same bytes. Surface modes
         only; each returns its counts in ``Frame.stats``. ``"octree"``: the scene's octrees (``Scene.octrees``)
         by ``visibility.octree.render_octree``, front to back, each face orientation shaded once with the
@@ -189,6 +193,12 @@ def render(
         per subsample through an A-buffer (exact whatever the order, anti-aliased edges; costs fragment memory).
     stats : bool
         ``method="depth-buffer"`` only: also count its depth tests (an extra counting pass) into ``Frame.stats``.
+    max_depth : int
+        ``method="ray-tracing"``: levels of reflected and refracted rays after the primary ray, 0 … 64
+        (0: primary rays and shadow rays only).
+    shadows : bool or None
+        Shadows: shadow rays toward every positioned light with ``cast_shadows`` (``method="ray-tracing"``,
+        where None means on); other methods draw none (None or False).
 
     Raises
     ------
@@ -209,6 +219,7 @@ def render(
         mode=mode, edges=edges, crease_angle=crease_angle, edge_color=edge_color, hidden=hidden,
         hidden_color=hidden_color, line_width=line_width, depth_cue=depth_cue, samples=samples, filter=filter,
         color_space=color_space, buffers=buffers, method=method, transparency=transparency, stats=stats,
+        max_depth=max_depth, shadows=shadows,
     )  # fmt: skip
     if options.factor == 1:
         return resolve(_draw(scene, camera, options), options)
@@ -257,7 +268,11 @@ def _draw_surfaces(scene: Scene, camera: Camera, options: RenderOptions, buffers
             lines.draw_polylines(scene.polylines, camera, options, buffers)
             composite.draw_volumes(scene, camera, buffers)
 
-    if options.method == "depth-buffer" and options.transparency == "sort":
+    if options.method == "ray-tracing":
+        from frustum.render import raytrace
+
+        raytrace.draw_surfaces(scene, camera, options, buffers, between)
+    elif options.method == "depth-buffer" and options.transparency == "sort":
         surfaces.draw_surfaces(scene, scene.items, camera, options, buffers, between)
         if options.counts is not None:
             methods.count_depth_tests(scene.items, camera, options)

@@ -45,10 +45,12 @@ COLOR_SPACES = ("linear", "srgb")
 BUFFERS = ("normals", "object_id")
 TRANSPARENCY_MODES = ("sort", "a-buffer")
 METHOD_NAMES = ("depth-buffer", "scan-line", "area-subdivision", "depth-sort", "bsp", "a-buffer", "octree",
-                "ray-casting")  # fmt: skip
+                "ray-casting", "ray-tracing")  # fmt: skip
 """``render(..., method=...)``, in the order error messages list them (``render.methods.RENDER_METHODS``)."""
 PLANNED_METHODS: dict[str, str] = {}
 """Methods of the visible-surface chapter that this version does not draw yet."""
+MAX_DEPTH = 64
+"""Largest ``max_depth`` (reflection and refraction levels) of ``method="ray-tracing"``."""
 MAX_LINE_WIDTH = 256.0
 """Widest line (and largest point) ``render`` draws, in output pixels."""
 
@@ -76,6 +78,8 @@ DEFAULTS: dict[str, Any] = {
     "method": "depth-buffer",
     "transparency": "sort",
     "stats": False,
+    "max_depth": 5,
+    "shadows": None,
 }
 """``render``'s keyword arguments and their defaults (a test holds them equal to ``render``'s signature)."""
 
@@ -109,6 +113,8 @@ class RenderOptions:
     color_space: str = "linear"
     environment: Any = None  # the scene's EnvironmentMap, for reflections (and the background, below)
     environment_background: bool = False  # no background given: the environment map is the background
+    max_depth: int = 5
+    shadows: bool = False
 
     @classmethod
     def from_keywords(cls, scene: Any, camera: Any, where: str = "render", **keywords: Any) -> RenderOptions:
@@ -131,12 +137,14 @@ class RenderOptions:
         options = method_options(options, k["method"], k["transparency"], k["stats"], where)
         choice(k["filter"], FILTERS, "filter", where)
         choice(k["color_space"], COLOR_SPACES, "color_space", where)
+        depth, shadows = ray_options(options, k["max_depth"], k["shadows"], k["depth_cue"], k["shading"], where)
         check_image_budget(camera, factor, options.buffers, k["filter"], k["color_space"], where)
         environment = getattr(scene, "environment", None)
         return dataclasses.replace(options, factor=factor, filter=k["filter"], color_space=k["color_space"],
                                    environment=environment,
                                    environment_background=environment is not None
-                                   and k["background"] is DEFAULT_BACKGROUND)  # fmt: skip
+                                   and k["background"] is DEFAULT_BACKGROUND,
+                                   max_depth=depth, shadows=shadows)  # fmt: skip
 
     def supersampled(self) -> RenderOptions:
         """The options for the √samples-times larger image: lines √samples times as wide (the same counts dict)."""
@@ -299,3 +307,31 @@ def method_options(options: RenderOptions, method: Any, transparency: Any, stats
     counted = method != "depth-buffer" or transparency != "sort" or bool(stats)
     counts = {"method": method} if counted else None
     return dataclasses.replace(options, method=method, transparency=transparency, counts=counts)
+
+
+def ray_options(options: RenderOptions, max_depth: Any, shadows: Any, depth_cue: Any, shading: Any,
+                where: str) -> tuple[int, bool]:  # fmt: skip
+    """``max_depth`` (0 … MAX_DEPTH) and ``shadows`` (None: on for ``method="ray-tracing"``, off otherwise);
+    what ``"ray-tracing"`` does not draw (other modes, shading models, depth cueing, A-buffer transparency)."""
+    if isinstance(max_depth, bool) or not isinstance(max_depth, int | np.integer) or not 0 <= max_depth <= MAX_DEPTH:
+        raise FrustumError(
+            f"{where}: max_depth = {describe(max_depth)} is not an integer in [0, {MAX_DEPTH}] (levels of reflected "
+            "and refracted rays)"
+        )
+    if shadows is not None and not isinstance(shadows, bool | np.bool_):
+        raise FrustumError(f"{where}: shadows = {describe(shadows)} is not True, False or None")
+    tracing = options.method == "ray-tracing"
+    if shadows and not tracing:
+        raise FrustumError(
+            f"{where}: shadows = {shadows!r} is drawn by method 'ray-tracing' (shadow rays); method = "
+            f"{options.method!r} draws no shadows"
+        )
+    if tracing:
+        name = "none" if shading is None else shading
+        if options.mode != "surface" or name != "phong" or depth_cue is not None or options.transparency != "sort":
+            raise FrustumError(
+                f"{where}: method 'ray-tracing' draws mode 'surface' with shading 'phong', no depth_cue and "
+                f"transparency 'sort' (transparent surfaces refract); got mode = {options.mode!r}, shading = "
+                f"{shading!r}, depth_cue = {describe(depth_cue)}, transparency = {options.transparency!r}"
+            )
+    return int(max_depth), bool(tracing if shadows is None else shadows)

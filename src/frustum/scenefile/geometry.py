@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from frustum._files import file_kind
 from frustum.errors import FrustumError
 from frustum.geometry import Mesh
 from frustum.scene import Node
@@ -376,7 +377,8 @@ def _mesh_file(report: _Report, path: tuple, params: dict, base: Path, loader: C
         return _BAD
     file = (base / name).resolve()
     if not file.is_file():
-        report.add((*path, "path"), name, f"does not exist (looked for {file})",
+        problem = f"is not a regular file ({file_kind(file)})" if file.exists() else "does not exist"
+        report.add((*path, "path"), name, f"{problem} (looked for {file})",
                    "give a mesh file relative to the scene file's folder")  # fmt: skip
         return _BAD
     if len(params) > 1:

@@ -40,7 +40,7 @@ _MAX_PIXELS = 8192
 _RENDER_KEYS = (
     "size", "shading", "specular", "background", "cull_back_faces", "mode", "edges", "crease_angle_deg", "edge_color",
     "hidden", "hidden_color", "line_width", "depth_cue", "samples", "filter", "color_space", "columns", "method",
-    "transparency",
+    "transparency", "max_depth", "shadows",
 )  # fmt: skip
 
 
@@ -83,6 +83,8 @@ def _render_options(report: _Report, path: tuple, value: Any) -> tuple[dict, tup
         "color_space": lambda p, v: _choice(report, p, v, ("linear", "srgb")),
         "method": lambda p, v: _choice(report, p, v, tuple(RENDER_METHODS)),
         "transparency": lambda p, v: _choice(report, p, v, TRANSPARENCY_MODES),
+        "max_depth": lambda p, v: _number(report, p, v, low=0, high=64, integer=True),
+        "shadows": lambda p, v: _boolean(report, p, v),
     }
     for key, check in simple.items():
         if key in params:

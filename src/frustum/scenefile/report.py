@@ -217,6 +217,15 @@ def _problem_text(error: Exception) -> str:
     return escape_control(str(error).splitlines()[0]) if str(error) else type(error).__name__
 
 
+def _toml_text(value: Any) -> str:
+    """``describe(value)`` with booleans spelled as the scene file wrote them: ``[2.2, 1.6, false]``."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, list) and any(isinstance(v, bool) for v in value) and len(value) <= 16:
+        return "[" + ", ".join(_toml_text(v) for v in value) + "]"
+    return describe(value)
+
+
 class _Report:
     """Collects every problem as ``file:line: key = value problem; what is valid``."""
 
@@ -250,7 +259,7 @@ class _Report:
 
     def add(self, path: Sequence, value: Any, problem: str, valid: str) -> None:
         """``key = value problem; valid``."""
-        self.problems.append(f"{self._where(path)}: {_path_text(path)} = {describe(value)} {problem}; {valid}")
+        self.problems.append(f"{self._where(path)}: {_path_text(path)} = {_toml_text(value)} {problem}; {valid}")
 
     def missing(self, path: Sequence, valid: str) -> None:
         self.problems.append(f"{self._where(path)}: {_path_text(path)} is missing; {valid}")
@@ -267,7 +276,9 @@ class _Report:
                 if key in value:
                     path, value = (*path, key), value[key]
                     break
-        self.problems.append(f"{self._where(path)}: {_path_text(path)} = {describe(value)} is not accepted: {message}")
+        self.problems.append(
+            f"{self._where(path)}: {_path_text(path)} = {_toml_text(value)} is not accepted: {message}"
+        )
 
     def raise_if_any(self) -> None:
         if self.problems:

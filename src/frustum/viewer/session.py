@@ -34,13 +34,15 @@ References: [HB 10] "The Three-Dimensional Viewing Pipeline"; [HB 16] "Depth-Buf
 
 from __future__ import annotations
 
+import logging
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
+from contextlib import AbstractContextManager, nullcontext
 from typing import Any
 
 import numpy as np
 
-from frustum._arrays import describe
+from frustum._arrays import describe, escape_control
 from frustum.camera import Camera
 from frustum.clipping import REGION_BOTTOM, REGION_FAR, REGION_LEFT, REGION_NEAR, REGION_RIGHT, REGION_TOP
 from frustum.errors import FrustumError
@@ -50,7 +52,9 @@ from frustum.shading import DepthCue
 from frustum.transforms import apply
 from frustum.viewer.interaction import PROJECTIONS, CameraControl
 
-__all__ = ["CONTROLS", "MODES", "SHADINGS", "ViewerSession", "scene_bounds"]
+__all__ = ["CONTROLS", "MODES", "SHADINGS", "ViewerSession", "frame_bytes", "scene_bounds"]
+
+_log = logging.getLogger("frustum.viewer")
 
 SHADINGS = ("phong", "gouraud", "flat", "normals", "depth", "none")
 """Shading models the viewer offers (``render``'s ``shading``)."""
@@ -89,6 +93,17 @@ def scene_bounds(scene: Scene) -> tuple[np.ndarray, float]:
     low, high = np.min(lows, axis=0), np.max(highs, axis=0)
     radius = float(np.linalg.norm(high - low)) / 2.0
     return (low + high) / 2.0, radius if radius > 0.0 else 1.0
+
+
+def frame_bytes(width: int, height: int, samples: int, object_id: bool = False) -> int:
+    """Peak memory of one viewer frame of width × height pixels with `samples` samples each (bytes).
+
+    Per rendered sample (width·height·samples of them) 24 bytes: measured with the peak RSS of the teapot at
+    1024×768 and 2048×1536, 4 samples (22–23 bytes: color and depth buffers, the renderer's work arrays), plus
+    4 for an ``object_id`` buffer (picks); per output pixel 8 bytes more: the RGBA bytes and their copy in the
+    WebSocket message.
+    """
+    return width * height * (samples * (24 + 4 * object_id) + 8)
 
 
 def _number(value: Any) -> float | None:
@@ -137,6 +152,8 @@ class ViewerSession:
                 "expected 1, 4, 9, 16, ..."
             )
         self.error: str | None = None
+        self.work: Callable[[int, str], AbstractContextManager[Any]] | None = None
+        """Called as ``with work(nbytes, cause):`` around every render (``frustum serve``'s ``WorkLedger``)."""
         self.control: CameraControl
         self.set_scene(scene, camera, options)
         self.rest_samples = rest_samples
@@ -216,7 +233,7 @@ class ViewerSession:
             return "rest"
         if kind == "control":
             name, value = message.get("name"), message.get("value")
-            if name not in CONTROLS or isinstance(value, bool) != (name == "depth_cue"):
+            if not isinstance(name, str) or name not in CONTROLS or isinstance(value, bool) != (name == "depth_cue"):
                 return None
             if value not in CONTROLS[name]:
                 return None
@@ -259,7 +276,15 @@ class ViewerSession:
         from frustum.render import render
 
         self.frames += 1
-        return render(self.scene, self.camera(quality), **self.render_options(quality))
+        camera, options = self.camera(quality), self.render_options(quality)
+        with self._work(camera, options["samples"], quality):
+            return render(self.scene, camera, **options)
+
+    def _work(self, camera: Camera, samples: int, what: str, object_id: bool = False) -> AbstractContextManager[Any]:
+        if self.work is None:
+            return nullcontext()
+        cause = f"a {what} frame of {camera.width} x {camera.height} pixels x samples = {samples}"
+        return self.work(frame_bytes(camera.width, camera.height, samples, object_id), cause)
 
     def frame_header(self, frame: Frame, quality: str, seq: Any = None) -> dict[str, Any]:
         """The JSON header sent before a frame's RGBA bytes."""
@@ -286,11 +311,13 @@ class ViewerSession:
 
     def replies(self, messages: Any) -> list[tuple[dict[str, Any], bytes | None]]:
         """What to send back for page messages (one, or a list that arrived together): (JSON header, RGBA bytes
-        or None) pairs, in order: picks, then at most one frame (its header holding the state).
+        or None) pairs, in order: the answer to a pick, then at most one frame (its header holding the state).
 
         The messages are applied in order and the view is rendered once, at rest quality if any of them asks
-        for it; the frame header carries the last ``seq`` seen (the page measures latency with it). A pick is
-        answered where it comes. ``{"type": "hello"}`` (a page that has just opened) gets the state and a rest
+        for it; the frame header carries the last ``seq`` seen (the page measures latency with it). Picks merge
+        like pointer moves: only the latest of a list is answered (each costs a full-size render). A message
+        whose handling raises is ignored (logged on the ``frustum.viewer`` logger), never raised.
+        ``{"type": "hello"}`` (a page that has just opened) gets the state and a rest
         frame; if every message was ignored the answer is ``{"type": "ignored"}`` (the page then sends its next
         pointer move). A render that fails (a ``FrustumError``, e.g. over the work budget) is answered with
         ``{"type": "error", "message": ...}``, shown above the picture.
@@ -300,19 +327,28 @@ class ViewerSession:
         quality: str | None = None
         seq = None
         ignored = False
+        pick = None
         for message in batch:
-            action = "rest" if isinstance(message, Mapping) and message.get("type") == "hello" else self.handle(message)
+            try:
+                hello = isinstance(message, Mapping) and message.get("type") == "hello"
+                action = "rest" if hello else self.handle(message)
+            except Exception as error:  # the guard: a message that breaks a handler is ignored, not fatal
+                reason = escape_control(str(error)[:120])
+                _log.warning("ignored a viewer message (%s: %s)", type(error).__name__, reason)
+                action = None
             if action is None:
                 ignored = True
             elif action == "pick":
-                try:
-                    out.append((self.pick(message["x"], message["y"]), None))
-                except FrustumError as error:
-                    out.append(({"type": "error", "message": str(error)}, None))
+                pick = message  # picks merge like pointer moves: the latest wins
             elif action:
                 quality = "rest" if "rest" in (quality, action) else action
-                if isinstance(message.get("seq"), int):
+                if isinstance(message.get("seq"), int) and not isinstance(message.get("seq"), bool):
                     seq = message["seq"]
+        if pick is not None:
+            try:
+                out.append((self.pick(pick["x"], pick["y"]), None))
+            except FrustumError as error:
+                out.append(({"type": "error", "message": str(error)}, None))
         if quality is not None:
             try:
                 frame = self.render(quality)
@@ -344,7 +380,8 @@ class ViewerSession:
         options = self.render_options("rest")
         options["samples"] = 1
         options["buffers"] = ("object_id",)
-        frame = render(self.scene, camera, **options)
+        with self._work(camera, 1, "pick", object_id=True):
+            frame = render(self.scene, camera, **options)
         depth = float(frame.depth[row, column])
         result: dict[str, Any] = {"type": "pick", "pixel": [column, row], "hit": False}
         if not depth < 1.0:

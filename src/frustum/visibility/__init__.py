@@ -22,7 +22,8 @@ References
 
 from __future__ import annotations
 
-from typing import Literal
+from collections.abc import Callable
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -72,14 +73,20 @@ def signed_window_areas(window: ArrayLike, faces: ArrayLike) -> NDArray[np.float
 
 
 def backface_mask(
-    vertices: ArrayLike, faces: ArrayLike, camera: Camera, method: Literal["plane", "window"] = "plane"
+    vertices: ArrayLike,
+    faces: ArrayLike,
+    camera: Camera,
+    method: Literal["plane", "window"] = "plane",
+    *,
+    record: Callable[..., Any] | None = None,
 ) -> NDArray[np.bool_]:
     """(M,) bool: True for the back faces of a mesh (world coordinates) seen by `camera`.
 
     ``method="plane"``: ``A·x + B·y + C·z + D·w < 0`` for the viewing position ``(x, y, z, w)``
     (``viewing_position``), in object (world) space. ``method="window"``: signed window area <= 0 after
     ``camera.project`` (clockwise or edge-on); a face with a corner on or behind the eye plane has no window
-    image and is reported by the plane test instead.
+    image and is reported by the plane test instead. ``record``, if given, is called as
+    ``record("planes", planes=..., position=..., values=...)`` with every face's plane test (``frustum.steps``).
 
     Raises
     ------
@@ -94,7 +101,11 @@ def backface_mask(
     points = as_points(vertices, "vertices", where=where)
     triangles = as_faces(faces, points.shape[0], where=where, error=GeometryError)
     planes = plane_equations(points, triangles)
-    by_plane = planes @ viewing_position(camera) < 0.0
+    position = viewing_position(camera)
+    values = planes @ position
+    by_plane = values < 0.0
+    if record is not None:  # frustum.steps: each face's plane test
+        record("planes", planes=planes, position=position, values=values)
     if method == "plane":
         return by_plane
     if method == "window":
@@ -103,4 +114,3 @@ def backface_mask(
         behind = ~np.isfinite(window[triangles].reshape(len(triangles), -1)).all(axis=1)
         return np.where(behind, by_plane, areas <= 0.0)
     raise FrustumError(f"{where}: method = {describe(method)} is unknown; expected 'plane' or 'window'")
-

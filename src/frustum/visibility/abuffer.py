@@ -22,7 +22,10 @@ L. Carpenter, "The A-buffer, an antialiased hidden surface method", SIGGRAPH 198
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import dataclasses
+from collections.abc import Iterator
 
 import numpy as np
 
@@ -30,7 +33,22 @@ from frustum.budgets import check_memory
 from frustum.errors import GeometryError
 from frustum.visibility.window import WindowTriangles
 
-__all__ = ["FRAGMENT_BYTES", "Fragments", "build_fragments", "resolve_fragments"]
+__all__ = ["FRAGMENT_BYTES", "Fragments", "build_fragments", "recording", "resolve_fragments"]
+
+_RECORDING: contextvars.ContextVar[list[dict] | None] = contextvars.ContextVar("a_buffer_log", default=None)
+
+
+@contextlib.contextmanager
+def recording() -> Iterator[list[dict]]:
+    """Recording mode (``frustum.steps``): every ``resolve_fragments`` inside the block appends to the list the
+    ``fragments`` it resolves and their ``premultiplied`` colors (the A-buffer's per-pixel lists as composited)."""
+    logs: list[dict] = []
+    token = _RECORDING.set(logs)
+    try:
+        yield logs
+    finally:
+        _RECORDING.reset(token)
+
 
 FRAGMENT_BYTES = 8 + 2 + 4 + 8 + 8 + 4
 """Bytes per fragment: triangle, mask, and the shading column (depth, code, barycentrics, color)."""
@@ -111,6 +129,9 @@ def resolve_fragments(
     from frustum.raster import abuffer
 
     height, width = color.shape[:2]
+    logs = _RECORDING.get()
+    if logs is not None:
+        logs.append({"fragments": fragments, "premultiplied": premultiplied.copy()})
     stats = np.zeros((height * width, 2), dtype=np.int64)
     abuffer.resolve(
         fragments.starts, fragments.triangle, fragments.mask, premultiplied, triangles.xy, triangles.zq, under,

@@ -13,6 +13,9 @@ The kernel is ``raster.octree.draw_octree`` (serial: the traversal order is the 
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
+from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
@@ -25,7 +28,22 @@ from frustum.frame import Frame, background_bytes
 from frustum.geometry.octree import Octree
 from frustum.shading import LIGHT_TYPES, DirectionalLight, Light, Material, illuminate
 
-__all__ = ["draw_octree_into", "octree_face_colors", "render_octree"]
+__all__ = ["draw_octree_into", "octree_face_colors", "recording", "render_octree"]
+
+_RECORDING: contextvars.ContextVar[list[np.ndarray] | None] = contextvars.ContextVar("octree_log", default=None)
+
+
+@contextlib.contextmanager
+def recording() -> Iterator[list[np.ndarray]]:
+    """Recording mode (``frustum.steps``): every ``draw_octree_into`` inside the block appends its traversal log,
+    an (N, 4) int64 array of ``(level, Morton code, outcome, pixels drawn)`` per node visited in order
+    (``raster.octree.draw_octree``)."""
+    logs: list[np.ndarray] = []
+    token = _RECORDING.set(logs)
+    try:
+        yield logs
+    finally:
+        _RECORDING.reset(token)
 
 _AXES = np.array([[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]], dtype=np.float64)
 _DEFAULT_LIGHTS: tuple[Light, ...] = (DirectionalLight((-0.4, -0.6, -1.0)),)
@@ -71,8 +89,16 @@ def draw_octree_into(
         tile_counts[:] = padded.reshape(tiles[0], kernels.TILE, tiles[1], kernels.TILE).sum(axis=(1, 3))
     full_codes = np.concatenate([np.asarray(c, dtype=np.uint64) for c in octree.full])
     partial_codes = np.concatenate([np.asarray(c, dtype=np.uint64) for c in octree.partial])
-    return int(kernels.draw_octree(full_codes, full_offsets, partial_codes, partial_offsets, params,
-                                   np.ascontiguousarray(face_rgba), color, depth, written, tile_counts))  # fmt: skip
+    logs = _RECORDING.get()
+    # a full node crossing the near plane is visited through its children, which are no nodes of the octree:
+    # room for eight times the nodes (a longer traversal keeps its first rows)
+    log = np.full((8 * octree.node_count + 64 if logs is not None else 0, 4), -1, dtype=np.int64)
+    rgba = np.ascontiguousarray(face_rgba)
+    visited = int(kernels.draw_octree(full_codes, full_offsets, partial_codes, partial_offsets, params, rgba, color,
+                                      depth, written, tile_counts, log))  # fmt: skip
+    if logs is not None:
+        logs.append(log[: min(visited, log.shape[0])])
+    return visited
 
 
 def render_octree(
@@ -131,5 +157,3 @@ def render_octree(
     faces = octree_face_colors(octree, material, lights, matrix, camera.frame.eye)
     draw_octree_into(octree, camera, matrix, faces, color, depth, written)
     return Frame(color=color, depth=depth)
-
-

@@ -15,11 +15,30 @@ References
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
+from collections.abc import Iterator
+
 import numpy as np
 
 from frustum.visibility.window import WindowTriangles
 
-__all__ = ["scan_line"]
+__all__ = ["recording", "scan_line"]
+
+_RECORDING: contextvars.ContextVar[list[dict] | None] = contextvars.ContextVar("scan_line_log", default=None)
+
+
+@contextlib.contextmanager
+def recording() -> Iterator[list[dict]]:
+    """Recording mode (``frustum.steps``): every ``scan_line`` run inside the block appends a dict to the list:
+    ``order``, ``bucket`` (the edge table), ``active`` (H, capacity, 3) and ``spans`` (H, 2·capacity + 1, 4)
+    (``raster.scanline``'s logs, −1 where unused), ``box`` (T, 4) and ``code`` (T,) of the triangles."""
+    logs: list[dict] = []
+    token = _RECORDING.set(logs)
+    try:
+        yield logs
+    finally:
+        _RECORDING.reset(token)
 
 
 def scan_line(triangles: WindowTriangles, depth: np.ndarray, codes: np.ndarray, bary: np.ndarray) -> dict:
@@ -52,10 +71,17 @@ def scan_line(triangles: WindowTriangles, depth: np.ndarray, codes: np.ndarray, 
     np.add.at(rows, box[:, 3] + 1, -1)
     capacity = int(max(1, np.cumsum(rows).max(initial=0)))
     stats = np.zeros((height, len(scanline.STATS)), dtype=np.int64)
+    logs = _RECORDING.get()
+    rows = height if logs is not None else 0
+    active_log = np.full((rows, capacity, 3), -1, dtype=np.int64)
+    span_log = np.full((rows, 2 * capacity + 1, 4), -1, dtype=np.int64)
     scanline.scan_lines(
         triangles.xy, triangles.zq, triangles.weights, triangles.code, box, order, bucket, capacity, depth, codes,
-        bary, stats,
+        bary, stats, active_log, span_log,
     )  # fmt: skip
+    if logs is not None:
+        logs.append({"order": order, "bucket": bucket, "active": active_log, "spans": span_log, "box": box.copy(),
+                     "code": triangles.code.copy()})  # fmt: skip
     totals = stats.sum(axis=0)
     result = {name: int(value) for name, value in zip(scanline.STATS, totals, strict=True)}
     result["active_max"] = capacity if triangles.count else 0

@@ -13,13 +13,31 @@ References
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
+from collections.abc import Iterator
+
 import numpy as np
 
 from frustum.budgets import check_memory
 from frustum.errors import GeometryError
 from frustum.visibility.window import WindowTriangles
 
-__all__ = ["area_subdivision"]
+__all__ = ["area_subdivision", "recording"]
+
+_RECORDING: contextvars.ContextVar[list[np.ndarray] | None] = contextvars.ContextVar("warnock_log", default=None)
+
+
+@contextlib.contextmanager
+def recording() -> Iterator[list[np.ndarray]]:
+    """Recording mode (``frustum.steps``): every ``area_subdivision`` run inside the block appends its area log,
+    an (A, 9) int64 array (``raster.warnock.LOG_COLUMNS``: one row per area visited, in order), to the list."""
+    logs: list[np.ndarray] = []
+    token = _RECORDING.set(logs)
+    try:
+        yield logs
+    finally:
+        _RECORDING.reset(token)
 
 
 def area_subdivision(triangles: WindowTriangles, depth: np.ndarray, codes: np.ndarray, bary: np.ndarray) -> dict:
@@ -46,9 +64,15 @@ def area_subdivision(triangles: WindowTriangles, depth: np.ndarray, codes: np.nd
     )  # fmt: skip
     lists = np.empty(entries, dtype=np.int32 if itemsize == 4 else np.int64)
     stats = np.zeros(warnock.LEVELS + len(warnock.STATS), dtype=np.int64)
+    logs = _RECORDING.get()
+    # an area of two pixels or more has at least two non-empty quarters, so at most 2·W·H areas are visited
+    log = np.full((2 * width * height + 1 if logs is not None else 0, 9), -1, dtype=np.int64)
     warnock.subdivide(
-        triangles.xy, triangles.zq, triangles.weights, triangles.code, triangles.box, lists, depth, codes, bary, stats
-    )
+        triangles.xy, triangles.zq, triangles.weights, triangles.code, triangles.box, lists, depth, codes, bary, stats,
+        log,
+    )  # fmt: skip
+    if logs is not None:
+        logs.append(log[: int(stats[: warnock.LEVELS].sum())])
     per_level = stats[: warnock.LEVELS]
     used = int(np.flatnonzero(per_level).max(initial=-1)) + 1
     result: dict = {"areas_per_level": [int(n) for n in per_level[:used]], "areas": int(per_level.sum())}

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -89,12 +90,15 @@ def _de_casteljau(points: FloatArray, t: FloatArray) -> FloatArray:
     return level[0]
 
 
-def _split_batch(pieces: FloatArray, t: float) -> tuple[FloatArray, FloatArray]:
-    """Split every control polygon of `pieces` (M, n+1, d) at t: the seed's A, AB, ABC, ABCD construction."""
+def _split_batch(pieces: FloatArray, t: float, record: Any = None) -> tuple[FloatArray, FloatArray]:
+    """Split every control polygon of `pieces` (M, n+1, d) at t: the seed's A, AB, ABC, ABCD construction.
+    ``record(level)`` (``frustum.steps``), if given, sees each level of points."""
     level = pieces
     left, right = [level[:, 0]], [level[:, -1]]
     for _ in range(pieces.shape[1] - 1):
         level = (1.0 - t) * level[:, :-1] + t * level[:, 1:]
+        if record is not None:
+            record(level)
         left.append(level[:, 0])
         right.append(level[:, -1])
     return np.stack(left, axis=1), np.stack(right[::-1], axis=1)

@@ -120,7 +120,7 @@ def _basis_matrix(knots: FloatArray, degree: int, count: int, u: FloatArray, ord
     return curve.evaluate(u)
 
 
-def cox_de_boor(knots: ArrayLike, i: int, k: int, u: ArrayLike) -> FloatArray | float:
+def cox_de_boor(knots: ArrayLike, i: int, k: int, u: ArrayLike, *, record: Any = None) -> FloatArray | float:
     """The B-spline basis function of order k (degree k − 1) by the seed's Cox–de Boor recursion.
 
     ``N_{i,k}(u) = (u − x_i)·N_{i,k−1}(u) / (x_{i+k−1} − x_i) + (x_{i+k} − u)·N_{i+1,k−1}(u) / (x_{i+k} − x_{i+1})``
@@ -138,6 +138,8 @@ def cox_de_boor(knots: ArrayLike, i: int, k: int, u: ArrayLike) -> FloatArray | 
         Order >= 1.
     u : float or (N,) array_like
         Parameters in [x_0, x_{m−1}].
+    record : callable, optional
+        Called as ``record(i, k, values)`` for every N_{i,k} the recursion computes (``frustum.steps``).
 
     References
     ----------
@@ -160,21 +162,25 @@ def cox_de_boor(knots: ArrayLike, i: int, k: int, u: ArrayLike) -> FloatArray | 
         )
     s, scalar = _as_parameters(u, "u", float(x[0]), float(x[-1]), where=where)
     last = int(np.flatnonzero(x[:-1] < x[1:])[-1]) if (x[:-1] < x[1:]).any() else -1
-    values = _cox_de_boor(x, int(i), k, s, last)
+    values = _cox_de_boor(x, int(i), k, s, last, record)
     return float(values[0]) if scalar else values
 
 
-def _cox_de_boor(x: FloatArray, i: int, k: int, u: FloatArray, last: int) -> FloatArray:
+def _cox_de_boor(x: FloatArray, i: int, k: int, u: FloatArray, last: int, record: Any = None) -> FloatArray:
+    """N_{i,k}(u); ``record(i, k, values)`` (``frustum.steps``), if given, sees every N_{i,k} computed."""
     if k == 1:
         inside = (x[i] <= u) & (u < x[i + 1])
         if i == last:
             inside |= u == x[i + 1]
-        return inside.astype(np.float64)
-    out = np.zeros_like(u)
-    if x[i + k - 1] != x[i]:
-        out += (u - x[i]) * _cox_de_boor(x, i, k - 1, u, last) / (x[i + k - 1] - x[i])
-    if x[i + k] != x[i + 1]:
-        out += (x[i + k] - u) * _cox_de_boor(x, i + 1, k - 1, u, last) / (x[i + k] - x[i + 1])
+        out = inside.astype(np.float64)
+    else:
+        out = np.zeros_like(u)
+        if x[i + k - 1] != x[i]:
+            out += (u - x[i]) * _cox_de_boor(x, i, k - 1, u, last, record) / (x[i + k - 1] - x[i])
+        if x[i + k] != x[i + 1]:
+            out += (x[i + k] - u) * _cox_de_boor(x, i + 1, k - 1, u, last, record) / (x[i + k] - x[i + 1])
+    if record is not None:
+        record(i, k, out)
     return out
 
 

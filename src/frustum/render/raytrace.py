@@ -1,0 +1,483 @@
+"""Whitted ray tracing: ``render(..., method="ray-tracing")`` and the rays of one pixel (``ray_path``).
+
+From the eye through the centre of each pixel a primary ray goes from the near plane toward the far plane (the
+view volume, as ``method="ray-casting"``: back faces skipped when culling); at the nearest surface it meets
+[HB 21 "Ray-Tracing Methods": basic ray-tracing algorithm, reflection and refraction]:
+
+* the local color ``I_local`` is the illumination formula of ``frustum.shading`` (the one the depth buffer
+  evaluates per pixel with ``shading="phong"``: interpolated vertex normal, flipped toward the ray on a back
+  face; base color = material color × vertex color; the same ambient, diffuse and specular terms, Blinn-Phong or
+  Phong), where each positioned light's diffuse and specular terms are multiplied by its visibility: a shadow ray
+  from the point toward the light (to a point or spot light's position, or along a directional light's to-light
+  direction without end) blocked by any surface, when shadows are on (``shadows`` None or True) and the light
+  has ``cast_shadows``. Shadow rays are cast only where ``N·L > 0`` (elsewhere the light adds nothing anyway).
+  Every surface blocks light, transparent ones included;
+* a **reflected** ray ``R = I + 2(N·(−I))N`` when ``Material.reflectivity`` k_r > 0;
+* a **refracted** ray when ``Material.opacity`` α < 1, bent by Snell's law ``η₁ sin θ₁ = η₂ sin θ₂`` with
+  ``η = 1/ior`` entering a surface from its front and ``ior`` leaving through its back (the outside is air:
+  index 1; media are not nested), ``T = ηI + (η cos θ₁ − √(1 − η²(1 − cos² θ₁)))N``. Beyond the critical angle
+  (``η² sin² θ₁ > 1``) the light is **totally reflected**: the transmitted weight goes to the reflected ray.
+
+The contributions are weighted without a Fresnel term (the default and only weighting; the textbook's
+``I = I_local + k_r·I_r + k_t·I_t`` with the local part scaled so that weights sum to one)::
+
+    I = (1 − k_r)·(α·I_local + (1 − α)·I_t) + k_r·I_r
+
+so that an opaque matte surface (k_r = 0, α = 1) gives the depth buffer's color, a perfect mirror (k_r = 1)
+only what it reflects, and a transparent surface of ``ior = 1`` the depth buffer's blend ``α·I + (1 − α)·behind``.
+Rays that leave the scene see the ``background`` color. After ``max_depth`` levels of reflected and refracted rays
+no more are spawned (their share of the color is black), and rays whose weight is below ``MIN_WEIGHT`` are not
+traced. The normal used to reflect and refract is the interpolated (shading) normal; rays start ``ε`` (1e-9 of
+the scene's size) off the surface along the geometric normal, on the side they leave to, so that they do not meet
+it again.
+
+The depth buffer receives the window depth of each primary hit, so volumes and particles are composited along
+the primary rays exactly as with ``method="ray-casting"``; ``buffers=("normals", "object_id")`` show the primary
+hit's. Surface textures are not sampled by this method (the base color is the material's and the vertex
+colors'). Every ray goes through the scene's ray index (``Scene.intersect``, ``Scene.occluded``:
+``raster.rays``); the shading is vectorized NumPy over the rays of one level, so no kernel beyond the index's
+two is compiled.
+
+References
+----------
+[HB 21] "Ray-Tracing Methods": "Basic Ray-Tracing Algorithm", "Ray-Surface Intersection Calculations",
+"Reflection and Refraction" (Snell's law, total internal reflection); T. Whitted, "An Improved Illumination
+Model for Shaded Display", CACM 23(6), 1980.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import NamedTuple
+
+import numpy as np
+from numpy.typing import NDArray
+
+from frustum.budgets import check_operations
+from frustum.camera import Camera
+from frustum.errors import FrustumError
+from frustum.raster.power import textbook_power
+from frustum.render.buffers import Buffers
+from frustum.render.options import RenderOptions
+from frustum.scene import Scene
+from frustum.shading import AmbientLight, DirectionalLight, SpotLight, pack_lights
+
+__all__ = ["MIN_WEIGHT", "RaySegment", "draw_surfaces", "ray_path"]
+
+MIN_WEIGHT = 1.0 / 1024.0
+"""Reflected and refracted rays whose share of a pixel's color is below this are not traced (< 1/4 of a level)."""
+CHUNK = 1 << 17
+"""Primary rays traced together (memory: about 2 KiB per ray of work arrays)."""
+COST_PER_RAY = 64
+"""Operations counted per ray against the work budget (a ray through the index: some tens of box and triangle
+tests)."""
+
+
+class RaySegment(NamedTuple):
+    """One ray of a pixel's tree (``ray_path``).
+
+    ``kind``: "primary", "reflected", "refracted" or "shadow"; ``depth``: 0 for the primary ray and its shadow
+    rays, +1 per reflection or refraction; ``parent``: the index in the path of the ray whose hit spawned it (−1
+    for the primary ray); ``origin``, ``direction`` (unit for reflected and refracted rays; the primary ray's runs
+    from the near to the far plane over t in [0, 1); a shadow ray's to a point light ends at t = 1);
+    ``t`` the hit's distance (inf: none; a shadow ray: where it is blocked); ``item`` (index into ``Scene.items``)
+    and ``face`` of the hit (−1); ``point`` and ``normal`` (the interpolated unit normal turned toward the ray) of
+    the hit (NaN without one); ``weight`` the ray's share of the pixel's color; ``light`` (shadow rays: the index
+    of the light in ``Scene.world_lights()``, else −1); ``blocked`` (shadow rays: whether a surface hides the
+    light); ``total_internal_reflection``: a reflected ray that also carries the refracted share."""
+
+    kind: str
+    depth: int
+    parent: int
+    origin: NDArray[np.float64]
+    direction: NDArray[np.float64]
+    t: float
+    item: int
+    face: int
+    point: NDArray[np.float64]
+    normal: NDArray[np.float64]
+    weight: float
+    light: int = -1
+    blocked: bool = False
+    total_internal_reflection: bool = False
+
+
+class _Scene:
+    """What the tracer reads of a scene, gathered once: the ray index, per-item material arrays, world vertex
+    normals and colors with faces in global vertex numbers, and the lights."""
+
+    def __init__(self, scene: Scene, specular_phong: bool, shadows: bool) -> None:
+        found = scene._triangle_index(where="render")
+        self.empty = found is None
+        self.lights = scene.world_lights()
+        self.ambient, _ = pack_lights(self.lights)
+        self.positioned = [(i, light) for i, light in enumerate(self.lights) if not isinstance(light, AmbientLight)]
+        self.shadows = shadows
+        self.specular_phong = specular_phong
+        if found is None:
+            return
+        items, self.index, self.starts = found
+        self.numbers, self.swapped = scene._pick_index[4], scene._pick_index[5]
+        materials = [item.material for item in items]
+        self.color = np.array([m.color for m in materials], dtype=np.float64)
+        self.emissive = np.array([m.emissive for m in materials], dtype=np.float64)
+        self.k = np.array([[m.ambient, m.diffuse, m.specular, m.shininess] for m in materials], dtype=np.float64)
+        self.reflectivity = np.array([m.reflectivity for m in materials], dtype=np.float64)
+        self.opacity = np.array([m.opacity for m in materials], dtype=np.float64)
+        self.ior = np.array([m.ior for m in materials], dtype=np.float64)
+        normals, faces, colors, offset = [], [], [], 0
+        any_colors = any(item.mesh.vertex_colors is not None for item in items)
+        for item in items:
+            mesh = item.mesh
+            matrix = np.asarray(item.world_from_model, dtype=np.float64)
+            normal_matrix = np.linalg.inv(matrix[:3, :3]).T
+            n = mesh.vertex_normals @ normal_matrix.T
+            n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
+            normals.append(n)
+            faces.append(mesh.faces.astype(np.int64) + offset)
+            if any_colors:
+                vc = mesh.vertex_colors
+                colors.append(np.ones((mesh.vertex_count, 3)) if vc is None else np.asarray(vc)[:, :3])
+            offset += mesh.vertex_count
+        self.normals = np.concatenate(normals)
+        self.faces = np.concatenate(faces)
+        self.vertex_colors = np.concatenate(colors) if any_colors else None
+        corners = self.index.triangles.reshape(-1, 3)
+        size = float(np.max(corners.max(axis=0) - corners.min(axis=0))) if corners.size else 1.0
+        self.epsilon = 1e-9 * max(size, float(np.abs(corners).max()), 1e-300)
+
+    def shadow_lights(self) -> int:
+        return sum(1 for _, light in self.positioned if self.shadows and light.cast_shadows)
+
+
+class _Hits(NamedTuple):
+    rows: NDArray[np.int64]  # which rays hit
+    t: NDArray[np.float64]
+    item: NDArray[np.int64]  # index into the items with faces
+    face: NDArray[np.int64]  # face in the item's mesh
+    point: NDArray[np.float64]
+    incoming: NDArray[np.float64]  # unit ray direction
+    normal: NDArray[np.float64]  # interpolated, toward the incoming side
+    geometric: NDArray[np.float64]  # geometric, toward the incoming side
+    back: NDArray[np.bool_]
+    base: NDArray[np.float64]  # vertex color (ones without vertex colors)
+
+
+def _hits(data: _Scene, origins: np.ndarray, directions: np.ndarray, t_max: float, cull: bool) -> _Hits:
+    from frustum.raster import rays
+
+    found = rays.closest_hits(data.index, origins, directions, 0.0, t_max, None, cull)
+    rows = np.flatnonzero(found.face >= 0)
+    face_global = found.face[rows]
+    k = np.searchsorted(data.starts, face_global, side="right") - 1
+    t = found.t[rows]
+    d = directions[rows]
+    point = origins[rows] + t[:, None] * d
+    incoming = d / np.linalg.norm(d, axis=1, keepdims=True)
+    tri = data.index.triangles[found.row[rows]]
+    geometric = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    geometric /= np.maximum(np.linalg.norm(geometric, axis=1, keepdims=True), 1e-300)
+    u, v = found.uv[rows, 0], found.uv[rows, 1]
+    flip = data.swapped[k]
+    weights = np.stack([1.0 - u - v, np.where(flip, v, u), np.where(flip, u, v)], axis=1)
+    corners = data.faces[face_global]
+    normal = np.einsum("nc,nci->ni", weights, data.normals[corners])
+    length = np.linalg.norm(normal, axis=1, keepdims=True)
+    normal = np.where(length > 0.0, normal / np.where(length > 0.0, length, 1.0), geometric)
+    back = found.back[rows] != 0
+    side = np.where(back, -1.0, 1.0)[:, None]
+    base = np.ones((rows.shape[0], 3)) if data.vertex_colors is None else np.einsum(
+        "nc,nci->ni", weights, data.vertex_colors[corners])  # fmt: skip
+    return _Hits(rows, t, k, face_global - data.starts[k], point, incoming, normal * side, geometric * side, back,
+                 base)  # fmt: skip
+
+
+def _local(data: _Scene, hit: _Hits, counts: dict, record: list | None, parents: np.ndarray | None,
+           depth: int) -> np.ndarray:  # fmt: skip
+    """I_local (n, 3) at the hits, with shadow rays (module docstring)."""
+    from frustum.raster import rays
+
+    k = hit.item
+    base = data.color[k] * hit.base
+    ka, kd, ks, shininess = data.k[k, 0], data.k[k, 1], data.k[k, 2], data.k[k, 3]
+    diffuse_sum = ka[:, None] * data.ambient[None, :]
+    specular_sum = np.zeros_like(diffuse_sum)
+    n = hit.normal
+    view = -hit.incoming
+    for number, light in data.positioned:
+        intensity = np.asarray(light.color, dtype=np.float64) * light.intensity
+        if isinstance(light, DirectionalLight):
+            to_light = np.broadcast_to(-np.asarray(light.direction, dtype=np.float64), n.shape)
+            falloff = np.ones(n.shape[0])
+        else:
+            offset = np.asarray(light.position, dtype=np.float64) - hit.point
+            distance = np.sqrt(np.einsum("ij,ij->i", offset, offset))
+            to_light = offset / np.maximum(distance, 1e-300)[:, None]
+            a0, a1, a2 = light.attenuation
+            falloff = 1.0 / (a0 + a1 * distance + a2 * distance * distance)
+            if isinstance(light, SpotLight):
+                cos_inner, cos_outer = math.cos(light.inner_angle), math.cos(light.outer_angle)
+                cos_alpha = -(to_light @ np.asarray(light.direction, dtype=np.float64))
+                if cos_inner > cos_outer:
+                    falloff = falloff * np.clip((cos_alpha - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0)
+                else:
+                    falloff = falloff * (cos_alpha >= cos_outer)
+        cosine = np.einsum("ij,ij->i", n, to_light)
+        ndl = np.maximum(cosine, 0.0)
+        lit = ndl > 0.0
+        if data.shadows and light.cast_shadows and lit.any():
+            chosen = np.flatnonzero(lit)
+            origins = hit.point[chosen] + data.epsilon * hit.geometric[chosen]
+            if isinstance(light, DirectionalLight):
+                directions, t_max = np.ascontiguousarray(to_light[chosen]), np.inf
+            else:
+                directions, t_max = np.asarray(light.position, dtype=np.float64) - origins, 1.0
+            blocked = rays.any_hits(data.index, origins, directions, 0.0, t_max)
+            counts["shadow_rays"] = counts.get("shadow_rays", 0) + int(chosen.shape[0])
+            lit[chosen[blocked]] = False
+            if record is not None and parents is not None:
+                for j, row in enumerate(chosen):
+                    record.append(RaySegment(
+                        "shadow", depth, int(parents[row]), origins[j], directions[j], np.inf, -1, -1,
+                        np.full(3, np.nan), np.full(3, np.nan), 0.0, number, bool(blocked[j]),
+                    ))  # fmt: skip
+        spec = np.zeros(n.shape[0])
+        on = lit
+        if on.any():
+            if data.specular_phong:
+                reflected = 2.0 * cosine[on, None] * n[on] - to_light[on]
+                x = np.maximum(np.einsum("ij,ij->i", reflected, view[on]), 0.0)
+            else:
+                half = to_light[on] + view[on]
+                half = half / np.sqrt(np.einsum("ij,ij->i", half, half))[:, None]
+                x = np.maximum(np.einsum("ij,ij->i", n[on], half), 0.0)
+            spec[on] = [textbook_power(float(a), float(b)) for a, b in zip(x, shininess[on], strict=True)] \
+                if x.shape[0] < 64 else _power(x, shininess[on])  # fmt: skip
+        shade = np.where(lit, falloff * ndl, 0.0)
+        diffuse_sum = diffuse_sum + (kd * shade)[:, None] * intensity
+        specular_sum = specular_sum + (ks * falloff * spec)[:, None] * intensity
+    return np.clip(base * diffuse_sum + specular_sum + data.emissive[k], 0.0, 1.0)
+
+
+def _power(x: np.ndarray, n: np.ndarray) -> np.ndarray:
+    """``textbook_power`` over arrays: repeated squaring for integral exponents in its range, else ``x**n``."""
+    from frustum.raster.power import SQUARING_MAX
+
+    out = np.empty_like(x)
+    integral = (n == np.floor(n)) & (n >= 0.0) & (n <= SQUARING_MAX)
+    out[~integral] = x[~integral] ** n[~integral]
+    for value in np.unique(n[integral]):
+        chosen = integral & (n == value)
+        base, result, e = x[chosen].copy(), np.ones(int(chosen.sum())), int(value)
+        while e > 0:
+            if e & 1:
+                result = result * base
+            base = base * base
+            e >>= 1
+        out[chosen] = result
+    return out
+
+
+def _primary(camera: Camera, rows: np.ndarray, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
+    """Origins on the near plane and directions to the far plane of the pixels `rows` (numbered j·W + i, y up),
+    as ``raster.rays.cast_pixels`` casts them."""
+    m = np.asarray(camera.world_from_window, dtype=np.float64)
+    x = (rows % width) + 0.5
+    y = (rows // width) + 0.5
+    nw = m[3, 0] * x + m[3, 1] * y + m[3, 3]
+    origin = np.stack([(m[a, 0] * x + m[a, 1] * y + m[a, 3]) / nw for a in range(3)], axis=1)
+    fw = nw + m[3, 2]
+    end = np.stack([(m[a, 0] * x + m[a, 1] * y + m[a, 2] + m[a, 3]) / fw for a in range(3)], axis=1)
+    return origin, end - origin
+
+
+def _trace(data: _Scene, origins: np.ndarray, directions: np.ndarray, pixel: np.ndarray, count: int,
+           max_depth: int, cull: bool, background: np.ndarray, counts: dict, window_from_world: np.ndarray | None,
+           record: list | None = None) -> tuple[np.ndarray, _Hits | None, np.ndarray]:  # fmt: skip
+    """The color (count, 3) of rays `origins`, `directions` (primary rays over t in [0, 1)) belonging to pixels
+    `pixel` (0 … count − 1); the primary hits and their window depths (None: not computed)."""
+    color = np.zeros((count, 3))
+    weight = np.ones(origins.shape[0])
+    kinds = np.zeros(origins.shape[0], dtype=np.int8)  # 0 primary, 1 reflected, 2 refracted
+    tir = np.zeros(origins.shape[0], dtype=bool)
+    parents = np.full(origins.shape[0], -1, dtype=np.int64)
+    primary: _Hits | None = None
+    z = np.empty(0, dtype=np.float32)
+    names = ("primary", "reflected", "refracted")
+    for depth in range(max_depth + 1):
+        if origins.shape[0] == 0:
+            break
+        counts["depth_reached"] = max(counts.get("depth_reached", 0), depth)
+        for kind in (0, 1, 2):
+            key = f"{names[kind]}_rays"
+            counts[key] = counts.get(key, 0) + int((kinds == kind).sum())
+        if data.empty:
+            hit = _Hits(*(np.empty(0, dtype=np.int64),) * 10)  # type: ignore[arg-type]
+            rows = np.empty(0, dtype=np.int64)
+        else:
+            hit = _hits(data, origins, directions, 1.0 if depth == 0 else np.inf, cull and depth == 0)
+            rows = hit.rows
+        if depth == 0 and window_from_world is not None and rows.shape[0]:
+            w = window_from_world
+            p = hit.point
+            zz = ((p @ w[2, :3] + w[2, 3]) / (p @ w[3, :3] + w[3, 3])).astype(np.float32)
+            near = zz < 1.0  # as the depth buffer: a depth that rounds to 1 is not drawn
+            if not near.all():
+                keep = np.flatnonzero(near)
+                hit = _Hits(*(field[keep] for field in hit))
+                rows = hit.rows
+                zz = zz[keep]
+            z = zz
+        if depth == 0:
+            primary = hit
+        counts["hits"] = counts.get("hits", 0) + int(rows.shape[0])
+        missed = np.ones(origins.shape[0], dtype=bool)
+        missed[rows] = False
+        np.add.at(color, pixel[missed], weight[missed, None] * background[None, :3])
+        segment_index = None
+        if record is not None:
+            segment_index = np.empty(origins.shape[0], dtype=np.int64)
+            for r in range(origins.shape[0]):
+                segment_index[r] = len(record)
+                found = np.flatnonzero(rows == r)
+                j = int(found[0]) if found.size else -1
+                record.append(RaySegment(
+                    names[kinds[r]], depth, int(parents[r]), origins[r], directions[r],
+                    float(hit.t[j]) if j >= 0 else np.inf, int(data.numbers[hit.item[j]]) if j >= 0 else -1,
+                    int(hit.face[j]) if j >= 0 else -1, hit.point[j] if j >= 0 else np.full(3, np.nan),
+                    hit.normal[j] if j >= 0 else np.full(3, np.nan), float(weight[r]),
+                    total_internal_reflection=bool(tir[r]),
+                ))  # fmt: skip
+        if rows.shape[0] == 0:
+            break
+        k = hit.item
+        w = weight[rows]
+        kr = data.reflectivity[k]
+        alpha = data.opacity[k]
+        local_weight = w * (1.0 - kr) * alpha
+        shaded = local_weight > 0.0
+        if shaded.any():
+            sub = _Hits(*(field[shaded] for field in hit))
+            hit_parents = None if segment_index is None else segment_index[sub.rows]
+            local = _local(data, sub, counts, record, hit_parents, depth)
+            np.add.at(color, pixel[sub.rows], local_weight[shaded, None] * local)
+        if depth == max_depth:
+            break
+        reflect_weight = w * kr
+        refract_weight = w * (1.0 - kr) * (1.0 - alpha)
+        n = hit.normal
+        incoming = hit.incoming
+        cos_i = np.clip(-np.einsum("ij,ij->i", n, incoming), 0.0, 1.0)
+        eta = np.where(hit.back, data.ior[k], 1.0 / data.ior[k])
+        sin2 = eta * eta * (1.0 - cos_i * cos_i)
+        total = (refract_weight > 0.0) & (sin2 > 1.0)
+        counts["total_internal_reflections"] = counts.get("total_internal_reflections", 0) + int(total.sum())
+        reflect_weight = reflect_weight + np.where(total, refract_weight, 0.0)
+        refract_weight = np.where(total, 0.0, refract_weight)
+        reflected = incoming + 2.0 * cos_i[:, None] * n
+        cos_t = np.sqrt(np.maximum(1.0 - sin2, 0.0))
+        refracted = eta[:, None] * incoming + (eta * cos_i - cos_t)[:, None] * n
+        go_r = np.flatnonzero(reflect_weight >= MIN_WEIGHT)
+        go_t = np.flatnonzero(refract_weight >= MIN_WEIGHT)
+        offset = data.epsilon * hit.geometric
+        origins = np.concatenate([hit.point[go_r] + offset[go_r], hit.point[go_t] - offset[go_t]])
+        directions = np.concatenate([reflected[go_r], refracted[go_t]])
+        pixel = np.concatenate([pixel[rows[go_r]], pixel[rows[go_t]]])
+        weight = np.concatenate([reflect_weight[go_r], refract_weight[go_t]])
+        kinds = np.concatenate([np.ones(go_r.shape[0], np.int8), np.full(go_t.shape[0], 2, np.int8)])
+        tir = np.concatenate([total[go_r], np.zeros(go_t.shape[0], dtype=bool)])
+        parents = np.empty(0, dtype=np.int64) if segment_index is None else np.concatenate(
+            [segment_index[rows[go_r]], segment_index[rows[go_t]]])  # fmt: skip
+        if parents.shape[0] != origins.shape[0]:
+            parents = np.full(origins.shape[0], -1, dtype=np.int64)
+    return color, primary, z
+
+
+def _check_work(camera: Camera, data: _Scene, max_depth: int, where: str) -> None:
+    """The work budget: rays (pixels × (max_depth + 1) levels × (1 + shadowing lights)) × COST_PER_RAY."""
+    pixels = camera.width * camera.height
+    rays_count = pixels * (max_depth + 1) * (1 + data.shadow_lights())
+    check_operations(rays_count * COST_PER_RAY, where=where, error=FrustumError,
+                     cause=f"ray tracing {camera.width} x {camera.height} pixels x (max_depth + 1 = {max_depth + 1}) "
+                           f"levels x {1 + data.shadow_lights()} rays per hit")  # fmt: skip
+
+
+def draw_surfaces(scene: Scene, camera: Camera, options: RenderOptions, buffers: Buffers,
+                  between: Callable[[], None]) -> None:  # fmt: skip
+    """``method="ray-tracing"``: color and depth of every pixel into `buffers`, then `between` (the volumes over
+    the primary hits' depth). Counts into ``options.counts``: rays per kind, hits, total internal reflections,
+    the deepest level reached."""
+    height, width = camera.height, camera.width
+    counts = options.counts if options.counts is not None else {}
+    data = _Scene(scene, _is_phong(options), options.shadows)
+    _check_work(camera, data, options.max_depth, "render")
+    buffers.depth = depth = np.ones((height, width), dtype=np.float32)
+    buffers.color = color = np.empty((height, width, 4), dtype=np.uint8)
+    color[:, :] = options.background
+    background = options.background.astype(np.float64) / 255.0
+    window_from_world = np.asarray(camera.viewport_matrix @ camera.clip_from_world, dtype=np.float64)
+    flat_color = color.reshape(-1, 4)
+    flat_depth = depth.reshape(-1)
+    for key in ("primary_rays", "shadow_rays", "reflected_rays", "refracted_rays", "hits",
+                "total_internal_reflections", "depth_reached"):  # fmt: skip
+        counts.setdefault(key, 0)
+    for start in range(0, width * height, CHUNK):
+        pixels = np.arange(start, min(start + CHUNK, width * height))
+        origins, directions = _primary(camera, pixels, width, height)
+        result, primary, z = _trace(data, origins, directions, np.arange(pixels.shape[0]), pixels.shape[0],
+                                    options.max_depth, options.cull, background, counts, window_from_world)  # fmt: skip
+        # pixel j·W + i (y up) is row H − 1 − j of the image
+        out = (height - 1 - pixels // width) * width + pixels % width
+        if primary is None or primary.rows.shape[0] == 0:
+            continue
+        rows = primary.rows
+        target = out[rows]
+        flat_color[target, :3] = np.floor(np.clip(result[rows], 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
+        flat_color[target, 3] = 255
+        flat_depth[target] = z
+        if buffers.normals is not None:
+            buffers.normals.reshape(-1, 3)[target] = primary.normal.astype(np.float32)
+        if buffers.object_id is not None:
+            buffers.object_id.reshape(-1)[target] = data.numbers[primary.item].astype(np.int32)
+    between()
+
+
+def _is_phong(options: RenderOptions) -> bool:
+    from frustum.raster import shade
+
+    return options.specular_model == shade.SPECULAR_PHONG
+
+
+def ray_path(scene: Scene, camera: Camera, x: float, y: float, *, max_depth: int = 5, shadows: bool = True,
+             cull_back_faces: bool = True, specular: str = "blinn-phong") -> list[RaySegment]:  # fmt: skip
+    """Every ray ``render(scene, camera, method="ray-tracing")`` traces for the window point (x, y) (y up; pixel
+    centres at half-integers): the primary ray, its shadow rays, and the reflected and refracted rays level by
+    level, in the order traced (``RaySegment.parent`` links the tree).
+
+    Raises
+    ------
+    FrustumError
+        Not a Scene or Camera, a non-finite point, or `max_depth` outside [0, 64].
+    """
+    from frustum._arrays import as_scalar, describe
+    from frustum.render.options import MAX_DEPTH
+
+    where = "ray_path"
+    if not isinstance(scene, Scene) or not isinstance(camera, Camera):
+        raise FrustumError(f"{where}: expected a Scene and a Camera, got {describe(scene)}, {describe(camera)}")
+    px = as_scalar(x, "x", where=where, error=FrustumError)
+    py = as_scalar(y, "y", where=where, error=FrustumError)
+    if isinstance(max_depth, bool) or not isinstance(max_depth, int | np.integer) or not 0 <= max_depth <= MAX_DEPTH:
+        raise FrustumError(f"{where}: max_depth = {describe(max_depth)} is not an integer in [0, {MAX_DEPTH}]")
+    data = _Scene(scene, specular == "phong", bool(shadows))
+    m = np.asarray(camera.world_from_window, dtype=np.float64)
+    nw = m[3, 0] * px + m[3, 1] * py + m[3, 3]
+    origin = np.array([(m[a, 0] * px + m[a, 1] * py + m[a, 3]) / nw for a in range(3)])
+    fw = nw + m[3, 2]
+    end = np.array([(m[a, 0] * px + m[a, 1] * py + m[a, 2] + m[a, 3]) / fw for a in range(3)])
+    record: list[RaySegment] = []
+    window_from_world = np.asarray(camera.viewport_matrix @ camera.clip_from_world, dtype=np.float64)
+    _trace(data, origin[None], (end - origin)[None], np.zeros(1, dtype=np.int64), 1, int(max_depth),
+           bool(cull_back_faces), np.zeros(4), {}, window_from_world, record)  # fmt: skip
+    return record
