@@ -238,10 +238,8 @@ def test_bad_input() -> None:
             Material(reflectivity=reflectivity)
     with pytest.raises(ShadingError, match="cast_shadows = 'yes' is not a bool"):
         PointLight((0, 1, 0), cast_shadows="yes")
-    with pytest.raises(FrustumError, match="shadows = 'soft' is not True, False or None"):
+    with pytest.raises(FrustumError, match="shadows = 'soft' is not None, False, True or 'ray'"):
         render(scene, camera, method="ray-tracing", shadows="soft")
-    with pytest.raises(FrustumError, match="shadows = True is drawn by method 'ray-tracing'"):
-        render(scene, camera, shadows=True)
     with pytest.raises(FrustumError, match="method 'ray-tracing' draws mode 'surface' with shading 'phong'"):
         render(scene, camera, method="ray-tracing", shading="flat")
     with pytest.raises(FrustumError, match=r"ray_path: max_depth = 99 is not an integer in \[0, 64\]"):

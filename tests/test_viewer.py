@@ -231,6 +231,7 @@ def test_state_matrices_equal_the_cameras(teapot_session):
         ("mode", "wireframe"),
         ("depth_cue", True),
         ("projection", "isometric"),
+        ("shadows", True),
     ],
 )
 def test_controls_reach_the_render_options(teapot_session, name, value):

@@ -415,12 +415,19 @@ def render_command(
     ] = None,
     size: Annotated[str | None, typer.Option(help="Image size WIDTHxHEIGHT, overriding the file's.")] = None,
     up: Annotated[str, typer.Option(help="A mesh file's up axis, y or z (glTF is always y).")] = "y",
+    shadows: Annotated[
+        str | None, typer.Option(help="Shadows, overriding the file's: on (shadow maps), off, or ray (shadow rays).")
+    ] = None,
 ) -> None:
     """Render a scene file or a mesh file (framed from a 3/4 view, default lights, the file's materials); without
     -o, the outputs the file names (or out/<name>.png beside it)."""
     from frustum.scenefile import render_scene_file
 
-    written = render_scene_file(scene, output or None, size=_image_size(size) if size else None, up=up)
+    choices = {None: None, "on": True, "off": False, "ray": "ray"}
+    if shadows not in choices:
+        raise FrustumError(f"render: --shadows {shadows!r} is unknown; expected on, off or ray")
+    written = render_scene_file(scene, output or None, size=_image_size(size) if size else None,
+                                shadows=choices[shadows], up=up)  # fmt: skip
     for path in written if isinstance(written, list) else [written]:
         console.print(f"wrote {path}", markup=False, highlight=False, soft_wrap=True)
 

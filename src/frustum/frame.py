@@ -24,9 +24,12 @@ class Frame:
     images are stored). ``depth`` is window depth in [0, 1], 1.0 where nothing was drawn. Color is linear RGB,
     not sRGB-encoded unless asked for. Optional buffers (``render(..., buffers=...)``): ``normals`` (H, W, 3)
     float32 unit world normals (0 where nothing was drawn) and ``object_id`` (H, W) int32, the index of the
-    scene item seen at each pixel (−1 for background). All arrays are read-only. ``stats``: the visible-surface
-    method's counts (``render(..., method=...)``; spans, areas per level, depth tests, fragments per pixel …),
-    with ``stats["method"]`` its name, or None where none were asked for.
+    scene item seen at each pixel (−1 for background); ``position`` (H, W, 3) float32 world points of the nearest
+    opaque surface (NaN where nothing was drawn) and ``shadow`` (H, W, L) float32, the fraction of each of the L
+    shadow-casting lights reaching the pixel (1 lit, 0 in shadow, NaN where nothing was drawn; lights in
+    ``Scene.world_lights`` order: the root's first, then those on nodes). All arrays are read-only. ``stats``:
+    the visible-surface method's counts (``render(..., method=...)``; spans, areas per level, depth tests,
+    fragments per pixel …), with ``stats["method"]`` its name, or None where none were asked for.
     """
 
     color: NDArray[np.uint8]
@@ -34,6 +37,8 @@ class Frame:
     normals: NDArray[np.float32] | None = None
     object_id: NDArray[np.int32] | None = None
     stats: dict | None = None
+    position: NDArray[np.float32] | None = None
+    shadow: NDArray[np.float32] | None = None
 
     def __post_init__(self) -> None:
         color = np.ascontiguousarray(self.color)
@@ -46,7 +51,12 @@ class Frame:
             raise OutputError(
                 f"Frame: depth has dtype {depth.dtype} and shape {depth.shape}; expected {color.shape[:2]} float32"
             )
-        for name, dtype, shape in (("normals", np.float32, (*depth.shape, 3)), ("object_id", np.int32, depth.shape)):
+        lights = None if self.shadow is None else np.shape(self.shadow)[2:3]
+        for name, dtype, shape in (
+            ("normals", np.float32, (*depth.shape, 3)), ("object_id", np.int32, depth.shape),
+            ("position", np.float32, (*depth.shape, 3)),
+            ("shadow", np.float32, (*depth.shape, *(lights or (-1,)))),
+        ):  # fmt: skip
             value = getattr(self, name)
             if value is None:
                 continue

@@ -324,6 +324,13 @@ class SpotLight:
         return replace(self, position=position, direction=direction)
 
 
+def sun_45(intensity: float = 1.0, color: Any = (1.0, 1.0, 1.0), cast_shadows: bool = True) -> DirectionalLight:
+    """The sciagraphy sun: rays along the diagonal of a cube from the upper left front, ``direction ∝ (1, −1, −1)``
+    (y up, the front elevation seen along −z), so in the front elevation and in the plan every ray and every
+    shadow edge runs at 45°, and a shadow's width equals the depth of what casts it (architects' convention)."""
+    return DirectionalLight((1.0, -1.0, -1.0), color=color, intensity=intensity, cast_shadows=cast_shadows)
+
+
 Light = AmbientLight | DirectionalLight | PointLight | SpotLight
 """Any light a scene holds."""
 LIGHT_TYPES = (AmbientLight, DirectionalLight, PointLight, SpotLight)

@@ -48,7 +48,8 @@ FORMATS = tuple(CAMERA_WRITERS)
 """Dataset formats (camera files): nerf, nerfstudio, colmap, files, webdataset."""
 DEPTH_FORMATS = ("npy", "png16")
 """Depth files: float32 .npy, or 16-bit PNG in steps of ``depth_scale`` world units."""
-_FOLDERS = {"color": "images", "depth": "depth", "normals": "normals", "object_id": "object_id", "mask": "masks"}
+_FOLDERS = {"color": "images", "depth": "depth", "normals": "normals", "object_id": "object_id", "mask": "masks",
+            "position": "position", "shadow": "shadow"}  # fmt: skip
 _SUFFIXES = {"color": ".png", "depth": ".npy", "normals": ".npy", "object_id": ".png", "mask": ".png"}
 _MANIFEST = "manifest.jsonl"
 _SHARED_FILES = ("cameras.json", "README.txt", "transforms.json", "sparse/0/cameras.txt", "sparse/0/images.txt",
@@ -292,6 +293,9 @@ def _readme(config: dict, camera: Camera, extra: dict) -> str:
         "  normals/<key>.npy    unit world-space normals, float32 (H, W, 3); 0 where nothing was drawn",
         "  object_id/<key>.png  uint16: index of the scene item seen + 1; 0 = background",
         "  masks/<key>.png      uint8: 255 where a surface was drawn, 0 elsewhere",
+        "  position/<key>.npy   (scenes with [render] shadows) world points, float32 (H, W, 3); NaN on background",
+        "  shadow/<key>.npy     (scenes with [render] shadows) fraction of each shadow-casting light reaching the",
+        "                       pixel, float32 (H, W, L), lights in the scene's order; NaN on background",
         "",
         "Cameras (cameras.json has every view in every convention below):",
         "  camera_to_world_opengl  4x4, OpenGL camera axes: x right, y up, looking down -z",
@@ -454,6 +458,8 @@ def render_dataset(
     kinds = dict(_SUFFIXES)
     if depth_format == "png16":
         kinds["depth"] = ".png"
+    if scene_file.options.get("shadows") in (True, "ray"):  # a scene with shadows: world points and light fractions
+        kinds["position"] = kinds["shadow"] = ".npy"
 
     def files_of(key: str) -> dict[str, str]:
         return {kind: f"{_FOLDERS[kind]}/{key}{suffix}" for kind, suffix in kinds.items()}

@@ -40,6 +40,8 @@ OUTPUT_KINDS = {
     "normals": (".npy",),
     "object_id": (".png",),
     "mask": (".png",),
+    "position": (".npy",),
+    "shadow": (".npy",),
 }
 """Output kinds a job may ask for, with the file suffixes each accepts."""
 TEMPORARY_MARK = ".partial-"
@@ -172,6 +174,8 @@ def _encoded(kind: str, suffix: str, frame: Any, camera: Any, depth_scale: float
         return _png_writer(steps.astype(np.uint16))
     if kind == "normals":
         return _npy_writer(frame.normals)
+    if kind in ("position", "shadow"):  # float32 (H, W, 3) world points / (H, W, L) light fractions, NaN background
+        return _npy_writer(getattr(frame, kind))
     if kind == "object_id":
         ids = frame.object_id.astype(np.int64) + 1  # background −1 → 0
         if ids.max(initial=0) > _MAX_UINT16:
@@ -195,7 +199,7 @@ def render_view(scene: Any, job: RenderJob, options: Mapping[str, Any] | None = 
     start = time.perf_counter()
     render_seconds = 0.0
     try:
-        buffers = tuple(b for b in ("normals", "object_id") if b in job.outputs)
+        buffers = tuple(b for b in ("normals", "object_id", "position", "shadow") if b in job.outputs)
         merged = {**(options or {}), **job.options, "buffers": buffers}
         frame = render(scene, job.camera, **merged)
         render_seconds = time.perf_counter() - start

@@ -944,6 +944,7 @@ def drawing_sheet(
     crease_angle: float = DEFAULT_CREASE_ANGLE,
     hidden: str | None = "dashed",
     stroke_width: float = 0.5,
+    shadows: bool = False,
     title_block: dict[str, Any] | None = None,
     path: str | os.PathLike | None = None,
 ) -> str:
@@ -995,6 +996,9 @@ def drawing_sheet(
         "overall".
     edges, crease_angle, hidden, stroke_width
         As in ``render_svg``; `stroke_width` (visible outlines) in paper millimetres.
+    shadows : bool
+        Sciagraphy: each view gets the exact shadow regions of the scene's directional and point lights
+        (``svg_shadows.shadow_polygons``) as a hatched group ``<view>-shadows`` (``sun_45()`` is the convention).
     title_block : dict, optional
         Title block fields, keys from ``TITLE_BLOCK_FIELDS``: "title" (else `title`), "drawing_number", "sheet"
         ("n/N" or (n, N)), "date", "author", "tolerance" (default "ISO 2768-m"), "units" (default "mm"); text.
@@ -1133,6 +1137,8 @@ def drawing_sheet(
         # a pictorial view shows visible edges only (hidden lines are for the orthographic views)
         view_hidden = None if view.name == "isometric" else hidden
         body.append(_view_group(view, placed, centre_x, centre_y, drawing_scale, view_hidden, width_line))
+        if shadows:  # sciagraphy: the exact shadow polygons of the scene's lights in each view, hatched
+            body.append(_view_shadows(scene, view, centre_x, centre_y, drawing_scale))
         body += [_mark_svg(mark, f"{view.name}-", centre_x, centre_y) for mark in marks[view.name]]
     paper_name = (
         paper.upper()
@@ -1200,6 +1206,26 @@ def _view_group(
     return (
         f'<g id="view-{view.name}" data-scale="{_number(scale)}" '
         f'data-centre="{_number(centre_x)} {_number(centre_y)}">{"".join(groups)}</g>'
+    )
+
+
+def _view_shadows(scene: Scene, view: _View, centre_x: float, centre_y: float, scale: float) -> str:
+    """The view's ``<g id="<view>-shadows">``: hatched shadow paths (``svg_shadows.shadow_polygons``) on paper."""
+    from frustum.output.svg_shadows import shadow_polygons
+
+    factor = scale * view.model_per_pixel
+    paths = []
+    for polygon in shadow_polygons(scene, view.camera):
+        loops = []
+        for loop in polygon.loops:
+            local = _to_local(loop, factor)
+            loops.append("M " + " L ".join(f"{_number(centre_x + x)} {_number(centre_y + y)}" for x, y in local) + " Z")
+        paths.append(f'<path d="{" ".join(loops)}" class="{polygon.kind}"/>')
+    return (
+        f'<g id="{view.name}-shadows" fill="url(#shadow-hatch)" fill-rule="evenodd" stroke="#000000" '
+        f'stroke-width="0.18"><defs><pattern id="shadow-hatch" patternUnits="userSpaceOnUse" width="1.5" '
+        'height="1.5" patternTransform="rotate(45)"><line x1="0" y1="0" x2="0" y2="1.5" stroke="#000000" '
+        f'stroke-width="0.18"/></pattern></defs>{"".join(paths)}</g>'
     )
 
 

@@ -440,6 +440,7 @@ def render_svg(
     stroke_width: float = 1.0,
     depth_cue: bool = False,
     background: str | None = "#ffffff",
+    shadows: bool = False,
 ) -> str:
     """An SVG line drawing of `scene` seen by `camera`, hidden lines removed exactly (object space).
 
@@ -476,6 +477,12 @@ def render_svg(
         Fade and thin distant visible lines.
     background : str or None
         A CSS color for a full-size background rectangle, or None for transparent.
+    shadows : bool
+        Add the exact shadow regions of every directional and point light that casts shadows on the visible
+        faces (``frustum.output.svg_shadows``: the object-space method from the light, then the visible parts
+        from the camera) as the group ``<g id="shadows">`` of ``<path>`` elements (absolute M/L/Z): translucent
+        gray over the faces with `fill`, hatched at 45° otherwise; under the lines. ``sun_45()`` is the
+        sciagraphy light.
 
     Returns
     -------
@@ -514,6 +521,12 @@ def render_svg(
     if fill:
         polygons, used = _fill_polygons(placed, _lights(scene), camera, fill_order)
         body.append(f'<g id="faces" data-order="{used}">{"".join(polygons)}</g>')
+    if not isinstance(shadows, bool | np.bool_):
+        raise OutputError(f"{where}: shadows = {describe(shadows)} is not a bool; give True or False")
+    if shadows:
+        from frustum.output.svg_shadows import shadow_group
+
+        body.append(shadow_group(scene, camera, fill=bool(fill)))
     body += _drawing_groups(lines, placed, to_paper, width, hidden, bool(depth_cue), camera=camera)
     if scene.volumes:  # a raster layer over faces and lines, its rays stopped by both (output/svg_volumes.py)
         from frustum.output.svg_volumes import volume_image_element

@@ -52,6 +52,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import sys
 from typing import Any
 
 from frustum.camera import Camera
@@ -92,7 +93,10 @@ def release_memory() -> int:
     The next ``render`` allocates (and first-touches) them anew. Call it when a program that rendered large
     frames goes on to other work.
     """
-    return Scratch.release_pool() + FrameBuffers.release()
+    released = Scratch.release_pool() + FrameBuffers.release()
+    if "frustum.shadow_pass" in sys.modules:  # the shadow maps and per-pixel arrays of the shadow pass
+        released += sys.modules["frustum.shadow_pass"].release_memory()
+    return released
 
 
 def render(
@@ -120,6 +124,8 @@ def render(
     stats: bool = False,
     max_depth: int = 5,
     shadows: bool | str | None = None,
+    shadow_map_size: int = 2048,
+    shadow_softness: float = 1.0,
 ) -> Frame:
     """Render `scene` seen by `camera` into a ``Frame`` (color (H, W, 4) uint8 and depth (H, W) float32).
 
@@ -172,9 +178,11 @@ def render(
         are drawn √samples times as wide, so they come out anti-aliased. Depth keeps each block's nearest.
     color_space : {"linear", "srgb"}
         Output encoding; "srgb" applies the sRGB transfer curve to the linear result.
-    buffers : tuple of {"normals", "object_id"}
-        Extra per-pixel outputs on the Frame: unit world normals (0 on background) and the index of the item
-        in ``scene.items`` (−1 on background).
+    buffers : tuple of {"normals", "object_id", "position", "shadow"}
+        Extra per-pixel outputs on the Frame: unit world normals (0 on background), the index of the item
+        in ``scene.items`` (−1 on background), the world point of the nearest opaque surface ((H, W, 3) float32,
+        NaN on background) and, with `shadows` on, the fraction of each shadow-casting light reaching it ((H, W,
+        L) float32, NaN on background; lights in ``Scene.world_lights`` order, ``frustum.shadow_pass``).
     method : str
         The visible-surface method (``RENDER_METHODS``, docs/visibility.md). For the meshes
         (``VISIBILITY_METHODS``): ``"depth-buffer"`` (the default), ``"scan-line"``, ``"area-subdivision"``
@@ -196,9 +204,18 @@ def render(
     max_depth : int
         ``method="ray-tracing"``: levels of reflected and refracted rays after the primary ray, 0 … 64
         (0: primary rays and shadow rays only).
-    shadows : bool or None
-        Shadows: shadow rays toward every positioned light with ``cast_shadows`` (``method="ray-tracing"``,
-        where None means on); other methods draw none (None or False).
+    shadows : None, False, True or "ray"
+        None: the method's own (on for ``method="ray-tracing"``, which casts shadow rays; off for the depth buffer
+        and the other methods, so pictures of today do not change); False: off; True: shadow maps (the
+        depth-buffer method from each light; ``"ray-tracing"`` always uses its shadow rays); ``"ray"``: exact
+        shadow rays through the scene's BVH (``method="ray-casting"`` always uses rays). Lights with
+        ``cast_shadows=False`` and ambient light cast none. Surface modes only; not with ``method="octree"`` or
+        ``"a-buffer"``. What casts, what receives and how each shading mode uses the result:
+        ``frustum.shadow_pass`` (pass: ``render.shadows``).
+    shadow_map_size : int
+        Texels on a side of each shadow map, a power of two in [64, 16384] (a point light has six).
+    shadow_softness : float
+        Percentage-closer filter radius in texels, in [0, 16]; 0: hard edges.
 
     Raises
     ------
@@ -219,7 +236,7 @@ def render(
         mode=mode, edges=edges, crease_angle=crease_angle, edge_color=edge_color, hidden=hidden,
         hidden_color=hidden_color, line_width=line_width, depth_cue=depth_cue, samples=samples, filter=filter,
         color_space=color_space, buffers=buffers, method=method, transparency=transparency, stats=stats,
-        max_depth=max_depth, shadows=shadows,
+        max_depth=max_depth, shadows=shadows, shadow_map_size=shadow_map_size, shadow_softness=shadow_softness,
     )  # fmt: skip
     if options.factor == 1:
         return resolve(_draw(scene, camera, options), options)

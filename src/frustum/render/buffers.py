@@ -178,6 +178,10 @@ def resolve(buffers: Buffers, options: RenderOptions) -> Frame:
         middle = factor // 2
         normals = None if normals is None else np.ascontiguousarray(normals[middle::factor, middle::factor])
         ids = None if ids is None else np.ascontiguousarray(ids[middle::factor, middle::factor])
+        if options.outputs:
+            for key in ("position", "seen"):  # the middle sample of each block, as for normals
+                if key in options.outputs:
+                    options.outputs[key] = np.ascontiguousarray(options.outputs[key][middle::factor, middle::factor])
     if options.color_space == "srgb":
         values = color.astype(np.float64) / 255.0 if linear is None else linear
         values[..., :3] = np.where(
@@ -186,7 +190,26 @@ def resolve(buffers: Buffers, options: RenderOptions) -> Frame:
         linear = values
     if linear is not None:
         color = np.floor(np.clip(linear, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
-    return Frame(color=color, depth=depth, normals=normals, object_id=ids, stats=options.counts)
+    position, shadow = _shadow_buffers(options)
+    return Frame(color=color, depth=depth, normals=normals, object_id=ids, stats=options.counts, position=position,
+                 shadow=shadow)  # fmt: skip
+
+
+def _shadow_buffers(options: RenderOptions) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """``Frame.position`` and ``Frame.shadow`` where asked for (float32, NaN where nothing is drawn) from what the
+    shadow pass (``render.shadows``) left in ``options.outputs``."""
+    if options.outputs is None or options.outputs.get("position") is None:
+        return None, None
+    points = options.outputs["position"]
+    position = points.astype(np.float32) if "position" in options.buffers else None
+    shadow = None
+    if "shadow" in options.buffers:
+        seen = options.outputs["seen"][..., options.outputs["casting"]]
+        shadow = np.where(np.isnan(points[..., :1]), np.float32(np.nan), seen).astype(np.float32)
+    from frustum.shadow_pass import give_back
+
+    give_back(points)  # copied out above: the next frame may have it
+    return position, shadow
 
 
 def resolve_color(big: np.ndarray, factor: int) -> np.ndarray:

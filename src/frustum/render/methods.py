@@ -16,6 +16,7 @@ import numpy as np
 from frustum.camera import Camera
 from frustum.frame import Frame, background_bytes
 from frustum.geometry import Mesh
+from frustum.render import shadows
 from frustum.render.buffers import Buffers, Scratch, clear_buffers
 from frustum.render.options import METHOD_NAMES, RenderOptions, check_arguments
 from frustum.render.stages import (
@@ -145,10 +146,12 @@ def draw_surfaces_by_method(
     else:
         tris = window_triangles(items, opaque, offsets, camera, options.cull)
         counts.update(draw(tris, depth, pixels.codes, pixels.bary))
+    attributes = {index: world_attributes(items[index], scratch) for index in opaque}
+    shadows.prepare(scene, items, [(i, attributes[i][0], offsets[i]) for i in opaque], camera, options, lighting,
+                    pixels)  # fmt: skip
     for index in opaque:
-        attributes = world_attributes(items[index], scratch)
-        shade_item(items[index], index, offsets[index], camera, options, lighting, attributes, pixels, (0, height),
-                   blend=False)  # fmt: skip
+        shadows.shade_item(items[index], index, offsets[index], camera, options, lighting, attributes[index], pixels,
+                           (0, height), blend=False)  # fmt: skip
     between()
     if not clear_items:
         return

@@ -42,7 +42,7 @@ HIDDEN_STYLES = (None, "dimmed", "dashed")
 EDGE_SETS = ("all", "feature")
 FILTERS = ("box", "tent")
 COLOR_SPACES = ("linear", "srgb")
-BUFFERS = ("normals", "object_id")
+BUFFERS = ("normals", "object_id", "position", "shadow")
 TRANSPARENCY_MODES = ("sort", "a-buffer")
 METHOD_NAMES = ("depth-buffer", "scan-line", "area-subdivision", "depth-sort", "bsp", "a-buffer", "octree",
                 "ray-casting", "ray-tracing")  # fmt: skip
@@ -80,6 +80,8 @@ DEFAULTS: dict[str, Any] = {
     "stats": False,
     "max_depth": 5,
     "shadows": None,
+    "shadow_map_size": 2048,
+    "shadow_softness": 1.0,
 }
 """``render``'s keyword arguments and their defaults (a test holds them equal to ``render``'s signature)."""
 
@@ -111,10 +113,12 @@ class RenderOptions:
     factor: int = 1
     filter: str = "box"
     color_space: str = "linear"
+    shadow: Any = None  # shadow_pass.ShadowOptions, or None: no shadows
+    outputs: dict | None = None  # "position", "seen", "casting" (render.shadows), filled while drawing
     environment: Any = None  # the scene's EnvironmentMap, for reflections (and the background, below)
     environment_background: bool = False  # no background given: the environment map is the background
     max_depth: int = 5
-    shadows: bool = False
+    shadows: bool = False  # method="ray-tracing": cast shadow rays (the other methods: ``shadow`` above)
 
     @classmethod
     def from_keywords(cls, scene: Any, camera: Any, where: str = "render", **keywords: Any) -> RenderOptions:
@@ -135,6 +139,9 @@ class RenderOptions:
         )  # fmt: skip
         factor = supersampling(k["samples"], where)
         options = method_options(options, k["method"], k["transparency"], k["stats"], where)
+        tracing = options.method == "ray-tracing"  # shadow rays of its own (ray_options), never shadow maps
+        options = shadow_options(options, None if tracing else k["shadows"], k["shadow_map_size"],
+                                 k["shadow_softness"], where)  # fmt: skip
         choice(k["filter"], FILTERS, "filter", where)
         choice(k["color_space"], COLOR_SPACES, "color_space", where)
         depth, shadows = ray_options(options, k["max_depth"], k["shadows"], k["depth_cue"], k["shading"], where)
@@ -155,6 +162,26 @@ class RenderOptions:
         """Whether the volumes are ray cast right after the opaque surfaces (``"surface"``, ``"surface+edges"``:
         before transparent items) rather than after the lines (``"wireframe"``, ``"points"``, ``"hidden-line"``)."""
         return self.mode in ("surface", "surface+edges")
+
+
+def shadow_options(options: RenderOptions, shadows: Any, map_size: Any, softness: Any, where: str) -> RenderOptions:
+    """Check the shadow arguments (``frustum.shadow_pass.check_shadows``); the options with the shadow settings and
+    an outputs dict where the shadow pass runs (shadows on, or the "position" buffer asked for)."""
+    from frustum.shadow_pass import check_shadows
+
+    shadow = check_shadows(shadows, map_size, softness, options.method, options.mode, where)
+    if "shadow" in options.buffers and shadow is None:
+        raise FrustumError(
+            f"{where}: buffers = {describe(options.buffers)} asks for 'shadow' with shadows = {describe(shadows)}; "
+            "give shadows=True or 'ray'"
+        )
+    if "position" in options.buffers and options.mode in LINE_MODES:
+        raise FrustumError(
+            f"{where}: buffers = {describe(options.buffers)} asks for 'position' with mode = {options.mode!r}; "
+            "positions are those of surfaces: use a surface mode"
+        )
+    wanted = shadow is not None or "position" in options.buffers
+    return dataclasses.replace(options, shadow=shadow, outputs={} if wanted else None)
 
 
 def choice(value: Any, valid: tuple, name: str, where: str) -> Any:
@@ -311,21 +338,19 @@ def method_options(options: RenderOptions, method: Any, transparency: Any, stats
 
 def ray_options(options: RenderOptions, max_depth: Any, shadows: Any, depth_cue: Any, shading: Any,
                 where: str) -> tuple[int, bool]:  # fmt: skip
-    """``max_depth`` (0 … MAX_DEPTH) and ``shadows`` (None: on for ``method="ray-tracing"``, off otherwise);
-    what ``"ray-tracing"`` does not draw (other modes, shading models, depth cueing, A-buffer transparency)."""
+    """``max_depth`` (0 … MAX_DEPTH) and whether ``method="ray-tracing"`` casts shadow rays (``shadows`` None, True
+    or "ray": yes; False: no; False for the other methods, whose shadows are the shadow pass's); what
+    ``"ray-tracing"`` does not draw (other modes, shading models, depth cueing, A-buffer transparency)."""
     if isinstance(max_depth, bool) or not isinstance(max_depth, int | np.integer) or not 0 <= max_depth <= MAX_DEPTH:
         raise FrustumError(
             f"{where}: max_depth = {describe(max_depth)} is not an integer in [0, {MAX_DEPTH}] (levels of reflected "
             "and refracted rays)"
         )
-    if shadows is not None and not isinstance(shadows, bool | np.bool_):
-        raise FrustumError(f"{where}: shadows = {describe(shadows)} is not True, False or None")
     tracing = options.method == "ray-tracing"
-    if shadows and not tracing:
-        raise FrustumError(
-            f"{where}: shadows = {shadows!r} is drawn by method 'ray-tracing' (shadow rays); method = "
-            f"{options.method!r} draws no shadows"
-        )
+    if not tracing:  # shadow maps or rays of the shadow pass: checked by shadow_options
+        return int(max_depth), False
+    if shadows is not None and not isinstance(shadows, bool | np.bool_) and shadows != "ray":
+        raise FrustumError(f"{where}: shadows = {describe(shadows)} is not None, False, True or 'ray'")
     if tracing:
         name = "none" if shading is None else shading
         if options.mode != "surface" or name != "phong" or depth_cue is not None or options.transparency != "sort":

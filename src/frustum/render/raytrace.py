@@ -25,11 +25,12 @@ The contributions are weighted without a Fresnel term (the default and only weig
 
 so that an opaque matte surface (k_r = 0, α = 1) gives the depth buffer's color, a perfect mirror (k_r = 1)
 only what it reflects, and a transparent surface of ``ior = 1`` the depth buffer's blend ``α·I + (1 − α)·behind``.
-Rays that leave the scene see the ``background`` color. After ``max_depth`` levels of reflected and refracted rays
-no more are spawned (their share of the color is black), and rays whose weight is below ``MIN_WEIGHT`` are not
-traced. The normal used to reflect and refract is the interpolated (shading) normal; rays start ``ε`` (1e-9 of
-the scene's size) off the surface along the geometric normal, on the side they leave to, so that they do not meet
-it again.
+Rays that leave the scene see the ``background`` color, or the scene's environment map (``Scene(environment=)``)
+along their direction for reflected and refracted rays (primary rays that miss show it as the depth buffer
+does). After ``max_depth`` levels of reflected and refracted rays no more are spawned (their share of the color
+is black), and rays whose weight is below ``MIN_WEIGHT`` are not traced. The normal used to reflect and refract
+is the interpolated (shading) normal; rays start ``ε`` (1e-9 of the scene's size) off the surface along the
+geometric normal, on the side they leave to, so that they do not meet it again.
 
 The depth buffer receives the window depth of each primary hit, so volumes and particles are composited along
 the primary rays exactly as with ``method="ray-casting"``; ``buffers=("normals", "object_id")`` show the primary
@@ -49,7 +50,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -294,7 +295,8 @@ def _primary(camera: Camera, rows: np.ndarray, width: int, height: int) -> tuple
 
 def _trace(data: _Scene, origins: np.ndarray, directions: np.ndarray, pixel: np.ndarray, count: int,
            max_depth: int, cull: bool, background: np.ndarray, counts: dict, window_from_world: np.ndarray | None,
-           record: list | None = None) -> tuple[np.ndarray, _Hits | None, np.ndarray]:  # fmt: skip
+           record: list | None = None, environment: Any = None,
+           ) -> tuple[np.ndarray, _Hits | None, np.ndarray]:  # fmt: skip
     """The color (count, 3) of rays `origins`, `directions` (primary rays over t in [0, 1)) belonging to pixels
     `pixel` (0 … count − 1); the primary hits and their window depths (None: not computed)."""
     color = np.zeros((count, 3))
@@ -334,7 +336,11 @@ def _trace(data: _Scene, origins: np.ndarray, directions: np.ndarray, pixel: np.
         counts["hits"] = counts.get("hits", 0) + int(rows.shape[0])
         missed = np.ones(origins.shape[0], dtype=bool)
         missed[rows] = False
-        np.add.at(color, pixel[missed], weight[missed, None] * background[None, :3])
+        if environment is not None and depth > 0:  # reflected and refracted rays that leave see the surroundings
+            seen = environment.lookup(directions[missed])
+            np.add.at(color, pixel[missed], weight[missed, None] * seen)
+        else:
+            np.add.at(color, pixel[missed], weight[missed, None] * background[None, :3])
         segment_index = None
         if record is not None:
             segment_index = np.empty(origins.shape[0], dtype=np.int64)
@@ -426,7 +432,8 @@ def draw_surfaces(scene: Scene, camera: Camera, options: RenderOptions, buffers:
         pixels = np.arange(start, min(start + CHUNK, width * height))
         origins, directions = _primary(camera, pixels, width, height)
         result, primary, z = _trace(data, origins, directions, np.arange(pixels.shape[0]), pixels.shape[0],
-                                    options.max_depth, options.cull, background, counts, window_from_world)  # fmt: skip
+                                    options.max_depth, options.cull, background, counts, window_from_world,
+                                    environment=options.environment)  # fmt: skip
         # pixel j·W + i (y up) is row H − 1 − j of the image
         out = (height - 1 - pixels // width) * width + pixels % width
         if primary is None or primary.rows.shape[0] == 0:

@@ -288,7 +288,8 @@ def directional(item: SceneItem, options: RenderOptions, lights: np.ndarray) -> 
         and options.shade_mode == shade.SHADE_PHONG and options.specular_model == shade.SPECULAR_BLINN
         and bool((lights[:, 0] == 0.0).all()) and getattr(mesh, "vertex_colors", None) is None
         and (item.material.texture is None or getattr(mesh, "uvs", None) is None)
-        and options.depth_cue is None and not options.buffers and _plain_surface(item, options)
+        and options.depth_cue is None and not options.buffers and options.shadow is None
+        and _plain_surface(item, options)
     )  # fmt: skip
 
 

@@ -9,6 +9,7 @@ from collections.abc import Callable
 import numpy as np
 
 from frustum.camera import Camera
+from frustum.render import shadows
 from frustum.render.buffers import Buffers, FrameBuffers, clear_buffers
 from frustum.render.options import RenderOptions
 from frustum.render.stages import (
@@ -59,9 +60,10 @@ def draw_surfaces(
         for index in opaque:
             world, normals, band = draw_item(items[index], camera, options.cull, offsets[index], pixels, scratch)
             drawn.append((index, world, normals, band))
+        shadows.prepare(scene, items, [(i, w, offsets[i]) for i, w, _, _ in drawn], camera, options, lighting, pixels)
         for index, world, normals, band in drawn:
-            shade_item(items[index], index, offsets[index], camera, options, lighting, (world, normals), pixels,
-                       band, blend=False)  # fmt: skip
+            shadows.shade_item(items[index], index, offsets[index], camera, options, lighting, (world, normals),
+                               pixels, band, blend=False)  # fmt: skip
     between()
     if clear_items and bary is None:
         bary = scratch.empty((height, width, 2), np.float32)

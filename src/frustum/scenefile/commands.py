@@ -4,6 +4,7 @@ counts (``explain_method``), and the example gallery (``render_examples``)."""
 
 from __future__ import annotations
 
+import dataclasses
 import importlib
 import re
 from collections.abc import Sequence
@@ -68,6 +69,7 @@ def render_scene_file(
     output: str | Path | Sequence[str | Path] | None = None,
     *,
     size: tuple[int, int] | None = None,
+    shadows: bool | str | None = None,
     up: str = "y",
 ) -> Path | list[Path]:
     """Render the scene file at `path` and write it by suffix: PNG, SVG or PDF (line drawing), GIF or MP4 (turntable).
@@ -75,11 +77,15 @@ def render_scene_file(
     Parameters
     ----------
     path : str or Path
-        A TOML scene file.
+        A TOML scene file, or a mesh file (``load_scene_file``).
     output : str, Path, a sequence of them, or None
         Where to write. None: the file's ``[output].files``, or ``out/<stem>.png`` next to the scene file.
     size : (int, int), optional
         Image width and height, replacing ``[render].size``.
+    shadows : True, False, "ray" or None
+        Replaces ``[render].shadows`` (None: the file's).
+    up : "y" or "z"
+        A mesh file's up axis (glTF is y-up and ignores it).
 
     Returns
     -------
@@ -97,6 +103,8 @@ def render_scene_file(
     scene_file = load_scene_file(path, up=up)
     if size is not None:
         scene_file = scene_file.resized(tuple(size))  # type: ignore[arg-type]
+    if shadows is not None:
+        scene_file = dataclasses.replace(scene_file, options={**scene_file.options, "shadows": shadows})
     if output is None:
         targets = list(scene_file.outputs) or [Path(path).parent / "out" / (Path(path).stem + ".png")]
         single = not scene_file.outputs

@@ -40,7 +40,7 @@ _MAX_PIXELS = 8192
 _RENDER_KEYS = (
     "size", "shading", "specular", "background", "cull_back_faces", "mode", "edges", "crease_angle_deg", "edge_color",
     "hidden", "hidden_color", "line_width", "depth_cue", "samples", "filter", "color_space", "columns", "method",
-    "transparency", "max_depth", "shadows",
+    "transparency", "max_depth", "shadows", "shadow_map_size", "shadow_softness",
 )  # fmt: skip
 
 
@@ -48,6 +48,14 @@ _DEPTH_CUE_KEYS = ("near", "far", "min_intensity", "max_intensity", "color")
 
 
 _DEFAULT_SIZE = (480, 360)
+
+
+def _shadows(report: _Report, path: tuple, value: Any) -> Any:
+    """``[render] shadows``: true (shadow maps), false, or "ray" (shadow rays)."""
+    if isinstance(value, bool) or value == "ray":
+        return value
+    report.add(path, value, "is not a shadow method", 'give true (shadow maps), false or "ray" (shadow rays)')
+    return _BAD
 
 
 def _render_options(report: _Report, path: tuple, value: Any) -> tuple[dict, tuple[int, int], int]:
@@ -84,7 +92,9 @@ def _render_options(report: _Report, path: tuple, value: Any) -> tuple[dict, tup
         "method": lambda p, v: _choice(report, p, v, tuple(RENDER_METHODS)),
         "transparency": lambda p, v: _choice(report, p, v, TRANSPARENCY_MODES),
         "max_depth": lambda p, v: _number(report, p, v, low=0, high=64, integer=True),
-        "shadows": lambda p, v: _boolean(report, p, v),
+        "shadows": lambda p, v: _shadows(report, p, v),
+        "shadow_map_size": lambda p, v: _number(report, p, v, low=64, high=16384, integer=True),
+        "shadow_softness": lambda p, v: _number(report, p, v, low=0.0, high=16.0),
     }
     for key, check in simple.items():
         if key in params:

@@ -13,7 +13,7 @@ message                                                       effect
 ``{"type": "wheel", "delta"}``                                zoom: "interactive" (the page asks for "rest")
 ``{"type": "rest"}``                                          the full-resolution, supersampled frame
 ``{"type": "key", "key"}``                                    a preset or reset (``interaction.KEYS``)
-``{"type": "control", "name", "value"}``                      projection, shading, mode, depth_cue
+``{"type": "control", "name", "value"}``                      projection, shading, mode, depth_cue, shadows
 ``{"type": "reset"}``                                         back to the starting camera
 ``{"type": "pick", "x", "y"}``                                pick the surface point under pixel (x, y)
 ============================================================  ================================================
@@ -65,8 +65,11 @@ CONTROLS: dict[str, tuple[Any, ...]] = {
     "shading": SHADINGS,
     "mode": MODES,
     "depth_cue": (False, True),
+    "shadows": (False, True),
 }
 """Each control's allowed values."""
+_SWITCHES = ("depth_cue", "shadows")
+"""Controls that are checkboxes (bool values)."""
 _REGIONS = (
     (REGION_LEFT, "left"),
     (REGION_RIGHT, "right"),
@@ -185,7 +188,9 @@ class ViewerSession:
             self.control = home
         base = dict(options or {})
         self.options = {
-            key: value for key, value in base.items() if key not in ("shading", "mode", "depth_cue", "samples")
+            key: value
+            for key, value in base.items()
+            if key not in ("shading", "mode", "depth_cue", "samples", "shadows")
         }
         shading = base.get("shading", "phong")
         self.controls = {
@@ -193,8 +198,10 @@ class ViewerSession:
             "shading": "none" if shading is None else shading,
             "mode": base.get("mode", "surface") if base.get("mode", "surface") in MODES else "surface",
             "depth_cue": base.get("depth_cue") is not None,
+            "shadows": base.get("shadows") in (True, "ray"),
         }
         self._file_depth_cue = base.get("depth_cue")
+        self._file_shadows = base.get("shadows") if base.get("shadows") in (True, "ray") else True
         self.scene = scene
 
     # --- messages -----------------------------------------------------------------------------------------
@@ -233,7 +240,7 @@ class ViewerSession:
             return "rest"
         if kind == "control":
             name, value = message.get("name"), message.get("value")
-            if not isinstance(name, str) or name not in CONTROLS or isinstance(value, bool) != (name == "depth_cue"):
+            if not isinstance(name, str) or name not in CONTROLS or isinstance(value, bool) != (name in _SWITCHES):
                 return None
             if value not in CONTROLS[name]:
                 return None
@@ -262,6 +269,9 @@ class ViewerSession:
                 d, r = self.control.distance, self.control.radius
                 cue = DepthCue(max(0.0, d - r), d + r, min_intensity=0.15)
             options["depth_cue"] = cue
+        # shadows fall on shaded surfaces: the file's method (maps or rays) in the surface modes, none in the others
+        surfaces = options["mode"] in ("surface", "surface+edges")
+        options["shadows"] = self._file_shadows if self.controls["shadows"] and surfaces else False
         return options
 
     def camera(self, quality: str = "rest") -> Camera:

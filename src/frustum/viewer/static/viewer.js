@@ -16,6 +16,7 @@ function mountViewer(el, transport) {
           <label>shading <select data-control="shading"></select></label>
           <label>mode <select data-control="mode"></select></label>
           <label><input type="checkbox" data-control="depth_cue"> depth cue</label>
+          <label><input type="checkbox" data-control="shadows"> shadows</label>
           <button class="fv-reset">reset</button>
         </div>
         <div class="fv-help">drag: orbit · right/shift drag: pan · wheel: zoom · click: pick ·

@@ -1,0 +1,129 @@
+"""The shadow pass's place in the surface passes: between filling the depth buffer with the opaque items and shading
+them, ``prepare`` finds each drawn pixel's world point and, with shadows on, the fraction of each light reaching
+it (``frustum.shadow_pass``: shadow maps drawn by ``draw_depth``, the renderer's own binning and tile fill from
+the light, or shadow rays); ``shade_item`` then shades with those fractions (``raster.shadow``) or, where there
+are none, exactly as ``stages.shade_item`` does. Off the ordinary path: nothing here runs, and no kernel of
+``raster.shadow`` compiles, unless ``render`` is asked for shadows or the "position" buffer."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from frustum.camera import Camera
+from frustum.geometry import Mesh
+from frustum.raster import shade, triangles
+from frustum.render.options import RenderOptions
+from frustum.render.stages import (
+    TILE_SIZE,
+    Lighting,
+    Pixels,
+    _plain_surface,
+    bin_item,
+    item_flags,
+    shading_parameters,
+    world_faces,
+)  # fmt: skip
+from frustum.render.stages import shade_item as shade_item_plainly
+from frustum.scene import Scene, SceneItem
+
+SHADOWED_MODES = (shade.SHADE_PHONG, shade.SHADE_GOURAUD, shade.SHADE_FLAT)
+"""Shading modes in which shadows darken the picture (``"none"``, ``"normals"`` and ``"depth"`` ignore them)."""
+
+
+def draw_depth(item: SceneItem, camera: Camera, depth: np.ndarray, codes: np.ndarray, bary: np.ndarray) -> None:
+    """Stages 1–4 of one item into `depth` alone (codes and weights are scratch): a shadow map. Both sides of an
+    open surface; the front faces alone of a closed one (``Mesh.is_watertight``: along any ray from outside the
+    first surface met is a front face, so the map is the same, for half the fill)."""
+    binned = bin_item(item, camera, bool(item.mesh.is_watertight))
+    tiling = np.array([TILE_SIZE, binned.tiles_x, 0, depth.shape[1], depth.shape[0]], dtype=np.int64)
+    triangles.rasterize_tiles(
+        binned.faces, binned.win_int, binned.win_float, binned.tri_int, binned.tri_float, binned.tri_weights,
+        binned.tile_starts, binned.tile_entries, tiling, depth, codes, bary,
+    )  # fmt: skip
+
+
+def prepare(
+    scene: Scene, items: list[SceneItem], drawn: list[tuple[int, np.ndarray, int]], camera: Camera,
+    options: RenderOptions, lighting: Lighting, pixels: Pixels,
+) -> None:  # fmt: skip
+    """World points of the drawn opaque pixels (items ``(index, world positions, face offset)``) and, with shadows
+    on, each light's fraction reaching them, into ``options.outputs`` ("position", "seen", "casting"). Nothing
+    without an outputs dict (no shadows, no "position" buffer)."""
+    if options.outputs is None:
+        return
+    from frustum import shadow_pass
+
+    points, facing = shadow_pass.surface_points(items, drawn, pixels.depth, pixels.codes, pixels.bary)
+    options.outputs["position"] = points
+    if options.shadow is not None:
+        options.outputs["seen"] = shadow_pass.light_fractions(
+            scene, items, camera, options.shadow, lighting.lights, pixels.depth, points, facing, draw_depth, "render"
+        )
+        options.outputs["casting"] = np.array(shadow_pass.shadow_lights(scene)[0], dtype=np.int64)
+    shadow_pass.give_back(facing)
+
+
+def shade_item(
+    item: SceneItem, index: int, face_offset: int, camera: Camera, options: RenderOptions, lighting: Lighting,
+    attributes: tuple[np.ndarray, np.ndarray], pixels: Pixels, band: tuple[int, int], blend: bool,
+) -> None:  # fmt: skip
+    """``stages.shade_item`` with shadows: an opaque item in a shadowed mode goes through
+    ``raster.shadow.shade_pixels_shadowed`` with the fractions ``prepare`` found; anything else is shaded as
+    without shadows (transparent items receive none, nor items with a bump or normal map or an environment to
+    reflect: their kernels take no shadow fractions yet)."""
+    seen = None if options.outputs is None else options.outputs.get("seen")
+    plain = seen is None or blend or options.shade_mode not in SHADOWED_MODES or seen.shape[:2] != pixels.codes.shape
+    if plain or not _plain_surface(item, options):  # bump, normal maps and reflections shade their own way
+        shade_item_plainly(item, index, face_offset, camera, options, lighting, attributes, pixels, band, blend)
+        return
+    from frustum.raster import shadow
+
+    mesh, material = item.mesh, item.material
+    ambient, lights = lighting
+    rows = slice(*band)
+    codes = pixels.codes[rows]
+    write_normals = pixels.extra[0].shape[:2] == pixels.codes.shape
+    write_ids = pixels.extra[1].shape == pixels.codes.shape
+    extra = (pixels.extra[0][rows] if write_normals else pixels.extra[0],
+             pixels.extra[1][rows] if write_ids else pixels.extra[1])  # fmt: skip
+    params = shading_parameters(item, camera, options, ambient)
+    faces = world_faces(item) if mesh.face_count else np.empty((0, 3), dtype=np.int64)
+    world, normals = (np.asarray(a, dtype=np.float64) for a in attributes)
+    lit = lit_per_light(mesh, faces, world, normals, params, lights, options)
+    vertex_colors = getattr(mesh, "vertex_colors", None)
+    vertex_colors = np.empty((0, 3)) if vertex_colors is None else np.ascontiguousarray(vertex_colors[:, :3], float)
+    uvs, texture = getattr(mesh, "uvs", None), material.texture
+    if texture is None or uvs is None:
+        texture, uvs = np.empty((0, 0, 4), dtype=np.float32), np.empty((0, 2))
+    else:
+        uvs = np.ascontiguousarray(uvs, dtype=np.float64)
+    flags = item_flags(index, face_offset, options, blend, write_normals, write_ids)
+    shadow.shade_pixels_shadowed(
+        pixels.depth[rows], codes, pixels.bary[rows], faces, world, normals, lit, vertex_colors, uvs, texture,
+        params, lights, flags, seen[rows], pixels.color[rows], extra[0], extra[1],
+    )  # fmt: skip
+
+
+def lit_per_light(
+    mesh: Mesh, faces: np.ndarray, world: np.ndarray, normals: np.ndarray, params: np.ndarray, lights: np.ndarray,
+    options: RenderOptions,
+) -> np.ndarray:  # fmt: skip
+    """Gouraud (per vertex) or flat (per face) terms kept apart per light: (rows, 3 + 6·K) with the ambient term
+    first, then each light's (D, S) without ambient (``raster.shadow.shade_pixels_shadowed``); empty for Phong."""
+    mode = options.shade_mode
+    if mode == shade.SHADE_PHONG or mesh.face_count == 0:
+        return np.empty((0, 3 + 6 * lights.shape[0]))
+    count = mesh.vertex_count if mode == shade.SHADE_GOURAUD else mesh.face_count
+    lit = np.empty((count, 3 + 6 * lights.shape[0]))
+    lit[:, :3] = params[shade.P_AMBIENT] * params[shade.P_LIGHT_AMBIENT : shade.P_LIGHT_AMBIENT + 3]
+    unlit = params.copy()
+    unlit[shade.P_LIGHT_AMBIENT : shade.P_LIGHT_AMBIENT + 3] = 0.0
+    terms = np.empty((count, 6))
+    for k in range(lights.shape[0]):
+        one = np.ascontiguousarray(lights[k : k + 1])
+        if mode == shade.SHADE_GOURAUD:
+            shade.light_vertices(world, normals, unlit, one, options.specular_model, terms)
+        else:
+            shade.light_faces(world, faces, unlit, one, options.specular_model, terms)
+        lit[:, 3 + 6 * k : 9 + 6 * k] = terms
+    return lit

@@ -1,0 +1,356 @@
+"""The shadow pass of ``render``: which part of each light reaches each visible point.
+
+"Apply a hidden-surface method with the light source at the view position" [HB 17, "Shadows"]: once the opaque
+surfaces are in the depth buffer, every drawn pixel's world point (``surface_points``) is tested against each
+shadow-casting light in one of two ways.
+
+- **Shadow maps** (``shadows=True``): the depth-buffer method run from the light (the renderer's own binning and
+  tile kernels, ``render.bin_item`` + ``raster.triangles.rasterize_tiles``, into a float32 depth map of
+  ``shadow_map_size``² texels, both sides of every face drawn). A directional light gets an orthographic map
+  fitted to what the camera sees (the light-space box of the drawn points, widened by the filter's reach) and
+  deep enough toward the light to hold every caster (the scene's box); a spot light a perspective map over its
+  cone; a point light a cube of six perspective maps (each a little wider than 90° so filter taps near a cube
+  edge stay on their face). A point is lit where its distance along the light's axis, less a bias, is not beyond
+  the map's: the bias is slope-scaled, ``texel·(1 + (1 + softness)·min(tan θ, 8))`` with θ the angle between the
+  face normal and the light, and the point is first moved one texel along its face normal (normal offset), so lit
+  faces show no acne while shadows stay attached at contact. Percentage-closer filtering averages the test over
+  a (2m + 1)² grid of taps spanning ±``shadow_softness`` texels (m = ⌈softness⌉; 0: one tap, hard edges).
+- **Shadow rays** (``shadows="ray"``): a ray from each point (moved off its face by a small epsilon along the face
+  normal) toward the light, any hit before the light ends it (``occluded``: ``Scene.occluded``, the any-hit
+  query through the scene's BVH, ``raster.rays``). Exact up to the epsilon.
+
+Either way a point whose drawn side faces away from the light gets 0 (the surface itself is in the way). What
+casts and receives: opaque meshes cast and receive; transparent items (``Material.opacity < 1``) cast no shadow
+and receive none; volumes, particles, polylines and edges neither cast nor receive. Outside a spot light's map
+(beyond its cone, where it gives no light anyway) the fraction is 1.
+
+How the fractions enter the shading (``raster.shadow.shade_pixels_shadowed``): per-pixel Phong scales each
+light's diffuse and specular terms at the pixel; Gouraud and flat shading keep each light's terms per vertex (per
+face) apart and scale them, interpolated (constant), by the pixel's fraction, so a shadow edge is as sharp as
+the map or the rays make it in every mode; ``"none"``, ``"normals"`` and ``"depth"`` ignore shadows.
+
+Lights are gathered as ``Scene.world_lights`` gathers them: the root's lights first, then the lights riding
+nodes in depth-first order; ``Frame.shadow[..., j]`` is the j-th of those with ``cast_shadows`` (ambient lights
+cast none).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import threading
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from frustum._arrays import describe
+from frustum.budgets import check_memory, format_bytes
+from frustum.camera import Camera, ViewFrame
+from frustum.errors import FrustumError
+from frustum.projection import Orthographic, Perspective
+from frustum.scene import Scene, SceneItem
+from frustum.shading import AmbientLight, DirectionalLight, PointLight, SpotLight
+
+__all__ = [
+    "SHADOW_METHODS", "ShadowOptions", "check_shadows", "give_back", "light_fractions", "occluded",
+    "release_memory", "shadow_lights", "surface_points",
+]  # fmt: skip
+
+SHADOW_METHODS = (None, False, True, "ray")
+"""``render(..., shadows=...)``: the method's own (off for every method of today), off, shadow maps, rays."""
+MIN_MAP_SIZE, MAX_MAP_SIZE = 64, 16384
+RAY_EPSILON = 1e-6
+"""Shadow rays start this far off the surface along its face normal, relative to the scene's size (its box's
+diagonal): well above the float64 round-off of a hit point, far below a pixel."""
+_MARGIN_TEXELS = 3.0
+_POOL: dict[tuple, list[np.ndarray]] = {}
+_POOL_LOCK = threading.Lock()
+
+
+def _take(shape: tuple[int, ...], dtype: Any) -> np.ndarray:
+    """An uninitialized work array, one a previous frame gave back where shape and dtype match (no first-touch
+    page faults for the maps and per-pixel arrays of an animation's every frame)."""
+    key = (tuple(shape), np.dtype(dtype).str)
+    with _POOL_LOCK:
+        arrays = _POOL.get(key)
+        if arrays:
+            return arrays.pop()
+    return np.empty(shape, dtype=dtype)
+
+
+def give_back(*arrays: np.ndarray) -> None:
+    """Keep `arrays` for the next frame (only the last frame's: the pool holds one array per shape)."""
+    with _POOL_LOCK:
+        for array in arrays:
+            _POOL[(array.shape, array.dtype.str)] = [array]
+
+
+def release_memory() -> int:
+    """Free the work arrays the shadow pass keeps between frames; return their bytes."""
+    with _POOL_LOCK:
+        released = sum(a.nbytes for arrays in _POOL.values() for a in arrays)
+        _POOL.clear()
+    return released
+
+
+@dataclasses.dataclass(frozen=True)
+class ShadowOptions:
+    """What ``render`` was asked for: ``"map"`` or ``"ray"``, the map size in texels and the PCF radius."""
+
+    method: str
+    map_size: int = 2048
+    softness: float = 1.0
+
+
+def check_shadows(
+    shadows: Any, shadow_map_size: Any, shadow_softness: Any, method: str, mode: str, where: str
+) -> ShadowOptions | None:  # fmt: skip
+    """The ``shadows``/``shadow_map_size``/``shadow_softness`` arguments checked; None where shadows are off."""
+    if not (shadows is None or isinstance(shadows, bool | np.bool_) or shadows == "ray"):
+        raise FrustumError(
+            f"{where}: shadows = {describe(shadows)} is unknown; expected None (the method's own), False, True "
+            "(shadow maps) or 'ray' (shadow rays)"
+        )
+    if isinstance(shadow_map_size, bool) or not isinstance(shadow_map_size, int | np.integer):
+        raise FrustumError(
+            f"{where}: shadow_map_size = {describe(shadow_map_size)} is not an integer; give a power of two in "
+            f"[{MIN_MAP_SIZE}, {MAX_MAP_SIZE}]"
+        )
+    size = int(shadow_map_size)
+    if not (MIN_MAP_SIZE <= size <= MAX_MAP_SIZE and size & (size - 1) == 0):
+        raise FrustumError(
+            f"{where}: shadow_map_size = {size} is not a power of two in [{MIN_MAP_SIZE}, {MAX_MAP_SIZE}]; give "
+            "e.g. 1024, 2048 or 4096"
+        )
+    try:
+        softness = float(shadow_softness)
+    except (TypeError, ValueError):
+        softness = math.nan
+    if isinstance(shadow_softness, bool) or not (0.0 <= softness <= 16.0):
+        raise FrustumError(
+            f"{where}: shadow_softness = {describe(shadow_softness)} is not a number in [0, 16]; give the "
+            "filter radius in shadow-map texels (0: hard edges)"
+        )
+    if shadows is None or shadows is False or (isinstance(shadows, np.bool_) and not shadows):
+        return None
+    if mode not in ("surface", "surface+edges"):
+        raise FrustumError(
+            f"{where}: shadows = {shadows!r} with mode = {mode!r}: shadows fall on shaded surfaces; use mode "
+            "'surface' or 'surface+edges', or shadows=False"
+        )
+    if method in ("octree", "a-buffer"):
+        raise FrustumError(
+            f"{where}: shadows = {shadows!r} is not available with method = {method!r}; use another method, "
+            "or shadows=False"
+        )
+    kind = "ray" if shadows == "ray" or method == "ray-casting" else "map"
+    return ShadowOptions(kind, size, softness)
+
+
+def shadow_lights(scene: Scene) -> tuple[list[int], list[Any]]:
+    """The positions among the packed (non-ambient) lights of those that cast shadows, and those lights, in
+    ``Scene.world_lights`` order (the order of ``Frame.shadow``'s channels)."""
+    rows, casting = [], []
+    packed = [light for light in scene.world_lights() if not isinstance(light, AmbientLight)]
+    for row, light in enumerate(packed):
+        if getattr(light, "cast_shadows", False):
+            rows.append(row)
+            casting.append(light)
+    return rows, casting
+
+
+def surface_points(
+    items: list[SceneItem], drawn: list[tuple[int, np.ndarray, int]], depth: np.ndarray, codes: np.ndarray,
+    bary: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """(H, W, 3) float64 world points (NaN where nothing is drawn) and unit face normals turned toward the viewer,
+    from the depth buffer's codes and weights of the drawn items ``(index, world positions, face offset)``."""
+    from frustum.raster import shadow
+
+    height, width = depth.shape
+    points = _take((height, width, 3), np.float64)
+    points.fill(np.nan)
+    facing = _take((height, width, 3), np.float64)
+    for index, world, offset in drawn:
+        item = items[index]
+        if item.mesh.face_count == 0:
+            continue
+        faces = _world_faces(item)
+        shadow.surface_points(depth, codes, bary, faces, np.ascontiguousarray(world, dtype=np.float64), offset,
+                              points, facing)  # fmt: skip
+    return points, facing
+
+
+def _world_faces(item: SceneItem) -> np.ndarray:
+    """The faces counter-clockwise after the modeling transform (corners 1, 2 swapped where det < 0)."""
+    faces = np.asarray(item.mesh.faces, dtype=np.int64)
+    if np.linalg.det(np.asarray(item.world_from_model, dtype=np.float64)[:3, :3]) < 0.0:
+        return np.ascontiguousarray(faces[:, [0, 2, 1]])
+    return faces
+
+
+def light_fractions(
+    scene: Scene, items: list[SceneItem], camera: Camera, options: ShadowOptions, lights: np.ndarray,
+    depth: np.ndarray, points: np.ndarray, facing: np.ndarray,
+    draw_depth: Callable[[SceneItem, Camera, np.ndarray, np.ndarray, np.ndarray], None], where: str,
+) -> np.ndarray:  # fmt: skip
+    """(H, W, K) float32: the fraction of each packed light (rows of `lights`) reaching each drawn pixel (1 for
+    lights that cast no shadow and on the background). `draw_depth(item, light_camera, depth, codes, bary)` is
+    the renderer's depth pass of one item (both sides)."""
+    from frustum.raster import shadow
+
+    height, width = depth.shape
+    seen = np.ones((height, width, lights.shape[0]), dtype=np.float32)
+    rows, casting = shadow_lights(scene)
+    casters = [item for item in items if item.material.opacity >= 1.0 and item.mesh.face_count > 0]
+    drawn = depth < 1.0
+    if not rows or not casters or not drawn.any():
+        return seen
+    box = _scene_box(casters)
+    if options.method == "ray":
+        epsilon = RAY_EPSILON * max(float(np.linalg.norm(box[1] - box[0])), 1e-300)
+        origin = points[drawn]
+        normal = facing[drawn]
+        for channel, light in zip(rows, casting, strict=True):
+            direction, t_max = _to_light(light, origin)
+            fraction = np.where((normal * direction).sum(axis=1) > 0.0, 1.0, 0.0)
+            toward = fraction > 0.0
+            start = origin[toward] + epsilon * normal[toward]
+            blocked = occluded(scene, start, direction[toward], t_max[toward])
+            fraction[np.flatnonzero(toward)[blocked]] = 0.0
+            seen[..., channel][drawn] = fraction
+        return seen
+    size = options.map_size
+    cube_count = sum(isinstance(light, PointLight) for light in casting)
+    nbytes = (6 * cube_count + len(casting) - cube_count) * size * size * 4 + size * size * 12
+    check_memory(
+        nbytes,
+        where=where,
+        cause=f"shadow_map_size = {size} with {len(casting)} shadow-casting light(s), "
+        f"{cube_count} of them point lights (a cube of six maps each, {format_bytes(6 * size * size * 4)})",
+    )
+    codes = _take((size, size), np.int32 if 2 * sum(i.mesh.face_count for i in items) < 2**31 else np.int64)
+    bary = _take((size, size, 2), np.float32)
+    seen_points = points[drawn]
+    for channel, light in zip(rows, casting, strict=True):
+        cameras = _light_cameras(light, seen_points, box, size, options.softness)
+        if not cameras:
+            continue
+        maps = _take((len(cameras), size, size), np.float32)
+        maps.fill(1.0)
+        views = np.zeros((len(cameras), shadow.MAP_FIELDS))
+        for face, (light_camera, texel) in enumerate(cameras):
+            for item in casters:
+                draw_depth(item, light_camera, maps[face], codes, bary)
+            views[face] = _map_record(light_camera, texel, light)
+        shadow.map_visibility(depth, points, facing, maps, views, np.ascontiguousarray(lights[channel]),
+                              float(options.softness), seen, channel)  # fmt: skip
+        give_back(maps)
+    give_back(codes, bary)
+    return seen
+
+
+def occluded(scene: Scene, origins: np.ndarray, directions: np.ndarray, t_max: np.ndarray) -> np.ndarray:
+    """(N,) bool: whether an opaque surface of `scene` meets each ray ``origin + t·direction``, 0 <= t < t_max.
+
+    ``Scene.occluded`` (the any-hit query through the scene's BVH). Transparent items cast no shadow: where the
+    scene has any, the rays go through a scene of its opaque items alone (whose index is built for the call)."""
+    origins = np.ascontiguousarray(origins, dtype=np.float64)
+    directions = np.ascontiguousarray(directions, dtype=np.float64)
+    t_max = np.ascontiguousarray(t_max, dtype=np.float64)
+    if origins.shape[0] == 0:
+        return np.zeros(0, dtype=bool)
+    if any(item.material.opacity < 1.0 for item in scene.items):
+        opaque = Scene()
+        for item in scene.items:
+            if item.material.opacity >= 1.0:
+                opaque.add(item.mesh, item.material, transform=item.world_from_model)
+        scene = opaque
+    return np.asarray(scene.occluded(origins, directions, t_max), dtype=bool)
+
+
+def _to_light(light: Any, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Unit directions from `points` toward `light` and the distance to it (inf for a directional light)."""
+    if isinstance(light, DirectionalLight):
+        direction = np.broadcast_to(-np.asarray(light.direction, dtype=np.float64), points.shape)
+        return np.ascontiguousarray(direction), np.full(points.shape[0], np.inf)
+    offset = np.asarray(light.position, dtype=np.float64) - points
+    distance = np.sqrt((offset * offset).sum(axis=1))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        direction = offset / distance[:, None]
+    return np.nan_to_num(direction), distance
+
+
+def _scene_box(items: list[SceneItem]) -> np.ndarray:
+    """(2, 3): the world-space bounding box of the items' vertices."""
+    lows, highs = [], []
+    for item in items:
+        m = np.asarray(item.world_from_model, dtype=np.float64)
+        corners = np.array(np.meshgrid(*item.mesh.bounds.T, indexing="ij")).reshape(3, -1).T
+        world = corners @ m[:3, :3].T + m[:3, 3]
+        lows.append(world.min(axis=0))
+        highs.append(world.max(axis=0))
+    return np.array([np.min(lows, axis=0), np.max(highs, axis=0)])
+
+
+def _up_for(axis: np.ndarray) -> np.ndarray:
+    """A view-up vector not parallel to `axis`."""
+    return np.array([0.0, 0.0, 1.0]) if abs(axis[1]) > 0.9 else np.array([0.0, 1.0, 0.0])
+
+
+def _light_cameras(
+    light: Any, seen_points: np.ndarray, box: np.ndarray, size: int, softness: float
+) -> list[tuple[Camera, float]]:  # fmt: skip
+    """The light's map cameras and their texel sizes (world units per texel for an orthographic map; per unit of
+    distance for a perspective one)."""
+    corners = np.array(np.meshgrid(*box.T, indexing="ij")).reshape(3, -1).T
+    reach = (softness + _MARGIN_TEXELS) / size  # filter taps and the normal offset stay on the map
+    if isinstance(light, DirectionalLight):
+        to_light = -np.asarray(light.direction, dtype=np.float64)
+        frame = ViewFrame(np.zeros(3), normal=to_light, up=_up_for(to_light))
+        view = frame.matrix[:3, :3]
+        # light-view coordinates of the seen points, row by row (no BLAS call: its threads fight the kernels')
+        seen = [(seen_points[:, 0] * r[0] + seen_points[:, 1] * r[1]) + seen_points[:, 2] * r[2] for r in view]
+        low = np.array([axis.min() for axis in seen])
+        high = np.array([axis.max() for axis in seen])
+        side = float(max(high[0] - low[0], high[1] - low[1]))
+        span = float(np.linalg.norm(box[1] - box[0]))
+        side = max(side, 1e-9 * max(span, 1.0)) * (1.0 + 2.0 * reach)
+        centre = 0.5 * (low + high)
+        eye = centre[0] * frame.u + centre[1] * frame.v
+        caster_z = float((corners @ view.T)[:, 2].max())
+        near, far = -caster_z, -float(low[2])
+        pad = 1e-3 * max(far - near, span, 1e-12)
+        light_frame = ViewFrame(eye, normal=to_light, up=_up_for(to_light))
+        camera = Camera(light_frame, Orthographic(side, near - pad, far + pad), size, size)
+        return [(camera, side / size)]
+    position = np.asarray(light.position, dtype=np.float64)
+    distances = np.linalg.norm(corners - position, axis=1)
+    far = float(distances.max()) * 1.01 + 1e-9
+    nearest = np.clip(position, box[0], box[1])
+    near = max(0.99 * float(np.linalg.norm(nearest - position)), 1e-3 * far)
+    if isinstance(light, SpotLight):
+        axis = np.asarray(light.direction, dtype=np.float64)
+        half = min(light.outer_angle, math.radians(85.0))
+        fovy = 2.0 * math.atan(math.tan(half) * (1.0 + 2.0 * reach))
+        frame = ViewFrame(position, normal=-axis, up=_up_for(axis))
+        return [(Camera(frame, Perspective(fovy, near, far), size, size), 2.0 * math.tan(fovy / 2.0) / size)]
+    cameras = []
+    fovy = 2.0 * math.atan(1.0 + 2.0 * reach)
+    for axis in np.array([[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]], dtype=np.float64):
+        frame = ViewFrame(position, normal=-axis, up=_up_for(axis))
+        cameras.append((Camera(frame, Perspective(fovy, near, far), size, size), 2.0 * math.tan(fovy / 2.0) / size))
+    return cameras
+
+
+def _map_record(camera: Camera, texel: float, light: Any) -> np.ndarray:
+    """The ``raster.shadow`` map record of one light camera."""
+    from frustum.raster import shadow
+
+    record = np.zeros(shadow.MAP_FIELDS)
+    record[shadow.M_MATRIX : shadow.M_MATRIX + 16] = (camera.viewport_matrix @ camera.clip_from_world).ravel()
+    record[shadow.M_KIND] = shadow.KIND_ORTHOGRAPHIC if camera.projection.parallel else shadow.KIND_PERSPECTIVE
+    record[shadow.M_NEAR], record[shadow.M_FAR] = camera.projection.near, camera.projection.far
+    record[shadow.M_TEXEL] = texel
+    return record

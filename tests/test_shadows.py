@@ -1,0 +1,563 @@
+"""Shadows (``render(..., shadows=...)``, ``frustum.shadow_pass``): shadow maps and shadow rays against Embree.
+
+Oracle: Embree through ``embreex`` (ORACLES.md): from each drawn pixel's ``Frame.position``, moved off the surface
+along ``Frame.normals``, a ray toward the light; the pixel is in shadow where Embree finds a hit nearer than the
+light. Shadow maps agree on >= 99 % of the drawn pixels (the rest within 2 pixels of an edge of the oracle's
+shadow), shadow rays on >= 99.9 %.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+from scipy import ndimage
+
+import frustum as fr
+from frustum.geometry.primitives import box, plane, uv_sphere
+from frustum.geometry.teapot import teapot as teapot_patches
+from frustum.transforms import rotate_x, translate
+
+embree_scene = pytest.importorskip("embreex.rtcore_scene")
+mesh_construction = pytest.importorskip("embreex.mesh_construction")
+
+GROUND = fr.Material(color=(0.8, 0.8, 0.8))
+OFFSET = 1e-4
+"""Oracle rays start this far along the normal: far above the float32 round-off of Frame.position (~5e-7 here),
+far below a pixel (~0.03); ORACLES.md's 2e-3 shifts shadow edges by a visible fraction of a pixel at grazing rays."""
+
+
+def _ground(scene: fr.Scene, size: float = 10.0) -> None:
+    scene.add(plane((size, size), divisions=(4, 4)), GROUND, transform=rotate_x(-math.pi / 2))
+
+
+def _sphere_and_box(light) -> fr.Scene:
+    scene = fr.Scene(lights=[fr.AmbientLight(intensity=0.2), light])
+    _ground(scene)
+    scene.add(box((1, 1, 1), center=(0, 0.5, 0)), fr.Material(color=(0.9, 0.3, 0.2)))
+    scene.add(uv_sphere(0.6, segments=48, rings=24), fr.Material(color=(0.2, 0.5, 0.9)),
+              transform=translate(1.8, 0.6, 0.5))  # fmt: skip
+    return scene
+
+
+def _teapot_on_plane(light) -> fr.Scene:
+    scene = fr.Scene(lights=[fr.AmbientLight(intensity=0.2), light])
+    _ground(scene)
+    teapot = teapot_patches().tessellate(8)
+    scene.add(teapot, fr.Material(color=(0.9, 0.8, 0.3)), transform=rotate_x(-math.pi / 2) @ np.diag([0.6] * 3 + [1]))
+    return scene
+
+
+def _grille(light) -> fr.Scene:
+    """Six slats 0.2 wide, 0.3 apart, 2 units above the ground, under a spot light."""
+    scene = fr.Scene(lights=[fr.AmbientLight(intensity=0.2), light])
+    _ground(scene)
+    for k in range(6):
+        scene.add(box((0.2, 0.05, 3.0), center=(-1.25 + 0.5 * k, 2.0, 0.0)), fr.Material(color=(0.4, 0.4, 0.4)))
+    return scene
+
+
+CAMERA = fr.Camera.look_at((4.0, 5.0, 7.0), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0), width=320, height=240)
+LIGHTS = {
+    "directional": fr.DirectionalLight((1.0, -0.8, -0.3)),
+    "point": fr.PointLight((-3.0, 3.0, 1.5)),
+    "spot": fr.SpotLight((-3.0, 4.0, 0.0), (0.6, -1.0, 0.0), inner_angle=0.4, outer_angle=0.6),
+}
+
+
+def _world_triangles(scene: fr.Scene) -> np.ndarray:
+    triangles = []
+    for item in scene.items:
+        m = np.asarray(item.world_from_model)
+        world = item.mesh.vertices @ m[:3, :3].T + m[:3, 3]
+        triangles.append(world[item.mesh.faces])
+    return np.concatenate(triangles).astype(np.float32)
+
+
+def embree_lit(scene: fr.Scene, frame: fr.Frame, light) -> np.ndarray:
+    """(H, W) bool: True where Embree finds no surface between the drawn point and the light (NaN background:
+    False, masked out by the callers)."""
+    drawn = np.isfinite(frame.position[..., 0])
+    points = frame.position[drawn].astype(np.float64)
+    normals = frame.normals[drawn].astype(np.float64)
+    if isinstance(light, fr.DirectionalLight):
+        direction = np.broadcast_to(-np.asarray(light.direction), points.shape)
+        distance = np.full(points.shape[0], np.inf)
+    else:
+        offset = np.asarray(light.position) - points
+        distance = np.linalg.norm(offset, axis=1)
+        direction = offset / distance[:, None]
+    origins = points + OFFSET * normals
+    rtc = embree_scene.EmbreeScene()
+    mesh_construction.TriangleMesh(rtc, _world_triangles(scene))
+    result = rtc.run(origins.astype(np.float32), np.ascontiguousarray(direction, dtype=np.float32), output=1)
+    blocked = (result["primID"] >= 0) & (result["tfar"] < distance - OFFSET)
+    lit = np.zeros(drawn.shape, dtype=bool)
+    lit[drawn] = ~blocked
+    return lit
+
+
+def _agreement(frame: fr.Frame, oracle: np.ndarray, light=None) -> tuple[float, np.ndarray]:
+    """Fraction of drawn pixels (inside a spot light's cone, for a spot) where the frame's lit/shadowed decision
+    (fraction >= 0.5) equals the oracle's, and the mask of disagreeing pixels."""
+    drawn = np.isfinite(frame.shadow[..., 0])
+    if isinstance(light, fr.SpotLight):
+        to_point = frame.position.astype(np.float64) - np.asarray(light.position)
+        cos = (to_point @ np.asarray(light.direction)) / np.linalg.norm(to_point, axis=2)
+        drawn &= cos > math.cos(light.outer_angle)
+    ours = frame.shadow[..., 0] >= 0.5
+    wrong = drawn & (ours != oracle)
+    return 1.0 - wrong.sum() / drawn.sum(), wrong
+
+
+def _near_oracle_edge(oracle: np.ndarray, drawn: np.ndarray, pixels: int = 2) -> np.ndarray:
+    """Pixels within `pixels` of a change in the oracle's lit mask (over the drawn pixels)."""
+    structure = np.ones((2 * pixels + 1, 2 * pixels + 1), dtype=bool)
+    lit = oracle & drawn
+    shadowed = ~oracle & drawn
+    return ndimage.binary_dilation(lit, structure) & ndimage.binary_dilation(shadowed, structure)
+
+
+SCENES = [("sphere_and_box", name) for name in LIGHTS] + [("teapot", "directional"), ("teapot", "point"),
+                                                           ("grille", "spot")]  # fmt: skip
+
+
+def _build(kind: str, light) -> fr.Scene:
+    return {"sphere_and_box": _sphere_and_box, "teapot": _teapot_on_plane, "grille": _grille}[kind](light)
+
+
+@pytest.mark.parametrize(("kind", "light_name"), SCENES)
+def test_shadow_maps_agree_with_embree(kind, light_name):
+    light = LIGHTS[light_name]
+    scene = _build(kind, light)
+    frame = fr.render(scene, CAMERA, shadows=True, buffers=("position", "normals", "shadow"),
+                      cull_back_faces=kind != "teapot")  # fmt: skip
+    oracle = embree_lit(scene, frame, light)
+    agreement, wrong = _agreement(frame, oracle, light)
+    shadowed = (frame.shadow[..., 0] < 0.5).sum()
+    print(f"{kind}/{light_name}: shadow maps agree with Embree on {agreement:.4%}, {shadowed} shadowed pixels")
+    assert shadowed > 100  # the scene does cast shadows into the picture
+    assert agreement >= 0.99
+    near_edge = _near_oracle_edge(oracle, np.isfinite(frame.shadow[..., 0]))
+    assert not (wrong & ~near_edge).any(), np.argwhere(wrong & ~near_edge)[:10]
+
+
+@pytest.mark.parametrize(("kind", "light_name"), SCENES)
+def test_shadow_rays_agree_with_embree(kind, light_name):
+    light = LIGHTS[light_name]
+    scene = _build(kind, light)
+    frame = fr.render(scene, CAMERA, shadows="ray", buffers=("position", "normals", "shadow"),
+                      cull_back_faces=kind != "teapot")  # fmt: skip
+    oracle = embree_lit(scene, frame, light)
+    agreement, _ = _agreement(frame, oracle, light)
+    print(f"{kind}/{light_name}: shadow rays agree with Embree on {agreement:.5%}")
+    assert agreement >= 0.999
+
+
+def test_no_acne_on_a_plane_lit_at_80_degrees():
+    """A lit plane facing the light at 80° from its normal has no shadowed pixel (slope-scaled bias)."""
+    for light in (
+        fr.DirectionalLight((math.sin(math.radians(80.0)), -math.cos(math.radians(80.0)), 0.0)),
+        fr.SpotLight((-11.0, 2.0, 0.0), (math.sin(math.radians(80.0)), -math.cos(math.radians(80.0)), 0.0),
+                     inner_angle=0.5, outer_angle=0.6),
+    ):  # fmt: skip
+        scene = fr.Scene(lights=[light])
+        _ground(scene)
+        for softness in (0.0, 1.0, 3.0):
+            frame = fr.render(scene, CAMERA, shadows=True, shadow_softness=softness, buffers=("shadow",))
+            values = frame.shadow[..., 0][np.isfinite(frame.shadow[..., 0])]
+            assert values.size > 10000
+            assert (values == 1.0).all(), (type(light).__name__, softness, (values < 1.0).sum())
+
+
+def test_box_on_plane_shadow_touches_its_base():
+    """Contact: no gap between a box resting on the plane and its shadow (no peter-panning): every ground pixel
+    that the exact shadow rays put in shadow and that the map calls lit lies within one pixel of the box's base
+    (or within 2 pixels of the shadow's edges on the ground, where the filter blurs)."""
+    light = fr.DirectionalLight((1.0, -0.6, 0.4))
+    scene = fr.Scene(lights=[light])
+    _ground(scene)
+    scene.add(box((1, 1, 1), center=(0, 0.5, 0)), fr.Material())
+    camera = fr.Camera.look_at((3.0, 2.5, 4.0), (0.5, 0.0, 0.0), (0.0, 1.0, 0.0), width=400, height=300)
+    exact = fr.render(scene, camera, shadows="ray", buffers=("shadow", "position"))
+    mapped = fr.render(scene, camera, shadows=True, buffers=("shadow",))
+    ground = np.abs(exact.position[..., 1]) < 1e-6
+    exact_lit = exact.shadow[..., 0] >= 0.5
+    # where the map calls lit what the rays shadow, away from the shadow's edges on the ground (filtered there)
+    gap = ground & ~exact_lit & (mapped.shadow[..., 0] >= 0.5) & ~_near_oracle_edge(exact_lit, ground)
+    # image distance of each gap pixel to the box's base square (its four edges projected)
+    corners = np.array([[-0.5, 0, -0.5], [0.5, 0, -0.5], [0.5, 0, 0.5], [-0.5, 0, 0.5]])
+    window = camera.project(corners)[:, :2]
+    rows, cols = np.nonzero(gap)
+    centres = np.stack([cols + 0.5, camera.height - 1 - rows + 0.5], axis=1)
+    distance = np.full(centres.shape[0], np.inf)
+    for k in range(4):
+        a, b = window[k], window[(k + 1) % 4]
+        t = np.clip(((centres - a) @ (b - a)) / ((b - a) @ (b - a)), 0.0, 1.0)
+        distance = np.minimum(distance, np.linalg.norm(centres - (a + t[:, None] * (b - a)), axis=1))
+    shadowed = (ground & (exact.shadow[..., 0] < 0.5)).sum()
+    assert shadowed > 1000
+    assert (distance <= 1.0 + 0.5 * math.sqrt(2)).all(), np.sort(distance)[-5:]  # within one pixel (centre to edge)
+
+
+def test_shadows_off_changes_no_byte():
+    scene = _sphere_and_box(LIGHTS["directional"])
+    plain = fr.render(scene, CAMERA)
+    for shadows in (None, False):
+        frame = fr.render(scene, CAMERA, shadows=shadows, shadow_map_size=256, shadow_softness=3.0)
+        assert np.array_equal(frame.color, plain.color) and np.array_equal(frame.depth, plain.depth)
+        assert frame.shadow is None and frame.position is None
+
+
+@pytest.mark.parametrize("light_name", list(LIGHTS))
+def test_lights_that_cast_no_shadow_give_the_unshadowed_bytes(light_name):
+    """Phong with every light's cast_shadows False: the shadowed shading kernel gives the plain picture's bytes."""
+    light = dataclasses.replace(LIGHTS[light_name], cast_shadows=False)
+    scene = _sphere_and_box(light)
+    plain = fr.render(scene, CAMERA)
+    for shadows in (True, "ray"):
+        frame = fr.render(scene, CAMERA, shadows=shadows, buffers=("shadow",))
+        assert frame.shadow.shape == (*plain.depth.shape, 0)
+        assert np.array_equal(frame.color, plain.color)
+
+
+@pytest.mark.parametrize("shading", ["phong", "gouraud", "flat"])
+def test_shadowed_ground_is_darker_in_every_shading_mode(shading):
+    scene = _sphere_and_box(LIGHTS["directional"])
+    lit = fr.render(scene, CAMERA, shading=shading, buffers=("object_id",))
+    frame = fr.render(scene, CAMERA, shading=shading, shadows=True, buffers=("shadow", "object_id"))
+    ground = frame.object_id == 0
+    shadowed = ground & (frame.shadow[..., 0] == 0.0)
+    sunny = ground & (frame.shadow[..., 0] == 1.0)
+    assert shadowed.sum() > 300
+    # in shadow only the ambient term is left; in the sun the picture equals the unshadowed one within a level
+    assert (frame.color[shadowed][:, :3].astype(int) < lit.color[shadowed][:, :3].astype(int) - 40).all()
+    assert np.abs(frame.color[sunny].astype(int) - lit.color[sunny].astype(int)).max() <= 1
+
+
+def test_position_buffer_is_the_unprojected_depth():
+    scene = _sphere_and_box(LIGHTS["point"])
+    frame = fr.render(scene, CAMERA, buffers=("position",))
+    drawn = frame.depth < 1.0
+    assert np.isnan(frame.position[~drawn]).all() and np.isfinite(frame.position[drawn]).all()
+    rows, cols = np.nonzero(drawn)
+    window = np.stack([cols + 0.5, CAMERA.height - 1 - rows + 0.5, frame.depth[drawn]], axis=1)
+    expected = CAMERA.unproject(window)
+    # float32 window depth: its round-off (~6e-8) times dz/d(depth) of a perspective camera at ~8 units
+    assert np.abs(frame.position[drawn] - expected).max() < 2e-3
+    assert frame.position.dtype == np.float32 and not frame.position.flags.writeable
+
+
+def test_shadows_with_other_methods_and_supersampling():
+    scene = _sphere_and_box(LIGHTS["directional"])
+    reference = fr.render(scene, CAMERA, shadows="ray", buffers=("shadow",))
+    for method in ("scan-line", "ray-casting"):
+        frame = fr.render(scene, CAMERA, method=method, shadows=True, buffers=("shadow",))
+        both = np.isfinite(frame.shadow) & np.isfinite(reference.shadow)
+        assert ((frame.shadow[both] >= 0.5) == (reference.shadow[both] >= 0.5)).mean() > 0.995
+    big = fr.render(scene, CAMERA, shadows=True, samples=4, buffers=("shadow", "position"))
+    assert big.shadow.shape == (CAMERA.height, CAMERA.width, 1)
+    assert big.position.shape == (CAMERA.height, CAMERA.width, 3)
+
+
+def test_light_order_of_the_shadow_buffer():
+    """Channels follow Scene.world_lights: the root's lights first, then lights riding nodes; lights with
+    cast_shadows=False and ambient lights have none."""
+    left = fr.DirectionalLight((1.0, -0.8, -0.3))
+    unshadowing = fr.DirectionalLight((0.0, -1.0, 0.0), cast_shadows=False)
+    scene = _sphere_and_box(left)
+    scene.root.lights.append(unshadowing)
+    rider = fr.Node("lamp", translate(0.0, 0.0, 0.0))
+    rider.add_light(fr.PointLight((3.0, 3.0, -2.0)))
+    scene.add(rider)
+    frame = fr.render(scene, CAMERA, shadows="ray", buffers=("shadow",))
+    assert frame.shadow.shape[2] == 2
+    alone = fr.render(_sphere_and_box(left), CAMERA, shadows="ray", buffers=("shadow",))
+    assert np.array_equal(frame.shadow[..., 0], alone.shadow[..., 0], equal_nan=True)
+
+
+@pytest.mark.parametrize(
+    ("options", "message"),
+    [
+        ({"shadows": True, "shadow_map_size": 100}, r"shadow_map_size = 100 is not a power of two in \[64, 16384\]"),
+        ({"shadows": True, "shadow_map_size": 32}, r"shadow_map_size = 32 is not a power of two"),
+        ({"shadows": True, "shadow_map_size": 32768}, r"shadow_map_size = 32768 is not a power of two"),
+        ({"shadows": True, "shadow_map_size": 2048.0}, r"shadow_map_size = 2048.0 is not an integer"),
+        ({"shadows": True, "shadow_softness": -1}, r"shadow_softness = -1 is not a number in \[0, 16\]"),
+        ({"shadows": True, "shadow_softness": "soft"}, r"shadow_softness = 'soft' is not a number"),
+        ({"shadows": "maps"}, r"shadows = 'maps' is unknown; expected None"),
+        ({"shadows": True, "mode": "wireframe"}, r"shadows = True with mode = 'wireframe'"),
+        ({"shadows": True, "mode": "hidden-line"}, r"mode = 'hidden-line'"),
+        ({"shadows": True, "method": "a-buffer"}, r"not available with method = 'a-buffer'"),
+        ({"buffers": ("shadow",)}, r"asks for 'shadow' with shadows = None; give shadows=True or 'ray'"),
+        ({"buffers": ("position",), "mode": "points"}, r"asks for 'position' with mode = 'points'"),
+    ],
+)
+def test_bad_shadow_arguments(options, message):
+    scene = _sphere_and_box(LIGHTS["point"])
+    with pytest.raises(fr.FrustumError, match=message):
+        fr.render(scene, CAMERA, **options)
+
+
+def test_cube_maps_over_the_memory_budget():
+    scene = _sphere_and_box(LIGHTS["point"])
+    with fr.budget(bytes=2**30), pytest.raises(fr.FrustumError, match=r"shadow_map_size = 8192 .* point light.*budget"):
+        fr.render(scene, CAMERA, shadows=True, shadow_map_size=8192)
+
+
+def test_cast_shadows_must_be_a_bool():
+    with pytest.raises(fr.FrustumError, match=r"PointLight: cast_shadows = 'yes' is not a bool"):
+        fr.PointLight((0, 1, 0), cast_shadows="yes")
+    with pytest.raises(fr.FrustumError, match=r"SpotLight: cast_shadows = 1 is not a bool"):
+        fr.SpotLight((0, 1, 0), (0, -1, 0), cast_shadows=1)
+    assert fr.DirectionalLight((0, -1, 0)).cast_shadows is True
+
+
+# --- scene files and the CLI ------------------------------------------------------------------------------
+
+SCENE_TOML = """
+[render]
+size = [96, 72]
+{render}
+
+[camera]
+eye = [4.0, 5.0, 7.0]
+target = [0.0, 0.0, 0.0]
+
+[[lights]]
+type = "directional"
+direction = [1.0, -0.8, -0.3]
+{light}
+
+[[nodes]]
+geometry = {{ type = "plane", size = [10.0, 10.0] }}
+transform = [{{ rotate_x_deg = -90 }}]
+
+[[nodes]]
+geometry = {{ type = "box", center = [0.0, 0.5, 0.0] }}
+"""
+
+
+def _scene_file(tmp_path, render="", light=""):
+    path = tmp_path / "shadows.toml"
+    path.write_text(SCENE_TOML.format(render=render, light=light))
+    return path
+
+
+@pytest.mark.parametrize("value", ["true", '"ray"'])
+def test_scene_file_shadows(tmp_path, value):
+    from frustum.scenefile import load_scene_file, render_scene_file
+
+    loaded = load_scene_file(_scene_file(tmp_path, f"shadows = {value}\nshadow_map_size = 512\nshadow_softness = 0"))
+    assert loaded.options["shadows"] == (True if value == "true" else "ray")
+    assert loaded.options["shadow_map_size"] == 512 and loaded.options["shadow_softness"] == 0
+    shadowed = fr.render(loaded.scene, loaded.camera, **loaded.options)
+    plain = fr.render(loaded.scene, loaded.camera, **{**loaded.options, "shadows": False})
+    assert (shadowed.color[..., :3].astype(int).sum(axis=2) < plain.color[..., :3].astype(int).sum(axis=2)).sum() > 50
+    written = render_scene_file(_scene_file(tmp_path, f"shadows = {value}"), tmp_path / "out.png")
+    assert written.is_file()
+
+
+def test_scene_file_light_without_shadows(tmp_path):
+    from frustum.scenefile import load_scene_file
+
+    loaded = load_scene_file(_scene_file(tmp_path, "shadows = true", "cast_shadows = false"))
+    assert [light.cast_shadows for light in loaded.scene.world_lights()] == [False]
+    frame = fr.render(loaded.scene, loaded.camera, **loaded.options)
+    plain = fr.render(loaded.scene, loaded.camera, **{**loaded.options, "shadows": False})
+    assert np.array_equal(frame.color, plain.color)
+
+
+@pytest.mark.parametrize(
+    ("render", "light", "message"),
+    [
+        ('shadows = "maps"', "", r"shadows.* is not a shadow method"),
+        ("shadow_map_size = 32", "", r"shadow_map_size"),
+        ("", 'cast_shadows = "yes"', r"cast_shadows"),
+    ],
+)
+def test_scene_file_bad_shadows(tmp_path, render, light, message):
+    from frustum.scenefile import load_scene_file
+
+    with pytest.raises(fr.FrustumError, match=message):
+        load_scene_file(_scene_file(tmp_path, render, light))
+
+
+def test_cli_shadows_option(tmp_path):
+    import subprocess
+    import sys
+
+    path = _scene_file(tmp_path)
+    command = [sys.executable, "-m", "frustum", "render", str(path), "-o"]
+    plain = subprocess.run([*command, str(tmp_path / "plain.png")], capture_output=True, text=True, timeout=600)
+    shadowed = subprocess.run([*command, str(tmp_path / "ray.png"), "--shadows", "ray"], capture_output=True, text=True,
+                              timeout=600)  # fmt: skip
+    assert plain.returncode == 0 and shadowed.returncode == 0, shadowed.stderr
+    from PIL import Image
+
+    a = np.asarray(Image.open(tmp_path / "plain.png")).astype(int)
+    b = np.asarray(Image.open(tmp_path / "ray.png")).astype(int)
+    assert (b[..., :3].sum(axis=2) < a[..., :3].sum(axis=2)).sum() > 50
+    bad = subprocess.run([*command, str(tmp_path / "x.png"), "--shadows", "maybe"], capture_output=True, text=True,
+                         timeout=600)  # fmt: skip
+    assert bad.returncode != 0 and "--shadows 'maybe' is unknown; expected on, off or ray" in bad.stderr
+    assert len(bad.stderr.strip().splitlines()) == 1
+
+
+# --- exact shadow polygons in vector drawings -------------------------------------------------------------
+
+shapely = pytest.importorskip("shapely")
+
+
+def _box_on_plane(light) -> fr.Scene:
+    scene = fr.Scene(lights=[light])
+    scene.add(plane((10, 10)), fr.Material(), transform=rotate_x(-math.pi / 2))
+    scene.add(box((1, 1, 1), center=(0, 0.5, 0)), fr.Material())
+    return scene
+
+
+SVG_LIGHTS = {"directional": fr.DirectionalLight((1.0, -1.0, -0.5)), "point": fr.PointLight((-2.0, 3.0, 1.5))}
+
+
+def _analytic_ground_shadow(light):
+    """The box's shadow on the ground, (x, z): hull of its corners projected from the light, and its base."""
+    corners = np.array([[x, y, z] for x in (-0.5, 0.5) for y in (0.0, 1.0) for z in (-0.5, 0.5)])
+    if isinstance(light, fr.DirectionalLight):
+        d = np.asarray(light.direction)
+        projected = corners - (corners[:, 1] / d[1])[:, None] * d
+    else:
+        p = np.asarray(light.position)
+        projected = p + (p[1] / (p[1] - corners[:, 1]))[:, None] * (corners - p)
+    hull = shapely.MultiPoint([tuple(q) for q in projected[:, [0, 2]]]).convex_hull
+    base = shapely.Polygon([(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)])
+    return hull, base
+
+
+@pytest.mark.parametrize("light_name", list(SVG_LIGHTS))
+def test_shadow_polygon_vertices_are_the_projected_silhouette(light_name):
+    """Seen from above (orthographic), the ground's shadow polygon is the projection of the box's silhouette from
+    the light less the base the box stands on: the same vertices to 1e-9."""
+    light = SVG_LIGHTS[light_name]
+    scene = _box_on_plane(light)
+    camera = fr.Camera(fr.ViewFrame((0.0, 10.0, 0.0), target=(0.0, 0.0, 0.0), up=(0.0, 0.0, -1.0)),
+                       fr.Orthographic(8.0, 0.1, 20.0), 400, 400)  # fmt: skip
+    polygons = [p for p in fr.shadow_polygons(scene, camera) if p.item == 0]
+    assert len(polygons) == 1 and polygons[0].kind == "cast" and len(polygons[0].loops) == 1
+    loop = polygons[0].loops[0]
+    hull, base = _analytic_ground_shadow(light)
+    expected_xz = np.array(hull.difference(base).exterior.coords)[:-1]
+    expected = camera.project(np.column_stack([expected_xz[:, 0], np.zeros(len(expected_xz)), expected_xz[:, 1]]))
+    expected = expected[:, :2]
+    assert loop.shape == expected.shape, (loop, expected)
+    distances = np.linalg.norm(loop[:, None, :] - expected[None, :, :], axis=2)
+    assert distances.min(axis=1).max() < 1e-9 and distances.min(axis=0).max() < 1e-9
+    assert polygons[0].area == pytest.approx(hull.difference(base).area * (400 / 8.0) ** 2, rel=1e-9)
+
+
+@pytest.mark.parametrize("light_name", list(SVG_LIGHTS))
+def test_shadow_polygon_area_equals_the_rasterized_shadow(light_name):
+    """Perspective view (the box hides part of its shadow): the polygons' area equals the area of the exact
+    shadow rays' Frame.shadow, 16x supersampled, within 1 %."""
+    light = SVG_LIGHTS[light_name]
+    scene = _box_on_plane(light)
+    eye, target = (3.0, 6.0, 5.0), (0.5, 0.0, 0.0)
+    camera = fr.Camera.look_at(eye, target, (0.0, 1.0, 0.0), width=300, height=225)
+    area = sum(p.area for p in fr.shadow_polygons(scene, camera))
+    fine = fr.Camera.look_at(eye, target, (0.0, 1.0, 0.0), width=1200, height=900)
+    frame = fr.render(scene, fine, shadows="ray", buffers=("shadow",))
+    raster = float((frame.shadow[..., 0] < 0.5).sum()) / 16.0
+    print(f"{light_name}: polygons {area:.2f} px², rasterized {raster:.2f} px²")
+    assert raster > 300
+    assert area == pytest.approx(raster, rel=0.01)
+
+
+def test_render_svg_and_drawing_sheet_draw_the_shadows():
+    scene = _box_on_plane(fr.sun_45())
+    assert np.allclose(fr.sun_45().direction, np.array([1.0, -1.0, -1.0]) / math.sqrt(3.0))
+    camera = fr.Camera.look_at((3.0, 6.0, 5.0), (0.5, 0.0, 0.0), (0.0, 1.0, 0.0), width=300, height=225)
+    plain = fr.render_svg(scene, camera)
+    assert 'id="shadows"' not in plain
+    filled = fr.render_svg(scene, camera, fill=True, shadows=True)
+    hatched = fr.render_svg(scene, camera, shadows=True)
+    assert '<g id="shadows" fill="#000000" fill-opacity="0.35"' in filled
+    assert 'fill="url(#shadow-hatch)"' in hatched and '<pattern id="shadow-hatch"' in hatched
+    assert hatched.count('class="cast"') >= 1 and hatched.count('class="attached"') >= 1
+    # the shadows lie under the lines: their group comes before the edges
+    assert hatched.index('id="shadows"') < hatched.index('id="visible"')
+    sheet = fr.drawing_sheet(scene, ("front", "top"), shadows=True)
+    assert 'id="top-shadows"' in sheet and 'id="front-shadows"' in sheet
+    with pytest.raises(fr.FrustumError, match=r"shadows = 'yes' is not a bool"):
+        fr.render_svg(scene, camera, shadows="yes")
+
+
+# --- the polygon operations of the vector shadows (properties) --------------------------------------------
+
+from hypothesis import given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+from frustum.output import svg_shadows  # noqa: E402
+
+_coordinates = st.floats(-10.0, 10.0, allow_nan=False, allow_infinity=False)
+_point_sets = st.lists(st.tuples(_coordinates, _coordinates), min_size=3, max_size=8)
+
+
+def _convex(points):
+    from scipy.spatial import ConvexHull, QhullError
+
+    array = np.array(points, dtype=np.float64)
+    try:
+        hull = ConvexHull(array)
+    except (QhullError, ValueError):
+        return None
+    polygon = array[hull.vertices]
+    return polygon if hull.volume > 1e-3 else None  # counter-clockwise (Qhull's 2-D order)
+
+
+@settings(max_examples=60, deadline=None)
+@given(_point_sets, _point_sets)
+def test_convex_difference_and_intersection_partition_the_polygon(a_points, b_points):
+    a, b = _convex(a_points), _convex(b_points)
+    if a is None or b is None:
+        return
+    tiny = 1e-18
+    inside = svg_shadows._intersect(a, b)
+    outside = svg_shadows._subtract(a, b, tiny)
+    area = lambda p: abs(svg_shadows._signed_area(p)) if p.shape[0] >= 3 else 0.0  # noqa: E731
+    # round-off of a few clipped corners of coordinates up to 10: 1e-9 of the area scale
+    assert area(inside) + sum(area(p) for p in outside) == pytest.approx(area(a), abs=1e-9 * max(1.0, area(a)))
+    for piece in outside:  # disjoint from B
+        assert area(svg_shadows._intersect(svg_shadows._ccw(piece), b)) < 1e-9 * max(1.0, area(a))
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.lists(_point_sets, min_size=1, max_size=4))
+def test_outline_of_the_union_has_the_union_area(point_sets):
+    polygons = [p for p in (_convex(points) for points in point_sets) if p is not None]
+    if not polygons:
+        return
+    pieces = svg_shadows._disjoint_union(polygons, 1e-18)
+    loops = svg_shadows._outline(pieces, 20.0)
+    union = shapely.union_all([shapely.Polygon(p) for p in polygons])
+    assert sum(svg_shadows._signed_area(loop) for loop in loops) == pytest.approx(union.area, abs=1e-6)
+
+
+@pytest.mark.parametrize("format", ["nerf", "webdataset"])
+def test_dataset_writes_position_and_shadow_for_a_scene_with_shadows(tmp_path, format):
+    from frustum.batch import render_dataset
+
+    path = _scene_file(tmp_path, "shadows = true")
+    result = render_dataset(path, tmp_path / "out", views=2, format=format, executor="serial", progress=False)
+    assert result.ok and len(result.rendered) == 2
+    if format == "nerf":
+        positions = sorted((tmp_path / "out" / "position").glob("*.npy"))
+        shadows = sorted((tmp_path / "out" / "shadow").glob("*.npy"))
+        assert len(positions) == 2 and len(shadows) == 2
+        position, shadow = np.load(positions[0]), np.load(shadows[0])
+        assert position.shape == (72, 96, 3) and shadow.shape == (72, 96, 1)
+        assert np.array_equal(np.isnan(position[..., 0]), np.isnan(shadow[..., 0]))
+        assert (shadow[np.isfinite(shadow)] == 0.0).any()
+    plain = _scene_file(tmp_path, "")
+    render_dataset(plain, tmp_path / "plain", views=1, format="nerf", executor="serial", progress=False)
+    assert not (tmp_path / "plain" / "shadow").exists()
