@@ -187,7 +187,8 @@ def main() -> None:
     parser.add_argument("--views", type=int, default=200)
     parser.add_argument("--size", type=int, default=512)
     parser.add_argument("--runs", default="serial,process1,process2,ray2")
-    parser.add_argument("--mesh", default="/work/shared/data/bunny/bun_zipper.ply")
+    bunny = Path(__file__).resolve().parents[1] / "tests" / "data" / "bunny" / "bun_zipper.ply"
+    parser.add_argument("--mesh", default=str(bunny))
     parser.add_argument("--out", default=None, help="folder for the datasets (default: a temporary one, removed)")
     parser.add_argument("--json", default=None)
     args = parser.parse_args()

@@ -30,10 +30,9 @@ import trimesh
 
 from frustum import Camera, Mesh, Octree, Perspective, Scene, render_octree
 
-DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
-BENCH_DIR = Path(__file__).resolve().parents[1].parent / "shared" / "bench"
-if not DATA.exists():
-    DATA = Path("/work/shared/data")
+DATA = Path(__file__).resolve().parents[1] / "tests" / "data"  # the bunny: in the repository
+BENCH_DIR = Path(__file__).resolve().parents[1].parent / "shared" / "bench"  # the shared standard scenes
+if not BENCH_DIR.exists():
     BENCH_DIR = Path("/work/shared/bench")
 
 

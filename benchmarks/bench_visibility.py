@@ -6,7 +6,7 @@
 Two sweeps, each method timed on the same scenes (the seed's comparison of object-space and image-space methods):
 
 * **faces**: three overlapping UV spheres (depth complexity up to 3) of 1k to 1M faces in all, at 512×512;
-* **image**: the Stanford bunny (``../shared/data/bunny/bun_zipper.ply``, 69 451 faces) at 256² to 2048².
+* **image**: the Stanford bunny (``tests/data/bunny/bun_zipper.ply``, 69 451 faces) at 256² to 2048².
 
 Every method runs once on a tiny scene first (compilation, or loading Numba's cache, is not timed); then each
 point is the best of ``--repeat`` renders (one where a render takes over a second): on a shared machine the
@@ -27,10 +27,7 @@ from pathlib import Path
 import numpy as np
 
 METHODS = ("depth-buffer", "scan-line", "area-subdivision", "ray-casting", "a-buffer", "depth-sort", "bsp")
-BUNNY = next(
-    (path for path in (Path(__file__).resolve().parents[1].parent / "shared", Path("/work/shared"))
-     if (path / "data" / "bunny" / "bun_zipper.ply").exists()), Path("/work/shared"),
-) / "data" / "bunny" / "bun_zipper.ply"  # fmt: skip
+BUNNY = Path(__file__).resolve().parents[1] / "tests" / "data" / "bunny" / "bun_zipper.ply"  # in the repository
 
 
 def spheres(faces: int):

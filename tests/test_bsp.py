@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import itertools
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -23,11 +22,9 @@ from hypothesis import strategies as st
 from frustum import Camera, CameraError, GeometryError, Mesh, Oblique, Orthographic, Perspective
 from frustum.bsp import BSPTree, DepthOrder, depth_sort
 from frustum.transforms import apply, translate
+from testdata import DATA
 
 WIDTH, HEIGHT = 120, 90
-DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
-if not DATA.exists():
-    DATA = Path("/work/shared/data")
 AGREEMENT = 0.995  # of the pixels the depth buffer covers; misses are pixels on the lines where triangles meet
 
 

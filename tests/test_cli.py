@@ -14,8 +14,9 @@ import trimesh
 from frustum import Camera, Perspective, __version__, compose, rotate_z, translate
 from frustum.cli import main, parse_step
 from frustum.trace import trace
+from testdata import DATA
 
-BUNNY = Path("/work/shared/data/bunny")
+BUNNY = DATA / "bunny"
 
 
 def run(*arguments: str) -> subprocess.CompletedProcess[str]:
@@ -268,6 +269,30 @@ def test_scene_file_errors_are_one_line_without_traceback(tmp_path):
     assert result.returncode == 1 and "Traceback" not in result.stderr
     assert "bad.toml:1:" in result.stderr and "bad.toml:2:" in result.stderr and "bad.toml:4:" in result.stderr
 
+
+
+@pytest.mark.parametrize("outside", ["../escaped.png", "/tmp/frustum-escaped-absolute.png"])  # outside: refused
+def test_output_outside_the_folder_is_refused_without_o_and_ignored_with_o(tmp_path, outside):
+    folder = tmp_path / "scenes"
+    folder.mkdir()
+    scene = folder / "escape.toml"
+    scene.write_text(
+        '[camera]\neye = [0, 0, 5]\ntarget = [0, 0, 0]\n[render]\nsize = [32, 24]\n'
+        '[[nodes]]\ngeometry = { type = "uv_sphere" }\n'
+        f'[output]\nfiles = ["{outside}"]\n'
+    )
+    # without -o the file's own outputs would be written: the one outside its folder is refused, nothing written
+    result = run("render", str(scene))
+    assert result.returncode == 1, result.stderr
+    assert f"escape.toml:9: output.files[0] = {outside!r} is outside the scene file's folder" in result.stderr
+    assert "use -o on the command line" in result.stderr
+    assert sorted(p.name for p in tmp_path.rglob("*")) == ["escape.toml", "scenes"]
+    # with -o they are not written, so they do not stop the render: the picture goes where -o says, only there
+    target = tmp_path / "picture.png"
+    result = run("render", str(scene), "-o", str(target))
+    assert result.returncode == 0, result.stderr
+    assert target.is_file() and sorted(p.name for p in tmp_path.rglob("*")) == ["escape.toml", "picture.png", "scenes"]
+    assert not (tmp_path / "escaped.png").exists()
 
 # --- the garbage collector of the short-lived program ------------------------------------------------------------
 

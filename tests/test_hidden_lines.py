@@ -9,7 +9,6 @@ must agree with the visible pieces on at least 99 % of the sampled edge points.
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -40,10 +39,7 @@ from frustum.hidden_lines import (
     feature_edges,
     remove_hidden_lines,
 )
-
-DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
-if not DATA.exists():
-    DATA = Path("/work/shared/data")
+from testdata import DATA
 
 
 def _box(extents, center=(0.0, 0.0, 0.0)) -> Mesh:

@@ -1,4 +1,4 @@
-"""Mesh files through trimesh: the reference data's counts (../shared/data/README.md), round trips of normals,
+"""Mesh files through trimesh: the reference data's counts (tests/data/README.md), round trips of normals,
 UVs, colors and textures, multi-object files, and clear GeometryErrors for bad paths and corrupt files."""
 
 from __future__ import annotations
@@ -14,17 +14,11 @@ from frustum import GeometryError
 from frustum.geometry import Mesh
 from frustum.geometry import primitives as prim
 from frustum.geometry.io import SUPPORTED_SUFFIXES, MeshPart, load, load_parts, save
-
-DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
-if not DATA.is_dir():
-    DATA = Path("/work/shared/data")
-needs_data = pytest.mark.skipif(not DATA.is_dir(), reason="reference data ../shared/data not present")
-
+from testdata import DATA
 
 # --- the reference data -------------------------------------------------------------------------------------
 
 
-@needs_data
 @pytest.mark.parametrize("name", ["spot_triangulated.obj", "spot_quadrangulated.obj"])
 def test_spot_counts_uvs_and_texture_match_the_readme(name):
     parts = load_parts(DATA / "spot" / name)
@@ -46,14 +40,12 @@ def test_spot_counts_uvs_and_texture_match_the_readme(name):
     np.testing.assert_array_equal(part.world_from_model, np.eye(4))
 
 
-@needs_data
 def test_spot_control_mesh_polygons_are_triangulated():
     mesh = load(DATA / "spot" / "spot_control_mesh.obj")
     assert mesh.face_count == 160 * 2 + 16 * 3 + 4  # 160 quads, 16 pentagons, 4 triangles
     assert mesh.welded().vertex_count == 188
 
 
-@needs_data
 def test_teapot_keeps_the_files_normals():
     mesh = load(DATA / "teapot_n10.obj")
     oracle = trimesh.load(DATA / "teapot_n10.obj", process=False)
@@ -66,7 +58,6 @@ def test_teapot_keeps_the_files_normals():
     assert (np.einsum("ij,ij->i", corner, mesh.face_normals) > 0).all()
 
 
-@needs_data
 @pytest.mark.parametrize(
     ("name", "vertices", "faces"),
     [("bun_zipper_res4.ply", 453, 948), ("bun_zipper_res2.ply", 8171, 16301), ("bun_zipper.ply", 35947, 69451)],

@@ -36,10 +36,8 @@ from frustum import (
 )
 from frustum.geometry.fractals import _menger_cells
 from frustum.geometry.octree import TEXTBOOK_OCTANTS, morton_decode, morton_encode
+from testdata import DATA
 
-DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
-if not DATA.exists():  # a git worktree one level deeper than the main checkout
-    DATA = Path(__file__).resolve().parents[3] / "shared" / "data"
 UNIT = [[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]]
 CUBE = [[-1.0, -1.0, -1.0], [1.0, 1.0, 1.0]]
 

@@ -29,6 +29,7 @@ from frustum.scenefile import (
     render_examples,
     render_scene_file,
 )
+from frustum.scenefile.loader import _load_scene
 from frustum.scenefile.report import _key_lines
 
 EXAMPLES = sorted(EXAMPLES_DIR.glob("*.toml"))
@@ -1050,3 +1051,17 @@ def test_the_format_sample_in_the_docs_loads() -> None:
     assert sample is not None
     scene_file = load_scene(sample.group(1))
     assert scene_file.stereo is not None and scene_file.outputs
+
+
+def test_outputs_outside_the_folder_are_refused_only_when_they_would_be_written(tmp_path):
+    outside = ["../out.png", "/tmp/frustum-absolute.png"]  # outside: refused (test_self_contained)
+    data = {"camera": {"eye": [0, 0, 5], "target": [0, 0, 0]}, "nodes": [{"geometry": {"type": "uv_sphere"}}],
+            "output": {"files": [outside[0], "inside.png", outside[1]]}}  # fmt: skip
+    with pytest.raises(SceneFileError) as info:
+        load_scene(data, base_dir=tmp_path)
+    assert str(info.value).count("is outside the scene file's folder") == 2
+    loaded = _load_scene(data, base_dir=tmp_path, check_outputs=False)  # the caller writes elsewhere (-o)
+    assert loaded.outputs == (tmp_path / "inside.png",)
+    data["output"]["files"].append("bad.xyz")  # a malformed entry stays an error either way
+    with pytest.raises(SceneFileError, match="has an unknown suffix"):
+        _load_scene(data, base_dir=tmp_path, check_outputs=False)

@@ -1,5 +1,5 @@
 """geometry/teapot.py: the Utah teaset patch data, and the tessellated teapot against three.js's
-``teapot_n10.obj`` (../shared/data; evaluated independently, float32 file)."""
+``teapot_n10.obj`` (tests/data; evaluated independently, float32 file)."""
 
 from __future__ import annotations
 
@@ -17,12 +17,9 @@ from frustum.geometry.mesh import Mesh
 from frustum.geometry.surfaces import BezierSurface
 from frustum.geometry.teapot import BezierPatchSet, teacup, teapot, teaspoon
 from oracles import assert_close
+from testdata import DATA
 
-DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
-if not DATA.is_dir():
-    DATA = Path("/work/shared/data")
 REFERENCE = DATA / "teapot_n10.obj"
-needs_reference = pytest.mark.skipif(not REFERENCE.is_file(), reason="../shared/data/teapot_n10.obj is absent")
 
 # teapot_n10.obj stores 9 significant digits of float32 values: 1.2e-7 is the documented agreement with an
 # independent (geomdl) evaluation of the same patches; 2e-7 leaves room for the last digit.
@@ -71,36 +68,27 @@ def test_teaset_patch_and_point_counts():
     assert_close(pot.grids.reshape(-1, 3).max(axis=0), [3.525, 2.0, 3.15], 1e-12)
 
 
-def test_package_data_is_the_shared_teaset_byte_for_byte():
+def test_package_data_is_the_reference_teaset_byte_for_byte():
     for name in ("teapot", "teacup", "teaspoon"):
         packaged = resources.files("frustum.geometry").joinpath("data", f"{name}.txt").read_bytes()
-        shared = DATA / f"{name}.txt"
-        if shared.is_file():
-            assert packaged == shared.read_bytes()
+        assert packaged == (DATA / f"{name}.txt").read_bytes()
         expected = {
             "teapot": "82fbc9d7fe0f83e3c915584fa6baaf183e4fdfed1d1c3eda27004f46b9875f01",
             "teacup": "a2cc007ae2c5325d9e7fa5de2e0dc24e7214fc586c346889467817667c0aed8a",
             "teaspoon": "3e57584b0c499e891395db241fafa3dc10e9b9e96f6830cc331243e83432a672",
         }[name]
-        assert hashlib.sha256(packaged).hexdigest() == expected  # the checksums of ../shared/data/README.md
+        assert hashlib.sha256(packaged).hexdigest() == expected  # the checksums of tests/data/README.md
 
 
 def test_patch_corners_follow_the_file_layout():
     # patch 0 = indices 1..16: row r, column c is point 4r + c; frustum stores grid[c, r] (u = t, v = s)
-    points = (
-        np.array(
-            [[float(x) for x in line.split(",")] for line in (DATA / "teapot.txt").read_text().splitlines()[34:50]]
-        )
-        if (DATA / "teapot.txt").is_file()
-        else None
-    )
+    lines = (DATA / "teapot.txt").read_text().splitlines()[34:50]
+    points = np.array([[float(x) for x in line.split(",")] for line in lines])
     grid = teapot().grids[0]
     assert_close(grid[0, 0], [1.4, 0.0, 2.4], 0)
-    if points is not None:
-        assert_close(grid.transpose(1, 0, 2).reshape(16, 3), points, 0)
+    assert_close(grid.transpose(1, 0, 2).reshape(16, 3), points, 0)
 
 
-@needs_reference
 def test_tessellation_matches_threejs_teapot_n10(mesh):
     v, vn, f = read_obj(REFERENCE)
     assert mesh.vertex_count == len(v) == 3872
@@ -117,7 +105,6 @@ def test_tessellation_matches_threejs_teapot_n10(mesh):
     assert ours == theirs
 
 
-@needs_reference
 def test_tessellation_is_geometrically_close_to_the_reference_at_other_resolutions():
     # Hausdorff distance between vertex sets (welded, order-free), as the renderer would see the shape:
     # at resolution 20 every reference vertex is also a frustum vertex (10 divides 20)
@@ -209,7 +196,6 @@ def test_bad_patch_sets_raise_geometry_error(grids, fragment):
         teapot().tessellate(0)
 
 
-@needs_reference
 def test_rendered_teapot_matches_a_rendering_of_the_reference_mesh(mesh):
     """Same camera, light and material: coverage equal on >= 99.9 % of pixels, colors within ±2 on >= 99 %."""
     from frustum import Camera, DirectionalLight, Material, Scene, render

@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from pyglm import glm
 
@@ -106,11 +106,20 @@ def test_orthographic_normalization_matches_glm_ortho_rh_no(view_height, width, 
 
 @settings(max_examples=30)
 @given(look_ats(), st.integers(1, 1000), st.integers(1, 1000))
+@example((np.zeros(3), np.array([0.0, 0.5, 0.0]), np.array([1.0, 0.0, 0.0])), 1, 1)  # points once fell behind the eye
 def test_viewport_window_matches_glm_project(frame, width, height):
     eye, target, up = frame
     camera = Camera.look_at(eye, target, up, Perspective(1.0, 0.5, 200.0), width, height)
-    points = target + np.random.default_rng(3).uniform(-1, 1, (5, 3))
+    # points around the target and in front of the eye: offsets of at most half the eye-target distance (|offset|
+    # <= scale * sqrt(3)), so every point's depth along the view direction is at least half that distance; behind
+    # the eye trace gives NaN (clip w <= 0) while glm.project mirrors the point
+    distance = float(np.linalg.norm(target - eye))
+    scale = min(1.0, 0.5 * distance / np.sqrt(3))
+    points = target + scale * np.random.default_rng(3).uniform(-1, 1, (5, 3))
+    depths = (points - eye) @ ((target - eye) / distance)
+    assert (depths >= 0.5 * distance - 1e-12).all()
     window = trace(points, camera).stage("viewport").points
+    assert np.isfinite(window).all()
     model = glm.lookAtRH(*map(glm_vec, frame))
     projection = glm.dmat4(glm.perspectiveRH_NO(1.0, width / height, 0.5, 200.0))
     for point, result in zip(points, window, strict=True):

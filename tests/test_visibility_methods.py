@@ -22,10 +22,11 @@ from frustum.scene import Scene
 from frustum.shading import DirectionalLight, Material
 from frustum.transforms import reflect, translate
 from frustum.visibility.abuffer import FRAGMENT_BYTES
+from testdata import DATA
 
 OPAQUE_METHODS = ["scan-line", "area-subdivision", "depth-sort", "bsp", "ray-casting"]
 LIGHT = DirectionalLight(direction=(-0.4, -0.8, -0.5))
-BUNNY = "/work/shared/data/bunny/bun_zipper_res4.ply"
+BUNNY = DATA / "bunny" / "bun_zipper_res4.ply"
 
 
 def assert_same_picture(frame, reference, share: float = 0.999) -> None:

@@ -21,6 +21,8 @@ Coplanar and on-plane decisions use a tolerance relative to the scene size (``1e
 bounding box). Polygons of zero area are skipped and counted. Polygons are convex and planar (triangles
 always are); fragments of a polygon lie in its plane and tile it exactly (their areas sum to its area).
 
+Why one module: the BSP tree and the depth sort share the plane tests, the splitting and the tolerance.
+
 References
 ----------
 [HB 16] "Depth-Sorting Method", "BSP-Tree Method"; [seed] "BSP Trees" (General Modeling Techniques).

@@ -422,6 +422,9 @@ def render_command(
     """Render a scene file or a mesh file (framed from a 3/4 view, default lights, the file's materials); without
     -o, the outputs the file names (or out/<name>.png beside it)."""
     from frustum.scenefile import render_scene_file
+    from frustum.warmup import compile_in_background
+
+    compile_in_background()  # a cold cache: a second process compiles part of the kernels meanwhile
 
     choices = {None: None, "on": True, "off": False, "ray": "ray"}
     if shadows not in choices:

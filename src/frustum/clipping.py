@@ -36,6 +36,8 @@ order, used here.
 ``clip_from_world``. So the divide after clipping is safe without an extra ``w > ε`` plane (which would not be
 homogeneous); for a point exactly on the near plane the divide gives ``z_ndc = −1``.
 
+Why one module: every clipping algorithm of the chapter on the one homogeneous region-code and plane convention.
+
 References are resolved in ``docs/references.md``: [HB 10] is Hearn & Baker chapter 10, "Three-Dimensional
 Viewing", which holds 3D clipping; [seed] is the lecture notes.
 """

@@ -14,6 +14,8 @@ The frozen types ``Perspective``, ``Frustum``, ``Orthographic``, ``Oblique`` and
 where ``aspect`` = image width / height comes from the camera. ``.steps(aspect)`` lists the named matrices
 whose product ``.matrix`` is, for ``trace``.
 
+Why one module: every projection of the viewing chapter, builder and frozen type, side by side.
+
 References: [HB 10] is Hearn & Baker, *Computer Graphics with OpenGL*, chapter 10, "Three-Dimensional
 Viewing"; [seed] is the lecture notes.
 """

@@ -4,6 +4,8 @@ A node's ``transform`` maps its own (model) coordinates into its parent's; the w
 the product down the parent chain, ``world_from_model = T_root · … · T_parent · T_node`` (column vectors: the
 node's own transform is applied first) [HB 9] "Composite Transformations", [HB 11] "Hierarchical Modeling"
 (the seed's hierarchical polygon-mesh models). One mesh may hang on many nodes (instancing).
+
+Why one module: the Scene and what it places (nodes, items, volumes, particles, lights, pick and ray queries).
 """
 
 from __future__ import annotations

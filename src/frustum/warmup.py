@@ -189,6 +189,42 @@ TASKS: dict[str, Callable[[], None]] = {
 """The families of kernels ``warmup`` compiles, each by running small examples of what uses them."""
 
 
+FIRST_PICTURE: tuple[tuple[str, str, str], ...] = (
+    ("frustum.raster.tiles", "fill_tiles",
+     "(Array(int32, 2, 'C', True, aligned=True), Array(uint8, 1, 'C', False, aligned=True), "
+     "Array(int32, 2, 'C', False, aligned=True), Array(int64, 1, 'C', False, aligned=True), "
+     "Array(int32, 1, 'C', False, aligned=True), Array(int32, 1, 'C', False, aligned=True), "
+     "Array(int64, 1, 'C', False, aligned=True), Array(int64, 2, 'C', False, aligned=True), "
+     "Array(int64, 1, 'C', False, aligned=True), Array(int64, 1, 'C', False, aligned=True), "
+     "Array(int64, 2, 'C', False, aligned=True), Array(int32, 1, 'C', False, aligned=True), int64, int64)"),
+    ("frustum.raster.shade", "shade_pixels_phong",
+     "(Array(float32, 2, 'C', False, aligned=True), Array(int32, 2, 'C', False, aligned=True), "
+     "Array(float32, 3, 'C', False, aligned=True), Array(int32, 2, 'C', True, aligned=True), "
+     "Array(float64, 2, 'C', False, aligned=True), Array(float64, 2, 'C', False, aligned=True), "
+     "Array(float64, 1, 'C', False, aligned=True), Array(float64, 2, 'C', False, aligned=True), "
+     "Array(int64, 1, 'C', False, aligned=True), Array(uint8, 3, 'C', False, aligned=True), int64, int64)"),
+    ("frustum.raster.lines", "draw_lines",
+     "(Array(float64, 2, 'C', False, aligned=True), Array(float64, 1, 'C', False, aligned=True), "
+     "Array(int64, 2, 'C', True, aligned=True), Array(float64, 2, 'C', True, aligned=True), "
+     "Array(float64, 1, 'C', False, aligned=True), Array(float64, 1, 'C', False, aligned=True), "
+     "Array(float32, 2, 'C', False, aligned=True), Array(uint8, 3, 'C', False, aligned=True))"),
+)  # fmt: skip
+"""Kernels of the README's first picture (``frustum render examples/teapot.toml``: Phong-shaded surfaces and
+depth-tested lines) that a second process compiles while the renderer compiles the others
+(``compile_in_background``), as ``(module, kernel, argument types)``, in the order the render needs them. The
+renderer itself compiles ``project_vertices``, ``count_tiles`` and ``rasterize_tiles`` (about 6 s of CPU) while
+the child compiles these three (about 6 s); each compiled kernel goes to the cache, where the renderer's first call
+finds it. ``tests/test_cold_start.py`` checks that these are the types the README render calls them with."""
+
+
+def compile_in_background(plan: tuple[tuple[str, str, str], ...] = FIRST_PICTURE):  # type: ignore[no-untyped-def]
+    """Start compiling `plan`'s kernels in a second process (``frustum.raster._background``); the running child,
+    or None where nothing was started (a warm cache, one core, ``FRUSTUM_BACKGROUND_COMPILE=0``)."""
+    from frustum.raster import _background
+
+    return _background.start(plan)
+
+
 def _run(name: str) -> int:
     """Run one task in this process; return how many kernels it compiled (outermost compilations)."""
     from numba.core import event

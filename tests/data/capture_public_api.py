@@ -4,13 +4,21 @@
 import inspect
 import json
 import sys
+from pathlib import Path
 
 
 def signature(obj):
+    """The signature as text, and its parameters as [name, kind, default] (default as repr, None when required)."""
     try:
-        return str(inspect.signature(obj))
+        found = inspect.signature(obj)
     except (TypeError, ValueError):
         return None
+    root = str(Path(sys.modules["frustum"].__file__).resolve().parents[2])  # the checkout: not part of the API
+    parameters = [
+        [p.name, p.kind.name, None if p.default is p.empty else repr(p.default).replace(root, "<root>")]
+        for p in found.parameters.values()
+    ]
+    return {"text": str(found).replace(root, "<root>"), "parameters": parameters}
 
 
 def describe(module, names):

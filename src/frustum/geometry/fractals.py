@@ -8,6 +8,8 @@ take a ``seed`` (``numpy.random.default_rng``): same seed, same bytes.
 
 Curves are returned as (N, 3) float64 polylines (2D curves lie in the plane z = 0); solids as a ``Mesh``.
 
+Why one module: the chapter's generators are short and share the budget check and the polyline helpers.
+
 References
 ----------
 [HB 15] "Fractal-Geometry Methods": "The Fractal Dimension", "Geometric Construction of Deterministic

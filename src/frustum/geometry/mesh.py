@@ -331,9 +331,9 @@ class Mesh:
 
     def save(self, path: str | Path) -> Path:
         """Write the mesh to `path`; the suffix picks the format (see ``frustum.geometry.io.save``)."""
-        from frustum.geometry.io import save
+        from frustum.geometry.mesh_writer import write_mesh  # (trimesh and PIL load only when a mesh is written)
 
-        return save(self, path)
+        return write_mesh(self, path)
 
     # --- constructors -------------------------------------------------------------------------------------
 

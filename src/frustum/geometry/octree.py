@@ -21,6 +21,8 @@ Besides the full cells an octree built by sampling keeps ``boundary``: the fines
 (mixed samples, or a triangle touching the cell); their state was decided by one sample near the cell's
 centre. ``volume_bounds`` counts them as empty and as full.
 
+Why one module: every operation works on the one Morton-code representation and its helpers.
+
 References
 ----------
 [HB 15] "Octrees" (octree encoding, set operations by simultaneous traversal); [HB 16] "Octree Methods"

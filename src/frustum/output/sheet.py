@@ -19,6 +19,8 @@ rear                      far right                    far right
 isometric                 upper right (top's row)      lower right (top's row)
 ========================  ===========================  ===========================
 
+Why one module: layout, views, dimensions and the title block of one sheet share its scale and paper geometry.
+
 References
 ----------
 [HB 10] "Orthogonal Projections" (front, side and rear elevations; plan view), "Axonometric and Isometric

@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from frustum.errors import FrustumError, OutputError, SceneFileError
-from frustum.scenefile.loader import SceneFile, load_scene_file
+from frustum.scenefile.loader import SceneFile, _load_scene_file, load_scene_file
 from frustum.scenefile.outputs import OUTPUT_SUFFIXES
 
 EXAMPLES_DIR = Path(__file__).resolve().parents[3] / "examples"
@@ -100,7 +100,8 @@ def render_scene_file(
         For an unknown output suffix or an unwritable path; ``FrustumError`` from the renderer for options it
         refuses.
     """
-    scene_file = load_scene_file(path, up=up)
+    # with `output`, the file's own outputs are not written
+    scene_file = _load_scene_file(path, check_outputs=output is None, up=up)
     if size is not None:
         scene_file = scene_file.resized(tuple(size))  # type: ignore[arg-type]
     if shadows is not None:

@@ -176,6 +176,15 @@ def load_scene(
         isinstance(data, str) and "\n" not in data and data.lower().endswith((".toml", *MODEL_SUFFIXES))
     ):
         return load_scene_file(data)
+    return _load_scene(data, source=source, base_dir=base_dir)
+
+
+def _load_scene(
+    data: Mapping[str, Any] | str, *, source: str = "<scene>", base_dir: str | Path = ".", check_outputs: bool = True
+) -> SceneFile:
+    """``load_scene``. ``check_outputs=False`` for a caller that writes elsewhere (``render_scene_file`` with an
+    output, ``frustum render FILE -o``): ``[output].files`` outside `base_dir` are not written, so not refused;
+    they are left out of ``outputs``."""
     lines: dict[tuple, int] | str | None = None
     if isinstance(data, str):
         _check_shape(data, source)
@@ -196,7 +205,7 @@ def load_scene(
     else:
         raise SceneFileError(f"{source}: data = {describe(data)} is not TOML text or a table; give a str or a dict")
     report = _Report(source, lines)
-    scene_file = _build(report, parsed, Path(base_dir))
+    scene_file = _build(report, parsed, Path(base_dir), check_outputs)
     report.raise_if_any()
     assert scene_file is not None
     return dataclasses.replace(scene_file, path=None)
@@ -273,7 +282,7 @@ def _radiosity(report: _Report, path: tuple, value: Any) -> dict | None:
     return settings
 
 
-def _build(report: _Report, data: dict, base: Path) -> SceneFile | None:
+def _build(report: _Report, data: dict, base: Path, check_outputs: bool = True) -> SceneFile | None:
     report.base = base  # image files of materials and the environment are read relative to it
     _unknown_keys(report, (), data, _TOP_LEVEL)
     for key in ("title", "description"):
@@ -329,7 +338,7 @@ def _build(report: _Report, data: dict, base: Path) -> SceneFile | None:
     if cameras and _fits(data) and not scene.world_lights() and "environment" not in data and "radiosity" not in data:
         for light in default_lights(cameras[0]):  # a fitted camera and no lights named: the default three-point set
             scene.root.add_light(light)
-    outputs, animation, svg = _outputs(report, data, base)
+    outputs, animation, svg = _outputs(report, data, base, check_outputs)
     _check_image_memory(report, options, size, max(len(cameras), 1))
     if not report.problems:
         _warm_up(report, scene, animation)
@@ -366,6 +375,11 @@ def load_scene_file(path: str | Path, *, up: str = "y") -> SceneFile:
     GeometryError
         If a mesh file cannot be read.
     """
+    return _load_scene_file(path, up=up)
+
+
+def _load_scene_file(path: str | Path, check_outputs: bool = True, *, up: str = "y") -> SceneFile:
+    """``load_scene_file``; ``check_outputs`` as for ``_load_scene``."""
     file = Path(path)
     if file.suffix.lower() in MODEL_SUFFIXES:
         return _model_scene_file(file, up)
@@ -380,7 +394,7 @@ def load_scene_file(path: str | Path, *, up: str = "y") -> SceneFile:
     except (OSError, UnicodeDecodeError) as error:
         reason = getattr(error, "strerror", None) or str(error)
         raise SceneFileError(f"{shown}: cannot be read ({reason}); give an existing UTF-8 TOML scene file") from None
-    scene_file = load_scene(text, source=str(file), base_dir=file.parent)
+    scene_file = _load_scene(text, source=str(file), base_dir=file.parent, check_outputs=check_outputs)
     return dataclasses.replace(scene_file, path=file)
 
 

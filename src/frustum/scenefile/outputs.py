@@ -14,6 +14,7 @@ from typing import Any
 from frustum.budgets import check_memory
 from frustum.errors import SceneFileError
 from frustum.render import RENDER_METHODS, RENDER_MODES, SHADING_MODES, TRANSPARENCY_MODES
+from frustum.render.options import COLOR_SPACES, EDGE_SETS, FILTERS, HIDDEN_STYLES
 from frustum.scenefile.checks import (
     _ANGLE_PARAMETERS,
     _boolean,
@@ -27,7 +28,7 @@ from frustum.scenefile.checks import (
     _vector,
 )
 from frustum.scenefile.report import _BAD, _Report
-from frustum.shading import DepthCue
+from frustum.shading import SPECULAR_MODELS, DepthCue
 
 OUTPUT_SUFFIXES = (".png", ".svg", ".pdf", ".gif", ".mp4")
 """What ``render_scene_file`` writes, chosen by the output's suffix."""
@@ -77,18 +78,18 @@ def _render_options(report: _Report, path: tuple, value: Any) -> tuple[dict, tup
             size = (int(checked[0]), int(checked[1]))
     simple: dict[str, Callable[[tuple, Any], Any]] = {
         "shading": lambda p, v: _choice(report, p, v, tuple(SHADING_MODES)),
-        "specular": lambda p, v: _choice(report, p, v, ("blinn-phong", "phong")),
+        "specular": lambda p, v: _choice(report, p, v, SPECULAR_MODELS),
         "background": lambda p, v: _color(report, p, v, alpha=True),
         "cull_back_faces": lambda p, v: _boolean(report, p, v),
         "mode": lambda p, v: _choice(report, p, v, RENDER_MODES),
-        "edges": lambda p, v: _choice(report, p, v, ("all", "feature")),
+        "edges": lambda p, v: _choice(report, p, v, EDGE_SETS),
         "edge_color": lambda p, v: _color(report, p, v, alpha=True),
-        "hidden": lambda p, v: _choice(report, p, v, ("dimmed", "dashed")),
+        "hidden": lambda p, v: _choice(report, p, v, HIDDEN_STYLES[1:]),  # (None: leave the key out)
         "hidden_color": lambda p, v: _color(report, p, v, alpha=True),
         "line_width": lambda p, v: _number(report, p, v, low=1.0, high=64.0),
         "samples": lambda p, v: _number(report, p, v, low=1, high=64, integer=True),
-        "filter": lambda p, v: _choice(report, p, v, ("box", "tent")),
-        "color_space": lambda p, v: _choice(report, p, v, ("linear", "srgb")),
+        "filter": lambda p, v: _choice(report, p, v, FILTERS),
+        "color_space": lambda p, v: _choice(report, p, v, COLOR_SPACES),
         "method": lambda p, v: _choice(report, p, v, tuple(RENDER_METHODS)),
         "transparency": lambda p, v: _choice(report, p, v, TRANSPARENCY_MODES),
         "max_depth": lambda p, v: _number(report, p, v, low=0, high=64, integer=True),
@@ -155,7 +156,7 @@ def _inside(base: Path, name: str) -> bool:
     return target != folder and target.is_relative_to(folder)
 
 
-def _outputs(report: _Report, data: dict, base: Path) -> tuple[tuple[Path, ...], dict, dict]:
+def _outputs(report: _Report, data: dict, base: Path, check: bool = True) -> tuple[tuple[Path, ...], dict, dict]:
     outputs: list[Path] = []
     if "output" in data:
         params = _table(report, ("output",), data["output"])
@@ -170,6 +171,8 @@ def _outputs(report: _Report, data: dict, base: Path) -> tuple[tuple[Path, ...],
                         report.add(("output", "files", i), name, "has an unknown suffix",
                                    f"expected one of {', '.join(OUTPUT_SUFFIXES)}")  # fmt: skip
                     elif not _inside(base, name):
+                        if not check:  # not written (the caller writes elsewhere: -o), so not refused either
+                            continue
                         report.add(("output", "files", i), name, "is outside the scene file's folder",
                                    "outputs named in a scene file must stay in its folder (no '..', no absolute "
                                    "path, no symlink pointing out); give a relative path, or use -o on the "

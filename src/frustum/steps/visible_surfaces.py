@@ -1,6 +1,8 @@
 """Visible surfaces, step by step: back-face detection, the BSP tree (splits, then back to front), the depth buffer
 (surface by surface).
 
+Why one module: the three methods of the chapter, recorded on the same scene and figure helpers.
+
 References: [HB 16] "Back-Face Detection", "BSP-Tree Method", "Depth-Buffer Method"; [seed] "Back-face
 detection", "BSP trees", "Depth-buffer method".
 """

@@ -39,15 +39,15 @@ class Continuity(NamedTuple):
 class PiecewiseBezier:
     """Bézier pieces of one degree joined end to end, piece i on the global parameter interval [b_i, b_{i+1}].
 
+    The constructors ``from_tangents`` (C¹) and ``interpolate_c2`` (C²) enforce continuity at the joins; the
+    plain constructor accepts any pieces and ``continuity`` reports what they have.
+
     Parameters
     ----------
     pieces : sequence of BezierCurve or (M, n + 1, d) array_like
         The pieces' control polygons, all of the same degree n and dimension d.
     breakpoints : (M + 1,) array_like, optional
         Strictly increasing global parameters of the joins; default 0, 1, ..., M.
-
-    The constructors ``from_tangents`` (C¹) and ``interpolate_c2`` (C²) enforce continuity at the joins; the
-    plain constructor accepts any pieces and ``continuity`` reports what they have.
 
     References
     ----------

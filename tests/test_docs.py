@@ -1,0 +1,151 @@
+"""The documentation site (mkdocs.yml, docs/): it builds with warnings as errors, a broken link makes it fail,
+every public name of frustum is in the generated API reference, and every Python block of the how-to guides runs.
+
+The two builds (the real docs and a copy with broken references) run at the same time in subprocesses, into
+temporary folders; nothing is cached outside them.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import inspect
+import os
+import re
+import shutil
+import subprocess
+import sys
+import types
+from pathlib import Path
+
+import pytest
+
+import frustum
+
+ROOT = Path(__file__).resolve().parents[1]
+HOWTO = ROOT / "docs" / "how-to"
+BLOCK = re.compile(r"(?P<skip><!--\s*not run:[^>]*-->\s*\n)?```python\n(?P<code>.*?)^```", re.S | re.M)
+
+
+def _build(config_dir: Path, site: Path) -> subprocess.Popen:
+    env = dict(os.environ, NO_MKDOCS_2_WARNING="1", PYTHONPATH=str(ROOT / "src"))
+    return subprocess.Popen(
+        [sys.executable, "-m", "mkdocs", "build", "--strict", "-f", str(config_dir / "mkdocs.yml"), "-d", str(site)],
+        cwd=config_dir, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+    )
+
+
+@pytest.fixture(scope="module")
+def builds(tmp_path_factory):
+    """(good build, broken build): each (return code, output, site folder)."""
+    tmp = tmp_path_factory.mktemp("docs")
+    broken = tmp / "broken"
+    broken.mkdir()
+    shutil.copy(ROOT / "mkdocs.yml", broken / "mkdocs.yml")
+    shutil.copytree(ROOT / "docs", broken / "docs", ignore=shutil.ignore_patterns("__pycache__"))
+    for name in ("src", "examples", "notebooks"):  # what the hook and mkdocstrings read, relative to the config
+        (broken / name).symlink_to(ROOT / name, target_is_directory=True)
+    page = broken / "docs" / "how-to" / "index.md"
+    page.write_text(
+        page.read_text(encoding="utf-8")
+        + "\nSee [a page that is not there](no-such-page.md) and [`frustum.no_such_name`][frustum.no_such_name].\n",
+        encoding="utf-8",
+    )
+    procs = [_build(ROOT, tmp / "site"), _build(broken, tmp / "broken-site")]
+    results = []
+    for proc, site in zip(procs, (tmp / "site", tmp / "broken-site"), strict=True):
+        output, _ = proc.communicate(timeout=600)
+        results.append((proc.returncode, output, site))
+    return results
+
+
+def test_site_builds_strict(builds):
+    code, output, site = builds[0]
+    assert code == 0, output[-4000:]
+    for page in ("index.html", "gallery/index.html", "reference/cli/index.html", "reference/scene-file/index.html",
+                 "how-to/textures/index.html", "tutorials/first-picture/index.html", "conventions/index.html"):
+        assert (site / page).is_file(), page
+    gallery = (site / "gallery" / "index.html").read_text(encoding="utf-8")
+    for toml in sorted((ROOT / "examples").glob("*.toml")):
+        assert f"examples/{toml.name}" in gallery, toml.name
+    cli = (site / "reference" / "cli" / "index.html").read_text(encoding="utf-8")
+    assert "frustum render" in cli and "frustum dataset" in cli
+
+
+def test_broken_reference_fails_the_build(builds):
+    code, output, _ = builds[1]
+    assert code != 0, "a strict build with broken references passed"
+    assert "no-such-page.md" in output, output[-4000:]
+    assert "frustum.no_such_name" in output, output[-4000:]
+
+
+def _public_names() -> list[str]:
+    """``dir(frustum)`` and ``__all__`` (lazy names included) without what frustum merely imports."""
+    names = set(dir(frustum)) | set(frustum.__all__) | set(getattr(frustum, "_LAZY", {}))
+    public = []
+    for name in sorted(names):
+        if name.startswith("_") or name == "TYPE_CHECKING":
+            continue
+        obj = getattr(frustum, name)
+        if isinstance(obj, types.ModuleType) and not obj.__name__.startswith("frustum"):
+            continue  # sys, importlib, types
+        if getattr(obj, "__module__", None) == "typing" and not isinstance(obj, types.ModuleType):
+            continue  # typing.Any
+        public.append(name)
+    return public
+
+
+def test_every_public_name_is_in_the_reference(builds):
+    code, output, site = builds[0]
+    assert code == 0, output[-4000:]
+    html = "".join(p.read_text(encoding="utf-8") for p in (site / "reference" / "api").rglob("index.html"))
+    anchors = set(re.findall(r'id="([\w.]+)"', html))
+    tails = {anchor.rsplit(".", 1)[-1] for anchor in anchors}
+    names = _public_names()
+    assert len(names) > 250
+    missing = [n for n in names if n not in tails and f"frustum.{n}" not in anchors]
+    assert not missing, f"public names missing from the API reference: {missing}"
+    # each documented with its docstring's first line
+    for name in ("render", "load_parts", "Camera", "drawing_sheet"):
+        first = inspect.getdoc(getattr(frustum, name)).splitlines()[0][:30]
+        assert first.split("`")[0][:20] in html, name
+
+
+def test_a_name_without_docstring_warns(monkeypatch, caplog):
+    spec = importlib.util.spec_from_file_location("frustum_docs_hook", ROOT / "docs" / "hooks" / "gen_pages.py")
+    hook = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(hook)
+
+    def undocumented_thing():
+        pass
+
+    undocumented_thing.__module__ = "frustum.render"
+    monkeypatch.setattr(frustum, "undocumented_thing", undocumented_thing, raising=False)
+    with caplog.at_level("WARNING"):
+        hook.api_entries()
+    assert any("undocumented_thing" in r.getMessage() and r.levelname == "WARNING" for r in caplog.records)
+
+
+def _blocks():
+    out = []
+    for page in sorted(HOWTO.glob("*.md")):
+        for number, match in enumerate(BLOCK.finditer(page.read_text(encoding="utf-8"))):
+            marks = [pytest.mark.skip(reason=match.group("skip").strip())] if match.group("skip") else []
+            out.append(pytest.param(page.name, match.group("code"), id=f"{page.stem}-{number}", marks=marks))
+    return out
+
+
+def test_howto_pages_have_blocks():
+    pages = {p.name for p in HOWTO.glob("*.md")} - {"index.md"}
+    with_blocks = {p for p, *_ in (b.values for b in _blocks())}
+    assert pages <= with_blocks, f"how-to pages without a runnable Python block: {pages - with_blocks}"
+
+
+@pytest.mark.parametrize(("page", "code"), _blocks())
+def test_howto_block_runs(page, code, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    budget = frustum.get_budget()
+    try:
+        exec(compile(code, f"docs/how-to/{page}", "exec"), {"__name__": "__docs__"})
+    finally:
+        frustum.set_budget(budget.bytes, budget.operations)
+        frustum.set_threads(None)
