@@ -282,6 +282,9 @@ from .radiosity import (
     RadiosityResult as RadiosityResult,
     radiosity as radiosity,
 )
+from .raster import (
+    set_compile_notice as set_compile_notice,
+)
 from .raster._jit import (
     set_threads as set_threads,
 )

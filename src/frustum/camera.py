@@ -398,6 +398,88 @@ class Camera:
         eye = center - radius * np.array(preset.direction)
         return cls.look_at(eye, center, preset.up, projection, width, height)
 
+    @classmethod
+    def fit(
+        cls,
+        scene_or_bounds: object,
+        direction: ArrayLike | None = None,
+        fovy: float = math.radians(40.0),
+        margin: float = 0.05,
+        *,
+        projection: Literal["perspective", "orthographic"] = "perspective",
+        width: int = 640,
+        height: int = 480,
+        up: ArrayLike = (0.0, 1.0, 0.0),
+    ) -> Camera:
+        """A camera framing the bounding sphere of a scene (or of bounds) so that it touches the image's nearer
+        edges `margin` in from them.
+
+        The sphere is centred on the axis-aligned bounding box (centre ``(low + high)/2``) with the radius of the
+        farthest point (for bounds ``[low, high]``: half the box's diagonal). Perspective:
+        ``distance = r / sin(atan((1 − 2·margin)·tan(half_fov)))`` where ``half_fov`` is the
+        smaller of the vertical and horizontal half angles, so the sphere's image circle — the cone tangent to the
+        sphere — spans ``1 − 2·margin`` of the smaller image side. Orthographic: the view height is
+        ``2r / ((1 − 2·margin)·min(1, width/height))`` and the eye stands 3r back.
+
+        Parameters
+        ----------
+        scene_or_bounds : Scene, SceneFile, Mesh, (2, 3) [low, high] or (N, 3) points
+        direction : (3,) array_like, optional
+            The line of sight (from the eye toward the centre). Default: the 3/4 view, the eye at azimuth 45°
+            (between +z and +x) and 30° above the horizon.
+        fovy : float
+            Vertical field of view in radians (perspective).
+        margin : float
+            Fraction of the smaller image side left free on each side, in [0, 0.5).
+        projection : "perspective" or "orthographic"
+        width, height : int
+            Image size in pixels.
+        up : (3,) array_like
+            View-up vector; when it is along `direction`, world −z (looking down) or +z (looking up) is used.
+
+        Raises
+        ------
+        CameraError
+            No points, non-finite bounds, a zero direction, fovy outside (0, π), margin outside [0, 0.5) or an
+            unknown projection name.
+        """
+        where = "Camera.fit"
+        points = _fit_points(scene_or_bounds, where)
+        low, high = points.min(axis=0), points.max(axis=0)
+        center = (low + high) / 2.0
+        radius = float(np.sqrt(((points - center) ** 2).sum(axis=1).max()))
+        radius = max(radius, 1e-6 * max(1.0, float(np.abs(center).max())))
+        m = as_scalar(margin, "margin", where=where, error=CameraError)
+        if not 0.0 <= m < 0.5:
+            raise CameraError(f"{where}: margin = {m!r} is out of range; give a fraction in [0, 0.5)")
+        if direction is None:
+            a, e = math.radians(45.0), math.radians(30.0)
+            line = -np.array([math.cos(e) * math.sin(a), math.sin(e), math.cos(e) * math.cos(a)])
+        else:
+            line = as_vector3(direction, "direction", where=where, error=CameraError)
+            norm = float(np.linalg.norm(line))
+            if not norm > 0.0:
+                raise CameraError(f"{where}: direction = {describe(direction)} has zero length; give a line of sight")
+            line = line / norm
+        view_up = as_vector3(up, "up", where=where, error=CameraError)
+        if np.linalg.norm(np.cross(view_up, line)) <= 1e-6 * float(np.linalg.norm(view_up)):
+            view_up = np.array([0.0, 0.0, -1.0 if line[1] < 0 else 1.0])
+        fill = 1.0 - 2.0 * m
+        aspect = width / height if isinstance(width, int) and isinstance(height, int) and height > 0 else 1.0
+        if projection == "perspective":
+            f = as_scalar(fovy, "fovy", where=where, error=CameraError)
+            if not 0.0 < f < math.pi:
+                raise CameraError(f"{where}: fovy = {f!r} is out of range; give radians in (0, pi)")
+            half = min(math.tan(f / 2.0), math.tan(f / 2.0) * aspect)
+            distance = radius / math.sin(math.atan(fill * half)) if fill > 0.0 else radius * 1e6
+            lens: Projection = Perspective(f, max(distance - 1.01 * radius, distance * 1e-4), distance + 1.01 * radius)
+        elif projection == "orthographic":
+            distance = 3.0 * radius
+            lens = Orthographic(2.0 * radius / (fill * min(1.0, aspect)), radius, 5.0 * radius)
+        else:
+            raise CameraError(f"{where}: projection = {describe(projection)} is not 'perspective' or 'orthographic'")
+        return cls.look_at(center - distance * line, center, view_up, lens, width, height)
+
     # --- matrices -----------------------------------------------------------------------------------------
 
     @property
@@ -585,3 +667,28 @@ class Camera:
         """
         points = [self.vanishing_point(axis) for axis in np.eye(3)]
         return PrincipalVanishingPoints(sum(p is not None for p in points), *points)
+
+
+def _fit_points(value: object, where: str) -> NDArray[np.float64]:
+    """World points whose bounds `Camera.fit` frames: a scene's placed vertices, a mesh's, or given points."""
+    from frustum.transforms import apply
+
+    scene = getattr(value, "scene", value)  # a SceneFile holds its scene
+    if hasattr(scene, "items") and not isinstance(scene, np.ndarray):
+        chunks = [apply(item.world_from_model, item.mesh.vertices) for item in scene.items if item.mesh.vertex_count]
+        if not chunks:
+            raise CameraError(f"{where}: the scene has no vertices; add a mesh before framing it")
+        points = np.concatenate(chunks)
+    elif hasattr(value, "vertices"):
+        points = np.asarray(value.vertices, dtype=np.float64)
+    else:
+        try:
+            points = np.asarray(value, dtype=np.float64)
+        except (TypeError, ValueError):
+            points = np.empty(0)
+        if points.ndim != 2 or points.shape[1] != 3 or len(points) == 0:
+            raise CameraError(f"{where}: scene_or_bounds = {describe(value)} is not a scene, a mesh, [low, high] or "
+                              "(N, 3) points")  # fmt: skip
+    if len(points) == 0 or not np.isfinite(points).all():
+        raise CameraError(f"{where}: the bounds are empty or not finite; give finite points")
+    return points

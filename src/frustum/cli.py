@@ -385,18 +385,18 @@ def turntable_command(
     axis: Annotated[str, typer.Option(help="Turntable axis through the mesh's center: x, y or z.")] = "y",
     elevation_deg: Annotated[float, typer.Option(help="Camera height above the horizon in degrees.")] = 20.0,
     mode: Annotated[str, typer.Option(help="surface, wireframe or points.")] = "surface",
+    up: Annotated[str, typer.Option(help="The model's up axis, y or z (glTF is always y).")] = "y",
 ) -> None:
-    """Render a mesh from a camera orbiting it once and write the frames as a looping GIF or an MP4."""
+    """Render a mesh from a camera orbiting it once and write the frames as a looping GIF or an MP4 (the file's
+    materials and textures, the default lights of frustum.scenefile.models)."""
     from frustum.output.animation import framing_camera, turntable
-    from frustum.scene import Scene
-    from frustum.shading import DirectionalLight, Material
+    from frustum.scenefile.models import model_scene
 
     width, height = _image_size(size)
     if not 0 <= abs(elevation_deg) < 90:
         raise UsageError(f"--elevation-deg = {elevation_deg!r} is out of range; give an angle in (-90, 90)")
-    loaded = _load_mesh(mesh, "turntable")
-    scene = Scene(lights=[DirectionalLight(direction=(-0.4, -0.8, -0.5))])
-    scene.add(loaded, Material(color=(0.8, 0.8, 0.78)))
+    _load_mesh(mesh, "turntable")  # the CLI's checks and messages for a bad mesh file
+    scene, _ = model_scene(mesh, up=up, size=(width, height))
     camera = framing_camera(scene, width, height, elevation=math.radians(elevation_deg))
     count = turntable(
         scene, camera, frames, axis, output, fps, progress=error_console, cull_back_faces=False, mode=mode
@@ -409,16 +409,18 @@ def turntable_command(
 
 @app.command("render")
 def render_command(
-    scene: Annotated[Path, typer.Argument(help="A TOML scene file.")],
+    scene: Annotated[Path, typer.Argument(help="A TOML scene file or a mesh file.")],
     output: Annotated[
         list[Path] | None, typer.Option("--output", "-o", help="Output file(s): .png .svg .pdf .gif .mp4.")
     ] = None,
     size: Annotated[str | None, typer.Option(help="Image size WIDTHxHEIGHT, overriding the file's.")] = None,
+    up: Annotated[str, typer.Option(help="A mesh file's up axis, y or z (glTF is always y).")] = "y",
     shadows: Annotated[
         str | None, typer.Option(help="Shadows, overriding the file's: on (shadow maps), off, or ray (shadow rays).")
     ] = None,
 ) -> None:
-    """Render a scene file; without -o, the outputs the file names (or out/<name>.png beside it)."""
+    """Render a scene file or a mesh file (framed from a 3/4 view, default lights, the file's materials); without
+    -o, the outputs the file names (or out/<name>.png beside it)."""
     from frustum.scenefile import render_scene_file
     from frustum.warmup import compile_in_background
 
@@ -428,14 +430,14 @@ def render_command(
     if shadows not in choices:
         raise FrustumError(f"render: --shadows {shadows!r} is unknown; expected on, off or ray")
     written = render_scene_file(scene, output or None, size=_image_size(size) if size else None,
-                                shadows=choices[shadows])  # fmt: skip
+                                shadows=choices[shadows], up=up)  # fmt: skip
     for path in written if isinstance(written, list) else [written]:
         console.print(f"wrote {path}", markup=False, highlight=False, soft_wrap=True)
 
 
 @app.command("explain")
 def explain_command(
-    scene: Annotated[Path, typer.Argument(help="A TOML scene file.")],
+    scene: Annotated[Path, typer.Argument(help="A TOML scene file or a mesh file.")],
     point: Annotated[str | None, typer.Option(help="A world point x,y,z (default: the scene's vertices).")] = None,
     markdown: Annotated[bool, typer.Option("--markdown", help="Print Markdown instead of tables.")] = False,
     latex: Annotated[bool, typer.Option("--latex", help="Print LaTeX instead of tables.")] = False,
@@ -462,7 +464,7 @@ def explain_command(
 
 @app.command("view")
 def view_command(
-    scene: Annotated[Path, typer.Argument(help="A TOML scene file.")],
+    scene: Annotated[Path, typer.Argument(help="A TOML scene file or a mesh file.")],
     output: Annotated[Path, typer.Option("--output", "-o", help="The sheet: .svg, .pdf, .png or .dxf (CAD).")],
     views: Annotated[
         str | None, typer.Option(help="Comma-separated views: front, top, right, left, rear, bottom, iso.")
@@ -514,11 +516,18 @@ def examples_command(
     out: Annotated[Path, typer.Option(help="Folder for the pictures.")] = Path("examples/out"),
     size: Annotated[str, typer.Option(help="Image size WIDTHxHEIGHT.")] = "320x240",
 ) -> None:
-    """Render the example gallery (examples/*.toml) into a folder."""
+    """Render the example gallery (examples/*.toml) into a folder; examples that need an optional extra which is
+    not installed are listed with the pip command (exit 0)."""
     from frustum.scenefile import render_examples
+    from frustum.scenefile.commands import extra_install_command
 
-    for path in render_examples(out, _image_size(size)):
+    skipped: list[tuple[str, str]] = []
+    for path in render_examples(out, _image_size(size), skipped=skipped):
         console.print(f"wrote {path}", markup=False, highlight=False, soft_wrap=True)
+    for name, message in skipped:  # exit 0: only optional extras are missing
+        command = extra_install_command(message)
+        console.print(f"skipped {name}: needs an optional extra ({command or message})",
+                      markup=False, highlight=False, soft_wrap=True)  # fmt: skip
 
 
 # --- datasets ---------------------------------------------------------------------------------------------------
@@ -526,7 +535,9 @@ def examples_command(
 
 @app.command("dataset")
 def dataset_command(
-    scene: Annotated[Path, typer.Argument(help="A TOML scene file (its camera sets projection, size and distance).")],
+    scene: Annotated[
+        Path, typer.Argument(help="A TOML scene file (its camera sets projection, size and distance) or a mesh file.")
+    ],
     out: Annotated[str, typer.Option("--out", help="Output folder or URL (s3://bucket/prefix); rerun to resume.")],
     views: Annotated[int | None, typer.Option(help="Number of views (default 100; --layout file: the file's).")] = None,
     layout: Annotated[str, typer.Option(help="orbit, sphere, random or file.")] = "orbit",
@@ -568,7 +579,7 @@ def dataset_command(
 
 @app.command("serve")
 def serve_command(
-    scene: Annotated[Path, typer.Argument(help="A TOML scene file (reloaded whenever it is saved).")],
+    scene: Annotated[Path, typer.Argument(help="A TOML scene file or a mesh file (reloaded whenever it is saved).")],
     host: Annotated[
         str, typer.Option(help="Interface to listen on; 127.0.0.1 is this machine only, 0.0.0.0 every interface.")
     ] = "127.0.0.1",

@@ -196,6 +196,19 @@ class Material:
         """A copy with some fields changed, e.g. ``material.with_(opacity=0.3)``."""
         return replace(self, **changes)
 
+    def __repr__(self) -> str:
+        """Short: images appear as their shapes (``<1024x1024x3 image>``), not their pixels."""
+        shown = []
+        for name in self.__dataclass_fields__:
+            value = getattr(self, name)
+            if isinstance(value, np.ndarray) and value.ndim >= 2:
+                shown.append(f"{name}=<{'x'.join(map(str, value.shape))} image>")
+            elif isinstance(value, np.ndarray):
+                shown.append(f"{name}=({', '.join(f'{float(v):g}' for v in value)})")
+            else:
+                shown.append(f"{name}={value!r}")
+        return f"Material({', '.join(shown)})"
+
 
 @dataclass(frozen=True, eq=False)
 class AmbientLight:

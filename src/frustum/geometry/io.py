@@ -61,6 +61,18 @@ class MeshPart(NamedTuple):
     texture: NDArray[np.uint8] | None
     color: tuple[float, float, float, float] | None
     normal_map: NDArray[np.uint8] | None = None
+    emissive: tuple[float, float, float] | None = None
+    """A glTF material's ``emissiveFactor`` (linear RGB), when not black: ``Material(emissive=)``."""
+    alpha_mode: str | None = None
+    """A glTF material's ``alphaMode`` ("OPAQUE", "MASK" or "BLEND"); None for other formats."""
+
+    def __repr__(self) -> str:
+        def image(array: Any) -> str:
+            return "None" if array is None else f"<{'x'.join(map(str, np.shape(array)))} image>"
+
+        return (f"MeshPart(name={self.name!r}, mesh={self.mesh!r}, texture={image(self.texture)}, "
+                f"color={self.color!r}, normal_map={image(self.normal_map)}, emissive={self.emissive!r}, "
+                f"alpha_mode={self.alpha_mode!r})")  # fmt: skip
 
 
 def load(path: str | Path, texture: str | Path | None = None) -> Mesh:
@@ -141,7 +153,9 @@ def load_parts(path: str | Path, texture: str | Path | None = None) -> list[Mesh
             if image is None and mesh.uvs is not None:
                 image = explicit if explicit is not None else _sibling_texture(file)
             matrix = np.array(world_from_model, dtype=np.float64)
-            parts.append(MeshPart(str(node), mesh, matrix, image, color, _normal_texture(geometry)))
+            emissive, alpha_mode = _emission_and_alpha(geometry)
+            parts.append(MeshPart(str(node), mesh, matrix, image, color, _normal_texture(geometry), emissive,
+                                  alpha_mode))  # fmt: skip
     except GeometryError as error:
         raise GeometryError(f"load: path = {str(file)!r} holds invalid geometry ({error}); check the file") from None
     except MemoryError:
@@ -209,13 +223,13 @@ def _check_binary_stl_size(file: Path) -> None:
             "truncated or not an STL file"
         )
     count = int(np.frombuffer(head[80:84], dtype="<u4")[0])
-    check_memory(count * _LOAD_BYTES_PER_TRIANGLE, where="load",
-                 cause=f"path = {str(file)!r} with {count} triangles", error=GeometryError)  # fmt: skip
-    if size < 84 + 50 * count:
+    if size < 84 + 50 * count:  # before the memory budget: a truncated or random file is not a huge one
         raise GeometryError(
             f"load: path = {str(file)!r} has {size} bytes but its header announces {count} triangles "
-            f"({84 + 50 * count} bytes); the file is truncated"
+            f"({84 + 50 * count} bytes); the file is truncated or not an STL file"
         )
+    check_memory(count * _LOAD_BYTES_PER_TRIANGLE, where="load",
+                 cause=f"path = {str(file)!r} with {count} triangles", error=GeometryError)  # fmt: skip
 
 
 def _check_glb_chunks(file: Path) -> None:
@@ -433,6 +447,19 @@ def _normal_texture(geometry: Any) -> NDArray[np.uint8] | None:
     if image is None or getattr(geometry.visual, "uv", None) is None:
         return None
     return np.asarray(image.convert("RGB"), dtype=np.uint8)
+
+
+def _emission_and_alpha(geometry: Any) -> tuple[tuple[float, float, float] | None, str | None]:
+    """A glTF material's ``emissiveFactor`` (None when black or absent) and ``alphaMode`` (None when absent)."""
+    material = getattr(geometry.visual, "material", None)
+    factor = getattr(material, "emissiveFactor", None)
+    emissive = None
+    if factor is not None:
+        rgb = np.asarray(factor, dtype=np.float64).ravel()[:3]
+        if rgb.size == 3 and np.isfinite(rgb).all() and rgb.max() > 0.0:
+            emissive = tuple(float(c) for c in np.clip(rgb, 0.0, 1.0))
+    mode = getattr(material, "alphaMode", None)
+    return emissive, (str(mode).upper() if mode is not None else None)
 
 
 def _material_image(material: Any) -> NDArray[np.uint8] | None:

@@ -21,6 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from frustum._arrays import as_direction, as_scalar, describe
 from frustum._files import atomic_path, os_reason, track_process
+from frustum.budgets import check_operations
 from frustum.camera import Camera, ViewFrame
 from frustum.errors import CameraError, OutputError
 from frustum.frame import Frame
@@ -443,6 +444,10 @@ def turntable(
         _suffix(path, where)
         _fps(fps, where)
     count = int(frames)
+    # the whole turn's work, estimated before the first frame: each frame touches every pixel and every triangle
+    triangles = sum(item.mesh.face_count for item in scene.items)
+    cause = f"frames = {count} of {camera.width}x{camera.height} pixels and {triangles} triangles"
+    check_operations(count * (camera.width * camera.height + triangles), where=where, cause=cause, error=OutputError)
     turns = _turns(_axis(axis, camera, where), camera.frame.target, count)
 
     def jobs() -> Iterator[tuple[Scene, Camera]]:  # one frame's scene and camera at a time: none are kept

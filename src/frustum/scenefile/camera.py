@@ -27,19 +27,38 @@ PROJECTIONS = (
 _CAMERA_KEYS = (
     "eye", "target", "up", "projection", "fovy_deg", "near", "far", "height", "left", "right", "bottom", "top",
     "alpha_deg", "phi_deg", "ratio", "rotation_y_deg", "rotation_x_deg", "pivot", "z_vp", "view", "distance",
-    "azimuth_deg", "elevation_deg", "stereo",
+    "azimuth_deg", "elevation_deg", "stereo", "fit", "margin",
 )  # fmt: skip
+
+AXONOMETRIC_VIEWS = {"iso": (-1.0, -1.0, -1.0), "isometric": (-1.0, -1.0, -1.0)}
+"""``camera.view`` names beside the multiview presets: the isometric line of sight (from +x, +y, +z), world y up
+(the names ``frustum view --views`` takes)."""
+
+VIEWS = (*sorted(MULTIVIEWS), *AXONOMETRIC_VIEWS)
+"""Every ``camera.view`` value."""
+
+
+def _view_direction(name: str) -> tuple[np.ndarray, list[float]]:
+    """The line of sight and up vector of a ``VIEWS`` name."""
+    if name in AXONOMETRIC_VIEWS:
+        return np.array(AXONOMETRIC_VIEWS[name]) / math.sqrt(3.0), [0.0, 1.0, 0.0]
+    preset = MULTIVIEWS[name]
+    return np.array(preset.direction, dtype=np.float64), list(preset.up)
 
 
 _STEREO_KEYS = ("eye_separation", "convergence_distance", "layout", "anaglyph_method", "cross_eyed")
 
 
-def _camera(report: _Report, path: tuple, value: Any, size: tuple[int, int]) -> Any:
+def _camera(report: _Report, path: tuple, value: Any, size: tuple[int, int], scene: Any = None) -> Any:
     """A Camera (or a StereoCamera, with ``[camera.stereo]``) from a camera table."""
     params = _table(report, path, value)
     if params is _BAD:
         return _BAD
     _unknown_keys(report, path, params, _CAMERA_KEYS)
+    if "fit" in params:
+        return _fitted(report, path, params, size, scene)
+    if "margin" in params:
+        report.add((*path, "margin"), params["margin"], "needs fit = true", "margin is the fitted camera's border")
     get = params.get
     target = _vector(report, (*path, "target"), get("target", [0.0, 0.0, 0.0]))
     placement = [key for key in ("eye", "view", "azimuth_deg") if key in params]
@@ -52,15 +71,14 @@ def _camera(report: _Report, path: tuple, value: Any, size: tuple[int, int]) -> 
     up = _vector(report, (*path, "up"), get("up", [0.0, 1.0, 0.0]))
     eye: Any = _BAD
     if how == "view":
-        view = _choice(report, (*path, "view"), params["view"], sorted(MULTIVIEWS))
+        view = _choice(report, (*path, "view"), params["view"], VIEWS)
         distance = _number(report, (*path, "distance"), get("distance", 10.0), low=0.0, low_open=True)
         if "up" in params:
             report.add((*path, "up"), params["up"], "conflicts with view", "a multiview preset fixes its own up vector")
             up = _BAD
         if not _bad(view, distance, target, up):
-            preset = MULTIVIEWS[view]
-            eye = list(np.array(target) - distance * np.array(preset.direction))
-            up = list(preset.up)
+            line, up = _view_direction(view)
+            eye = list(np.array(target) - distance * line)
     elif how == "azimuth_deg":
         azimuth = _number(report, (*path, "azimuth_deg"), params["azimuth_deg"])
         elevation = _number(report, (*path, "elevation_deg"), get("elevation_deg", 0.0), low=-89.999, high=89.999)
@@ -102,6 +120,68 @@ def _camera(report: _Report, path: tuple, value: Any, size: tuple[int, int]) -> 
         report.refused(path, params, error)
         return _BAD
     if "stereo" in params:
+        return _stereo(report, (*path, "stereo"), params["stereo"], camera, distance)
+    return camera
+
+
+def _fitted(report: _Report, path: tuple, params: dict, size: tuple[int, int], scene: Any) -> Any:
+    """``fit = true``: ``Camera.fit`` of the scene from `view`, from `azimuth_deg`/`elevation_deg`, or the 3/4 view;
+    perspective (``fovy_deg``) or orthographic, ``margin`` the free border (a fraction of the smaller side)."""
+    fit = _boolean(report, (*path, "fit"), params["fit"])
+    allowed = ("fit", "view", "azimuth_deg", "elevation_deg", "projection", "fovy_deg", "margin", "stereo")
+    for key in params:
+        if key not in allowed and key in _CAMERA_KEYS:
+            report.add(
+                (*path, key),
+                params[key],
+                "does not apply to fit = true",
+                f"a fitted camera takes {', '.join(allowed[1:])}; it places eye, target and distance itself",
+            )
+            return _BAD
+    if fit is _BAD:
+        return _BAD
+    if not fit:
+        report.add((*path, "fit"), False, "is false", "give fit = true, or leave it out and place the camera")
+        return _BAD
+    if "view" in params and "azimuth_deg" in params:
+        report.add((*path, "azimuth_deg"), params["azimuth_deg"], "conflicts with view", "give one of them")
+        return _BAD
+    direction: Any = None
+    up = [0.0, 1.0, 0.0]
+    if "view" in params:
+        view = _choice(report, (*path, "view"), params["view"], VIEWS)
+        if view is _BAD:
+            return _BAD
+        direction, up = _view_direction(view)
+    elif "azimuth_deg" in params or "elevation_deg" in params:
+        azimuth = _number(report, (*path, "azimuth_deg"), params.get("azimuth_deg", 45.0))
+        elevation = _number(report, (*path, "elevation_deg"), params.get("elevation_deg", 30.0), low=-89.999,
+                            high=89.999)  # fmt: skip
+        if _bad(azimuth, elevation):
+            return _BAD
+        a, e = math.radians(azimuth), math.radians(elevation)
+        direction = -np.array([math.cos(e) * math.sin(a), math.sin(e), math.cos(e) * math.cos(a)])
+    name = _choice(
+        report,
+        (*path, "projection"),
+        params.get("projection", "orthographic" if "view" in params else "perspective"),
+        ("perspective", "orthographic"),
+    )
+    fovy = _number(report, (*path, "fovy_deg"), params.get("fovy_deg", 40.0), low=0.0, high=180.0, low_open=True)
+    margin = _number(report, (*path, "margin"), params.get("margin", 0.05), low=0.0, high=0.49)
+    if _bad(name, fovy, margin):
+        return _BAD
+    if scene is None or not scene.items:
+        report.add((*path, "fit"), True, "has nothing to frame", "add [[nodes]] with geometry, or place the camera")
+        return _BAD
+    try:
+        camera = Camera.fit(scene, direction, math.radians(fovy), margin, projection=name, width=size[0],
+                            height=size[1], up=up)  # fmt: skip
+    except FrustumError as error:
+        report.refused(path, params, error)
+        return _BAD
+    if "stereo" in params:
+        distance = float(np.linalg.norm(np.array(camera.frame.eye) - np.array(camera.frame.target)))
         return _stereo(report, (*path, "stereo"), params["stereo"], camera, distance)
     return camera
 

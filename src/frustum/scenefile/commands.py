@@ -6,13 +6,14 @@ from __future__ import annotations
 
 import dataclasses
 import importlib
+import re
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from frustum.errors import OutputError, SceneFileError
+from frustum.errors import FrustumError, OutputError, SceneFileError
 from frustum.scenefile.loader import SceneFile, _load_scene_file, load_scene_file
 from frustum.scenefile.outputs import OUTPUT_SUFFIXES
 
@@ -64,21 +65,27 @@ def _write(scene_file: SceneFile, target: Path) -> Path:
 
 
 def render_scene_file(
-    path: str | Path, output: str | Path | Sequence[str | Path] | None = None, *, size: tuple[int, int] | None = None,
+    path: str | Path,
+    output: str | Path | Sequence[str | Path] | None = None,
+    *,
+    size: tuple[int, int] | None = None,
     shadows: bool | str | None = None,
-) -> Path | list[Path]:  # fmt: skip
+    up: str = "y",
+) -> Path | list[Path]:
     """Render the scene file at `path` and write it by suffix: PNG, SVG or PDF (line drawing), GIF or MP4 (turntable).
 
     Parameters
     ----------
     path : str or Path
-        A TOML scene file.
+        A TOML scene file, or a mesh file (``load_scene_file``).
     output : str, Path, a sequence of them, or None
         Where to write. None: the file's ``[output].files``, or ``out/<stem>.png`` next to the scene file.
     size : (int, int), optional
         Image width and height, replacing ``[render].size``.
     shadows : True, False, "ray" or None
         Replaces ``[render].shadows`` (None: the file's).
+    up : "y" or "z"
+        A mesh file's up axis (glTF is y-up and ignores it).
 
     Returns
     -------
@@ -93,7 +100,8 @@ def render_scene_file(
         For an unknown output suffix or an unwritable path; ``FrustumError`` from the renderer for options it
         refuses.
     """
-    scene_file = _load_scene_file(path, check_outputs=output is None)  # with `output`, the file's are not written
+    # with `output`, the file's own outputs are not written
+    scene_file = _load_scene_file(path, check_outputs=output is None, up=up)
     if size is not None:
         scene_file = scene_file.resized(tuple(size))  # type: ignore[arg-type]
     if shadows is not None:
@@ -185,8 +193,12 @@ def render_examples(
     size: tuple[int, int] | None = (320, 240),
     *,
     examples_dir: str | Path | None = None,
+    skipped: list[tuple[str, str]] | None = None,
 ) -> list[Path]:
     """Render every ``*.toml`` of the example gallery to ``out_dir/<stem>.png`` (at `size`; None: each file's own).
+
+    With a `skipped` list, an example that needs an optional extra which is not installed (its error names a
+    ``pip install`` command) is appended as ``(file name, message)`` and the rest are still rendered.
 
     Raises
     ------
@@ -198,4 +210,18 @@ def render_examples(
     if not files:
         raise OutputError(f"render_examples: examples_dir = {str(folder)!r} holds no *.toml scene files")
     out = Path(out_dir)
-    return [render_scene_file(file, out / (file.stem + ".png"), size=size) for file in files]  # type: ignore[misc]
+    written = []
+    for file in files:
+        try:
+            written.append(render_scene_file(file, out / (file.stem + ".png"), size=size))
+        except FrustumError as error:
+            if skipped is None or "pip install" not in str(error):
+                raise
+            skipped.append((file.name, str(error)))
+    return written  # type: ignore[return-value]
+
+
+def extra_install_command(message: str) -> str:
+    """The ``pip install ...`` command an extra-missing error message names ("" when none)."""
+    found = re.search(r"pip install ('[^']+'|\S+)", message)
+    return found.group(0).rstrip(";,.") if found else ""

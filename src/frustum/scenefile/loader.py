@@ -22,6 +22,7 @@ from frustum.scene import Scene
 from frustum.scenefile.camera import _camera, _Stereo, _stereo_modules
 from frustum.scenefile.checks import _table, _table_list, _unknown_keys
 from frustum.scenefile.lights_materials import _environment, _lights, _material
+from frustum.scenefile.models import default_lights
 from frustum.scenefile.nodes import _explode_and_cut, _node
 from frustum.scenefile.outputs import _DEFAULT_SIZE, _MAX_PIXELS, _check_image_memory, _outputs, _render_options
 from frustum.scenefile.report import _BAD, _Report
@@ -105,6 +106,8 @@ class SceneFile:
             raise OutputError(f"{where}: size = {describe(size)} is not (width, height); give two positive integers")
         width, height = int(size[0]), int(size[1])
         cameras = tuple(dataclasses.replace(c, width=width, height=height) for c in self.cameras)
+        if self.path is not None and self.path.suffix.lower() in MODEL_SUFFIXES and self.camera is not None:
+            cameras = (Camera.fit(self.scene, -self.camera.frame.n, width=width, height=height),)  # keep it framed
         stereo = self.stereo
         if stereo is not None:
             centre = dataclasses.replace(stereo.camera.camera, width=width, height=height)
@@ -146,16 +149,19 @@ def _tile(frames: list[Frame], columns: int, background: Sequence[float]) -> Fra
     return Frame(color, depth)
 
 
-def load_scene(data: Mapping[str, Any] | str, *, source: str = "<scene>", base_dir: str | Path = ".") -> SceneFile:
-    """Validate and build a scene from TOML text or an already parsed dictionary.
+def load_scene(
+    data: Mapping[str, Any] | str | Path, *, source: str = "<scene>", base_dir: str | Path = "."
+) -> SceneFile:
+    """Validate and build a scene from TOML text or an already parsed dictionary; or load a file: a ``Path``, or a
+    one-line string ending in ``.toml`` or a mesh suffix (``MODEL_SUFFIXES``), goes to ``load_scene_file``.
 
     Every problem is collected first; then one ``SceneFileError`` lists them all, one per line, as
     ``source:line: key = value problem; what is valid`` (no line numbers for a dictionary).
 
     Parameters
     ----------
-    data : str or mapping
-        TOML text, or the dictionary ``tomllib.loads`` would return.
+    data : str, Path or mapping
+        TOML text, or the dictionary ``tomllib.loads`` would return, or the path of a scene or mesh file.
     source : str
         The name errors start with (the file name).
     base_dir : str or Path
@@ -166,6 +172,10 @@ def load_scene(data: Mapping[str, Any] | str, *, source: str = "<scene>", base_d
     SceneFileError
         Malformed TOML (tomllib's own line and column), or any invalid key or value.
     """
+    if isinstance(data, Path) or (
+        isinstance(data, str) and "\n" not in data and data.lower().endswith((".toml", *MODEL_SUFFIXES))
+    ):
+        return load_scene_file(data)
     return _load_scene(data, source=source, base_dir=base_dir)
 
 
@@ -314,17 +324,20 @@ def _build(report: _Report, data: dict, base: Path, check_outputs: bool = True) 
                 report.add(("cameras", i, "stereo"), entry["stereo"], "is not allowed in [[cameras]]",
                            "stereo goes with a single [camera]")  # fmt: skip
                 continue
-            camera = _camera(report, ("cameras", i), entry, size)
+            camera = _camera(report, ("cameras", i), entry, size, scene)
             if camera is not _BAD:
                 cameras.append(camera)
     elif "camera" in data:
-        camera = _camera(report, ("camera",), data["camera"], size)
+        camera = _camera(report, ("camera",), data["camera"], size, scene)
         if isinstance(camera, _Stereo):
             stereo, camera = camera, camera.camera.camera
         if camera is not _BAD:
             cameras.append(camera)
     else:
         report.missing(("camera",), "add a [camera] table with eye and target (or [[cameras]])")
+    if cameras and _fits(data) and not scene.world_lights() and "environment" not in data and "radiosity" not in data:
+        for light in default_lights(cameras[0]):  # a fitted camera and no lights named: the default three-point set
+            scene.root.add_light(light)
     outputs, animation, svg = _outputs(report, data, base, check_outputs)
     _check_image_memory(report, options, size, max(len(cameras), 1))
     if not report.problems:
@@ -340,21 +353,36 @@ def _build(report: _Report, data: dict, base: Path, check_outputs: bool = True) 
                      sheet=sheet, radiosity=radiosity)  # fmt: skip
 
 
-def load_scene_file(path: str | Path) -> SceneFile:
-    """Read, validate and build the TOML scene file at `path` (relative paths inside resolve against its folder).
+def _fits(data: dict) -> bool:
+    """Whether the file's camera (or first camera) is placed by ``fit = true``."""
+    camera = data.get("camera", (data.get("cameras") or [None])[0] if isinstance(data.get("cameras"), list) else None)
+    return isinstance(camera, dict) and camera.get("fit") is True
+
+
+def load_scene_file(path: str | Path, *, up: str = "y") -> SceneFile:
+    """Read, validate and build the TOML scene file at `path` (relative paths inside resolve against its folder),
+    or the scene of a mesh file (.obj .stl .ply .off .gltf .glb).
+
+    A mesh file gives the scene a file with only ``[[nodes]] geometry = { type = "mesh", path = ... }`` would,
+    with the file's materials and textures, a camera framing it from a 3/4 view (``Camera.fit``) and the default
+    lights (``frustum.scenefile.models``); `up` = "z" stands a z-up model upright (glTF is y-up and ignores it).
 
     Raises
     ------
     SceneFileError
         If the file cannot be read, is not valid TOML, or has invalid keys or values; the message lists every
         problem as ``file:line: key = value problem; what is valid``.
+    GeometryError
+        If a mesh file cannot be read.
     """
-    return _load_scene_file(path)
+    return _load_scene_file(path, up=up)
 
 
-def _load_scene_file(path: str | Path, check_outputs: bool = True) -> SceneFile:
+def _load_scene_file(path: str | Path, check_outputs: bool = True, *, up: str = "y") -> SceneFile:
     """``load_scene_file``; ``check_outputs`` as for ``_load_scene``."""
     file = Path(path)
+    if file.suffix.lower() in MODEL_SUFFIXES:
+        return _model_scene_file(file, up)
     shown = escape_control(str(file))
     try:
         with open(file, "rb") as handle:
@@ -368,3 +396,14 @@ def _load_scene_file(path: str | Path, check_outputs: bool = True) -> SceneFile:
         raise SceneFileError(f"{shown}: cannot be read ({reason}); give an existing UTF-8 TOML scene file") from None
     scene_file = _load_scene(text, source=str(file), base_dir=file.parent, check_outputs=check_outputs)
     return dataclasses.replace(scene_file, path=file)
+
+
+MODEL_SUFFIXES = (".obj", ".stl", ".ply", ".off", ".gltf", ".glb")
+"""Suffixes ``load_scene_file`` reads as a mesh file (a model) instead of a TOML scene file."""
+
+
+def _model_scene_file(file: Path, up: str) -> SceneFile:
+    from frustum.scenefile.models import model_scene
+
+    scene, camera = model_scene(file, up=up, size=_DEFAULT_SIZE)
+    return SceneFile(scene, camera, {}, (), (camera,), size=_DEFAULT_SIZE, title=file.stem, path=file)

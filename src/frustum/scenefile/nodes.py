@@ -6,11 +6,14 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from frustum.errors import FrustumError
 from frustum.scene import Node, Scene, cutaway, exploded
 from frustum.scenefile.checks import _boolean, _number, _table, _table_list, _unknown_keys, _vector
-from frustum.scenefile.geometry import _geometry
+from frustum.scenefile.geometry import _geometry, _mesh_file
 from frustum.scenefile.lights_materials import _lights, _material_reference
+from frustum.scenefile.models import part_material, part_nodes
 from frustum.scenefile.report import _BAD, _bad, _Report
 from frustum.scenefile.transforms import _transform
 
@@ -28,7 +31,15 @@ def _node(report: _Report, path: tuple, value: dict, base: Path, materials: dict
     if "material" in value:
         material = _material_reference(report, (*path, "material"), value["material"], materials)
     geometry, extras = (None, [])
-    if "geometry" in value:
+    table = value.get("geometry")
+    if isinstance(table, dict) and table.get("type") == "mesh":  # a mesh file: its parts with their materials
+        geometry, extras, own = _mesh_file_parts(report, (*path, "geometry"), table, base)
+        if material is None:
+            material = own
+        elif extras:  # the node's material replaces the file's on every part
+            for child in extras:
+                child.material = None
+    elif "geometry" in value:
         geometry, extras = _geometry(report, (*path, "geometry"), value["geometry"], base, materials)
     lights = _lights(report, (*path, "lights"), value["lights"]) if "lights" in value else []
     children = []
@@ -43,6 +54,23 @@ def _node(report: _Report, path: tuple, value: dict, base: Path, materials: dict
     except FrustumError as error:
         report.refused(path, name, error)
         return _BAD
+
+
+def _mesh_file_parts(report: _Report, path: tuple, table: dict, base: Path) -> tuple[Any, list[Node], Any]:
+    """A ``type = "mesh"`` file as (mesh, [], its material or None) for one part at the file's origin, else
+    (None, a node per part with its own material, None): base colours, textures and normal maps from OBJ/MTL and
+    glTF (``frustum.geometry.io.load_parts``) reach scene files."""
+    from frustum.geometry.io import load_parts
+
+    params = {key: item for key, item in table.items() if key != "type"}
+    parts = _mesh_file(report, path, params, base, load_parts)
+    if parts is _BAD:
+        return _BAD, [], None
+    if len(parts) == 1 and np.allclose(parts[0].world_from_model, np.eye(4)):
+        part = parts[0]
+        has_own = any(x is not None for x in (part.texture, part.color, part.normal_map, part.emissive))
+        return part.mesh, [], part_material(part) if has_own else None
+    return None, part_nodes(parts), None
 
 
 def _explode_and_cut(report: _Report, data: dict, scene: Scene) -> Scene:

@@ -68,7 +68,10 @@ def _render_options(report: _Report, path: tuple, value: Any) -> tuple[dict, tup
     size = _DEFAULT_SIZE
     if "size" in params:
         checked = _vector(report, (*path, "size"), params["size"], 2, "width, height")
-        if checked is not _BAD and not all(c.is_integer() and 1 <= c <= _MAX_PIXELS for c in checked):
+        if checked is not _BAD and all(c.is_integer() and c >= 1 for c in checked) and max(checked) > _MAX_PIXELS:
+            report.add((*path, "size"), params["size"], f"is over the limit of {_MAX_PIXELS} pixels a side",
+                       f"give [width, height], integers in [1, {_MAX_PIXELS}]")  # fmt: skip
+        elif checked is not _BAD and not all(c.is_integer() and 1 <= c <= _MAX_PIXELS for c in checked):
             report.add((*path, "size"), params["size"], "is not two positive integer pixel counts",
                        f"give [width, height], integers in [1, {_MAX_PIXELS}]")  # fmt: skip
         elif checked is not _BAD:

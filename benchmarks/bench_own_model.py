@@ -1,0 +1,113 @@
+"""Your own model in one command (issue 36): `frustum render <mesh file> -o out.png` on six real files, cold (an
+empty Numba cache) and warm, beside F3D's headless render of the same files, in the same run.
+
+Each timing is a whole process, as a user runs it: ``frustum render FILE -o out.png`` against a Python one-liner
+that opens F3D offscreen (``f3d.Engine.create(True)``), adds the file, renders 480x360 and saves the PNG. Warm
+timings are medians of `--repeat` runs; cold is one run of the first file with an empty ``NUMBA_CACHE_DIR``.
+F3D is the anchor: the ratio frustum / F3D per file is what this reports (target: warm <= 1).
+
+    python benchmarks/bench_own_model.py [--repeat 3] [--no-cold]
+
+Needs ``pip install f3d`` (otherwise only frustum's times are printed) and trimesh (for the GLB, STL and OFF
+made from the reference files).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+DATA = ROOT / "tests" / "data"
+
+F3D_SCRIPT = """
+import sys, f3d
+engine = f3d.Engine.create(True)
+engine.window.size = (480, 360)
+engine.scene.add(sys.argv[1])
+engine.window.render_to_image().save(sys.argv[2])
+"""
+
+
+def make_files(folder: Path) -> dict[str, tuple[Path, str]]:
+    """The six files: bunny PLY, Spot OBJ + MTL + PNG, Spot GLB (texture embedded), teapot OBJ, bunny STL, OFF."""
+    import trimesh
+    from PIL import Image
+
+    bunny = trimesh.load(DATA / "bunny" / "bun_zipper_res2.ply", process=False)
+    bunny.export(folder / "bunny.stl")
+    bunny.export(folder / "bunny.off")
+    spot_obj = DATA / "spot" / "spot_triangulated.obj"
+    (folder / "spot.mtl").write_text("newmtl cow\nKd 1 1 1\nmap_Kd spot_texture.png\n")
+    (folder / "spot.obj").write_text("mtllib spot.mtl\nusemtl cow\n" + spot_obj.read_text())
+    shutil.copy(DATA / "spot" / "spot_texture.png", folder / "spot_texture.png")
+    mesh = trimesh.load(spot_obj, process=False)
+    material = trimesh.visual.material.PBRMaterial(
+        baseColorTexture=Image.open(DATA / "spot" / "spot_texture.png"), baseColorFactor=[255, 255, 255, 255]
+    )
+    mesh.visual = trimesh.visual.TextureVisuals(uv=mesh.visual.uv, material=material)
+    mesh.export(folder / "spot.glb")
+    return {
+        "bunny.ply": (DATA / "bunny" / "bun_zipper_res2.ply", "y"),
+        "spot.obj+mtl": (folder / "spot.obj", "y"),
+        "spot.glb": (folder / "spot.glb", "y"),
+        "teapot.obj": (DATA / "teapot_n10.obj", "z"),
+        "bunny.stl": (folder / "bunny.stl", "y"),
+        "bunny.off": (folder / "bunny.off", "y"),
+    }
+
+
+def timed(command: list[str], env: dict[str, str] | None = None) -> float:
+    start = time.perf_counter()
+    subprocess.run(command, check=True, env=env, capture_output=True)
+    return time.perf_counter() - start
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--no-cold", action="store_true")
+    args = parser.parse_args()
+    frustum_cli = [sys.executable, "-m", "frustum"]
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "src") + os.pathsep + os.environ.get("PYTHONPATH", "")}
+    try:
+        import f3d  # noqa: F401
+
+        have_f3d = True
+    except ImportError:
+        have_f3d = False
+        print("f3d is not installed (pip install f3d): frustum's times only")
+    with tempfile.TemporaryDirectory() as temp:
+        folder = Path(temp)
+        files = make_files(folder)
+        first_name, (first, up) = next(iter(files.items()))
+        if not args.no_cold:
+            cold_env = {**env, "NUMBA_CACHE_DIR": str(folder / "empty_cache")}
+            cold = timed([*frustum_cli, "render", str(first), "-o", str(folder / "cold.png"), "--up", up], cold_env)
+            print(f"cold (empty NUMBA_CACHE_DIR), {first_name}: {cold:.2f} s")
+        timed([*frustum_cli, "render", str(first), "-o", str(folder / "warm.png")], env)  # the cache is warm
+        print(f"{'file':<14} {'frustum warm s':>15} {'F3D s':>8} {'ratio':>7}")
+        for name, (path, up) in files.items():
+            ours = statistics.median(
+                timed([*frustum_cli, "render", str(path), "-o", str(folder / "ours.png"), "--up", up], env)
+                for _ in range(args.repeat)
+            )
+            line = f"{name:<14} {ours:>15.2f}"
+            if have_f3d:
+                theirs = statistics.median(
+                    timed([sys.executable, "-c", F3D_SCRIPT, str(path), str(folder / "f3d.png")], env)
+                    for _ in range(args.repeat)
+                )
+                line += f" {theirs:>8.2f} {ours / theirs:>7.2f}"
+            print(line, flush=True)
+
+
+if __name__ == "__main__":
+    main()

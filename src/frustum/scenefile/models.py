@@ -1,0 +1,103 @@
+"""A mesh file where a scene file goes: the scene a ``[[nodes]] geometry = { type = "mesh", path = ... }`` file
+gives, with the file's own materials (base colours, textures, normal maps), a camera framing the model from a 3/4
+view (``Camera.fit``) and the default lights (``default_lights``) when nothing else names lights.
+
+Default lights (a three-point setup placed relative to the camera, so every view of a fitted model reads well):
+
+- key: a white directional light from the camera's upper left, in front (intensity 0.85);
+- fill: from the right, a little below the key, at about half its strength (0.35), softening the key's shadows;
+- rim: from behind and above (0.45), separating the silhouette from a dark background;
+- ambient: 0.35, so faces turned away from every light keep their colour instead of going black.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from frustum.camera import Camera
+from frustum.scene import Node, Scene
+from frustum.shading import AmbientLight, DirectionalLight, Material
+
+MODEL_UP_AXES = ("y", "z")
+"""``up`` values for a mesh file: the model axis that points up in the picture (glTF is always y-up)."""
+
+_Z_UP_TO_Y_UP = np.array([[1.0, 0, 0, 0], [0, 0, 1.0, 0], [0, -1.0, 0, 0], [0, 0, 0, 1.0]])  # rotate_x(-90°)
+
+
+def default_lights(camera: Camera) -> list[Any]:
+    """The key, fill and rim directional lights and an ambient light, placed in world space around `camera`'s view
+    (see the module docstring); each ``direction`` is where the light travels."""
+    u, v, n = camera.frame.u, camera.frame.v, camera.frame.n  # right, up, back toward the eye
+
+    def towards_model(source: np.ndarray) -> tuple[float, ...]:
+        direction = -source / np.linalg.norm(source)
+        return tuple(float(x) for x in direction)
+
+    return [
+        DirectionalLight(towards_model(-0.6 * u + 0.8 * v + 0.7 * n), intensity=0.85),
+        DirectionalLight(towards_model(0.9 * u + 0.1 * v + 0.5 * n), intensity=0.35),
+        DirectionalLight(towards_model(0.3 * u + 0.6 * v - 1.0 * n), intensity=0.45),
+        AmbientLight(intensity=0.35),
+    ]
+
+
+def part_material(part: Any) -> Material:
+    """The ``Material`` a loaded ``MeshPart`` carries: its base colour (white under a texture, which it multiplies),
+    its texture, its normal map, glTF's emissive factor, its alpha as opacity (not for glTF's alphaMode OPAQUE);
+    a part with none of them gets a light neutral gray."""
+    color = part.color
+    texture = part.texture
+    normal_map = getattr(part, "normal_map", None)
+    if color is None:
+        rgb, opacity = ((1.0, 1.0, 1.0) if texture is not None else (0.8, 0.8, 0.78)), 1.0
+    else:
+        rgb, opacity = tuple(float(c) for c in color[:3]), float(color[3]) if len(color) > 3 else 1.0
+    if getattr(part, "alpha_mode", None) == "OPAQUE":  # glTF: alpha is ignored unless the mode is BLEND (or MASK)
+        opacity = 1.0
+    emissive = getattr(part, "emissive", None) or (0.0, 0.0, 0.0)
+    return Material(color=rgb, texture=texture, normal_map=normal_map, opacity=opacity, specular=0.2,
+                    emissive=emissive)  # fmt: skip
+
+
+def part_nodes(parts: list[Any], transform: np.ndarray | None = None) -> list[Node]:
+    """One ``Node`` per part, placed by its matrix (then `transform`), with its ``part_material``."""
+    nodes = []
+    for part in parts:
+        matrix = np.asarray(part.world_from_model, dtype=np.float64)
+        if transform is not None:
+            matrix = transform @ matrix
+        placed = None if np.allclose(matrix, np.eye(4)) else matrix
+        nodes.append(Node(part.name or "part", placed, part.mesh, part_material(part)))
+    return nodes
+
+
+def model_scene(path: str | Path, *, up: str = "y", size: tuple[int, int] = (640, 480)) -> tuple[Scene, Camera]:
+    """The scene (the file's parts with their materials, default lights) and the fitted 3/4-view camera of the mesh
+    file at `path`. `up` = "z" turns a z-up model (STL/OBJ from CAD tools) so that +z points up; glTF files are
+    y-up by specification and ignore it.
+
+    Raises
+    ------
+    GeometryError
+        If the file cannot be read as a mesh (``frustum.geometry.io.load_parts``).
+    SceneFileError
+        If `up` is not "y" or "z".
+    """
+    from frustum.errors import SceneFileError
+    from frustum.geometry.io import load_parts
+
+    if up not in MODEL_UP_AXES:
+        raise SceneFileError(f"up = {up!r} is not an axis; give 'y' or 'z'")
+    file = Path(path)
+    turn = _Z_UP_TO_Y_UP if up == "z" and file.suffix.lower() not in (".glb", ".gltf") else None
+    scene = Scene()
+    for node in part_nodes(load_parts(file), turn):
+        scene.add(node)
+    width, height = size
+    camera = Camera.fit(scene, width=width, height=height)
+    for light in default_lights(camera):
+        scene.root.add_light(light)
+    return scene, camera
