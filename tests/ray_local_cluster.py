@@ -26,6 +26,14 @@ import psutil
 
 SRC = Path(__file__).resolve().parents[1] / "src"
 RAY = Path(sys.executable).with_name("ray")
+REPOSITORY = Path(__file__).resolve().parents[1]
+
+
+def _kept_under_tmp() -> list[str]:
+    """The folders under /tmp that a worker node must still see: the repository and its Python, when a clone lives
+    under /tmp (as CI's may) — the private tmpfs over /tmp would hide them otherwise."""
+    needed = sorted({str(p) for p in (REPOSITORY, Path(sys.prefix).resolve()) if p.is_relative_to("/tmp")})
+    return [p for p in needed if not any(p != q and p.startswith(q + "/") for q in needed)]
 OBJECT_STORE = "200000000"  # bytes per node: the machine is shared
 # the head declares a node dead after 3 missed health checks 1 s apart (Ray's default waits longer)
 HEAD_CONFIG = json.dumps({"health_check_period_ms": 1000, "health_check_failure_threshold": 3})
@@ -122,8 +130,14 @@ class Cluster:
 
     def add_worker(self, name: str, cpus: int = 1) -> int:
         """A worker node in its own mount namespace: /tmp a fresh tmpfs holding its copy of the token."""
+        kept = _kept_under_tmp()
+        # a clone under /tmp (and its venv) stays visible through bind mounts parked on a private tmpfs at /mnt; the
+        # driver's output folders (pytest's temporary folders) do not
+        park = "".join(f"mkdir -p /mnt/k{i}; mount --bind '{path}' /mnt/k{i}; " for i, path in enumerate(kept))
+        park = f"mount -t tmpfs -o size=1m tmpfs /mnt; {park}" if kept else ""
+        restore = "".join(f"mkdir -p '{path}'; mount --bind /mnt/k{i} '{path}'; " for i, path in enumerate(kept))
         script = (
-            "set -e; mount -t tmpfs -o size=2g tmpfs /tmp; mkdir -p /tmp/node; "
+            f"set -e; {park}mount -t tmpfs -o size=2g tmpfs /tmp; {restore}mkdir -p /tmp/node; "
             'printf %s "$NODE_TOKEN" > /tmp/node/auth_token; export RAY_AUTH_TOKEN_PATH=/tmp/node/auth_token; '
             f"exec {RAY} start --address=127.0.0.1:{self.port} --num-cpus={cpus} --node-ip-address=127.0.0.1 "
             f"--object-store-memory={self.object_store} --temp-dir=/tmp/node/ray --disable-usage-stats "
