@@ -648,13 +648,16 @@ def test_url_datasets_equal_a_folder_and_resume_and_refuse_like_one(scene_path, 
 def test_url_resume_after_sigkill_reads_the_parts_of_the_run_log(scene_path, tmp_path) -> None:
     """A URL's run log is written in parts every few seconds: a killed run leaves them, the next run reads them.
 
-    300 views: the run must outlast the first part (``URL_LOG_SECONDS`` = 2 s) on a fast machine too."""
+    The killed run writes a part every 0.05 s (``URL_LOG_SECONDS`` is 2 s: on a quiet machine the 300 views took
+    less than that, so the first run finished before any part was written)."""
     pytest.importorskip("fsspec")
     arguments = ["--views", "300", "--layout", "sphere", "--format", "files", "--size", "200x150", "--no-progress",
                  "--executor", "serial"]  # fmt: skip
     url = f"file://{tmp_path}/killed"
     environment = {**os.environ, "PYTHONPATH": os.pathsep.join([str(SRC), os.environ.get("PYTHONPATH", "")])}
-    process = subprocess.Popen([sys.executable, "-m", "frustum", "dataset", str(scene_path), "--out", url,
+    program = ("import sys; import frustum.batch.dataset as d; d.URL_LOG_SECONDS = 0.05; "
+               "from frustum.cli import main; sys.argv[0] = 'frustum'; main()")  # fmt: skip
+    process = subprocess.Popen([sys.executable, "-c", program, "dataset", str(scene_path), "--out", url,
                                 *arguments], env=environment, stdout=subprocess.DEVNULL,
                                stderr=subprocess.DEVNULL)  # fmt: skip
     parts = tmp_path / "killed/manifest.parts"

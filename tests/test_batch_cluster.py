@@ -171,7 +171,8 @@ def test_two_nodes_write_a_complete_dataset_on_the_driver_side(cluster, scene_pa
     assert workers and {w.rsplit(":", 1)[1] for w in workers} <= node_a  # rendered on the other node
     # the worker node cannot see the folder (its /tmp is its own): the files came through the object store
     raylet = next(p for p in cluster.processes("a") if p.name() == "raylet")
-    assert (tmp_path / "ray/images").is_dir() and not Path(f"/proc/{raylet.pid}/root{tmp_path}").exists()
+    seen_by_worker = Path("/proc") / str(raylet.pid) / "root" / tmp_path.relative_to("/")
+    assert (tmp_path / "ray/images").is_dir() and not seen_by_worker.exists()
 
 
 def test_workers_writing_a_local_folder_on_two_nodes_is_refused(cluster, scene_path, tmp_path) -> None:

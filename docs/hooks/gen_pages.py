@@ -23,6 +23,7 @@ import inspect
 import json
 import logging
 import pkgutil
+import re
 import sys
 import types
 from pathlib import Path
@@ -114,6 +115,16 @@ def _defining_module(name: str, obj, fr) -> str:
 _MISSING = object()
 
 
+def _stub_module(fr: types.ModuleType, name: str) -> str:
+    """The module that defines lazy name `name`, from the package's ``__init__.pyi`` stub (``from .x import (y as
+    y)``), without importing it."""
+    stub = Path(fr.__file__).with_suffix(".pyi").read_text(encoding="utf-8")
+    for match in re.finditer(r"from \.([\w.]+) import \(([^)]*)\)", stub):
+        if re.search(rf"\b{re.escape(name)} as {re.escape(name)}\b", match.group(2)):
+            return f"frustum.{match.group(1)}"
+    return getattr(fr, "_LAZY", {}).get(name, "frustum")
+
+
 def api_entries() -> dict[str, list[tuple[str, str, str]]]:
     """{group: [(name, identifier for mkdocstrings, kind)]} for every public name of frustum."""
     fr = _frustum()
@@ -129,7 +140,7 @@ def api_entries() -> dict[str, list[tuple[str, str, str]]]:
         try:
             obj = getattr(fr, name)
         except ImportError:  # a lazy name whose extra is missing (Viewer without anywidget): read statically
-            module = fr._LAZY[name]
+            module = _stub_module(fr, name)
             groups.setdefault(module.split(".")[1], []).append((name, f"{module}.{name}", "lazy"))
             continue
         module = _defining_module(name, obj, fr)
