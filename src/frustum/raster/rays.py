@@ -1,19 +1,25 @@
 """The ray-query index: a surface-area-heuristic BVH over world triangles and its traversal kernels (Numba).
 
-Build (``build``): a binary bounding-volume hierarchy by the binned surface area heuristic [Wald 2007]: at each
-node the triangles' box centres are put into ``BINS`` bins along each of the three axes, and the plane between
-two bins with the least ``A_left·N_left + A_right·N_right`` (A: surface area of the side's bounding box, N: its
-triangle count) splits them; a range of at most ``LEAF_SIZE`` triangles is a leaf (shallow leaves: one
-triangle test per leaf), a range whose centres coincide is cut in the middle. Nodes hold the boxes of their
-two children (one node's boxes are one cache line: float32, rounded outward, so a box never shrinks), and a
-node over triangles ``[s, e)`` numbered ``k`` has its left child at ``k + 1`` and its right child at
-``k + (m − s)`` (m: the split), so every subtree owns a fixed range of node numbers: the top of the tree is
-built on one thread, the subtrees below ``PARALLEL_CUTOFF`` triangles in parallel (``_jit.parallel_kernel``),
-and the result is the same bytes on any number of threads.
+Build (``build``): a binary bounding-volume hierarchy by the binned surface area heuristic [Wald 2007]: each
+triangle's box is rounded outward to float32 once (``_prepare``; outward rounding is monotone, so every union of
+them is the float64 union rounded outward: a box never shrinks below its triangles) and these rows are
+partitioned in place with the triangle numbers, so each node reads its range sequentially. At a node the
+triangles' box centres are put into ``BINS`` bins along each of the three axes, and the plane between two bins
+with the least ``A_left·N_left + A_right·N_right`` (A: surface area of the side's bounding box, N: its triangle
+count) splits them; the partition pass also gathers each side's centre bounds, so no node rescans its range for
+them. A range of at most ``SMALL`` triangles is split by the exact SAH (every cut of the triangles sorted by
+centre, on each axis), one of at most ``LEAF_SIZE`` is a leaf (shallow leaves: one triangle test per leaf), and
+a range whose centres coincide is cut in the middle. Nodes hold the boxes of their two children, and a node over
+triangles ``[s, e)`` numbered ``k`` has its left child at ``k + 1`` and its right child at ``k + (m − s)`` (m:
+the split), so every subtree owns a fixed range of node numbers: the top of the tree is built on one thread, the
+subtrees below ``PARALLEL_CUTOFF`` triangles (or a sixteenth of them all) in parallel
+(``_jit.parallel_kernel``), and the result is the same bytes on any number of threads.
 
-Traversal: per ray, both child boxes of a node are tested (slab test, far bound widened by ``1 + 2γ₃`` so
-that rounding never loses a hit, PBRT 3.9.2); the nearer child is entered first and the farther one pushed with
-its entry distance, skipped when popped if a nearer hit has been found since; leaves are tested with the
+Traversal: per ray, both child boxes of a node are tested (slab test in float64 on the float32-rounded boxes,
+stored as float64 so no test converts; far bound widened by ``1 + 2γ₃`` so that rounding never loses a hit,
+PBRT 3.9.2); the nearer child is entered first and the farther one pushed with its entry distance (chosen by
+selects rather than branches: which child is nearer is a coin toss for the branch predictor), skipped when
+popped if a nearer hit has been found since; leaves are tested with the
 Möller–Trumbore ray–triangle test in float64 (the same arithmetic as ``raster.bvh``, so hits are the same).
 Closest hit (``closest_hits``): the least t in ``[t_min, t_max)``, ties to the lower triangle index (boxes are
 searched up to ``best·(1 + 2⁻⁴⁰)``, so a triangle whose t rounds a few ulps below its box's entry, or ties,
@@ -47,16 +53,20 @@ LEAF_SIZE = 1
 BINS = 16
 """Bins per axis of the binned SAH."""
 PARALLEL_CUTOFF = 16384
-"""Subtrees of at most this many triangles are built in parallel, after the top of the tree."""
+"""Subtrees of at most this many triangles (or a sixteenth of them all, if more) are built in parallel, after the
+top of the tree."""
 _ROBUST = 1.0 + 2.0 * (3.0 * 2.0**-53) / (1.0 - 3.0 * 2.0**-53)
 _WIDE = 1.0 + 2.0**-40
 """The best hit's t times this bounds the boxes still searched: a triangle's Möller–Trumbore t may round a few
 ulps below its box's entry, and a tie (the same t) must still reach the lower-numbered triangle."""
 _TASKS = 4096
+SMALL = 8
+"""Ranges of at most this many triangles are split by the exact SAH (every cut on every axis) instead of bins."""
 
 
 class Index(NamedTuple):
-    """``boxes`` (N, 12) float32: the boxes of each node's two children (left lo, left hi, right lo, right hi);
+    """``boxes`` (N, 12) float64 holding float32 values rounded outward: the boxes of each node's two children (left
+    lo, left hi, right lo, right hi);
     ``links`` (N, 2) int64: each child, a node number (>= 0) or a leaf ``~(start·8 + count)``; ``triangles``
     (F, 3, 3) float64 corners in leaf order; ``order`` (F,) int64 original index of each; ``depth`` the deepest
     node's depth (the traversal stack's size); ``nodes`` inner nodes built."""
@@ -72,67 +82,169 @@ class Index(NamedTuple):
 # --- build -----------------------------------------------------------------------------------------------------
 
 
+@parallel_kernel(lambda triangles, *_: triangles.shape[0], grain=32768)
+def _prepare(triangles, data, start, stop):
+    """Each triangle's bounding box in float32 rounded outward (``data`` rows lo x y z, hi x y z), for
+    triangles [start, stop). Outward rounding is monotone, so a union of these boxes is the float64 union
+    rounded outward: a node's box never shrinks below its triangles."""
+    for f in range(start, stop):
+        for a in range(3):
+            x0, x1, x2 = triangles[f, 0, a], triangles[f, 1, a], triangles[f, 2, a]
+            low = min(x0, x1, x2)
+            high = max(x0, x1, x2)
+            low32 = np.float32(low)
+            if low32 > low:
+                low32 = np.nextafter(low32, np.float32(-np.inf))
+            high32 = np.float32(high)
+            if high32 < high:
+                high32 = np.nextafter(high32, np.float32(np.inf))
+            data[f, a] = low32
+            data[f, 3 + a] = high32
+
+
 @kernel
-def _split(lo, hi, centre, index, s, e, bin_lo, bin_hi, bin_count):
-    """The best SAH split of ``index[s:e]``: (m, left box (6), right box (6)), partitioning ``index[s:e]``
-    in place so that ``[s, m)`` is the left side. ``bin_*``: scratch."""
-    c_lo = np.full(3, np.inf)
-    c_hi = np.full(3, -np.inf)
+def _union(data, s, e, box, at):
+    """``box[at : at + 6]`` = the union of ``data[s:e]`` (lo, hi)."""
+    for q in range(3):
+        box[at + q] = np.inf
+        box[at + 3 + q] = -np.inf
     for k in range(s, e):
-        f = index[k]
-        for a in range(3):
-            c = centre[f, a]
-            if c < c_lo[a]:
-                c_lo[a] = c
-            if c > c_hi[a]:
-                c_hi[a] = c
-    scale = np.zeros(3)
+        for q in range(3):
+            if data[k, q] < box[at + q]:
+                box[at + q] = data[k, q]
+            if data[k, 3 + q] > box[at + 3 + q]:
+                box[at + 3 + q] = data[k, 3 + q]
+
+
+@kernel
+def _swap(data, index, i, j):
+    for q in range(6):
+        data[i, q], data[j, q] = data[j, q], data[i, q]
+    index[i], index[j] = index[j], index[i]
+
+
+@kernel
+def _sweep(data, index, s, e, box, keys, order, costs, rows, ids):
+    """The exact SAH split of a small range ``[s, e)`` (at most ``SMALL`` triangles): on each axis the triangles
+    sorted by box centre (stable), every cut tried; the range is put in the best axis's order and the cut
+    returned; `box` receives the two sides' boxes. The rest: scratch."""
+    n = e - s
+    best_cost = np.inf
+    best_axis, best_cut = 0, 1
     for a in range(3):
-        if c_hi[a] > c_lo[a]:
-            scale[a] = BINS * (1.0 - 1e-9) / (c_hi[a] - c_lo[a])
-    left = np.empty(6)
-    right = np.empty(6)
-    if scale[0] == 0.0 and scale[1] == 0.0 and scale[2] == 0.0:  # all centres coincide: cut in the middle
+        for p in range(n):
+            keys[p] = np.float64(data[s + p, a]) + np.float64(data[s + p, 3 + a])
+            order[a, p] = p
+        for p in range(1, n):  # insertion sort (stable)
+            item = order[a, p]
+            key = keys[item]
+            q = p - 1
+            while q >= 0 and keys[order[a, q]] > key:
+                order[a, q + 1] = order[a, q]
+                q -= 1
+            order[a, q + 1] = item
+        x0, y0, z0, x1, y1, z1 = np.inf, np.inf, np.inf, -np.inf, -np.inf, -np.inf
+        for p in range(n - 1, 0, -1):  # costs[p]: the area of order[p:] times its count
+            r = s + order[a, p]
+            x0, y0, z0 = min(x0, data[r, 0]), min(y0, data[r, 1]), min(z0, data[r, 2])
+            x1, y1, z1 = max(x1, data[r, 3]), max(y1, data[r, 4]), max(z1, data[r, 5])
+            dx, dy, dz = np.float64(x1) - x0, np.float64(y1) - y0, np.float64(z1) - z0
+            costs[p] = (dx * dy + dy * dz + dz * dx) * (n - p)
+        x0, y0, z0, x1, y1, z1 = np.inf, np.inf, np.inf, -np.inf, -np.inf, -np.inf
+        for p in range(1, n):  # cut before order[p]
+            r = s + order[a, p - 1]
+            x0, y0, z0 = min(x0, data[r, 0]), min(y0, data[r, 1]), min(z0, data[r, 2])
+            x1, y1, z1 = max(x1, data[r, 3]), max(y1, data[r, 4]), max(z1, data[r, 5])
+            dx, dy, dz = np.float64(x1) - x0, np.float64(y1) - y0, np.float64(z1) - z0
+            cost = (dx * dy + dy * dz + dz * dx) * p + costs[p]
+            if cost < best_cost:
+                best_cost, best_axis, best_cut = cost, a, p
+    for p in range(n):
+        r = s + order[best_axis, p]
+        for q in range(6):
+            rows[p, q] = data[r, q]
+        ids[p] = index[r]
+    for p in range(n):
+        for q in range(6):
+            data[s + p, q] = rows[p, q]
+        index[s + p] = ids[p]
+    m = s + best_cut
+    _union(data, s, m, box, 0)
+    _union(data, m, e, box, 6)
+    return m
+
+
+@kernel
+def _split(data, index, s, e, cb, box, child_cb, bins, bin_count, area_right, count_right):
+    """The binned SAH split of ``[s, e)`` whose box centres (doubled: lo + hi, float64) lie in `cb` (lo x y z,
+    hi x y z): partitions ``data[s:e]``/``index[s:e]`` in place and returns the cut m (``[s, m)`` the left side);
+    `box` receives the sides' boxes (left lo, hi, right lo, hi) and `child_cb` their centre bounds."""
+    scale0, scale1, scale2 = 0.0, 0.0, 0.0
+    if cb[3] > cb[0]:
+        scale0 = BINS * (1.0 - 1e-9) / (cb[3] - cb[0])
+    if cb[4] > cb[1]:
+        scale1 = BINS * (1.0 - 1e-9) / (cb[4] - cb[1])
+    if cb[5] > cb[2]:
+        scale2 = BINS * (1.0 - 1e-9) / (cb[5] - cb[2])
+    if scale0 == 0.0 and scale1 == 0.0 and scale2 == 0.0:  # all centres coincide: cut in the middle
         m = (s + e) // 2
-        left[:3], left[3:] = np.inf, -np.inf
-        right[:3], right[3:] = np.inf, -np.inf
-        for k in range(s, e):
-            f = index[k]
-            box = left if k < m else right
-            for a in range(3):
-                box[a] = min(box[a], lo[f, a])
-                box[3 + a] = max(box[3 + a], hi[f, a])
-        return m, left, right
-    bin_lo[:] = np.inf
-    bin_hi[:] = -np.inf
-    bin_count[:] = 0
+        _union(data, s, m, box, 0)
+        _union(data, m, e, box, 6)
+        for q in range(6):
+            child_cb[q] = cb[q]
+            child_cb[6 + q] = cb[q]
+        return m
+    c0, c1, c2 = cb[0], cb[1], cb[2]
+    for a in range(3):
+        for b in range(BINS):
+            bin_count[a, b] = 0
+            for q in range(3):
+                bins[(a * BINS + b) * 6 + q] = np.inf
+                bins[(a * BINS + b) * 6 + 3 + q] = -np.inf
+    six = np.uint64(6)
     for k in range(s, e):
-        f = index[k]
+        l0, l1, l2, h0, h1, h2 = data[k, 0], data[k, 1], data[k, 2], data[k, 3], data[k, 4], data[k, 5]
         for a in range(3):
-            if scale[a] == 0.0:
-                continue
-            b = int((centre[f, a] - c_lo[a]) * scale[a])
+            if a == 0:
+                if scale0 == 0.0:
+                    continue
+                b = int((np.float64(l0) + np.float64(h0) - c0) * scale0)
+            elif a == 1:
+                if scale1 == 0.0:
+                    continue
+                b = int((np.float64(l1) + np.float64(h1) - c1) * scale1)
+            else:
+                if scale2 == 0.0:
+                    continue
+                b = int((np.float64(l2) + np.float64(h2) - c2) * scale2)
             if b >= BINS:
                 b = BINS - 1
             bin_count[a, b] += 1
-            for q in range(3):
-                if lo[f, q] < bin_lo[a, b, q]:
-                    bin_lo[a, b, q] = lo[f, q]
-                if hi[f, q] > bin_hi[a, b, q]:
-                    bin_hi[a, b, q] = hi[f, q]
+            first = np.uint64(a * BINS + b) * six  # unsigned: no negative-index wraparound in this loop
+            if l0 < bins[first]:
+                bins[first] = l0
+            if l1 < bins[first + np.uint64(1)]:
+                bins[first + np.uint64(1)] = l1
+            if l2 < bins[first + np.uint64(2)]:
+                bins[first + np.uint64(2)] = l2
+            if h0 > bins[first + np.uint64(3)]:
+                bins[first + np.uint64(3)] = h0
+            if h1 > bins[first + np.uint64(4)]:
+                bins[first + np.uint64(4)] = h1
+            if h2 > bins[first + np.uint64(5)]:
+                bins[first + np.uint64(5)] = h2
     best_cost = np.inf
     best_axis, best_bin = -1, -1
-    area_right = np.empty(BINS)
-    count_right = np.empty(BINS, dtype=np.int64)
     for a in range(3):
-        if scale[a] == 0.0:
+        if (scale0, scale1, scale2)[a] == 0.0:
             continue
         bx0, by0, bz0, bx1, by1, bz1 = np.inf, np.inf, np.inf, -np.inf, -np.inf, -np.inf
         n = 0
         for b in range(BINS - 1, 0, -1):  # area_right[b]: bins b … BINS − 1
             if bin_count[a, b] > 0:
-                bx0, by0, bz0 = min(bx0, bin_lo[a, b, 0]), min(by0, bin_lo[a, b, 1]), min(bz0, bin_lo[a, b, 2])
-                bx1, by1, bz1 = max(bx1, bin_hi[a, b, 0]), max(by1, bin_hi[a, b, 1]), max(bz1, bin_hi[a, b, 2])
+                k = (a * BINS + b) * 6
+                bx0, by0, bz0 = min(bx0, bins[k]), min(by0, bins[k + 1]), min(bz0, bins[k + 2])
+                bx1, by1, bz1 = max(bx1, bins[k + 3]), max(by1, bins[k + 4]), max(bz1, bins[k + 5])
                 n += bin_count[a, b]
             dx, dy, dz = bx1 - bx0, by1 - by0, bz1 - bz0
             area_right[b] = dx * dy + dy * dz + dz * dx if n > 0 else 0.0
@@ -141,8 +253,9 @@ def _split(lo, hi, centre, index, s, e, bin_lo, bin_hi, bin_count):
         n = 0
         for b in range(BINS - 1):  # split between bins b and b + 1
             if bin_count[a, b] > 0:
-                bx0, by0, bz0 = min(bx0, bin_lo[a, b, 0]), min(by0, bin_lo[a, b, 1]), min(bz0, bin_lo[a, b, 2])
-                bx1, by1, bz1 = max(bx1, bin_hi[a, b, 0]), max(by1, bin_hi[a, b, 1]), max(bz1, bin_hi[a, b, 2])
+                k = (a * BINS + b) * 6
+                bx0, by0, bz0 = min(bx0, bins[k]), min(by0, bins[k + 1]), min(bz0, bins[k + 2])
+                bx1, by1, bz1 = max(bx1, bins[k + 3]), max(by1, bins[k + 4]), max(bz1, bins[k + 5])
                 n += bin_count[a, b]
             if n == 0 or count_right[b + 1] == 0:
                 continue
@@ -150,43 +263,84 @@ def _split(lo, hi, centre, index, s, e, bin_lo, bin_hi, bin_count):
             cost = (dx * dy + dy * dz + dz * dx) * n + area_right[b + 1] * count_right[b + 1]
             if cost < best_cost:
                 best_cost, best_axis, best_bin = cost, a, b
-    if best_axis < 0:  # one bin holds every centre on every axis with extent (cannot happen): the middle
-        best_axis = 0 if scale[0] > 0.0 else (1 if scale[1] > 0.0 else 2)
+    if best_axis < 0:  # (cannot happen: the extreme centres fall in the first and the last bin) the middle
+        best_axis = 0 if scale0 > 0.0 else (1 if scale1 > 0.0 else 2)
         best_bin = BINS // 2 - 1
     a = best_axis
+    scale = (scale0, scale1, scale2)[a]
+    low = cb[a]
+    for q in range(3):
+        child_cb[q] = np.inf
+        child_cb[3 + q] = -np.inf
+        child_cb[6 + q] = np.inf
+        child_cb[9 + q] = -np.inf
     i, j = s, e - 1
-    while i <= j:  # partition: bins <= best_bin to the left
-        b = int((centre[index[i], a] - c_lo[a]) * scale[a])
+    while i <= j:  # partition: bins <= best_bin to the left; each side's centre bounds on the way
+        b = int((np.float64(data[i, a]) + np.float64(data[i, 3 + a]) - low) * scale)
         if b <= best_bin:
+            at = 0
+            r = i
             i += 1
         else:
-            index[i], index[j] = index[j], index[i]
+            _swap(data, index, i, j)
+            at = 6
+            r = j
             j -= 1
+        for q in range(3):
+            c = np.float64(data[r, q]) + np.float64(data[r, 3 + q])
+            if c < child_cb[at + q]:
+                child_cb[at + q] = c
+            if c > child_cb[at + 3 + q]:
+                child_cb[at + 3 + q] = c
     m = i
-    left[:3], left[3:] = np.inf, -np.inf
-    right[:3], right[3:] = np.inf, -np.inf
+    for q in range(3):
+        box[q], box[3 + q], box[6 + q], box[9 + q] = np.inf, -np.inf, np.inf, -np.inf
     for b in range(BINS):
         if bin_count[a, b] == 0:
             continue
-        box = left if b <= best_bin else right
+        at = 0 if b <= best_bin else 6
         for q in range(3):
-            box[q] = min(box[q], bin_lo[a, b, q])
-            box[3 + q] = max(box[3 + q], bin_hi[a, b, q])
+            box[at + q] = min(box[at + q], bins[(a * BINS + b) * 6 + q])
+            box[at + 3 + q] = max(box[at + 3 + q], bins[(a * BINS + b) * 6 + 3 + q])
     if m in (s, e):  # (cannot happen: both sides counted triangles) a middle cut keeps the build going
         m = (s + e) // 2
-    return m, left, right
+        _union(data, s, m, box, 0)
+        _union(data, m, e, box, 6)
+        for q in range(6):
+            child_cb[q] = cb[q]
+            child_cb[6 + q] = cb[q]
+    return m
 
 
 @kernel
-def _build_from(lo, hi, centre, index, root_slot, root_s, root_e, root_depth, boxes, links, cutoff, tasks):
-    """Build the subtree over ``index[root_s:root_e]`` (> LEAF_SIZE triangles) at node `root_slot`. With
-    `cutoff` > 0, inner subtrees of at most `cutoff` triangles are appended to `tasks` (rows slot, s, e, depth;
-    row 0 column 0 counts them) instead of being built, while there is room. Returns (deepest depth, nodes)."""
-    bin_lo = np.empty((3, BINS, 3))
-    bin_hi = np.empty((3, BINS, 3))
+def _build_from(data, index, root_slot, root_s, root_e, root_depth, root_cb, boxes, links, cutoff, tasks, task_cb):
+    """Build the subtree over ``[root_s, root_e)`` (> LEAF_SIZE triangles, centre bounds `root_cb`) at node
+    `root_slot`. With `cutoff` > 0, inner subtrees of at most `cutoff` triangles are appended to `tasks` (rows
+    slot, s, e, depth; row 0 column 0 counts them; their centre bounds in `task_cb`) instead of being built,
+    while there is room. Returns (deepest depth, nodes)."""
+    bins = np.empty(3 * BINS * 6, dtype=np.float32)  # axis, bin, (lo, hi)
     bin_count = np.empty((3, BINS), dtype=np.int64)
+    area_right = np.empty(BINS)
+    count_right = np.empty(BINS, dtype=np.int64)
+    keys = np.empty(SMALL)
+    order = np.empty((3, SMALL), dtype=np.int64)
+    rows = np.empty((SMALL, 6), dtype=np.float32)
+    ids = np.empty(SMALL, dtype=np.int64)
+    box = np.empty(12, dtype=np.float32)
+    child_cb = np.empty(12)
     stack = np.empty((256, 4), dtype=np.int64)
+    stack_cb = np.empty((256, 6))
     stack[0, 0], stack[0, 1], stack[0, 2], stack[0, 3] = root_slot, root_s, root_e, root_depth
+    stack_cb[0] = root_cb
+    if np.isnan(root_cb[0]):  # the root: its centre bounds
+        for q in range(3):
+            stack_cb[0, q] = np.inf
+            stack_cb[0, 3 + q] = -np.inf
+        for k in range(root_s, root_e):
+            for q in range(3):
+                c = np.float64(data[k, q]) + np.float64(data[k, 3 + q])
+                stack_cb[0, q] = min(stack_cb[0, q], c)
+                stack_cb[0, 3 + q] = max(stack_cb[0, 3 + q], c)
     top = 1
     deepest = root_depth
     built = 0
@@ -194,10 +348,17 @@ def _build_from(lo, hi, centre, index, root_slot, root_s, root_e, root_depth, bo
         top -= 1
         slot, s, e, depth = stack[top, 0], stack[top, 1], stack[top, 2], stack[top, 3]
         built += 1
-        m, left, right = _split(lo, hi, centre, index, s, e, bin_lo, bin_hi, bin_count)
-        for q in range(6):
-            boxes[slot, q] = left[q]
-            boxes[slot, 6 + q] = right[q]
+        n = e - s
+        if n == 2:
+            m = s + 1
+            _union(data, s, m, box, 0)
+            _union(data, m, e, box, 6)
+        elif n <= SMALL:
+            m = _sweep(data, index, s, e, box, keys, order, area_right, rows, ids)
+        else:
+            m = _split(data, index, s, e, stack_cb[top], box, child_cb, bins, bin_count, area_right, count_right)
+        for q in range(12):
+            boxes[slot, q] = box[q]
         if depth + 1 > deepest:
             deepest = depth + 1
         for side in range(2):
@@ -211,75 +372,86 @@ def _build_from(lo, hi, centre, index, root_slot, root_s, root_e, root_depth, bo
                 tasks[0, 0] += 1
                 row = tasks[0, 0]
                 tasks[row, 0], tasks[row, 1], tasks[row, 2], tasks[row, 3] = child, cs, ce, depth + 1
+                for q in range(6):
+                    task_cb[row, q] = child_cb[6 * side + q]
                 continue
             if top == stack.shape[0]:
                 grown = np.empty((2 * top, 4), dtype=np.int64)
                 grown[:top] = stack
                 stack = grown
+                grown_cb = np.empty((2 * top, 6))
+                grown_cb[:top] = stack_cb
+                stack_cb = grown_cb
             stack[top, 0], stack[top, 1], stack[top, 2], stack[top, 3] = child, cs, ce, depth + 1
+            for q in range(6):
+                stack_cb[top, q] = child_cb[6 * side + q]
             top += 1
     return deepest, built
 
 
-@parallel_kernel(lambda lo, hi, centre, index, tasks, *_: tasks.shape[0], pieces_per_thread=16)
-def _build_tasks(lo, hi, centre, index, tasks, boxes, links, results, start, stop):
-    """``_build_from`` for each task row (slot, s, e, depth); (deepest, nodes) into `results`."""
+@parallel_kernel(lambda data, index, tasks, *_: tasks.shape[0], pieces_per_thread=16)
+def _build_tasks(data, index, tasks, task_cb, boxes, links, results, start, stop):
+    """``_build_from`` for each task row (slot, s, e, depth; centre bounds `task_cb`); (deepest, nodes) into
+    `results`."""
     none = np.zeros((1, 4), dtype=np.int64)
+    none_cb = np.zeros((1, 6))
     for r in range(start, stop):
-        results[r, 0], results[r, 1] = _build_from(lo, hi, centre, index, tasks[r, 0], tasks[r, 1], tasks[r, 2],
-                                                   tasks[r, 3], boxes, links, 0, none)  # fmt: skip
+        results[r, 0], results[r, 1] = _build_from(data, index, tasks[r, 0], tasks[r, 1], tasks[r, 2], tasks[r, 3],
+                                                   task_cb[r], boxes, links, 0, none, none_cb)  # fmt: skip
 
 
-def _outward32(values: np.ndarray, down: bool) -> np.ndarray:
-    """float64 → float32 rounded toward −inf (`down`) or +inf."""
-    rounded = values.astype(np.float32)
-    if down:
-        return np.where(rounded > values, np.nextafter(rounded, np.float32(-np.inf)), rounded)
-    return np.where(rounded < values, np.nextafter(rounded, np.float32(np.inf)), rounded)
+@parallel_kernel(lambda triangles, index, *_: index.shape[0], grain=32768)
+def _gather(triangles, index, out, start, stop):
+    """``out[k] = triangles[index[k]]`` for k in [start, stop)."""
+    for k in range(start, stop):
+        f = index[k]
+        for i in range(3):
+            for a in range(3):
+                out[k, i, a] = triangles[f, i, a]
 
 
 def build(triangles: np.ndarray) -> Index:
     """The index of (F, 3, 3) float64 triangles (corner rows), F >= 1."""
     tri = np.ascontiguousarray(triangles, dtype=np.float64)
     count = tri.shape[0]
-    lo = tri.min(axis=1)
-    hi = tri.max(axis=1)
-    centre = 0.5 * (lo + hi)
+    data = np.empty((count, 6), dtype=np.float32)
+    _prepare(tri, data)
     index = np.arange(count, dtype=np.int64)
     slots = max(1, count - 1)
-    boxes = np.empty((slots, 12))
-    boxes[:, 0:3] = boxes[:, 6:9] = np.inf
-    boxes[:, 3:6] = boxes[:, 9:12] = -np.inf
-    links = np.full((slots, 2), ~np.int64(0), dtype=np.int64)  # ~0: an empty leaf
+    boxes = np.empty((slots, 12))  # float32 values (rounded outward) held as float64: no conversions per test
+    links = np.empty((slots, 2), dtype=np.int64)
     if count <= LEAF_SIZE:  # one node: the leaf on the left, an empty box on the right
-        boxes[0, 0:3] = lo.min(axis=0)
-        boxes[0, 3:6] = hi.max(axis=0)
+        boxes[0, 0:3] = data[:, :3].min(axis=0)
+        boxes[0, 3:6] = data[:, 3:].max(axis=0)
+        boxes[0, 6:9] = np.inf
+        boxes[0, 9:12] = -np.inf
         links[0, 0] = ~np.int64(count)
+        links[0, 1] = ~np.int64(0)  # ~0: an empty leaf
         depth, nodes = 1, 1
     else:
-        cutoff = PARALLEL_CUTOFF if count > 2 * PARALLEL_CUTOFF else 0
+        root_cb = np.full(6, np.nan)  # NaN: found by _build_from
+        cutoff = max(PARALLEL_CUTOFF, count // 16) if count > 2 * PARALLEL_CUTOFF else 0
         tasks = np.zeros((_TASKS if cutoff else 1, 4), dtype=np.int64)
-        depth, nodes = _build_from(lo, hi, centre, index, 0, 0, count, 0, boxes, links, cutoff, tasks)
+        task_cb = np.zeros((tasks.shape[0], 6))
+        depth, nodes = _build_from(data, index, 0, 0, count, 0, root_cb, boxes, links, cutoff, tasks, task_cb)
         found = int(tasks[0, 0])
         if found:
-            work = tasks[1 : found + 1]
-            work = np.ascontiguousarray(work[np.argsort(work[:, 1] - work[:, 2], kind="stable")])  # largest first
+            rank = np.argsort(tasks[1 : found + 1, 1] - tasks[1 : found + 1, 2], kind="stable") + 1  # largest first
+            work = np.ascontiguousarray(tasks[rank])
             results = np.zeros((found, 2), dtype=np.int64)
-            _build_tasks(lo, hi, centre, index, work, boxes, links, results)
+            _build_tasks(data, index, work, np.ascontiguousarray(task_cb[rank]), boxes, links, results)
             depth = max(depth, int(results[:, 0].max()))
             nodes += int(results[:, 1].sum())
-    packed = np.empty((slots, 12), dtype=np.float32)
-    for side in (0, 6):
-        packed[:, side : side + 3] = _outward32(boxes[:, side : side + 3], down=True)
-        packed[:, side + 3 : side + 6] = _outward32(boxes[:, side + 3 : side + 6], down=False)
-    return Index(packed, links, np.ascontiguousarray(tri[index]), index, int(depth), int(nodes))
+    del data
+    ordered = np.empty_like(tri)
+    _gather(tri, index, ordered)
+    return Index(boxes, links, ordered, index, int(depth), int(nodes))
 
 
 def memory_bytes(count: int) -> int:
-    """Bytes ``build`` holds at its peak for `count` triangles: boxes and centres (72 each), the order (8), the
-    triangles in leaf order (72), and per node float64 boxes while building (96), the links (16), float32 boxes
-    (48)."""
-    return count * (72 + 72 + 8 + 72) + max(1, count - 1) * (96 + 16 + 48)
+    """Bytes ``build`` holds at its peak for `count` triangles: float32 boxes while building (24), the order (8),
+    the triangles in leaf order (72), and per node the boxes (96) and the links (16)."""
+    return count * (24 + 8 + 72) + max(1, count - 1) * (96 + 16)
 
 
 # --- traversal -------------------------------------------------------------------------------------------------
@@ -346,22 +518,13 @@ def _closest(boxes, links, triangles, order, skip, ox, oy, oz, dx, dy, dz, t_min
                     else:
                         t_near1 = t0
             left, right = links[node, 0], links[node, 1]
-            if t_near0 < np.inf:
-                if t_near1 < np.inf:
-                    if t_near1 < t_near0:
-                        stack[top] = left
-                        entry[top] = t_near0
-                        node = right
-                    else:
-                        stack[top] = right
-                        entry[top] = t_near1
-                        node = left
-                    top += 1
-                else:
-                    node = left
-                continue
-            if t_near1 < np.inf:
-                node = right
+            swap = t_near1 < t_near0  # selects, not branches: the order is a coin toss for the predictor
+            if (t_near1 if swap else t_near0) < np.inf:  # the nearer child now, the other one pushed if met
+                far = t_near0 if swap else t_near1
+                stack[top] = left if swap else right
+                entry[top] = far
+                top += 1 if far < np.inf else 0
+                node = right if swap else left
                 continue
         else:
             code = ~node
@@ -448,20 +611,12 @@ def _any(boxes, links, triangles, ox, oy, oz, dx, dy, dz, t_min, t_max, stack):
                         near0 = t0
                     else:
                         near1 = t0
-            if near0 < np.inf:
-                if near1 < np.inf:
-                    if near1 < near0:
-                        stack[top] = links[node, 0]
-                        node = links[node, 1]
-                    else:
-                        stack[top] = links[node, 1]
-                        node = links[node, 0]
-                    top += 1
-                else:
-                    node = links[node, 0]
-                continue
-            if near1 < np.inf:
-                node = links[node, 1]
+            left, right = links[node, 0], links[node, 1]
+            swap = near1 < near0
+            if (near1 if swap else near0) < np.inf:
+                stack[top] = left if swap else right
+                top += 1 if (near0 if swap else near1) < np.inf else 0
+                node = right if swap else left
                 continue
         else:
             code = ~node
