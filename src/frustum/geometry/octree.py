@@ -775,17 +775,17 @@ class Octree:
 
     @cached_property
     def _surface_index(self) -> tuple[Mesh, Any]:
-        from frustum.raster import bvh
+        from frustum.raster import rays
 
         mesh = self.surface
-        return mesh, (bvh.build(np.asarray(mesh.vertices[mesh.faces], dtype=np.float64)) if mesh.face_count else None)
+        return mesh, (rays.build(np.asarray(mesh.vertices[mesh.faces], dtype=np.float64)) if mesh.face_count else None)
 
     def ray_hits(self, origins: ArrayLike, directions: ArrayLike) -> OctreeHits:
         """First hit of each ray ``origin + t·direction`` (t >= 0) on the solid: distance, point and full leaf.
 
         The rays are traced against the exposed cell faces (``to_mesh``) through a bounding-volume hierarchy
-        (``raster.bvh``); a ray starting inside a full cell hits at t = 0. Distances are in units of the
-        direction's length.
+        (``raster.rays``, the index of ``Scene.intersect``); a ray starting inside a full cell hits at t = 0.
+        Distances are in units of the direction's length.
 
         Parameters
         ----------
@@ -806,9 +806,9 @@ class Octree:
         distance[start_inside] = 0.0
         mesh, index = self._surface_index
         if mesh.face_count:
-            from frustum.raster import bvh
+            from frustum.raster import rays
 
-            t, _ = bvh.first_hits(index, o, v)
+            t = rays.closest_hits(index, o, v).t
             distance = np.where(start_inside, 0.0, t)
         hit = np.isfinite(distance)
         point = np.full(o.shape, np.nan)

@@ -20,7 +20,7 @@ stored as float64 so no test converts; far bound widened by ``1 + 2γ₃`` so th
 PBRT 3.9.2); the nearer child is entered first and the farther one pushed with its entry distance (chosen by
 selects rather than branches: which child is nearer is a coin toss for the branch predictor), skipped when
 popped if a nearer hit has been found since; leaves are tested with the
-Möller–Trumbore ray–triangle test in float64 (the same arithmetic as ``raster.bvh``, so hits are the same).
+Möller–Trumbore ray–triangle test in float64 (the arithmetic ``tests/test_rays.py``'s brute force repeats).
 Closest hit (``closest_hits``): the least t in ``[t_min, t_max)``, ties to the lower triangle index (boxes are
 searched up to ``best·(1 + 2⁻⁴⁰)``, so a triangle whose t rounds a few ulps below its box's entry, or ties,
 is still found). Any hit
