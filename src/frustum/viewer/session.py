@@ -435,7 +435,7 @@ class ViewerSession:
         options = {key: value for key, value in self.options.items() if key in _STEPS_OPTIONS}
         options["shading"] = self.controls["shading"]
         try:
-            with self._work(camera, 1, f"a {algorithm} steps recording"):
+            with self._work(camera, 1, f"{algorithm} steps"):
                 recorded = record(self.scene, camera, **options)
                 figures = [recorded.figure(i) for i in range(len(recorded))]
         except FrustumError as error:
