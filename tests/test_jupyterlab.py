@@ -109,10 +109,12 @@ def _status(port: int, token: str) -> int | None:
 
 @pytest.fixture(scope="module")
 def lab(tmp_path_factory):
-    pytest.importorskip("jupyterlab")
-    pytest.importorskip("jupyterlab_widgets")
-    pytest.importorskip("anywidget")
-    psutil = pytest.importorskip("psutil")
+    # test dependencies (the test extra): a missing one fails the test, it does not skip it
+    import anywidget  # noqa: F401
+    import jupyterlab  # noqa: F401
+    import jupyterlab_widgets  # noqa: F401
+    import psutil
+
     folder = tmp_path_factory.mktemp("lab")
     root = folder / "root"
     root.mkdir()
@@ -185,6 +187,11 @@ def notebook_page(lab):
             }""",
             timeout=PAGE_TIMEOUT_MS,
         )
+        plugins = page.evaluate(
+            "(ids) => ids.filter((id) => !window.jupyterapp.hasPlugin(id))",
+            ["@jupyter-widgets/jupyterlab-manager:plugin", "anywidget:plugin"],
+        )
+        assert not plugins, f"JupyterLab has no widget front end {plugins} (jupyterlab_widgets, anywidget)"
         page.evaluate(
             """() => {
               window.runAll = { done: false, result: null, error: null };
