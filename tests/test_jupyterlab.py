@@ -277,6 +277,7 @@ def test_viewer_widget_renders_and_a_drag_changes_its_picture(notebook_page):
     assert 0.05 < covered < 0.95  # the scene is drawn
     state = widget.evaluate("(el) => el.frustumViewer.state")
     azimuth, frames = state["camera"]["azimuth"], widget.evaluate("(el) => el.frustumViewer.frames")
+    canvas.evaluate("(c) => c.scrollIntoView({ block: 'center' })")  # the whole picture in the notebook's view
     box = canvas.bounding_box()
     x0, y0 = box["x"] + 100, box["y"] + 120
     page.mouse.move(x0, y0)

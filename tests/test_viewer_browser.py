@@ -411,6 +411,7 @@ def test_steps_panel_records_the_view_and_steps_through_it(page):
     assert page.evaluate("document.querySelector('.fv-steps-figure').dataset.step") == str(count - 1)
     assert page.evaluate("document.querySelector('.fv-steps-figure').innerHTML.length") > 1000
     # the view changes: the record says it belongs to an earlier view
+    page.evaluate("window.scrollTo(0, 0)")  # the figure scrolled the page: the whole picture in view again
     box = page.locator(".fv-canvas").bounding_box()
     frames = page.evaluate("window.frustumViewer.frames")
     page.mouse.move(box["x"] + 300, box["y"] + 300)
