@@ -49,8 +49,7 @@ class Viewer(anywidget.AnyWidget):
     presets and 0 resets (``frustum.viewer.interaction`` gives the formulas). The steps panel below records a
     visible-surface method on the current view (``ViewerSession.steps``) and steps through its figures. While
     dragging, frames are rendered at half size with one sample; at rest, at full size with `rest_samples`. Without
-    a widget
-    front end (a static notebook render, GitHub, nbconvert) the output shows the rest frame as a PNG.
+    a widget front end (a static notebook render, GitHub, nbconvert) the output shows the rest frame as a PNG.
 
     Parameters
     ----------
