@@ -122,8 +122,10 @@ def lab(tmp_path_factory):
     port, token = _free_port(), secrets.token_hex(16)
     env = dict(os.environ)
     env["PYTHONPATH"] = os.pathsep.join([str(ROOT / "src"), env.get("PYTHONPATH", "")])
-    for name, sub in (("JUPYTER_CONFIG_DIR", "config"), ("JUPYTER_RUNTIME_DIR", "runtime"), ("IPYTHONDIR", "ipython"),
-                      ("JUPYTERLAB_WORKSPACES_DIR", "workspaces")):  # fmt: skip
+    # the user's Jupyter folders stay untouched (the venv's kernel spec and lab extensions are found in sys.prefix)
+    folders = {"JUPYTER_CONFIG_DIR": "config", "JUPYTER_DATA_DIR": "data", "JUPYTER_RUNTIME_DIR": "runtime",
+               "IPYTHONDIR": "ipython", "JUPYTERLAB_WORKSPACES_DIR": "workspaces"}  # fmt: skip
+    for name, sub in folders.items():
         env[name] = str(folder / sub)
     env["JUPYTERLAB_SETTINGS_DIR"] = str(_settings(folder))
     env.pop("JUPYTER_TOKEN", None)
