@@ -2,7 +2,7 @@
 
 Three kinds of input:
 
-- **points** (N, d), d = 1, 2 or 3: with given sizes, boxes are the cells ``floor(P / ε)`` of a grid
+- **points** (N, d), d = 1, 2 or 3: with given sizes, boxes are the cells $floor(P / ε)$ of a grid
   **anchored at the origin** (not re-centred: a construction on [0, 1]^d then gives exact counts; sample cell
   centres or interior points, not vertices that sit on box edges). With default sizes, boxes of side
   ε = extent/m tile the data's bounding box from its lower corner, the last box closed, and the fit keeps the

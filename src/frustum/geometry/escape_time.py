@@ -203,7 +203,7 @@ def quaternion_julia_mesh(c: ArrayLike = (-0.2, 0.6, 0.2, 0.0), *, resolution: i
                           max_bytes: int | None = None) -> Mesh:  # fmt: skip
     """The quaternion Julia set's 3D slice as a triangle mesh (marching cubes, scikit-image).
 
-    Contours ``quaternion_julia(...)`` at `level` (default ``max_iter − 1``: points that survive nearly all
+    Contours ``quaternion_julia(...)`` at `level` (default $max_iter − 1$: points that survive nearly all
     iterations). Faces wind counter-clockwise seen from outside (outward normals); vertex normals point up the
     field's descent, out of the set. The grid is padded by one sample below the level so the surface closes.
 

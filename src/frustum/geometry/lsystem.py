@@ -292,8 +292,8 @@ def tube_mesh(path: TurtlePath, radius: float = 0.1, *, taper: float = 0.7, side
               max_bytes: int | None = None) -> Mesh:  # fmt: skip
     """A closed prism (tube with end caps) around every segment of `path`.
 
-    A segment at branch depth d has radius ``radius·taper**d``. Each tube has `sides` quads (two triangles
-    each) and two fan caps of ``sides − 2`` triangles, wound outward.
+    A segment at branch depth d has radius $radius·taper**d$. Each tube has `sides` quads (two triangles
+    each) and two fan caps of $sides − 2$ triangles, wound outward.
 
     Returns
     -------
