@@ -38,10 +38,12 @@
   }
 
   function name(word) {
+    if (word === "Σ") return "\\sum ";
+    if (word === "Π") return "\\prod ";
     if (OPERATORS.indexOf(word) >= 0) return "\\" + word + " ";
     if (RENAMED[word]) return RENAMED[word] + " ";
     var m = /^([A-Za-z]+)([0-9]*)$/.exec(word);
-    if (m && m[1].length === 1) return word;
+    if (word.length === 1 || (m && m[1].length === 1)) return word;
     return "\\mathrm{" + word + "}";
   }
 
@@ -92,7 +94,7 @@
     // x_(i+1) and x^(n-1): the parenthesised group is the script
     s = s.replace(/([_^])\(([^()]*)\)/g, "$1{$2}");
     var out = "";
-    var re = /\\[A-Za-z]+|\\.|[A-Za-z][A-Za-z0-9]*(?:_[A-Za-z0-9]+)*|[0-9.]+|\s+|[\s\S]/g;
+    var re = /\\[A-Za-z]+|\\.|[A-Za-z][A-Za-z0-9]*(?:_[A-Za-z0-9]+)*|[\u0391-\u03A9\u03B1-\u03C9](?:_[A-Za-z0-9]+)*|[0-9.]+|\s+|[\s\S]/g;
     var m, word = false, space = false;
     while ((m = re.exec(s)) !== null) {
       var t = m[0];
@@ -102,7 +104,7 @@
       space = false;
       word = isWord;
       if (t[0] === "\\") out += t;
-      else if (/^[A-Za-z]/.test(t)) out += identifier(t);
+      else if (/^[A-Za-z\u0391-\u03A9\u03B1-\u03C9]/.test(t)) out += identifier(t);
       else if (ACCENTS[t]) out = accent(out, ACCENTS[t]);
       else if (SYMBOLS[t]) out += SYMBOLS[t];
       else out += t;

@@ -122,7 +122,7 @@ def _oblique_alpha(alpha: float, where: str) -> float:
 
 
 def orthographic(left: float, right: float, bottom: float, top: float, near: float, far: float) -> Matrix4:
-    """Clip-from-view matrix M_ortho,norm: the orthogonal view box onto the symmetric cube [−1, 1]³.
+    """Clip-from-view matrix $M_{ortho,norm}$: the orthogonal view box onto the symmetric cube [−1, 1]³.
 
     $x_n = 2x/(xw_max − xw_min) − (xw_max + xw_min)/(xw_max − xw_min)$, alike for y, and
     $z_n = −2z/(z_near − z_far) + (z_near + z_far)/(z_near − z_far)$ with $z_near = −near$,
@@ -246,7 +246,7 @@ def _cube(size: float, where: str) -> Matrix4:
 def isometric(size: float = 1.0) -> Matrix4:
     """Clip-from-world matrix of the isometric view of an object centered at the origin.
 
-    $M = M_ortho,norm · R_x(35.264°) · R_y(45°)$ with $sin 35.264° = tan 30°$: the three principal axes make
+    $M = M_{ortho,norm} · R_x(35.264°) · R_y(45°)$ with $sin 35.264° = tan 30°$: the three principal axes make
     equal angles with the view plane and are all foreshortened by √(2/3) ≈ 0.8165 (before the normalization
     scale 1/size). The view volume is the cube [−size, size]³ around the origin.
 
@@ -265,7 +265,7 @@ def isometric(size: float = 1.0) -> Matrix4:
 def dimetric(ratio: float, size: float = 1.0) -> Matrix4:
     """Clip-from-world matrix of a dimetric view: x and z foreshortened equally, y by `ratio` times as much.
 
-    $M = M_ortho,norm · R_x(α) · R_y(45°)$ with $sin²α = (2 − ratio²)/(2 + ratio²)$, so that
+    $M = M_{ortho,norm} · R_x(α) · R_y(45°)$ with $sin²α = (2 − ratio²)/(2 + ratio²)$, so that
     $f_x = f_z = √((1 + sin²α)/2)$ and $f_y = cos α = ratio · f_x$. $ratio = 1$ is the isometric view;
     $ratio = 0.5$ draws verticals at half the scale of the two horizontal axes.
 
@@ -293,7 +293,7 @@ def dimetric(ratio: float, size: float = 1.0) -> Matrix4:
 def trimetric(rotation_y: float, rotation_x: float, size: float = 1.0) -> Matrix4:
     """Clip-from-world matrix of a trimetric view: rotate about y, then about x, then project orthogonally.
 
-    $M = M_ortho,norm · R_x(rotation_x) · R_y(rotation_y)$; the foreshortenings ``f_i = |(R e_i)_xy|`` are all
+    $M = M_{ortho,norm} · R_x(rotation_x) · R_y(rotation_y)$; the foreshortenings ``f_i = |(R e_i)_xy|`` are all
     different for general angles (rotation_y = 45° gives a dimetric view, plus rotation_x = 35.264° the
     isometric one).
 
@@ -420,7 +420,7 @@ def oblique_normalized(
     far: float,
     z_vp: float = 0.0,
 ) -> Matrix4:
-    """Clip-from-view matrix of an oblique parallel projection: $M_oblique,norm = M_ortho,norm · M_oblique$.
+    """Clip-from-view matrix of an oblique parallel projection: $M_{oblique,norm} = M_{ortho,norm} · M_oblique$.
 
     The shear turns the oblique view volume (a parallelepiped along Vp) into the orthogonal box
     [left, right] × [bottom, top] × [−far, −near], which ``orthographic`` maps onto [−1, 1]³.
@@ -585,10 +585,10 @@ def general_perspective_steps(
     (xw_min, xw_max, yw_min, yw_max) on it:
 
     1. $T(−PRP)$: move the PRP to the origin (window and view plane move with it: z'_vp = z_vp − z_prp).
-    2. ``M_zshear``: $x' = x + sh_zx·z$, $y' = y + sh_zy·z$ with ``sh_zx = −(xw_min + xw_max)/(2z'_vp)``,
-       ``sh_zy = −(yw_min + yw_max)/(2z'_vp)`` (window relative to the PRP): the frustum centerline, from the
+    2. ``M_zshear``: $x' = x + sh_zx·z$, $y' = y + sh_zy·z$ with $sh_zx = −(xw_min + xw_max)/(2z'_vp)$,
+       $sh_zy = −(yw_min + yw_max)/(2z'_vp)$ (window relative to the PRP): the frustum centerline, from the
        PRP through the window center, becomes the z axis.
-    3. ``M_pers``: ``x_h = −z'_vp·x``, ``y_h = −z'_vp·y``, $z_h = s_z·z + t_z$, $h = −z$ with
+    3. ``M_pers``: $x_h = −z'_vp·x$, $y_h = −z'_vp·y$, $z_h = s_z·z + t_z$, $h = −z$ with
        $s_z = (z_near + z_far)/(z_near − z_far)$, $t_z = −2·z_near·z_far/(z_near − z_far)$: the perspective
        transformation onto the view plane, keeping depth (near → −1, far → +1 after the divide).
     4. $M_xyscale = S(2/(xw_max − xw_min), 2/(yw_max − yw_min), 1)$: the symmetric frustum becomes the
@@ -816,7 +816,7 @@ class Orthographic:
             object.__setattr__(self, name, value)
 
     def matrix(self, aspect: float) -> Matrix4:
-        """Clip-from-view matrix M_ortho,norm for an image of the given width / height."""
+        """Clip-from-view matrix $M_{ortho,norm}$ for an image of the given width / height."""
         half_width = self.height * _aspect(aspect, "Orthographic.matrix") / 2
         return orthographic(-half_width, half_width, -self.height / 2, self.height / 2, self.near, self.far)
 
@@ -827,7 +827,7 @@ class Orthographic:
 
 @dataclass(frozen=True)
 class Oblique:
-    """Oblique parallel projection (alpha, phi) normalized to the canonical cube: M_ortho,norm · M_oblique.
+    """Oblique parallel projection (alpha, phi) normalized to the canonical cube: $M_{ortho,norm} · M_oblique$.
 
     The view plane is $z = z_vp$; by default $z_vp = −(near + far)/2$, the middle of the depth range, so
     an object placed there (a camera target at that distance) is drawn true-size and stays centered.
@@ -864,7 +864,7 @@ class Oblique:
         return cls(CABINET_ALPHA, phi, height, near, far)
 
     def steps(self, aspect: float) -> tuple[Step, ...]:
-        """M_oblique, then M_ortho,norm, first-applied first."""
+        """$M_oblique$, then $M_{ortho,norm}$, first-applied first."""
         half_width = self.height * _aspect(aspect, "Oblique.matrix") / 2
         box = (-half_width, half_width, -self.height / 2, self.height / 2, self.near, self.far)
         assert self.z_vp is not None  # set in __post_init__
@@ -874,7 +874,7 @@ class Oblique:
         )
 
     def matrix(self, aspect: float) -> Matrix4:
-        """Clip-from-view matrix $M_ortho,norm · M_oblique$ for an image of the given width / height."""
+        """Clip-from-view matrix $M_{ortho,norm} · M_oblique$ for an image of the given width / height."""
         return compose(*(step.matrix for step in self.steps(aspect)))
 
 
@@ -882,7 +882,7 @@ class Oblique:
 class Axonometric:
     """Axonometric parallel projection: rotate view space about a pivot, then project orthogonally.
 
-    $matrix(aspect) = M_ortho,norm · T(0, 0, −pivot) · R_x(rotation_x) · R_y(rotation_y) · T(0, 0, pivot)$:
+    $matrix(aspect) = M_{ortho,norm} · T(0, 0, −pivot) · R_x(rotation_x) · R_y(rotation_y) · T(0, 0, pivot)$:
     the rotation turns the scene about the point at distance `pivot` on the line of sight (default the middle
     of [near, far]), so a camera aimed at a target at that distance keeps it centered while the principal axes
     of a camera looking down world −z are drawn isometrically, dimetrically or trimetrically.
@@ -924,7 +924,7 @@ class Axonometric:
         return cls(rotation_y, rotation_x, height, near, far)
 
     def steps(self, aspect: float) -> tuple[Step, ...]:
-        """Rotation about the pivot, then M_ortho,norm, first-applied first."""
+        """Rotation about the pivot, then $M_{ortho,norm}$, first-applied first."""
         assert self.pivot is not None  # set in __post_init__
         rotation = translate(0.0, 0.0, -self.pivot) @ axonometric_rotation(self.rotation_y, self.rotation_x)
         rotation = rotation @ translate(0.0, 0.0, self.pivot)

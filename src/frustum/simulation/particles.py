@@ -25,7 +25,7 @@ operations on one thread, so the same seed gives the same bytes on any machine t
 References
 ----------
 W. T. Reeves, "Particle Systems — a Technique for Modeling a Class of Fuzzy Objects", SIGGRAPH 1983, §2
-(generation ``NParts = MeanParts + Rand()·VarParts``, attributes, dynamics, extinction); [HB 15] "Particle
+(generation $NParts = MeanParts + Rand()·VarParts$, attributes, dynamics, extinction); [HB 15] "Particle
 Systems"; [seed] "Particle systems".
 """
 
