@@ -7,8 +7,10 @@ temporary folders; nothing is cached outside them.
 
 from __future__ import annotations
 
+import ast
 import importlib.util
 import inspect
+import json
 import os
 import re
 import shutil
@@ -69,6 +71,32 @@ def test_site_builds_strict(builds):
         assert f"examples/{toml.name}" in gallery, toml.name
     cli = (site / "reference" / "cli" / "index.html").read_text(encoding="utf-8")
     assert "frustum render" in cli and "frustum dataset" in cli
+    # the scene-file tables named in `frustum view` and `frustum radiosity --help` (rich markup used to swallow them)
+    assert "[sheet] table" in cli and "[radiosity]" in cli
+
+
+# formulas of the docstrings, as the built reference carries them: arithmatex spans that assets/math.js typesets
+FORMULAS = {
+    "projection": "x_c = (f/aspect)·x",
+    "camera": "u = V×n/|V×n|",
+    "shading": "f(d) = f_min + (f_max − f_min)·(d_far − d)/(d_far − d_near)",
+    "transforms": "x' = x + tx, y' = y + ty, z' = z + tz",
+    "clipping": "−w &lt;= x, y, z &lt;= w",
+}
+
+
+def test_formulas_are_math_in_the_reference(builds):
+    code, output, site = builds[0]
+    assert code == 0, output[-4000:]
+    for page, formula in FORMULAS.items():
+        html = (site / "reference" / "api" / page / "index.html").read_text(encoding="utf-8")
+        assert f'<span class="arithmatex">\\({formula}\\)</span>' in html, (page, formula)
+    index = (site / "index.html").read_text(encoding="utf-8")
+    # KaTeX and the typesetting script come from the site itself (offline), with KaTeX's licence beside them
+    assert 'src="assets/katex/katex.min.js"' in index and 'src="assets/math.js"' in index
+    assert 'href="assets/katex/katex.min.css"' in index
+    assert (site / "assets" / "katex" / "LICENSE").is_file()
+    assert (site / "assets" / "katex" / "fonts" / "KaTeX_Main-Regular.woff2").is_file()
 
 
 def test_broken_reference_fails_the_build(builds):
@@ -125,6 +153,56 @@ def test_a_name_without_docstring_warns(monkeypatch, caplog):
     with caplog.at_level("WARNING"):
         hook.api_entries()
     assert any("undocumented_thing" in r.getMessage() and r.levelname == "WARNING" for r in caplog.records)
+
+
+MATH = re.compile(r"(?<!\\)\$(?!\s)((?:\\.|[^\\$])+?)(?<!\s)\$")  # arithmatex's inline $...$
+CODE = re.compile(r"\bfr\.|\bnp\.|\"|\w\(\w+=|==|[A-Za-z_]\.[A-Za-z_]|\(\)|<\w+>|[A-Z][a-z]{2,}\w*\(|\bif\b|\bfor\b")
+
+
+def _docstrings():
+    """(where, docstring) of every module, class and function of the package, read statically."""
+    out = []
+    for path in sorted((ROOT / "src" / "frustum").rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)):
+                doc = ast.get_docstring(node)
+                if doc:
+                    out.append((f"{path.relative_to(ROOT)}:{getattr(node, 'name', '')}", doc))
+    return out
+
+
+_KATEX_CHECK = """
+const katex = require(process.argv[1] + "/docs/assets/katex/katex.min.js");
+const {toTex} = require(process.argv[1] + "/docs/assets/math.js");
+const bad = [];
+for (const [where, formula] of JSON.parse(require("fs").readFileSync(0, "utf8"))) {
+  try { katex.renderToString(toTex(formula), {throwOnError: true, strict: "error"}); }
+  catch (e) { bad.push([where, formula, e.message.slice(0, 200)]); }
+}
+console.log(JSON.stringify(bad));
+"""
+
+
+@pytest.mark.skipif(shutil.which("node") is None, reason="Node.js runs KaTeX (the site's own copy) for this check")
+def test_docstring_formulas_typeset():
+    """Every $...$ formula of the docstrings typesets with the site's KaTeX after assets/math.js's toTex (KaTeX in
+    strict mode: an unknown symbol fails too), and a broken formula is reported."""
+    formulas = [(where, m.group(1)) for where, doc in _docstrings()
+                for m in MATH.finditer(re.sub(r"``.*?``", "", doc, flags=re.S))]
+    assert len(formulas) > 500
+    broken = [("broken", "x_{(1 − t"), ("unknown symbol", "a ⍰ b")]
+    result = subprocess.run(["node", "-e", _KATEX_CHECK, str(ROOT)], input=json.dumps(formulas + broken),
+                            capture_output=True, text=True, timeout=120, check=True)
+    bad = json.loads(result.stdout)
+    assert [b[0] for b in bad] == ["broken", "unknown symbol"], bad
+
+
+def test_formulas_are_not_code_spans():
+    """The convention (docs/contributing.md): a formula is written $...$, not as a ``literal``; a literal with
+    a math operator and no code in it is a formula left behind."""
+    left = [(where, m.group(1)) for where, doc in _docstrings() for m in re.finditer(r"``(.+?)``", doc, re.S)
+            if re.search("[·×−²³√≤≥∑Σ]", m.group(1)) and not CODE.search(m.group(1))]
+    assert not left, left
 
 
 def _blocks():
