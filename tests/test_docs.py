@@ -25,6 +25,7 @@ import frustum
 
 ROOT = Path(__file__).resolve().parents[1]
 HOWTO = ROOT / "docs" / "how-to"
+TUTORIALS = ROOT / "docs" / "tutorials"
 BLOCK = re.compile(r"(?P<skip><!--\s*not run:[^>]*-->\s*\n)?```python\n(?P<code>.*?)^```", re.S | re.M)
 
 
@@ -229,3 +230,100 @@ def test_howto_block_runs(page, code, tmp_path, monkeypatch):
     finally:
         frustum.set_budget(budget.bytes, budget.operations)
         frustum.set_threads(None)
+
+
+# --- tutorials: every code block runs, in page order, in one folder and one namespace per page --------------------
+
+FENCE = re.compile(r"(?P<marks>(?:<!--[^>]*-->[ \t]*\n)*)```(?P<lang>\w+)\n(?P<code>.*?)^```", re.S | re.M)
+MARK = re.compile(r"<!--\s*(not run|save as|append to):\s*([^>]*?)\s*-->")
+# shell steps a tutorial shows but the test does not repeat: the reader's own install, done once for the tests
+SETUP = (("python3", "-m", "venv"), (".venv/bin/pip", "install"))
+
+
+def _tutorial_blocks(page: Path) -> list[tuple[str, str, dict[str, str]]]:
+    """(language, code, {mark: value}) of every fenced block of `page`, in order. A block may be preceded by
+    HTML comments (invisible on the site): ``<!-- save as: NAME -->`` / ``<!-- append to: NAME -->`` write the
+    block to that file of the tutorial's folder (a TOML scene, say), ``<!-- not run: REASON -->`` skips it."""
+    return [(m.group("lang"), m.group("code"), dict(MARK.findall(m.group("marks"))))
+            for m in FENCE.finditer(page.read_text(encoding="utf-8"))]
+
+
+def _shell_commands(code: str) -> list[tuple[list[str], str | None]]:
+    """(argv, expected error or None) for each command of a shell block; a ``# error: TEXT`` line right after a
+    command says it fails with TEXT (up to a trailing "...") in its output."""
+    import shlex
+
+    commands: list[tuple[list[str], str | None]] = []
+    for line in code.splitlines():
+        line = line.strip()
+        if line.startswith("# error:"):
+            argv, _ = commands[-1]
+            commands[-1] = (argv, line[len("# error:"):].strip().removesuffix("...").strip())
+        elif line and not line.startswith("#"):
+            for part in line.split("&&"):
+                commands.append((shlex.split(part, comments=True), None))
+    return commands
+
+
+def _run_shell(code: str, where: str) -> None:
+    env = dict(os.environ, PYTHONPATH=str(ROOT / "src"), NO_COLOR="1", COLUMNS="100")
+    for argv, error in _shell_commands(code):
+        if any(tuple(argv[: len(s)]) == s for s in SETUP):
+            continue
+        assert Path(argv[0]).name == "frustum", f"{where}: a shell command the test cannot run: {argv}"
+        result = subprocess.run([sys.executable, "-m", "frustum", *argv[1:]], env=env, capture_output=True,
+                                text=True, timeout=300)
+        output = result.stdout + result.stderr
+        if error is None:
+            assert result.returncode == 0, f"{where}: {' '.join(argv)} failed:\n{output[-2000:]}"
+            if "-o" in argv:
+                assert Path(argv[argv.index("-o") + 1]).is_file(), f"{where}: {' '.join(argv)} wrote nothing"
+        else:
+            assert result.returncode != 0, f"{where}: {' '.join(argv)} should fail"
+            assert error in output, f"{where}: {' '.join(argv)}: expected {error!r} in:\n{output[-2000:]}"
+
+
+def _tutorial_pages():
+    return sorted(TUTORIALS.glob("*.md"))
+
+
+@pytest.mark.parametrize("page", _tutorial_pages(), ids=lambda p: p.stem)
+def test_tutorial_runs(page, tmp_path, monkeypatch):
+    """Each tutorial as a reader follows it: its blocks in order, in a fresh folder (with the repository's
+    ``examples/`` beside it), Python blocks in one namespace, ``frustum`` commands as subprocesses."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "examples").symlink_to(ROOT / "examples", target_is_directory=True)
+    namespace = {"__name__": "__docs__"}
+    ran = 0
+    for number, (lang, code, marks) in enumerate(_tutorial_blocks(page)):
+        where = f"docs/tutorials/{page.name} block {number}"
+        if "not run" in marks:
+            continue
+        if "save as" in marks or "append to" in marks:
+            target = tmp_path / (marks.get("save as") or marks["append to"])
+            with target.open("w" if "save as" in marks else "a", encoding="utf-8") as out:
+                out.write(code if "save as" in marks else "\n" + code)
+        elif lang == "python":
+            exec(compile(code, where, "exec"), namespace)
+        elif lang in ("bash", "sh", "console", "shell"):
+            _run_shell(code, where)
+        else:
+            pytest.fail(f"{where}: a {lang} block neither run nor saved (mark it <!-- save as: NAME --> or "
+                        "<!-- not run: REASON -->)")
+        ran += 1
+    assert ran, f"{page.name}: no block ran"
+
+
+def test_tutorials_are_tested():
+    pages = {p.name for p in _tutorial_pages()}
+    assert {"first-picture.md", "your-own-model.md", "scene-file.md"} <= pages
+    for page in _tutorial_pages():
+        blocks = _tutorial_blocks(page)
+        assert any(lang == "python" and "not run" not in marks for lang, _, marks in blocks), page.name
+
+
+def test_shell_blocks_parse():
+    commands = _shell_commands("a && .venv/bin/frustum render x.toml -o y.png   # note\n"
+                               "frustum render broken.toml\n# error: broken.toml:3: bad ...\n")
+    assert commands == [(["a"], None), ([".venv/bin/frustum", "render", "x.toml", "-o", "y.png"], None),
+                        (["frustum", "render", "broken.toml"], "broken.toml:3: bad")]
