@@ -92,6 +92,8 @@ def test_formulas_are_math_in_the_reference(builds):
     for page, formula in FORMULAS.items():
         html = (site / "reference" / "api" / page / "index.html").read_text(encoding="utf-8")
         assert f'<span class="arithmatex">\\({formula}\\)</span>' in html, (page, formula)
+    shading = (site / "reference" / "api" / "shading" / "index.html").read_text(encoding="utf-8")
+    assert '<div class="arithmatex">\\[I = C·(k_a·I_a + Σ_l f_l·k_d·I_l·max(N·L_l, 0))' in shading  # displayed
     index = (site / "index.html").read_text(encoding="utf-8")
     # KaTeX and the typesetting script come from the site itself (offline), with KaTeX's licence beside them
     assert 'src="assets/katex/katex.min.js"' in index and 'src="assets/math.js"' in index

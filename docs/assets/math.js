@@ -98,7 +98,11 @@
     var m, word = false, space = false;
     while ((m = re.exec(s)) !== null) {
       var t = m[0];
-      if (/^\s/.test(t)) { space = true; continue; }
+      if (/^\s/.test(t)) {
+        if (/^ {3,}$/.test(t) && out) out += "\\qquad ";  // "N' = …,   N = P_u × P_v": two formulas on one line
+        space = true;
+        continue;
+      }
       var isWord = /^[A-Za-z0-9.]/.test(t);
       if (space && word && isWord) out += "\\ ";  // "depth at the pixel": words keep their spaces
       space = false;

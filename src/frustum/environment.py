@@ -3,9 +3,10 @@
 [HB "Environment Mapping"]: the surroundings are painted on a sphere (or a cube) around the scene, far enough that
 only the direction of a ray matters. A shiny surface shows the map where its reflected view vector points,
 
-    R = V − 2 (N·V) N         (V the unit view vector from the eye to the surface point, N the unit normal),
+$$R = V − 2 (N·V) N$$
 
-and a pixel where nothing is drawn shows the map along its own viewing ray. Two layouts:
+with V the unit view vector from the eye to the surface point and N the unit normal, and a pixel where nothing
+is drawn shows the map along its own viewing ray. Two layouts:
 
 * ``kind="equirect"``: a (H, 2H) latitude–longitude image, y up. A unit direction (x, y, z) maps to
   $u = 1/2 + atan2(x, −z) / 2π$ (columns left to right: −z at the centre, +x at three quarters) and

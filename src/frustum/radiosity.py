@@ -1,23 +1,27 @@
 """The radiosity lighting model: diffuse light bouncing between surfaces, by hemicubes and progressive refinement.
 
 Every surface is split into small patches k with area A_k, reflectance ρ_k and emission E_k; the light leaving
-each patch (its radiosity B_k, uniform over the patch) obeys [HB "Radiosity Lighting Model"]
+each patch (its radiosity $B_k$, uniform over the patch) obeys the radiosity equation [HB "Radiosity Lighting
+Model"]
 
-    B_k = E_k + ρ_k Σ_j B_j F_jk                         (the radiosity equation)
+$$B_k = E_k + ρ_k Σ_j B_j F_jk$$
 
-with the form factor F_jk, the fraction of the light leaving patch j that arrives at patch k. Reciprocity
+with the form factor $F_jk$, the fraction of the light leaving patch j that arrives at patch k. Reciprocity
 $A_j F_jk = A_k F_kj$ gives the shooting form $B_k += ρ_k ΔB_j F_jk A_j / A_k$.
 
 * **Form factors by the hemicube** (Cohen & Greenberg 1985): a half cube of side 2 centred on the shooting patch,
   its top face at height 1 along the patch normal, is rasterized face by face (five faces: the top and the upper
   halves of the four sides) with frustum's own depth-buffer kernels (``raster.tiles`` / ``raster.triangles``
   through the render package's item pass), writing the code of the nearest patch into each pixel. Each pixel adds
-  its *delta form factor* to the patch it shows:
+  its *delta form factor* to the patch it shows, at (x, y, 1) on the top face and at (x, 1, z) on a side face
 
-      top face (x, y, 1):   ΔF = ΔA / (π (x² + y² + 1)²)
-      side face (x, 1, z):  ΔF = z ΔA / (π (x² + z² + 1)²)      (ΔA = (2/N)², N the hemicube resolution)
+    $$ΔF = ΔA / (π (x² + y² + 1)²)$$
 
-  The delta form factors of the whole hemicube sum to 1 (up to the pixel sampling).
+    $$ΔF = z ΔA / (π (x² + z² + 1)²)$$
+
+    with $ΔA = (2/N)²$, N the hemicube resolution. The delta form factors of the whole hemicube sum to 1 (up to
+    the pixel sampling).
+
 * **Progressive refinement** (Cohen, Chen, Wallace & Greenberg 1988): repeatedly shoot the patch with the most
   unshot power ΔB_j A_j: render its hemicube, add $ρ_k ΔB_j F_jk A_j / A_k$ to B_k and to the unshot ΔB_k of
   every patch it sees, and set ΔB_j = 0. The residual is the unshot power over the power emitted.

@@ -7,17 +7,18 @@ Both change only the *shading* normal (the geometry stays flat), per pixel, from
   world units) displaces the surface along its normal, $P'(u, v) = P + B N/|N|$; to first order the displaced
   surface's normal is
 
-      N' = N + (B_u (N × P_v) − B_v (N × P_u)) / |N|,       N = P_u × P_v,
+    $$N' = N + (B_u (N × P_v) − B_v (N × P_u)) / |N|,   N = P_u × P_v$$
 
-  with $P_u = ∂P/∂u$, $P_v = ∂P/∂v$ from the mesh's UVs (``tangent_frames``) and ``B_u``, ``B_v`` the height's
-  gradient in texture space (central differences on the image, one-sided at its edges, scaled by its size and
-  sampled bilinearly as textures are: ``height_gradient``). With a smooth-shaded mesh the interpolated unit
-  normal n stands for N/|N| and $|N| = |P_u × P_v|$.
+    with $P_u = ∂P/∂u$, $P_v = ∂P/∂v$ from the mesh's UVs (``tangent_frames``) and $B_u$, $B_v$ the height's
+    gradient in texture space (central differences on the image, one-sided at its edges, scaled by its size and
+    sampled bilinearly as textures are: ``height_gradient``). With a smooth-shaded mesh the interpolated unit
+    normal n stands for $N/|N|$ and $|N| = |P_u × P_v|$.
+
 * **Normal map**: each texel stores a unit normal in the surface's tangent frame, $n_t = (255·rgb − 128) / 127$
   clamped to [−1, 1] (8-bit values b as (b − 128)/127: 128 is exactly 0 and 255 is 1, so a "flat" map of
   (128, 128, 255) is exactly (0, 0, 1); glTF's $2·b/255 − 1$ differs by at most 0.008), in the
   OpenGL convention (+x along the tangent T = P_u, +y along the bitangent = P_v: "green up", as glTF's
-  ``normalTexture``); ``N' = normalize(T̂ n_t.x + B̂ n_t.y + n n_t.z)`` with T̂ made perpendicular to n
+  ``normalTexture``); $N' = normalize(T̂ n_t.x + B̂ n_t.y + n n_t.z)$ with T̂ made perpendicular to n
   (Gram–Schmidt) and $B̂ = ±(n × T̂)$, the sign that of the UV layout's handedness.
 
 The renderer evaluates them per pixel in Phong shading only: flat shading lights each face once and Gouraud
