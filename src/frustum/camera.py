@@ -186,7 +186,7 @@ class ViewFrame:
 
     @cached_property
     def matrix(self) -> Matrix4:
-        """view_from_world = R · T(−P0): rows u, v, n and last column −(u·P0, v·P0, n·P0)."""
+        """$view_from_world = R · T(−P0)$: rows u, v, n and last column $−(u·P0, v·P0, n·P0)$."""
         return read_only(compose(*(step.matrix for step in self.steps)))
 
     @cached_property

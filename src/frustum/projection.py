@@ -294,7 +294,7 @@ def trimetric(rotation_y: float, rotation_x: float, size: float = 1.0) -> Matrix
     """Clip-from-world matrix of a trimetric view: rotate about y, then about x, then project orthogonally.
 
     $M = M_{ortho,norm} · R_x(rotation_x) · R_y(rotation_y)$; the foreshortenings ``f_i = |(R e_i)_xy|`` are all
-    different for general angles (rotation_y = 45° gives a dimetric view, plus rotation_x = 35.264° the
+    different for general angles ($rotation_y = 45°$ gives a dimetric view, plus $rotation_x = 35.264°$ the
     isometric one).
 
     Raises
@@ -445,10 +445,10 @@ def oblique_normalized(
 def perspective(fovy: float, aspect: float, near: float, far: float) -> Matrix4:
     """Clip-from-view matrix of a symmetric perspective frustum (right-handed view, NDC z in [−1, 1]).
 
-    With f = cot(fovy/2): $x_c = (f/aspect)·x$, $y_c = f·y$,
+    With $f = cot(fovy/2)$: $x_c = (f/aspect)·x$, $y_c = f·y$,
     $z_c = (z_near + z_far)/(z_near − z_far)·z − 2·z_near·z_far/(z_near − z_far)$, $w_c = −z$, where
     $z_near = −near$, $z_far = −far$. Equal to glm ``perspectiveRH_NO``, and to ``frustum`` with
-    top = near·tan(fovy/2), right = aspect·top.
+    $top = near·tan(fovy/2)$, $right = aspect·top$.
 
     Parameters
     ----------
@@ -493,8 +493,8 @@ def perspective(fovy: float, aspect: float, near: float, far: float) -> Matrix4:
 def frustum(left: float, right: float, bottom: float, top: float, near: float, far: float) -> Matrix4:
     """Clip-from-view matrix of a general (possibly oblique, off-axis) perspective frustum.
 
-    $x_c = (−2z_near·x + (xw_max + xw_min)·z)/(xw_max − xw_min)$, alike for y, z_c and w_c = −z as in
-    ``perspective``; the window [left, right] × [bottom, top] lies on the near plane z = z_near = −near.
+    $x_c = (−2z_near·x + (xw_max + xw_min)·z)/(xw_max − xw_min)$, alike for y, $z_c$ and $w_c = −z$ as in
+    ``perspective``; the window [left, right] × [bottom, top] lies on the near plane $z = z_near = −near$.
     Off-center windows (left != −right) are the oblique frusta used for stereo pairs. Equal to glm
     ``frustumRH_NO``, and to ``general_perspective`` with the PRP at the origin and z_vp = −near.
 
@@ -584,7 +584,7 @@ def general_perspective_steps(
     With the projection reference point PRP, the view plane z = z_vp and the clipping window
     (xw_min, xw_max, yw_min, yw_max) on it:
 
-    1. $T(−PRP)$: move the PRP to the origin (window and view plane move with it: z'_vp = z_vp − z_prp).
+    1. $T(−PRP)$: move the PRP to the origin (window and view plane move with it: $z'_vp = z_vp − z_prp$).
     2. ``M_zshear``: $x' = x + sh_zx·z$, $y' = y + sh_zy·z$ with $sh_zx = −(xw_min + xw_max)/(2z'_vp)$,
        $sh_zy = −(yw_min + yw_max)/(2z'_vp)$ (window relative to the PRP): the frustum centerline, from the
        PRP through the window center, becomes the z axis.
@@ -910,12 +910,12 @@ class Axonometric:
 
     @classmethod
     def isometric(cls, height: float, near: float, far: float) -> Axonometric:
-        """Isometric view: rotation_y = 45°, rotation_x = 35.264° (all axes foreshortened by √(2/3))."""
+        """Isometric view: $rotation_y = 45°$, $rotation_x = 35.264°$ (all axes foreshortened by $√(2/3)$)."""
         return cls(math.pi / 4, ISOMETRIC_ROTATION_X, height, near, far)
 
     @classmethod
     def dimetric(cls, ratio: float, height: float, near: float, far: float) -> Axonometric:
-        """Dimetric view with f_y / f_x = f_y / f_z = `ratio` in (0, √2), as ``dimetric``."""
+        """Dimetric view with $f_y / f_x = f_y / f_z = ratio ∈ (0, √2)$, as ``dimetric``."""
         return cls(math.pi / 4, _dimetric_rotation_x(ratio, "Axonometric.dimetric"), height, near, far)
 
     @classmethod

@@ -24,13 +24,13 @@ $A_j F_jk = A_k F_kj$ gives the shooting form $B_k += ρ_k ΔB_j F_jk A_j / A_k$
 
 * **Progressive refinement** (Cohen, Chen, Wallace & Greenberg 1988): repeatedly shoot the patch with the most
   unshot power ΔB_j A_j: render its hemicube, add $ρ_k ΔB_j F_jk A_j / A_k$ to B_k and to the unshot ΔB_k of
-  every patch it sees, and set ΔB_j = 0. The residual is the unshot power over the power emitted.
+  every patch it sees, and set $ΔB_j = 0$. The residual is the unshot power over the power emitted.
 * **Ambient term for display**: the unshot power not yet distributed is spread as an ambient term
   $B_k + ρ_k · R · Σ_j ΔB_j A_j / Σ_j A_j$ with the mean interreflection factor $R = 1 / (1 − ρ_avg)$,
   $ρ_avg = Σ ρ_j A_j / Σ A_j$ (Cohen et al. 1988) — it vanishes as the solution converges.
 
 Units: B is in the same units as the local illumination model's diffuse term. Emitters are faces whose material
-has ``emissive`` × ``emission`` > 0 (E_k = emissive · emission, which may exceed 1); the scene's positioned
+has ``emissive`` × ``emission`` > 0 ($E_k = emissive · emission$, which may exceed 1); the scene's positioned
 lights shoot first: their direct light on each patch is the depth buffer's diffuse term $ρ_k f_l I_l max(N·L,
 0)$ (attenuation and spot cone included), averaged over four points of the patch, each lit when the light's own
 depth-buffer view (a cube of six faces for point and spot lights, an orthographic view for directional lights)
@@ -410,7 +410,7 @@ def radiosity(
     Parameters
     ----------
     scene : Scene
-        Meshes (their materials give ρ = diffuse · color and E = emissive · emission) and lights (each positioned
+        Meshes (their materials give $ρ = diffuse · color$ and $E = emissive · emission$) and lights (each positioned
         light shoots first; ambient lights add nothing: radiosity computes the ambient light).
     patch_size : float, optional
         Longest patch edge in world units; default a twentieth of the scene's bounding-box diagonal.

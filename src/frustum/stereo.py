@@ -6,10 +6,10 @@ parallax at the image corners); each eye is offset by half the eye separation e 
 and its near-plane window is shifted toward the other eye so that both view volumes meet on the plane of
 zero parallax, the convergence plane at distance D in front of the eyes:
 
-    eye_left  = eye − (e/2)·u,   window x in [−w + s, w + s]
-    eye_right = eye + (e/2)·u,   window x in [−w − s, w − s],   s = (e/2)·near/D
+$$eye_left = eye − (e/2)·u,   eye_right = eye + (e/2)·u,   s = (e/2)·near/D$$
 
-with $w = near·tan(fovy/2)·aspect$ the half width of the centre camera's near-plane window. A point on
+the left window spanning $x ∈ [−w + s, w + s]$ and the right one $x ∈ [−w − s, w − s]$, with
+$w = near·tan(fovy/2)·aspect$ the half width of the centre camera's near-plane window. A point on
 the convergence plane then lands on the same window position in both images (zero parallax); a point beyond
 it has positive parallax (x_right − x_left > 0, it appears behind the screen), a point in front of it negative
 parallax (it appears in front of the screen).

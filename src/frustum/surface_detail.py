@@ -44,7 +44,7 @@ def tangent_frames(
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """(P_u, P_v) per vertex, (N, 3) float64 each: ∂P/∂u and ∂P/∂v of the faces around each vertex, averaged.
 
-    Per face with edges e1 = P1 − P0, e2 = P2 − P0 and UV differences (Δu1, Δv1), (Δu2, Δv2):
+    Per face with edges $e1 = P1 − P0$, $e2 = P2 − P0$ and UV differences (Δu1, Δv1), (Δu2, Δv2):
     $P_u = (e1 Δv2 − e2 Δv1) / det$, $P_v = (e2 Δu1 − e1 Δu2) / det$, $det = Δu1 Δv2 − Δu2 Δv1$.
     Faces with a degenerate UV triangle (det = 0) add nothing; a vertex with no other face gets zeros.
     """
@@ -117,7 +117,7 @@ def bumped_normals(
     normal: ArrayLike, p_u: ArrayLike, p_v: ArrayLike, b_u: ArrayLike, b_v: ArrayLike
 ) -> NDArray[np.float64]:
     """(N, 3) unit normals of the bumped surface: $N' = |N| n + B_u (n × P_v) − B_v (n × P_u)$, $|N| = |P_u × P_v|$
-    (Blinn's formula with n = N/|N| the unit shading normal)."""
+    (Blinn's formula with $n = N/|N|$ the unit shading normal)."""
     n = _unit(np.asarray(normal, dtype=np.float64))
     pu, pv = np.asarray(p_u, dtype=np.float64), np.asarray(p_v, dtype=np.float64)
     size = np.linalg.norm(np.cross(pu, pv), axis=-1, keepdims=True)

@@ -12,8 +12,8 @@ Turtle commands (Prusinkiewicz & Lindenmayer, *The Algorithmic Beauty of Plants*
 ``[``/``]``  push / pop the turtle state (position, orientation, branch depth)
 =========  ==========================================================================================
 
-The turtle frame is right-handed, H × L = U. "Turn left by δ" rotates H towards L:
-H' = H cos δ + L sin δ, L' = −H sin δ + L cos δ (counter-clockwise seen from +U). Pitch down rotates H
+The turtle frame is right-handed, $H × L = U$. "Turn left by δ" rotates H towards L:
+$H' = H cos δ + L sin δ$, $L' = −H sin δ + L cos δ$ (counter-clockwise seen from +U). Pitch down rotates H
 towards −U, roll left rotates L towards U. Any other symbol must have a production (a variable such as
 ``X``) or be listed in ``ignore``; it is then skipped by the turtle.
 

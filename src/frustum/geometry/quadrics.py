@@ -164,7 +164,7 @@ def sphere(radius: float = 1.0, segments: int = 32, rings: int = 16) -> Mesh:
 def ellipsoid(radii: ArrayLike = (1.0, 1.0, 1.0), segments: int = 32, rings: int = 16) -> Mesh:
     """The ellipsoid $(x/rx)² + (y/ry)² + (z/rz)² = 1$: $(rx cos η cos ω, ry cos η sin ω, rz sin η)$.
 
-    Normals ∝ ∇F = (x/rx², y/ry², z/rz²). `segments` (>= 3) around z, `rings` (>= 2) pole to pole.
+    Normals $∝ ∇F = (x/rx², y/ry², z/rz²)$. `segments` (>= 3) around z, `rings` (>= 2) pole to pole.
     """
     return _superquadric_mesh(_radii(radii, "ellipsoid"), 1.0, 1.0, segments, rings, "ellipsoid")
 

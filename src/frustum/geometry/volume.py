@@ -2,7 +2,9 @@
 
 A ``Volume`` holds ``data[i, j, k]``, the value at the grid point
 
-    P_model = origin + direction · ((i, j, k) ⊙ spacing)          (ITK / NIfTI "index to physical" mapping)
+$$P_model = origin + direction · ((i, j, k) ⊙ spacing)$$
+
+(ITK / NIfTI "index to physical" mapping),
 
 so axis 0 of the array runs along model x, axis 1 along y, axis 2 along z (with the default identity
 `direction`). ``model_from_grid`` is that map as a 4x4 matrix. Values between grid points are trilinear

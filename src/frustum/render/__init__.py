@@ -8,7 +8,7 @@ particles over the surfaces); ``stages`` holds the per-item stages the surface p
 
 Fast path, per scene item (one compiled pass each, buffers shared between items):
 
-1. ``raster.vertices.project_vertices``: clip = clip_from_world·world_from_model·P, region codes and, for the
+1. ``raster.vertices.project_vertices``: $clip = clip_from_world·world_from_model·P$, region codes and, for the
    vertices inside the view volume, the perspective divide, viewport and snap to 1/256 pixel, once per vertex
    (parallel over vertices; clip coordinates are not stored).
 2. ``raster.tiles.count_tiles`` / ``fill_tiles`` (triangle setup and binning in one): per face trivial reject,

@@ -19,11 +19,11 @@ view volume, as ``method="ray-casting"``: back faces skipped when culling); at t
   ($η² sin² θ₁ > 1$) the light is **totally reflected**: the transmitted weight goes to the reflected ray.
 
 The contributions are weighted without a Fresnel term (the default and only weighting; the textbook's
-$I = I_local + k_r·I_r + k_t·I_t$ with the local part scaled so that weights sum to one)::
+$I = I_local + k_r·I_r + k_t·I_t$ with the local part scaled so that weights sum to one):
 
-    I = (1 − k_r)·(α·I_local + (1 − α)·I_t) + k_r·I_r
+$$I = (1 − k_r)·(α·I_local + (1 − α)·I_t) + k_r·I_r$$
 
-so that an opaque matte surface (k_r = 0, α = 1) gives the depth buffer's color, a perfect mirror (k_r = 1)
+so that an opaque matte surface ($k_r = 0$, $α = 1$) gives the depth buffer's color, a perfect mirror ($k_r = 1$)
 only what it reflects, and a transparent surface of $ior = 1$ the depth buffer's blend $α·I + (1 − α)·behind$.
 Rays that leave the scene see the ``background`` color, or the scene's environment map (``Scene(environment=)``)
 along their direction for reflected and refracted rays (primary rays that miss show it as the depth buffer

@@ -3,7 +3,7 @@
 Spring s joins masses i and j with stiffness k, damping c and rest length L. With $d = x_j − x_i$,
 $l = |d|$ and $u = d/l$, the force on i is (Hooke's law plus damping along the spring)
 
-    f_i = k·(l − L)·u + c·((v_j − v_i)·u)·u,      f_j = −f_i,
+$$f_i = k·(l − L)·u + c·((v_j − v_i)·u)·u,   f_j = −f_i,$$
 
 plus gravity $m·g$ and air drag $−drag·m·v$ on every mass (drag per unit mass, so a finer mesh of the
 same total mass falls the same way). Pinned masses never move. The energy

@@ -185,7 +185,7 @@ def _cox_de_boor(x: FloatArray, i: int, k: int, u: FloatArray, last: int, record
 
 
 class BSpline:
-    """A B-spline curve $C(u) = Σ_{i=0}^{n} P_i · N_{i,k}(u)$ of degree p = k − 1, evaluated by de Boor's algorithm.
+    """A B-spline curve $C(u) = Σ_{i=0}^{n} P_i · N_{i,k}(u)$ of degree $p = k − 1$, evaluated by de Boor's algorithm.
 
     Parameters
     ----------
@@ -486,7 +486,7 @@ class NURBSCurve:
 
     @classmethod
     def ellipse(cls, a: float = 1.0, b: float = 0.5, center: ArrayLike = (0.0, 0.0, 0.0)) -> NURBSCurve:
-        """The exact ellipse (x/a)² + (y/b)² = 1 about `center`: the circle's net scaled (weights unchanged)."""
+        """The exact ellipse $(x/a)² + (y/b)² = 1$ about `center`: the circle's net scaled (weights unchanged)."""
         where = "NURBSCurve.ellipse"
         sa = as_scalar(a, "a", where=where, error=GeometryError)
         sb = as_scalar(b, "b", where=where, error=GeometryError)

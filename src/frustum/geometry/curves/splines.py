@@ -146,7 +146,7 @@ class CubicSpline:
         ``periodic``: a closed curve, C² across points[0]; the first point is appended at the end unless the
         last point already equals it. ``not-a-knot``: P''' continuous at the second and second-to-last knot.
     parameterization : {"uniform", "chordal", "centripetal"}
-        Knot spacing s_{k+1} − s_k = 1, |P_{k+1} − P_k| or |P_{k+1} − P_k|^(1/2); s_0 = 0.
+        Knot spacing $s_{k+1} − s_k = 1$, $|P_{k+1} − P_k|$ or $|P_{k+1} − P_k|^(1/2)$; $s_0 = 0$.
     end_tangents : (2, d) array_like, optional
         Required for ``clamped``.
 
