@@ -24,7 +24,7 @@
     "∇": "\\nabla ", "∂": "\\partial ", "→": "\\to ", "←": "\\leftarrow ", "⇒": "\\Rightarrow ", "∘": "\\circ ",
     "⊗": "\\otimes ", "∧": "\\wedge ", "∨": "\\vee ", "⌊": "\\lfloor ", "⌋": "\\rfloor ", "⌈": "\\lceil ",
     "⌉": "\\rceil ", "⟨": "\\langle ", "⟩": "\\rangle ", "%": "\\%", "#": "\\#", "&": "\\&", "@": "\\mathbin{@}",
-    "±": "\\pm ", "½": "\\tfrac12", "⅓": "\\tfrac13", "¼": "\\tfrac14", "⌀": "\\varnothing ",
+    "±": "\\pm ", "·": "\\cdot ", "½": "\\tfrac12", "⅓": "\\tfrac13", "¼": "\\tfrac14", "⌀": "\\varnothing ",
     "~": "\\mathord{\\sim}", "\u2AFD": "\\mathbin{/\\mkern-5mu/}", "⊙": "\\odot ", "∩": "\\cap ", "∪": "\\cup ",
     "¬": "\\lnot ", "⊥": "\\perp ", "∓": "\\mp ", "≪": "\\ll ", "≫": "\\gg ", "∝": "\\propto ", "≡": "\\equiv " };
 
