@@ -1,5 +1,7 @@
 """The documentation site (mkdocs.yml, docs/): it builds with warnings as errors, a broken link makes it fail,
-every public name of frustum is in the generated API reference, and every Python block of the how-to guides runs.
+every public name of frustum is in the generated API reference, the docstrings' formulas are math that typesets
+(docs/contributing.md), every Python block of the how-to guides runs, and every tutorial runs as a reader follows
+it (Python, the files it saves, its ``frustum`` commands).
 
 The two builds (the real docs and a copy with broken references) run at the same time in subprocesses, into
 temporary folders; nothing is cached outside them.
