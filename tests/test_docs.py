@@ -190,11 +190,18 @@ console.log(JSON.stringify(bad));
 
 @pytest.mark.skipif(shutil.which("node") is None, reason="Node.js runs KaTeX (the site's own copy) for this check")
 def test_docstring_formulas_typeset():
-    """Every $...$ formula of the docstrings typesets with the site's KaTeX after assets/math.js's toTex (KaTeX in
-    strict mode: an unknown symbol fails too), and a broken formula is reported."""
+    """Every $...$ formula of the docstrings and the pages typesets with the site's KaTeX after assets/math.js's
+    toTex (KaTeX in strict mode: an unknown symbol fails too), and a broken formula is reported."""
     formulas = [(where, m.group(1)) for where, doc in _docstrings()
                 for m in MATH.finditer(re.sub(r"``.*?``", "", doc, flags=re.S))]
     assert len(formulas) > 500
+    on_pages = []
+    for page in sorted((ROOT / "docs").rglob("*.md")):
+        text = re.sub(r"^```.*?^```", "", page.read_text(encoding="utf-8"), flags=re.S | re.M)  # code blocks
+        text = re.sub(r"(`+)(?s:.+?)\1", "", text)  # code spans
+        on_pages += [(str(page.relative_to(ROOT)), m.group(1)) for m in MATH.finditer(text)]
+    assert len(on_pages) > 100
+    formulas += on_pages
     broken = [("broken", "x_{(1 − t"), ("unknown symbol", "a ⍰ b")]
     result = subprocess.run(["node", "-e", _KATEX_CHECK, str(ROOT)], input=json.dumps(formulas + broken),
                             capture_output=True, text=True, timeout=120, check=True)
