@@ -27,8 +27,8 @@ pointer drags, at half the width and height with one sample; at rest, at full si
 per pixel.
 
 Picking reads the depth buffer of a full-size frame: pixel (column c, row r from the top) is the window point
-``(c + 0.5, H − r − 0.5, depth[r, c])``, which ``Camera.unproject`` maps back to the world
-(``P = (window_from_world)⁻¹·(x, y, depth, 1)`` then divide by w); the frame's ``object_id`` buffer names the
+$(c + 0.5, H − r − 0.5, depth[r, c])$, which ``Camera.unproject`` maps back to the world
+($P = (window_from_world)⁻¹·(x, y, depth, 1)$ then divide by w); the frame's ``object_id`` buffer names the
 scene item, whose inverse modeling transformation gives the point in modeling coordinates, and
 ``frustum.trace`` follows it through every stage.
 
