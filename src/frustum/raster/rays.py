@@ -5,24 +5,24 @@ triangle's box is rounded outward to float32 once (``_prepare``; outward roundin
 them is the float64 union rounded outward: a box never shrinks below its triangles) and these rows are partitioned
 in place with the triangle numbers, so each node reads its range sequentially. At a node the triangles' box centres
 are put into ``BINS`` bins along the longest extent of the centres, and the plane between two bins with the least
-``A_left·N_left + A_right·N_right`` (A: surface area of the side's bounding box, N: its triangle count) splits them;
+$A_left·N_left + A_right·N_right$ (A: surface area of the side's bounding box, N: its triangle count) splits them;
 the partition pass also gathers each side's centre bounds, so no node rescans its range for them. A range of at most
 ``SMALL`` triangles is split by the exact SAH (every cut of the triangles sorted by centre, on each axis), one of at
 most ``LEAF_SIZE`` is a leaf (shallow leaves: one triangle test per leaf), and a range whose centres coincide is cut
 in the middle. Nodes hold the boxes of their two children, and a node over triangles ``[s, e)`` numbered ``k`` has
-its left child at ``k + 1`` and its right child at ``k + (m − s)`` (m: the split), so every subtree owns a fixed
+its left child at ``k + 1`` and its right child at $k + (m − s)$ (m: the split), so every subtree owns a fixed
 range of node numbers: the top of the tree is built on one thread, the subtrees below ``PARALLEL_CUTOFF`` triangles
 (or a sixteenth of them all) in parallel (``_jit.parallel_kernel``), and the result is the same bytes on any number
 of threads.
 
 Traversal: per ray, both child boxes of a node are tested (slab test in float64 on the float32-rounded boxes,
-stored as float64 so no test converts; far bound widened by ``1 + 2γ₃`` so that rounding never loses a hit,
+stored as float64 so no test converts; far bound widened by $1 + 2γ₃$ so that rounding never loses a hit,
 PBRT 3.9.2); the nearer child is entered first and the farther one pushed with its entry distance (chosen by
 selects rather than branches: which child is nearer is a coin toss for the branch predictor), skipped when
 popped if a nearer hit has been found since; leaves are tested with the
 Möller–Trumbore ray–triangle test in float64 (the arithmetic ``tests/test_rays.py``'s brute force repeats).
 Closest hit (``closest_hits``): the least t in ``[t_min, t_max)``, ties to the lower triangle index (boxes are
-searched up to ``best·(1 + 2⁻⁴⁰)``, so a triangle whose t rounds a few ulps below its box's entry, or ties,
+searched up to $best·(1 + 2⁻⁴⁰)$, so a triangle whose t rounds a few ulps below its box's entry, or ties,
 is still found). Any hit
 (``any_hits``): stops at the first triangle met with t in ``[t_min, t_max)`` (shadow rays). Rays run in parallel
 over pieces of the ray array.
@@ -68,7 +68,7 @@ SMALL = 8
 class Index(NamedTuple):
     """``boxes`` (N, 12) float64 holding float32 values rounded outward: the boxes of each node's two children (left
     lo, left hi, right lo, right hi);
-    ``links`` (N, 2) int64: each child, a node number (>= 0) or a leaf ``~(start·8 + count)``; ``triangles``
+    ``links`` (N, 2) int64: each child, a node number (>= 0) or a leaf $~(start·8 + count)$; ``triangles``
     (F, 3, 3) float64 corners in leaf order; ``order`` (F,) int64 original index of each; ``depth`` the deepest
     node's depth (the traversal stack's size); ``nodes`` inner nodes built."""
 
@@ -428,7 +428,7 @@ def _closest(boxes, links, triangles, order, skip, ox, oy, oz, dx, dy, dz, t_min
 
     The least t in [t_min, t_max) over the triangles (ties: the lower original index ``order[row]``), skipping
     ``skip[order[row]] != 0`` (`skip` empty: none) and, when `cull`, back faces (Möller–Trumbore's determinant
-    ``e1·(d × e2) = −d·N`` negative). u, v: the weights of corners 1 and 2; back = 1 for a back face; a miss
+    $e1·(d × e2) = −d·N$ negative). u, v: the weights of corners 1 and 2; back = 1 for a back face; a miss
     is (inf, −1, …). Counts: box (slab) tests, nodes visited (inner nodes and leaves entered), ray–triangle
     tests. `stack`, `entry`: scratch of at least the index's depth + 1.
     """
@@ -659,7 +659,7 @@ def closest_hits(
     index: Index, origins: np.ndarray, directions: np.ndarray, t_min: float | np.ndarray = 0.0,
     t_max: float | np.ndarray = np.inf, skip: np.ndarray | None = None, cull: bool = False,
 ) -> Hits:  # fmt: skip
-    """The first hit of each ray ``origin + t·direction`` with t in [t_min, t_max) (scalars or one per ray)."""
+    """The first hit of each ray $origin + t·direction$ with t in [t_min, t_max) (scalars or one per ray)."""
     o = np.ascontiguousarray(origins, dtype=np.float64)
     d = np.ascontiguousarray(directions, dtype=np.float64)
     count = o.shape[0]
@@ -702,10 +702,10 @@ def cast_pixels(boxes, links, triangles, order, depth_max, skip, world_from_wind
     """A ray through the centre of every pixel of window rows [start, stop) (y up); the first hit's window depth,
     face code and barycentrics, as the depth buffer writes them.
 
-    Pixel (i, j) casts ``origin + t·(end − origin)``, t in [0, 1), from ``origin = unproject(i + ½, j + ½, 0)``
-    on the near plane to ``end = unproject(i + ½, j + ½, 1)`` on the far plane: hits inside the view volume
+    Pixel (i, j) casts $origin + t·(end − origin)$, t in [0, 1), from $origin = unproject(i + ½, j + ½, 0)$
+    on the near plane to $end = unproject(i + ½, j + ½, 1)$ on the far plane: hits inside the view volume
     only. At a hit, ``depth`` (H, W) float32 (top row first: row H − 1 − j) receives the window depth
-    ``z_w = (M₂·P)/(M₃·P)`` (M = `window_from_world`), ``codes`` ``2·face + back``, ``bary`` the weights of
+    $z_w = (M₂·P)/(M₃·P)$ (M = `window_from_world`), ``codes`` $2·face + back$, ``bary`` the weights of
     the face's corners 1 and 2; a depth that rounds to 1 is not written. ``stats`` (H, len(CAST_STATS)) int64
     receives each row's counts. `cull` != 0 skips back faces; `skip` (F,) uint8 marks triangles not drawn.
     """
