@@ -612,7 +612,9 @@ def _any(boxes, links, triangles, ox, oy, oz, dx, dy, dz, t_min, t_max, stack):
         node = stack[top]
 
 
-@parallel_kernel(lambda boxes, links, triangles, order, depth, skip, origins, *_: origins.shape[0], grain=256)
+# small pieces (16 per thread): a thread that a busy host holds back leaves a short tail to the others
+@parallel_kernel(lambda boxes, links, triangles, order, depth, skip, origins, *_: origins.shape[0], grain=256,
+                 pieces_per_thread=16)  # fmt: skip
 def _closest_rays(boxes, links, triangles, order, depth, skip, origins, directions, t_min, t_max, cull, t_out, row_out,
                   uv_out, back_out, start, stop):  # fmt: skip
     """``_closest`` for rays [start, stop): t (inf: miss), leaf-order row (−1), (u, v), back."""
@@ -630,7 +632,7 @@ def _closest_rays(boxes, links, triangles, order, depth, skip, origins, directio
         back_out[r] = back
 
 
-@parallel_kernel(lambda boxes, links, triangles, depth, origins, *_: origins.shape[0], grain=256)
+@parallel_kernel(lambda boxes, links, triangles, depth, origins, *_: origins.shape[0], grain=256, pieces_per_thread=16)
 def _any_rays(boxes, links, triangles, depth, origins, directions, t_min, t_max, out, start, stop):
     """``_any`` for rays [start, stop) into `out` (uint8)."""
     stack = np.empty(depth + 2, dtype=np.int64)
