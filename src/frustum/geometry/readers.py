@@ -272,6 +272,8 @@ def _read_obj(file: Path, data: bytes) -> list[RawPart]:
         inverse[used] = np.arange(used.sum())
         new_faces, mask_v = inverse[faces], used
     vertices = v[mask_v]
+    if library is not None and not _plain_name(library):
+        raise UnsupportedError("a path in the library name")
     materials = _read_mtl(file.parent / library) if library is not None else {}
     name = file.name
     if len(materials) > 1 and material is not None:
@@ -285,6 +287,11 @@ def _read_obj(file: Path, data: bytes) -> list[RawPart]:
     if normals is not None:
         normals = _file_normals(normals, vertices)
     return [RawPart(name, vertices, new_faces, normals, uv, _IDENTITY.copy(), image, color)]
+
+
+def _plain_name(name: str) -> bool:
+    """A file name without folders, options or odd characters: resolved beside the OBJ file, as trimesh does."""
+    return bool(re.fullmatch(r"[\w.+-]+", name)) and name not in (".", "..")
 
 
 def _obj_table(rows: list[str], widths: tuple[int, ...]) -> NDArray[np.float64]:
@@ -358,8 +365,10 @@ def _read_mtl(file: Path) -> dict[str, tuple[Any, tuple[float, float, float, flo
     give them (``Kd`` rounded to bytes; no ``Kd``: trimesh's default gray)."""
     from PIL import Image
 
+    if not _plain_name(file.name):
+        raise UnsupportedError("a path in the library name")  # trimesh's resolver tries several readings
     if not file.is_file():
-        raise UnsupportedError("no material library")  # trimesh logs it and reads on; keep its exact behaviour
+        return {}  # as trimesh: the file reads on without materials
     materials: dict[str, tuple[Any, tuple[float, float, float, float]]] = {}
     name = None
     image: Any = None
@@ -373,14 +382,18 @@ def _read_mtl(file: Path) -> dict[str, tuple[Any, tuple[float, float, float, flo
             if name is not None:
                 materials[name] = (image, color)
             name, image, color = " ".join(words[1:]), None, _DEFAULT_OBJ_COLOR
+        elif key.startswith("#"):
+            continue
         elif name is None:
-            raise UnsupportedError("a statement before newmtl")
+            if key == "map_kd":
+                raise UnsupportedError("a texture before newmtl")
+            continue  # trimesh ignores statements before the first material
         elif key == "map_kd":
             index = line.lower().index("map_kd") + 6
             texture = file.parent / line[index:].strip()
-            if not texture.is_file():
-                raise UnsupportedError("texture not found as named")  # trimesh's resolver tries harder
-            image = Image.open(io.BytesIO(texture.read_bytes()))
+            if not _plain_name(line[index:].strip()):
+                raise UnsupportedError("a path or options in map_Kd")  # trimesh's resolver tries several readings
+            image = Image.open(io.BytesIO(texture.read_bytes())) if texture.is_file() else None
         elif key == "kd":
             values = [float(x) for x in words[1:]]
             if len(values) != 3:
