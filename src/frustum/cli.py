@@ -16,9 +16,7 @@ from __future__ import annotations
 
 import gc
 import math
-import os
 import sys
-import threading
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -31,6 +29,19 @@ from rich.console import Console
 import frustum.raster
 from frustum import __version__
 from frustum._arrays import escape_control
+from frustum._program import (  # noqa: F401 - shared with the program's own plain-render path, kept as names here
+    _STATE,
+    GC_PAUSE_S,
+    INTERRUPTED_STATUS,
+    MAX_SIZE,
+    REPORTED,
+    UsageError,
+    _resume_gc_when_due,
+    _run_interruptible,
+    failure,
+    render_files,
+)
+from frustum._program import image_size as _image_size
 from frustum.camera import Camera
 from frustum.errors import FrustumError, GeometryError, OutputError
 from frustum.geometry import Mesh
@@ -62,11 +73,6 @@ console = Console()
 error_console = Console(stderr=True, highlight=False, soft_wrap=True)
 
 
-class UsageError(FrustumError):
-    """A command-line argument that frustum cannot read (exit status 2)."""
-
-
-_STATE: dict[str, Any] = {"debug": False, "resume_gc_at": None}
 
 
 def _numbers(text: str, counts: tuple[int, ...], step: str) -> list[float]:
@@ -212,27 +218,6 @@ def _vector3(text: str, option: str) -> list[float]:
     if len(values) != 3:
         raise UsageError(f"{option} = {text!r} has {len(values)} numbers; expected 3, written x,y,z")
     return values
-
-
-MAX_SIZE = 8192
-"""Largest --size width or height (the scene files' ``[render] size`` limit)."""
-
-
-def _image_size(text: str) -> tuple[int, int]:
-    """``WxH`` (e.g. 640x480) as two positive integers, or a UsageError."""
-    width, sep, height = text.lower().partition("x")
-    try:
-        size = (int(width), int(height)) if sep else None
-    except ValueError:
-        size = None
-    if size is None or min(size) <= 0:
-        raise UsageError(f"--size = {text!r} is not WIDTHxHEIGHT; write two positive integers, e.g. 640x480")
-    if max(size) > MAX_SIZE:
-        raise UsageError(
-            f"--size = {text!r} is over the limit of {MAX_SIZE} pixels a side; give width and height in "
-            f"[1, {MAX_SIZE}]"
-        )
-    return size
 
 
 @app.command("trace")
@@ -421,17 +406,7 @@ def render_command(
 ) -> None:
     """Render a scene file or a mesh file (framed from a 3/4 view, default lights, the file's materials); without
     -o, the outputs the file names (or out/<name>.png beside it)."""
-    from frustum.scenefile import render_scene_file
-    from frustum.warmup import compile_in_background
-
-    compile_in_background()  # a cold cache: a second process compiles part of the kernels meanwhile
-
-    choices = {None: None, "on": True, "off": False, "ray": "ray"}
-    if shadows not in choices:
-        raise FrustumError(f"render: --shadows {shadows!r} is unknown; expected on, off or ray")
-    written = render_scene_file(scene, output or None, size=_image_size(size) if size else None,
-                                shadows=choices[shadows], up=up)  # fmt: skip
-    for path in written if isinstance(written, list) else [written]:
+    for path in render_files(scene, output or None, size, up, shadows):  # also run without Typer: frustum._program
         console.print(f"wrote {path}", markup=False, highlight=False, soft_wrap=True)
 
 
@@ -720,61 +695,10 @@ def _fail(message: str, status: int) -> None:
     raise SystemExit(status)
 
 
-INTERRUPTED_STATUS = 130
-"""Exit status after Ctrl-C (128 + SIGINT), as shells report it."""
-
-
-def _run_interruptible(work: Callable[[], Any]) -> Any:
-    """Run `work` on a worker thread while the main thread waits in short timeouts, so Ctrl-C is honoured at once.
-
-    Python delivers SIGINT to the main thread only; a Numba kernel (nogil) or an import that catches
-    ``BaseException`` (trimesh's optional imports) on the worker cannot swallow or delay it. On Ctrl-C the
-    output files still being written (temporaries, ``frustum._files``) are removed, one line is printed and
-    the process exits with status 130 at once, abandoning the worker.
-    """
-    outcome: dict[str, Any] = {}
-
-    def target() -> None:
-        try:
-            outcome["value"] = work()
-        except BaseException as error:  # handed to the main thread, which re-raises it
-            outcome["error"] = error
-
-    worker = threading.Thread(target=target, name="frustum-work", daemon=True)
-    try:
-        worker.start()
-        while worker.is_alive():
-            worker.join(0.1)
-            _resume_gc_when_due()
-    except KeyboardInterrupt:
-        from frustum._files import remove_partial_files
-
-        remove_partial_files()
-        error_console.print("error: interrupted (Ctrl-C); no output file was written or changed", markup=False)
-        sys.stdout.flush()
-        sys.stderr.flush()
-        os._exit(INTERRUPTED_STATUS)
-    if "error" in outcome:
-        raise outcome["error"]
-    return outcome.get("value")
-
-
 def _compile_notice() -> None:
     """Told by the kernels once they have been compiling for a second (a first run in a new environment)."""
     error_console.print("compiling render kernels, first run only (`frustum warmup` does it ahead of time) ...",
                         markup=False, highlight=False)  # fmt: skip
-
-
-GC_PAUSE_S = 3.0
-"""Seconds the ``frustum`` program runs with Python's cyclic garbage collector paused (``main``)."""
-
-
-def _resume_gc_when_due() -> None:
-    """Re-enable the garbage collector once the program has run ``GC_PAUSE_S`` (checked by the waiting main thread)."""
-    due = _STATE.get("resume_gc_at")
-    if due is not None and time.monotonic() >= due:
-        _STATE["resume_gc_at"] = None
-        gc.enable()
 
 
 def main(arguments: Sequence[str] | None = None) -> None:
@@ -813,24 +737,15 @@ def _main(argv: list[str]) -> None:
         _fail(message, 2)
     except typer.Abort:
         _fail("aborted", 1)
-    except RecursionError:
+    except RecursionError as error:
         if _STATE["debug"]:
             raise
-        _fail("the input is nested too deeply to process", 1)
+        _fail(*failure(error))
     except _CLICK_EXCEPTION as error:
         _fail(" ".join(error.format_message().split()), error.exit_code)
-    except UsageError as error:
+    except REPORTED as error:
         if _STATE["debug"]:
             raise
-        _fail(str(error), 2)
-    except FrustumError as error:
-        if _STATE["debug"]:
-            raise
-        _fail(str(error), 1)
-    except (OSError, ValueError, TypeError, RuntimeError, MemoryError) as error:
-        if _STATE["debug"]:
-            raise
-        text = " ".join(str(error).split()) or "no details"
-        _fail(f"{type(error).__name__}: {text}", 1)
+        _fail(*failure(error))
     if isinstance(status, int) and status:
         raise SystemExit(status)
