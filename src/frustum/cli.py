@@ -206,6 +206,27 @@ def compose_command(
         console.print(f"M · ({', '.join(f'{v:g}' for v in p)}, 1) = ({', '.join(f'{v:.6g}' for v in moved)}, 1)")
 
 
+def _check_up(up: str) -> None:
+    """A mesh file's ``--up`` axis: y or z (the message ``load_scene_file`` gives for a mesh file)."""
+    from frustum.scenefile.models import MODEL_UP_AXES
+
+    if up not in MODEL_UP_AXES:
+        from frustum.errors import SceneFileError
+
+        raise SceneFileError(f"up = {up!r} is not an axis; give 'y' or 'z'")
+
+
+def _model_scene_file(path: Path, up: str) -> Any:
+    """A mesh file loaded with its `up` axis (a ``SceneFile``), or the path of any other file as it is."""
+    from frustum.scenefile.loader import MODEL_SUFFIXES
+
+    if path.suffix.lower() not in MODEL_SUFFIXES:
+        return path
+    from frustum.scenefile import load_scene_file
+
+    return load_scene_file(path, up=up)
+
+
 # --- trace ----------------------------------------------------------------------------------------------------
 
 
@@ -420,17 +441,18 @@ def explain_command(
         str | None,
         typer.Option(help="A visible-surface method (scan-line, area-subdivision, a-buffer, ...): print its counts."),
     ] = None,
+    up: Annotated[str, typer.Option(help="A mesh file's up axis, y or z (glTF is always y).")] = "y",
 ) -> None:
     """Print every stage of the pipeline (matrices in column- and row-vector form) for the scene's camera; with
     --method, what that visible-surface method counted drawing the scene (spans, areas per level, fragments …)."""
     from frustum.scenefile import explain_method, explain_scene_file
 
     if method is not None:
-        for key, value in explain_method(scene, method).items():
+        for key, value in explain_method(scene, method, up=up).items():
             console.print(f"{key:>24}  {value}", markup=False, highlight=False, soft_wrap=True)
         return
 
-    trace = explain_scene_file(scene, _vector3(point, "--point") if point else None)
+    trace = explain_scene_file(scene, _vector3(point, "--point") if point else None, up=up)
     if markdown or latex:
         console.print(trace.to_markdown() if markdown else trace.to_latex(), markup=False, highlight=False)
     else:
@@ -459,6 +481,7 @@ def view_command(
     author: Annotated[str | None, typer.Option(help="Title block: drawn by.")] = None,
     tolerance: Annotated[str | None, typer.Option(help="Title block: general tolerances (ISO 2768-m).")] = None,
     units: Annotated[str | None, typer.Option(help="Title block: model units (mm).")] = None,
+    up: Annotated[str, typer.Option(help="A mesh file's up axis, y or z (glTF is always y).")] = "y",
 ) -> None:
     """Draw the scene as an engineering sheet: orthographic views at the largest standard scale that fits, with
     hidden lines, dimensions, title block and scale bar (the scene file's [sheet] table sets the defaults)."""
@@ -468,7 +491,7 @@ def view_command(
               "author": author, "tolerance": tolerance, "units": units}  # fmt: skip
     written = render_view_sheet(
         scene, output, tuple(v.strip() for v in views.split(",") if v.strip()) if views is not None else None,
-        paper=paper, orientation=orientation, projection_angle=angle,
+        up=up, paper=paper, orientation=orientation, projection_angle=angle,
         dimensions=False if dimensions == "none" else dimensions,
         title_block={key: value for key, value in fields.items() if value is not None},
     )  # fmt: skip
@@ -528,6 +551,7 @@ def dataset_command(
     overwrite: Annotated[bool, typer.Option("--overwrite", help="Start again over a different configuration.")] = False,
     retries: Annotated[int, typer.Option(help="Tries again for failed views before listing them.")] = 1,
     progress: Annotated[bool, typer.Option("--progress/--no-progress", help="Show the progress bar.")] = True,
+    up: Annotated[str, typer.Option(help="A mesh file's up axis, y or z (glTF is always y).")] = "y",
 ) -> None:
     """Render a multi-view dataset: color, metric depth, normals, object ids, masks and the cameras of a format.
 
@@ -536,7 +560,8 @@ def dataset_command(
     from frustum.batch import render_dataset
 
     result = render_dataset(
-        scene, out, views=views if views is not None or layout == "file" else 100, layout=layout, format=format_,
+        _model_scene_file(scene, up), out,
+        views=views if views is not None or layout == "file" else 100, layout=layout, format=format_,
         size=_image_size(size) if size else None, seed=seed, cameras_file=cameras, depth_format=depth_format,
         executor=executor, workers=workers, progress=progress, overwrite=overwrite, retries=retries,
         address=address, collect=collect,
@@ -567,9 +592,12 @@ def serve_command(
     no_token: Annotated[
         bool, typer.Option("--no-token", help="Serve a non-loopback --host without the random URL token.")
     ] = False,
+    up: Annotated[str, typer.Option(help="A mesh file's up axis, y or z (glTF is always y).")] = "y",
 ) -> None:
     """Open an interactive viewer of a scene file in the browser (orbit, pan, zoom, the pipeline beside it)."""
     from frustum.viewer.server import serve
+
+    _check_up(up)  # before serving: the page would show it only after the first connection
 
     def ready(url: str) -> None:
         console.print(f"frustum serve: {scene} at {url}", markup=False, highlight=False, soft_wrap=True)
@@ -581,7 +609,8 @@ def serve_command(
                           markup=False, highlight=False, soft_wrap=True)  # fmt: skip
         console.file.flush()
 
-    serve(scene, host, port, ready=ready, allow_origins=tuple(allow_origin or ()), token=False if no_token else None)
+    serve(scene, host, port, ready=ready, allow_origins=tuple(allow_origin or ()), token=False if no_token else None,
+          up=up)  # fmt: skip
 
 
 @app.command("steps")
@@ -604,6 +633,7 @@ def steps_command(
     u: Annotated[str | None, typer.Option("--u", help="B-spline parameter whose knot span is shown.")] = None,
     seed: Annotated[str | None, typer.Option(help="Random seed.")] = None,
     fps: Annotated[float, typer.Option(help="Animation frames (steps) per second.")] = 1.0,
+    up: Annotated[str, typer.Option(help="A mesh file's up axis, y or z (glTF is always y).")] = "y",
 ) -> None:
     """Record an algorithm of the lecture notes step by step and write its figures, animation, page or table."""
     from frustum.steps.catalog import build, describe_algorithms
@@ -619,7 +649,7 @@ def steps_command(
     if scene_file is not None:
         from frustum.scenefile import load_scene_file
 
-        loaded = load_scene_file(scene_file)
+        loaded = load_scene_file(scene_file, up=up)
         camera = loaded.camera or loaded.cameras[0]
         if size is not None:
             width, height = _image_size(size)
@@ -645,6 +675,7 @@ def radiosity_command(
     hemicube: Annotated[int | None, typer.Option(help="Hemicube pixels a side (default 128).")] = None,
     tolerance: Annotated[float | None, typer.Option(help="Stop at this unshot / emitted power (default 1e-3).")] = None,
     size: Annotated[str | None, typer.Option(help="Image size WIDTHxHEIGHT, overriding the file's.")] = None,
+    up: Annotated[str, typer.Option(help="A mesh file's up axis, y or z (glTF is always y).")] = "y",
 ) -> None:
     """Light a scene file by radiosity (diffuse light bouncing between surfaces, hemicube form factors, progressive
     refinement) and render the lit scene from the file's camera: each pixel the interpolated radiosity."""
@@ -656,7 +687,7 @@ def radiosity_command(
 
     if output.suffix.lower() != ".png":
         raise OutputError(f"radiosity: output = {str(output)!r} is not a .png file; radiosity writes a PNG picture")
-    scene_file = load_scene_file(scene)
+    scene_file = load_scene_file(scene, up=up)
     if size:
         scene_file = scene_file.resized(_image_size(size))
     settings = dict(getattr(scene_file, "radiosity", None) or {})
