@@ -177,3 +177,73 @@ def test_serve_takes_up_for_a_z_up_model(tower):
     width = {name: np.ptp(np.nonzero(_mask(image))[1]) for name, image in (("z", standing), ("y", lying))}
     assert height["z"] > width["z"]  # the tower stands: taller than wide on the screen
     assert height["y"] < width["y"]
+
+
+# --- default lights for every scene file that names none -------------------------------------------------------
+
+PLACED = "[camera]\neye = [2.5, 2.0, 3.5]\ntarget = [0, 0, 0]\nfovy_deg = 40\n[render]\nsize = [96, 72]\n"
+SPHERE = '[[nodes]]\ngeometry = { type = "uv_sphere", radius = 1.0, segments = 24, rings = 12 }\n'
+
+
+def _model_luminance(scene_file) -> float:
+    color = np.asarray(scene_file.render().color)
+    mask = (color != color[0, 0]).any(axis=-1)
+    return float((color[mask][:, :3].astype(float) @ [0.2126, 0.7152, 0.0722] / 255).mean())
+
+
+def test_a_scene_file_without_lights_and_a_placed_camera_gets_the_default_lights():
+    from frustum.scenefile import load_scene
+    from frustum.scenefile.models import default_lights
+
+    scene_file = load_scene(PLACED + SPHERE)
+    lights = scene_file.scene.world_lights()
+    expected = default_lights(scene_file.camera)
+    assert len(lights) == len(expected) == 4
+    for light, want in zip(lights, expected, strict=True):
+        assert type(light) is type(want) and light.intensity == want.intensity
+        assert np.allclose(getattr(light, "direction", 0.0), getattr(want, "direction", 0.0))
+    assert 0.25 < _model_luminance(scene_file) < 0.8  # lit, not the near-black silhouette of an unlit scene
+
+
+@pytest.mark.parametrize(
+    "extra",
+    [
+        "lights = []\n",  # unlit on purpose
+        '[[lights]]\ntype = "ambient"\nintensity = 0.2\n',  # lights of its own
+        '[render]\nmode = "wireframe"\n',
+        '[render]\nmode = "hidden-line"\n',
+        '[render]\nshading = "none"\n',
+        '[render]\nshading = "normals"\n',
+    ],
+)
+def test_files_that_name_lights_or_draw_unlit_pictures_get_no_default_lights(extra):
+    from frustum.scenefile import load_scene
+
+    text = PLACED + SPHERE
+    text = text.replace("[render]\n", extra) if extra.startswith("[render]") else extra + text
+    lights = load_scene(text).scene.world_lights()
+    assert len(lights) == (1 if "ambient" in extra else 0)
+
+
+def test_lights_in_nodes_count_as_named():
+    from frustum.scenefile import load_scene
+
+    node_light = SPHERE + '[[nodes.lights]]\ntype = "point"\nposition = [2, 2, 2]\n'
+    assert len(load_scene(PLACED + node_light).scene.world_lights()) == 1
+
+
+def test_no_example_changes_its_lights(monkeypatch):
+    """Every example keeps exactly its own lights (those naming lights, and the five unlit on purpose: a
+    radiosity box, a wireframe, two hidden-line drawings, a volume), so no example picture changes."""
+    import frustum.scenefile.loader as loader
+    from frustum.scenefile.commands import EXAMPLES_DIR
+
+    def lights(path: Path) -> list:
+        return [repr(light) for light in load_scene_file(path).scene.world_lights()]
+
+    examples = sorted(EXAMPLES_DIR.glob("*.toml"))
+    assert len(examples) > 20
+    now = {path.name: lights(path) for path in examples}
+    assert sum(1 for named in now.values() if named) >= len(examples) - 5
+    monkeypatch.setattr(loader, "default_lights", lambda camera: [])
+    assert now == {path.name: lights(path) for path in examples}
