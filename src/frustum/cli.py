@@ -484,7 +484,7 @@ def view_command(
     up: Annotated[str, typer.Option(help="A mesh file's up axis, y or z (glTF is always y).")] = "y",
 ) -> None:
     """Draw the scene as an engineering sheet: orthographic views at the largest standard scale that fits, with
-    hidden lines, dimensions, title block and scale bar (the scene file's [sheet] table sets the defaults)."""
+    hidden lines, dimensions, title block and scale bar (the scene file's \\[sheet] table sets the defaults)."""
     from frustum.scenefile import render_view_sheet
 
     fields = {"title": title, "drawing_number": drawing_number, "sheet": sheet_number, "date": date,
@@ -669,7 +669,8 @@ def radiosity_command(
     scene: Annotated[Path, typer.Argument(help="A TOML scene file (emissive materials and/or lights).")],
     output: Annotated[Path, typer.Option("--output", "-o", help="The picture to write (.png).")],
     patch_size: Annotated[
-        float | None, typer.Option(help="Longest patch edge in world units (default: the [radiosity] table's, or a "
+        # "\\[": rich markup would take [radiosity] for a style tag and drop it
+        float | None, typer.Option(help="Longest patch edge in world units (default: the \\[radiosity] table's, or a "
                                         "twentieth of the scene's diagonal).")
     ] = None,
     hemicube: Annotated[int | None, typer.Option(help="Hemicube pixels a side (default 128).")] = None,
