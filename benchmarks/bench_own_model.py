@@ -5,7 +5,9 @@ Each timing is a whole process, as a user runs it: ``frustum render FILE -o out.
 that opens F3D offscreen (``f3d.Engine.create(True)``), adds the file, renders 480x360 and saves the PNG. Warm
 timings are medians of `--repeat` runs; cold is one run of the first file with an empty ``NUMBA_CACHE_DIR``.
 F3D is the anchor: the ratio frustum / F3D per file is what this reports (target: warm <= 1), in wall time and in
-CPU time (user + system of the whole process: steadier than wall time on a shared machine).
+CPU time (user + system of the whole process: steadier than wall time on a shared machine). Warm means the kernel
+cache and Python's bytecode cache are filled (``PYTHONDONTWRITEBYTECODE`` is dropped for the runs: a source
+checkout under that setting compiles frustum's ~40 modules from source on every run, ~0.1 s).
 
     python benchmarks/bench_own_model.py [--repeat 3] [--no-cold]
 
@@ -91,6 +93,7 @@ def main() -> None:
     args = parser.parse_args()
     frustum_cli = [sys.executable, "-m", "frustum"]
     env = {**os.environ, "PYTHONPATH": str(ROOT / "src") + os.pathsep + os.environ.get("PYTHONPATH", "")}
+    env.pop("PYTHONDONTWRITEBYTECODE", None)  # warm = bytecode cached too, as pip install leaves a package
     try:
         import f3d  # noqa: F401
 
