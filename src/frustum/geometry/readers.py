@@ -278,12 +278,9 @@ def _read_obj(file: Path, data: bytes) -> list[RawPart]:
     name = file.name
     if len(materials) > 1 and material is not None:
         name = material
-    image = color = None
+    image = color = None  # no material: no texture, no colour (UVs alone get trimesh's placeholder: the same)
     if material in materials:
         image, color = materials[material]
-    elif uv is None:
-        pass  # no visual: no texture, no colour
-    # UVs without a material: trimesh's placeholder material, i.e. no image and no colour
     if normals is not None:
         normals = _file_normals(normals, vertices)
     return [RawPart(name, vertices, new_faces, normals, uv, _IDENTITY.copy(), image, color)]
