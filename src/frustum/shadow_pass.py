@@ -193,11 +193,11 @@ def _world_faces(item: SceneItem) -> np.ndarray:
 def light_fractions(
     scene: Scene, items: list[SceneItem], camera: Camera, options: ShadowOptions, lights: np.ndarray,
     depth: np.ndarray, points: np.ndarray, facing: np.ndarray,
-    draw_depth: Callable[[SceneItem, Camera, np.ndarray, np.ndarray, np.ndarray], None], where: str,
+    draw_depth: Callable[[SceneItem, Camera, np.ndarray, bool], None], where: str,
 ) -> np.ndarray:  # fmt: skip
     """(H, W, K) float32: the fraction of each packed light (rows of `lights`) reaching each drawn pixel (1 for
-    lights that cast no shadow and on the background). `draw_depth(item, light_camera, depth, codes, bary)` is
-    the renderer's depth pass of one item (both sides)."""
+    lights that cast no shadow and on the background). `draw_depth(item, light_camera, depth, fresh)` is
+    the renderer's depth pass of one item into a map (cleared first where `fresh`)."""
     from frustum.raster import shadow
 
     height, width = depth.shape
@@ -230,24 +230,20 @@ def light_fractions(
         cause=f"shadow_map_size = {size} with {len(casting)} shadow-casting light(s), "
         f"{cube_count} of them point lights (a cube of six maps each, {format_bytes(6 * size * size * 4)})",
     )
-    codes = _take((size, size), np.int32 if 2 * sum(i.mesh.face_count for i in items) < 2**31 else np.int64)
-    bary = _take((size, size, 2), np.float32)
     seen_points = points[drawn]
     for channel, light in zip(rows, casting, strict=True):
         cameras = _light_cameras(light, seen_points, box, size, options.softness)
         if not cameras:
             continue
         maps = _take((len(cameras), size, size), np.float32)
-        maps.fill(1.0)
         views = np.zeros((len(cameras), shadow.MAP_FIELDS))
         for face, (light_camera, texel) in enumerate(cameras):
-            for item in casters:
-                draw_depth(item, light_camera, maps[face], codes, bary)
+            for number, item in enumerate(casters):
+                draw_depth(item, light_camera, maps[face], number == 0)
             views[face] = _map_record(light_camera, texel, light)
         shadow.map_visibility(depth, points, facing, maps, views, np.ascontiguousarray(lights[channel]),
                               float(options.softness), seen, channel)  # fmt: skip
         give_back(maps)
-    give_back(codes, bary)
     return seen
 
 

@@ -11,10 +11,10 @@ import numpy as np
 
 from frustum.camera import Camera
 from frustum.geometry import Mesh
-from frustum.raster import shade, triangles
+from frustum.raster import shade
 from frustum.render.options import RenderOptions
 from frustum.render.stages import (
-    TILE_SIZE,
+    TILED_BITS,
     Lighting,
     Pixels,
     _plain_surface,
@@ -30,15 +30,18 @@ SHADOWED_MODES = (shade.SHADE_PHONG, shade.SHADE_GOURAUD, shade.SHADE_FLAT)
 """Shading modes in which shadows darken the picture (``"none"``, ``"normals"`` and ``"depth"`` ignore them)."""
 
 
-def draw_depth(item: SceneItem, camera: Camera, depth: np.ndarray, codes: np.ndarray, bary: np.ndarray) -> None:
-    """Stages 1–4 of one item into `depth` alone (codes and weights are scratch): a shadow map. Both sides of an
-    open surface; the front faces alone of a closed one (``Mesh.is_watertight``: along any ray from outside the
-    first surface met is a front face, so the map is the same, for half the fill)."""
-    binned = bin_item(item, camera, bool(item.mesh.is_watertight))
-    tiling = np.array([TILE_SIZE, binned.tiles_x, 0, depth.shape[1], depth.shape[0]], dtype=np.int64)
-    triangles.rasterize_tiles(
-        binned.faces, binned.win_int, binned.win_float, binned.tri_int, binned.tri_float, binned.tri_weights,
-        binned.tile_starts, binned.tile_entries, tiling, depth, codes, bary,
+def draw_depth(item: SceneItem, camera: Camera, depth: np.ndarray, fresh: bool) -> None:
+    """Stages 1–4 of one item into `depth` alone (``raster.shadow.fill_depth_tiles``: no face codes or weights,
+    64-pixel tiles): a shadow map, cleared first where `fresh`. Both sides of an open surface; the front faces alone
+    of a closed one (``Mesh.is_watertight``: along any ray from outside the first surface met is a front face, so
+    the map is the same, for half the fill)."""
+    from frustum.raster import shadow
+
+    binned = bin_item(item, camera, bool(item.mesh.is_watertight), tile_bits=TILED_BITS)
+    tiling = np.array([1 << TILED_BITS, binned.tiles_x, 0, depth.shape[1], depth.shape[0]], dtype=np.int64)
+    shadow.fill_depth_tiles(
+        binned.faces, binned.win_int, binned.win_float, binned.tri_int, binned.tri_float, binned.tile_starts,
+        binned.tile_entries, tiling, depth, fresh,
     )  # fmt: skip
 
 
