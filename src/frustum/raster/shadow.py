@@ -55,6 +55,8 @@ from frustum.raster.shade import (
     power,
 )  # fmt: skip
 from frustum.raster.triangles import (
+    _ALPHA,
+    _BETA,
     _FLOAT_ROWS,
     _GENERAL,
     _IMAX,
@@ -71,8 +73,6 @@ from frustum.raster.triangles import (
     _Y1,
     _Y2,
     _Z0,
-    _ALPHA,
-    _BETA,
     FILL_BLOCK,
     NARROW,
     _setup_entries,
@@ -193,7 +193,7 @@ def _lookup(
     if 0.0 < softness <= 1.0:  # the four texels around P, bilinearly weighted (ramps `softness` texels wide)
         gx, gy = x - 0.5, y - 0.5
         fx, fy = math.floor(gx), math.floor(gy)
-        col, up = int(fx), int(fy)  # noqa: RUF046
+        col, up = int(fx), int(fy)
         wx = min(max((gx - fx - 0.5) / softness + 0.5, 0.0), 1.0)
         wy = min(max((gy - fy - 0.5) / softness + 0.5, 0.0), 1.0)
         t00 = _tap(shadow_map, view, size - 1 - up, col, receiver - bias)
