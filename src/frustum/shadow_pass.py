@@ -53,8 +53,8 @@ from frustum.scene import Scene, SceneItem
 from frustum.shading import AmbientLight, DirectionalLight, PointLight, SpotLight
 
 __all__ = [
-    "SHADOW_METHODS", "ShadowOptions", "check_shadows", "give_back", "light_fractions", "occluded",
-    "release_memory", "shadow_lights", "surface_points",
+    "SHADOW_METHODS", "ShadowOptions", "check_shadows", "give_back", "light_fractions", "map_record", "occluded",
+    "release_memory", "shadow_lights", "surface_points", "take_array", "view_map",
 ]  # fmt: skip
 
 SHADOW_METHODS = (None, False, True, "ray")
@@ -68,7 +68,7 @@ _POOL: dict[tuple, list[np.ndarray]] = {}
 _POOL_LOCK = threading.Lock()
 
 
-def _take(shape: tuple[int, ...], dtype: Any) -> np.ndarray:
+def take_array(shape: tuple[int, ...], dtype: Any) -> np.ndarray:
     """An uninitialized work array, one a previous frame gave back where shape and dtype match (no first-touch
     page faults for the maps and per-pixel arrays of an animation's every frame)."""
     key = (tuple(shape), np.dtype(dtype).str)
@@ -169,9 +169,9 @@ def surface_points(
     from frustum.raster import shadow
 
     height, width = depth.shape
-    points = _take((height, width, 3), np.float64)
+    points = take_array((height, width, 3), np.float64)
     points.fill(np.nan)
-    facing = _take((height, width, 3), np.float64)
+    facing = take_array((height, width, 3), np.float64)
     for index, world, offset in drawn:
         item = items[index]
         if item.mesh.face_count == 0:
@@ -235,12 +235,12 @@ def light_fractions(
         cameras = _light_cameras(light, seen_points, box, size, options.softness)
         if not cameras:
             continue
-        maps = _take((len(cameras), size, size), np.float32)
+        maps = take_array((len(cameras), size, size), np.float32)
         views = np.zeros((len(cameras), shadow.MAP_FIELDS))
         for face, (light_camera, texel) in enumerate(cameras):
             for number, item in enumerate(casters):
                 draw_depth(item, light_camera, maps[face], number == 0)
-            views[face] = _map_record(light_camera, texel, light)
+            views[face] = map_record(light_camera, texel, light)
         shadow.map_visibility(depth, points, facing, maps, views, np.ascontiguousarray(lights[channel]),
                               float(options.softness), seen, channel)  # fmt: skip
         give_back(maps)
@@ -310,17 +310,7 @@ def _light_cameras(
         seen = [(seen_points[:, 0] * r[0] + seen_points[:, 1] * r[1]) + seen_points[:, 2] * r[2] for r in view]
         low = np.array([axis.min() for axis in seen])
         high = np.array([axis.max() for axis in seen])
-        side = float(max(high[0] - low[0], high[1] - low[1]))
-        span = float(np.linalg.norm(box[1] - box[0]))
-        side = max(side, 1e-9 * max(span, 1.0)) * (1.0 + 2.0 * reach)
-        centre = 0.5 * (low + high)
-        eye = centre[0] * frame.u + centre[1] * frame.v
-        caster_z = float((corners @ view.T)[:, 2].max())
-        near, far = -caster_z, -float(low[2])
-        pad = 1e-3 * max(far - near, span, 1e-12)
-        light_frame = ViewFrame(eye, normal=to_light, up=_up_for(to_light))
-        camera = Camera(light_frame, Orthographic(side, near - pad, far + pad), size, size)
-        return [(camera, side / size)]
+        return [_directional_camera(to_light, low, high, box, size, reach)]
     position = np.asarray(light.position, dtype=np.float64)
     distances = np.linalg.norm(corners - position, axis=1)
     far = float(distances.max()) * 1.01 + 1e-9
@@ -340,7 +330,92 @@ def _light_cameras(
     return cameras
 
 
-def _map_record(camera: Camera, texel: float, light: Any) -> np.ndarray:
+def _directional_camera(
+    to_light: np.ndarray, low: np.ndarray, high: np.ndarray, box: np.ndarray, size: int, reach: float
+) -> tuple[Camera, float]:  # fmt: skip
+    """The orthographic map over the light-view box [low, high] of the receivers (``_light_cameras``), deep enough
+    toward the light for the casters' box, widened by `reach` (a fraction of its side) on each side."""
+    frame = ViewFrame(np.zeros(3), normal=to_light, up=_up_for(to_light))
+    view = frame.matrix[:3, :3]
+    corners = np.array(np.meshgrid(*box.T, indexing="ij")).reshape(3, -1).T
+    side = float(max(high[0] - low[0], high[1] - low[1]))
+    span = float(np.linalg.norm(box[1] - box[0]))
+    side = max(side, 1e-9 * max(span, 1.0)) * (1.0 + 2.0 * reach)
+    centre = 0.5 * (low + high)
+    eye = centre[0] * frame.u + centre[1] * frame.v
+    caster_z = float((corners @ view.T)[:, 2].max())
+    near, far = -caster_z, -float(low[2])
+    pad = 1e-3 * max(far - near, span, 1e-12)
+    light_frame = ViewFrame(eye, normal=to_light, up=_up_for(to_light))
+    return Camera(light_frame, Orthographic(side, near - pad, far + pad), size, size), side / size
+
+
+def view_map(
+    light: DirectionalLight, world: np.ndarray, camera: Camera, size: int, softness: float
+) -> tuple[Camera, float] | None:  # fmt: skip
+    """The orthographic map of a directional light fitted, before anything is drawn, to what the camera can see
+    of one mesh (world vertex positions `world`): the light-view box of the part of the mesh's box inside the
+    camera's view volume (their intersection, a convex polytope, clipped exactly), cut down to the light-view box
+    of the vertices. (The stage-by-stage path fits its map to the drawn points themselves, ``light_fractions``:
+    the one-mesh tile pipeline shades as it draws.) None where the mesh's box misses the view volume."""
+    box = np.array([world.min(axis=0), world.max(axis=0)], dtype=np.float64)
+    polytope = _box_in_view(box, camera)
+    if polytope.shape[0] == 0:
+        return None
+    to_light = -np.asarray(light.direction, dtype=np.float64)
+    view = ViewFrame(np.zeros(3), normal=to_light, up=_up_for(to_light)).matrix[:3, :3]
+    inside = polytope @ view.T
+    seen = [(world[:, 0] * r[0] + world[:, 1] * r[1]) + world[:, 2] * r[2] for r in view]
+    low = np.maximum(inside.min(axis=0), [axis.min() for axis in seen])
+    high = np.minimum(inside.max(axis=0), [axis.max() for axis in seen])
+    if (low > high).any():
+        return None
+    return _directional_camera(to_light, low, high, box, size, (softness + _MARGIN_TEXELS) / size)
+
+
+def _box_in_view(box: np.ndarray, camera: Camera) -> np.ndarray:
+    """(V, 3): the corners of the intersection of the world box `box` (2, 3) with the camera's view volume (empty
+    where they do not meet): every face of each solid clipped by the other's planes (Sutherland–Hodgman)."""
+    clip = np.asarray(camera.clip_from_world, dtype=np.float64)
+    view_planes = [clip[3] + clip[i] for i in range(3)] + [clip[3] - clip[i] for i in range(3)]
+    box_planes = []
+    for axis in range(3):
+        low, high = np.zeros(4), np.zeros(4)
+        low[axis], low[3] = 1.0, -box[0, axis]
+        high[axis], high[3] = -1.0, box[1, axis]
+        box_planes += [low, high]
+    cube = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], dtype=np.float64)
+    quads = [[0, 1, 3, 2], [4, 5, 7, 6], [0, 1, 5, 4], [2, 3, 7, 6], [0, 2, 6, 4], [1, 3, 7, 5]]
+    box_corners = box[0] + cube * (box[1] - box[0])
+    ndc = np.hstack([2.0 * cube - 1.0, np.ones((8, 1))]) @ np.linalg.inv(clip).T
+    view_corners = ndc[:, :3] / ndc[:, 3:]
+    found = []
+    for corners, planes in ((box_corners, view_planes), (view_corners, box_planes)):
+        for quad in quads:
+            polygon = corners[quad]
+            for plane in planes:
+                polygon = _clip_polygon(polygon, plane)
+                if polygon.shape[0] == 0:
+                    break
+            found.append(polygon)
+    return np.concatenate(found) if found else np.empty((0, 3))
+
+
+def _clip_polygon(polygon: np.ndarray, plane: np.ndarray) -> np.ndarray:
+    """The part of a convex polygon (V, 3) where ``plane · (p, 1) >= 0`` (Sutherland–Hodgman)."""
+    values = polygon @ plane[:3] + plane[3]
+    kept = []
+    for i in range(polygon.shape[0]):
+        j = (i + 1) % polygon.shape[0]
+        if values[i] >= 0.0:
+            kept.append(polygon[i])
+        if (values[i] >= 0.0) != (values[j] >= 0.0):
+            t = values[i] / (values[i] - values[j])
+            kept.append(polygon[i] + t * (polygon[j] - polygon[i]))
+    return np.array(kept) if kept else np.empty((0, 3))
+
+
+def map_record(camera: Camera, texel: float, light: Any) -> np.ndarray:
     """The ``raster.shadow`` map record of one light camera."""
     from frustum.raster import shadow
 

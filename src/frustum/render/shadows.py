@@ -7,11 +7,15 @@ are none, exactly as ``stages.shade_item`` does. Off the ordinary path: nothing 
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
+from frustum.budgets import check_memory
 from frustum.camera import Camera
 from frustum.geometry import Mesh
 from frustum.raster import shade
+from frustum.render.buffers import Buffers
 from frustum.render.options import RenderOptions
 from frustum.render.stages import (
     TILED_BITS,
@@ -19,8 +23,10 @@ from frustum.render.stages import (
     Pixels,
     _plain_surface,
     bin_item,
+    directional,
     item_flags,
     shading_parameters,
+    world_attributes,
     world_faces,
 )  # fmt: skip
 from frustum.render.stages import shade_item as shade_item_plainly
@@ -130,3 +136,49 @@ def lit_per_light(
             shade.light_faces(world, faces, unlit, one, options.specular_model, terms)
         lit[:, 3 + 6 * k : 9 + 6 * k] = terms
     return lit
+
+
+def tiled(scene: Scene, item: SceneItem, options: RenderOptions, lights: np.ndarray) -> bool:
+    """Whether a frame of this one opaque mesh with shadow maps goes through the one-mesh tile pipeline with
+    shadows (``draw_tiled``): shading that is the directional fast path's without shadows (``stages.directional``)
+    and no buffer to read back."""
+    if options.shadow is None or options.shadow.method != "map" or options.buffers:
+        return False
+    return directional(item, dataclasses.replace(options, shadow=None), lights)
+
+
+def draw_tiled(
+    scene: Scene, item: SceneItem, camera: Camera, options: RenderOptions, lighting: Lighting, buffers: Buffers
+) -> None:  # fmt: skip
+    """Stages 1–5 of a frame of one opaque mesh with shadow maps, tile by tile (``raster.shadow_tiled``): each
+    shadow-casting (directional) light's map is fitted to what the camera can see of the mesh before anything is
+    drawn (``shadow_pass.view_map``) and filled; then each tile is filled and shaded, the map lookups made per
+    pixel inside the shading (no image-sized world points, normals or fractions)."""
+    from frustum import shadow_pass
+    from frustum.raster import shadow, shadow_tiled
+
+    binned = bin_item(item, camera, options.cull, 0, buffers.scratch, tile_bits=TILED_BITS)
+    world, normals = world_attributes(item, buffers.scratch)
+    lights = lighting.lights
+    size, softness = options.shadow.map_size, float(options.shadow.softness)
+    rows, casting = shadow_pass.shadow_lights(scene)
+    fitted = [shadow_pass.view_map(light, world, camera, size, softness) for light in casting]
+    records = [(row, found) for row, found in zip(rows, fitted, strict=True) if found is not None]
+    check_memory(len(records) * size * size * 4, where="render",
+                 cause=f"shadow_map_size = {size} with {len(records)} shadow-casting light(s)")  # fmt: skip
+    maps = shadow_pass.take_array((max(len(records), 1), size, size), np.float32)
+    views = np.zeros((max(len(records), 1), shadow.MAP_FIELDS))
+    map_of = np.full(lights.shape[0], -1, dtype=np.int64)
+    for m, (row, (light_camera, texel)) in enumerate(records):
+        draw_depth(item, light_camera, maps[m], True)
+        views[m] = shadow_pass.map_record(light_camera, texel, None)
+        map_of[row] = m
+    tiling = np.array([1 << TILED_BITS, binned.tiles_x, 0, camera.width, camera.height], dtype=np.int64)
+    params = shading_parameters(item, camera, options, lighting.ambient)
+    flags = item_flags(0, 0, options, False, False, False)
+    shadow_tiled.draw_tiles_shadowed(
+        binned.faces, binned.win_int, binned.win_float, binned.tri_int, binned.tri_float, binned.tri_weights,
+        binned.tile_starts, binned.tile_entries, tiling, buffers.depth, world, normals, params, lights,
+        flags, options.background, buffers.color, maps, views, map_of, softness,
+    )  # fmt: skip
+    shadow_pass.give_back(maps)
