@@ -561,3 +561,111 @@ def test_dataset_writes_position_and_shadow_for_a_scene_with_shadows(tmp_path, f
     plain = _scene_file(tmp_path, "")
     render_dataset(plain, tmp_path / "plain", views=1, format="nerf", executor="serial", progress=False)
     assert not (tmp_path / "plain" / "shadow").exists()
+
+
+# --- one mesh: the tile pipeline with shadows (raster.shadow_tiled) -----------------------------------------------
+
+
+def _one_mesh(scene: fr.Scene) -> fr.Scene:
+    """`scene`'s items merged into one mesh in world space (one material): a frame the one-mesh tile pipeline
+    draws."""
+    vertices, normals, faces, base = [], [], [], 0
+    for item in scene.items:
+        m = np.asarray(item.world_from_model, dtype=np.float64)
+        vertices.append(item.mesh.vertices @ m[:3, :3].T + m[:3, 3])
+        turned = item.mesh.vertex_normals @ np.linalg.inv(m[:3, :3])
+        normals.append(turned / np.linalg.norm(turned, axis=1, keepdims=True))
+        faces.append(np.asarray(item.mesh.faces) + base)
+        base += item.mesh.vertex_count
+    merged = fr.Scene(lights=list(scene.lights))
+    merged.add(fr.Mesh(np.concatenate(vertices), np.concatenate(faces), vertex_normals=np.concatenate(normals)),
+               fr.Material(color=(0.9, 0.8, 0.3)))  # fmt: skip
+    return merged
+
+
+def _spy_tiled(monkeypatch) -> list:
+    """Record each call of the shadowed tile kernel (so a test knows the one-mesh path drew its frame)."""
+    from frustum.raster import shadow_tiled
+
+    calls = []
+    kernel = shadow_tiled.draw_tiles_shadowed
+
+    def spy(*args):
+        calls.append(args[17].shape)
+        return kernel(*args)
+
+    monkeypatch.setattr(shadow_tiled, "draw_tiles_shadowed", spy)
+    return calls
+
+
+def _fraction_from_colors(scene: fr.Scene, camera: fr.Camera, light, **options) -> tuple[np.ndarray, np.ndarray]:
+    """The light's fraction at each pixel read back from the colors of a shadowed frame (a frame without
+    buffers: the one-mesh tile pipeline), between the unshadowed frame (1) and the frame without that light (0);
+    and where that is well defined (the light adds at least 24 levels)."""
+    on = fr.render(scene, camera, shadows=True, **options).color[..., :3].astype(float)
+    full = fr.render(scene, camera).color[..., :3].astype(float)
+    without = fr.Scene(lights=[dataclasses.replace(x, intensity=0.0) if x is light else x for x in scene.lights])
+    for item in scene.items:
+        without.add(item.mesh, item.material, transform=item.world_from_model)
+    none = fr.render(without, camera).color[..., :3].astype(float)
+    span = full - none
+    channel = np.argmax(span, axis=2)[..., None]
+    top = np.take_along_axis(span, channel, axis=2)[..., 0]
+    fraction = (np.take_along_axis(on - none, channel, axis=2)[..., 0]) / np.maximum(top, 1.0)
+    return fraction, top >= 24.0
+
+
+def test_one_mesh_tile_pipeline_shadows_agree_with_embree(monkeypatch):
+    """The teapot and its ground as one mesh: the frame goes tile by tile with the map lookups in the shading
+    (map fitted before drawing); its shadows, read back from the colors, agree with Embree's rays as the
+    stage-by-stage path's must (>= 99 %, the rest within 2 pixels of an edge)."""
+    light = LIGHTS["directional"]
+    scene = _one_mesh(_teapot_on_plane(light))
+    calls = _spy_tiled(monkeypatch)
+    fraction, defined = _fraction_from_colors(scene, CAMERA, light, cull_back_faces=False)
+    assert calls, "the one-mesh tile pipeline did not draw the frame"
+    buffers = fr.render(scene, CAMERA, buffers=("position", "normals"), cull_back_faces=False)
+    oracle = embree_lit(scene, buffers, light)
+    drawn = np.isfinite(buffers.position[..., 0]) & defined
+    wrong = drawn & ((fraction >= 0.5) != oracle)
+    agreement = 1.0 - wrong.sum() / drawn.sum()
+    shadowed = (drawn & (fraction < 0.5)).sum()
+    print(f"one mesh: shadow maps agree with Embree on {agreement:.4%} of {drawn.sum()}, {shadowed} shadowed")
+    assert shadowed > 500 and drawn.sum() > 20000
+    assert agreement >= 0.99
+    near_edge = _near_oracle_edge(oracle, np.isfinite(buffers.position[..., 0]))
+    assert not (wrong & ~near_edge).any(), np.argwhere(wrong & ~near_edge)[:10]
+
+
+def test_one_mesh_tile_pipeline_no_acne_and_no_shadow_without_casting_lights(monkeypatch):
+    """A plane lit at 80° from its normal (one mesh, the tile pipeline with shadows) has the unshadowed frame's
+    bytes at every softness (no pixel darkened: no acne); so does a frame whose light casts no shadow."""
+    calls = _spy_tiled(monkeypatch)
+    light = fr.DirectionalLight((math.sin(math.radians(80.0)), -math.cos(math.radians(80.0)), 0.0))
+    scene = fr.Scene(lights=[light])
+    _ground(scene)
+    plain = fr.render(scene, CAMERA)
+    for softness in (0.0, 0.5, 1.0, 3.0):
+        frame = fr.render(scene, CAMERA, shadows=True, shadow_softness=softness)
+        assert np.array_equal(frame.color, plain.color), softness
+        assert np.array_equal(frame.depth, plain.depth)
+    assert len(calls) == 4
+    scene = _one_mesh(_teapot_on_plane(dataclasses.replace(LIGHTS["directional"], cast_shadows=False)))
+    frame = fr.render(scene, CAMERA, shadows=True, cull_back_faces=False)
+    assert len(calls) == 5
+    assert np.array_equal(frame.color, fr.render(scene, CAMERA, cull_back_faces=False).color)
+
+
+def test_one_mesh_tile_pipeline_matches_the_stage_by_stage_shading():
+    """Where the one-mesh pipeline and the stage-by-stage path (forced by asking for a buffer) find the same
+    fraction, they give the same bytes: the shading with shadows is the same in both (their maps are fitted
+    differently, so fractions may differ near shadow edges)."""
+    light = LIGHTS["directional"]
+    scene = _one_mesh(_teapot_on_plane(light))
+    tiled = fr.render(scene, CAMERA, shadows=True, cull_back_faces=False)
+    staged = fr.render(scene, CAMERA, shadows=True, cull_back_faces=False, buffers=("shadow",))
+    whole = np.isfinite(staged.shadow[..., 0]) & ((staged.shadow[..., 0] == 0.0) | (staged.shadow[..., 0] == 1.0))
+    same = np.all(tiled.color == staged.color, axis=2)
+    assert whole.sum() > 20000
+    assert same[whole].mean() >= 0.99, same[whole].mean()
+    assert np.array_equal(tiled.depth, staged.depth)
