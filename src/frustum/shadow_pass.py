@@ -358,14 +358,15 @@ def view_map(
     camera's view volume (their intersection, a convex polytope, clipped exactly), cut down to the light-view box
     of the vertices. (The stage-by-stage path fits its map to the drawn points themselves, ``light_fractions``:
     the one-mesh tile pipeline shades as it draws.) None where the mesh's box misses the view volume."""
-    box = np.array([world.min(axis=0), world.max(axis=0)], dtype=np.float64)
+    columns = np.ascontiguousarray(np.asarray(world, dtype=np.float64).T)  # (3, N): fast reductions, no BLAS
+    box = np.array([columns.min(axis=1), columns.max(axis=1)])
     polytope = _box_in_view(box, camera)
     if polytope.shape[0] == 0:
         return None
     to_light = -np.asarray(light.direction, dtype=np.float64)
     view = ViewFrame(np.zeros(3), normal=to_light, up=_up_for(to_light)).matrix[:3, :3]
     inside = polytope @ view.T
-    seen = [(world[:, 0] * r[0] + world[:, 1] * r[1]) + world[:, 2] * r[2] for r in view]
+    seen = [(columns[0] * r[0] + columns[1] * r[1]) + columns[2] * r[2] for r in view]
     low = np.maximum(inside.min(axis=0), [axis.min() for axis in seen])
     high = np.minimum(inside.max(axis=0), [axis.max() for axis in seen])
     if (low > high).any():
@@ -375,44 +376,47 @@ def view_map(
 
 def _box_in_view(box: np.ndarray, camera: Camera) -> np.ndarray:
     """(V, 3): the corners of the intersection of the world box `box` (2, 3) with the camera's view volume (empty
-    where they do not meet): every face of each solid clipped by the other's planes (Sutherland–Hodgman)."""
+    where they do not meet): every face of each solid clipped by the other's planes (Sutherland–Hodgman, in
+    Python floats: a few hundred small steps)."""
     clip = np.asarray(camera.clip_from_world, dtype=np.float64)
-    view_planes = [clip[3] + clip[i] for i in range(3)] + [clip[3] - clip[i] for i in range(3)]
+    view_planes = [tuple(clip[3] + clip[i]) for i in range(3)] + [tuple(clip[3] - clip[i]) for i in range(3)]
     box_planes = []
     for axis in range(3):
-        low, high = np.zeros(4), np.zeros(4)
-        low[axis], low[3] = 1.0, -box[0, axis]
-        high[axis], high[3] = -1.0, box[1, axis]
-        box_planes += [low, high]
+        low, high = [0.0] * 4, [0.0] * 4
+        low[axis], low[3] = 1.0, -float(box[0, axis])
+        high[axis], high[3] = -1.0, float(box[1, axis])
+        box_planes += [tuple(low), tuple(high)]
     cube = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], dtype=np.float64)
     quads = [[0, 1, 3, 2], [4, 5, 7, 6], [0, 1, 5, 4], [2, 3, 7, 6], [0, 2, 6, 4], [1, 3, 7, 5]]
-    box_corners = box[0] + cube * (box[1] - box[0])
+    box_corners = (box[0] + cube * (box[1] - box[0])).tolist()
     ndc = np.hstack([2.0 * cube - 1.0, np.ones((8, 1))]) @ np.linalg.inv(clip).T
-    view_corners = ndc[:, :3] / ndc[:, 3:]
-    found = []
+    view_corners = (ndc[:, :3] / ndc[:, 3:]).tolist()
+    found: list = []
     for corners, planes in ((box_corners, view_planes), (view_corners, box_planes)):
         for quad in quads:
-            polygon = corners[quad]
+            polygon = [corners[k] for k in quad]
             for plane in planes:
                 polygon = _clip_polygon(polygon, plane)
-                if polygon.shape[0] == 0:
+                if not polygon:
                     break
-            found.append(polygon)
-    return np.concatenate(found) if found else np.empty((0, 3))
+            found += polygon
+    return np.array(found, dtype=np.float64).reshape(-1, 3)
 
 
-def _clip_polygon(polygon: np.ndarray, plane: np.ndarray) -> np.ndarray:
-    """The part of a convex polygon (V, 3) where ``plane · (p, 1) >= 0`` (Sutherland–Hodgman)."""
-    values = polygon @ plane[:3] + plane[3]
+def _clip_polygon(polygon: list, plane: tuple) -> list:
+    """The part of a convex polygon (a list of [x, y, z]) where ``plane · (p, 1) >= 0`` (Sutherland–Hodgman)."""
+    a, b, c, d = plane
+    values = [(a * p[0] + b * p[1]) + (c * p[2] + d) for p in polygon]
     kept = []
-    for i in range(polygon.shape[0]):
-        j = (i + 1) % polygon.shape[0]
+    for i, p in enumerate(polygon):
+        j = (i + 1) % len(polygon)
         if values[i] >= 0.0:
-            kept.append(polygon[i])
+            kept.append(p)
         if (values[i] >= 0.0) != (values[j] >= 0.0):
             t = values[i] / (values[i] - values[j])
-            kept.append(polygon[i] + t * (polygon[j] - polygon[i]))
-    return np.array(kept) if kept else np.empty((0, 3))
+            q = polygon[j]
+            kept.append([p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1]), p[2] + t * (q[2] - p[2])])
+    return kept
 
 
 def map_record(camera: Camera, texel: float, light: Any) -> np.ndarray:

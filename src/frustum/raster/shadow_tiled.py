@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-from frustum.raster._jit import fence, kernel, parallel_kernel, stream
+from frustum.raster._jit import fence, kernel, parallel_kernel, prefetch, stream
 from frustum.raster.shade import (
     _CHUNK,
     _DB,
@@ -196,13 +196,16 @@ def _fractions(
             for i in range(n):
                 s[row_k + i] = 1.0
             continue
-        m = np.uint64(at)
-        v = views[m]
+        shadow_map = maps[np.uint64(at)]
+        v = views[np.uint64(at)]
         lx, ly, lz = lights[k, 7], lights[k, 8], lights[k, 9]
         texel, near, depth_range = v[M_TEXEL], v[M_NEAR], v[M_FAR] - v[M_NEAR]
+        # first where each point falls on the map (the _DR… rows: free until _shade_chunk_shadowed), its texel rows
+        # prefetched; then the filters, their loads in flight meanwhile
         for i in range(n):
             nx, ny, nz = s[_VX + i], s[_VY + i], s[_VZ + i]
             cos_theta = (nx * lx + ny * ly) + nz * lz
+            s[_SR + i] = 0.0
             if cos_theta <= 0.0:
                 s[row_k + i] = 0.0
                 continue
@@ -217,28 +220,38 @@ def _fractions(
                 s[row_k + i] = 1.0
                 continue
             receiver = near + min(max(z, 0.0), 1.0) * depth_range
-            limit = receiver - texel * (1.0 + (1.0 + softness) * tan_theta)  # bias taken off
-            s[row_k + i] = float(np.float32(_filter(maps, m, x, y, limit, near, depth_range, softness)))
+            s[_DR + i], s[_DG + i] = x, y
+            s[_DB + i] = receiver - texel * (1.0 + (1.0 + softness) * tan_theta)  # bias taken off
+            s[_SR + i] = 1.0
+            row, col = size - 1 - int(y), int(x)
+            prefetch(shadow_map, np.uint64(row), np.uint64(col))
+            if row > 0:
+                prefetch(shadow_map, np.uint64(row - 1), np.uint64(col))
+            if row + 1 < size:
+                prefetch(shadow_map, np.uint64(row + 1), np.uint64(col))
+        for i in range(n):
+            if s[_SR + i] != 0.0:
+                found = _filter(shadow_map, s[_DR + i], s[_DG + i], s[_DB + i], near, depth_range, softness)
+                s[row_k + i] = float(np.float32(found))
 
 
 @kernel
 def _filter(
-    maps: np.ndarray, m: np.uint64, x: float, y: float, limit: float, near: float, depth_range: float,
-    softness: float,
+    shadow_map: np.ndarray, x: float, y: float, limit: float, near: float, depth_range: float, softness: float
 ) -> float:  # fmt: skip
-    """``raster.shadow._lookup``'s filter on orthographic map m at window point (x, y): the share of its taps whose
+    """``raster.shadow._lookup``'s filter on an orthographic map at window point (x, y): the share of its taps whose
     stored distance ``near + stored·range`` is not nearer than `limit` (or that are empty, or off the map)."""
-    size = maps.shape[1]
+    size = shadow_map.shape[0]
     if 0.0 < softness <= 1.0:
         gx, gy = x - 0.5, y - 0.5
         fx, fy = math.floor(gx), math.floor(gy)
         col, up = int(fx), int(fy)
         wx = min(max((gx - fx - 0.5) / softness + 0.5, 0.0), 1.0)
         wy = min(max((gy - fy - 0.5) / softness + 0.5, 0.0), 1.0)
-        t00 = _tap(maps, m, size - 1 - up, col, limit, near, depth_range)
-        t10 = _tap(maps, m, size - 1 - up, col + 1, limit, near, depth_range)
-        t01 = _tap(maps, m, size - 2 - up, col, limit, near, depth_range)
-        t11 = _tap(maps, m, size - 2 - up, col + 1, limit, near, depth_range)
+        t00 = _tap(shadow_map, size - 1 - up, col, limit, near, depth_range)
+        t10 = _tap(shadow_map, size - 1 - up, col + 1, limit, near, depth_range)
+        t01 = _tap(shadow_map, size - 2 - up, col, limit, near, depth_range)
+        t11 = _tap(shadow_map, size - 2 - up, col + 1, limit, near, depth_range)
         return (1.0 - wy) * ((1.0 - wx) * t00 + wx * t10) + wy * ((1.0 - wx) * t01 + wx * t11)
     steps = int(math.ceil(softness))  # noqa: RUF046 (an int in Python, a float's type for Numba's typing)
     step = softness / steps if steps > 0 else 0.0
@@ -246,19 +259,18 @@ def _filter(
     for j in range(-steps, steps + 1):
         row = size - 1 - int(math.floor(y + j * step))  # noqa: RUF046
         for i in range(-steps, steps + 1):
-            lit += _tap(maps, m, row, int(math.floor(x + i * step)), limit, near, depth_range)  # noqa: RUF046
+            lit += _tap(shadow_map, row, int(math.floor(x + i * step)), limit, near, depth_range)  # noqa: RUF046
     return lit / ((2 * steps + 1) * (2 * steps + 1))
 
 
 @kernel
-def _tap(
-    maps: np.ndarray, m: np.uint64, row: int, col: int, limit: float, near: float, depth_range: float
-) -> float:  # fmt: skip
-    """1.0 where texel (row, col) of map m lets a point whose biased distance is `limit` see the light."""
-    size = maps.shape[1]
+def _tap(shadow_map: np.ndarray, row: int, col: int, limit: float, near: float, depth_range: float) -> float:
+    """1.0 where texel (row, col) lets a point whose biased distance is `limit` see the light (or lies off the
+    map)."""
+    size = shadow_map.shape[0]
     if row < 0 or row >= size or col < 0 or col >= size:
         return 1.0
-    stored = maps[m, np.uint64(row), np.uint64(col)]
+    stored = shadow_map[np.uint64(row), np.uint64(col)]
     return 1.0 if stored >= 1.0 or limit <= near + stored * depth_range else 0.0
 
 
