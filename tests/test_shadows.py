@@ -669,3 +669,59 @@ def test_one_mesh_tile_pipeline_matches_the_stage_by_stage_shading():
     assert whole.sum() > 20000
     assert same[whole].mean() >= 0.99, same[whole].mean()
     assert np.array_equal(tiled.depth, staged.depth)
+
+
+# --- receivers with bump or normal maps, or an environment to reflect -----------------------------------------------
+
+
+def _box_on_ground(ground: fr.Material, environment=None) -> fr.Scene:
+    scene = fr.Scene(lights=[fr.AmbientLight(intensity=0.2), LIGHTS["directional"]], environment=environment)
+    scene.add(plane((10.0, 10.0), divisions=(4, 4)), ground, transform=rotate_x(-math.pi / 2))
+    scene.add(box((1, 1, 1), center=(0, 0.5, 0)), fr.Material(color=(0.9, 0.3, 0.2)))
+    return scene
+
+
+def test_items_with_normal_or_bump_maps_receive_shadows():
+    """A ground with a flat normal map (every texel the unperturbed normal) receives the same shadow as a plain
+    ground (within a level); with a real bump map it is still darkened where the map puts the pixel in shadow."""
+    flat_map = np.zeros((16, 16, 3), dtype=np.uint8)
+    flat_map[:] = (128, 128, 255)
+    plain = fr.render(_box_on_ground(GROUND), CAMERA, shadows=True, buffers=("shadow",))
+    shadowed = plain.shadow[..., 0] == 0.0
+    mapped = fr.render(_box_on_ground(dataclasses.replace(GROUND, normal_map=flat_map)), CAMERA, shadows=True)
+    assert np.abs(mapped.color.astype(int) - plain.color.astype(int)).max() <= 1
+    rng = np.random.default_rng(3)
+    bumpy = dataclasses.replace(GROUND, bump=ndimage.gaussian_filter(rng.random((64, 64)), 2.0), bump_scale=0.3)
+    lit = fr.render(_box_on_ground(bumpy), CAMERA)
+    frame = fr.render(_box_on_ground(bumpy), CAMERA, shadows=True, buffers=("shadow", "object_id"))
+    assert np.abs(lit.color.astype(int) - plain.color.astype(int))[~shadowed].max() > 3  # the bumps show
+    assert np.array_equal(frame.shadow[..., 0] == 0.0, shadowed)
+    dark = shadowed & (frame.object_id == 0)  # on the bumpy ground
+    assert dark.sum() > 300
+    # in shadow only the ambient term is left: clearly darker than the lit bumpy ground there
+    assert (frame.color[dark][:, :3].astype(int) < lit.color[dark][:, :3].astype(int) - 20).mean() > 0.99
+    sunny = frame.shadow[..., 0] == 1.0
+    assert np.abs(frame.color[sunny].astype(int) - lit.color[sunny].astype(int)).max() <= 1
+
+
+def test_reflective_items_receive_shadows():
+    """A half-mirror ground under an environment: its shadowed pixels keep the reflection and lose the light
+    (darker than without shadows by about (1 − reflectivity) of the light's share); its sunny pixels keep the
+    unshadowed bytes."""
+    env = np.zeros((16, 32, 3))
+    env[:8] = (0.3, 0.5, 0.9)
+    env[8:] = (0.4, 0.3, 0.2)
+    ground = dataclasses.replace(GROUND, reflectivity=0.5)
+    scene = _box_on_ground(ground, environment=fr.EnvironmentMap(env))
+    lit = fr.render(scene, CAMERA)
+    frame = fr.render(scene, CAMERA, shadows=True, buffers=("shadow", "object_id"))
+    flat = fr.render(_box_on_ground(GROUND), CAMERA, shadows=True, buffers=("shadow",))
+    assert np.array_equal(frame.shadow[..., 0] == 0.0, flat.shadow[..., 0] == 0.0)
+    dark = (frame.shadow[..., 0] == 0.0) & (frame.object_id == 0)  # on the mirror ground
+    assert dark.sum() > 300
+    drop = lit.color[dark][:, :3].astype(int) - frame.color[dark][:, :3].astype(int)
+    unreflected = fr.render(_box_on_ground(GROUND), CAMERA).color[dark][:, :3].astype(int) - flat.color[dark][:, :3]
+    assert (np.abs(drop - 0.5 * unreflected) <= 1.5).all(), np.abs(drop - 0.5 * unreflected).max()
+    assert drop.min() > 10
+    sunny = frame.shadow[..., 0] == 1.0
+    assert np.array_equal(frame.color[sunny], lit.color[sunny])

@@ -15,13 +15,13 @@ from frustum.budgets import check_memory
 from frustum.camera import Camera
 from frustum.geometry import Mesh
 from frustum.raster import shade
+from frustum.render import bumps, reflection
 from frustum.render.buffers import Buffers
 from frustum.render.options import RenderOptions
 from frustum.render.stages import (
     TILED_BITS,
     Lighting,
     Pixels,
-    _plain_surface,
     bin_item,
     directional,
     item_flags,
@@ -77,12 +77,13 @@ def shade_item(
     attributes: tuple[np.ndarray, np.ndarray], pixels: Pixels, band: tuple[int, int], blend: bool,
 ) -> None:  # fmt: skip
     """``stages.shade_item`` with shadows: an opaque item in a shadowed mode goes through
-    ``raster.shadow.shade_pixels_shadowed`` with the fractions ``prepare`` found; anything else is shaded as
-    without shadows (transparent items receive none, nor items with a bump or normal map or an environment to
-    reflect: their kernels take no shadow fractions yet)."""
+    ``raster.shadow.shade_pixels_shadowed`` with the fractions ``prepare`` found (an item with a bump or normal
+    map in Phong shading: ``bumps.shade_detailed`` with those fractions; an environment to reflect is blended in
+    afterwards, as without shadows); anything else is shaded as without shadows (transparent items receive
+    none)."""
     seen = None if options.outputs is None else options.outputs.get("seen")
     plain = seen is None or blend or options.shade_mode not in SHADOWED_MODES or seen.shape[:2] != pixels.codes.shape
-    if plain or not _plain_surface(item, options):  # bump, normal maps and reflections shade their own way
+    if plain:
         shade_item_plainly(item, index, face_offset, camera, options, lighting, attributes, pixels, band, blend)
         return
     from frustum.raster import shadow
@@ -98,19 +99,27 @@ def shade_item(
     params = shading_parameters(item, camera, options, ambient)
     faces = world_faces(item) if mesh.face_count else np.empty((0, 3), dtype=np.int64)
     world, normals = (np.asarray(a, dtype=np.float64) for a in attributes)
-    lit = lit_per_light(mesh, faces, world, normals, params, lights, options)
-    vertex_colors = getattr(mesh, "vertex_colors", None)
-    vertex_colors = np.empty((0, 3)) if vertex_colors is None else np.ascontiguousarray(vertex_colors[:, :3], float)
-    uvs, texture = getattr(mesh, "uvs", None), material.texture
-    if texture is None or uvs is None:
-        texture, uvs = np.empty((0, 0, 4), dtype=np.float32), np.empty((0, 2))
-    else:
-        uvs = np.ascontiguousarray(uvs, dtype=np.float64)
     flags = item_flags(index, face_offset, options, blend, write_normals, write_ids)
-    shadow.shade_pixels_shadowed(
-        pixels.depth[rows], codes, pixels.bary[rows], faces, world, normals, lit, vertex_colors, uvs, texture,
-        params, lights, flags, seen[rows], pixels.color[rows], extra[0], extra[1],
-    )  # fmt: skip
+    if options.shade_mode == shade.SHADE_PHONG and bumps.has_detail(item):  # per-pixel normals from the maps
+        bumps.shade_detailed(item, faces, world, normals, params, lights, flags, pixels.depth[rows], codes,
+                             pixels.bary[rows], pixels.color[rows], extra, seen=seen[rows])  # fmt: skip
+    else:
+        lit = lit_per_light(mesh, faces, world, normals, params, lights, options)
+        vertex_colors = getattr(mesh, "vertex_colors", None)
+        vertex_colors = (np.empty((0, 3)) if vertex_colors is None
+                         else np.ascontiguousarray(vertex_colors[:, :3], float))  # fmt: skip
+        uvs, texture = getattr(mesh, "uvs", None), material.texture
+        if texture is None or uvs is None:
+            texture, uvs = np.empty((0, 0, 4), dtype=np.float32), np.empty((0, 2))
+        else:
+            uvs = np.ascontiguousarray(uvs, dtype=np.float64)
+        shadow.shade_pixels_shadowed(
+            pixels.depth[rows], codes, pixels.bary[rows], faces, world, normals, lit, vertex_colors, uvs, texture,
+            params, lights, flags, seen[rows], pixels.color[rows], extra[0], extra[1],
+        )  # fmt: skip
+    if options.environment is not None and material.reflectivity > 0.0:
+        reflection.reflect(faces, face_offset, material.reflectivity, camera, options, normals, pixels.depth[rows],
+                           codes, pixels.bary[rows], pixels.color[rows], band[0])  # fmt: skip
 
 
 def lit_per_light(
