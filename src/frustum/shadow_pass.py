@@ -5,24 +5,28 @@ surfaces are in the depth buffer, every drawn pixel's world point (``surface_poi
 shadow-casting light in one of two ways.
 
 - **Shadow maps** (``shadows=True``): the depth-buffer method run from the light (the renderer's own binning and
-  tile kernels, ``render.bin_item`` + ``raster.triangles.rasterize_tiles``, into a float32 depth map of
-  ``shadow_map_size``² texels, both sides of every face drawn). A directional light gets an orthographic map
-  fitted to what the camera sees (the light-space box of the drawn points, widened by the filter's reach) and
+  tile set-up, ``render.bin_item`` + ``raster.shadow.fill_depth_tiles``, depth alone, into a float32 depth map of
+  ``shadow_map_size``² texels; both sides of an open surface, the front faces of a closed one). A directional
+  light gets an orthographic map fitted to what the camera sees (the light-space box of the drawn points, widened
+  by the filter's reach; a frame of one mesh drawn tile by tile, ``render.shadows.draw_tiled``, fits it before
+  drawing: ``view_map``) and
   deep enough toward the light to hold every caster (the scene's box); a spot light a perspective map over its
   cone; a point light a cube of six perspective maps (each a little wider than 90° so filter taps near a cube
   edge stay on their face). A point is lit where its distance along the light's axis, less a bias, is not beyond
   the map's: the bias is slope-scaled, ``texel·(1 + (1 + softness)·min(tan θ, 8))`` with θ the angle between the
   face normal and the light, and the point is first moved one texel along its face normal (normal offset), so lit
-  faces show no acne while shadows stay attached at contact. Percentage-closer filtering averages the test over
-  a (2m + 1)² grid of taps spanning ±``shadow_softness`` texels (m = ⌈softness⌉; 0: one tap, hard edges).
+  faces show no acne while shadows stay attached at contact. Percentage-closer filtering: softness 0, the
+  nearest texel (hard edges); 0 < softness <= 1 (the default 1), the 2 × 2 texels around the point bilinearly
+  weighted (``sampler2DShadow`` with linear filtering), each weight ramping over ``softness`` texels; above 1, a
+  (2m + 1)² grid of taps spanning ±``shadow_softness`` texels (m = ⌈softness⌉).
 - **Shadow rays** (``shadows="ray"``): a ray from each point (moved off its face by a small epsilon along the face
   normal) toward the light, any hit before the light ends it (``occluded``: ``Scene.occluded``, the any-hit
   query through the scene's BVH, ``raster.rays``). Exact up to the epsilon.
 
 Either way a point whose drawn side faces away from the light gets 0 (the surface itself is in the way). What
-casts and receives: opaque meshes cast and receive; transparent items (``Material.opacity < 1``) cast no shadow
-and receive none; volumes, particles, polylines and edges neither cast nor receive. Outside a spot light's map
-(beyond its cone, where it gives no light anyway) the fraction is 1.
+casts and receives: opaque meshes cast and receive (with bump or normal maps, or reflective, too); transparent
+items (``Material.opacity < 1``) cast no shadow and receive none; volumes, particles, polylines and edges neither
+cast nor receive. Outside a spot light's map (beyond its cone, where it gives no light anyway) the fraction is 1.
 
 How the fractions enter the shading (``raster.shadow.shade_pixels_shadowed``): per-pixel Phong scales each
 light's diffuse and specular terms at the pixel; Gouraud and flat shading keep each light's terms per vertex (per
