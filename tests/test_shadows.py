@@ -725,3 +725,42 @@ def test_reflective_items_receive_shadows():
     assert drop.min() > 10
     sunny = frame.shadow[..., 0] == 1.0
     assert np.array_equal(frame.color[sunny], lit.color[sunny])
+
+
+@pytest.mark.parametrize("closed", [True, False])
+def test_depth_only_map_fill_equals_the_tile_rasterizer(closed):
+    """``raster.shadow.fill_depth_tiles`` (depth alone, 64-pixel tiles, branch-free rows) writes the same map as
+    ``raster.triangles.rasterize_tiles`` for the same items (a second item drawn over the first: fresh=False)."""
+    from frustum.raster import shadow, triangles
+    from frustum.render import shadows as render_shadows
+    from frustum.render.stages import TILE_SIZE, bin_item
+
+    scene = _sphere_and_box(LIGHTS["directional"])
+    teapot = _teapot_on_plane(LIGHTS["directional"]).items[1]
+    scene.add(teapot.mesh, teapot.material, transform=teapot.world_from_model)
+    assert sum(bool(item.mesh.is_watertight) for item in scene.items) == 2  # the box and the sphere: culled
+    light_camera = fr.Camera.look_at((3.0, 5.0, 2.0), (0.0, 0.5, 0.0), (0.0, 1.0, 0.0),
+                                     projection=fr.Orthographic(6.0, 0.5, 12.0), width=512, height=384)  # fmt: skip
+    ours = np.empty((384, 512), dtype=np.float32)
+    theirs = np.ones((384, 512), dtype=np.float32)
+    codes = np.zeros((384, 512), dtype=np.int64)
+    bary = np.zeros((384, 512, 2), dtype=np.float32)
+    for number, item in enumerate(reversed(scene.items)):
+        render_shadows.draw_depth(item, light_camera, ours, number == 0) if closed else shadow.fill_depth_tiles(
+            *_binned_fill_arguments(item, light_camera, ours), number == 0)  # fmt: skip
+        binned = bin_item(item, light_camera, closed and bool(item.mesh.is_watertight))
+        tiling = np.array([TILE_SIZE, binned.tiles_x, 0, 512, 384], dtype=np.int64)
+        triangles.rasterize_tiles(binned.faces, binned.win_int, binned.win_float, binned.tri_int, binned.tri_float,
+                                  binned.tri_weights, binned.tile_starts, binned.tile_entries, tiling, theirs, codes,
+                                  bary)  # fmt: skip
+    assert (theirs < 1.0).sum() > 20000
+    assert np.array_equal(ours, theirs)
+
+
+def _binned_fill_arguments(item, camera, depth):
+    from frustum.render.stages import TILED_BITS, bin_item
+
+    binned = bin_item(item, camera, False, tile_bits=TILED_BITS)
+    tiling = np.array([1 << TILED_BITS, binned.tiles_x, 0, depth.shape[1], depth.shape[0]], dtype=np.int64)
+    return (binned.faces, binned.win_int, binned.win_float, binned.tri_int, binned.tri_float, binned.tile_starts,
+            binned.tile_entries, tiling, depth)  # fmt: skip

@@ -74,7 +74,6 @@ from frustum.raster.triangles import (
     _Y2,
     _Z0,
     FILL_BLOCK,
-    NARROW,
     _setup_entries,
     _span,
 )  # fmt: skip
@@ -423,6 +422,12 @@ def shade_pixels_shadowed(
                 id_out[row, col] = item[I_OBJECT_ID]
 
 
+MAP_NARROW = 24
+"""Boxes of a shadow-map triangle at most this wide test every centre of each row without a branch (vectorized);
+wider ones find each row's covered span first. A 2048² map of bunny_like_100k (median box 11 texels): 2× faster
+than the branching test of ``triangles._fill_tile`` (whose threshold is 8)."""
+
+
 @parallel_kernel(lambda *args: args[5].shape[0] - 1, work=lambda *args: args[6].shape[0], grain=256)
 def fill_depth_tiles(
     faces: np.ndarray, win_int: np.ndarray, win_float: np.ndarray, tri_int: np.ndarray, tri_float: np.ndarray,
@@ -504,7 +509,7 @@ def _fill_depth_tile(
             columns = i_max - i_min + 1
             step0, step1, step2 = dy0 * SUBPIXEL, dy1 * SUBPIXEL, dy2 * SUBPIXEL
             inverse0, inverse1, inverse2 = 0.0, 0.0, 0.0
-            if columns > NARROW:
+            if columns > MAP_NARROW:
                 inverse0 = 1.0 / step0 if step0 != 0 else 0.0
                 inverse1 = 1.0 / step1 if step1 != 0 else 0.0
                 inverse2 = 1.0 / step2 if step2 != 0 else 0.0
@@ -514,29 +519,22 @@ def _fill_depth_tile(
                 e1 = dx1 * (py - y2) - dy1 * (px0 - x2)
                 e2 = dx2 * (py - y0) - dy2 * (px0 - x0)
                 z_row = z0 + beta * float(py - y0)
-                x_off = float(px0 - x0)
                 at_row = np.uint64(top - j)
                 first_column, last_column = 0, columns - 1
-                if columns > NARROW:
+                if columns > MAP_NARROW:  # a wide box: the row's covered centres found first (_span)
                     first_column, last_column = _span(e0, step0, bias0, inverse0, first_column, last_column)
                     first_column, last_column = _span(e1, step1, bias1, inverse1, first_column, last_column)
                     first_column, last_column = _span(e2, step2, bias2, inverse2, first_column, last_column)
-                    e0, e1, e2 = e0 - step0 * first_column, e1 - step1 * first_column, e2 - step2 * first_column
-                    x_off += SUBPIXEL * first_column
-                    for i in range(i_min + first_column - col0, i_min + last_column + 1 - col0):
-                        z = np.float32(z_row + alpha * x_off)
-                        at = np.uint64(i)
+                    for k in range(first_column, last_column + 1):
+                        # X_P − X_0 as an integer: the same float as _fill_tile's running sum, no chain
+                        z = np.float32(z_row + alpha * float(px0 - x0 + SUBPIXEL * k))
+                        at = np.uint64(i_min + k - col0)
                         if z < depth[at_row, at]:
                             depth[at_row, at] = z
-                        x_off += SUBPIXEL
                     continue
-                for i in range(i_min - col0, i_max + 1 - col0):
-                    if e0 >= bias0 and e1 >= bias1 and e2 >= bias2:
-                        z = np.float32(z_row + alpha * x_off)
-                        at = np.uint64(i)
-                        if z < depth[at_row, at]:
-                            depth[at_row, at] = z
-                    e0 -= step0
-                    e1 -= step1
-                    e2 -= step2
-                    x_off += SUBPIXEL
+                for k in range(columns):  # every centre of the box, without a branch (LLVM vectorizes it)
+                    at = np.uint64(i_min + k - col0)
+                    d = depth[at_row, at]
+                    z = np.float32(z_row + alpha * float(px0 - x0 + SUBPIXEL * k))
+                    inside = (e0 - step0 * k >= bias0) & (e1 - step1 * k >= bias1) & (e2 - step2 * k >= bias2)
+                    depth[at_row, at] = z if inside & (z < d) else d
