@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-from frustum.raster._jit import fence, kernel, parallel_kernel, prefetch, stream
+from frustum.raster._jit import fence, kernel, parallel_kernel, stream
 from frustum.raster.shade import (
     _CHUNK,
     _DB,
@@ -223,16 +223,40 @@ def _fractions(
             s[_DR + i], s[_DG + i] = x, y
             s[_DB + i] = receiver - texel * (1.0 + (1.0 + softness) * tan_theta)  # bias taken off
             s[_SR + i] = 1.0
-            row, col = size - 1 - int(y), int(x)
-            prefetch(shadow_map, np.uint64(row), np.uint64(col))
-            if row > 0:
-                prefetch(shadow_map, np.uint64(row - 1), np.uint64(col))
-            if row + 1 < size:
-                prefetch(shadow_map, np.uint64(row + 1), np.uint64(col))
+        if not 0.0 < softness <= 1.0:  # hard, or a wider grid: the general filter
+            for i in range(n):
+                if s[_SR + i] != 0.0:
+                    found = _filter(shadow_map, s[_DR + i], s[_DG + i], s[_DB + i], near, depth_range, softness)
+                    s[row_k + i] = float(np.float32(found))
+            continue
+        # the default, 2 × 2 texels bilinearly weighted (_filter's first case), inline: a call taking the map
+        # costs its reference counting per pixel
+        ramp = 1.0 / softness
         for i in range(n):
-            if s[_SR + i] != 0.0:
-                found = _filter(shadow_map, s[_DR + i], s[_DG + i], s[_DB + i], near, depth_range, softness)
-                s[row_k + i] = float(np.float32(found))
+            if s[_SR + i] == 0.0:
+                continue
+            gx, gy, limit = s[_DR + i] - 0.5, s[_DG + i] - 0.5, s[_DB + i]
+            fx, fy = math.floor(gx), math.floor(gy)
+            wx = min(max((gx - fx - 0.5) * ramp + 0.5, 0.0), 1.0)
+            wy = min(max((gy - fy - 0.5) * ramp + 0.5, 0.0), 1.0)
+            col, row = int(fx), size - 1 - int(fy)  # texel columns col, col + 1; rows row (lower), row − 1
+            t00, t10, t01, t11 = 1.0, 1.0, 1.0, 1.0
+            if 0 <= row < size:
+                if 0 <= col < size:
+                    stored = shadow_map[np.uint64(row), np.uint64(col)]
+                    t00 = 1.0 if stored >= 1.0 or limit <= near + stored * depth_range else 0.0
+                if 0 <= col + 1 < size:
+                    stored = shadow_map[np.uint64(row), np.uint64(col + 1)]
+                    t10 = 1.0 if stored >= 1.0 or limit <= near + stored * depth_range else 0.0
+            if 0 <= row - 1 < size:
+                if 0 <= col < size:
+                    stored = shadow_map[np.uint64(row - 1), np.uint64(col)]
+                    t01 = 1.0 if stored >= 1.0 or limit <= near + stored * depth_range else 0.0
+                if 0 <= col + 1 < size:
+                    stored = shadow_map[np.uint64(row - 1), np.uint64(col + 1)]
+                    t11 = 1.0 if stored >= 1.0 or limit <= near + stored * depth_range else 0.0
+            taps = (1.0 - wy) * ((1.0 - wx) * t00 + wx * t10) + wy * ((1.0 - wx) * t01 + wx * t11)
+            s[row_k + i] = float(np.float32(taps))
 
 
 @kernel
