@@ -142,17 +142,6 @@ def _linear_depth(view: np.ndarray, z: float) -> float:
 
 
 @kernel
-def _tap(shadow_map: np.ndarray, view: np.ndarray, row: int, col: int, receiver: float) -> float:
-    """1.0 where texel (row, col) lets a point at distance `receiver` (bias taken off) see the light, or lies off
-    the map; else 0.0."""
-    size = shadow_map.shape[0]
-    if row < 0 or row >= size or col < 0 or col >= size:
-        return 1.0
-    stored = shadow_map[row, col]
-    return 1.0 if stored >= 1.0 or receiver <= _linear_depth(view, stored) else 0.0
-
-
-@kernel
 def _lookup(
     shadow_map: np.ndarray, view: np.ndarray, px: float, py: float, pz: float, nx: float, ny: float, nz: float,
     lx: float, ly: float, lz: float, softness: float,
@@ -195,10 +184,22 @@ def _lookup(
         col, up = int(fx), int(fy)
         wx = min(max((gx - fx - 0.5) / softness + 0.5, 0.0), 1.0)
         wy = min(max((gy - fy - 0.5) / softness + 0.5, 0.0), 1.0)
-        t00 = _tap(shadow_map, view, size - 1 - up, col, receiver - bias)
-        t10 = _tap(shadow_map, view, size - 1 - up, col + 1, receiver - bias)
-        t01 = _tap(shadow_map, view, size - 2 - up, col, receiver - bias)
-        t11 = _tap(shadow_map, view, size - 2 - up, col + 1, receiver - bias)
+        limit, row = receiver - bias, size - 1 - up
+        t00, t10, t01, t11 = 1.0, 1.0, 1.0, 1.0  # inline: a call taking the map costs reference counting
+        if 0 <= row < size:
+            if 0 <= col < size:
+                stored = shadow_map[row, col]
+                t00 = 1.0 if stored >= 1.0 or limit <= _linear_depth(view, stored) else 0.0
+            if 0 <= col + 1 < size:
+                stored = shadow_map[row, col + 1]
+                t10 = 1.0 if stored >= 1.0 or limit <= _linear_depth(view, stored) else 0.0
+        if 0 <= row - 1 < size:
+            if 0 <= col < size:
+                stored = shadow_map[row - 1, col]
+                t01 = 1.0 if stored >= 1.0 or limit <= _linear_depth(view, stored) else 0.0
+            if 0 <= col + 1 < size:
+                stored = shadow_map[row - 1, col + 1]
+                t11 = 1.0 if stored >= 1.0 or limit <= _linear_depth(view, stored) else 0.0
         return (1.0 - wy) * ((1.0 - wx) * t00 + wx * t10) + wy * ((1.0 - wx) * t01 + wx * t11)
     steps = int(math.ceil(softness))  # noqa: RUF046 (an int in Python, a float's type for Numba's typing)
     step = softness / steps if steps > 0 else 0.0
