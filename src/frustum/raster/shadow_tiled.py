@@ -264,7 +264,7 @@ def _filter(
     shadow_map: np.ndarray, x: float, y: float, limit: float, near: float, depth_range: float, softness: float
 ) -> float:  # fmt: skip
     """``raster.shadow._lookup``'s filter on an orthographic map at window point (x, y): the share of its taps whose
-    stored distance ``near + stored·range`` is not nearer than `limit` (or that are empty, or off the map)."""
+    stored distance $near + stored·range$ is not nearer than `limit` (or that are empty, or off the map)."""
     size = shadow_map.shape[0]
     if 0.0 < softness <= 1.0:
         gx, gy = x - 0.5, y - 0.5
@@ -303,7 +303,7 @@ def _shade_chunk_shadowed(
     n: int, s: np.ndarray, where: np.ndarray, params: np.ndarray, lights: np.ndarray, words: np.ndarray
 ) -> None:  # fmt: skip
     """``shade._shade_chunk`` with light k's diffuse and specular terms scaled by its fraction (scratch row
-    ``_FIELDS + k``): ``k_d·(f·ndl)``, ``k_s·(f·spec)``, nothing added where f = 0 (``_illuminate_visible``)."""
+    ``_FIELDS + k``): $k_d·(f·ndl)$, $k_s·(f·spec)$, nothing added where $f = 0$ (``_illuminate_visible``)."""
     ex, ey, ez = params[P_EYE], params[P_EYE + 1], params[P_EYE + 2]
     ka, kd, ks, shininess = params[P_AMBIENT], params[P_DIFFUSE], params[P_SPECULAR], params[P_SHININESS]
     ar, ag, ab = ka * params[P_LIGHT_AMBIENT], ka * params[P_LIGHT_AMBIENT + 1], ka * params[P_LIGHT_AMBIENT + 2]
