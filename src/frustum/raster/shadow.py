@@ -468,7 +468,7 @@ def _fill_depth_tile(
     tri_float: np.ndarray, tile_starts: np.ndarray, tile_entries: np.ndarray, tiling: np.ndarray, depth: np.ndarray,
     block: np.ndarray, values: np.ndarray, origin_row: int, col0: int, col1: int, row0: int, row1: int,
 ) -> None:  # fmt: skip
-    """``triangles._fill_tile`` for depth alone: image pixel (row, col) is ``depth[row − origin_row, col − col0]``."""
+    """``triangles._fill_tile`` for depth alone: image pixel (row, col) is ``depth[row - origin_row, col - col0]``."""
     face_offset, height = tiling[2], tiling[4]
     first_slot, last_slot = tile_starts[tile], tile_starts[tile + 1]
     top = height - 1 - origin_row
