@@ -5,7 +5,7 @@
 On a standard scene of ``../shared/bench`` (default ``bunny_like_100k``, 1024², its directional light; the torus
 knot shadows itself), in one run, medians of ``--frames`` frames after ``--warmup``:
 
-- frustum: shadows off, shadow maps (``shadows=True``, 2048² map, PCF radius 1), shadow rays (``shadows="ray"``),
+- frustum: shadows off, shadow maps (``shadows=True``, 2048² map, 2×2 bilinear PCF), shadow rays (``shadows="ray"``),
   with the scene's directional light and with one point light (shadows off and on); ratio shadowed / unshadowed
   (target: <= 1.5 for the directional light);
 - llvmpipe (``benchmarks/anchor_moderngl_shadows.py``, a child process): the same scene without and with a

@@ -561,3 +561,206 @@ def test_dataset_writes_position_and_shadow_for_a_scene_with_shadows(tmp_path, f
     plain = _scene_file(tmp_path, "")
     render_dataset(plain, tmp_path / "plain", views=1, format="nerf", executor="serial", progress=False)
     assert not (tmp_path / "plain" / "shadow").exists()
+
+
+# --- one mesh: the tile pipeline with shadows (raster.shadow_tiled) -----------------------------------------------
+
+
+def _one_mesh(scene: fr.Scene) -> fr.Scene:
+    """`scene`'s items merged into one mesh in world space (one material): a frame the one-mesh tile pipeline
+    draws."""
+    vertices, normals, faces, base = [], [], [], 0
+    for item in scene.items:
+        m = np.asarray(item.world_from_model, dtype=np.float64)
+        vertices.append(item.mesh.vertices @ m[:3, :3].T + m[:3, 3])
+        turned = item.mesh.vertex_normals @ np.linalg.inv(m[:3, :3])
+        normals.append(turned / np.linalg.norm(turned, axis=1, keepdims=True))
+        faces.append(np.asarray(item.mesh.faces) + base)
+        base += item.mesh.vertex_count
+    merged = fr.Scene(lights=list(scene.lights))
+    merged.add(fr.Mesh(np.concatenate(vertices), np.concatenate(faces), vertex_normals=np.concatenate(normals)),
+               fr.Material(color=(0.9, 0.8, 0.3)))  # fmt: skip
+    return merged
+
+
+def _spy_tiled(monkeypatch) -> list:
+    """Record each call of the shadowed tile kernel (so a test knows the one-mesh path drew its frame)."""
+    from frustum.raster import shadow_tiled
+
+    calls = []
+    kernel = shadow_tiled.draw_tiles_shadowed
+
+    def spy(*args):
+        calls.append(args[17].shape)
+        return kernel(*args)
+
+    monkeypatch.setattr(shadow_tiled, "draw_tiles_shadowed", spy)
+    return calls
+
+
+def _fraction_from_colors(scene: fr.Scene, camera: fr.Camera, light, **options) -> tuple[np.ndarray, np.ndarray]:
+    """The light's fraction at each pixel read back from the colors of a shadowed frame (a frame without
+    buffers: the one-mesh tile pipeline), between the unshadowed frame (1) and the frame without that light (0);
+    and where that is well defined (the light adds at least 24 levels)."""
+    on = fr.render(scene, camera, shadows=True, **options).color[..., :3].astype(float)
+    full = fr.render(scene, camera).color[..., :3].astype(float)
+    without = fr.Scene(lights=[dataclasses.replace(x, intensity=0.0) if x is light else x for x in scene.lights])
+    for item in scene.items:
+        without.add(item.mesh, item.material, transform=item.world_from_model)
+    none = fr.render(without, camera).color[..., :3].astype(float)
+    span = full - none
+    channel = np.argmax(span, axis=2)[..., None]
+    top = np.take_along_axis(span, channel, axis=2)[..., 0]
+    fraction = (np.take_along_axis(on - none, channel, axis=2)[..., 0]) / np.maximum(top, 1.0)
+    return fraction, top >= 24.0
+
+
+def test_one_mesh_tile_pipeline_shadows_agree_with_embree(monkeypatch):
+    """The teapot and its ground as one mesh: the frame goes tile by tile with the map lookups in the shading
+    (map fitted before drawing); its shadows, read back from the colors, agree with Embree's rays as the
+    stage-by-stage path's must (>= 99 %, the rest within 2 pixels of an edge)."""
+    light = LIGHTS["directional"]
+    scene = _one_mesh(_teapot_on_plane(light))
+    calls = _spy_tiled(monkeypatch)
+    fraction, defined = _fraction_from_colors(scene, CAMERA, light, cull_back_faces=False)
+    assert calls, "the one-mesh tile pipeline did not draw the frame"
+    buffers = fr.render(scene, CAMERA, buffers=("position", "normals"), cull_back_faces=False)
+    oracle = embree_lit(scene, buffers, light)
+    drawn = np.isfinite(buffers.position[..., 0]) & defined
+    wrong = drawn & ((fraction >= 0.5) != oracle)
+    agreement = 1.0 - wrong.sum() / drawn.sum()
+    shadowed = (drawn & (fraction < 0.5)).sum()
+    print(f"one mesh: shadow maps agree with Embree on {agreement:.4%} of {drawn.sum()}, {shadowed} shadowed")
+    assert shadowed > 500 and drawn.sum() > 20000
+    assert agreement >= 0.99
+    near_edge = _near_oracle_edge(oracle, np.isfinite(buffers.position[..., 0]))
+    assert not (wrong & ~near_edge).any(), np.argwhere(wrong & ~near_edge)[:10]
+
+
+def test_one_mesh_tile_pipeline_no_acne_and_no_shadow_without_casting_lights(monkeypatch):
+    """A plane lit at 80° from its normal (one mesh, the tile pipeline with shadows) has the unshadowed frame's
+    bytes at every softness (no pixel darkened: no acne); so does a frame whose light casts no shadow."""
+    calls = _spy_tiled(monkeypatch)
+    light = fr.DirectionalLight((math.sin(math.radians(80.0)), -math.cos(math.radians(80.0)), 0.0))
+    scene = fr.Scene(lights=[light])
+    _ground(scene)
+    plain = fr.render(scene, CAMERA)
+    for softness in (0.0, 0.5, 1.0, 3.0):
+        frame = fr.render(scene, CAMERA, shadows=True, shadow_softness=softness)
+        assert np.array_equal(frame.color, plain.color), softness
+        assert np.array_equal(frame.depth, plain.depth)
+    assert len(calls) == 4
+    scene = _one_mesh(_teapot_on_plane(dataclasses.replace(LIGHTS["directional"], cast_shadows=False)))
+    frame = fr.render(scene, CAMERA, shadows=True, cull_back_faces=False)
+    assert len(calls) == 5
+    assert np.array_equal(frame.color, fr.render(scene, CAMERA, cull_back_faces=False).color)
+
+
+def test_one_mesh_tile_pipeline_matches_the_stage_by_stage_shading():
+    """Where the one-mesh pipeline and the stage-by-stage path (forced by asking for a buffer) find the same
+    fraction, they give the same bytes: the shading with shadows is the same in both (their maps are fitted
+    differently, so fractions may differ near shadow edges)."""
+    light = LIGHTS["directional"]
+    scene = _one_mesh(_teapot_on_plane(light))
+    tiled = fr.render(scene, CAMERA, shadows=True, cull_back_faces=False)
+    staged = fr.render(scene, CAMERA, shadows=True, cull_back_faces=False, buffers=("shadow",))
+    whole = np.isfinite(staged.shadow[..., 0]) & ((staged.shadow[..., 0] == 0.0) | (staged.shadow[..., 0] == 1.0))
+    same = np.all(tiled.color == staged.color, axis=2)
+    assert whole.sum() > 20000
+    assert same[whole].mean() >= 0.99, same[whole].mean()
+    assert np.array_equal(tiled.depth, staged.depth)
+
+
+# --- receivers with bump or normal maps, or an environment to reflect -----------------------------------------------
+
+
+def _box_on_ground(ground: fr.Material, environment=None) -> fr.Scene:
+    scene = fr.Scene(lights=[fr.AmbientLight(intensity=0.2), LIGHTS["directional"]], environment=environment)
+    scene.add(plane((10.0, 10.0), divisions=(4, 4)), ground, transform=rotate_x(-math.pi / 2))
+    scene.add(box((1, 1, 1), center=(0, 0.5, 0)), fr.Material(color=(0.9, 0.3, 0.2)))
+    return scene
+
+
+def test_items_with_normal_or_bump_maps_receive_shadows():
+    """A ground with a flat normal map (every texel the unperturbed normal) receives the same shadow as a plain
+    ground (within a level); with a real bump map it is still darkened where the map puts the pixel in shadow."""
+    flat_map = np.zeros((16, 16, 3), dtype=np.uint8)
+    flat_map[:] = (128, 128, 255)
+    plain = fr.render(_box_on_ground(GROUND), CAMERA, shadows=True, buffers=("shadow",))
+    shadowed = plain.shadow[..., 0] == 0.0
+    mapped = fr.render(_box_on_ground(dataclasses.replace(GROUND, normal_map=flat_map)), CAMERA, shadows=True)
+    assert np.abs(mapped.color.astype(int) - plain.color.astype(int)).max() <= 1
+    rng = np.random.default_rng(3)
+    bumpy = dataclasses.replace(GROUND, bump=ndimage.gaussian_filter(rng.random((64, 64)), 2.0), bump_scale=0.3)
+    lit = fr.render(_box_on_ground(bumpy), CAMERA)
+    frame = fr.render(_box_on_ground(bumpy), CAMERA, shadows=True, buffers=("shadow", "object_id"))
+    assert np.abs(lit.color.astype(int) - plain.color.astype(int))[~shadowed].max() > 3  # the bumps show
+    assert np.array_equal(frame.shadow[..., 0] == 0.0, shadowed)
+    dark = shadowed & (frame.object_id == 0)  # on the bumpy ground
+    assert dark.sum() > 300
+    # in shadow only the ambient term is left: clearly darker than the lit bumpy ground there
+    assert (frame.color[dark][:, :3].astype(int) < lit.color[dark][:, :3].astype(int) - 20).mean() > 0.99
+    sunny = frame.shadow[..., 0] == 1.0
+    assert np.abs(frame.color[sunny].astype(int) - lit.color[sunny].astype(int)).max() <= 1
+
+
+def test_reflective_items_receive_shadows():
+    """A half-mirror ground under an environment: its shadowed pixels keep the reflection and lose the light
+    (darker than without shadows by about (1 − reflectivity) of the light's share); its sunny pixels keep the
+    unshadowed bytes."""
+    env = np.zeros((16, 32, 3))
+    env[:8] = (0.3, 0.5, 0.9)
+    env[8:] = (0.4, 0.3, 0.2)
+    ground = dataclasses.replace(GROUND, reflectivity=0.5)
+    scene = _box_on_ground(ground, environment=fr.EnvironmentMap(env))
+    lit = fr.render(scene, CAMERA)
+    frame = fr.render(scene, CAMERA, shadows=True, buffers=("shadow", "object_id"))
+    flat = fr.render(_box_on_ground(GROUND), CAMERA, shadows=True, buffers=("shadow",))
+    assert np.array_equal(frame.shadow[..., 0] == 0.0, flat.shadow[..., 0] == 0.0)
+    dark = (frame.shadow[..., 0] == 0.0) & (frame.object_id == 0)  # on the mirror ground
+    assert dark.sum() > 300
+    drop = lit.color[dark][:, :3].astype(int) - frame.color[dark][:, :3].astype(int)
+    unreflected = fr.render(_box_on_ground(GROUND), CAMERA).color[dark][:, :3].astype(int) - flat.color[dark][:, :3]
+    assert (np.abs(drop - 0.5 * unreflected) <= 1.5).all(), np.abs(drop - 0.5 * unreflected).max()
+    assert drop.min() > 10
+    sunny = frame.shadow[..., 0] == 1.0
+    assert np.array_equal(frame.color[sunny], lit.color[sunny])
+
+
+@pytest.mark.parametrize("closed", [True, False])
+def test_depth_only_map_fill_equals_the_tile_rasterizer(closed):
+    """``raster.shadow.fill_depth_tiles`` (depth alone, 64-pixel tiles, branch-free rows) writes the same map as
+    ``raster.triangles.rasterize_tiles`` for the same items (a second item drawn over the first: fresh=False)."""
+    from frustum.raster import shadow, triangles
+    from frustum.render import shadows as render_shadows
+    from frustum.render.stages import TILE_SIZE, bin_item
+
+    scene = _sphere_and_box(LIGHTS["directional"])
+    teapot = _teapot_on_plane(LIGHTS["directional"]).items[1]
+    scene.add(teapot.mesh, teapot.material, transform=teapot.world_from_model)
+    assert sum(bool(item.mesh.is_watertight) for item in scene.items) == 2  # the box and the sphere: culled
+    light_camera = fr.Camera.look_at((3.0, 5.0, 2.0), (0.0, 0.5, 0.0), (0.0, 1.0, 0.0),
+                                     projection=fr.Orthographic(6.0, 0.5, 12.0), width=512, height=384)  # fmt: skip
+    ours = np.empty((384, 512), dtype=np.float32)
+    theirs = np.ones((384, 512), dtype=np.float32)
+    codes = np.zeros((384, 512), dtype=np.int64)
+    bary = np.zeros((384, 512, 2), dtype=np.float32)
+    for number, item in enumerate(reversed(scene.items)):
+        render_shadows.draw_depth(item, light_camera, ours, number == 0) if closed else shadow.fill_depth_tiles(
+            *_binned_fill_arguments(item, light_camera, ours), number == 0)  # fmt: skip
+        binned = bin_item(item, light_camera, closed and bool(item.mesh.is_watertight))
+        tiling = np.array([TILE_SIZE, binned.tiles_x, 0, 512, 384], dtype=np.int64)
+        triangles.rasterize_tiles(binned.faces, binned.win_int, binned.win_float, binned.tri_int, binned.tri_float,
+                                  binned.tri_weights, binned.tile_starts, binned.tile_entries, tiling, theirs, codes,
+                                  bary)  # fmt: skip
+    assert (theirs < 1.0).sum() > 20000
+    assert np.array_equal(ours, theirs)
+
+
+def _binned_fill_arguments(item, camera, depth):
+    from frustum.render.stages import TILED_BITS, bin_item
+
+    binned = bin_item(item, camera, False, tile_bits=TILED_BITS)
+    tiling = np.array([1 << TILED_BITS, binned.tiles_x, 0, depth.shape[1], depth.shape[0]], dtype=np.int64)
+    return (binned.faces, binned.win_int, binned.win_float, binned.tri_int, binned.tri_float, binned.tile_starts,
+            binned.tile_entries, tiling, depth)  # fmt: skip

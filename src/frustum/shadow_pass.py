@@ -5,24 +5,28 @@ surfaces are in the depth buffer, every drawn pixel's world point (``surface_poi
 shadow-casting light in one of two ways.
 
 - **Shadow maps** (``shadows=True``): the depth-buffer method run from the light (the renderer's own binning and
-  tile kernels, ``render.bin_item`` + ``raster.triangles.rasterize_tiles``, into a float32 depth map of
-  ``shadow_map_size``² texels, both sides of every face drawn). A directional light gets an orthographic map
-  fitted to what the camera sees (the light-space box of the drawn points, widened by the filter's reach) and
+  tile set-up, ``render.bin_item`` + ``raster.shadow.fill_depth_tiles``, depth alone, into a float32 depth map of
+  ``shadow_map_size``² texels; both sides of an open surface, the front faces of a closed one). A directional
+  light gets an orthographic map fitted to what the camera sees (the light-space box of the drawn points, widened
+  by the filter's reach; a frame of one mesh drawn tile by tile, ``render.shadows.draw_tiled``, fits it before
+  drawing: ``view_map``) and
   deep enough toward the light to hold every caster (the scene's box); a spot light a perspective map over its
   cone; a point light a cube of six perspective maps (each a little wider than 90° so filter taps near a cube
   edge stay on their face). A point is lit where its distance along the light's axis, less a bias, is not beyond
   the map's: the bias is slope-scaled, $texel·(1 + (1 + softness)·min(tan θ, 8))$ with θ the angle between the
   face normal and the light, and the point is first moved one texel along its face normal (normal offset), so lit
-  faces show no acne while shadows stay attached at contact. Percentage-closer filtering averages the test over
-  a (2m + 1)² grid of taps spanning ±``shadow_softness`` texels (m = ⌈softness⌉; 0: one tap, hard edges).
+  faces show no acne while shadows stay attached at contact. Percentage-closer filtering: softness 0, the
+  nearest texel (hard edges); 0 < softness <= 1 (the default 1), the 2 × 2 texels around the point bilinearly
+  weighted (``sampler2DShadow`` with linear filtering), each weight ramping over ``softness`` texels; above 1, a
+  (2m + 1)² grid of taps spanning ±``shadow_softness`` texels (m = ⌈softness⌉).
 - **Shadow rays** (``shadows="ray"``): a ray from each point (moved off its face by a small epsilon along the face
   normal) toward the light, any hit before the light ends it (``occluded``: ``Scene.occluded``, the any-hit
   query through the scene's BVH, ``raster.rays``). Exact up to the epsilon.
 
 Either way a point whose drawn side faces away from the light gets 0 (the surface itself is in the way). What
-casts and receives: opaque meshes cast and receive; transparent items (``Material.opacity < 1``) cast no shadow
-and receive none; volumes, particles, polylines and edges neither cast nor receive. Outside a spot light's map
-(beyond its cone, where it gives no light anyway) the fraction is 1.
+casts and receives: opaque meshes cast and receive (with bump or normal maps, or reflective, too); transparent
+items (``Material.opacity < 1``) cast no shadow and receive none; volumes, particles, polylines and edges neither
+cast nor receive. Outside a spot light's map (beyond its cone, where it gives no light anyway) the fraction is 1.
 
 How the fractions enter the shading (``raster.shadow.shade_pixels_shadowed``): per-pixel Phong scales each
 light's diffuse and specular terms at the pixel; Gouraud and flat shading keep each light's terms per vertex (per
@@ -53,8 +57,8 @@ from frustum.scene import Scene, SceneItem
 from frustum.shading import AmbientLight, DirectionalLight, PointLight, SpotLight
 
 __all__ = [
-    "SHADOW_METHODS", "ShadowOptions", "check_shadows", "give_back", "light_fractions", "occluded",
-    "release_memory", "shadow_lights", "surface_points",
+    "SHADOW_METHODS", "ShadowOptions", "check_shadows", "give_back", "light_fractions", "map_record", "occluded",
+    "release_memory", "shadow_lights", "surface_points", "take_array", "view_map",
 ]  # fmt: skip
 
 SHADOW_METHODS = (None, False, True, "ray")
@@ -68,7 +72,7 @@ _POOL: dict[tuple, list[np.ndarray]] = {}
 _POOL_LOCK = threading.Lock()
 
 
-def _take(shape: tuple[int, ...], dtype: Any) -> np.ndarray:
+def take_array(shape: tuple[int, ...], dtype: Any) -> np.ndarray:
     """An uninitialized work array, one a previous frame gave back where shape and dtype match (no first-touch
     page faults for the maps and per-pixel arrays of an animation's every frame)."""
     key = (tuple(shape), np.dtype(dtype).str)
@@ -169,9 +173,9 @@ def surface_points(
     from frustum.raster import shadow
 
     height, width = depth.shape
-    points = _take((height, width, 3), np.float64)
+    points = take_array((height, width, 3), np.float64)
     points.fill(np.nan)
-    facing = _take((height, width, 3), np.float64)
+    facing = take_array((height, width, 3), np.float64)
     for index, world, offset in drawn:
         item = items[index]
         if item.mesh.face_count == 0:
@@ -193,11 +197,11 @@ def _world_faces(item: SceneItem) -> np.ndarray:
 def light_fractions(
     scene: Scene, items: list[SceneItem], camera: Camera, options: ShadowOptions, lights: np.ndarray,
     depth: np.ndarray, points: np.ndarray, facing: np.ndarray,
-    draw_depth: Callable[[SceneItem, Camera, np.ndarray, np.ndarray, np.ndarray], None], where: str,
+    draw_depth: Callable[[SceneItem, Camera, np.ndarray, bool], None], where: str,
 ) -> np.ndarray:  # fmt: skip
     """(H, W, K) float32: the fraction of each packed light (rows of `lights`) reaching each drawn pixel (1 for
-    lights that cast no shadow and on the background). `draw_depth(item, light_camera, depth, codes, bary)` is
-    the renderer's depth pass of one item (both sides)."""
+    lights that cast no shadow and on the background). `draw_depth(item, light_camera, depth, fresh)` is
+    the renderer's depth pass of one item into a map (cleared first where `fresh`)."""
     from frustum.raster import shadow
 
     height, width = depth.shape
@@ -230,24 +234,20 @@ def light_fractions(
         cause=f"shadow_map_size = {size} with {len(casting)} shadow-casting light(s), "
         f"{cube_count} of them point lights (a cube of six maps each, {format_bytes(6 * size * size * 4)})",
     )
-    codes = _take((size, size), np.int32 if 2 * sum(i.mesh.face_count for i in items) < 2**31 else np.int64)
-    bary = _take((size, size, 2), np.float32)
     seen_points = points[drawn]
     for channel, light in zip(rows, casting, strict=True):
         cameras = _light_cameras(light, seen_points, box, size, options.softness)
         if not cameras:
             continue
-        maps = _take((len(cameras), size, size), np.float32)
-        maps.fill(1.0)
+        maps = take_array((len(cameras), size, size), np.float32)
         views = np.zeros((len(cameras), shadow.MAP_FIELDS))
         for face, (light_camera, texel) in enumerate(cameras):
-            for item in casters:
-                draw_depth(item, light_camera, maps[face], codes, bary)
-            views[face] = _map_record(light_camera, texel, light)
+            for number, item in enumerate(casters):
+                draw_depth(item, light_camera, maps[face], number == 0)
+            views[face] = map_record(light_camera, texel, light)
         shadow.map_visibility(depth, points, facing, maps, views, np.ascontiguousarray(lights[channel]),
                               float(options.softness), seen, channel)  # fmt: skip
         give_back(maps)
-    give_back(codes, bary)
     return seen
 
 
@@ -314,17 +314,7 @@ def _light_cameras(
         seen = [(seen_points[:, 0] * r[0] + seen_points[:, 1] * r[1]) + seen_points[:, 2] * r[2] for r in view]
         low = np.array([axis.min() for axis in seen])
         high = np.array([axis.max() for axis in seen])
-        side = float(max(high[0] - low[0], high[1] - low[1]))
-        span = float(np.linalg.norm(box[1] - box[0]))
-        side = max(side, 1e-9 * max(span, 1.0)) * (1.0 + 2.0 * reach)
-        centre = 0.5 * (low + high)
-        eye = centre[0] * frame.u + centre[1] * frame.v
-        caster_z = float((corners @ view.T)[:, 2].max())
-        near, far = -caster_z, -float(low[2])
-        pad = 1e-3 * max(far - near, span, 1e-12)
-        light_frame = ViewFrame(eye, normal=to_light, up=_up_for(to_light))
-        camera = Camera(light_frame, Orthographic(side, near - pad, far + pad), size, size)
-        return [(camera, side / size)]
+        return [_directional_camera(to_light, low, high, box, size, reach)]
     position = np.asarray(light.position, dtype=np.float64)
     distances = np.linalg.norm(corners - position, axis=1)
     far = float(distances.max()) * 1.01 + 1e-9
@@ -344,7 +334,96 @@ def _light_cameras(
     return cameras
 
 
-def _map_record(camera: Camera, texel: float, light: Any) -> np.ndarray:
+def _directional_camera(
+    to_light: np.ndarray, low: np.ndarray, high: np.ndarray, box: np.ndarray, size: int, reach: float
+) -> tuple[Camera, float]:  # fmt: skip
+    """The orthographic map over the light-view box [low, high] of the receivers (``_light_cameras``), deep enough
+    toward the light for the casters' box, widened by `reach` (a fraction of its side) on each side."""
+    frame = ViewFrame(np.zeros(3), normal=to_light, up=_up_for(to_light))
+    view = frame.matrix[:3, :3]
+    corners = np.array(np.meshgrid(*box.T, indexing="ij")).reshape(3, -1).T
+    side = float(max(high[0] - low[0], high[1] - low[1]))
+    span = float(np.linalg.norm(box[1] - box[0]))
+    side = max(side, 1e-9 * max(span, 1.0)) * (1.0 + 2.0 * reach)
+    centre = 0.5 * (low + high)
+    eye = centre[0] * frame.u + centre[1] * frame.v
+    caster_z = float((corners @ view.T)[:, 2].max())
+    near, far = -caster_z, -float(low[2])
+    pad = 1e-3 * max(far - near, span, 1e-12)
+    light_frame = ViewFrame(eye, normal=to_light, up=_up_for(to_light))
+    return Camera(light_frame, Orthographic(side, near - pad, far + pad), size, size), side / size
+
+
+def view_map(
+    light: DirectionalLight, world: np.ndarray, camera: Camera, size: int, softness: float
+) -> tuple[Camera, float] | None:  # fmt: skip
+    """The orthographic map of a directional light fitted, before anything is drawn, to what the camera can see
+    of one mesh (world vertex positions `world`): the light-view box of the part of the mesh's box inside the
+    camera's view volume (their intersection, a convex polytope, clipped exactly), cut down to the light-view box
+    of the vertices. (The stage-by-stage path fits its map to the drawn points themselves, ``light_fractions``:
+    the one-mesh tile pipeline shades as it draws.) None where the mesh's box misses the view volume."""
+    columns = np.ascontiguousarray(np.asarray(world, dtype=np.float64).T)  # (3, N): fast reductions, no BLAS
+    box = np.array([columns.min(axis=1), columns.max(axis=1)])
+    polytope = _box_in_view(box, camera)
+    if polytope.shape[0] == 0:
+        return None
+    to_light = -np.asarray(light.direction, dtype=np.float64)
+    view = ViewFrame(np.zeros(3), normal=to_light, up=_up_for(to_light)).matrix[:3, :3]
+    inside = polytope @ view.T
+    seen = [(columns[0] * r[0] + columns[1] * r[1]) + columns[2] * r[2] for r in view]
+    low = np.maximum(inside.min(axis=0), [axis.min() for axis in seen])
+    high = np.minimum(inside.max(axis=0), [axis.max() for axis in seen])
+    if (low > high).any():
+        return None
+    return _directional_camera(to_light, low, high, box, size, (softness + _MARGIN_TEXELS) / size)
+
+
+def _box_in_view(box: np.ndarray, camera: Camera) -> np.ndarray:
+    """(V, 3): the corners of the intersection of the world box `box` (2, 3) with the camera's view volume (empty
+    where they do not meet): every face of each solid clipped by the other's planes (Sutherland–Hodgman, in
+    Python floats: a few hundred small steps)."""
+    clip = np.asarray(camera.clip_from_world, dtype=np.float64)
+    view_planes = [tuple(clip[3] + clip[i]) for i in range(3)] + [tuple(clip[3] - clip[i]) for i in range(3)]
+    box_planes = []
+    for axis in range(3):
+        low, high = [0.0] * 4, [0.0] * 4
+        low[axis], low[3] = 1.0, -float(box[0, axis])
+        high[axis], high[3] = -1.0, float(box[1, axis])
+        box_planes += [tuple(low), tuple(high)]
+    cube = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], dtype=np.float64)
+    quads = [[0, 1, 3, 2], [4, 5, 7, 6], [0, 1, 5, 4], [2, 3, 7, 6], [0, 2, 6, 4], [1, 3, 7, 5]]
+    box_corners = (box[0] + cube * (box[1] - box[0])).tolist()
+    ndc = np.hstack([2.0 * cube - 1.0, np.ones((8, 1))]) @ np.linalg.inv(clip).T
+    view_corners = (ndc[:, :3] / ndc[:, 3:]).tolist()
+    found: list = []
+    for corners, planes in ((box_corners, view_planes), (view_corners, box_planes)):
+        for quad in quads:
+            polygon = [corners[k] for k in quad]
+            for plane in planes:
+                polygon = _clip_polygon(polygon, plane)
+                if not polygon:
+                    break
+            found += polygon
+    return np.array(found, dtype=np.float64).reshape(-1, 3)
+
+
+def _clip_polygon(polygon: list, plane: tuple) -> list:
+    """The part of a convex polygon (a list of [x, y, z]) where $plane · (p, 1) ≥ 0$ (Sutherland–Hodgman)."""
+    a, b, c, d = plane
+    values = [(a * p[0] + b * p[1]) + (c * p[2] + d) for p in polygon]
+    kept = []
+    for i, p in enumerate(polygon):
+        j = (i + 1) % len(polygon)
+        if values[i] >= 0.0:
+            kept.append(p)
+        if (values[i] >= 0.0) != (values[j] >= 0.0):
+            t = values[i] / (values[i] - values[j])
+            q = polygon[j]
+            kept.append([p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1]), p[2] + t * (q[2] - p[2])])
+    return kept
+
+
+def map_record(camera: Camera, texel: float, light: Any) -> np.ndarray:
     """The ``raster.shadow`` map record of one light camera."""
     from frustum.raster import shadow
 

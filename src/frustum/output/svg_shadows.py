@@ -22,6 +22,7 @@ them as the SVG group ``<g id="shadows">`` of ``<path>`` elements (absolute M/L/
 
 from __future__ import annotations
 
+import math
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -180,8 +181,29 @@ def _outline(pieces: list[NDArray], scale: float) -> list[NDArray]:
             points = [p] + [vertices[np.flatnonzero(inside)[np.argmin(np.abs(t[inside] - s))]] for s in stops] + [q]
             segments.extend((points[k], points[k + 1]) for k in range(len(points) - 1))
 
-    def key(point: NDArray) -> tuple[int, int]:
-        return (round(float(point[0]) / tolerance), round(float(point[1]) / tolerance))
+    # corners within the tolerance are one corner: each joins the first one met within it (grid cells of the
+    # tolerance, the 3 × 3 around it searched), so two corners either side of a cell boundary still meet
+    cells: dict[tuple[int, int], list[tuple[float, float, int]]] = {}
+    known: dict[tuple[float, float], int] = {}
+    corners: list[NDArray] = []  # each merged corner's first point: the loops are written with these
+
+    def key(point: NDArray) -> int:
+        x, y = float(point[0]), float(point[1])
+        found = known.get((x, y))
+        if found is not None:
+            return found
+        cx, cy = math.floor(x / tolerance), math.floor(y / tolerance)
+        for dx in (-1, 0, 1):
+            for dy in (-1, 0, 1):
+                for qx, qy, number in cells.get((cx + dx, cy + dy), ()):
+                    if abs(qx - x) <= tolerance and abs(qy - y) <= tolerance:
+                        known[(x, y)] = number
+                        return number
+        number = len(corners)
+        corners.append(point)
+        cells.setdefault((cx, cy), []).append((x, y, number))
+        known[(x, y)] = number
+        return number
 
     directed: dict[tuple, list[int]] = {}
     for index, (p, q) in enumerate(segments):
@@ -203,27 +225,39 @@ def _outline(pieces: list[NDArray], scale: float) -> list[NDArray]:
         while index in alive:
             alive.discard(index)
             p, q = segments[index]
-            loop.append(p)
+            if not loop or key(p) != key(loop[-1]):  # a corner met twice in a row (merged points): once
+                loop.append(corners[key(p)])
             following = [i for i in starts.get(key(q), []) if i in alive]
             if not following:
                 break
             index = following[0]
+        if len(loop) > 1 and key(loop[0]) == key(loop[-1]):
+            loop.pop()
         if len(loop) >= 3:
             loops.append(_without_collinear(np.array(loop), tolerance))
     return [loop for loop in loops if loop.shape[0] >= 3]
 
 
 def _without_collinear(loop: NDArray, tolerance: float) -> NDArray:
-    keep = []
-    count = loop.shape[0]
-    for i in range(count):
-        a, b, c = loop[i - 1], loop[i], loop[(i + 1) % count]
+    """The loop without corners lying on the line between their kept neighbours (within `tolerance`, and ahead of
+    the previous one): each corner tested against the corners kept so far, so that of two corners closer than the
+    tolerance one is kept (each tested against the original neighbours dropped both)."""
+
+    def between(a: NDArray, b: NDArray, c: NDArray) -> bool:
         d = c - a
         length = float(np.hypot(d[0], d[1]))
-        if length > 0.0 and abs((b - a) @ np.array([-d[1], d[0]])) / length <= tolerance and (b - a) @ d > 0.0:
-            continue
-        keep.append(b)
-    return np.array(keep)
+        return length > 0.0 and abs((b - a) @ np.array([-d[1], d[0]])) / length <= tolerance and (b - a) @ d > 0.0
+
+    kept: list[NDArray] = []
+    for point in loop:
+        kept.append(point)
+        while len(kept) >= 3 and between(kept[-3], kept[-2], kept[-1]):
+            del kept[-2]
+    while len(kept) >= 3 and between(kept[-2], kept[-1], kept[0]):  # across the loop's start
+        kept.pop()
+    while len(kept) >= 3 and between(kept[-1], kept[0], kept[1]):
+        kept.pop(0)
+    return np.array(kept)
 
 
 # --- faces, lights and projections --------------------------------------------------------------------------

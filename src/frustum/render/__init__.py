@@ -215,7 +215,8 @@ def render(
     shadow_map_size : int
         Texels on a side of each shadow map, a power of two in [64, 16384] (a point light has six).
     shadow_softness : float
-        Percentage-closer filter radius in texels, in [0, 16]; 0: hard edges.
+        Percentage-closer filter width in texels, in [0, 16]; 0: hard edges; up to 1 (default): the 2 × 2 texels
+        around the point, bilinearly weighted (``frustum.shadow_pass``).
 
     Raises
     ------

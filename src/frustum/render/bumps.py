@@ -29,10 +29,12 @@ def has_detail(item: SceneItem) -> bool:
 def shade_detailed(
     item: SceneItem, faces: np.ndarray, world: np.ndarray, normals: np.ndarray, params: np.ndarray,
     lights: np.ndarray, flags: np.ndarray, depth: np.ndarray, codes: np.ndarray, bary: np.ndarray,
-    color: np.ndarray, extra: tuple[np.ndarray, np.ndarray],
+    color: np.ndarray, extra: tuple[np.ndarray, np.ndarray], seen: np.ndarray | None = None,
 ) -> None:  # fmt: skip
     """Shade the item's pixels of these image rows with perturbed normals (module docstring); `flags` is the item
-    record of ``raster.shade`` (its face offset tells the item's pixels)."""
+    record of ``raster.shade`` (its face offset tells the item's pixels). With `seen` (rows, W, K) float32, the
+    fraction of each light reaching each pixel (shadows, ``render.shadows``): ``raster.shadow``'s kernel instead,
+    each light's terms scaled by its fraction."""
     mesh, material = item.mesh, item.material
     face_offset = int(flags[shade.I_FACE_OFFSET])
     face = codes.astype(np.int64) // 2 - face_offset
@@ -83,13 +85,34 @@ def shade_detailed(
     id_strip = np.zeros((1, count), dtype=np.int32) if write_ids else extra[1]
     record = flags.copy()
     record[shade.I_FACE_OFFSET] = 0
-    shade.shade_pixels(
-        depth[rows, cols].reshape(1, count), virtual_codes, weights, virtual_faces, np.repeat(point, 3, axis=0),
-        np.repeat(normal, 3, axis=0), np.empty((0, 6)), vertex_colors, virtual_uvs, texture, params, lights, record,
-        strip, normal_strip, id_strip,
-    )  # fmt: skip
+    if seen is not None:
+        from frustum.raster import shadow
+
+        shadow.shade_pixels_shadowed(
+            depth[rows, cols].reshape(1, count), virtual_codes, weights, virtual_faces, np.repeat(point, 3, axis=0),
+            np.repeat(normal, 3, axis=0), np.empty((0, 3 + 6 * lights.shape[0])), vertex_colors, virtual_uvs,
+            texture, params, lights, record, np.ascontiguousarray(seen[rows, cols]).reshape(1, count, -1), strip,
+            normal_strip, id_strip,
+        )  # fmt: skip
+    else:
+        _shade_plainly(depth, rows, cols, count, virtual_codes, weights, virtual_faces, point, normal,
+                       vertex_colors, virtual_uvs, texture, params, lights, record, strip, normal_strip, id_strip)
     color[rows, cols] = strip[0]
     if write_normals:
         extra[0][rows, cols] = normal_strip[0]
     if write_ids:
         extra[1][rows, cols] = id_strip[0]
+
+
+def _shade_plainly(
+    depth: np.ndarray, rows: np.ndarray, cols: np.ndarray, count: int, virtual_codes: np.ndarray,
+    weights: np.ndarray, virtual_faces: np.ndarray, point: np.ndarray, normal: np.ndarray,
+    vertex_colors: np.ndarray, virtual_uvs: np.ndarray, texture: np.ndarray, params: np.ndarray,
+    lights: np.ndarray, record: np.ndarray, strip: np.ndarray, normal_strip: np.ndarray, id_strip: np.ndarray,
+) -> None:  # fmt: skip
+    """The strip of ``shade_detailed`` through ``raster.shade.shade_pixels`` (no shadows)."""
+    shade.shade_pixels(
+        depth[rows, cols].reshape(1, count), virtual_codes, weights, virtual_faces, np.repeat(point, 3, axis=0),
+        np.repeat(normal, 3, axis=0), np.empty((0, 6)), vertex_colors, virtual_uvs, texture, params, lights, record,
+        strip, normal_strip, id_strip,
+    )  # fmt: skip

@@ -7,20 +7,26 @@ are none, exactly as ``stages.shade_item`` does. Off the ordinary path: nothing 
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
+from frustum.budgets import check_memory
 from frustum.camera import Camera
 from frustum.geometry import Mesh
-from frustum.raster import shade, triangles
+from frustum.raster import shade
+from frustum.render import bumps, reflection
+from frustum.render.buffers import Buffers
 from frustum.render.options import RenderOptions
 from frustum.render.stages import (
-    TILE_SIZE,
+    TILED_BITS,
     Lighting,
     Pixels,
-    _plain_surface,
     bin_item,
+    directional,
     item_flags,
     shading_parameters,
+    world_attributes,
     world_faces,
 )  # fmt: skip
 from frustum.render.stages import shade_item as shade_item_plainly
@@ -30,15 +36,18 @@ SHADOWED_MODES = (shade.SHADE_PHONG, shade.SHADE_GOURAUD, shade.SHADE_FLAT)
 """Shading modes in which shadows darken the picture (``"none"``, ``"normals"`` and ``"depth"`` ignore them)."""
 
 
-def draw_depth(item: SceneItem, camera: Camera, depth: np.ndarray, codes: np.ndarray, bary: np.ndarray) -> None:
-    """Stages 1–4 of one item into `depth` alone (codes and weights are scratch): a shadow map. Both sides of an
-    open surface; the front faces alone of a closed one (``Mesh.is_watertight``: along any ray from outside the
-    first surface met is a front face, so the map is the same, for half the fill)."""
-    binned = bin_item(item, camera, bool(item.mesh.is_watertight))
-    tiling = np.array([TILE_SIZE, binned.tiles_x, 0, depth.shape[1], depth.shape[0]], dtype=np.int64)
-    triangles.rasterize_tiles(
-        binned.faces, binned.win_int, binned.win_float, binned.tri_int, binned.tri_float, binned.tri_weights,
-        binned.tile_starts, binned.tile_entries, tiling, depth, codes, bary,
+def draw_depth(item: SceneItem, camera: Camera, depth: np.ndarray, fresh: bool) -> None:
+    """Stages 1–4 of one item into `depth` alone (``raster.shadow.fill_depth_tiles``: no face codes or weights,
+    64-pixel tiles): a shadow map, cleared first where `fresh`. Both sides of an open surface; the front faces alone
+    of a closed one (``Mesh.is_watertight``: along any ray from outside the first surface met is a front face, so
+    the map is the same, for half the fill)."""
+    from frustum.raster import shadow
+
+    binned = bin_item(item, camera, bool(item.mesh.is_watertight), tile_bits=TILED_BITS)
+    tiling = np.array([1 << TILED_BITS, binned.tiles_x, 0, depth.shape[1], depth.shape[0]], dtype=np.int64)
+    shadow.fill_depth_tiles(
+        binned.faces, binned.win_int, binned.win_float, binned.tri_int, binned.tri_float, binned.tile_starts,
+        binned.tile_entries, tiling, depth, fresh,
     )  # fmt: skip
 
 
@@ -68,12 +77,13 @@ def shade_item(
     attributes: tuple[np.ndarray, np.ndarray], pixels: Pixels, band: tuple[int, int], blend: bool,
 ) -> None:  # fmt: skip
     """``stages.shade_item`` with shadows: an opaque item in a shadowed mode goes through
-    ``raster.shadow.shade_pixels_shadowed`` with the fractions ``prepare`` found; anything else is shaded as
-    without shadows (transparent items receive none, nor items with a bump or normal map or an environment to
-    reflect: their kernels take no shadow fractions yet)."""
+    ``raster.shadow.shade_pixels_shadowed`` with the fractions ``prepare`` found (an item with a bump or normal
+    map in Phong shading: ``bumps.shade_detailed`` with those fractions; an environment to reflect is blended in
+    afterwards, as without shadows); anything else is shaded as without shadows (transparent items receive
+    none)."""
     seen = None if options.outputs is None else options.outputs.get("seen")
     plain = seen is None or blend or options.shade_mode not in SHADOWED_MODES or seen.shape[:2] != pixels.codes.shape
-    if plain or not _plain_surface(item, options):  # bump, normal maps and reflections shade their own way
+    if plain:
         shade_item_plainly(item, index, face_offset, camera, options, lighting, attributes, pixels, band, blend)
         return
     from frustum.raster import shadow
@@ -89,19 +99,27 @@ def shade_item(
     params = shading_parameters(item, camera, options, ambient)
     faces = world_faces(item) if mesh.face_count else np.empty((0, 3), dtype=np.int64)
     world, normals = (np.asarray(a, dtype=np.float64) for a in attributes)
-    lit = lit_per_light(mesh, faces, world, normals, params, lights, options)
-    vertex_colors = getattr(mesh, "vertex_colors", None)
-    vertex_colors = np.empty((0, 3)) if vertex_colors is None else np.ascontiguousarray(vertex_colors[:, :3], float)
-    uvs, texture = getattr(mesh, "uvs", None), material.texture
-    if texture is None or uvs is None:
-        texture, uvs = np.empty((0, 0, 4), dtype=np.float32), np.empty((0, 2))
-    else:
-        uvs = np.ascontiguousarray(uvs, dtype=np.float64)
     flags = item_flags(index, face_offset, options, blend, write_normals, write_ids)
-    shadow.shade_pixels_shadowed(
-        pixels.depth[rows], codes, pixels.bary[rows], faces, world, normals, lit, vertex_colors, uvs, texture,
-        params, lights, flags, seen[rows], pixels.color[rows], extra[0], extra[1],
-    )  # fmt: skip
+    if options.shade_mode == shade.SHADE_PHONG and bumps.has_detail(item):  # per-pixel normals from the maps
+        bumps.shade_detailed(item, faces, world, normals, params, lights, flags, pixels.depth[rows], codes,
+                             pixels.bary[rows], pixels.color[rows], extra, seen=seen[rows])  # fmt: skip
+    else:
+        lit = lit_per_light(mesh, faces, world, normals, params, lights, options)
+        vertex_colors = getattr(mesh, "vertex_colors", None)
+        vertex_colors = (np.empty((0, 3)) if vertex_colors is None
+                         else np.ascontiguousarray(vertex_colors[:, :3], float))  # fmt: skip
+        uvs, texture = getattr(mesh, "uvs", None), material.texture
+        if texture is None or uvs is None:
+            texture, uvs = np.empty((0, 0, 4), dtype=np.float32), np.empty((0, 2))
+        else:
+            uvs = np.ascontiguousarray(uvs, dtype=np.float64)
+        shadow.shade_pixels_shadowed(
+            pixels.depth[rows], codes, pixels.bary[rows], faces, world, normals, lit, vertex_colors, uvs, texture,
+            params, lights, flags, seen[rows], pixels.color[rows], extra[0], extra[1],
+        )  # fmt: skip
+    if options.environment is not None and material.reflectivity > 0.0:
+        reflection.reflect(faces, face_offset, material.reflectivity, camera, options, normals, pixels.depth[rows],
+                           codes, pixels.bary[rows], pixels.color[rows], band[0])  # fmt: skip
 
 
 def lit_per_light(
@@ -127,3 +145,49 @@ def lit_per_light(
             shade.light_faces(world, faces, unlit, one, options.specular_model, terms)
         lit[:, 3 + 6 * k : 9 + 6 * k] = terms
     return lit
+
+
+def tiled(scene: Scene, item: SceneItem, options: RenderOptions, lights: np.ndarray) -> bool:
+    """Whether a frame of this one opaque mesh with shadow maps goes through the one-mesh tile pipeline with
+    shadows (``draw_tiled``): shading that is the directional fast path's without shadows (``stages.directional``)
+    and no buffer to read back."""
+    if options.shadow is None or options.shadow.method != "map" or options.buffers:
+        return False
+    return directional(item, dataclasses.replace(options, shadow=None), lights)
+
+
+def draw_tiled(
+    scene: Scene, item: SceneItem, camera: Camera, options: RenderOptions, lighting: Lighting, buffers: Buffers
+) -> None:  # fmt: skip
+    """Stages 1–5 of a frame of one opaque mesh with shadow maps, tile by tile (``raster.shadow_tiled``): each
+    shadow-casting (directional) light's map is fitted to what the camera can see of the mesh before anything is
+    drawn (``shadow_pass.view_map``) and filled; then each tile is filled and shaded, the map lookups made per
+    pixel inside the shading (no image-sized world points, normals or fractions)."""
+    from frustum import shadow_pass
+    from frustum.raster import shadow, shadow_tiled
+
+    binned = bin_item(item, camera, options.cull, 0, buffers.scratch, tile_bits=TILED_BITS)
+    world, normals = world_attributes(item, buffers.scratch)
+    lights = lighting.lights
+    size, softness = options.shadow.map_size, float(options.shadow.softness)
+    rows, casting = shadow_pass.shadow_lights(scene)
+    fitted = [shadow_pass.view_map(light, world, camera, size, softness) for light in casting]
+    records = [(row, found) for row, found in zip(rows, fitted, strict=True) if found is not None]
+    check_memory(len(records) * size * size * 4, where="render",
+                 cause=f"shadow_map_size = {size} with {len(records)} shadow-casting light(s)")  # fmt: skip
+    maps = shadow_pass.take_array((max(len(records), 1), size, size), np.float32)
+    views = np.zeros((max(len(records), 1), shadow.MAP_FIELDS))
+    map_of = np.full(lights.shape[0], -1, dtype=np.int64)
+    for m, (row, (light_camera, texel)) in enumerate(records):
+        draw_depth(item, light_camera, maps[m], True)
+        views[m] = shadow_pass.map_record(light_camera, texel, None)
+        map_of[row] = m
+    tiling = np.array([1 << TILED_BITS, binned.tiles_x, 0, camera.width, camera.height], dtype=np.int64)
+    params = shading_parameters(item, camera, options, lighting.ambient)
+    flags = item_flags(0, 0, options, False, False, False)
+    shadow_tiled.draw_tiles_shadowed(
+        binned.faces, binned.win_int, binned.win_float, binned.tri_int, binned.tri_float, binned.tri_weights,
+        binned.tile_starts, binned.tile_entries, tiling, buffers.depth, world, normals, params, lights,
+        flags, options.background, buffers.color, maps, views, map_of, softness,
+    )  # fmt: skip
+    shadow_pass.give_back(maps)

@@ -51,6 +51,8 @@ def draw_surfaces(
     bary = None
     if len(items) == 1 and opaque and face_total and directional(items[0], options, lighting.lights):
         draw_tiled(items[0], camera, options, lighting, buffers)
+    elif len(items) == 1 and opaque and face_total and shadows.tiled(scene, items[0], options, lighting.lights):
+        shadows.draw_tiled(scene, items[0], camera, options, lighting, buffers)
     else:
         codes = scratch.empty((height, width), codes_dtype)
         bary = scratch.empty((height, width, 2), np.float32)  # codes and bary are read only where depth < 1
