@@ -64,9 +64,11 @@ COLLECT = ("driver", "workers")
 RAY_BYTES_IN_FLIGHT = 256 * 2**20
 """collect="driver": most bytes of encoded views handed out and not yet written (an upper bound per view:
 4 + 4 + 12 + 2 + 1 bytes per pixel for color, depth, normals, ids, mask)."""
-RAY_TASK_BYTES = 4 * 2**20
-"""collect="driver": most bytes of encoded views per Ray task (same bound; at least one view per task), so that a
-task's reply stays below Ray's 10 MiB limit of values sent inline with it (``task_rpc_inlined_bytes_limit``)."""
+RAY_TASK_BYTES = 2**20
+"""collect="driver": most bytes of encoded views per Ray task (same bound; at least one view per task): a task's
+reply stays far below Ray's 10 MiB limit of values sent inline with it (``task_rpc_inlined_bytes_limit``), and the
+driver's heap holds little of it at a time (2,000 views at 256²: +7 and +11 MiB of RSS after the first 100 views
+with one view a task, +2 to +32 MiB with three)."""
 RAY_INLINE_BYTES = 96 * 1024
 """collect="driver": a task returns its views' files cut into pieces of at most this size, each a value of its
 own, below Ray's 100 KiB limit (``max_direct_call_object_size``) for values sent to the driver inside the task's
