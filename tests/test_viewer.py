@@ -438,3 +438,82 @@ def test_default_camera_frames_the_whole_scene():
     assert (window[:, 0] > 0).all() and (window[:, 0] < 800).all()
     assert (window[:, 1] > 0).all() and (window[:, 1] < 600).all()
     assert ((window[:, 2] > 0) & (window[:, 2] < 1)).all()  # between near and far
+
+
+# --- the steps panel ------------------------------------------------------------------------------------------
+
+
+def test_steps_camera_is_the_current_view_made_small(teapot_session):
+    s = teapot_session
+    s.handle({"type": "reset"})
+    s.handle({"type": "wheel", "delta": -240})
+    full, small = s.control.camera(), s.steps_camera()
+    assert (small.width, small.height) == (64, 48)  # 160 x 120 at most STEPS_SIZE = 64 across
+    assert_close(small.view_matrix, full.view_matrix, 0.0)
+    assert_close(small.projection_matrix, full.projection_matrix, 1e-15)  # the same view volume (aspect 4:3)
+    s.handle({"type": "reset"})
+
+
+@pytest.mark.parametrize("algorithm", ["depth-buffer", "scan-line", "warnock", "a-buffer", "ray-casting"])
+def test_steps_panel_records_the_method_on_the_current_view(teapot_session, algorithm):
+    from frustum import steps
+    from frustum.viewer.session import STEPS_METHODS
+
+    s = teapot_session
+    s.handle({"type": "reset"})
+    drag = [
+        {"type": "pointer", "action": "down", "x": 80, "y": 60, "button": 0},
+        {"type": "pointer", "action": "move", "x": 110, "y": 70},
+        {"type": "pointer", "action": "up"},
+    ]
+    s.replies(drag)
+    assert algorithm in STEPS_METHODS and s.state()["steps"]["methods"] == list(STEPS_METHODS)
+    ((answer, data),) = s.replies({"type": "steps", "algorithm": algorithm})  # no frame: the view did not change
+    assert data is None and "error" not in answer
+    assert answer["type"] == "steps" and answer["algorithm"] == algorithm and answer["size"] == [64, 48]
+    assert answer["camera"] == s.control.state()
+    function = {"depth-buffer": steps.depth_buffer, "scan-line": steps.scan_line, "warnock": steps.area_subdivision,
+                "a-buffer": steps.a_buffer, "ray-casting": steps.ray_casting}[algorithm]  # fmt: skip
+    options = {key: s.options[key] for key in ("background", "cull_back_faces") if key in s.options}
+    expected = function(s.scene, s.steps_camera(), shading=s.controls["shading"], **options)
+    assert answer["titles"] == [step.title for step in expected]
+    assert answer["figures"] == [expected.figure(i) for i in range(len(expected))]
+    # the last step shows the production picture of this view
+    method = {"warnock": "area-subdivision"}.get(algorithm, algorithm)
+    frame = frustum.render(s.scene, s.steps_camera(), method=method, shading=s.controls["shading"], **options)
+    np.testing.assert_array_equal(expected.result.color, frame.color)
+    # another view, another record
+    s.handle({"type": "key", "key": "t"})
+    again = s.steps(algorithm)
+    assert again["camera"] != answer["camera"] and again["figures"] != answer["figures"]
+    s.handle({"type": "reset"})
+
+
+@pytest.mark.parametrize(
+    "message",
+    [
+        {"type": "steps"},
+        {"type": "steps", "algorithm": "bsp"},
+        {"type": "steps", "algorithm": ["scan-line"]},
+        {"type": "steps", "algorithm": "scan-line; rm -rf /"},
+    ],
+)
+def test_steps_requests_for_other_methods_are_ignored(teapot_session, message):
+    assert teapot_session.handle(message) is None
+    assert teapot_session.replies([message]) == [({"type": "ignored"}, None)]
+
+
+def test_steps_requests_merge_and_a_record_over_the_budget_is_reported(teapot_session):
+    s = teapot_session
+    recorded = []
+    original = s.steps
+    try:
+        s.steps = lambda algorithm: recorded.append(algorithm) or original(algorithm)
+        replies = s.replies([{"type": "steps", "algorithm": "scan-line"}, {"type": "rest"},
+                             {"type": "steps", "algorithm": "warnock"}])  # fmt: skip
+    finally:
+        del s.steps
+    assert recorded == ["warnock"] and [header["type"] for header, _ in replies] == ["steps", "frame"]
+    with frustum.budget(bytes=100_000):  # the scan-line record of 48 rows at 64 x 48 needs more
+        answer = s.steps("scan-line")
+    assert "figures" not in answer and "steps.scan_line" in answer["error"] and "budget" in answer["error"]

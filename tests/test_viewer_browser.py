@@ -373,3 +373,63 @@ def test_controls_change_the_projection_and_the_panel_follows(page):
     page.wait_for_function("window.frustumViewer.state.controls.projection === 'perspective'", timeout=60_000)
     page.select_option('select[data-control="mode"]', "surface")
     page.uncheck('input[data-control="depth_cue"]')
+
+
+def test_steps_panel_records_the_view_and_steps_through_it(page):
+    """The steps panel: pick a visible-surface method, record it on the current view, step with the buttons and
+    the slider; the figures are Python's ``Steps.figure`` of that view; a later drag marks the record stale."""
+    page.locator(".fv-canvas").focus()
+    page.keyboard.press("0")
+    page.wait_for_function("window.frustumViewer.state.zoom === 1", timeout=60_000)
+    page.click(".fv-steps summary")
+    methods = page.eval_on_selector_all(".fv-steps-method option", "options => options.map(o => o.value)")
+    assert methods == ["depth-buffer", "scan-line", "warnock", "a-buffer", "ray-casting"]
+    page.select_option(".fv-steps-method", "scan-line")
+    page.click(".fv-steps-record")
+    page.wait_for_function(
+        "window.frustumViewer.steps && window.frustumViewer.steps.algorithm === 'scan-line'", timeout=300_000
+    )
+    record = page.evaluate("window.frustumViewer.steps")
+    assert "error" not in record, record.get("error")
+    assert record["size"] == [64, 48] and record["camera"] == page.evaluate("window.frustumViewer.state.camera")
+    count = len(record["figures"])
+    assert count == len(record["titles"]) > 2
+    assert page.locator(".fv-steps-nav").is_visible()
+    figure = page.locator(".fv-steps-figure svg title")
+    assert figure.text_content() == f"Scan-line method: step 1 of {count}: {record['titles'][0]}"
+    assert page.locator(".fv-steps-status").get_attribute("data-stale") == "false"
+    page.click(".fv-steps-next")
+    assert figure.text_content().startswith(f"Scan-line method: step 2 of {count}: ")
+    assert page.evaluate("window.frustumViewer.stepIndex") == 1
+    page.click(".fv-steps-prev")
+    page.click(".fv-steps-prev")  # stays at the first step
+    assert page.evaluate("window.frustumViewer.stepIndex") == 0
+    page.locator(".fv-steps-slider").fill(str(count - 1))
+    assert figure.text_content() == f"Scan-line method: step {count} of {count}: {record['titles'][-1]}"
+    assert f"{count} / {count}" in page.locator(".fv-steps-counter").inner_text()
+    # the figure drawn is Python's figure of that step (the browser's SVG serialization of it)
+    assert page.evaluate("document.querySelector('.fv-steps-figure').dataset.step") == str(count - 1)
+    assert page.evaluate("document.querySelector('.fv-steps-figure').innerHTML.length") > 1000
+    # the view changes: the record says it belongs to an earlier view
+    page.evaluate("window.scrollTo(0, 0)")  # the figure scrolled the page: the whole picture in view again
+    box = page.locator(".fv-canvas").bounding_box()
+    frames = page.evaluate("window.frustumViewer.frames")
+    page.mouse.move(box["x"] + 300, box["y"] + 300)
+    page.mouse.down()
+    for k in range(1, 6):
+        page.mouse.move(box["x"] + 300 + 15 * k, box["y"] + 300)
+    page.mouse.up()
+    _wait_for_rest_frame(page, frames)
+    page.wait_for_function("document.querySelector('.fv-steps-status').dataset.stale === 'true'", timeout=60_000)
+    assert "record again" in page.locator(".fv-steps-status").inner_text()
+    page.select_option(".fv-steps-method", "warnock")
+    page.click(".fv-steps-record")
+    page.wait_for_function(
+        "window.frustumViewer.steps.algorithm === 'warnock' && "
+        "document.querySelector('.fv-steps-status').dataset.stale === 'false'",
+        timeout=300_000,
+    )
+    assert ": step 1 of " in page.locator(".fv-steps-figure svg title").text_content()
+    page.keyboard.press("Escape")
+    page.locator(".fv-canvas").focus()
+    page.keyboard.press("0")

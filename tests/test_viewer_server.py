@@ -401,3 +401,28 @@ def test_work_ledger_counts_held_frames_and_frees_retained_arrays(monkeypatch):
         with ledger.hold(500), refused, ledger.admit(600, "a frame"):
             pass
         assert ledger.held == 0
+
+
+# --- the steps panel: the same socket, the same access rules -------------------------------------------------
+
+
+def test_steps_panel_is_served_over_the_guarded_socket_only(tmp_path):
+    with _server(tmp_path, token="s3cret") as (port, _, _, _):
+        with pytest.raises(InvalidStatus) as refused:  # no token, or another page: no socket, so no steps
+            _connect(port)
+        assert refused.value.response.status_code == 403
+        with pytest.raises(InvalidStatus):
+            _connect(port, query="?token=s3cret", origin="http://evil.example")
+        with _connect(port, query="?token=s3cret") as ws:
+            _greeted(ws)
+            ws.send(json.dumps({"type": "steps", "algorithm": "depth-buffer"}))
+            answer = _until(ws, "steps")[-1]
+            assert answer["algorithm"] == "depth-buffer" and answer["size"] == [64, 48]
+            assert len(answer["figures"]) == len(answer["titles"]) == 2  # empty buffers, then the teapot
+            assert all(figure.startswith("<svg") for figure in answer["figures"])
+            with frustum.budget(bytes=20_000):  # the record of 64 x 48 does not fit: said, not raised
+                ws.send(json.dumps({"type": "steps", "algorithm": "depth-buffer"}))
+                refused_record = _until(ws, "steps")[-1]
+            assert "figures" not in refused_record and "budget" in refused_record["error"]
+            ws.send(json.dumps({"type": "steps", "algorithm": "../etc/passwd"}))
+            assert _until(ws, "ignored")[-1] == {"type": "ignored"}

@@ -1,6 +1,6 @@
 """frustum: the classical 3D graphics pipeline, faithful, inspectable and fast, rendering headless on any machine.
 
-Conventions (``docs/conventions.md``): column vectors (``P' = M @ P``), radians, right-handed world and view
+Conventions (``docs/conventions.md``): column vectors ($P' = M @ P$), radians, right-handed world and view
 coordinates with the camera looking down −z, left-handed normalized device coordinates [−1, 1]³.
 
 Every public name is listed once, in ``__init__.pyi`` (the stub editors and type checkers read), and loaded on

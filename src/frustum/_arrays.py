@@ -230,8 +230,8 @@ def as_faces(
     """Return `value` as a C-contiguous (M, 3) int64 array of vertex indices in [0, vertex_count); (0, 3) is valid.
 
     Indices must already be integers (an integer dtype): a float array is refused rather than rounded. With
-    `compact`, the array is int32 when every index fits (``vertex_count <= 2**31``): lossless, half the memory;
-    code combining such indices arithmetically (edge keys ``i·N + j``) must widen to int64 first. With `share`,
+    `compact`, the array is int32 when every index fits ($vertex_count <= 2**31$): lossless, half the memory;
+    code combining such indices arithmetically (edge keys $i·N + j$) must widen to int64 first. With `share`,
     an input array that already has that dtype and layout is returned itself, not copied.
     """
     index_type = np.int32 if compact and vertex_count <= INT32_LIMIT else np.int64

@@ -64,7 +64,7 @@ Polygon = NDArray[np.float64]
 
 
 def _vector_area(vertices: Polygon) -> NDArray[np.float64]:
-    """Half the sum of ``P_i × P_(i+1)``: normal times area for a planar polygon (Newell's method)."""
+    """Half the sum of $P_i × P_(i+1)$: normal times area for a planar polygon (Newell's method)."""
     a, b = vertices, np.concatenate((vertices[1:], vertices[:1]))  # P_i, P_(i+1)
     x = (a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]).sum()
     y = (a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]).sum()
@@ -132,7 +132,7 @@ def _scene_tolerance(polygons: list[Polygon] | NDArray) -> float:
 
 
 def _plane(vertices: Polygon) -> NDArray[np.float64]:
-    """(4,) unit normal (A, B, C) and D of the polygon's plane ``A x + B y + C z + D = 0``."""
+    """(4,) unit normal (A, B, C) and D of the polygon's plane $A x + B y + C z + D = 0$."""
     normal = _vector_area(vertices)
     normal = normal / np.linalg.norm(normal)
     return np.append(normal, -normal @ vertices.mean(axis=0))
@@ -141,8 +141,8 @@ def _plane(vertices: Polygon) -> NDArray[np.float64]:
 def _split(vertices: Polygon, plane: NDArray, tolerance: float) -> tuple[Polygon | None, Polygon | None]:
     """Front and back part of a convex polygon cut by `plane`; vertices within `tolerance` go to both.
 
-    An edge whose ends lie strictly on opposite sides is cut at ``P = P_i + t (P_j − P_i)``,
-    ``t = d_i / (d_i − d_j)`` with the signed distances ``d = N·P + D``.
+    An edge whose ends lie strictly on opposite sides is cut at $P = P_i + t (P_j − P_i)$,
+    $t = d_i / (d_i − d_j)$ with the signed distances $d = N·P + D$.
     """
     distances = vertices @ plane[:3] + plane[3]
     sides = np.where(distances > tolerance, 1, np.where(distances < -tolerance, -1, 0))
@@ -261,7 +261,7 @@ class BSPTree:
     """Binary space-partitioning tree of polygons, read back to front from any viewing position.
 
     Each node holds a partitioning plane (the plane of one of its polygons), the polygons lying in that plane,
-    and a front subtree (``N·P + D > 0``) and a back subtree. A polygon straddling the plane is split into
+    and a front subtree ($N·P + D > 0$) and a back subtree. A polygon straddling the plane is split into
     its front and back part, both convex polygons (k, 3) (a polygon of more than 8 corners is stored as a fan
     of pieces of at most 8). The splitter at each node is the candidate plane (up to 8, evenly spaced through
     the node's list) that splits the fewest polygons, then balances the two sides best, counted on up to 256
@@ -470,8 +470,8 @@ class BSPTree:
     ) -> list[tuple[Polygon, int]]:
         """Fragments in painting order (farthest first) seen from `eye`, along view `direction`, or by `camera`.
 
-        At each node with plane ``N·P + D = 0``: if the viewer is in front (``N·E + D > 0``, or
-        ``−N·d > 0`` for a viewer at infinity looking along d) draw the back subtree, the node's polygons, then
+        At each node with plane $N·P + D = 0$: if the viewer is in front ($N·E + D > 0$, or
+        $−N·d > 0$ for a viewer at infinity looking along d) draw the back subtree, the node's polygons, then
         the front subtree; otherwise the reverse. A viewer in the plane sees its polygons edge-on. A convex
         cell paints its faces turned away from the viewer first.
 
@@ -618,14 +618,14 @@ def depth_sort(
     The polygons are clipped by the near plane, then mapped to normalized device coordinates, where every
     projection (perspective, oblique, orthographic) is a parallel one along z and planes stay planes; each
     axis is rescaled to the scene's extent. Sorted by greatest depth z_max, the list is processed from its
-    farthest polygon P: every Q with ``z_max(Q) > z_min(P)`` is checked by the tests of [HB 16], in order of
+    farthest polygon P: every Q with $z_max(Q) > z_min(P)$ is checked by the tests of [HB 16], in order of
     cost, each of which shows that P cannot hide Q:
 
     1. the bounding rectangles of P and Q in xy do not overlap;
     2. P lies wholly behind the plane of Q (on the far side from the viewer);
     3. Q lies wholly in front of the plane of P;
     4. the projections of P and Q do not overlap, or where they do, P is behind Q: each plane
-       ``A x + B y + C z + D = 0`` is the affine depth ``z(x, y) = −(A x + B y + D)/C``, so comparing the
+       $A x + B y + C z + D = 0$ is the affine depth $z(x, y) = −(A x + B y + D)/C$, so comparing the
        two at the corners of the common (convex) region of the projections is exact.
 
     If all fail, P hides part of Q: Q is moved to the head of the list and marked. A marked Q met again

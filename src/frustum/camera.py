@@ -1,12 +1,12 @@
 """The viewing frame (uvw), world-to-view transformation, and the Camera that bundles frame, projection and image.
 
 World and view coordinates are right-handed; the camera sits at the view point P0 and looks down −z_view.
-The seed's frame: ``n = N/|N|`` (N points from the look-at point back toward the eye), ``u = V×n/|V×n|``
-(V is the view-up vector), ``v = n×u``. ``view_from_world`` translates P0 to the origin and then rotates
+The seed's frame: $n = N/|N|$ (N points from the look-at point back toward the eye), $u = V×n/|V×n|$
+(V is the view-up vector), $v = n×u$. ``view_from_world`` translates P0 to the origin and then rotates
 u, v, n onto x, y, z; glm ``lookAtRH`` builds the same matrix.
 
 A ``Camera`` maps world points to window coordinates in the order of the pipeline:
-``window_from_world = window_from_ndc · divide · clip_from_view · view_from_world``. Window coordinates have
+$window_from_world = window_from_ndc · divide · clip_from_view · view_from_world$. Window coordinates have
 x in [0, width] to the right and **y in [0, height] upward** (OpenGL), pixel centers at half-integers, and
 depth in [0, 1] with 1 = far. Images stored top row first use row = height − 1 − floor(y).
 
@@ -97,7 +97,7 @@ def _frame_axes(
 class ViewFrame:
     """The uvw viewing frame at the view point `eye`: n from the view-plane normal N, u, v from the up vector V.
 
-    ``n = N/|N|``, ``u = V×n/|V×n|``, ``v = n×u`` with ``N = eye − target`` (or the given `normal`): a
+    $n = N/|N|$, $u = V×n/|V×n|$, $v = n×u$ with $N = eye − target$ (or the given `normal`): a
     right-handed orthonormal frame, u to the right, v up, n back toward the viewer, so the camera looks along
     −n. ``matrix`` is view_from_world: translate P0 = eye to the origin, then rotate u, v, n onto x, y, z
     (``R`` has rows u, v, n); ``steps`` gives both matrices separately.
@@ -170,7 +170,7 @@ class ViewFrame:
 
     @cached_property
     def rotation(self) -> Matrix4:
-        """The rotation step: rows u, v, n (or u, v, −n for a left-handed frame), ``x_view = u·(P − P0)``."""
+        """The rotation step: rows u, v, n (or u, v, −n for a left-handed frame), $x_view = u·(P − P0)$."""
         matrix = np.eye(4)
         matrix[0, :3], matrix[1, :3] = self.u, self.v
         matrix[2, :3] = self.n if self.handedness == "right" else -self.n
@@ -186,7 +186,7 @@ class ViewFrame:
 
     @cached_property
     def matrix(self) -> Matrix4:
-        """view_from_world = R · T(−P0): rows u, v, n and last column −(u·P0, v·P0, n·P0)."""
+        """$view_from_world = R · T(−P0)$: rows u, v, n and last column $−(u·P0, v·P0, n·P0)$."""
         return read_only(compose(*(step.matrix for step in self.steps)))
 
     @cached_property
@@ -198,8 +198,8 @@ class ViewFrame:
 def look_at(eye: ArrayLike, target: ArrayLike, up: ArrayLike = (0.0, 1.0, 0.0)) -> Matrix4:
     """View-from-world matrix of a camera at `eye` looking at `target` with view-up `up` (right-handed).
 
-    ``view_from_world = R · T(−eye)`` with R's rows ``u = V×n/|V×n|``, ``v = n×u``,
-    ``n = (eye − target)/|eye − target|``; equal to glm ``lookAtRH`` and to ``ViewFrame(eye, target, up=up).matrix``.
+    $view_from_world = R · T(−eye)$ with R's rows $u = V×n/|V×n|$, $v = n×u$,
+    $n = (eye − target)/|eye − target|$; equal to glm ``lookAtRH`` and to ``ViewFrame(eye, target, up=up).matrix``.
 
     Raises
     ------
@@ -223,7 +223,7 @@ def look_at(eye: ArrayLike, target: ArrayLike, up: ArrayLike = (0.0, 1.0, 0.0)) 
 
 
 class Ray(NamedTuple):
-    """A picking ray in world coordinates: points ``origin + t·direction`` for t >= 0, direction of unit length."""
+    """A picking ray in world coordinates: points $origin + t·direction$ for t >= 0, direction of unit length."""
 
     origin: Points
     direction: Points
@@ -265,9 +265,9 @@ MAX_IMAGE_SIZE = 65536
 class Camera:
     """A viewing frame, a projection and an image size: everything that maps world points to pixels.
 
-    ``window_from_world = window_from_ndc · (divide by w) · clip_from_view · view_from_world`` with
+    $window_from_world = window_from_ndc · (divide by w) · clip_from_view · view_from_world$ with
     ``view_from_world = frame.matrix``, ``clip_from_view = projection.matrix(width / height)`` and
-    ``window_from_ndc = viewport(0, 0, width, height)``.
+    $window_from_ndc = viewport(0, 0, width, height)$.
 
     Parameters
     ----------
@@ -346,7 +346,7 @@ class Camera:
     ) -> Camera:
         """Camera on a sphere around `target`, world y up, looking at the target.
 
-        ``eye = target + distance·(cos e·sin a, sin e, cos e·cos a)`` for azimuth a (radians about +y, from +z
+        $eye = target + distance·(cos e·sin a, sin e, cos e·cos a)$ for azimuth a (radians about +y, from +z
         toward +x) and elevation e (radians above the xz plane, |e| < π/2: straight up or down leaves the
         view-up vector y parallel to the line of sight).
 
@@ -416,10 +416,10 @@ class Camera:
 
         The sphere is centred on the axis-aligned bounding box (centre ``(low + high)/2``) with the radius of the
         farthest point (for bounds ``[low, high]``: half the box's diagonal). Perspective:
-        ``distance = r / sin(atan((1 − 2·margin)·tan(half_fov)))`` where ``half_fov`` is the
+        $distance = r / sin(atan((1 − 2·margin)·tan(half_fov)))$ where ``half_fov`` is the
         smaller of the vertical and horizontal half angles, so the sphere's image circle — the cone tangent to the
-        sphere — spans ``1 − 2·margin`` of the smaller image side. Orthographic: the view height is
-        ``2r / ((1 − 2·margin)·min(1, width/height))`` and the eye stands 3r back.
+        sphere — spans $1 − 2·margin$ of the smaller image side. Orthographic: the view height is
+        $2r / ((1 − 2·margin)·min(1, width/height))$ and the eye stands 3r back.
 
         Parameters
         ----------
@@ -531,9 +531,9 @@ class Camera:
     def project(self, points: ArrayLike) -> Points:
         """Window coordinates of world points: x right in [0, width], **y up** in [0, height], depth in [0, 1].
 
-        ``window = window_from_ndc · (clip / w)`` with ``clip = clip_from_view · view_from_world · P``; equal
+        $window = window_from_ndc · (clip / w)$ with $clip = clip_from_view · view_from_world · P$; equal
         to glm ``project`` (OpenGL window, y up, depth (z_ndc + 1)/2). Pixel (i, j) has its center at
-        (i + 0.5, j + 0.5); an image stored top row first shows it in row ``height − 1 − j``. Points inside the
+        (i + 0.5, j + 0.5); an image stored top row first shows it in row $height − 1 − j$. Points inside the
         view volume land inside the viewport with depth in [0, 1] (1 = far plane). Points on or behind the eye
         plane (w <= 0 under a perspective projection) have no image and come back as NaN rows; clip first.
 
@@ -564,7 +564,7 @@ class Camera:
     def unproject(self, window: ArrayLike) -> Points:
         """World points whose window coordinates are `window`: the inverse of ``project``.
 
-        ``P = (window_from_world)⁻¹ · (x_w, y_w, depth, 1)``, then divide by w. Depth 0 gives the point on the
+        $P = (window_from_world)⁻¹ · (x_w, y_w, depth, 1)$, then divide by w. Depth 0 gives the point on the
         near plane, 1 the point on the far plane; y is up, as in ``project`` (glm ``unProject``).
 
         Parameters
@@ -591,7 +591,7 @@ class Camera:
     def ray(self, pixel: ArrayLike) -> Ray:
         """World-space ray through window position `pixel` = (x, y), for picking.
 
-        ``origin = unproject(x, y, 0)`` on the near plane, ``direction = unproject(x, y, 1) − origin``
+        $origin = unproject(x, y, 0)$ on the near plane, $direction = unproject(x, y, 1) − origin$
         normalized. Window y is up; the center of pixel column i, row j (counted from the bottom) is
         (i + 0.5, j + 0.5), and row r counted from the top is y = height − r − 0.5. For a perspective camera
         the ray's line passes through the eye; for a parallel one its direction is the projection direction.
@@ -618,8 +618,8 @@ class Camera:
     def vanishing_point(self, direction: ArrayLike) -> NDArray[np.float64] | None:
         """Window (x, y) where projected world lines along `direction` meet, or None if they stay parallel.
 
-        A direction is the point at infinity ``[d, 0]``; its image ``h = clip_from_world · [d, 0]`` divides to
-        ``h_xy / h_w``, mapped through the viewport. ``h_w = 0`` (d parallel to the view plane, or any parallel
+        A direction is the point at infinity ``[d, 0]``; its image $h = clip_from_world · [d, 0]$ divides to
+        ``h_xy / h_w``, mapped through the viewport. $h_w = 0$ (d parallel to the view plane, or any parallel
         projection) means the projected lines stay parallel: None. d and −d give the same point.
 
         Parameters

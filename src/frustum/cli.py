@@ -486,7 +486,7 @@ def view_command(
     units: Annotated[str | None, typer.Option(help="Title block: model units (mm).")] = None,
 ) -> None:
     """Draw the scene as an engineering sheet: orthographic views at the largest standard scale that fits, with
-    hidden lines, dimensions, title block and scale bar (the scene file's [sheet] table sets the defaults)."""
+    hidden lines, dimensions, title block and scale bar (the scene file's \\[sheet] table sets the defaults)."""
     from frustum.scenefile import render_view_sheet
 
     fields = {"title": title, "drawing_number": drawing_number, "sheet": sheet_number, "date": date,
@@ -664,7 +664,8 @@ def radiosity_command(
     scene: Annotated[Path, typer.Argument(help="A TOML scene file (emissive materials and/or lights).")],
     output: Annotated[Path, typer.Option("--output", "-o", help="The picture to write (.png).")],
     patch_size: Annotated[
-        float | None, typer.Option(help="Longest patch edge in world units (default: the [radiosity] table's, or a "
+        # "\\[": rich markup would take [radiosity] for a style tag and drop it
+        float | None, typer.Option(help="Longest patch edge in world units (default: the \\[radiosity] table's, or a "
                                         "twentieth of the scene's diagonal).")
     ] = None,
     hemicube: Annotated[int | None, typer.Option(help="Hemicube pixels a side (default 128).")] = None,

@@ -1,15 +1,15 @@
 """Clipping in homogeneous clip space, before the perspective divide: points, lines, polygons, triangle batches.
 
-The view volume is the symmetric cube ``−w <= x, y, z <= w`` of clip space (NDC ``[−1, 1]³`` before the
-divide). Clipping here, not after the divide, is what handles points behind the eye (``w < 0``) correctly: a
+The view volume is the symmetric cube $−w <= x, y, z <= w$ of clip space (NDC $[−1, 1]³$ before the
+divide). Clipping here, not after the divide, is what handles points behind the eye ($w < 0$) correctly: a
 segment from in front of the eye to behind it keeps only its visible part and never wraps around through
 infinity, because the divide is done only on what survives.
 
 **Planes.** A clip-space plane is a 4-vector ``(a, b, c, d)``; a point ``(x, y, z, w)`` is inside when
-``a·x + b·y + c·z + d·w >= 0`` (exact sign test, no tolerance). ``VIEW_VOLUME_PLANES`` holds the cube's six, in
+$a·x + b·y + c·z + d·w >= 0$ (exact sign test, no tolerance). ``VIEW_VOLUME_PLANES`` holds the cube's six, in
 region-code order. User planes (a cutaway) take the same form and are always applied *in addition* to the
 cube; ``plane_from_point_normal`` builds one in world space and ``transform_plane`` carries it to clip space.
-In clip space the plane's normal is the whole 4-vector (``(0, 0, 0, 1)``, i.e. ``w >= 0``, is a real plane), so
+In clip space the plane's normal is the whole 4-vector (``(0, 0, 0, 1)``, i.e. $w >= 0$, is a real plane), so
 only the zero 4-vector is degenerate; for Cartesian points (``clip_line_convex`` with (3,) points) the normal
 is ``(a, b, c)`` and must be nonzero.
 
@@ -18,23 +18,23 @@ is ``(a, b, c)`` and must be nonzero.
 ====  =====  ==========  ========================
 bit   value  name        set when
 ====  =====  ==========  ========================
-1     1      left        ``w + x < 0``
-2     2      right       ``w − x < 0``
-3     4      bottom      ``w + y < 0``
-4     8      top         ``w − y < 0``
-5     16     near        ``w + z < 0``
-6     32     far         ``w − z < 0``
+1     1      left        $w + x < 0$
+2     2      right       $w − x < 0$
+3     4      bottom      $w + y < 0$
+4     8      top         $w − y < 0$
+5     16     near        $w + z < 0$
+6     32     far         $w − z < 0$
 ====  =====  ==========  ========================
 
-The seed's transcription prints these inequalities with x and z swapped (``h + z_n < 0 (left)``, ...,
-``h − x_n < 0 (far)``); its own tables decide: ``010000`` is the centre of "in front of near plane" and
+The seed's transcription prints these inequalities with x and z swapped ($h + z_n < 0 (left)$, ...,
+$h − x_n < 0 (far)$); its own tables decide: ``010000`` is the centre of "in front of near plane" and
 ``011001`` its top-left corner, so bit 5 is near and bits 1 and 4 are left and top. That is Hearn & Baker's
 order, used here.
 
-**Nothing with w <= 0 survives.** The near and far planes together give ``2w >= 0`` for every kept point, and
-``w = 0`` only at the clip-space origin ``(0, 0, 0, 0)``, which is the image of no point under an invertible
-``clip_from_world``. So the divide after clipping is safe without an extra ``w > ε`` plane (which would not be
-homogeneous); for a point exactly on the near plane the divide gives ``z_ndc = −1``.
+**Nothing with w <= 0 survives.** The near and far planes together give $2w >= 0$ for every kept point, and
+$w = 0$ only at the clip-space origin ``(0, 0, 0, 0)``, which is the image of no point under an invertible
+``clip_from_world``. So the divide after clipping is safe without an extra $w > ε$ plane (which would not be
+homogeneous); for a point exactly on the near plane the divide gives $z_ndc = −1$.
 
 Why one module: every clipping algorithm of the chapter on the one homogeneous region-code and plane convention.
 
@@ -130,8 +130,8 @@ Recorder = Callable[..., Any]
 def region_code(points_h: ArrayLike) -> NDArray[np.int64] | int:
     """The six-bit region code of each homogeneous point: which cube planes it is outside of.
 
-    ``code = [w+x<0]·1 | [w−x<0]·2 | [w+y<0]·4 | [w−y<0]·8 | [w+z<0]·16 | [w−z<0]·32`` (module docstring
-    for the bit order). A code of 0 means inside (or on the boundary of) ``−w <= x, y, z <= w``.
+    $code = [w+x<0]·1 | [w−x<0]·2 | [w+y<0]·4 | [w−y<0]·8 | [w+z<0]·16 | [w−z<0]·32$ (module docstring
+    for the bit order). A code of 0 means inside (or on the boundary of) $−w <= x, y, z <= w$.
 
     Parameters
     ----------
@@ -197,9 +197,9 @@ def trivially_rejected(codes: ArrayLike) -> NDArray[np.bool_] | bool:
 
 
 def inside_view_volume(points_h: ArrayLike) -> NDArray[np.bool_] | bool:
-    """Point clipping: True where ``−w <= x, y, z <= w`` and ``w > 0``.
+    """Point clipping: True where $−w <= x, y, z <= w$ and $w > 0$.
 
-    ``region_code(P) == 0`` is the textbook test; the extra ``w > 0`` only excludes the clip-space origin
+    ``region_code(P) == 0`` is the textbook test; the extra $w > 0$ only excludes the clip-space origin
     ``(0, 0, 0, 0)``, the one point with code 0 that has no Cartesian position.
 
     Parameters
@@ -230,7 +230,7 @@ def inside_view_volume(points_h: ArrayLike) -> NDArray[np.bool_] | bool:
 def plane_from_point_normal(point: ArrayLike, normal: ArrayLike) -> NDArray[np.float64]:
     """The world-space plane through `point` whose inside is the side `normal` points to.
 
-    ``(a, b, c, d) = (n_x, n_y, n_z, −n·p)``: a Cartesian point q (w = 1) is inside when ``n·q − n·p >= 0``.
+    $(a, b, c, d) = (n_x, n_y, n_z, −n·p)$: a Cartesian point q (w = 1) is inside when $n·q − n·p >= 0$.
     The normal is not normalized (its length does not change the inside).
 
     Raises
@@ -240,7 +240,7 @@ def plane_from_point_normal(point: ArrayLike, normal: ArrayLike) -> NDArray[np.f
 
     References
     ----------
-    [HB 10] "Arbitrary Clipping Planes" (cutaway views cut by a plane ``A·x + B·y + C·z + D = 0``).
+    [HB 10] "Arbitrary Clipping Planes" (cutaway views cut by a plane $A·x + B·y + C·z + D = 0$).
     """
     p = _single_point(point, "point", "plane_from_point_normal", (3,))
     n = _single_point(normal, "normal", "plane_from_point_normal", (3,))
@@ -250,10 +250,10 @@ def plane_from_point_normal(point: ArrayLike, normal: ArrayLike) -> NDArray[np.f
 
 
 def transform_plane(clip_from_world: ArrayLike, plane: ArrayLike) -> NDArray[np.float64]:
-    """Carry a plane (or (K, 4) planes) from world to clip space: ``plane_clip = (M⁻¹)ᵀ · plane_world``.
+    """Carry a plane (or (K, 4) planes) from world to clip space: $plane_clip = (M⁻¹)ᵀ · plane_world$.
 
-    For a world point ``P`` and ``P_clip = M·P``: ``plane_clip · P_clip = plane_worldᵀ·M⁻¹·M·P =
-    plane_world · P``, so every point keeps its inside/outside side, also where ``w_clip < 0``. Planes are
+    For a world point ``P`` and $P_clip = M·P$: $plane_clip · P_clip = plane_worldᵀ·M⁻¹·M·P =
+    plane_world · P$, so every point keeps its inside/outside side, also where $w_clip < 0$. Planes are
     covectors, like normals: they transform by the inverse transpose (pbrt's ``Normal3`` rule).
 
     Parameters
@@ -261,7 +261,7 @@ def transform_plane(clip_from_world: ArrayLike, plane: ArrayLike) -> NDArray[np.
     clip_from_world : (4, 4) array_like
         Invertible matrix, e.g. ``clip_from_view @ view_from_world``.
     plane : (4,) or (K, 4) array_like
-        ``(a, b, c, d)`` with inside ``a·x + b·y + c·z + d >= 0`` for world points.
+        ``(a, b, c, d)`` with inside $a·x + b·y + c·z + d >= 0$ for world points.
 
     Returns
     -------
@@ -293,7 +293,7 @@ def transform_plane(clip_from_world: ArrayLike, plane: ArrayLike) -> NDArray[np.
 
 
 class ClippedSegment(NamedTuple):
-    """The visible part of a segment: endpoints and their parameters on ``P = P1 + (P2 − P1)u``."""
+    """The visible part of a segment: endpoints and their parameters on $P = P1 + (P2 − P1)u$."""
 
     start: NDArray[np.float64]
     """(4,) (or (3,) for Cartesian input to ``clip_line_convex``) float64: the point at ``u_start``."""
@@ -330,13 +330,13 @@ def clip_line(
 
     Three algorithms, equal up to round-off:
 
-    - ``"liang-barsky"`` (default): parametric ``P = P1 + (P2 − P1)u``; per plane ``p_k·u <= q_k`` with
-      ``p_k = d(P1) − d(P2)``, ``q_k = d(P1)``, narrowing ``[u0, u1]`` from ``[0, 1]`` (a compiled kernel).
+    - ``"liang-barsky"`` (default): parametric $P = P1 + (P2 − P1)u$; per plane $p_k·u <= q_k$ with
+      $p_k = d(P1) − d(P2)$, $q_k = d(P1)$, narrowing ``[u0, u1]`` from ``[0, 1]`` (a compiled kernel).
     - ``"cohen-sutherland"``: region codes; trivially accept (``c1 | c2 == 0``) or reject (``c1 & c2 != 0``),
       else move an outside end to its lowest set bit's plane and recompute its code.
-    - ``"cyrus-beck"``: ``t = −N·P1 / N·D`` for the inward normals N (the cube's six here).
+    - ``"cyrus-beck"``: $t = −N·P1 / N·D$ for the inward normals N (the cube's six here).
 
-    An end inside every plane is returned bit for bit. The segment crossing ``w = 0`` (one end behind the eye)
+    An end inside every plane is returned bit for bit. The segment crossing $w = 0$ (one end behind the eye)
     keeps only the part in front, as a segment: it is never wrapped around through infinity.
 
     Parameters
@@ -345,7 +345,7 @@ def clip_line(
         Clip-space points ``(x, y, z, w)``.
     method : {"liang-barsky", "cohen-sutherland", "cyrus-beck"}
     planes : (K, 4) or (4,) array_like, optional
-        Extra clip-space planes (inside ``a·x + b·y + c·z + d·w >= 0``), applied after the cube's six.
+        Extra clip-space planes (inside $a·x + b·y + c·z + d·w >= 0$), applied after the cube's six.
     record : callable, optional
         Called as ``record(event, **values)`` at each step (``frustum.steps`` builds its record from it).
         Liang–Barsky then runs in the Python twin of its kernel (``_liang_barsky``, tested equal bit for bit).
@@ -362,7 +362,7 @@ def clip_line(
     References
     ----------
     [HB 10] "Three-Dimensional Point and Line Clipping", "Clipping in Three-Dimensional Homogeneous
-    Coordinates"; [seed] "3D Point and Line Clipping" (``P = P1 + (P2 − P1)u``).
+    Coordinates"; [seed] "3D Point and Line Clipping" ($P = P1 + (P2 − P1)u$).
     """
     start = _point4(p0, "p0", "clip_line")
     end = _point4(p1, "p1", "clip_line")
@@ -388,7 +388,7 @@ def clip_lines(p0s: ArrayLike, p1s: ArrayLike, planes: ArrayLike | None = None) 
     p0s, p1s : (N, 4) array_like
         First and second ends of each segment.
     planes : (K, 4) array_like, optional
-        Extra clip-space planes, at most ``MAX_KERNEL_PLANES − 6``.
+        Extra clip-space planes, at most $MAX_KERNEL_PLANES − 6$.
 
     Returns
     -------
@@ -421,9 +421,9 @@ def clip_lines(p0s: ArrayLike, p1s: ArrayLike, planes: ArrayLike | None = None) 
 def clip_line_convex(p0: ArrayLike, p1: ArrayLike, planes: ArrayLike) -> ClippedSegment | None:
     """Cyrus–Beck: the part of segment p0 → p1 inside the convex region bounded by `planes` (no cube), or None.
 
-    With inward normals N_k: ``N·P(t) >= 0`` for ``P(t) = P1 + D·t``, ``D = P2 − P1``. Where ``N·D > 0`` the
-    segment enters at ``t = −N·P1 / N·D`` (raise t_lower), where ``N·D < 0`` it leaves (lower t_upper), where
-    ``N·D = 0`` it is parallel and is rejected if ``N·P1 < 0``. Visible iff ``t_lower <= t_upper``.
+    With inward normals N_k: $N·P(t) >= 0$ for $P(t) = P1 + D·t$, $D = P2 − P1$. Where $N·D > 0$ the
+    segment enters at $t = −N·P1 / N·D$ (raise t_lower), where $N·D < 0$ it leaves (lower t_upper), where
+    $N·D = 0$ it is parallel and is rejected if $N·P1 < 0$. Visible iff $t_lower <= t_upper$.
 
     Parameters
     ----------
@@ -431,7 +431,7 @@ def clip_line_convex(p0: ArrayLike, p1: ArrayLike, planes: ArrayLike) -> Clipped
         Both Cartesian ``(x, y, z)`` (taken with w = 1, e.g. world space for a cutaway box) or both
         homogeneous ``(x, y, z, w)`` (clip space). The result has the same width.
     planes : (K, 4) or (4,) array_like
-        ``(a, b, c, d)``, inside ``a·x + b·y + c·z + d·w >= 0``: the region is their intersection.
+        ``(a, b, c, d)``, inside $a·x + b·y + c·z + d·w >= 0$: the region is their intersection.
 
     Raises
     ------
@@ -576,7 +576,7 @@ def clip_polygon(
 
     Plane after plane, each edge S → E of the current polygon gives: E inside and S outside → the
     intersection then E; both inside → E; S inside and E outside → the intersection; both outside → nothing.
-    The intersection is ``P = P_in + (P_out − P_in)u`` with ``u = d_in / (d_in − d_out)``, computed from the
+    The intersection is $P = P_in + (P_out − P_in)u$ with $u = d_in / (d_in − d_out)$, computed from the
     inside end; attributes interpolate with the same u, i.e. linearly in clip space (the perspective-correct
     choice: they are then divided by w with the position). A convex polygon stays convex; a concave one may
     come back with zero-width connecting edges along a plane (the algorithm's known trait; its area is right).
@@ -703,7 +703,7 @@ class ClippedTriangles(NamedTuple):
     def interpolate(self, faces: ArrayLike, attributes: ArrayLike) -> NDArray[np.float64]:
         """Per-vertex `attributes` (V, ...) of the input mesh extended to all V + K output vertices.
 
-        `faces` are the input faces given to ``clip_triangles``. New vertices get ``Σ_j w_j·attribute_j``
+        `faces` are the input faces given to ``clip_triangles``. New vertices get $Σ_j w_j·attribute_j$
         over their source triangle's corners (linear in clip space).
         """
         values = np.asarray(attributes, dtype=np.float64)
@@ -729,7 +729,7 @@ def clip_triangles(vertices_h: ArrayLike, faces: ArrayLike, planes: ArrayLike | 
         Vertex indices of each triangle.
     planes : (K, 4) array_like, optional
         Extra clip-space planes (a cutaway: ``transform_plane(clip_from_world, plane_world)``), at most
-        ``MAX_KERNEL_PLANES − 6``.
+        $MAX_KERNEL_PLANES − 6$.
 
     Returns
     -------

@@ -3,17 +3,18 @@
 [HB "Environment Mapping"]: the surroundings are painted on a sphere (or a cube) around the scene, far enough that
 only the direction of a ray matters. A shiny surface shows the map where its reflected view vector points,
 
-    R = V − 2 (N·V) N         (V the unit view vector from the eye to the surface point, N the unit normal),
+$$R = V − 2 (N·V) N$$
 
-and a pixel where nothing is drawn shows the map along its own viewing ray. Two layouts:
+with V the unit view vector from the eye to the surface point and N the unit normal, and a pixel where nothing
+is drawn shows the map along its own viewing ray. Two layouts:
 
 * ``kind="equirect"``: a (H, 2H) latitude–longitude image, y up. A unit direction (x, y, z) maps to
-  ``u = 1/2 + atan2(x, −z) / 2π`` (columns left to right: −z at the centre, +x at three quarters) and
-  ``v = acos(y) / π`` (rows top to bottom: +y at the top row). This is the layout of most HDR panoramas
+  $u = 1/2 + atan2(x, −z) / 2π$ (columns left to right: −z at the centre, +x at three quarters) and
+  $v = acos(y) / π$ (rows top to bottom: +y at the top row). This is the layout of most HDR panoramas
   (Poly Haven's, Blender's) seen from inside with −z forward.
 * ``kind="cube"``: six square faces (6, S, S, 3) in OpenGL's order +x, −x, +y, −y, +z, −z, each as seen from the
-  centre by the OpenGL cube-map rules (the major axis picks the face; ``s = (sc/|ma| + 1)/2``,
-  ``t = (tc/|ma| + 1)/2`` with sc, tc from the GL specification's table, t down the rows).
+  centre by the OpenGL cube-map rules (the major axis picks the face; $s = (sc/|ma| + 1)/2$,
+  $t = (tc/|ma| + 1)/2$ with sc, tc from the GL specification's table, t down the rows).
 
 Lookups are bilinear (equirect wraps in u); ``intensity`` scales the map (an HDR map may exceed 1; the renderer
 clamps when it writes bytes). Images load with ``EnvironmentMap.load``: PNG/JPEG through imageio (bytes / 255,
@@ -46,7 +47,7 @@ ENVIRONMENT_KINDS = ("equirect", "cube")
 
 
 def reflect_directions(view: ArrayLike, normal: ArrayLike) -> NDArray[np.float64]:
-    """(N, 3) reflected view vectors ``R = V − 2 (N·V) N`` for unit view vectors V (eye → surface) and unit N."""
+    """(N, 3) reflected view vectors $R = V − 2 (N·V) N$ for unit view vectors V (eye → surface) and unit N."""
     v = np.asarray(view, dtype=np.float64)
     n = np.asarray(normal, dtype=np.float64)
     return v - 2.0 * (v * n).sum(axis=-1, keepdims=True) * n

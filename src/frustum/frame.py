@@ -20,7 +20,7 @@ __all__ = ["Frame", "background_bytes"]
 class Frame:
     """What ``render`` returns: ``color`` (H, W, 4) uint8 RGBA and ``depth`` (H, W) float32, top row first.
 
-    Row ``r`` of both arrays is window row ``y_w = H − 1 − r`` (OpenGL's readback flipped vertically, the way
+    Row ``r`` of both arrays is window row $y_w = H − 1 − r$ (OpenGL's readback flipped vertically, the way
     images are stored). ``depth`` is window depth in [0, 1], 1.0 where nothing was drawn. Color is linear RGB,
     not sRGB-encoded unless asked for. Optional buffers (``render(..., buffers=...)``): ``normals`` (H, W, 3)
     float32 unit world normals (0 where nothing was drawn) and ``object_id`` (H, W) int32, the index of the
@@ -119,7 +119,7 @@ class Frame:
 
 
 def background_bytes(background: Any, where: str) -> np.ndarray:
-    """An RGBA color in [0, 1] as the (4,) uint8 bytes every renderer paints, ``floor(255·v + 1/2)``."""
+    """An RGBA color in [0, 1] as the (4,) uint8 bytes every renderer paints, $floor(255·v + 1/2)$."""
     try:
         values = np.asarray(background, dtype=np.float64)
     except (TypeError, ValueError):

@@ -17,7 +17,7 @@ pixel grid. For line drawings that means: for every drawn edge, find the parts t
    grid over the window bins the projected triangles' bounding boxes; an edge meets only the triangles of the
    cells it passes through (each pair once: in the first such cell the triangle's box covers).
 4. **Hidden intervals.** Triangle T hides the t for which the point lies inside T's projection (three edge
-   functions ``E_k(t) >= 0``) and behind T's plane (``z_edge(t) − z_T(t) > 0``): four linear inequalities in
+   functions $E_k(t) >= 0$) and behind T's plane ($z_edge(t) − z_T(t) > 0$): four linear inequalities in
    t, solved like Liang–Barsky clipping. The interval ends are exactly where the edge crosses a projected
    triangle edge or pierces the triangle's plane; it counts only if the gap exceeds ε = 1e-9 (NDC z) at one
    end, so an edge lying in a face's plane is never hidden by round-off. The union of these intervals is the
@@ -263,12 +263,12 @@ def feature_edges(
 
     Faces are adjacent when they share two vertex *positions* (``welded_faces``: split vertices at shading
     seams do not make boundaries). An edge is a *boundary* with one adjacent face (or more than two), a
-    *crease* when the angle between its two unit face normals, ``atan2(|n1 × n2|, n1·n2)``, exceeds
+    *crease* when the angle between its two unit face normals, $atan2(|n1 × n2|, n1·n2)$, exceeds
     `crease_angle`, a *silhouette* when exactly one of the two faces is front-facing for `camera`. Neighbours
     within ``COPLANAR_ANGLE`` (1e-4 rad) of each other are coplanar: their edge is neither, so the triangles of
     a flat face never draw lines between them. Front-facing is the plane test against the centre of
     projection, computed in clip space as ``det[(x, y, w)_0; (x, y, w)_1; (x, y, w)_2] > 0`` (the signed
-    window area times ``w0·w1·w2``, valid also for corners behind the eye). Faces of zero area have no
+    window area times $w0·w1·w2$, valid also for corners behind the eye). Faces of zero area have no
     normal: their edges are neither creases nor silhouettes.
 
     Parameters
@@ -310,7 +310,7 @@ def front_facing(clip_from_world: Matrix4, points_world: NDArray, faces: NDArray
     """(M,) True for faces whose front the camera sees: the plane test against the centre of projection, as
     ``det[(x, y, w)_0; (x, y, w)_1; (x, y, w)_2] > 0`` of the corners' clip rows (valid behind the eye too).
 
-    A face seen edge-on (``det = a·((b − a) × (c − a))`` within 1e-9 of ``|a|·|b − a|·|c − a|``, about 1e-9
+    A face seen edge-on ($det = a·((b − a) × (c − a))$ within 1e-9 of $|a|·|b − a|·|c − a|$, about 1e-9
     rad) counts as not front-facing, whatever the round-off sign: the silhouette is then the boundary of the
     front-facing region, the nearest of the edges that project onto the edge-on face's line.
     """
@@ -448,7 +448,7 @@ def remove_hidden_lines(
     """Visible and hidden pieces of the drawn edges of `meshes` seen by `camera`, exact in floating point.
 
     A point ``E(t)`` of a projected edge is hidden by triangle T when it lies inside T's projection and
-    ``z_edge(t) − z_T(t) > 0`` (depth along the line of sight; the gap must exceed ε = 1e-9 in NDC z somewhere
+    $z_edge(t) − z_T(t) > 0$ (depth along the line of sight; the gap must exceed ε = 1e-9 in NDC z somewhere
     on the interval); both depths are affine in the window-space parameter t, so each hidden interval is found
     exactly, like a Liang–Barsky clip.
 

@@ -1,9 +1,9 @@
 """The particle pass of ``render``: every particle layer of the scene over the finished opaque surfaces.
 
 For each layer (``Scene.add_particles``), in scene order, the particles' world positions go through the camera
-(``clip = clip_from_world·[x, 1]``, divide, ``window_from_ndc``); a particle is drawn when ``w > 0`` and
-``−w <= z_clip <= w`` (between the near and far planes). Its radius in pixels is the projected size,
-``R = size·|P₁₁|·H/2 / w`` (P the projection matrix, w the clip w: the view distance in perspective, 1 in
+($clip = clip_from_world·[x, 1]$, divide, ``window_from_ndc``); a particle is drawn when $w > 0$ and
+$−w <= z_clip <= w$ (between the near and far planes). Its radius in pixels is the projected size,
+$R = size·|P₁₁|·H/2 / w$ (P the projection matrix, w the clip w: the view distance in perspective, 1 in
 parallel projections). Sprites smaller than one pixel are drawn with R = 1 and α scaled by R² (the same
 total light, no sprite lost between pixel centres); points with R at least ½.
 
@@ -11,10 +11,10 @@ Styles: ``"sprites"`` (camera-facing round discs with soft edges, ``raster.parti
 (hard squares of side 2R), ``"streaks"`` (a 1-pixel line from each particle's previous position to its current
 one: motion blur; both ends must be in front of the camera). Blending: ``"additive"`` (fire, sparks: order
 free) or ``"alpha"`` (smoke: drawn back to front by clip w, farthest first, a stable sort). Depth: tested
-against the depth buffer of the surfaces (``z < depth``), never written, so particles behind a mesh are hidden
+against the depth buffer of the surfaces ($z < depth$), never written, so particles behind a mesh are hidden
 and particles do not hide one another.
 
-Colors accumulate in float32 byte units and are rounded once per render (``⌊min(C, 255) + ½⌋``); the alpha
+Colors accumulate in float32 byte units and are rounded once per render ($⌊min(C, 255) + ½⌋$); the alpha
 channel is left as the surfaces made it.
 
 References

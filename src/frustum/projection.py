@@ -7,7 +7,7 @@ at z_ndc = −1 and the far plane at +1, as in OpenGL and glm's ``*RH_NO`` build
 ``window_from_ndc``.
 
 ``near`` and ``far`` are positive distances in front of the eye, as in glm. The textbook writes the same
-planes as view-plane coordinates ``z_near = −near`` and ``z_far = −far``; each docstring gives both forms.
+planes as view-plane coordinates $z_near = −near$ and $z_far = −far$; each docstring gives both forms.
 
 The frozen types ``Perspective``, ``Frustum``, ``Orthographic``, ``Oblique`` and ``Axonometric`` are what a
 ``Camera`` holds: each stores its parameters (validated once) and builds its matrix with ``.matrix(aspect)``,
@@ -122,11 +122,11 @@ def _oblique_alpha(alpha: float, where: str) -> float:
 
 
 def orthographic(left: float, right: float, bottom: float, top: float, near: float, far: float) -> Matrix4:
-    """Clip-from-view matrix M_ortho,norm: the orthogonal view box onto the symmetric cube [−1, 1]³.
+    """Clip-from-view matrix $M_{ortho,norm}$: the orthogonal view box onto the symmetric cube [−1, 1]³.
 
-    ``x_n = 2x/(xw_max − xw_min) − (xw_max + xw_min)/(xw_max − xw_min)``, alike for y, and
-    ``z_n = −2z/(z_near − z_far) + (z_near + z_far)/(z_near − z_far)`` with ``z_near = −near``,
-    ``z_far = −far``; w stays 1. The target cube is left-handed (z_view = −near maps to −1, −far to +1).
+    $x_n = 2x/(xw_max − xw_min) − (xw_max + xw_min)/(xw_max − xw_min)$, alike for y, and
+    $z_n = −2z/(z_near − z_far) + (z_near + z_far)/(z_near − z_far)$ with $z_near = −near$,
+    $z_far = −far$; w stays 1. The target cube is left-handed (z_view = −near maps to −1, −far to +1).
     Equal to glm ``orthoRH_NO``.
 
     Parameters
@@ -214,8 +214,8 @@ def multiview(name: str) -> MultiView:
 def axonometric_rotation(rotation_y: float, rotation_x: float) -> Matrix4:
     """Rotation that turns an object for an axonometric view: first about y, then about x.
 
-    ``R = R_x(rotation_x) · R_y(rotation_y)``. An orthogonal projection of the rotated object onto the xy plane
-    foreshortens the unit axes by ``f_i = |(R e_i)_xy|``, with ``f_x² + f_y² + f_z² = 2`` for any rotation.
+    $R = R_x(rotation_x) · R_y(rotation_y)$. An orthogonal projection of the rotated object onto the xy plane
+    foreshortens the unit axes by ``f_i = |(R e_i)_xy|``, with $f_x² + f_y² + f_z² = 2$ for any rotation.
 
     References
     ----------
@@ -246,7 +246,7 @@ def _cube(size: float, where: str) -> Matrix4:
 def isometric(size: float = 1.0) -> Matrix4:
     """Clip-from-world matrix of the isometric view of an object centered at the origin.
 
-    ``M = M_ortho,norm · R_x(35.264°) · R_y(45°)`` with ``sin 35.264° = tan 30°``: the three principal axes make
+    $M = M_{ortho,norm} · R_x(35.264°) · R_y(45°)$ with $sin 35.264° = tan 30°$: the three principal axes make
     equal angles with the view plane and are all foreshortened by √(2/3) ≈ 0.8165 (before the normalization
     scale 1/size). The view volume is the cube [−size, size]³ around the origin.
 
@@ -265,9 +265,9 @@ def isometric(size: float = 1.0) -> Matrix4:
 def dimetric(ratio: float, size: float = 1.0) -> Matrix4:
     """Clip-from-world matrix of a dimetric view: x and z foreshortened equally, y by `ratio` times as much.
 
-    ``M = M_ortho,norm · R_x(α) · R_y(45°)`` with ``sin²α = (2 − ratio²)/(2 + ratio²)``, so that
-    ``f_x = f_z = √((1 + sin²α)/2)`` and ``f_y = cos α = ratio · f_x``. ``ratio = 1`` is the isometric view;
-    ``ratio = 0.5`` draws verticals at half the scale of the two horizontal axes.
+    $M = M_{ortho,norm} · R_x(α) · R_y(45°)$ with $sin²α = (2 − ratio²)/(2 + ratio²)$, so that
+    $f_x = f_z = √((1 + sin²α)/2)$ and $f_y = cos α = ratio · f_x$. $ratio = 1$ is the isometric view;
+    $ratio = 0.5$ draws verticals at half the scale of the two horizontal axes.
 
     Parameters
     ----------
@@ -293,8 +293,8 @@ def dimetric(ratio: float, size: float = 1.0) -> Matrix4:
 def trimetric(rotation_y: float, rotation_x: float, size: float = 1.0) -> Matrix4:
     """Clip-from-world matrix of a trimetric view: rotate about y, then about x, then project orthogonally.
 
-    ``M = M_ortho,norm · R_x(rotation_x) · R_y(rotation_y)``; the foreshortenings ``f_i = |(R e_i)_xy|`` are all
-    different for general angles (rotation_y = 45° gives a dimetric view, plus rotation_x = 35.264° the
+    $M = M_{ortho,norm} · R_x(rotation_x) · R_y(rotation_y)$; the foreshortenings ``f_i = |(R e_i)_xy|`` are all
+    different for general angles ($rotation_y = 45°$ gives a dimetric view, plus $rotation_x = 35.264°$ the
     isometric one).
 
     Raises
@@ -316,7 +316,7 @@ def trimetric(rotation_y: float, rotation_x: float, size: float = 1.0) -> Matrix
 def oblique_from_vector(projection_vector: ArrayLike, z_vp: float = 0.0) -> Matrix4:
     """The seed's M_oblique: shear view space along the projection vector Vp onto orthogonal coordinates.
 
-    ``x_p = x + (z_vp − z)·Vpx/Vpz``, ``y_p = y + (z_vp − z)·Vpy/Vpz``, z unchanged (kept for depth), so an
+    $x_p = x + (z_vp − z)·Vpx/Vpz$, $y_p = y + (z_vp − z)·Vpy/Vpz$, z unchanged (kept for depth), so an
     orthogonal projection of the sheared points is the oblique projection onto the view plane z = z_vp.
 
     Parameters
@@ -362,9 +362,9 @@ def _oblique_vector(alpha: float, phi: float, where: str) -> Vector3:
 def oblique(alpha: float, phi: float, z_vp: float = 0.0) -> Matrix4:
     """M_oblique for projection lines at angle `alpha` to the view plane, receding edges drawn at angle `phi`.
 
-    ``x_p = x + L1·(z_vp − z)·cos φ``, ``y_p = y + L1·(z_vp − z)·sin φ`` with ``L1 = 1/tan α`` (Hearn & Baker's
+    $x_p = x + L1·(z_vp − z)·cos φ$, $y_p = y + L1·(z_vp − z)·sin φ$ with $L1 = 1/tan α$ (Hearn & Baker's
     sign: a point a distance d behind the view plane moves by L1·d along the direction φ). This is
-    ``oblique_from_vector((L1 cos φ, L1 sin φ, 1), z_vp)``. A unit edge perpendicular to the view plane is
+    $oblique_from_vector((L1 cos φ, L1 sin φ, 1), z_vp)$. A unit edge perpendicular to the view plane is
     drawn with length L1 at angle φ from the x axis.
 
     Parameters
@@ -391,7 +391,7 @@ def oblique(alpha: float, phi: float, z_vp: float = 0.0) -> Matrix4:
 
 
 def cavalier(phi: float = math.pi / 4, z_vp: float = 0.0) -> Matrix4:
-    """Cavalier projection: ``oblique(α = 45°, phi)``, L1 = 1, receding edges drawn at full length.
+    """Cavalier projection: $oblique(α = 45°, phi)$, L1 = 1, receding edges drawn at full length.
 
     References
     ----------
@@ -401,7 +401,7 @@ def cavalier(phi: float = math.pi / 4, z_vp: float = 0.0) -> Matrix4:
 
 
 def cabinet(phi: float = math.pi / 4, z_vp: float = 0.0) -> Matrix4:
-    """Cabinet projection: ``oblique(α = atan 2 ≈ 63.43°, phi)``, L1 = 1/2, receding edges drawn at half length.
+    """Cabinet projection: $oblique(α = atan 2 ≈ 63.43°, phi)$, L1 = 1/2, receding edges drawn at half length.
 
     References
     ----------
@@ -420,7 +420,7 @@ def oblique_normalized(
     far: float,
     z_vp: float = 0.0,
 ) -> Matrix4:
-    """Clip-from-view matrix of an oblique parallel projection: ``M_oblique,norm = M_ortho,norm · M_oblique``.
+    """Clip-from-view matrix of an oblique parallel projection: $M_{oblique,norm} = M_{ortho,norm} · M_oblique$.
 
     The shear turns the oblique view volume (a parallelepiped along Vp) into the orthogonal box
     [left, right] × [bottom, top] × [−far, −near], which ``orthographic`` maps onto [−1, 1]³.
@@ -445,10 +445,10 @@ def oblique_normalized(
 def perspective(fovy: float, aspect: float, near: float, far: float) -> Matrix4:
     """Clip-from-view matrix of a symmetric perspective frustum (right-handed view, NDC z in [−1, 1]).
 
-    With f = cot(fovy/2): ``x_c = (f/aspect)·x``, ``y_c = f·y``,
-    ``z_c = (z_near + z_far)/(z_near − z_far)·z − 2·z_near·z_far/(z_near − z_far)``, ``w_c = −z``, where
-    ``z_near = −near``, ``z_far = −far``. Equal to glm ``perspectiveRH_NO``, and to ``frustum`` with
-    top = near·tan(fovy/2), right = aspect·top.
+    With $f = cot(fovy/2)$: $x_c = (f/aspect)·x$, $y_c = f·y$,
+    $z_c = (z_near + z_far)/(z_near − z_far)·z − 2·z_near·z_far/(z_near − z_far)$, $w_c = −z$, where
+    $z_near = −near$, $z_far = −far$. Equal to glm ``perspectiveRH_NO``, and to ``frustum`` with
+    $top = near·tan(fovy/2)$, $right = aspect·top$.
 
     Parameters
     ----------
@@ -493,8 +493,8 @@ def perspective(fovy: float, aspect: float, near: float, far: float) -> Matrix4:
 def frustum(left: float, right: float, bottom: float, top: float, near: float, far: float) -> Matrix4:
     """Clip-from-view matrix of a general (possibly oblique, off-axis) perspective frustum.
 
-    ``x_c = (−2z_near·x + (xw_max + xw_min)·z)/(xw_max − xw_min)``, alike for y, z_c and w_c = −z as in
-    ``perspective``; the window [left, right] × [bottom, top] lies on the near plane z = z_near = −near.
+    $x_c = (−2z_near·x + (xw_max + xw_min)·z)/(xw_max − xw_min)$, alike for y, $z_c$ and $w_c = −z$ as in
+    ``perspective``; the window [left, right] × [bottom, top] lies on the near plane $z = z_near = −near$.
     Off-center windows (left != −right) are the oblique frusta used for stereo pairs. Equal to glm
     ``frustumRH_NO``, and to ``general_perspective`` with the PRP at the origin and z_vp = −near.
 
@@ -533,12 +533,12 @@ def frustum(left: float, right: float, bottom: float, top: float, near: float, f
 def perspective_onto_plane(prp: ArrayLike, z_vp: float) -> Matrix4:
     """The seed's parametric perspective projection onto the view plane z = z_vp, as a homogeneous matrix.
 
-    Along the line from P to the projection reference point PRP, ``P' = P − (P − PRP)·u``; where it meets the
-    view plane, ``u = (z_vp − z)/(z_prp − z)``, so
-    ``x_p = (x·(z_prp − z_vp) + x_prp·(z_vp − z))/(z_prp − z)`` (alike for y) and ``z_p = z_vp``.
-    Homogeneous form: ``h = z_prp − z``,
-    ``M_pers = [[d_p, 0, −x_prp, x_prp·z_vp], [0, d_p, −y_prp, y_prp·z_vp], [0, 0, −z_vp, z_vp·z_prp],
-    [0, 0, −1, z_prp]]`` with ``d_p = z_prp − z_vp``. The depth is lost; ``general_perspective`` keeps it.
+    Along the line from P to the projection reference point PRP, $P' = P − (P − PRP)·u$; where it meets the
+    view plane, $u = (z_vp − z)/(z_prp − z)$, so
+    $x_p = (x·(z_prp − z_vp) + x_prp·(z_vp − z))/(z_prp − z)$ (alike for y) and $z_p = z_vp$.
+    Homogeneous form: $h = z_prp − z$,
+    $M_pers = [[d_p, 0, −x_prp, x_prp·z_vp], [0, d_p, −y_prp, y_prp·z_vp], [0, 0, −z_vp, z_vp·z_prp],
+    [0, 0, −1, z_prp]]$ with $d_p = z_prp − z_vp$. The depth is lost; ``general_perspective`` keeps it.
 
     Parameters
     ----------
@@ -584,14 +584,14 @@ def general_perspective_steps(
     With the projection reference point PRP, the view plane z = z_vp and the clipping window
     (xw_min, xw_max, yw_min, yw_max) on it:
 
-    1. ``T(−PRP)``: move the PRP to the origin (window and view plane move with it: z'_vp = z_vp − z_prp).
-    2. ``M_zshear``: ``x' = x + sh_zx·z``, ``y' = y + sh_zy·z`` with ``sh_zx = −(xw_min + xw_max)/(2z'_vp)``,
-       ``sh_zy = −(yw_min + yw_max)/(2z'_vp)`` (window relative to the PRP): the frustum centerline, from the
+    1. $T(−PRP)$: move the PRP to the origin (window and view plane move with it: $z'_vp = z_vp − z_prp$).
+    2. ``M_zshear``: $x' = x + sh_zx·z$, $y' = y + sh_zy·z$ with $sh_zx = −(xw_min + xw_max)/(2z'_vp)$,
+       $sh_zy = −(yw_min + yw_max)/(2z'_vp)$ (window relative to the PRP): the frustum centerline, from the
        PRP through the window center, becomes the z axis.
-    3. ``M_pers``: ``x_h = −z'_vp·x``, ``y_h = −z'_vp·y``, ``z_h = s_z·z + t_z``, ``h = −z`` with
-       ``s_z = (z_near + z_far)/(z_near − z_far)``, ``t_z = −2·z_near·z_far/(z_near − z_far)``: the perspective
+    3. ``M_pers``: $x_h = −z'_vp·x$, $y_h = −z'_vp·y$, $z_h = s_z·z + t_z$, $h = −z$ with
+       $s_z = (z_near + z_far)/(z_near − z_far)$, $t_z = −2·z_near·z_far/(z_near − z_far)$: the perspective
        transformation onto the view plane, keeping depth (near → −1, far → +1 after the divide).
-    4. ``M_xyscale = S(2/(xw_max − xw_min), 2/(yw_max − yw_min), 1)``: the symmetric frustum becomes the
+    4. $M_xyscale = S(2/(xw_max − xw_min), 2/(yw_max − yw_min), 1)$: the symmetric frustum becomes the
        canonical cube [−1, 1]³.
 
     Parameters
@@ -604,8 +604,8 @@ def general_perspective_steps(
         (xw_min, xw_max, yw_min, yw_max) on the view plane, view coordinates; min < max.
     near, far : float
         Positive distances of the clipping planes in front of the PRP, 0 < near < far; in the PRP-centered
-        coordinates of step 3 they are ``z_near = −near``, ``z_far = −far`` (in view coordinates
-        ``z_prp − near`` and ``z_prp − far``).
+        coordinates of step 3 they are $z_near = −near$, $z_far = −far$ (in view coordinates
+        $z_prp − near$ and $z_prp − far$).
 
     Raises
     ------
@@ -659,7 +659,7 @@ def general_perspective_steps(
 
 
 def general_perspective(prp: ArrayLike, z_vp: float, window: ArrayLike, near: float, far: float) -> Matrix4:
-    """Clip-from-view matrix of the seed's general perspective: ``M_xyscale · M_pers · M_zshear · T(−PRP)``.
+    """Clip-from-view matrix of the seed's general perspective: $M_xyscale · M_pers · M_zshear · T(−PRP)$.
 
     ``general_perspective_steps`` explains each factor and the parameters; their product maps the frustum
     from the PRP through the window onto [−1, 1]³ (near → −1, far → +1).
@@ -677,8 +677,8 @@ def general_perspective(prp: ArrayLike, z_vp: float, window: ArrayLike, near: fl
 def viewport(x: float, y: float, width: float, height: float, depth_range: tuple[float, float] = (0.0, 1.0)) -> Matrix4:
     """Window-from-NDC matrix: the canonical cube [−1, 1]³ onto the viewport rectangle and the depth range.
 
-    ``x_w = x + width·(x_n + 1)/2``, ``y_w = y + height·(y_n + 1)/2``,
-    ``z_w = d_near + (d_far − d_near)·(z_n + 1)/2``. Window y points up (OpenGL, glm ``project``); window
+    $x_w = x + width·(x_n + 1)/2$, $y_w = y + height·(y_n + 1)/2$,
+    $z_w = d_near + (d_far − d_near)·(z_n + 1)/2$. Window y points up (OpenGL, glm ``project``); window
     coordinates are continuous, with pixel (i, j) covering [x + i, x + i + 1) × [y + j, y + j + 1) and its
     center at the half-integers (x + i + 0.5, y + j + 0.5). NDC x = −1 is the left edge of pixel 0, not its
     center. Depth 1 is the far plane.
@@ -733,7 +733,7 @@ def _aspect(aspect: float, where: str) -> float:
 class Perspective:
     """Symmetric perspective projection with vertical field of view `fovy`; the camera supplies the aspect.
 
-    ``matrix(aspect) = perspective(fovy, aspect, near, far)``. fovy in radians, 0 < fovy < π; 0 < near < far.
+    $matrix(aspect) = perspective(fovy, aspect, near, far)$. fovy in radians, 0 < fovy < π; 0 < near < far.
     """
 
     fovy: float
@@ -761,7 +761,7 @@ class Perspective:
 class Frustum:
     """Perspective projection through a fixed, possibly off-center window on the near plane (stereo, tiles).
 
-    ``matrix(aspect) = frustum(left, right, bottom, top, near, far)``; `aspect` is ignored, so choose a window
+    $matrix(aspect) = frustum(left, right, bottom, top, near, far)$; `aspect` is ignored, so choose a window
     with (right − left)/(top − bottom) equal to the image aspect or the picture is stretched.
     """
 
@@ -799,7 +799,7 @@ def _centered_box(height: float, near: float, far: float, where: str) -> tuple[f
 class Orthographic:
     """Orthogonal projection of a centered view window `height` units tall (width = height · aspect).
 
-    ``matrix(aspect) = orthographic(−w/2, w/2, −height/2, height/2, near, far)`` with w = height · aspect.
+    $matrix(aspect) = orthographic(−w/2, w/2, −height/2, height/2, near, far)$ with w = height · aspect.
     near < far; near may be <= 0 for a parallel projection.
     """
 
@@ -816,7 +816,7 @@ class Orthographic:
             object.__setattr__(self, name, value)
 
     def matrix(self, aspect: float) -> Matrix4:
-        """Clip-from-view matrix M_ortho,norm for an image of the given width / height."""
+        """Clip-from-view matrix $M_{ortho,norm}$ for an image of the given width / height."""
         half_width = self.height * _aspect(aspect, "Orthographic.matrix") / 2
         return orthographic(-half_width, half_width, -self.height / 2, self.height / 2, self.near, self.far)
 
@@ -827,9 +827,9 @@ class Orthographic:
 
 @dataclass(frozen=True)
 class Oblique:
-    """Oblique parallel projection (alpha, phi) normalized to the canonical cube: M_ortho,norm · M_oblique.
+    """Oblique parallel projection (alpha, phi) normalized to the canonical cube: $M_{ortho,norm} · M_oblique$.
 
-    The view plane is ``z = z_vp``; by default ``z_vp = −(near + far)/2``, the middle of the depth range, so
+    The view plane is $z = z_vp$; by default $z_vp = −(near + far)/2$, the middle of the depth range, so
     an object placed there (a camera target at that distance) is drawn true-size and stays centered.
     ``Oblique.cavalier(...)`` and ``Oblique.cabinet(...)`` fix alpha at 45° and atan 2.
     """
@@ -864,7 +864,7 @@ class Oblique:
         return cls(CABINET_ALPHA, phi, height, near, far)
 
     def steps(self, aspect: float) -> tuple[Step, ...]:
-        """M_oblique, then M_ortho,norm, first-applied first."""
+        """$M_oblique$, then $M_{ortho,norm}$, first-applied first."""
         half_width = self.height * _aspect(aspect, "Oblique.matrix") / 2
         box = (-half_width, half_width, -self.height / 2, self.height / 2, self.near, self.far)
         assert self.z_vp is not None  # set in __post_init__
@@ -874,7 +874,7 @@ class Oblique:
         )
 
     def matrix(self, aspect: float) -> Matrix4:
-        """Clip-from-view matrix ``M_ortho,norm · M_oblique`` for an image of the given width / height."""
+        """Clip-from-view matrix $M_{ortho,norm} · M_oblique$ for an image of the given width / height."""
         return compose(*(step.matrix for step in self.steps(aspect)))
 
 
@@ -882,7 +882,7 @@ class Oblique:
 class Axonometric:
     """Axonometric parallel projection: rotate view space about a pivot, then project orthogonally.
 
-    ``matrix(aspect) = M_ortho,norm · T(0, 0, −pivot) · R_x(rotation_x) · R_y(rotation_y) · T(0, 0, pivot)``:
+    $matrix(aspect) = M_{ortho,norm} · T(0, 0, −pivot) · R_x(rotation_x) · R_y(rotation_y) · T(0, 0, pivot)$:
     the rotation turns the scene about the point at distance `pivot` on the line of sight (default the middle
     of [near, far]), so a camera aimed at a target at that distance keeps it centered while the principal axes
     of a camera looking down world −z are drawn isometrically, dimetrically or trimetrically.
@@ -910,12 +910,12 @@ class Axonometric:
 
     @classmethod
     def isometric(cls, height: float, near: float, far: float) -> Axonometric:
-        """Isometric view: rotation_y = 45°, rotation_x = 35.264° (all axes foreshortened by √(2/3))."""
+        """Isometric view: $rotation_y = 45°$, $rotation_x = 35.264°$ (all axes foreshortened by $√(2/3)$)."""
         return cls(math.pi / 4, ISOMETRIC_ROTATION_X, height, near, far)
 
     @classmethod
     def dimetric(cls, ratio: float, height: float, near: float, far: float) -> Axonometric:
-        """Dimetric view with f_y / f_x = f_y / f_z = `ratio` in (0, √2), as ``dimetric``."""
+        """Dimetric view with $f_y / f_x = f_y / f_z = ratio ∈ (0, √2)$, as ``dimetric``."""
         return cls(math.pi / 4, _dimetric_rotation_x(ratio, "Axonometric.dimetric"), height, near, far)
 
     @classmethod
@@ -924,7 +924,7 @@ class Axonometric:
         return cls(rotation_y, rotation_x, height, near, far)
 
     def steps(self, aspect: float) -> tuple[Step, ...]:
-        """Rotation about the pivot, then M_ortho,norm, first-applied first."""
+        """Rotation about the pivot, then $M_{ortho,norm}$, first-applied first."""
         assert self.pivot is not None  # set in __post_init__
         rotation = translate(0.0, 0.0, -self.pivot) @ axonometric_rotation(self.rotation_y, self.rotation_x)
         rotation = rotation @ translate(0.0, 0.0, self.pivot)

@@ -1,9 +1,9 @@
-"""Quaternions ``q = w + x·i + y·j + z·k`` for rotations about arbitrary axes, and slerp between them.
+"""Quaternions $q = w + x·i + y·j + z·k$ for rotations about arbitrary axes, and slerp between them.
 
 Component order is (w, x, y, z), scalar first, as in glm and pytransform3d (SciPy's default is scalar last:
-``docs/conventions.md`` has the table). A unit quaternion ``q = (cos θ/2, sin θ/2 · k)`` rotates a point p by
-``p' = q·p·q⁻¹`` (p as the pure quaternion (0, p)): θ radians about the unit axis k, right-hand rule.
-``q`` and ``−q`` are the same rotation. Products apply the right-hand factor first, like matrices:
+``docs/conventions.md`` has the table). A unit quaternion $q = (cos θ/2, sin θ/2 · k)$ rotates a point p by
+$p' = q·p·q⁻¹$ (p as the pure quaternion (0, p)): θ radians about the unit axis k, right-hand rule.
+``q`` and $−q$ are the same rotation. Products apply the right-hand factor first, like matrices:
 ``(q1 * q2).rotate(p) == q1.rotate(q2.rotate(p))``.
 
 References
@@ -39,7 +39,7 @@ _ROTATION_TOLERANCE = 1e-6
 
 @dataclass(frozen=True)
 class Quaternion:
-    """A quaternion ``w + x·i + y·j + z·k``; the unit ones are rotations (see the module docstring)."""
+    """A quaternion $w + x·i + y·j + z·k$; the unit ones are rotations (see the module docstring)."""
 
     w: float
     x: float
@@ -59,7 +59,7 @@ class Quaternion:
 
     @classmethod
     def from_axis_angle(cls, axis: ArrayLike, angle: float) -> Quaternion:
-        """Unit quaternion of the rotation by `angle` radians about `axis`: ``(cos θ/2, sin θ/2 · k)``.
+        """Unit quaternion of the rotation by `angle` radians about `axis`: $(cos θ/2, sin θ/2 · k)$.
 
         Raises
         ------
@@ -85,9 +85,9 @@ class Quaternion:
     def from_matrix(cls, matrix: ArrayLike) -> Quaternion:
         """Unit quaternion (with w >= 0) of a rotation matrix, (3, 3) or (4, 4) without translation.
 
-        Shepperd's method: take the largest of ``4w², 4x², 4y², 4z²`` (from the trace and the diagonal) for
+        Shepperd's method: take the largest of $4w², 4x², 4y², 4z²$ (from the trace and the diagonal) for
         the square root, and the others from the off-diagonal sums and differences, e.g. for w:
-        ``w = √(1 + R00 + R11 + R22)/2, x = (R21 − R12)/(4w)``.
+        $w = √(1 + R00 + R11 + R22)/2, x = (R21 − R12)/(4w)$.
 
         Raises
         ------
@@ -131,7 +131,7 @@ class Quaternion:
         return np.array([self.x, self.y, self.z])
 
     def __mul__(self, other: Quaternion | float) -> Quaternion:
-        """Hamilton product ``(w1·w2 − v1·v2, w1·v2 + w2·v1 + v1 × v2)``, or scaling by a real number."""
+        """Hamilton product $(w1·w2 − v1·v2, w1·v2 + w2·v1 + v1 × v2)$, or scaling by a real number."""
         if isinstance(other, Quaternion):
             v1, v2 = self.vector, other.vector
             return Quaternion(self.w * other.w - v1 @ v2, *(self.w * v2 + other.w * v1 + np.cross(v1, v2)))
@@ -158,15 +158,15 @@ class Quaternion:
         return Quaternion(-self.w, -self.x, -self.y, -self.z)
 
     def dot(self, other: Quaternion) -> float:
-        """Four-dimensional dot product ``w1·w2 + x1·x2 + y1·y2 + z1·z2`` (cos of half the angle between)."""
+        """Four-dimensional dot product $w1·w2 + x1·x2 + y1·y2 + z1·z2$ (cos of half the angle between)."""
         return float(self.as_array() @ other.as_array())
 
     def conjugate(self) -> Quaternion:
-        """``q* = (w, −x, −y, −z)``; for a unit quaternion, the inverse rotation."""
+        """$q* = (w, −x, −y, −z)$; for a unit quaternion, the inverse rotation."""
         return Quaternion(self.w, -self.x, -self.y, -self.z)
 
     def norm(self) -> float:
-        """``|q| = √(w² + x² + y² + z²)``."""
+        """$|q| = √(w² + x² + y² + z²)$."""
         return float(np.linalg.norm(self.as_array()))
 
     def normalized(self) -> Quaternion:
@@ -174,7 +174,7 @@ class Quaternion:
         return Quaternion(*(self.as_array() / self._nonzero_norm("normalized")))
 
     def inverse(self) -> Quaternion:
-        """``q⁻¹ = q* / |q|²``, so that ``q * q.inverse()`` is the identity."""
+        """$q⁻¹ = q* / |q|²$, so that ``q * q.inverse()`` is the identity."""
         return Quaternion(*(self.conjugate().as_array() / self._nonzero_norm("inverse") ** 2))
 
     # --- as a rotation ------------------------------------------------------------------------------------
@@ -182,8 +182,8 @@ class Quaternion:
     def to_matrix(self) -> Matrix4:
         """The (4, 4) rotation matrix of ``q/|q|``, column-vector convention.
 
-        With q unit: ``[[1 − 2(y² + z²), 2(xy − wz), 2(xz + wy)], [2(xy + wz), 1 − 2(x² + z²), 2(yz − wx)],
-        [2(xz − wy), 2(yz + wx), 1 − 2(x² + y²)]]`` in the upper-left block.
+        With q unit: $[[1 − 2(y² + z²), 2(xy − wz), 2(xz + wy)], [2(xy + wz), 1 − 2(x² + z²), 2(yz − wx)],
+        [2(xz − wy), 2(yz + wx), 1 − 2(x² + y²)]]$ in the upper-left block.
         """
         w, x, y, z = self.as_array() / self._nonzero_norm("to_matrix")
         # fmt: off
@@ -196,7 +196,7 @@ class Quaternion:
         # fmt: on
 
     def rotate(self, points: ArrayLike) -> Points:
-        """``p' = q·p·q⁻¹`` for every row of `points` ((N, 3) or a single (3,) point), vectorized."""
+        """$p' = q·p·q⁻¹$ for every row of `points` ((N, 3) or a single (3,) point), vectorized."""
         rotation = self.to_matrix()[:3, :3]
         try:
             single = np.shape(points) == (3,)
@@ -207,7 +207,7 @@ class Quaternion:
         return as_points(points, where="Quaternion.rotate") @ rotation.T
 
     def to_axis_angle(self) -> tuple[Vector3, float]:
-        """``(k, θ)`` with θ in [0, π] and k a unit axis: ``θ = 2·atan2(|v|, w)`` after choosing w >= 0.
+        """$(k, θ)$ with θ in [0, π] and k a unit axis: $θ = 2·atan2(|v|, w)$ after choosing w >= 0.
 
         The identity rotation has no axis; it returns ``((1, 0, 0), 0.0)``.
         """
@@ -232,9 +232,9 @@ class Quaternion:
 def slerp(q0: Quaternion, q1: Quaternion, t: float | ArrayLike) -> Quaternion | tuple[Quaternion, ...]:
     """Spherical linear interpolation from `q0` (t = 0) to `q1` (t = 1) along the shorter arc.
 
-    ``slerp = (sin((1 − t)·Ω)·q0 + sin(t·Ω)·q1) / sin Ω`` with ``cos Ω = q0·q1`` after normalizing both and
-    negating q1 when ``q0·q1 < 0`` (q and −q are one rotation; the negation picks the short path). Ω is
-    computed as ``2·atan2(|q0 − q1|, |q0 + q1|)``, accurate for any angle; below 1e-9 rad the result is the
+    $slerp = (sin((1 − t)·Ω)·q0 + sin(t·Ω)·q1) / sin Ω$ with $cos Ω = q0·q1$ after normalizing both and
+    negating q1 when $q0·q1 < 0$ (q and −q are one rotation; the negation picks the short path). Ω is
+    computed as $2·atan2(|q0 − q1|, |q0 + q1|)$, accurate for any angle; below 1e-9 rad the result is the
     normalized linear blend. `t` outside [0, 1] extrapolates along the same great circle.
 
     Returns

@@ -1,34 +1,38 @@
 """The radiosity lighting model: diffuse light bouncing between surfaces, by hemicubes and progressive refinement.
 
 Every surface is split into small patches k with area A_k, reflectance ρ_k and emission E_k; the light leaving
-each patch (its radiosity B_k, uniform over the patch) obeys [HB "Radiosity Lighting Model"]
+each patch (its radiosity $B_k$, uniform over the patch) obeys the radiosity equation [HB "Radiosity Lighting
+Model"]
 
-    B_k = E_k + ρ_k Σ_j B_j F_jk                         (the radiosity equation)
+$$B_k = E_k + ρ_k Σ_j B_j F_jk$$
 
-with the form factor F_jk, the fraction of the light leaving patch j that arrives at patch k. Reciprocity
-``A_j F_jk = A_k F_kj`` gives the shooting form ``B_k += ρ_k ΔB_j F_jk A_j / A_k``.
+with the form factor $F_jk$, the fraction of the light leaving patch j that arrives at patch k. Reciprocity
+$A_j F_jk = A_k F_kj$ gives the shooting form $B_k += ρ_k ΔB_j F_jk A_j / A_k$.
 
 * **Form factors by the hemicube** (Cohen & Greenberg 1985): a half cube of side 2 centred on the shooting patch,
   its top face at height 1 along the patch normal, is rasterized face by face (five faces: the top and the upper
   halves of the four sides) with frustum's own depth-buffer kernels (``raster.tiles`` / ``raster.triangles``
   through the render package's item pass), writing the code of the nearest patch into each pixel. Each pixel adds
-  its *delta form factor* to the patch it shows:
+  its *delta form factor* to the patch it shows, at (x, y, 1) on the top face and at (x, 1, z) on a side face
 
-      top face (x, y, 1):   ΔF = ΔA / (π (x² + y² + 1)²)
-      side face (x, 1, z):  ΔF = z ΔA / (π (x² + z² + 1)²)      (ΔA = (2/N)², N the hemicube resolution)
+    $$ΔF = ΔA / (π (x² + y² + 1)²)$$
 
-  The delta form factors of the whole hemicube sum to 1 (up to the pixel sampling).
+    $$ΔF = z ΔA / (π (x² + z² + 1)²)$$
+
+    with $ΔA = (2/N)²$, N the hemicube resolution. The delta form factors of the whole hemicube sum to 1 (up to
+    the pixel sampling).
+
 * **Progressive refinement** (Cohen, Chen, Wallace & Greenberg 1988): repeatedly shoot the patch with the most
-  unshot power ΔB_j A_j: render its hemicube, add ``ρ_k ΔB_j F_jk A_j / A_k`` to B_k and to the unshot ΔB_k of
-  every patch it sees, and set ΔB_j = 0. The residual is the unshot power over the power emitted.
+  unshot power ΔB_j A_j: render its hemicube, add $ρ_k ΔB_j F_jk A_j / A_k$ to B_k and to the unshot ΔB_k of
+  every patch it sees, and set $ΔB_j = 0$. The residual is the unshot power over the power emitted.
 * **Ambient term for display**: the unshot power not yet distributed is spread as an ambient term
-  ``B_k + ρ_k · R · Σ_j ΔB_j A_j / Σ_j A_j`` with the mean interreflection factor ``R = 1 / (1 − ρ_avg)``,
-  ``ρ_avg = Σ ρ_j A_j / Σ A_j`` (Cohen et al. 1988) — it vanishes as the solution converges.
+  $B_k + ρ_k · R · Σ_j ΔB_j A_j / Σ_j A_j$ with the mean interreflection factor $R = 1 / (1 − ρ_avg)$,
+  $ρ_avg = Σ ρ_j A_j / Σ A_j$ (Cohen et al. 1988) — it vanishes as the solution converges.
 
 Units: B is in the same units as the local illumination model's diffuse term. Emitters are faces whose material
-has ``emissive`` × ``emission`` > 0 (E_k = emissive · emission, which may exceed 1); the scene's positioned
-lights shoot first: their direct light on each patch is the depth buffer's diffuse term ``ρ_k f_l I_l max(N·L,
-0)`` (attenuation and spot cone included), averaged over four points of the patch, each lit when the light's own
+has ``emissive`` × ``emission`` > 0 ($E_k = emissive · emission$, which may exceed 1); the scene's positioned
+lights shoot first: their direct light on each patch is the depth buffer's diffuse term $ρ_k f_l I_l max(N·L,
+0)$ (attenuation and spot cone included), averaged over four points of the patch, each lit when the light's own
 depth-buffer view (a cube of six faces for point and spot lights, an orthographic view for directional lights)
 shows that patch there. With emission given as radiance, B equals radiance as a path tracer measures it (the
 radiosity equation divided by π): no scale between frustum's B and, e.g., Mitsuba's pixel values.
@@ -193,8 +197,8 @@ def _estimated_patches(scene: Scene, patch_size: float) -> float:
 def hemicube_delta_form_factors(resolution: int) -> tuple[np.ndarray, np.ndarray]:
     """Delta form factors of the hemicube's pixels: ``(top, side)``, (N, N) and (N/2, N) float64, rows top first.
 
-    Top face pixel centre (x, y, 1): ``ΔF = ΔA / (π (x² + y² + 1)²)``; side face pixel centre (x, 1, z), z the
-    height above the patch plane: ``ΔF = z ΔA / (π (x² + z² + 1)²)``; ``ΔA = (2/N)²``. Row 0 is the top of each
+    Top face pixel centre (x, y, 1): $ΔF = ΔA / (π (x² + y² + 1)²)$; side face pixel centre (x, 1, z), z the
+    height above the patch plane: $ΔF = z ΔA / (π (x² + z² + 1)²)$; $ΔA = (2/N)²$. Row 0 is the top of each
     face's image (z = 1 on a side face), as the frame buffers store them.
     """
     n = resolution
@@ -223,7 +227,7 @@ class _Rasterizer:
         self.item = SceneItem(mesh, Material(), np.eye(4))
 
     def codes(self, camera: Camera) -> tuple[np.ndarray, np.ndarray]:
-        """(depth, codes) of one view: codes ``2·patch + back`` where drawn, depth 1 elsewhere (no culling:
+        """(depth, codes) of one view: codes $2·patch + back$ where drawn, depth 1 elsewhere (no culling:
         a patch seen from behind hides what lies beyond it but receives nothing)."""
         from frustum.render.buffers import Scratch
         from frustum.render.stages import Pixels, draw_item
@@ -401,12 +405,12 @@ def radiosity(
     shooter: float = 4.0,
     progress: Callable[[int, float], None] | None = None,
 ) -> RadiosityResult:
-    """Solve ``B_k = E_k + ρ_k Σ_j B_j F_jk`` for the scene's surfaces by progressive refinement (module docstring).
+    """Solve $B_k = E_k + ρ_k Σ_j B_j F_jk$ for the scene's surfaces by progressive refinement (module docstring).
 
     Parameters
     ----------
     scene : Scene
-        Meshes (their materials give ρ = diffuse · color and E = emissive · emission) and lights (each positioned
+        Meshes (their materials give $ρ = diffuse · color$ and $E = emissive · emission$) and lights (each positioned
         light shoots first; ambient lights add nothing: radiosity computes the ambient light).
     patch_size : float, optional
         Longest patch edge in world units; default a twentieth of the scene's bounding-box diagonal.
@@ -418,7 +422,7 @@ def radiosity(
         Most shots from patch groups (default: 50 per group, which always reaches a residual well below 1e-3 in a
         closed scene with ρ ≤ 0.9 or an open one).
     shooter : float
-        Patches shoot in groups of about ``shooter × patch_size`` (those of one item facing the same way in one
+        Patches shoot in groups of about $shooter × patch_size$ (those of one item facing the same way in one
         grid cell), from the group's area-weighted centre; every patch receives on its own. 1 shoots from every
         patch alone (the plain method, several times slower); the default 4 keeps wall means within 1 % of it.
     progress : callable(shots, residual), optional
@@ -514,7 +518,7 @@ def radiosity(
 
 
 def _display(patches: Patches, radiosity_b: np.ndarray, unshot: np.ndarray) -> np.ndarray:
-    """B plus Cohen's ambient term ``ρ_k · R · Σ ΔB_j A_j / Σ A_j`` with ``R = 1 / (1 − ρ_avg)``."""
+    """B plus Cohen's ambient term $ρ_k · R · Σ ΔB_j A_j / Σ A_j$ with $R = 1 / (1 − ρ_avg)$."""
     area = patches.area
     total = area.sum()
     rho_avg = (patches.reflectance * area[:, None]).sum(axis=0) / total

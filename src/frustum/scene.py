@@ -1,7 +1,7 @@
 """The world: a hierarchy of nodes placing geometry with materials, the lights, exploded and cutaway views.
 
 A node's ``transform`` maps its own (model) coordinates into its parent's; the world transform of a node is
-the product down the parent chain, ``world_from_model = T_root · … · T_parent · T_node`` (column vectors: the
+the product down the parent chain, $world_from_model = T_root · … · T_parent · T_node$ (column vectors: the
 node's own transform is applied first) [HB 9] "Composite Transformations", [HB 11] "Hierarchical Modeling"
 (the seed's hierarchical polygon-mesh models). One mesh may hang on many nodes (instancing).
 
@@ -61,7 +61,7 @@ _IDENTITY.flags.writeable = False
 
 
 class SceneItem(NamedTuple):
-    """One placed mesh: ``world = world_from_model · model``, drawn with ``material``."""
+    """One placed mesh: $world = world_from_model · model$, drawn with ``material``."""
 
     mesh: Mesh
     material: Material
@@ -102,7 +102,7 @@ class Pick(NamedTuple):
 class RayHits(NamedTuple):
     """What ``Scene.intersect`` finds for N rays (a miss: t = inf, item = face = −1, the other fields NaN).
 
-    ``t`` (N,) distance along each ray in units of its direction's length (``point = origin + t·direction``);
+    ``t`` (N,) distance along each ray in units of its direction's length ($point = origin + t·direction$);
     ``item`` (N,) index into ``Scene.items``; ``face`` (N,) the face index in that item's mesh;
     ``barycentrics`` (N, 3) the weights of the face's corners 0, 1, 2 (in the mesh's corner order) at the hit;
     ``point`` (N, 3) the world point; ``normal`` (N, 3) the **geometric** unit normal: the face's plane normal in
@@ -296,7 +296,7 @@ class Scene:
     ``scene.items`` lists the placed meshes in drawing order (depth-first). The depth buffer makes the image
     independent of that order except for exactly equal depths (the first drawn wins under the "less" test).
     ``environment`` (an ``EnvironmentMap`` or None): the surroundings, shown where nothing is drawn (when
-    ``render`` is given no background) and reflected by materials with ``reflectivity > 0``.
+    ``render`` is given no background) and reflected by materials with $reflectivity > 0$.
     """
 
     def __init__(self, lights: Iterable[Light] = (), *, environment: EnvironmentMap | None = None) -> None:
@@ -365,7 +365,7 @@ class Scene:
         clip_planes: Iterable[tuple[ArrayLike, ArrayLike]] = (),
         sampling: str = "entry",
     ) -> VolumeItem:
-        """Place a ``Volume`` (``world = transform · model``) to be ray cast by ``render``; returns its record.
+        """Place a ``Volume`` ($world = transform · model$) to be ray cast by ``render``; returns its record.
 
         `transfer_function` defaults to the grayscale preset over the data's range; `mode` is one of
         ``VOLUME_MODES``; `step` the sample distance in model units (default half the smallest spacing);
@@ -515,7 +515,7 @@ class Scene:
         return Pick(items[item_index], int(face[0] - starts[item_index]), point, float(hits.t[0]))
 
     def intersect(self, origins: Any, directions: Any) -> RayHits:
-        """The first surface each ray ``origin + t·direction`` (t >= 0) meets: a ``RayHits`` of N rows.
+        """The first surface each ray $origin + t·direction$ (t >= 0) meets: a ``RayHits`` of N rows.
 
         `origins`, `directions`: (N, 3) or (3,) world coordinates (directions need not be unit length; t is in
         units of their length). Every placed mesh (``Scene.items``) is hit, both sides of every face, through the
@@ -581,7 +581,7 @@ class Scene:
         return RayHits(t, item, face, barycentrics, points, normals, shading_normals, back)
 
     def occluded(self, origins: Any, directions: Any, t_max: Any) -> NDArray[np.bool_]:
-        """(N,) bool: whether each ray ``origin + t·direction`` meets a surface at some 0 <= t < `t_max`.
+        """(N,) bool: whether each ray $origin + t·direction$ meets a surface at some 0 <= t < `t_max`.
 
         `t_max` is a scalar or one value per ray (for a shadow ray from a point P to a light at Q: direction
         Q − P and t_max 1; to a directional light: ``np.inf``). Both sides of every face count. This is the
@@ -710,12 +710,12 @@ def _world_centroid(node: Node, world: Matrix4) -> np.ndarray | None:
 
 
 def exploded(target: Scene | Node, factor: float, center: ArrayLike | None = None) -> Scene | Node:
-    """An exploded view: each part moved away from the assembly center by ``factor·(c_part − center)``.
+    """An exploded view: each part moved away from the assembly center by $factor·(c_part − center)$.
 
     The parts of a node are its children; each child's world centroid ``c_part`` (area-weighted) moves by
-    ``factor·(c_part − center)`` in world space, ``center`` being the assembly's centroid unless given.
+    $factor·(c_part − center)$ in world space, ``center`` being the assembly's centroid unless given.
     Hierarchy-aware: a child with children (a sub-assembly) is then exploded within itself about its own
-    centroid. Returns a new scene or node; the original is not changed. ``factor = 0`` gives the same transforms.
+    centroid. Returns a new scene or node; the original is not changed. $factor = 0$ gives the same transforms.
     """
     where = "exploded"
     amount = as_scalar(factor, "factor", where=where, error=GeometryError)
@@ -753,8 +753,8 @@ def cutaway(
     ghost: Material | float | None = None,
     hatch: float | None = 6.0,
 ) -> Scene:
-    """A cutaway view: geometry on the side of ``plane = (point, normal)`` the normal points to, or inside the
-    axis-aligned world ``box = (min_corner, max_corner)``, is removed.
+    """A cutaway view: geometry on the side of $plane = (point, normal)$ the normal points to, or inside the
+    axis-aligned world $box = (min_corner, max_corner)$, is removed.
 
     Each mesh is cut in world coordinates (the result's nodes keep the hierarchy; cut meshes are placed with
     their node's world transform baked in). With ``cap`` a closed (watertight) mesh gets its cross-section

@@ -3,26 +3,28 @@
 For a surface point P with unit normal N, seen from the eye E, with base color C (material color × vertex
 color × texture), the intensity of each channel is [HB 17]:
 
-    I = C·(k_a·I_a + Σ_l f_l·k_d·I_l·max(N·L_l, 0)) + Σ_l f_l·k_s·I_l·spec_l + emissive
+$$I = C·(k_a·I_a + Σ_l f_l·k_d·I_l·max(N·L_l, 0)) + Σ_l f_l·k_s·I_l·spec_l + emissive$$
 
-    L_l     unit vector from P toward light l (−direction for a directional light)
-    V       = (E − P) / |E − P|, toward the viewer
-    spec_l  Blinn-Phong: max(N·H, 0)^n with H = (L + V)/|L + V|;  Phong: max(R·V, 0)^n with R = 2(N·L)N − L;
-            0 where N·L <= 0 (no highlight on the unlit side)
-    I_a     the ambient illumination: the sum of the scene's ``AmbientLight``s, or white of intensity 1 if it
-            has none (so ``k_a`` alone sets the "background illumination", as in the benchmark formula)
-    I_l     light color × intensity
-    f_l     radial attenuation 1 / (a_0 + a_1·d + a_2·d²) of point and spot lights (1 for directional
-            lights), times the spot cone factor clamp((cos α − cos θ_outer)/(cos θ_inner − cos θ_outer), 0, 1)
+with
 
-Colors are linear RGB in [0, 1]; the result is clamped to [0, 1] and stored as ``floor(I·255 + 0.5)``.
+- $L_l$ the unit vector from P toward light l ($−direction$ for a directional light);
+- $V = (E − P)/|E − P|$, toward the viewer;
+- $spec_l$ for Blinn-Phong $max(N·H, 0)^n$ with $H = (L + V)/|L + V|$, for Phong $max(R·V, 0)^n$ with
+  $R = 2(N·L)N − L$; 0 where $N·L <= 0$ (no highlight on the unlit side);
+- $I_a$ the ambient illumination: the sum of the scene's ``AmbientLight``s, or white of intensity 1 if it has
+  none (so ``k_a`` alone sets the "background illumination", as in the benchmark formula);
+- $I_l$ the light's color × intensity;
+- $f_l$ the radial attenuation $1/(a_0 + a_1·d + a_2·d²)$ of point and spot lights (1 for directional lights),
+  times the spot cone factor $clamp((cos α − cos θ_outer)/(cos θ_inner − cos θ_outer), 0, 1)$.
+
+Colors are linear RGB in [0, 1]; the result is clamped to [0, 1] and stored as $floor(I·255 + 0.5)$.
 With one white directional light of intensity 1 and no ambient light this is exactly the formula of
 ``../shared/bench/README.md``, bit for bit. ``illuminate`` below is the readable one-point version; the
 kernels are in ``raster/shade.py``.
 
 Depth cueing [HB 10] "Depth Cueing" blends each color toward a cue color by its distance d from the viewing
-plane: ``f(d) = f_min + (f_max − f_min)·(d_far − d)/(d_far − d_near)`` clamped to [f_min, f_max], then
-``color' = f·color + (1 − f)·cue_color``.
+plane: $f(d) = f_min + (f_max − f_min)·(d_far − d)/(d_far − d_near)$ clamped to [f_min, f_max], then
+$color' = f·color + (1 − f)·cue_color$.
 
 References
 ----------
@@ -131,16 +133,16 @@ class Material:
     ``texture`` an (H, W[, 3|4]) image sampled bilinearly at the mesh's UV coordinates (v up: v = 0 is the
     image's bottom row; uint8 bytes are taken as linear values / 255), multiplied into the base color.
     ``emission`` (>= 0, default 1) scales ``emissive`` for ``radiosity``: an emitter's radiance is
-    ``emissive · emission``, which may exceed 1 (the local illumination model adds ``emissive`` alone).
+    $emissive · emission$, which may exceed 1 (the local illumination model adds ``emissive`` alone).
     ``reflectivity`` in [0, 1]: the share of the color that is the mirror reflection of the surroundings (the
-    scene's environment map in the depth-buffer pipeline: ``(1 − r)·I + r·env(R)``).
+    scene's environment map in the depth-buffer pipeline: $(1 − r)·I + r·env(R)$).
     ``bump`` an (H, W[, 3|4]) height image (gray, in [0, 1], times ``bump_scale`` world units) and ``normal_map``
     an (H, W, 3|4) tangent-space normal image (OpenGL convention, +y up): both perturb the shading normal per pixel
     in Phong shading, from the mesh's UVs (``frustum.surface_detail``; flat and Gouraud shading ignore them).
     ``hatch`` (vector output only): the spacing of 45° section lines drawn over the faces in filled SVG/PDF,
     in drawing units, as engineering drawings mark cut surfaces (``cutaway`` sets it on section caps).
     With ``render(..., method="ray-tracing")`` ``reflectivity`` is the weight of the traced mirror-reflected ray
-    (the same ``(1 − r)·I + r·reflected``), and ``ior`` (index of refraction, > 0; 1 bends nothing, glass 1.5;
+    (the same $(1 − r)·I + r·reflected$), and ``ior`` (index of refraction, > 0; 1 bends nothing, glass 1.5;
     read by that method only) bends the ray transmitted through a surface of opacity < 1 (Snell's law;
     docs/ray-tracing.md).
     Raises ``ShadingError`` for a non-finite or negative coefficient, a color outside [0, 1] or a bad texture.
@@ -212,7 +214,7 @@ class Material:
 
 @dataclass(frozen=True, eq=False)
 class AmbientLight:
-    """Background illumination ``I_a = color · intensity`` reaching every surface equally (the k_a term)."""
+    """Background illumination $I_a = color · intensity$ reaching every surface equally (the k_a term)."""
 
     color: Vector3 = (1.0, 1.0, 1.0)  # type: ignore[assignment]
     intensity: float = 1.0
@@ -228,7 +230,7 @@ class AmbientLight:
 
 @dataclass(frozen=True, eq=False)
 class DirectionalLight:
-    """A light at infinity whose rays travel along ``direction`` (glTF convention); ``to_light = −direction``."""
+    """A light at infinity whose rays travel along ``direction`` (glTF convention); $to_light = −direction$."""
 
     direction: Vector3
     color: Vector3 = (1.0, 1.0, 1.0)  # type: ignore[assignment]
@@ -246,7 +248,7 @@ class DirectionalLight:
 
     @property
     def to_light(self) -> Vector3:
-        """L, the unit vector from a surface toward the light: ``−direction``."""
+        """L, the unit vector from a surface toward the light: $−direction$."""
         return -self.direction
 
     def transformed(self, world_from_model: Matrix4) -> DirectionalLight:
@@ -257,7 +259,7 @@ class DirectionalLight:
 
 @dataclass(frozen=True, eq=False)
 class PointLight:
-    """A light at ``position`` shining equally in all directions, dimmed by ``1/(a0 + a1·d + a2·d²)``."""
+    """A light at ``position`` shining equally in all directions, dimmed by $1/(a0 + a1·d + a2·d²)$."""
 
     position: Vector3
     color: Vector3 = (1.0, 1.0, 1.0)  # type: ignore[assignment]
@@ -325,7 +327,7 @@ class SpotLight:
 
 
 def sun_45(intensity: float = 1.0, color: Any = (1.0, 1.0, 1.0), cast_shadows: bool = True) -> DirectionalLight:
-    """The sciagraphy sun: rays along the diagonal of a cube from the upper left front, ``direction ∝ (1, −1, −1)``
+    """The sciagraphy sun: rays along the diagonal of a cube from the upper left front, $direction ∝ (1, −1, −1)$
     (y up, the front elevation seen along −z), so in the front elevation and in the plan every ray and every
     shadow edge runs at 45°, and a shadow's width equals the depth of what casts it (architects' convention)."""
     return DirectionalLight((1.0, -1.0, -1.0), color=color, intensity=intensity, cast_shadows=cast_shadows)
@@ -338,7 +340,7 @@ LIGHT_TYPES = (AmbientLight, DirectionalLight, PointLight, SpotLight)
 
 @dataclass(frozen=True, eq=False)
 class DepthCue:
-    """Depth cueing: ``f(d) = f_min + (f_max − f_min)·(far − d)/(far − near)``, clamped; ``c' = f·c + (1 − f)·cue``.
+    """Depth cueing: $f(d) = f_min + (f_max − f_min)·(far − d)/(far − near)$, clamped; $c' = f·c + (1 − f)·cue$.
 
     ``d`` is the distance in front of the viewing plane (−z_view); ``color=None`` cues toward the render's
     background color. Raises ``ShadingError`` unless 0 <= near < far and 0 <= min <= max <= 1.
@@ -481,7 +483,7 @@ def illuminate(
 def blinn_phong(
     material: Material, light: DirectionalLight, normal: ArrayLike, point: ArrayLike, eye: ArrayLike
 ) -> tuple[int, int, int]:
-    """8-bit RGB of one point lit by one directional light: ``floor(illuminate(...)·255 + 0.5)`` (the bench formula)."""
+    """8-bit RGB of one point lit by one directional light: $floor(illuminate(...)·255 + 0.5)$ (the bench formula)."""
     rgb = illuminate(material, [light], point, normal, eye)
     r, g, b = np.floor(rgb * 255.0 + 0.5).astype(int).tolist()
     return r, g, b

@@ -11,7 +11,7 @@ shadow-casting light in one of two ways.
   deep enough toward the light to hold every caster (the scene's box); a spot light a perspective map over its
   cone; a point light a cube of six perspective maps (each a little wider than 90° so filter taps near a cube
   edge stay on their face). A point is lit where its distance along the light's axis, less a bias, is not beyond
-  the map's: the bias is slope-scaled, ``texel·(1 + (1 + softness)·min(tan θ, 8))`` with θ the angle between the
+  the map's: the bias is slope-scaled, $texel·(1 + (1 + softness)·min(tan θ, 8))$ with θ the angle between the
   face normal and the light, and the point is first moved one texel along its face normal (normal offset), so lit
   faces show no acne while shadows stay attached at contact. Percentage-closer filtering averages the test over
   a (2m + 1)² grid of taps spanning ±``shadow_softness`` texels (m = ⌈softness⌉; 0: one tap, hard edges).
@@ -252,7 +252,7 @@ def light_fractions(
 
 
 def occluded(scene: Scene, origins: np.ndarray, directions: np.ndarray, t_max: np.ndarray) -> np.ndarray:
-    """(N,) bool: whether an opaque surface of `scene` meets each ray ``origin + t·direction``, 0 <= t < t_max.
+    """(N,) bool: whether an opaque surface of `scene` meets each ray $origin + t·direction$, 0 <= t < t_max.
 
     ``Scene.occluded`` (the any-hit query through the scene's BVH). Transparent items cast no shadow: where the
     scene has any, the rays go through a scene of its opaque items alone (whose index is built for the call)."""

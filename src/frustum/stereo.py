@@ -6,10 +6,10 @@ parallax at the image corners); each eye is offset by half the eye separation e 
 and its near-plane window is shifted toward the other eye so that both view volumes meet on the plane of
 zero parallax, the convergence plane at distance D in front of the eyes:
 
-    eye_left  = eye − (e/2)·u,   window x in [−w + s, w + s]
-    eye_right = eye + (e/2)·u,   window x in [−w − s, w − s],   s = (e/2)·near/D
+$$eye_left = eye − (e/2)·u,   eye_right = eye + (e/2)·u,   s = (e/2)·near/D$$
 
-with ``w = near·tan(fovy/2)·aspect`` the half width of the centre camera's near-plane window. A point on
+the left window spanning $x ∈ [−w + s, w + s]$ and the right one $x ∈ [−w − s, w − s]$, with
+$w = near·tan(fovy/2)·aspect$ the half width of the centre camera's near-plane window. A point on
 the convergence plane then lands on the same window position in both images (zero parallax); a point beyond
 it has positive parallax (x_right − x_left > 0, it appears behind the screen), a point in front of it negative
 parallax (it appears in front of the screen).
@@ -40,9 +40,9 @@ __all__ = ["StereoCamera"]
 class StereoCamera:
     """A stereo pair built from one perspective `camera`: ``left`` and ``right`` cameras with off-axis frusta.
 
-    Each eye sits at ``eye ∓ (e/2)·u`` with the centre camera's view direction and up vector, and projects
-    through ``frustum(−w ± s, w ± s, −t, t, near, far)`` (upper sign: left eye) with ``t = near·tan(fovy/2)``,
-    ``w = t·aspect`` and the shift ``s = (e/2)·near/D``, so that the convergence plane at distance D is the
+    Each eye sits at $eye ∓ (e/2)·u$ with the centre camera's view direction and up vector, and projects
+    through $frustum(−w ± s, w ± s, −t, t, near, far)$ (upper sign: left eye) with $t = near·tan(fovy/2)$,
+    $w = t·aspect$ and the shift $s = (e/2)·near/D$, so that the convergence plane at distance D is the
     plane of zero parallax. The images have the centre camera's size.
 
     Parameters
@@ -116,11 +116,11 @@ class StereoCamera:
 
     @property
     def eyes(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """World positions of the left and right eye, ``eye ∓ (e/2)·u``."""
+        """World positions of the left and right eye, $eye ∓ (e/2)·u$."""
         return np.array(self.left.frame.eye), np.array(self.right.frame.eye)
 
     def parallax(self, points: ArrayLike) -> NDArray[np.float64]:
-        """(N,) horizontal screen parallax ``x_right − x_left`` of world points, in pixels (window x).
+        """(N,) horizontal screen parallax $x_right − x_left$ of world points, in pixels (window x).
 
         Zero on the convergence plane, positive behind it (the point appears behind the screen), negative in
         front of it. Points behind either eye give NaN (see ``Camera.project``).

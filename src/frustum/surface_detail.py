@@ -4,21 +4,22 @@ Both change only the *shading* normal (the geometry stays flat), per pixel, from
 [HB "Adding Surface Detail": bump mapping, frame mapping]:
 
 * **Bump map** (Blinn 1978): a height field B(u, v) (the image's gray value in [0, 1] times ``bump_scale``, in
-  world units) displaces the surface along its normal, ``P'(u, v) = P + B N/|N|``; to first order the displaced
+  world units) displaces the surface along its normal, $P'(u, v) = P + B N/|N|$; to first order the displaced
   surface's normal is
 
-      N' = N + (B_u (N × P_v) − B_v (N × P_u)) / |N|,       N = P_u × P_v,
+    $$N' = N + (B_u (N × P_v) − B_v (N × P_u)) / |N|,   N = P_u × P_v$$
 
-  with ``P_u = ∂P/∂u``, ``P_v = ∂P/∂v`` from the mesh's UVs (``tangent_frames``) and ``B_u``, ``B_v`` the height's
-  gradient in texture space (central differences on the image, one-sided at its edges, scaled by its size and
-  sampled bilinearly as textures are: ``height_gradient``). With a smooth-shaded mesh the interpolated unit
-  normal n stands for N/|N| and ``|N| = |P_u × P_v|``.
-* **Normal map**: each texel stores a unit normal in the surface's tangent frame, ``n_t = (255·rgb − 128) / 127``
+    with $P_u = ∂P/∂u$, $P_v = ∂P/∂v$ from the mesh's UVs (``tangent_frames``) and $B_u$, $B_v$ the height's
+    gradient in texture space (central differences on the image, one-sided at its edges, scaled by its size and
+    sampled bilinearly as textures are: ``height_gradient``). With a smooth-shaded mesh the interpolated unit
+    normal n stands for $N/|N|$ and $|N| = |P_u × P_v|$.
+
+* **Normal map**: each texel stores a unit normal in the surface's tangent frame, $n_t = (255·rgb − 128) / 127$
   clamped to [−1, 1] (8-bit values b as (b − 128)/127: 128 is exactly 0 and 255 is 1, so a "flat" map of
-  (128, 128, 255) is exactly (0, 0, 1); glTF's ``2·b/255 − 1`` differs by at most 0.008), in the
+  (128, 128, 255) is exactly (0, 0, 1); glTF's $2·b/255 − 1$ differs by at most 0.008), in the
   OpenGL convention (+x along the tangent T = P_u, +y along the bitangent = P_v: "green up", as glTF's
-  ``normalTexture``); ``N' = normalize(T̂ n_t.x + B̂ n_t.y + n n_t.z)`` with T̂ made perpendicular to n
-  (Gram–Schmidt) and ``B̂ = ±(n × T̂)``, the sign that of the UV layout's handedness.
+  ``normalTexture``); $N' = normalize(T̂ n_t.x + B̂ n_t.y + n n_t.z)$ with T̂ made perpendicular to n
+  (Gram–Schmidt) and $B̂ = ±(n × T̂)$, the sign that of the UV layout's handedness.
 
 The renderer evaluates them per pixel in Phong shading only: flat shading lights each face once and Gouraud
 shading each vertex once, so a per-pixel normal has nowhere to go there (documented as a no-op).
@@ -43,8 +44,8 @@ def tangent_frames(
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """(P_u, P_v) per vertex, (N, 3) float64 each: ∂P/∂u and ∂P/∂v of the faces around each vertex, averaged.
 
-    Per face with edges e1 = P1 − P0, e2 = P2 − P0 and UV differences (Δu1, Δv1), (Δu2, Δv2):
-    ``P_u = (e1 Δv2 − e2 Δv1) / det``, ``P_v = (e2 Δu1 − e1 Δu2) / det``, ``det = Δu1 Δv2 − Δu2 Δv1``.
+    Per face with edges $e1 = P1 − P0$, $e2 = P2 − P0$ and UV differences (Δu1, Δv1), (Δu2, Δv2):
+    $P_u = (e1 Δv2 − e2 Δv1) / det$, $P_v = (e2 Δu1 − e1 Δu2) / det$, $det = Δu1 Δv2 − Δu2 Δv1$.
     Faces with a degenerate UV triangle (det = 0) add nothing; a vertex with no other face gets zeros.
     """
     p = np.asarray(vertices, dtype=np.float64)
@@ -93,10 +94,10 @@ def _bilinear_wrapped(values: NDArray[np.float64], u: NDArray, v: NDArray) -> ND
 def height_gradient(
     image: NDArray[np.float32], scale: float, u: ArrayLike, v: ArrayLike
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """(B_u, B_v) at texture coordinates (u, v): the gradient of ``B = scale · gray(image)`` in texture space.
+    """(B_u, B_v) at texture coordinates (u, v): the gradient of $B = scale · gray(image)$ in texture space.
 
     Central differences on the image (one-sided at its borders, so a linear ramp has the same slope everywhere),
-    ``B_u = scale · W · ∂gray/∂column``, ``B_v = −scale · H · ∂gray/∂row`` (rows run down, v up), sampled bilinearly.
+    $B_u = scale · W · ∂gray/∂column$, $B_v = −scale · H · ∂gray/∂row$ (rows run down, v up), sampled bilinearly.
     """
     gray = _gray(image)
     height, width = gray.shape
@@ -115,8 +116,8 @@ def _unit(vectors: NDArray[np.float64]) -> NDArray[np.float64]:
 def bumped_normals(
     normal: ArrayLike, p_u: ArrayLike, p_v: ArrayLike, b_u: ArrayLike, b_v: ArrayLike
 ) -> NDArray[np.float64]:
-    """(N, 3) unit normals of the bumped surface: ``N' = |N| n + B_u (n × P_v) − B_v (n × P_u)``, ``|N| = |P_u × P_v|``
-    (Blinn's formula with n = N/|N| the unit shading normal)."""
+    """(N, 3) unit normals of the bumped surface: $N' = |N| n + B_u (n × P_v) − B_v (n × P_u)$, $|N| = |P_u × P_v|$
+    (Blinn's formula with $n = N/|N|$ the unit shading normal)."""
     n = _unit(np.asarray(normal, dtype=np.float64))
     pu, pv = np.asarray(p_u, dtype=np.float64), np.asarray(p_v, dtype=np.float64)
     size = np.linalg.norm(np.cross(pu, pv), axis=-1, keepdims=True)

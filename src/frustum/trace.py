@@ -83,7 +83,7 @@ class Stage(NamedTuple):
     """One stage of the pipeline: its matrix (from the previous stage) and the traced points' coordinates there.
 
     ``points`` is ``(N, 4)`` homogeneous up to ``"clipping"`` and ``(N, 3)`` from ``"perspective_divide"`` on;
-    ``points_here = points_before @ matrix.T`` (``P' = M·P``) wherever ``matrix`` is not None. ``codes`` holds
+    ``points_here = points_before @ matrix.T`` ($P' = M·P$) wherever ``matrix`` is not None. ``codes`` holds
     the six-bit region code of each point at the clipping stage (None elsewhere).
     """
 
@@ -105,7 +105,7 @@ class Stage(NamedTuple):
 
     @property
     def row_matrix(self) -> Matrix4 | None:
-        """The row-vector form ``Mᵀ`` (``P' = P·Mᵀ``), or None."""
+        """The row-vector form $Mᵀ$ ($P' = P·Mᵀ$), or None."""
         return None if self.matrix is None else self.matrix.T
 
 
@@ -218,8 +218,8 @@ class Trace:
 
     ``str(trace)`` is a plain-text report; ``to_markdown()`` and ``to_latex()`` give the same content to paste
     into notes; Jupyter shows the Markdown (``_repr_markdown_``) and Rich prints tables (``__rich__``). Every
-    matrix appears twice: the column-vector form ``M`` (``P' = M·P``, frustum's) and the row-vector form
-    ``Mᵀ`` (``P' = P·Mᵀ``).
+    matrix appears twice: the column-vector form ``M`` ($P' = M·P$, frustum's) and the row-vector form
+    $Mᵀ$ ($P' = P·Mᵀ$).
     """
 
     camera: Camera
@@ -607,7 +607,7 @@ def trace(
 ) -> Trace:
     """Follow points (or every vertex of a mesh or scene) through each stage of the viewing pipeline.
 
-    ``window = window_from_ndc · divide(normalization · projection · R(u, v, n) · T(−P0) · world_from_model · P)``
+    $window = window_from_ndc · divide(normalization · projection · R(u, v, n) · T(−P0) · world_from_model · P)$
     — the renderer's order; the window positions equal ``camera.project`` of the world points and the pixels
     ``render(..., mode="points")`` draws.
 
@@ -617,7 +617,7 @@ def trace(
         Points in model coordinates; a ``Mesh`` (its vertices, and what clipping does to its triangles); or a
         ``Scene`` (every vertex of every placed mesh, one ``TracedPart`` per mesh, in drawing order; then one
         part per placed volume (``Scene.add_volume``): the 8 corners of its grid's box, model coordinates
-        ``model_from_grid·(i, j, k)``, and what clipping does to the box's 12 triangles — the region its rays
+        $model_from_grid·(i, j, k)$, and what clipping does to the box's 12 triangles — the region its rays
         are cast through).
     camera : Camera
     model : (4, 4) array_like, optional

@@ -1,8 +1,8 @@
 """4x4 homogeneous transformations: builders, composition, and applying them to points, directions, normals.
 
-Column-vector convention throughout: a point is ``P = [x, y, z, 1]ᵀ`` and ``P' = M · P``. A composite that
+Column-vector convention throughout: a point is $P = [x, y, z, 1]ᵀ$ and $P' = M · P$. A composite that
 applies ``A``, then ``B``, then ``C`` is ``C @ B @ A``; ``compose(A, B, C)`` returns exactly that. Row-vector
-readers (the seed's "row major" tables, ``P' = P · R``) use ``to_row_major(M)``, which is ``M.T``.
+readers (the seed's "row major" tables, $P' = P · R$) use ``to_row_major(M)``, which is ``M.T``.
 Angles are radians. Every builder returns a fresh, writable ``(4, 4) float64`` array.
 
 References are resolved in ``docs/references.md``: [HB 9] is Hearn & Baker, *Computer Graphics with OpenGL*,
@@ -71,7 +71,7 @@ class Step(NamedTuple):
 def translate(tx: float, ty: float, tz: float) -> Matrix4:
     """Matrix moving every point by (tx, ty, tz).
 
-    ``x' = x + tx, y' = y + ty, z' = z + tz``, i.e. ``P' = T · P`` with the offsets in the last column.
+    $x' = x + tx, y' = y + ty, z' = z + tz$, i.e. $P' = T · P$ with the offsets in the last column.
 
     References
     ----------
@@ -86,7 +86,7 @@ def translate(tx: float, ty: float, tz: float) -> Matrix4:
 def rotate_z(angle: float) -> Matrix4:
     """Counter-clockwise rotation by `angle` radians about the z axis (right-handed, looking down -z).
 
-    ``x' = x·cosθ − y·sinθ, y' = x·sinθ + y·cosθ, z' = z``. ``rotate_x`` and ``rotate_y`` are this formula
+    $x' = x·cosθ − y·sinθ, y' = x·sinθ + y·cosθ, z' = z$. ``rotate_x`` and ``rotate_y`` are this formula
     under the cyclic permutation x → y → z → x of the seed.
 
     References
@@ -107,7 +107,7 @@ def rotate_z(angle: float) -> Matrix4:
 def rotate_x(angle: float) -> Matrix4:
     """Counter-clockwise rotation by `angle` radians about the x axis.
 
-    ``y' = y·cosθ − z·sinθ, z' = y·sinθ + z·cosθ, x' = x`` (``rotate_z`` with x → y → z → x).
+    $y' = y·cosθ − z·sinθ, z' = y·sinθ + z·cosθ, x' = x$ (``rotate_z`` with x → y → z → x).
 
     References
     ----------
@@ -127,9 +127,9 @@ def rotate_x(angle: float) -> Matrix4:
 def rotate_y(angle: float) -> Matrix4:
     """Counter-clockwise rotation by `angle` radians about the y axis.
 
-    ``z' = z·cosθ − x·sinθ, x' = z·sinθ + x·cosθ, y' = y`` (``rotate_x`` with x → y → z → x). The seed's
-    column-major R_y shows ``+sinθ`` in both off-diagonal places; that is a transcription slip: its own
-    equations, and Hearn & Baker, give ``−sinθ`` in row z', column x, as here.
+    $z' = z·cosθ − x·sinθ, x' = z·sinθ + x·cosθ, y' = y$ (``rotate_x`` with x → y → z → x). The seed's
+    column-major R_y shows $+sinθ$ in both off-diagonal places; that is a transcription slip: its own
+    equations, and Hearn & Baker, give $−sinθ$ in row z', column x, as here.
 
     References
     ----------
@@ -149,8 +149,8 @@ def rotate_y(angle: float) -> Matrix4:
 def rotate(axis: ArrayLike, angle: float, point: ArrayLike = (0.0, 0.0, 0.0)) -> Matrix4:
     """Rotation by `angle` radians about the line through `point` along `axis` (right-hand rule).
 
-    ``M = T(p) · R(k, θ) · T(−p)`` with Rodrigues' rotation
-    ``R = cosθ·I + sinθ·[k]ₓ + (1 − cosθ)·k·kᵀ`` for the unit axis ``k``. It equals the quaternion route,
+    $M = T(p) · R(k, θ) · T(−p)$ with Rodrigues' rotation
+    $R = cosθ·I + sinθ·[k]ₓ + (1 − cosθ)·k·kᵀ$ for the unit axis ``k``. It equals the quaternion route,
     ``T(p) · Quaternion.from_axis_angle(k, θ).to_matrix() · T(−p)``, and the seed's translate–rotate–translate
     sequence for an axis parallel to a coordinate axis; ``rotate_steps`` lists the textbook's seven steps.
 
@@ -192,10 +192,10 @@ def rotate(axis: ArrayLike, angle: float, point: ArrayLike = (0.0, 0.0, 0.0)) ->
 def rotate_steps(axis: ArrayLike, angle: float, point: ArrayLike = (0.0, 0.0, 0.0)) -> tuple[Step, ...]:
     """The textbook's seven matrices for a rotation about an arbitrary axis, first-applied first.
 
-    ``R(θ) = T⁻¹ · Rx⁻¹(α) · Ry⁻¹(β) · Rz(θ) · Ry(β) · Rx(α) · T``: translate the axis through the origin,
-    rotate about x into the xz plane (``cos α = c/d, sin α = b/d`` with ``d = √(b² + c²)``), rotate about y
-    onto the z axis (``cos β = d, sin β = −a``), rotate by θ about z, then undo the alignment. ``compose(*m for
-    _, m in rotate_steps(...))`` equals ``rotate(axis, angle, point)``. When the axis is the x axis, ``d = 0``
+    $R(θ) = T⁻¹ · Rx⁻¹(α) · Ry⁻¹(β) · Rz(θ) · Ry(β) · Rx(α) · T$: translate the axis through the origin,
+    rotate about x into the xz plane ($cos α = c/d, sin α = b/d$ with $d = √(b² + c²)$), rotate about y
+    onto the z axis ($cos β = d, sin β = −a$), rotate by θ about z, then undo the alignment. ``compose(*m for
+    _, m in rotate_steps(...))`` equals ``rotate(axis, angle, point)``. When the axis is the x axis, $d = 0$
     and the x rotation is the identity.
 
     References
@@ -225,7 +225,7 @@ def rotate_steps(axis: ArrayLike, angle: float, point: ArrayLike = (0.0, 0.0, 0.
 def scale(sx: float, sy: float, sz: float, fixed: ArrayLike = (0.0, 0.0, 0.0)) -> Matrix4:
     """Scaling by (sx, sy, sz) about the fixed point `fixed`, which does not move.
 
-    ``x' = x·sx + (1 − sx)·xf`` (and alike for y, z), i.e. ``T(f) · S(sx, sy, sz) · T(−f)``. Factors may be
+    $x' = x·sx + (1 − sx)·xf$ (and alike for y, z), i.e. $T(f) · S(sx, sy, sz) · T(−f)$. Factors may be
     negative (a reflection) or zero (a flattening, which ``invert`` then refuses).
 
     References
@@ -245,8 +245,8 @@ _PLANE_NORMALS = {"xy": (0.0, 0.0, 1.0), "yz": (1.0, 0.0, 0.0), "zx": (0.0, 1.0,
 def reflect(normal: ArrayLike | str, point: ArrayLike = (0.0, 0.0, 0.0)) -> Matrix4:
     """Mirror reflection through the plane with normal `normal` passing through `point`.
 
-    ``P' = P − 2·((P − p)·n)·n`` for the unit normal n: the 3x3 block is the Householder matrix
-    ``I − 2·n·nᵀ`` (det −1, so ``swaps_handedness`` is true). `normal` may also name a coordinate plane:
+    $P' = P − 2·((P − p)·n)·n$ for the unit normal n: the 3x3 block is the Householder matrix
+    $I − 2·n·nᵀ$ (det −1, so ``swaps_handedness`` is true). `normal` may also name a coordinate plane:
     ``reflect("xy")`` is the seed's M_zreflect (z → −z); ``"yz"`` flips x, ``"zx"`` (or ``"xz"``) flips y.
     A reflection about an axis (a line) is a rotation by π about it: ``rotate(axis, np.pi, point)``.
 
@@ -280,13 +280,13 @@ _SHEAR_AXES = {"x": (0, (1, 2)), "y": (1, (0, 2)), "z": (2, (0, 1))}
 def shear(axis: str, a: float, b: float, ref: float = 0.0) -> Matrix4:
     """Shear along the other two coordinates in proportion to the distance along `axis` from `ref`.
 
-    - ``"x"``: ``y' = y + a·(x − ref), z' = z + b·(x − ref)`` (the seed's x-axis shear, a = sh_y, b = sh_z)
-    - ``"y"``: ``x' = x + a·(y − ref), z' = z + b·(y − ref)``
-    - ``"z"``: ``x' = x + a·(z − ref), y' = y + b·(z − ref)`` (the seed's M_zshear, a = sh_zx, b = sh_zy,
-      ref = z_ref; its last column is ``−sh_zx·z_ref, −sh_zy·z_ref``)
+    - ``"x"``: $y' = y + a·(x − ref), z' = z + b·(x − ref)$ (the seed's x-axis shear, a = sh_y, b = sh_z)
+    - ``"y"``: $x' = x + a·(y − ref), z' = z + b·(y − ref)$
+    - ``"z"``: $x' = x + a·(z − ref), y' = y + b·(z − ref)$ (the seed's M_zshear, a = sh_zx, b = sh_zy,
+      ref = z_ref; its last column is $−sh_zx·z_ref, −sh_zy·z_ref$)
 
     `a` always drives the first of the two other axes in x, y, z order, `b` the second. Points on the plane
-    ``axis = ref`` do not move.
+    $axis = ref$ do not move.
 
     References
     ----------
@@ -308,10 +308,10 @@ def shear(axis: str, a: float, b: float, ref: float = 0.0) -> Matrix4:
 
 
 def compose(*matrices: ArrayLike) -> Matrix4:
-    """The composite that applies the arguments in order: ``compose(A, B, C) = C @ B @ A``.
+    """The composite that applies the arguments in order: $compose(A, B, C) = C @ B @ A$.
 
     With no arguments it returns the identity. Read a chain of ``b_from_a`` names right to left:
-    ``compose(world_from_model, view_from_world) = view_from_world @ world_from_model = view_from_model``.
+    $compose(world_from_model, view_from_world) = view_from_world @ world_from_model = view_from_model$.
 
     References
     ----------
@@ -322,11 +322,11 @@ def compose(*matrices: ArrayLike) -> Matrix4:
 
 
 def to_row_major(matrix: ArrayLike) -> Matrix4:
-    """The same transformation for row vectors, ``P' = P · Mᵀ``: returns the transpose of `matrix`.
+    """The same transformation for row vectors, $P' = P · Mᵀ$: returns the transpose of `matrix`.
 
     ``P_h @ to_row_major(M)`` equals ``apply_homogeneous(M, P)``, and after dividing by w, ``apply(M, P)``.
     This is the seed's "row major" table: the column-major matrix transposed, composites then read left to
-    right (``P · A · B`` applies A first).
+    right ($P · A · B$ applies A first).
     """
     return as_matrix(matrix, where="to_row_major").T.copy()
 
@@ -334,8 +334,8 @@ def to_row_major(matrix: ArrayLike) -> Matrix4:
 def invert(matrix: ArrayLike) -> Matrix4:
     """Inverse of `matrix`: exact transpose for rigid motions, affine inverse for affine maps, general otherwise.
 
-    - rigid (orthonormal 3x3 block R, bottom row 0 0 0 1): ``M⁻¹ = [Rᵀ, −Rᵀ·t]``
-    - affine (bottom row 0 0 0 1): ``M⁻¹ = [A⁻¹, −A⁻¹·t]``
+    - rigid (orthonormal 3x3 block R, bottom row 0 0 0 1): $M⁻¹ = [Rᵀ, −Rᵀ·t]$
+    - affine (bottom row 0 0 0 1): $M⁻¹ = [A⁻¹, −A⁻¹·t]$
     - projective: the general 4x4 inverse.
 
     Raises
@@ -361,12 +361,12 @@ def invert(matrix: ArrayLike) -> Matrix4:
 
 
 def swaps_handedness(matrix: ArrayLike) -> bool:
-    """True when `matrix` turns right-handed frames into left-handed ones: ``det(M) < 0``.
+    """True when `matrix` turns right-handed frames into left-handed ones: $det(M) < 0$.
 
     Reflections (and an odd number of negative scale factors) swap handedness, so triangles transformed by
     such a matrix reverse their winding; ``Mesh.transformed`` flips faces when this is true. For affine
-    matrices ``det(M) = det(A)`` of the 3x3 block; for projective ones the sign of ``det(M)`` gives the
-    orientation where ``w > 0`` (``perspective`` is a swap: right-handed view space to left-handed NDC).
+    matrices $det(M) = det(A)$ of the 3x3 block; for projective ones the sign of ``det(M)`` gives the
+    orientation where $w > 0$ (``perspective`` is a swap: right-handed view space to left-handed NDC).
 
     Raises
     ------
@@ -383,7 +383,7 @@ def swaps_handedness(matrix: ArrayLike) -> bool:
 
 
 def apply(matrix: ArrayLike, points: ArrayLike) -> Points:
-    """``P' = M·P`` for every row P of `points`, then the homogeneous divide by w.
+    """$P' = M·P$ for every row P of `points`, then the homogeneous divide by w.
 
     Parameters
     ----------
@@ -399,7 +399,7 @@ def apply(matrix: ArrayLike, points: ArrayLike) -> Points:
     Raises
     ------
     TransformError
-        If a point maps to ``w = 0`` (a point at infinity, e.g. a point in the eye plane under a
+        If a point maps to $w = 0$ (a point at infinity, e.g. a point in the eye plane under a
         perspective projection); ``apply_homogeneous`` keeps w instead.
     """
     single, rows = _point_rows(points, "apply")
@@ -418,9 +418,9 @@ def apply(matrix: ArrayLike, points: ArrayLike) -> Points:
 
 
 def apply_homogeneous(matrix: ArrayLike, points: ArrayLike) -> Points:
-    """``P_h = M·P`` for every row, without the divide: (N, 3) points (w = 1) or (N, 4) in, (N, 4) out.
+    """$P_h = M·P$ for every row, without the divide: (N, 3) points (w = 1) or (N, 4) in, (N, 4) out.
 
-    This is how positions enter clip space: ``points_clip = apply_homogeneous(clip_from_world, points)``.
+    This is how positions enter clip space: $points_clip = apply_homogeneous(clip_from_world, points)$.
     """
     m = as_matrix(matrix, where="apply_homogeneous")
     try:
@@ -435,10 +435,10 @@ def apply_homogeneous(matrix: ArrayLike, points: ArrayLike) -> Points:
 
 
 def apply_to_directions(matrix: ArrayLike, vectors: ArrayLike) -> Points:
-    """``d' = A·d`` with the 3x3 block A of `matrix`: directions have w = 0, so translation does not move them.
+    """$d' = A·d$ with the 3x3 block A of `matrix`: directions have w = 0, so translation does not move them.
 
     Not normalized: a scale changes a direction's length, as it changes a displacement. For a projective
-    matrix this is the x, y, z part of ``M·[d, 0]`` (the w part, ``M[3, :3]·d``, is the vanishing point's w).
+    matrix this is the x, y, z part of $M·[d, 0]$ (the w part, $M[3, :3]·d$, is the vanishing point's w).
 
     Parameters
     ----------
@@ -451,11 +451,11 @@ def apply_to_directions(matrix: ArrayLike, vectors: ArrayLike) -> Points:
 
 
 def apply_to_normals(matrix: ArrayLike, normals: ArrayLike) -> Points:
-    """``n' = (A⁻¹)ᵀ·n``, renormalized to unit length, with A the 3x3 block of an affine `matrix`.
+    """$n' = (A⁻¹)ᵀ·n$, renormalized to unit length, with A the 3x3 block of an affine `matrix`.
 
-    Normals are not directions: under a non-uniform scale or a shear, ``A·n`` is no longer perpendicular to
-    the transformed surface, but the inverse transpose is (a tangent t with ``n·t = 0`` maps to ``A·t`` and
-    ``((A⁻¹)ᵀ n)·(A t) = n·t = 0``). This is pbrt's ``Normal3`` rule. Under a reflection the result is the
+    Normals are not directions: under a non-uniform scale or a shear, $A·n$ is no longer perpendicular to
+    the transformed surface, but the inverse transpose is (a tangent t with $n·t = 0$ maps to $A·t$ and
+    $((A⁻¹)ᵀ n)·(A t) = n·t = 0$). This is pbrt's ``Normal3`` rule. Under a reflection the result is the
     mirrored normal; callers that flip face winding keep it (the surface's outside is mirrored too).
 
     Parameters

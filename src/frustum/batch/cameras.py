@@ -2,7 +2,7 @@
 
 frustum's camera (``frustum.camera``) looks down −z_view with x right and y up (OpenGL); window coordinates
 have **y up**, pixel centres at half-integers, and depth in [0, 1] (1 = far). Images are stored top row first,
-so the pixel in stored row ``r``, column ``i`` has its centre at window ``(i + 0.5, H − r − 0.5)``.
+so the pixel in stored row ``r``, column ``i`` has its centre at window $(i + 0.5, H − r − 0.5)$.
 
 - Blender NeRF ``transforms.json``: OpenGL camera axes (x right, y up, looking down −z), camera-to-world 4x4,
   ``camera_angle_x`` (horizontal field of view), principal point at the image centre.
@@ -12,15 +12,15 @@ so the pixel in stored row ``r``, column ``i`` has its centre at window ``(i + 0
   ``QW QX QY QZ`` and ``TX TY TZ``; ``PINHOLE fx fy cx cy`` with the top-left pixel's centre at (0.5, 0.5).
 
 With the projection's clip_from_view matrix ``P`` (a perspective one: bottom row (0, 0, −1, 0)) and an image
-of W x H pixels, a view point (x, y, z) lands at window ``x_w = W/2·(P00·x/(−z) − P02 + 1)``; in pixel
+of W x H pixels, a view point (x, y, z) lands at window $x_w = W/2·(P00·x/(−z) − P02 + 1)$; in pixel
 coordinates u (right), v (down) with the top-left pixel centre at (0.5, 0.5):
-``fx = W/2·P00``, ``cx = W/2·(1 − P02)``, ``fy = H/2·P11``, ``cy = H/2·(1 + P12)`` — for a symmetric
-``Perspective`` ``fx = fy = H / (2·tan(fovy/2))``, ``cx = W/2``, ``cy = H/2``. OpenCV axes are the OpenGL ones
-turned half a turn about x: ``camera_cv = diag(1, −1, −1) · camera_gl``.
+$fx = W/2·P00$, $cx = W/2·(1 − P02)$, $fy = H/2·P11$, $cy = H/2·(1 + P12)$ — for a symmetric
+``Perspective`` $fx = fy = H / (2·tan(fovy/2))$, $cx = W/2$, $cy = H/2$. OpenCV axes are the OpenGL ones
+turned half a turn about x: $camera_cv = diag(1, −1, −1) · camera_gl$.
 
 Depth: the Frame's window depth d in [0, 1] goes back to view z through the projection's third and fourth rows,
-``z_ndc = 2d − 1 = (A·z + B)/(C·z + D)``, so ``z = (B − z_ndc·D)/(z_ndc·C − A)``; the metric z-depth written to
-datasets is ``−z`` (distance along the viewing axis), 0 where nothing was drawn.
+$z_ndc = 2d − 1 = (A·z + B)/(C·z + D)$, so $z = (B − z_ndc·D)/(z_ndc·C − A)$; the metric z-depth written to
+datasets is $−z$ (distance along the viewing axis), 0 where nothing was drawn.
 
 References: [HB 10] "The Viewport Transformation and Three-Dimensional Screen Coordinates"; COLMAP "Output
 format" and "Camera models"; nerfstudio "Data conventions"; the NeRF synthetic data set's transforms.json.
@@ -68,7 +68,7 @@ def _clip_from_view(camera: Camera) -> Matrix4:
 def intrinsics(camera: Camera, *, where: str = "intrinsics") -> dict[str, float]:
     """Pinhole intrinsics of a perspective camera in pixels: fx, fy, cx, cy (u right, v down, top-left centre 0.5).
 
-    ``fx = W/2·P00``, ``fy = H/2·P11``, ``cx = W/2·(1 − P02)``, ``cy = H/2·(1 + P12)`` from clip_from_view P.
+    $fx = W/2·P00$, $fy = H/2·P11$, $cx = W/2·(1 − P02)$, $cy = H/2·(1 + P12)$ from clip_from_view P.
 
     Raises
     ------
@@ -108,7 +108,7 @@ def opengl_camera_to_world(camera: Camera) -> Matrix4:
 def colmap_pose(camera: Camera) -> tuple[tuple[float, float, float, float], tuple[float, float, float]]:
     """COLMAP's world-to-camera pose: scalar-first unit quaternion (QW, QX, QY, QZ) and translation (TX, TY, TZ).
 
-    ``camera_cv = R·world + t`` with ``[R | t] = OPENCV_FROM_OPENGL · (world_from_camera_gl)⁻¹``.
+    $camera_cv = R·world + t$ with $[R | t] = OPENCV_FROM_OPENGL · (world_from_camera_gl)⁻¹$.
     """
     frame = camera.frame
     rotation_gl = np.array([frame.u, frame.v, frame.n])  # rows u, v, n: view_from_world's rotation
@@ -123,8 +123,8 @@ def colmap_pose(camera: Camera) -> tuple[tuple[float, float, float, float], tupl
 def metric_depth(window_depth: NDArray[np.float32], camera: Camera) -> NDArray[np.float32]:
     """Metric z-depth (distance along the viewing axis, world units) of a Frame's window depth; 0 on background.
 
-    ``z_ndc = 2d − 1``, ``z_view = (B − z_ndc·D)/(z_ndc·C − A)`` with (A, B) and (C, D) the z and w entries of
-    clip_from_view's third and fourth rows; the result is ``−z_view`` (positive in front of the camera).
+    $z_ndc = 2d − 1$, $z_view = (B − z_ndc·D)/(z_ndc·C − A)$ with (A, B) and (C, D) the z and w entries of
+    clip_from_view's third and fourth rows; the result is $−z_view$ (positive in front of the camera).
     Computed in float64, returned as float32.
 
     Parameters

@@ -138,8 +138,8 @@ def dataset_cameras(
     """``(key, camera)`` per view: `camera`'s projection and size, placed by `layout` around `target`.
 
     The radius is `camera`'s distance to `target` (default: its look-at point). ``"orbit"``: azimuths
-    ``a₀ + 2πi/N`` at the camera's elevation (y up). ``"sphere"``: the Fibonacci sphere,
-    ``y_i = 1 − (2i + 1)/N``, longitude ``i·π(3 − √5)``. ``"random"``: a direction uniform on the sphere drawn
+    $a₀ + 2πi/N$ at the camera's elevation (y up). ``"sphere"``: the Fibonacci sphere,
+    $y_i = 1 − (2i + 1)/N$, longitude $i·π(3 − √5)$. ``"random"``: a direction uniform on the sphere drawn
     from ``view_seed(seed, key)``. ``"file"``: a JSON list of ``{"eye", "target", "up"}`` (`views` None or
     equal to its length). Views within 2.6° of the poles use z as the up vector.
 
@@ -447,7 +447,7 @@ def render_dataset(
     size : (width, height) or None
         Overrides the scene file's image size.
     depth_format : {"npy", "png16"}
-        png16 stores ``round(depth / scale)`` with ``scale = far / 65535``, written in README.txt (and as
+        png16 stores ``round(depth / scale)`` with $scale = far / 65535$, written in README.txt (and as
         nerfstudio's ``depth_unit_scale_factor``).
     out : str or Path
         A folder (created), or an fsspec URL (``s3://bucket/prefix``, ``gs://…``, ``file://…``, ``memory://…``).

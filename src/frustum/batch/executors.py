@@ -3,7 +3,7 @@
 Each executor sends every distinct scene to a worker **once** (the pool's initializer; Ray's object store)
 and then only jobs (a camera, options and paths: a few hundred bytes). Workers are long-lived, so the compiled
 kernels load once per worker; each worker runs ``frustum.set_threads(threads)`` (the threads of the parallel
-kernels) with ``workers × threads ≤ cores``, so the pool does not oversubscribe the machine. A view's bytes do
+kernels) with $workers × threads ≤ cores$, so the pool does not oversubscribe the machine. A view's bytes do
 not depend on the thread count (each piece of a kernel owns its pixels), so every executor and worker count
 writes the same files.
 

@@ -44,7 +44,7 @@ def union(a: Mesh, b: Mesh, *others: Mesh, sharp_angle: float = 60.0) -> Mesh:
 
 
 def difference(a: Mesh, b: Mesh, *others: Mesh, sharp_angle: float = 60.0) -> Mesh:
-    """``A − B − …``: the points inside `a` and outside every other solid. Parameters as for ``union``."""
+    """$A − B − …$: the points inside `a` and outside every other solid. Parameters as for ``union``."""
     return _boolean("difference", (a, b, *others), sharp_angle)
 
 

@@ -1,8 +1,8 @@
-"""Measuring fractal dimension by box counting: D = −slope of log N(ε) against log ε.
+"""Measuring fractal dimension by box counting: $D$ = −slope of $log N(ε)$ against $log ε$.
 
 Three kinds of input:
 
-- **points** (N, d), d = 1, 2 or 3: with given sizes, boxes are the cells ``floor(P / ε)`` of a grid
+- **points** (N, d), d = 1, 2 or 3: with given sizes, boxes are the cells $floor(P / ε)$ of a grid
   **anchored at the origin** (not re-centred: a construction on [0, 1]^d then gives exact counts; sample cell
   centres or interior points, not vertices that sit on box edges). With default sizes, boxes of side
   ε = extent/m tile the data's bounding box from its lower corner, the last box closed, and the fit keeps the
@@ -10,7 +10,7 @@ Three kinds of input:
 - **image**: a boolean (H, W) array; boxes are s × s pixel blocks from the top-left corner; ε = s pixels.
 - **heightfield**: a float (H, W) array z = h(x, y) on a grid of spacing ``spacing`` (default 1/(max(H, W) − 1),
   the unit square); differential box counting: a block of s × s cells needs ⌈max/ε⌉ − ⌊min/ε⌋ boxes of
-  side ε = s·spacing (at least 1). An fBm surface with Hurst exponent H has D = 3 − H.
+  side ε = s·spacing (at least 1). An fBm surface with Hurst exponent H has $D = 3 − H$.
 - **Mesh**: points sampled inside every triangle (sub-triangle centroids finer than the smallest ε), moved
   by 1e-9·ε_min against the face normal so that a face lying on a box boundary counts for the box its solid
   is in.
@@ -43,7 +43,7 @@ class BoxCounting:
     Attributes
     ----------
     dimension : float
-        The fitted slope D of log N(ε) = −D log ε + b (least squares).
+        The fitted slope D of $log N(ε) = −D log ε + b$ (least squares).
     interval : (float, float)
         The `confidence` interval of D from the regression's standard error and Student's t with k − 2
         degrees of freedom (k box sizes).
@@ -169,7 +169,7 @@ def _default_counts(points: NDArray) -> tuple[NDArray[np.float64], NDArray[np.in
 
 def box_counting_dimension(data: Any, sizes: ArrayLike | None = None, *, confidence: float = 0.95,
                            spacing: float | None = None) -> BoxCounting:  # fmt: skip
-    """Box-counting dimension of points, an image, a heightfield or a mesh: D = −d log N(ε) / d log ε.
+    """Box-counting dimension of points, an image, a heightfield or a mesh: $D = −d log N(ε) / d log ε$.
 
     N(ε) ∝ ε^(−D); D is the least-squares slope of log N against log(1/ε) over the given box sizes.
 

@@ -2,12 +2,12 @@
 
 The self-squaring map z ← z² + c is iterated until |z| > R (the escape radius) or ``max_iter`` steps pass.
 Images hold the **escape time**: the iteration count n at which |z_n| > R first held, or with ``smooth=True``
-the continuous count ν = n + 1 − log₂(ln|z_n| / ln R) (renormalized iteration count), which removes the
+the continuous count $ν = n + 1 − log₂(ln|z_n| / ln R)$ (renormalized iteration count), which removes the
 colour bands. Points that never escape within ``max_iter`` get ``np.inf``, so ``np.isfinite(image)`` is the
 outside mask.
 
-Pixel (row i, column j) samples the centre of its cell: x = x_min + (j + ½)·(x_max − x_min)/W,
-y = y_max − (i + ½)·(y_max − y_min)/H (row 0 at the top, as in an image).
+Pixel (row i, column j) samples the centre of its cell: $x = x_min + (j + ½)·(x_max − x_min)/W$,
+$y = y_max − (i + ½)·(y_max − y_min)/H$ (row 0 at the top, as in an image).
 
 References
 ----------
@@ -84,9 +84,9 @@ def _image(where: str, window: Any, width: Any, height: Any, max_iter: Any, esca
 def mandelbrot(window: ArrayLike = (-2.0, 1.0, -1.5, 1.5), width: int = 512, height: int = 512, *,
                max_iter: int = 256, escape_radius: float = 256.0, smooth: bool = True,
                max_bytes: int | None = None) -> NDArray[np.float64]:  # fmt: skip
-    """Mandelbrot set image: escape time of z ← z² + c from z₀ = 0, with c the pixel's point.
+    """Mandelbrot set image: escape time of $z ← z² + c$ from $z₀ = 0$, with c the pixel's point.
 
-    z_{n+1} = z_n² + c; ν = n + 1 − log₂(ln|z_n| / ln R) when smooth.
+    $z_{n+1} = z_n² + c$; $ν = n + 1 − log₂(ln|z_n| / ln R)$ when smooth.
 
     Parameters
     ----------
@@ -113,7 +113,7 @@ def mandelbrot(window: ArrayLike = (-2.0, 1.0, -1.5, 1.5), width: int = 512, hei
 def julia(c: complex, window: ArrayLike = (-1.6, 1.6, -1.2, 1.2), width: int = 512, height: int = 384, *,
           max_iter: int = 256, escape_radius: float = 256.0, smooth: bool = True,
           max_bytes: int | None = None) -> NDArray[np.float64]:  # fmt: skip
-    """Julia set image of z ← z² + c: escape time from z₀ = the pixel's point (same conventions as
+    """Julia set image of $z ← z² + c$: escape time from z₀ = the pixel's point (same conventions as
     ``mandelbrot``).
 
     References
@@ -134,7 +134,7 @@ def escape_time_colors(image: ArrayLike, *, period: float = 32.0, inside: ArrayL
         -> NDArray[np.uint8]:  # fmt: skip
     """Colour an escape-time image with a cyclic cosine palette: (H, W, 3) uint8, `inside` for ``inf``.
 
-    channel_k = ½ + ½·cos(2π(ν/period + φ_k)) with phases φ = (0, 0.15, 0.3) (Quilez's cosine palette).
+    $channel_k = ½ + ½·cos(2π(ν/period + φ_k))$ with phases $φ = (0, 0.15, 0.3)$ (Quilez's cosine palette).
     """
     where = "escape_time_colors"
     nu = np.asarray(image, dtype=np.float64)
@@ -160,7 +160,7 @@ def quaternion_julia(c: ArrayLike = (-0.2, 0.6, 0.2, 0.0), *, resolution: int = 
                      max_bytes: int | None = None) -> NDArray[np.float64]:  # fmt: skip
     """Smooth escape time of the quaternion map q ← q² + c on the 3D slice w = `slice_w` of 4D space.
 
-    q = (x, y, z, w) = x + y i + z j + w k; q² = (s² − |v|², 2 s v) for q = (s, v). Points that stay within
+    $q = (x, y, z, w) = x + y i + z j + w k$; $q² = (s² − |v|², 2 s v)$ for $q = (s, v)$. Points that stay within
     `escape_radius` for `max_iter` steps get the value ``max_iter`` (finite, so the field can be contoured).
 
     Returns
@@ -203,7 +203,7 @@ def quaternion_julia_mesh(c: ArrayLike = (-0.2, 0.6, 0.2, 0.0), *, resolution: i
                           max_bytes: int | None = None) -> Mesh:  # fmt: skip
     """The quaternion Julia set's 3D slice as a triangle mesh (marching cubes, scikit-image).
 
-    Contours ``quaternion_julia(...)`` at `level` (default ``max_iter − 1``: points that survive nearly all
+    Contours ``quaternion_julia(...)`` at `level` (default $max_iter − 1$: points that survive nearly all
     iterations). Faces wind counter-clockwise seen from outside (outward normals); vertex normals point up the
     field's descent, out of the set. The grid is padded by one sample below the level so the surface closes.
 

@@ -148,7 +148,7 @@ def _with_z(points2: NDArray[np.float64]) -> Points:
 def similarity_dimension(n_copies: Any, scale: Any) -> float:
     """Similarity (fractal) dimension of a set made of `n_copies` copies of itself scaled by `scale`.
 
-    D = log N / log(1/s)  (the seed writes D = log N / log r with r = 1/s the magnification)
+    $D = log N / log(1/s)$ (the seed writes $D = log N / log r$ with $r = 1/s$ the magnification)
 
     Parameters
     ----------
@@ -192,7 +192,7 @@ def koch_curve(level: int, start: ArrayLike = (0.0, 0.0), end: ArrayLike = (1.0,
     """Koch curve from `start` to `end`: a polyline of 4^level segments in the plane z = 0.
 
     Each segment is replaced by four of a third of its length, the middle third raised into an equilateral
-    bump on the left of the direction of travel. D = log 4 / log 3 ≈ 1.2619. ``record(k, points)``
+    bump on the left of the direction of travel. $D = log 4 / log 3 ≈ 1.2619$. ``record(k, points)``
     (``frustum.steps``), if given, sees the (M, 2) polyline after each iteration k = 1 … level.
 
     Returns
@@ -247,7 +247,7 @@ def cantor_set(level: int, start: float = 0.0, end: float = 1.0, *,
                max_bytes: int | None = None) -> NDArray[np.float64]:  # fmt: skip
     """Cantor set: remove the open middle third of every interval, `level` times.
 
-    D = log 2 / log 3 ≈ 0.6309.
+    $D = log 2 / log 3 ≈ 0.6309$.
 
     Returns
     -------
@@ -279,7 +279,7 @@ def sierpinski_triangle(level: int, corners: ArrayLike = ((0.0, 0.0), (1.0, 0.0)
                         max_bytes: int | None = None) -> Mesh:  # fmt: skip
     """Sierpinski triangle (gasket): keep the three corner half-size triangles, `level` times.
 
-    D = log 3 / log 2 ≈ 1.5850. Each kept triangle is one face with its own three vertices (no sharing),
+    $D = log 3 / log 2 ≈ 1.5850$. Each kept triangle is one face with its own three vertices (no sharing),
     wound like `corners`; in the plane z = 0.
 
     Parameters
@@ -321,7 +321,7 @@ _TETRA_FACES = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]], dtype=np.i
 def sierpinski_tetrahedron(level: int, size: float = 1.0, *, max_bytes: int | None = None) -> Mesh:
     """Sierpinski tetrahedron: keep the four corner half-size tetrahedra, `level` times.
 
-    D = log 4 / log 2 = 2. The initiator is the regular tetrahedron with corners (0, 0, 0), (s, 0, 0),
+    $D = log 4 / log 2 = 2$. The initiator is the regular tetrahedron with corners (0, 0, 0), (s, 0, 0),
     (s/2, s√3/2, 0), (s/2, s√3/6, s√(2/3)). Each kept tetrahedron contributes 4 outward faces with their own
     vertices (flat shading).
 
@@ -388,7 +388,7 @@ def menger_sponge(
     outward normals. With ``shared_vertices`` (default) vertices are merged on the 3^level lattice, so the mesh
     is closed (watertight); with ``shared_vertices=False`` every square has its own 4 vertices whose normal is
     the face normal, for flat shading of the cube faces.
-    D = log 20 / log 3 ≈ 2.7268; volume (20/27)^level·size³; exposed squares 2·20^level + 4·8^level.
+    $D = log 20 / log 3 ≈ 2.7268$; volume $(20/27)^level·size³$; exposed squares $2·20^level + 4·8^level$.
 
     Returns
     -------
@@ -562,9 +562,9 @@ def peano_curve(level: int, *, max_bytes: int | None = None) -> Points:
 
 @dataclass(frozen=True, eq=False)
 class IFS:
-    """An iterated function system: contractive affine maps wᵢ(P) = Aᵢ·P + bᵢ chosen with probabilities pᵢ.
+    """An iterated function system: contractive affine maps $wᵢ(P) = Aᵢ·P + bᵢ$ chosen with probabilities $pᵢ$.
 
-    The attractor is the unique set with S = ∪ᵢ wᵢ(S) (Hutchinson); ``points`` iterates that union
+    The attractor is the unique set with $S = ∪ᵢ wᵢ(S)$ (Hutchinson); ``points`` iterates that union
     deterministically, ``chaos_game`` walks it at random (Barnsley).
 
     Parameters
@@ -661,7 +661,7 @@ class IFS:
         return int(self.affine_maps.shape[0])
 
     def fixed_point(self, i: int = 0) -> Points:
-        """(3,) the fixed point of map i, P = Aᵢ·P + bᵢ (it lies on the attractor)."""
+        """(3,) the fixed point of map i, $P = Aᵢ·P + bᵢ$ (it lies on the attractor)."""
         d = self.dim
         point = np.zeros(3)
         point[:d] = np.linalg.solve(np.eye(d) - self.linear[i, :d, :d], self.offset[i, :d])
@@ -670,7 +670,7 @@ class IFS:
     def points(self, level: int, *, max_bytes: int | None = None) -> Points:
         """Deterministic algorithm: apply every map to the point set `level` times, from map 0's fixed point.
 
-        S_{n+1} = ∪ᵢ wᵢ(S_n), S_0 = {fixed point of w₀}; every point lies on the attractor.
+        $S_{n+1} = ∪ᵢ wᵢ(S_n)$, $S_0$ = {fixed point of $w₀$}; every point lies on the attractor.
 
         Returns
         -------
@@ -731,7 +731,7 @@ def barnsley_fern() -> IFS:
 
 
 def sierpinski_ifs(corners: ArrayLike = ((0.0, 0.0), (1.0, 0.0), (0.5, _SQRT3 / 2.0))) -> IFS:
-    """The Sierpinski triangle as an IFS: wᵢ(P) = (P + cᵢ)/2 for the three corners cᵢ, probabilities 1/3."""
+    """The Sierpinski triangle as an IFS: $wᵢ(P) = (P + cᵢ)/2$ for the three corners $cᵢ$, probabilities 1/3."""
     tri = np.asarray(corners, dtype=np.float64)
     if tri.shape != (3, 2) or not np.isfinite(tri).all():
         raise GeometryError(f"sierpinski_ifs: corners = {describe(corners)} is not (3, 2) finite numbers")
@@ -784,14 +784,14 @@ def fbm_terrain(level: int, hurst: float = 0.8, *, seed: int, method: str = "dia
     """Fractional Brownian heightfield on a (2^level + 1)² grid by random midpoint displacement.
 
     Corners start as N(0, σ²) samples. At refinement step k (squares of side 2^(level-k) cells) every new point
-    is the mean of its parents plus a Gaussian offset of standard deviation σ_k = σ·2^(-k·H), and the
+    is the mean of its parents plus a Gaussian offset of standard deviation $σ_k = σ·2^(-k·H)$, and the
     second half-step of diamond-square uses σ_k·2^(-H/2):
 
     - ``"diamond-square"``: centres from the 4 square corners (diamond), then edge midpoints from their up to
       4 diamond neighbours (square).
     - ``"midpoint"``: edge midpoints from their 2 edge ends, centres from the 4 corners (the textbook scheme).
 
-    The surface's expected fractal dimension is D = 3 − H (H near 1 smooth, near 0 rough).
+    The surface's expected fractal dimension is $D = 3 − H$ (H near 1 smooth, near 0 rough).
 
     Returns
     -------
@@ -844,7 +844,7 @@ def heightfield_mesh(heights: ArrayLike, size: float = 1.0, *, max_bytes: int | 
     """Triangulate a heightfield z = heights[i, j] over the square [0, size]² (x = column, y = row).
 
     Two counter-clockwise triangles per grid cell (seen from +z); vertex normals from central differences,
-    n = (−∂z/∂x, −∂z/∂y, 1) normalized.
+    $n = (−∂z/∂x, −∂z/∂y, 1)$ normalized.
 
     Returns
     -------
@@ -883,7 +883,7 @@ def fractal_coastline(polyline: ArrayLike, level: int, *, seed: int, hurst: floa
     """Fractal coastline: midpoint displacement of a polyline in the xy plane, `level` times.
 
     Each segment p→q gains the midpoint (p + q)/2 + g·σ_k·n̂, with n̂ the unit normal of p→q in the xy plane,
-    g ~ N(0, 1) and σ_k = amplitude·L̄·2^(−k·H) at step k (L̄ the mean initial segment length); z is
+    g ~ N(0, 1) and $σ_k = amplitude·L̄·2^(−k·H)$ at step k (L̄ the mean initial segment length); z is
     interpolated. Endpoints stay fixed; for a closed outline repeat the first point at the end. The curve's
     dimension is about 2 − H. ``record(k, points, sigma)`` (``frustum.steps``), if given, sees the polyline
     after each step k = 1 … level and that step's σ_k.

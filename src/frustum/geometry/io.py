@@ -355,7 +355,7 @@ def _world_placements(graph: Any) -> dict[Any, tuple[NDArray[np.float64], Any]]:
     """(world_from_model, geometry name) of every node of a trimesh scene graph that holds a geometry, in one
     walk from the root.
 
-    ``world_from_child = world_from_node · node_from_child`` down each edge, so the walk is linear in the node
+    $world_from_child = world_from_node · node_from_child$ down each edge, so the walk is linear in the node
     count (trimesh's ``graph[node]`` finds each node's path and multiplies it with ``multi_dot``, whose
     matrix-chain ordering is cubic in the depth: 3,000 chained glTF nodes took minutes). As trimesh does,
     identity edges are skipped and the result is repaired to a rigid transform within ``graph.repair_rigid``.

@@ -12,8 +12,8 @@ Turtle commands (Prusinkiewicz & Lindenmayer, *The Algorithmic Beauty of Plants*
 ``[``/``]``  push / pop the turtle state (position, orientation, branch depth)
 =========  ==========================================================================================
 
-The turtle frame is right-handed, H × L = U. "Turn left by δ" rotates H towards L:
-H' = H cos δ + L sin δ, L' = −H sin δ + L cos δ (counter-clockwise seen from +U). Pitch down rotates H
+The turtle frame is right-handed, $H × L = U$. "Turn left by δ" rotates H towards L:
+$H' = H cos δ + L sin δ$, $L' = −H sin δ + L cos δ$ (counter-clockwise seen from +U). Pitch down rotates H
 towards −U, roll left rotates L towards U. Any other symbol must have a production (a variable such as
 ``X``) or be listed in ``ignore``; it is then skipped by the turtle.
 
@@ -292,8 +292,8 @@ def tube_mesh(path: TurtlePath, radius: float = 0.1, *, taper: float = 0.7, side
               max_bytes: int | None = None) -> Mesh:  # fmt: skip
     """A closed prism (tube with end caps) around every segment of `path`.
 
-    A segment at branch depth d has radius ``radius·taper**d``. Each tube has `sides` quads (two triangles
-    each) and two fan caps of ``sides − 2`` triangles, wound outward.
+    A segment at branch depth d has radius $radius·taper**d$. Each tube has `sides` quads (two triangles
+    each) and two fan caps of $sides − 2$ triangles, wound outward.
 
     Returns
     -------

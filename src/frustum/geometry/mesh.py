@@ -37,9 +37,9 @@ class Mesh:
     """An indexed triangle mesh: ``vertices`` (N, 3), ``faces`` (M, 3), unit ``vertex_normals`` (N, 3).
 
     Faces list vertex indices **counter-clockwise seen from the front** (the side the normals point to), so
-    the face normal is ``(v1 − v0) × (v2 − v0)``. Without given normals, each vertex normal is the
+    the face normal is $(v1 − v0) × (v2 − v0)$. Without given normals, each vertex normal is the
     area-weighted average of the normals of the faces around it: the sum of the unnormalized cross products
-    ``(v1 − v0) × (v2 − v0)`` (whose length is twice the face area), normalized. A vertex that no face uses, or
+    $(v1 − v0) × (v2 − v0)$ (whose length is twice the face area), normalized. A vertex that no face uses, or
     whose faces cancel, gets the normal (0, 0, 1), so shading stays finite.
 
     Parameters
@@ -50,7 +50,7 @@ class Mesh:
         being exact). Other inputs are never narrowed.
     faces : (M, 3) array_like of int
         Vertex indices in [0, N), stored int32 (N <= 2**31: every index fits; code that combines indices, such as
-        an edge key ``i·N + j``, widens to int64 first). An empty mesh (M = 0) is valid.
+        an edge key $i·N + j$, widens to int64 first). An empty mesh (M = 0) is valid.
     vertex_normals : (N, 3) array_like, optional
         Finite, nonzero per-vertex normals; normalized on construction (in float64; a float32 array is stored
         float32 again, the nearest float32 of the unit vector). Computed normals are float64.
@@ -124,7 +124,7 @@ class Mesh:
 
     @cached_property
     def face_normals(self) -> Points:
-        """(M, 3) unit face normals ``(v1 − v0) × (v2 − v0)`` normalized; (0, 0, 0) for a zero-area face."""
+        """(M, 3) unit face normals $(v1 − v0) × (v2 − v0)$ normalized; (0, 0, 0) for a zero-area face."""
         cross = _face_cross_products(self.vertices, self.faces)
         lengths = np.sqrt((cross * cross).sum(axis=1))
         with np.errstate(invalid="ignore", divide="ignore"):
@@ -133,7 +133,7 @@ class Mesh:
 
     @cached_property
     def face_areas(self) -> NDArray[np.float64]:
-        """(M,) triangle areas ``A = ½ |(v1 − v0) × (v2 − v0)|``."""
+        """(M,) triangle areas $A = ½ |(v1 − v0) × (v2 − v0)|$."""
         cross = _face_cross_products(self.vertices, self.faces)
         return read_only(0.5 * np.sqrt((cross * cross).sum(axis=1)))
 
@@ -146,12 +146,12 @@ class Mesh:
 
     @cached_property
     def area(self) -> float:
-        """Total surface area, the sum of the triangle areas ``½ |(v1 − v0) × (v2 − v0)|`` (0 for no faces)."""
+        """Total surface area, the sum of the triangle areas $½ |(v1 − v0) × (v2 − v0)|$ (0 for no faces)."""
         return float(self.face_areas.sum())
 
     @cached_property
     def centroid(self) -> NDArray[np.float64]:
-        """(3,) area-weighted centroid of the surface: ``Σ A_f·(v0 + v1 + v2)/3 / Σ A_f``.
+        """(3,) area-weighted centroid of the surface: $Σ A_f·(v0 + v1 + v2)/3 / Σ A_f$.
 
         This is the centre of a thin shell of uniform density (trimesh's ``centroid``); it does not move when a
         region is tessellated more finely. A mesh whose faces all have zero area falls back to the mean of the
@@ -169,7 +169,7 @@ class Mesh:
 
     @cached_property
     def edges(self) -> NDArray[np.int64]:
-        """(E, 2) the unique undirected edges, each row ``(i, j)`` with ``i < j``, sorted lexicographically."""
+        """(E, 2) the unique undirected edges, each row ``(i, j)`` with $i < j$, sorted lexicographically."""
         pairs = np.sort(_directed_edges(self.faces), axis=1).astype(np.int64)  # int32 faces: i·n + j needs int64
         n = max(self.vertex_count, 1)
         keys = np.sort(pairs[:, 0] * n + pairs[:, 1])  # one int64 key per edge; sort + diff beats np.unique
@@ -199,7 +199,7 @@ class Mesh:
 
     @cached_property
     def volume(self) -> float:
-        """Signed enclosed volume by the divergence theorem: ``V = Σ_f v0 · (v1 × v2) / 6``.
+        """Signed enclosed volume by the divergence theorem: $V = Σ_f v0 · (v1 × v2) / 6$.
 
         Positive when the faces wind counter-clockwise seen from outside (outward normals), negative when they
         all point inward. The sum is independent of the origin only for a closed surface.
@@ -225,9 +225,9 @@ class Mesh:
     # --- operations returning new meshes ------------------------------------------------------------------
 
     def transformed(self, matrix: ArrayLike) -> Mesh:
-        """The mesh with ``P' = M·P`` applied to its vertices and ``n' = (A⁻¹)ᵀ·n`` to its normals.
+        """The mesh with $P' = M·P$ applied to its vertices and $n' = (A⁻¹)ᵀ·n$ to its normals.
 
-        When `matrix` swaps handedness (``det < 0``: a reflection or an odd number of negative scales), the
+        When `matrix` swaps handedness ($det < 0$: a reflection or an odd number of negative scales), the
         winding of every face is reversed, so faces stay counter-clockwise seen from the (mirrored) outside
         and a closed mesh keeps a positive volume. UVs and colors are carried over.
 
@@ -292,7 +292,7 @@ class Mesh:
         Each group of merged vertices keeps the position, UV and color of its lowest-index member, and groups
         are numbered in order of that member, so the result is deterministic. Vertex normals are recomputed
         (area-weighted) on the welded mesh: welding joins the surface across seams, so shading becomes smooth
-        there. ``tolerance = 0`` merges only exactly coincident vertices.
+        there. $tolerance = 0$ merges only exactly coincident vertices.
         """
         where = "Mesh.welded"
         tol = as_scalar(tolerance, "tolerance", where=where, error=GeometryError)
@@ -375,7 +375,7 @@ class Mesh:
 
         Quad ``(i, j)`` has corners ``P[i, j], P[i+1, j], P[i+1, j+1], P[i, j+1]`` and is split into the
         triangles ``(P[i,j], P[i+1,j], P[i+1,j+1])`` and ``(P[i,j], P[i+1,j+1], P[i,j+1])``, so the front side is
-        the one where ``∂P/∂i × ∂P/∂j`` points.
+        the one where $∂P/∂i × ∂P/∂j$ points.
 
         Parameters
         ----------
@@ -409,7 +409,7 @@ class Mesh:
     def from_polygons(cls, vertices: ArrayLike, polygons: ArrayLike | Sequence[Sequence[int]]) -> Mesh:
         """Triangulate polygons (quads, or a ragged list of k-gons) into a triangle mesh.
 
-        Each polygon ``(p_0, …, p_k−1)`` becomes the fan ``(p_0, p_i, p_i+1)``, i = 1 … k − 2, which keeps its
+        Each polygon $(p_0, …, p_k−1)$ becomes the fan ``(p_0, p_i, p_i+1)``, i = 1 … k − 2, which keeps its
         winding and is exact for convex polygons (and any polygon star-shaped from its first vertex); k − 2
         triangles per polygon.
 
@@ -446,7 +446,7 @@ def _float64(array: np.ndarray) -> np.ndarray:
 
 
 def _row_lengths(rows: np.ndarray) -> np.ndarray:
-    """(N,) Euclidean lengths of (N, 3) float64 rows, ``sqrt((x² + y²) + z²)``: the same sums as
+    """(N,) Euclidean lengths of (N, 3) float64 rows, $sqrt((x² + y²) + z²)$: the same sums as
     ``(rows * rows).sum(axis=1)`` without its (N, 3) temporary."""
     squares = rows[:, 0] * rows[:, 0]
     squares += rows[:, 1] * rows[:, 1]

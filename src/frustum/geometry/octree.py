@@ -1,6 +1,6 @@
 """Octrees: solids as linear octrees of Morton codes, their set operations, measures and conversions.
 
-The region is a cube ``bounds = (min_corner, max_corner)`` cut `depth` times in halves along x, y and z; a
+The region is a cube $bounds = (min_corner, max_corner)$ cut `depth` times in halves along x, y and z; a
 node at level l (0 = the whole region, `depth` = the finest cells) is one of ``8^l`` cubes of side
 ``size / 2^l``. Every node is **full** (inside the solid), **empty** (the textbook's "void") or **partial**
 (heterogeneous: subdivided into eight children). Finest cells are full or empty.
@@ -9,13 +9,13 @@ Storage is array-based, no Python object per node: ``full[l]`` is the sorted ``u
 codes of the maximal full nodes at level l; the partial nodes (every strict ancestor of a full node that is not
 itself covered) are derived from it. A node's Morton code interleaves the bits of its integer coordinates
 ``(i, j, k)`` (x, y, z, each in ``[0, 2^l)``), x in the lowest bit, so the child of code c in octant o is
-``8·c + o`` with ``o = x + 2y + 4z`` (x, y, z ∈ {0, 1} the child's halves). The tree is canonical: eight full
+$8·c + o$ with $o = x + 2y + 4z$ (x, y, z ∈ {0, 1} the child's halves). The tree is canonical: eight full
 siblings are always merged into their full parent, so equal sets give identical arrays.
 
 **Octant numbering.** The textbook [HB 15, "Octrees"] numbers the octants of a node 0–3 in the front
 (the half toward a viewer on +z) and 4–7 in the back, each face counted like a quadrant: 0 = (x low, y low),
-1 = (x high, y low), 2 = (x low, y high), 3 = (x high, y high). So textbook ``t = x + 2y + 4(1 − z)`` and
-``o = t XOR 4`` (``TEXTBOOK_OCTANTS[o]`` is t).
+1 = (x high, y low), 2 = (x low, y high), 3 = (x high, y high). So textbook $t = x + 2y + 4(1 − z)$ and
+$o = t XOR 4$ (``TEXTBOOK_OCTANTS[o]`` is t).
 
 Besides the full cells an octree built by sampling keeps ``boundary``: the finest cells the surface crossed
 (mixed samples, or a triangle touching the cell); their state was decided by one sample near the cell's
@@ -228,12 +228,12 @@ class Octree:
 
     @cached_property
     def full_cell_count(self) -> int:
-        """Number of finest cells inside the solid: ``Σ_l |full[l]|·8^(depth − l)``."""
+        """Number of finest cells inside the solid: $Σ_l |full[l]|·8^(depth − l)$."""
         return int(sum(c.size * 8 ** (self.depth - level) for level, c in enumerate(self.full)))
 
     @property
     def volume(self) -> float:
-        """Exact volume of the full cells: ``full_cell_count · cell_size³``."""
+        """Exact volume of the full cells: $full_cell_count · cell_size³$."""
         return self.full_cell_count * self.cell_size**3
 
     @property
@@ -357,7 +357,7 @@ class Octree:
     def from_function(
         cls, f: Callable[[NDArray, NDArray, NDArray], ArrayLike], bounds: ArrayLike, depth: int
     ) -> Octree:
-        """Octree of the implicit solid ``f(x, y, z) <= 0`` inside the cube `bounds` (a box is enlarged to a cube
+        """Octree of the implicit solid $f(x, y, z) <= 0$ inside the cube `bounds` (a box is enlarged to a cube
         about its centre), down to `depth` levels.
 
         Top-down subdivision: `f` is called on whole batches of points (three (N,) float64 arrays, returning
@@ -585,12 +585,12 @@ class Octree:
         return Octree(a.bounds, a.depth, tuple(levels), _unique(np.concatenate([a.boundary, b.boundary])))
 
     def intersection(self, other: Octree) -> Octree:
-        """``A ∩ B = ¬(¬A ∪ ¬B)`` (De Morgan within the region), canonical."""
+        """$A ∩ B = ¬(¬A ∪ ¬B)$ (De Morgan within the region), canonical."""
         a, b = _same_region(self, other, "Octree.intersection")
         return a.complement().union(b.complement()).complement()
 
     def difference(self, other: Octree) -> Octree:
-        """``A − B = A ∩ ¬B``, canonical."""
+        """$A − B = A ∩ ¬B$, canonical."""
         a, b = _same_region(self, other, "Octree.difference")
         return a.intersection(b.complement())
 
@@ -732,7 +732,7 @@ class Octree:
         return Mesh(vertices, faces)
 
     def _exposed_squares(self, where: str) -> NDArray[np.int64]:
-        """(Q, 4) lattice-point keys ``(i·m1 + j)·m1 + k`` of every exposed finest square of full cells."""
+        """(Q, 4) lattice-point keys $(i·m1 + j)·m1 + k$ of every exposed finest square of full cells."""
         d = self.depth
         m1 = 2**d + 1
         out = []
@@ -781,7 +781,7 @@ class Octree:
         return mesh, (bvh.build(np.asarray(mesh.vertices[mesh.faces], dtype=np.float64)) if mesh.face_count else None)
 
     def ray_hits(self, origins: ArrayLike, directions: ArrayLike) -> OctreeHits:
-        """First hit of each ray ``origin + t·direction`` (t >= 0) on the solid: distance, point and full leaf.
+        """First hit of each ray $origin + t·direction$ (t >= 0) on the solid: distance, point and full leaf.
 
         The rays are traced against the exposed cell faces (``to_mesh``) through a bounding-volume hierarchy
         (``raster.bvh``); a ray starting inside a full cell hits at t = 0. Distances are in units of the

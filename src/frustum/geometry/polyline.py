@@ -18,7 +18,7 @@ __all__ = ["Polyline"]
 
 @dataclass(frozen=True, eq=False)
 class Polyline:
-    """Points ``P_0 … P_{N−1}`` (N, 3) joined by the segments ``P_i P_{i+1}`` (and ``P_{N−1} P_0`` when ``closed``).
+    """Points $P_0 … P_{N−1}$ (N, 3) joined by the segments ``P_i P_{i+1}`` (and $P_{N−1} P_0$ when ``closed``).
 
     ``markers=True`` draws the points themselves (as squares of the line width plus two pixels) instead of the
     segments, e.g. the control points of a curve. ``pairs`` (S, 2) indices replace the consecutive segments by

@@ -73,7 +73,7 @@ def plane(size: ArrayLike = (1.0, 1.0), divisions: int | ArrayLike = (1, 1)) -> 
     size : (2,) array_like or float
         Width (x) and depth (y), each > 0; one number gives a square.
     divisions : int or (2,) ints
-        Quads along x and y, each >= 1: ``2·nx·ny`` triangles. UV (0, 0) is the (−x, −y) corner.
+        Quads along x and y, each >= 1: $2·nx·ny$ triangles. UV (0, 0) is the (−x, −y) corner.
     """
     where = "plane"
     width, depth = _pair(size, "size", where, as_float=True)
@@ -98,9 +98,9 @@ def grid(size: ArrayLike = (1.0, 1.0), divisions: int | ArrayLike = (10, 10)) ->
 
 
 def uv_sphere(radius: float = 1.0, segments: int = 32, rings: int = 16) -> Mesh:
-    """A latitude-longitude sphere ``x² + y² + z² = r²``: `segments` around z (>= 3), `rings` pole to pole (>= 2).
+    """A latitude-longitude sphere $x² + y² + z² = r²$: `segments` around z (>= 3), `rings` pole to pole (>= 2).
 
-    ``2·segments·(rings − 1)`` triangles (one per segment at each pole). Normals are ``P/r``. UVs are the
+    $2·segments·(rings − 1)$ triangles (one per segment at each pole). Normals are ``P/r``. UVs are the
     equirectangular map: u = longitude/2π from +x counter-clockwise, v = 0 at the south pole, 1 at the north.
     """
     where = "uv_sphere"
@@ -119,7 +119,7 @@ def uv_sphere(radius: float = 1.0, segments: int = 32, rings: int = 16) -> Mesh:
 def icosphere(radius: float = 1.0, subdivisions: int = 2) -> Mesh:
     """A geodesic sphere: the icosahedron with each triangle split in four `subdivisions` times (0 … 8).
 
-    ``20·4^k`` triangles whose vertices are pushed onto the sphere; normals ``P/r``. UVs are the
+    $20·4^k$ triangles whose vertices are pushed onto the sphere; normals ``P/r``. UVs are the
     equirectangular map (u = longitude/2π, v = latitude/π + ½), with vertices duplicated along the u seam so
     no triangle wraps around the texture.
     """
@@ -169,7 +169,7 @@ def cylinder(radius: float = 1.0, height: float = 1.0, segments: int = 32, caps:
 def cone(radius: float = 1.0, height: float = 1.0, segments: int = 32, cap: bool = True) -> Mesh:
     """A circular cone about z: base of `radius` at z = −h/2, apex at z = +h/2, `segments` >= 3 around.
 
-    Side normals are the analytic ``(h·cos θ, h·sin θ, r)/√(h² + r²)``; the apex is split into one vertex per
+    Side normals are the analytic $(h·cos θ, h·sin θ, r)/√(h² + r²)$; the apex is split into one vertex per
     segment so each triangle there keeps its own normal direction. The base cap faces −z.
     """
     where = "cone"
@@ -185,9 +185,9 @@ def cone(radius: float = 1.0, height: float = 1.0, segments: int = 32, cap: bool
 def torus(
     major_radius: float = 1.0, minor_radius: float = 0.25, major_segments: int = 48, minor_segments: int = 24
 ) -> Mesh:
-    """A ring torus about the z axis: ``(√(x² + y²) − R)² + z² = r²`` with 0 < r < R.
+    """A ring torus about the z axis: $(√(x² + y²) − R)² + z² = r²$ with 0 < r < R.
 
-    ``2·major_segments·minor_segments`` triangles; normals point from the tube's centre circle to the surface.
+    $2·major_segments·minor_segments$ triangles; normals point from the tube's centre circle to the surface.
     UVs: u = angle about z / 2π, v = angle about the tube / 2π.
     """
     where = "torus"
@@ -228,7 +228,7 @@ def arrow(
 ) -> Mesh:
     """A closed arrow from `origin` along `direction`: a cylindrical shaft and a conical head, total `length`.
 
-    Requires ``head_length < length`` and ``shaft_radius < head_radius``. Built along +z, then rotated onto
+    Requires $head_length < length$ and $shaft_radius < head_radius$. Built along +z, then rotated onto
     `direction` and moved to `origin`.
     """
     where = "arrow"
@@ -309,7 +309,7 @@ def _revolve(profile: NDArray, normals: NDArray, v: NDArray, segments: int) -> M
 
 
 def _cap(radius: float, z: float, segments: int, up: bool) -> Mesh:
-    """A disk at height z facing +z (`up`) or −z, with planar UVs ``(½ + x/2r, ½ ± y/2r)``."""
+    """A disk at height z facing +z (`up`) or −z, with planar UVs $(½ + x/2r, ½ ± y/2r)$."""
     nz = 1.0 if up else -1.0
     profile = np.array([[0.0, z], [radius, z]]) if up else np.array([[radius, z], [0.0, z]])
     mesh = _revolve(profile, np.array([[0.0, nz], [0.0, nz]]), np.zeros(2), segments)

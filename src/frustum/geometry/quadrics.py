@@ -1,8 +1,8 @@
 """Quadric and superquadric surfaces: implicit functions, parametric forms with signed powers, and meshes.
 
 Implicit functions return the left-hand side F of the seed's Cartesian equation, so the surface is F = 1,
-the inside F < 1 and the outside F > 1. Parametric forms use the **signed power** ``spow(c, e) = sign(c)·|c|^e``
-(Barr 1981): a plain ``cos(θ)^s`` is NaN for negative cosines and non-integer s, and the octants collapse.
+the inside F < 1 and the outside F > 1. Parametric forms use the **signed power** $spow(c, e) = sign(c)·|c|^e$
+(Barr 1981): a plain $cos(θ)^s$ is NaN for negative cosines and non-integer s, and the octants collapse.
 Meshes are sampled on a latitude η ∈ [−π/2, π/2] × longitude ω ∈ [0, 2π) grid (rows north to south, like
 ``uv_sphere``), with normals from the analytic gradient ∇F, which at the parametric point simplifies to
 
@@ -48,7 +48,7 @@ __all__ = [
 
 
 def signed_power(c: ArrayLike, e: float) -> NDArray[np.float64]:
-    """``spow(c, e) = sign(c)·|c|^e``, the odd extension of ``c^e`` used by superquadric parametric forms."""
+    """$spow(c, e) = sign(c)·|c|^e$, the odd extension of ``c^e`` used by superquadric parametric forms."""
     c = np.asarray(c, dtype=np.float64)
     return np.sign(c) * np.abs(c) ** e
 
@@ -57,7 +57,7 @@ def signed_power(c: ArrayLike, e: float) -> NDArray[np.float64]:
 
 
 def sphere_implicit(points: ArrayLike, radius: float = 1.0) -> NDArray[np.float64]:
-    """``F = (x² + y² + z²)/r²`` for each point: the sphere ``x² + y² + z² = r²`` is F = 1.
+    """$F = (x² + y² + z²)/r²$ for each point: the sphere $x² + y² + z² = r²$ is F = 1.
 
     References
     ----------
@@ -70,7 +70,7 @@ def sphere_implicit(points: ArrayLike, radius: float = 1.0) -> NDArray[np.float6
 
 
 def ellipsoid_implicit(points: ArrayLike, radii: ArrayLike = (1.0, 1.0, 1.0)) -> NDArray[np.float64]:
-    """``F = (x/rx)² + (y/ry)² + (z/rz)²``: the ellipsoid is F = 1.
+    """$F = (x/rx)² + (y/ry)² + (z/rz)²$: the ellipsoid is F = 1.
 
     References
     ----------
@@ -83,7 +83,7 @@ def ellipsoid_implicit(points: ArrayLike, radii: ArrayLike = (1.0, 1.0, 1.0)) ->
 
 
 def superellipse_implicit(points: ArrayLike, radii: ArrayLike = (1.0, 1.0), s: float = 1.0) -> NDArray[np.float64]:
-    """``F = |x/rx|^(2/s) + |y/ry|^(2/s)`` for (N, 2) points: the superellipse is F = 1 (s = 1: an ellipse).
+    """$F = |x/rx|^(2/s) + |y/ry|^(2/s)$ for (N, 2) points: the superellipse is F = 1 (s = 1: an ellipse).
 
     References
     ----------
@@ -99,7 +99,7 @@ def superellipse_implicit(points: ArrayLike, radii: ArrayLike = (1.0, 1.0), s: f
 def superellipsoid_implicit(
     points: ArrayLike, radii: ArrayLike = (1.0, 1.0, 1.0), s1: float = 1.0, s2: float = 1.0
 ) -> NDArray[np.float64]:
-    """``F = (|x/rx|^(2/s2) + |y/ry|^(2/s2))^(s2/s1) + |z/rz|^(2/s1)``: the superellipsoid is F = 1.
+    """$F = (|x/rx|^(2/s2) + |y/ry|^(2/s2))^(s2/s1) + |z/rz|^(2/s1)$: the superellipsoid is F = 1.
 
     s1 shapes the latitude (north–south) profile, s2 the cross-section about z; s1 = s2 = 1 is the ellipsoid.
 
@@ -117,9 +117,9 @@ def superellipsoid_implicit(
 def supertoroid_implicit(
     points: ArrayLike, major_radius: float = 1.0, minor_radius: float = 0.25, s1: float = 1.0, s2: float = 1.0
 ) -> NDArray[np.float64]:
-    """``F = |((|x|^(2/s2) + |y|^(2/s2))^(s2/2) − R)/r|^(2/s1) + |z/r|^(2/s1)``: the supertoroid is F = 1.
+    """$F = |((|x|^(2/s2) + |y|^(2/s2))^(s2/2) − R)/r|^(2/s1) + |z/r|^(2/s1)$: the supertoroid is F = 1.
 
-    s1 = s2 = 1 gives the ring torus ``(√(x² + y²) − R)² + z² = r²``.
+    s1 = s2 = 1 gives the ring torus $(√(x² + y²) − R)² + z² = r²$.
 
     References
     ----------
@@ -137,10 +137,10 @@ def supertoroid_implicit(
 
 
 def superellipse(radii: ArrayLike = (1.0, 1.0), s: float = 1.0, segments: int = 64) -> NDArray[np.float64]:
-    """Points ``(rx·spow(cos θ, s), ry·spow(sin θ, s))`` at θ = 2πk/segments: a closed curve, counter-clockwise.
+    """Points $(rx·spow(cos θ, s), ry·spow(sin θ, s))$ at θ = 2πk/segments: a closed curve, counter-clockwise.
 
     Returns (segments, 2) float64 (the first point is not repeated at the end). s = 1 gives the ellipse
-    ``(rx cos θ, ry sin θ)`` exactly; s < 1 bulges toward a rectangle, s = 2 is a rhombus, s > 2 pinches in.
+    $(rx cos θ, ry sin θ)$ exactly; s < 1 bulges toward a rectangle, s = 2 is a rhombus, s > 2 pinches in.
 
     References
     ----------
@@ -156,15 +156,15 @@ def superellipse(radii: ArrayLike = (1.0, 1.0), s: float = 1.0, segments: int = 
 
 
 def sphere(radius: float = 1.0, segments: int = 32, rings: int = 16) -> Mesh:
-    """The sphere ``x² + y² + z² = r²`` as a latitude-longitude mesh (an ``ellipsoid`` with equal radii)."""
+    """The sphere $x² + y² + z² = r²$ as a latitude-longitude mesh (an ``ellipsoid`` with equal radii)."""
     r = _positive(radius, "radius", "sphere")
     return _superquadric_mesh((r, r, r), 1.0, 1.0, segments, rings, "sphere")
 
 
 def ellipsoid(radii: ArrayLike = (1.0, 1.0, 1.0), segments: int = 32, rings: int = 16) -> Mesh:
-    """The ellipsoid ``(x/rx)² + (y/ry)² + (z/rz)² = 1``: ``(rx cos η cos ω, ry cos η sin ω, rz sin η)``.
+    """The ellipsoid $(x/rx)² + (y/ry)² + (z/rz)² = 1$: $(rx cos η cos ω, ry cos η sin ω, rz sin η)$.
 
-    Normals ∝ ∇F = (x/rx², y/ry², z/rz²). `segments` (>= 3) around z, `rings` (>= 2) pole to pole.
+    Normals $∝ ∇F = (x/rx², y/ry², z/rz²)$. `segments` (>= 3) around z, `rings` (>= 2) pole to pole.
     """
     return _superquadric_mesh(_radii(radii, "ellipsoid"), 1.0, 1.0, segments, rings, "ellipsoid")
 
@@ -174,8 +174,8 @@ def superellipsoid(
 ) -> Mesh:
     """The superellipsoid sampled from its parametric form (signed powers):
 
-    ``x = rx·spow(cos η, s1)·spow(cos ω, s2)``, ``y = ry·spow(cos η, s1)·spow(sin ω, s2)``,
-    ``z = rz·spow(sin η, s1)``, with η ∈ [−π/2, π/2], ω ∈ [0, 2π). s1 = s2 = 1 gives ``ellipsoid`` exactly.
+    $x = rx·spow(cos η, s1)·spow(cos ω, s2)$, $y = ry·spow(cos η, s1)·spow(sin ω, s2)$,
+    $z = rz·spow(sin η, s1)$, with η ∈ [−π/2, π/2], ω ∈ [0, 2π). s1 = s2 = 1 gives ``ellipsoid`` exactly.
 
     References
     ----------
@@ -195,8 +195,8 @@ def supertoroid(
     major_segments: int = 48,
     minor_segments: int = 24,
 ) -> Mesh:
-    """The supertoroid about z: ``x = (R + r·spow(cos η, s1))·spow(cos ω, s2)``,
-    ``y = (R + r·spow(cos η, s1))·spow(sin ω, s2)``, ``z = r·spow(sin η, s1)``, η, ω ∈ [0, 2π); needs r < R.
+    """The supertoroid about z: $x = (R + r·spow(cos η, s1))·spow(cos ω, s2)$,
+    $y = (R + r·spow(cos η, s1))·spow(sin ω, s2)$, $z = r·spow(sin η, s1)$, η, ω ∈ [0, 2π); needs r < R.
 
     References
     ----------

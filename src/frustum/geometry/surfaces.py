@@ -1,12 +1,12 @@
 """Tensor-product surfaces: Bézier, B-spline and NURBS patches, their normals and tessellation into a ``Mesh``.
 
-A surface maps (u, v) in its domain to a 3-D point, ``S(u, v) = Σ_i Σ_j B_i(u)·B_j(v)·P_ij``, with the control
+A surface maps (u, v) in its domain to a 3-D point, $S(u, v) = Σ_i Σ_j B_i(u)·B_j(v)·P_ij$, with the control
 grid ``P[i, j]`` of shape ``(m + 1, n + 1, 3)``: the first grid index goes with u, the second with v. The
-normal is ``S_u × S_v`` normalized, and tessellated faces are counter-clockwise seen from that side.
+normal is $S_u × S_v$ normalized, and tessellated faces are counter-clockwise seen from that side.
 
 Where a whole edge of the control grid collapses to one point (a pole, as at the teapot's lid knob and bottom,
-or a NURBS sphere's poles) ``S_u × S_v`` vanishes. There the normal is its limit from inside the patch: with
-``S_v → 0`` on the edge u = 0, ``S_v ≈ u·S_uv`` and the normal is ``S_u × S_uv`` (signs follow the side).
+or a NURBS sphere's poles) $S_u × S_v$ vanishes. There the normal is its limit from inside the patch: with
+``S_v → 0`` on the edge u = 0, $S_v ≈ u·S_uv$ and the normal is $S_u × S_uv$ (signs follow the side).
 
 References
 ----------
@@ -121,7 +121,7 @@ class _Surface:
     __call__ = evaluate
 
     def partial(self, u: ArrayLike, v: ArrayLike, du: int = 1, dv: int = 0) -> FloatArray:
-        """The partial derivative ``∂^(du+dv) S / ∂u^du ∂v^dv`` (du, dv in {0, 1}): (N, 3) or (3,)."""
+        """The partial derivative $∂^(du+dv) S / ∂u^du ∂v^dv$ (du, dv in {0, 1}): (N, 3) or (3,)."""
         where = f"{type(self).__name__}.partial"
         du, dv = as_count(du, "du", 0, where=where), as_count(dv, "dv", 0, where=where)
         if du > 1 or dv > 1:
@@ -131,7 +131,7 @@ class _Surface:
         return values[0] if scalar else values
 
     def normal(self, u: ArrayLike, v: ArrayLike) -> FloatArray:
-        """Unit normals ``(S_u × S_v)/|S_u × S_v|``, the limit from inside the patch at collapsed edges."""
+        """Unit normals $(S_u × S_v)/|S_u × S_v|$, the limit from inside the patch at collapsed edges."""
         su, sv, scalar = self._params(u, v, f"{type(self).__name__}.normal")
         d = self._derivatives(lambda a, b: self._raw(su, sv, a, b))
         normals = _unit_normals(d, su, sv, self.domain_u, self.domain_v, self._scale())
@@ -163,7 +163,7 @@ class _Surface:
     def tessellate(self, nu: int = 16, nv: int = 16) -> Mesh:
         """A ``Mesh`` of (nu + 1)·(nv + 1) vertices on the uniform parameter grid with analytic unit normals.
 
-        Vertex ``i·(nv + 1) + j`` is ``S(u_i, v_j)``. Each grid cell gives two triangles, counter-clockwise seen
+        Vertex $i·(nv + 1) + j$ is ``S(u_i, v_j)``. Each grid cell gives two triangles, counter-clockwise seen
         from the normal side; triangles with two coincident corners (at collapsed edges) are dropped.
         """
         where = f"{type(self).__name__}.tessellate"
@@ -185,7 +185,7 @@ class _Surface:
         """(nu, nv) such that the uniform tessellation is within `tolerance` of the surface.
 
         Uses the bound for piecewise-linear interpolation on a triangulated grid of steps (h_u, h_v):
-        ``|S − T| <= (h_u²·M_uu + 2·h_u·h_v·M_uv + h_v²·M_vv)/8`` with M bounds of the second partials
+        $|S − T| <= (h_u²·M_uu + 2·h_u·h_v·M_uv + h_v²·M_vv)/8$ with M bounds of the second partials
         (Filip, Magedson & Markot 1986). Polynomial patches take M from the control nets of the second
         derivatives (convex hull property, a true bound); NURBS patches estimate M on a 33 × 33 sample, × 1.5.
         """
@@ -328,7 +328,7 @@ def _bernstein_matrix(degree: int, t: FloatArray, order: int) -> FloatArray:
 
 
 class BezierSurface(_Surface):
-    """A tensor-product Bézier patch of degree m × n: ``S(u, v) = Σ_i Σ_j b_{m,i}(u)·b_{n,j}(v)·P_ij``, u, v in [0, 1].
+    """A tensor-product Bézier patch of degree m × n: $S(u, v) = Σ_i Σ_j b_{m,i}(u)·b_{n,j}(v)·P_ij$, u, v in [0, 1].
 
     Parameters
     ----------
@@ -399,7 +399,7 @@ class BezierSurface(_Surface):
 
 
 class BSplineSurface(_Surface):
-    """A tensor-product B-spline surface ``S(u, v) = Σ_i Σ_j N_{i,p}(u)·N_{j,q}(v)·P_ij``.
+    """A tensor-product B-spline surface $S(u, v) = Σ_i Σ_j N_{i,p}(u)·N_{j,q}(v)·P_ij$.
 
     Parameters
     ----------
@@ -466,7 +466,7 @@ class BSplineSurface(_Surface):
 
 
 def _derivative_net(net: FloatArray, knots: FloatArray, degree: int, axis: int) -> FloatArray:
-    """Control net of the derivative along `axis`: ``p·(P_{i+1} − P_i)/(t_{i+p+1} − t_{i+1})`` (0/0 = 0)."""
+    """Control net of the derivative along `axis`: $p·(P_{i+1} − P_i)/(t_{i+p+1} − t_{i+1})$ (0/0 = 0)."""
     if degree == 0:
         return np.zeros_like(net)
     count = net.shape[axis]
@@ -492,10 +492,10 @@ def _surface_knots(kind: Any, count: int, degree: int, where: str, name: str) ->
 
 
 class NURBSSurface(BSplineSurface):
-    """A rational B-spline surface ``S = Σ w_ij·P_ij·N_i(u)·N_j(v) / Σ w_ij·N_i(u)·N_j(v)``: exact quadrics.
+    """A rational B-spline surface $S = Σ w_ij·P_ij·N_i(u)·N_j(v) / Σ w_ij·N_i(u)·N_j(v)$: exact quadrics.
 
     Evaluated as a B-spline surface in homogeneous coordinates (w·P, w); derivatives by the quotient rule
-    ``S_u = (A_u − w_u·S)/w``, ``S_uv = (A_uv − w_uv·S − w_u·S_v − w_v·S_u)/w``.
+    $S_u = (A_u − w_u·S)/w$, $S_uv = (A_uv − w_uv·S − w_u·S_v − w_v·S_u)/w$.
 
     Parameters
     ----------
@@ -580,7 +580,7 @@ class NURBSSurface(BSplineSurface):
     def sphere(cls, radius: float = 1.0, center: ArrayLike = (0.0, 0.0, 0.0)) -> NURBSSurface:
         """The exact sphere: a quadratic NURBS circle (u, longitude) times a half circle (v, south to north pole).
 
-        ``P_ij = (x_j·c_i, z_j)`` with weight ``w_i·w_j``; ``S_u × S_v`` points outward; the poles are collapsed
+        $P_ij = (x_j·c_i, z_j)$ with weight $w_i·w_j$; $S_u × S_v$ points outward; the poles are collapsed
         rows (their normals are the limits, ±z).
         """
         where = "NURBSSurface.sphere"

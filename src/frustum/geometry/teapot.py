@@ -4,9 +4,9 @@ The patch data ships with frustum as package data (``frustum/geometry/data/*.txt
 format: a patch count, one line of 16 one-based control-point indices per patch, a point count, one ``x,y,z``
 line per point). Newell's data is public domain.
 
-Each patch's 16 indices form a 4 × 4 grid in row-major order, ``P(s, t) = Σ_r Σ_c B_r(s)·B_c(t)·V[idx[4r + c]]``.
+Each patch's 16 indices form a 4 × 4 grid in row-major order, $P(s, t) = Σ_r Σ_c B_r(s)·B_c(t)·V[idx[4r + c]]$.
 frustum stores the patch with its grid transposed, ``grid[c, r]``, so that u = t and v = s: then
-``S_u × S_v = ∂P/∂t × ∂P/∂s`` is the outward normal on the teapot's body, lid, bottom, handle and spout (the
+$S_u × S_v = ∂P/∂t × ∂P/∂s$ is the outward normal on the teapot's body, lid, bottom, handle and spout (the
 choice three.js makes), and ``tessellate`` turns the faces counter-clockwise from outside.
 
 References
@@ -81,7 +81,7 @@ class BezierPatchSet:
     def tessellate(self, resolution: int = 10) -> Mesh:
         """One ``Mesh`` of every patch tessellated ``resolution`` × ``resolution`` (vertices not welded).
 
-        Patch p contributes vertices ``p·(resolution + 1)² + i·(resolution + 1) + j`` at (u_i, v_j), with analytic
+        Patch p contributes vertices $p·(resolution + 1)² + i·(resolution + 1) + j$ at (u_i, v_j), with analytic
         normals (limits at the lid's and bottom's collapsed edges); triangles with coincident corners are
         dropped, as three.js does.
         """

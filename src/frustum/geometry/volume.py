@@ -2,7 +2,9 @@
 
 A ``Volume`` holds ``data[i, j, k]``, the value at the grid point
 
-    P_model = origin + direction · ((i, j, k) ⊙ spacing)          (ITK / NIfTI "index to physical" mapping)
+$$P_model = origin + direction · ((i, j, k) ⊙ spacing)$$
+
+(ITK / NIfTI "index to physical" mapping),
 
 so axis 0 of the array runs along model x, axis 1 along y, axis 2 along z (with the default identity
 `direction`). ``model_from_grid`` is that map as a 4x4 matrix. Values between grid points are trilinear
@@ -13,7 +15,7 @@ per axis (no half-voxel border). Sources: arrays, ``.npy`` and NIfTI files (``Vo
 quaternion Julia set (``quaternion_julia_volume``).
 
 A ``TransferFunction`` maps a scalar s to color and opacity, both piecewise linear in s [HB 15] "Visual
-Representations for Scalar Fields": ``(r, g, b, α)(s)`` interpolates the control rows around s and is constant
+Representations for Scalar Fields": $(r, g, b, α)(s)$ interpolates the control rows around s and is constant
 past the first and last control value. The renderer samples it into a lookup table (``TransferFunction.table``).
 
 References
@@ -149,8 +151,8 @@ class TransferFunction:
     """Piecewise-linear color and opacity over the scalar range: ``TransferFunction(values, colors, opacities)``.
 
     ``rgba(s)`` interpolates linearly between the control rows whose `values` bracket s; below the first value
-    it is the first row, above the last the last row. Opacity is per unit distance ``Δ₀`` (the volume's
-    smallest spacing): a ray step Δ uses ``α' = 1 − (1 − α)^(Δ/Δ₀)`` (the renderer's opacity correction).
+    it is the first row, above the last the last row. Opacity is per unit distance $Δ₀$ (the volume's
+    smallest spacing): a ray step Δ uses $α' = 1 − (1 − α)^(Δ/Δ₀)$ (the renderer's opacity correction).
 
     Parameters
     ----------
@@ -161,7 +163,7 @@ class TransferFunction:
     opacities : (K,) array_like
         Opacity in [0, 1] at each control value.
     range : (2,) array_like, optional
-        The scalar range the function covers, ``low < high``; every control value must lie inside. Default
+        The scalar range the function covers, $low < high$; every control value must lie inside. Default
         ``(values[0], values[-1])``. The renderer's lookup table spans this range.
 
     Raises
@@ -229,7 +231,7 @@ class TransferFunction:
     def table(self, size: int = 4096) -> NDArray[np.float64]:
         """(size, 4) float64: the function at ``size`` evenly spaced values over ``range`` (the kernel's table).
 
-        Entry t holds ``rgba(low + t·(high − low)/(size − 1))``; the kernel interpolates linearly between
+        Entry t holds $rgba(low + t·(high − low)/(size − 1))$; the kernel interpolates linearly between
         entries, so the table is exact wherever no control value falls strictly between two entries.
         """
         size = as_count(size, "size", 2, where="TransferFunction.table")
@@ -237,7 +239,7 @@ class TransferFunction:
 
     @classmethod
     def preset(cls, name: str, range: Any, opacity: Any = None) -> TransferFunction:
-        """A named color ramp over ``range = (low, high)``: one of ``TRANSFER_PRESETS``.
+        """A named color ramp over $range = (low, high)$: one of ``TRANSFER_PRESETS``.
 
         `opacity`: None for a linear ramp 0 → 1 over the range, a number for a constant, or (M,) opacities at
         M evenly spaced values (M >= 2).
@@ -320,7 +322,7 @@ def _direction(value: Any, where: str) -> NDArray[np.float64]:
 class Volume:
     """A 3D scalar grid placed in model coordinates: ``Volume(data, spacing=(1, 1, 1), origin=(0, 0, 0))``.
 
-    ``data[i, j, k]`` is the value at ``origin + direction · ((i, j, k) ⊙ spacing)``: axis 0 along x, axis 1
+    ``data[i, j, k]`` is the value at $origin + direction · ((i, j, k) ⊙ spacing)$: axis 0 along x, axis 1
     along y, axis 2 along z for the default identity `direction`.
 
     Parameters
@@ -387,7 +389,7 @@ class Volume:
 
     @cached_property
     def model_from_grid(self) -> Matrix4:
-        """4x4: grid index (i, j, k) → model point ``origin + direction · ((i, j, k) ⊙ spacing)``."""
+        """4x4: grid index (i, j, k) → model point $origin + direction · ((i, j, k) ⊙ spacing)$."""
         matrix = np.eye(4)
         matrix[:3, :3] = self.direction * self.spacing
         matrix[:3, 3] = self.origin
@@ -417,7 +419,7 @@ class Volume:
     def load(cls, path: str | os.PathLike) -> Volume:
         """A volume from a ``.npy`` file (spacing 1, origin 0) or a NIfTI ``.nii`` / ``.nii.gz`` file.
 
-        NIfTI: ``data[i, j, k]`` lies at ``affine · (i, j, k, 1)`` (the file's voxel-to-world affine; sform or
+        NIfTI: ``data[i, j, k]`` lies at $affine · (i, j, k, 1)$ (the file's voxel-to-world affine; sform or
         qform as nibabel chooses), split into spacing (column lengths), direction (unit columns) and origin.
         Needs nibabel (``pip install 'frustum[nifti]'``). A 4D file keeps its first volume only if the extra
         axes have length 1.
@@ -456,11 +458,11 @@ class Volume:
 
     @classmethod
     def from_function(cls, function: Callable[[NDArray], ArrayLike], bounds: ArrayLike, shape: Any) -> Volume:
-        """Sample an implicit function on a regular grid over the model box ``bounds = (min, max)``.
+        """Sample an implicit function on a regular grid over the model box $bounds = (min, max)$.
 
         ``function(points)`` takes (N, 3) model points and returns (N,) values, as
         ``quadrics.sphere_implicit`` or ``superellipsoid_implicit`` do; ``shape`` (nx, ny, nz) grid points,
-        each >= 2, with ``data[i, j, k] = function(min + (i, j, k) ⊙ (max − min) / (shape − 1))``.
+        each >= 2, with $data[i, j, k] = function(min + (i, j, k) ⊙ (max − min) / (shape − 1))$.
         """
         where = "Volume.from_function"
         low, high, counts = _grid(bounds, shape, where)
@@ -501,8 +503,8 @@ class Volume:
         it (default the middle of the box) returns the (n_a, n_b) image over the other two model axes in
         order (for axis "z": ``image[a, b]`` at x_a, y_b over the box's x and y extent, at the grid's
         resolution along them). Oblique: ``slice(point=p, normal=n, size=(w, h), resolution=(nu, nv))``
-        samples the plane through p with normal n on an (nu, nv) grid ``image[a, b] = p + (a/(nu−1) − ½)·w·u
-        + (b/(nv−1) − ½)·h·v``, where v is `up` (default the model axis least parallel to n) made
+        samples the plane through p with normal n on an (nu, nv) grid $image[a, b] = p + (a/(nu−1) − ½)·w·u
+        + (b/(nv−1) − ½)·h·v$, where v is `up` (default the model axis least parallel to n) made
         perpendicular to n and u = v × n. Points outside the box get `outside`.
         """
         where = "Volume.slice"
@@ -549,10 +551,10 @@ class Volume:
     # --- isosurfaces --------------------------------------------------------------------------------------
 
     def isosurface(self, level: float, step: int = 1, *, inside: str = "above") -> Mesh:
-        """The surface ``value = level`` as a Mesh in model units, by marching cubes (scikit-image).
+        """The surface $value = level$ as a Mesh in model units, by marching cubes (scikit-image).
 
         ``verts, faces = skimage.measure.marching_cubes(data[::step, ::step, ::step], level,
-        spacing=step·spacing)``, then ``P = origin + direction · verts`` (the documented coordinate map). The
+        spacing=step·spacing)``, then $P = origin + direction · verts$ (the documented coordinate map). The
         winding is made counter-clockwise seen from outside, so normals point out of the region `inside`
         ("above": values above `level` are inside, as dense tissue in CT; "below": values below are inside, as
         a distance field). Vertex normals are the area-weighted face normals.
@@ -642,11 +644,11 @@ def _grid_points(low: NDArray, high: NDArray, counts: tuple[int, int, int]) -> N
 
 def blobby_volume(centers: ArrayLike, radii: ArrayLike, shape: Any = 64, *, strengths: ArrayLike | None = None,
                   bounds: ArrayLike | None = None) -> Volume:  # fmt: skip
-    """Blobby objects (metaballs): ``f(P) = Σ_k b_k · exp(−a_k·r_k²)`` with ``a_k = 1/R_k²`` [HB 13] "Blobby Objects".
+    """Blobby objects (metaballs): $f(P) = Σ_k b_k · exp(−a_k·r_k²)$ with $a_k = 1/R_k²$ [HB 13] "Blobby Objects".
 
     `centers` (K, 3), `radii` (K,) R_k > 0, `strengths` (K,) b_k (default 1). The field is sampled on `shape`
     grid points over `bounds` (default the centres' box grown by 2·R). A blobby surface is its isosurface
-    ``f = T`` (e.g. T = 0.5): ``volume.isosurface(0.5)`` or the renderer's isosurface mode.
+    $f = T$ (e.g. T = 0.5): ``volume.isosurface(0.5)`` or the renderer's isosurface mode.
     """
     where = "blobby_volume"
     c = _float_array(centers, "centers", where).reshape(-1, 3) if np.size(centers) % 3 == 0 else None
@@ -674,7 +676,7 @@ def blobby_volume(centers: ArrayLike, radii: ArrayLike, shape: Any = 64, *, stre
 
 def fbm_cloud(shape: Any = 64, *, octaves: int = 5, hurst: float = 0.5, frequency: float = 4.0, seed: int = 0,
               size: float = 1.0) -> Volume:  # fmt: skip
-    """A fractional-Brownian-motion cloud: ``f(P) = Σ_o 2^(−H·o) · noise(2^o · frequency · P)``, rescaled to [0, 1].
+    """A fractional-Brownian-motion cloud: $f(P) = Σ_o 2^(−H·o) · noise(2^o · frequency · P)$, rescaled to [0, 1].
 
     `noise` is trilinear value noise on an integer lattice of seeded uniform values (periodic), so each octave
     doubles the frequency and scales the amplitude by 2^(−H) (H = `hurst`, 0 < H <= 1; spectral exponent
@@ -729,7 +731,7 @@ def fbm_cloud(shape: Any = 64, *, octaves: int = 5, hurst: float = 0.5, frequenc
 def quaternion_julia_volume(c: ArrayLike = (-0.2, 0.6, 0.2, 0.0), *, resolution: int = 64, bound: float = 1.5,
                             slice_w: float = 0.0, max_iter: int = 12) -> Volume:  # fmt: skip
     """The smooth escape-time field of the quaternion Julia set (``escape_time.quaternion_julia``) as a Volume
-    over the cube [−bound, bound]³; inside points have the value `max_iter`, so ``isosurface(max_iter − 0.5)``
+    over the cube [−bound, bound]³; inside points have the value `max_iter`, so $isosurface(max_iter − 0.5)$
     or a transfer function rising near `max_iter` shows the set."""
     from frustum.geometry.escape_time import quaternion_julia
 

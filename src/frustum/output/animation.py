@@ -302,7 +302,7 @@ def _axis(axis: Any, camera: Camera, where: str) -> NDArray[np.float64]:
 def orbit_cameras(camera: Camera, frames: int, axis: str | ArrayLike | None = None) -> list[Camera]:
     """`frames` cameras spaced evenly around one turn of `camera` about the line through its target along `axis`.
 
-    Camera k has ``eye_k = target + R(axis, 2πk/frames)·(eye − target)`` and ``up_k = R·up`` (the rotation of
+    Camera k has $eye_k = target + R(axis, 2πk/frames)·(eye − target)$ and $up_k = R·up$ (the rotation of
     ``transforms.rotate``, counter-clockwise about `axis`), the same projection and image size; camera 0 is
     `camera` itself and the last stops one step short of a full turn, so the animation loops seamlessly.
 
@@ -395,7 +395,7 @@ def turntable(
 ) -> list[Frame] | int:
     """Render `scene` from `frames` cameras orbiting one full turn around the camera's target, as a loop.
 
-    ``eye_k = target + R(axis, 2πk/frames)·(eye − target)`` (``orbit_cameras``). With `path`, the frames are
+    $eye_k = target + R(axis, 2πk/frames)·(eye − target)$ (``orbit_cameras``). With `path`, the frames are
     written as they are rendered (``write_animation``) and the frame count is returned; without, the list of
     ``Frame`` objects is returned.
 

@@ -953,8 +953,8 @@ def drawing_sheet(
     """An SVG engineering drawing of `scene`: multiview orthographic views, dimensions, title block, scale bar.
 
     Model units are millimetres; the SVG's user unit is one millimetre of paper (``width="420mm"`` with a
-    matching viewBox), so a model length L parallel to a view plane measures exactly ``L · scale`` in that
-    orthographic view: paper ``x = x0 + scale·x_view``, ``y = y0 − scale·y_view``. The isometric view is the
+    matching viewBox), so a model length L parallel to a view plane measures exactly $L · scale$ in that
+    orthographic view: paper $x = x0 + scale·x_view$, $y = y0 − scale·y_view$. The isometric view is the
     isometric *projection* (every axis foreshortened by √(2/3)), drawn at the same scale.
 
     Only what a drawing shows is drawn: boundaries, creases and silhouettes of the solids (faces adjacent by
@@ -989,7 +989,7 @@ def drawing_sheet(
     dimensions : {"parts", "overall"} or False
         "parts" (default): each part (placed mesh, a scene-graph node with geometry) gets its sizes, each
         stated once in the view that shows it best (``_plan_parts``): a diameter leader (``⌀d``, ``S⌀d`` for a
-        sphere, ``n× ⌀d`` for equal circles in one view) on each of its circles, linear dimensions for the
+        sphere, $n× ⌀d$ for equal circles in one view) on each of its circles, linear dimensions for the
         extents the diameters do not state, stacked outward 7 mm apart so that no extension line crosses a
         dimension line or its text (radii "R r" on arcs). When the parts' dimensions crowd the paper at the
         four largest standard scales at which the views fit (or at the given `scale`), the sheet falls back to

@@ -2,7 +2,7 @@
 
 The DXF holds what the SVG sheet draws, in **model units at full size**: one drawing unit is one model unit
 (``$INSUNITS``), the sheet drawn at 1 / scale (a CAD user measures the model's lengths directly), y up:
-``x_dxf = x_paper / scale``, ``y_dxf = (paper height − y_paper) / scale``. So a CIRCLE's radius and a DIMENSION's
+$x_dxf = x_paper / scale$, $y_dxf = (paper height − y_paper) / scale$. So a CIRCLE's radius and a DIMENSION's
 measurement are the model's values; lettering and arrowheads keep their paper size through ``DIMSCALE`` and
 text heights divided by the scale.
 

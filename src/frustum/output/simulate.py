@@ -2,8 +2,8 @@
 
 ``simulate(scene, camera, frames, fps=30, substeps=2)`` yields ``Frame`` objects; with ``path=`` it writes them
 as a GIF or MP4 through ``write_animation`` (with a progress bar on a terminal) and returns the frame count.
-Frame k shows the state at ``t = warmup + k/fps``: frame 0 is rendered first, then every system advances by
-``substeps`` steps of ``dt = 1/(fps·substeps)`` (in the order they were added), and every mass–spring node
+Frame k shows the state at $t = warmup + k/fps$: frame 0 is rendered first, then every system advances by
+``substeps`` steps of $dt = 1/(fps·substeps)$ (in the order they were added), and every mass–spring node
 gets its system's new mesh (normals recomputed).
 """
 
@@ -69,7 +69,7 @@ def simulate(
     fps : float
         Frames per second of simulated time (and of the file), in (0, 100].
     substeps : int
-        Simulation steps per frame, >= 1 (``dt = 1/(fps·substeps)``): more for stiff springs or fast particles.
+        Simulation steps per frame, >= 1 ($dt = 1/(fps·substeps)$): more for stiff springs or fast particles.
     warmup : float
         Seconds simulated before the first frame (a fountain already running), >= 0.
     path : str or PathLike, optional

@@ -5,9 +5,9 @@ whose channels are linear RGB. An anaglyph codes the left image in the red chann
 green and blue, for red (left) / cyan (right) glasses:
 
 * ``"color"``: ``(R_left, G_right, B_right)``, the full-color anaglyph;
-* ``"gray"``: ``(Y_left, Y_right, Y_right)`` with the luma ``Y = 0.299 R + 0.587 G + 0.114 B`` (ITU-R BT.601),
+* ``"gray"``: ``(Y_left, Y_right, Y_right)`` with the luma $Y = 0.299 R + 0.587 G + 0.114 B$ (ITU-R BT.601),
   no retinal rivalry between differently colored objects;
-* ``"dubois"``: Dubois's least-squares projection ``RGB = clip(M_left · RGB_left + M_right · RGB_right)``,
+* ``"dubois"``: Dubois's least-squares projection $RGB = clip(M_left · RGB_left + M_right · RGB_right)$,
   which accounts for the transmission of real red/cyan filters (less ghosting).
 
 Alpha of an anaglyph is the larger of the two alphas. Side-by-side puts the left image on the left (parallel
@@ -69,8 +69,8 @@ def _pair(left: ArrayLike, right: ArrayLike, where: str) -> tuple[NDArray[np.uin
 def anaglyph(left: ArrayLike, right: ArrayLike, method: str = "color") -> NDArray[np.uint8]:
     """Red/cyan anaglyph of a stereo pair: the left image in red, the right one in green and blue.
 
-    ``"color"``: ``(R_l, G_r, B_r)``; ``"gray"``: ``(Y_l, Y_r, Y_r)``, ``Y = 0.299 R + 0.587 G + 0.114 B``;
-    ``"dubois"``: ``clip(M_l · rgb_l + M_r · rgb_r, 0, 1)`` with Dubois's least-squares matrices. Alpha is
+    ``"color"``: ``(R_l, G_r, B_r)``; ``"gray"``: ``(Y_l, Y_r, Y_r)``, $Y = 0.299 R + 0.587 G + 0.114 B$;
+    ``"dubois"``: $clip(M_l · rgb_l + M_r · rgb_r, 0, 1)$ with Dubois's least-squares matrices. Alpha is
     ``max(A_l, A_r)``.
 
     Parameters

@@ -1,7 +1,7 @@
 """Exact vector drawings: hidden-line SVG (and PDF or PNG through cairosvg) of a scene seen by a camera.
 
 ``render_svg`` draws the edges that ``frustum.hidden_lines.remove_hidden_lines`` finds, visible solid and hidden
-dashed (or dimmed), in window coordinates with **y down** as SVG wants it (``y_svg = height − y_window``), one
+dashed (or dimmed), in window coordinates with **y down** as SVG wants it ($y_svg = height − y_window$), one
 SVG user unit per pixel. With ``fill=True`` it first paints the faces as flat-shaded polygons back to front (a
 BSP tree, ``frustum.bsp``, or a plain depth sort), so filled drawings are correct where a painter's algorithm
 on whole faces is not. Curves: under a parallel projection the window image of a Bézier control polygon is
@@ -118,7 +118,7 @@ def _point(x: float, y: float) -> str:
 
 
 def svg_path_from_polyline(points_window: ArrayLike, height: float, closed: bool = False) -> str:
-    """SVG path data ``M x0 y0 L x1 y1 …`` of window points (y up), flipped to SVG's y down: ``y = height − y_w``.
+    """SVG path data ``M x0 y0 L x1 y1 …`` of window points (y up), flipped to SVG's y down: $y = height − y_w$.
 
     Parameters
     ----------
@@ -145,7 +145,7 @@ def svg_path_from_bezier(control_points_window: ArrayLike, height: float | None 
     """SVG path data of a Bézier curve from its window control points: exact under a parallel projection.
 
     An affine map (any parallel projection and the viewport) sends the control points of a Bézier curve to
-    the control points of the image curve, ``A·Σ B_k,n(u) P_k = Σ B_k,n(u) A·P_k`` (the Bernstein weights sum
+    the control points of the image curve, $A·Σ B_k,n(u) P_k = Σ B_k,n(u) A·P_k$ (the Bernstein weights sum
     to 1), so the projected curve is exactly the SVG curve with the projected controls. Degree 1 gives ``L``,
     2 a quadratic ``Q``, 3 a cubic ``C``; 3k + 1 points are read as k cubic pieces joined end to start (a
     composite Bézier spline). A perspective projection is not affine: draw a polyline of curve points instead.
@@ -155,7 +155,7 @@ def svg_path_from_bezier(control_points_window: ArrayLike, height: float | None 
     control_points_window : (n + 1, 2) or (n + 1, 3) array_like
         Window coordinates, y up; 2 (line), 3 (quadratic), 4 (cubic) or 3k + 1 (k cubics) points.
     height : float, optional
-        Window height: y is flipped to SVG's y down as ``height − y``; None keeps y as given.
+        Window height: y is flipped to SVG's y down as $height − y$; None keeps y as given.
 
     Returns
     -------
@@ -449,7 +449,7 @@ def render_svg(
     The SVG has ``width`` × ``height`` = the camera's image size, one user unit per pixel, y down:
     a window point (x, y_w) is drawn at (x, height − y_w). Visible pieces are solid, hidden pieces dashed or
     gray (``hidden``); with ``depth_cue`` each visible piece gets a gray level and a width that fall off
-    linearly with window depth, ``f = (z − z_near)/(z_far − z_near)``: gray = 0.75·f, width ·(1 − 0.6·f).
+    linearly with window depth, $f = (z − z_near)/(z_far − z_near)$: gray = 0.75·f, width ·(1 − 0.6·f).
     Placed volumes (``Scene.add_volume``) have no vector form: their ray-cast picture (``render``'s kernels)
     is embedded as one PNG ``<image>`` in the group ``volumes`` over the faces and lines, each ray stopped at the
     nearest face or visible line (``frustum.output.svg_volumes``).

@@ -65,7 +65,7 @@ def _signed_area(polygon: NDArray) -> float:
 
 
 def _clip_half_plane(polygon: NDArray, normal: NDArray, offset: float) -> NDArray:
-    """The part of a convex polygon (n, 2) where ``normal·p + offset >= 0`` (Sutherland–Hodgman, one edge)."""
+    """The part of a convex polygon (n, 2) where $normal·p + offset >= 0$ (Sutherland–Hodgman, one edge)."""
     if polygon.shape[0] == 0:
         return polygon
     side = polygon @ normal + offset
@@ -115,7 +115,7 @@ def _intersect(a: NDArray, b: NDArray) -> NDArray:
 
 
 def _subtract(a: NDArray, b: NDArray, tiny: float) -> list[NDArray]:
-    """``a − b`` for convex counter-clockwise polygons, as disjoint convex pieces."""
+    """$a − b$ for convex counter-clockwise polygons, as disjoint convex pieces."""
     if _intersect(a, b).shape[0] < 3 or abs(_signed_area(_intersect(a, b))) <= tiny:
         return [a]
     pieces = []
@@ -263,7 +263,7 @@ def _scene_faces(scene: Scene, camera: Camera) -> _Faces:
 
 
 def _clip_space(polygon: NDArray, normal: NDArray, offset: float, low: float, high: float | None) -> NDArray:
-    """The part of a convex 3D polygon (n, 3) with ``low < normal·x + offset`` (and ``< high`` if given)."""
+    """The part of a convex 3D polygon (n, 3) with $low < normal·x + offset$ (and ``< high`` if given)."""
     for sign, bound in ((1.0, low), (-1.0, high)):
         if bound is None or polygon.shape[0] == 0:
             continue

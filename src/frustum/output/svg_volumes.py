@@ -13,7 +13,7 @@ lines and under the particles. Each ray stops at the nearest of
 so over a face or a line only the part of a volume in front of it is painted: a line inside a cloud is seen
 through the cloud in front of it, a line or face in front of a volume is not covered, and an
 ``"isosurface"``-mode volume hides what lies behind it. The image stores straight (not premultiplied) alpha:
-``color = C/A`` of the ray's premultiplied ``(C, A)``, so a viewer's "over" gives ``C + (1 − A)·under``, the
+$color = C/A$ of the ray's premultiplied ``(C, A)``, so a viewer's "over" gives $C + (1 − A)·under$, the
 renderer's blend, within a level.
 
 References: [HB 15] "Visualization of Data Sets" (volume rendering); [HB 16] "Wire-Frame Visibility Methods".

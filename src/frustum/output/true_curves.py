@@ -1,8 +1,8 @@
 """True curves for vector drawings: the edges of circular features drawn as exact circles, ellipses and arcs.
 
 A tessellated solid draws a circle as the polygon of its facets' edges. Under a parallel projection (any view of
-an engineering sheet) the image of a circle ``P(θ) = c + r·(cos θ·e1 + sin θ·e2)`` is exactly the ellipse
-``p(θ) = C + cos θ·A + sin θ·B`` with ``C``, ``A = proj(c + r·e1) − C``, ``B = proj(c + r·e2) − C`` (an affine
+an engineering sheet) the image of a circle $P(θ) = c + r·(cos θ·e1 + sin θ·e2)$ is exactly the ellipse
+$p(θ) = C + cos θ·A + sin θ·B$ with ``C``, $A = proj(c + r·e1) − C$, $B = proj(c + r·e2) − C$ (an affine
 map keeps the parametrization): a circle seen end-on, an ellipse seen obliquely, a line seen edge-on. So the
 polygon's visible and hidden pieces are replaced by the arcs of that ellipse over the same angles.
 
@@ -23,7 +23,7 @@ Circular features are found in any mesh, whoever built it (``find_circles``):
   through the face's centroid (a polyhedron with few faces, or a short cylinder, is not a sphere): its
   silhouette under a parallel projection is the great circle perpendicular to the line of sight, drawn as a
   circle of radius r (the faceted silhouette's zigzag lies inside it);
-* **tori** — a mesh whose vertices satisfy ``(ρ − R)² + h² = r²`` about the axis of their smallest second
+* **tori** — a mesh whose vertices satisfy $(ρ − R)² + h² = r²$ about the axis of their smallest second
   moment (least squares in R and R² − r², same tolerance, r < R, faces turned like the surface): seen along
   its axis, its silhouette is the outer and inner equator, circles of radii R ± r.
 
@@ -118,10 +118,10 @@ class Circle:
 
 
 class EllipseArc(NamedTuple):
-    """The arc ``p(θ) = centre + cos θ·axes[:, 0] + sin θ·axes[:, 1]`` for θ from `start` to `end` (> start).
+    """The arc $p(θ) = centre + cos θ·axes[:, 0] + sin θ·axes[:, 1]$ for θ from `start` to `end` (> start).
 
     In the drawing's 2D coordinates; `axes` are two conjugate semi-diameters (columns), equal and perpendicular
-    for a circle seen end-on. ``end − start = 2π`` is the whole ellipse.
+    for a circle seen end-on. $end − start = 2π$ is the whole ellipse.
     """
 
     centre: NDArray[np.float64]

@@ -154,7 +154,7 @@ so the loads of many iterations are in flight at once instead of each waiting in
 
 @intrinsic
 def _stream(typingctx, array, i, j, value):
-    """``array[i, j] = value`` as a non-temporal store (LLVM ``!nontemporal``)."""
+    """$array[i, j] = value$ as a non-temporal store (LLVM ``!nontemporal``)."""
 
     def codegen(context, builder, signature, args):
         kind = signature.args[0]

@@ -1,13 +1,13 @@
 """A-buffer kernels (Carpenter): per pixel a list of fragments with 4×4 coverage masks, resolved front to back.
 
 A fragment is one triangle's part of one pixel: the triangle t, a 16-bit coverage mask of the 4×4 subsamples
-at ``(256·i + 32 + 64·a, 256·j + 32 + 64·b)`` (fixed point, a, b = 0..3; bit ``4·b + a``; top-left rule at each
+at $(256·i + 32 + 64·a, 256·j + 32 + 64·b)$ (fixed point, a, b = 0..3; bit $4·b + a$; top-left rule at each
 subsample), and the shading inputs at the centroid of its covered subsamples (depth, face code, barycentrics:
 shaded once per fragment by the shading kernel). ``count_fragments`` counts them per triangle and
 ``write_fragments`` writes them triangle by triangle (both in parallel over triangles), ``group_by_pixel`` orders
 them pixel by pixel (a counting sort keeping the triangle order within a pixel), and
 ``resolve`` composites each subsample: the fragments covering it sorted by their plane's depth at the subsample,
-``C = Σ_k T_k·α_k·c_k + T·under`` with ``T_k = Π_{m<k} (1 − α_m)`` (premultiplied colors), the pixel the mean of
+$C = Σ_k T_k·α_k·c_k + T·under$ with $T_k = Π_{m<k} (1 − α_m)$ (premultiplied colors), the pixel the mean of
 its 16 subsamples. Intersecting and cyclically overlapping surfaces come out right per subsample.
 """
 
@@ -137,7 +137,7 @@ def resolve(
     """Composite pixels [start, stop) (row-major over the (H, W) image) front to back per subsample.
 
     starts (H·W + 1,) int64: pixel p's fragments are ``starts[p]:starts[p + 1]``; premultiplied (N, 4) uint8
-    ``α·c`` and ``α`` of each fragment; under (H, W, 4) uint8: what lies behind every fragment (background, or
+    $α·c$ and $α$ of each fragment; under (H, W, 4) uint8: what lies behind every fragment (background, or
     the opaque surfaces), and under_depth (H, W) float32 its depth: subsamples of fragments at or behind it are
     dropped. color (H, W, 4) uint8 receives the rounded mean of the 16 subsamples; depth (H, W) float32 the
     nearest opaque fragment's depth at the pixel centre where one covers it (left alone elsewhere).

@@ -113,7 +113,7 @@ def _cast_ray(lo, hi, triangles, order, skip, ox, oy, oz, dx, dy, dz, t_max, cul
 
     The nearest t in [0, t_max) over the triangles (ties: the lower triangle index), skipping those with
     ``skip[face] != 0`` (`skip` empty: none) and, when `cull`, the back faces (Möller–Trumbore's determinant
-    ``e1·(d × e2) = −d·N`` negative: the ray meets the side the counter-clockwise normal N points away from).
+    $e1·(d × e2) = −d·N$ negative: the ray meets the side the counter-clockwise normal N points away from).
     u, v are the weights of corners 1 and 2 at the hit (world barycentrics: perspective-correct), back = 1 for a
     back face; inf, −1 for a miss. The counts: box (slab) tests, nodes visited (popped and still nearer than the
     best hit so far), ray–triangle tests. A node is entered nearer child first; a node whose box entry is
@@ -214,7 +214,7 @@ def _trace_parallel(lo, hi, triangles, order, origins, directions, t_out, face_o
 
 
 def first_hits(hierarchy: Hierarchy, origins: np.ndarray, directions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(N,) nearest t >= 0 of each ray ``origin + t·direction`` (inf for a miss) and its triangle index (−1)."""
+    """(N,) nearest t >= 0 of each ray $origin + t·direction$ (inf for a miss) and its triangle index (−1)."""
     o = np.ascontiguousarray(origins, dtype=np.float64)
     d = np.ascontiguousarray(directions, dtype=np.float64)
     t = np.empty(o.shape[0])
@@ -235,11 +235,11 @@ def cast_pixels(lo, hi, triangles, order, skip, world_from_window, window_from_w
     """A ray through the centre of every pixel of window rows [start, stop) (y up); the first hit's window depth,
     face code and barycentrics, as the depth buffer writes them.
 
-    Pixel (i, j) casts ``origin + t·(end − origin)``, t in [0, 1), from ``origin = unproject(i + ½, j + ½, 0)``
-    on the near plane to ``end = unproject(i + ½, j + ½, 1)`` on the far plane (``Camera.ray``'s line; for a
+    Pixel (i, j) casts $origin + t·(end − origin)$, t in [0, 1), from $origin = unproject(i + ½, j + ½, 0)$
+    on the near plane to $end = unproject(i + ½, j + ½, 1)$ on the far plane (``Camera.ray``'s line; for a
     parallel projection the projection direction): hits inside the view volume only. At a hit, ``depth`` (H, W)
-    float32 (top row first: row H − 1 − j) receives the window depth ``z_w = (M₂·P)/(M₃·P)`` (M =
-    `window_from_world`), ``codes`` ``2·face + back``, ``bary`` the weights of the face's corners 1 and 2; a
+    float32 (top row first: row H − 1 − j) receives the window depth $z_w = (M₂·P)/(M₃·P)$ (M =
+    `window_from_world`), ``codes`` $2·face + back$, ``bary`` the weights of the face's corners 1 and 2; a
     depth that rounds to 1 is not written (the depth buffer's test "less" against its clear value). ``stats``
     (H, len(CAST_STATS)) int64 receives each row's counts. `cull` != 0 skips back faces (the ray goes on to
     what lies behind them, as the depth buffer never draws them); `skip` (F,) uint8 marks triangles not drawn.

@@ -1,9 +1,9 @@
 """Clip-space clipping kernels: region codes, Liang–Barsky segments, Sutherland–Hodgman triangles.
 
 Every kernel works on homogeneous clip-space points ``(x, y, z, w)`` and on planes given as 4-vectors
-``(a, b, c, d)``: a point is inside a plane when ``a·x + b·y + c·z + d·w >= 0`` (exactly; no tolerance). The
-symmetric view volume ``−w <= x, y, z <= w`` is the six planes ``w + x >= 0`` (left), ``w − x >= 0`` (right),
-``w + y`` (bottom), ``w − y`` (top), ``w + z`` (near), ``w − z`` (far); ``clipping.py`` builds that array and
+``(a, b, c, d)``: a point is inside a plane when $a·x + b·y + c·z + d·w >= 0$ (exactly; no tolerance). The
+symmetric view volume $−w <= x, y, z <= w$ is the six planes $w + x >= 0$ (left), $w − x >= 0$ (right),
+``w + y`` (bottom), $w − y$ (top), ``w + z`` (near), $w − z$ (far); ``clipping.py`` builds that array and
 appends any user planes. Plane ``k`` owns bit ``k`` (value ``1 << k``) of a region code, so at most 63 planes.
 
 Contracts (kernels never validate): arrays are C-contiguous float64 (int64 for faces and codes), faces index
@@ -43,7 +43,7 @@ TRIANGLE_CROSSING = 2
 
 @kernel
 def plane_distance(plane: np.ndarray, point: np.ndarray) -> float:
-    """Signed plane value ``a·x + b·y + c·z + d·w`` of one (4,) point: ``>= 0`` is inside."""
+    """Signed plane value $a·x + b·y + c·z + d·w$ of one (4,) point: ``>= 0`` is inside."""
     return plane[0] * point[0] + plane[1] * point[1] + plane[2] * point[2] + plane[3] * point[3]
 
 
@@ -80,11 +80,11 @@ def classify_triangles(faces: np.ndarray, codes: np.ndarray, status: np.ndarray)
 
 @kernel
 def clip_segment(start: np.ndarray, end: np.ndarray, planes: np.ndarray) -> tuple[float, float]:
-    """Liang–Barsky: the parameter interval ``[u0, u1]`` of ``P = P1 + (P2 − P1)u`` inside every plane.
+    """Liang–Barsky: the parameter interval ``[u0, u1]`` of $P = P1 + (P2 − P1)u$ inside every plane.
 
-    For each plane, ``p_k = d(P1) − d(P2)`` and ``q_k = d(P1)``; the inside part satisfies ``p_k·u <= q_k``.
-    ``p_k < 0`` (entering) raises u0 to ``q_k/p_k``, ``p_k > 0`` (leaving) lowers u1, ``p_k = 0`` (parallel)
-    rejects when ``q_k < 0``. Returns ``(u0, u1)``; ``u0 > u1`` means nothing is inside (``(1.0, 0.0)``).
+    For each plane, $p_k = d(P1) − d(P2)$ and $q_k = d(P1)$; the inside part satisfies $p_k·u <= q_k$.
+    $p_k < 0$ (entering) raises u0 to ``q_k/p_k``, $p_k > 0$ (leaving) lowers u1, $p_k = 0$ (parallel)
+    rejects when $q_k < 0$. Returns ``(u0, u1)``; $u0 > u1$ means nothing is inside (``(1.0, 0.0)``).
     """
     u0, u1 = 0.0, 1.0
     for k in range(planes.shape[0]):
@@ -111,7 +111,7 @@ def clip_segments(
     clipped_ends: np.ndarray,
     parameters: np.ndarray,
 ) -> None:
-    """Liang–Barsky on every segment; rows of a fully clipped segment get NaN and ``parameters = (1, 0)``.
+    """Liang–Barsky on every segment; rows of a fully clipped segment get NaN and $parameters = (1, 0)$.
 
     starts, ends (N, 4) float64; clipped_starts, clipped_ends (N, 4) and parameters (N, 2) written. An end
     that is not moved (u0 = 0 or u1 = 1) is copied bit for bit.
@@ -134,7 +134,7 @@ def _write_intersection(
     inside: int, outside: int, u: float, positions: np.ndarray, weights: np.ndarray, out: int,
     out_positions: np.ndarray, out_weights: np.ndarray,
 ) -> None:  # fmt: skip
-    """``P = P_in + (P_out − P_in)u`` for the position and the barycentric weights alike."""
+    """$P = P_in + (P_out − P_in)u$ for the position and the barycentric weights alike."""
     for j in range(4):
         out_positions[out, j] = positions[inside, j] + (positions[outside, j] - positions[inside, j]) * u
     for j in range(3):
@@ -220,7 +220,7 @@ def clip_triangle(
 
     The clipped convex polygon is written to ``positions[0, :count]`` with, in ``weights[0, :count]``, each
     vertex's barycentric weights with respect to (p0, p1, p2): any per-vertex attribute interpolates as
-    ``Σ weights[j]·attribute_j``. An unclipped corner keeps the exact one-hot weights of its corner. Scratch:
+    $Σ weights[j]·attribute_j$. An unclipped corner keeps the exact one-hot weights of its corner. Scratch:
     positions (2, 3 + P, 4), weights (2, 3 + P, 3) float64, owned by the caller.
     """
     for j in range(4):

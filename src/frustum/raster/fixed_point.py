@@ -1,6 +1,6 @@
 """The 1/256-pixel fixed-point grid shared by the triangle and line kernels (8 fractional bits, as llvmpipe).
 
-Window x and y snap to ``X = floor(x_w·256 + 0.5)``; pixel (i, j) has its centre at ``(256·i + 128, 256·j + 128)``.
+Window x and y snap to $X = floor(x_w·256 + 0.5)$; pixel (i, j) has its centre at $(256·i + 128, 256·j + 128)$.
 """
 
 from __future__ import annotations
@@ -23,5 +23,5 @@ HALF_SUBPIXEL = 128
 
 @kernel
 def snap(value: float) -> int:
-    """Round a window coordinate to the 1/256 pixel grid: ``floor(v·256 + 0.5)``."""
+    """Round a window coordinate to the 1/256 pixel grid: $floor(v·256 + 0.5)$."""
     return np.int64(math.floor(value * 256.0 + 0.5))

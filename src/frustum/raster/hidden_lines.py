@@ -48,8 +48,8 @@ def _fill_cells(boxes, columns, cursor, cell_triangles):  # pragma: no cover - c
 def _triangle_interval(a, b, tri, depth_tolerance):  # pragma: no cover - compiled
     """(t0, t1) of segment a→b (window x, y, z) hidden by window triangle `tri`; t0 >= t1 when none.
 
-    Liang–Barsky on four linear inequalities in t: three edge functions ``σ·E_k(t) >= 0`` (inside the closed
-    projected triangle, σ its orientation) and ``z_a + t(z_b − z_a) − z_T(t) > 0`` (behind its plane), kept
+    Liang–Barsky on four linear inequalities in t: three edge functions $σ·E_k(t) >= 0$ (inside the closed
+    projected triangle, σ its orientation) and $z_a + t(z_b − z_a) − z_T(t) > 0$ (behind its plane), kept
     only where the depth gap exceeds ε at one of its ends.
     """
     x0, y0, z0 = tri[0, 0], tri[0, 1], tri[0, 2]

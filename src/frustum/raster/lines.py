@@ -1,31 +1,31 @@
 """Line and point kernels: wireframe edges and vertex dots into the shared color and depth buffers.
 
-Window coordinates are those of ``raster/triangles.py``: ``x_w = (x_c / w)·(W/2) + W/2`` (y alike, y up),
-snapped to 1/256 pixel as ``X = floor(x_w·256 + 0.5)`` (int64), and ``z_w = (z_c / w)·0.5 + 0.5``. Pixel
-(i, j) has its centre at ``(256·i + 128, 256·j + 128)``; buffers are top row first (window row j is array
-row ``H − 1 − j``). Depth test "less" against float32 ``depth``: a pixel is written (depth ``float32(z)``,
-color the item's RGBA bytes) when ``float32(z) < depth``.
+Window coordinates are those of ``raster/triangles.py``: $x_w = (x_c / w)·(W/2) + W/2$ (y alike, y up),
+snapped to 1/256 pixel as $X = floor(x_w·256 + 0.5)$ (int64), and $z_w = (z_c / w)·0.5 + 0.5$. Pixel
+(i, j) has its centre at $(256·i + 128, 256·j + 128)$; buffers are top row first (window row j is array
+row $H − 1 − j$). Depth test "less" against float32 ``depth``: a pixel is written (depth ``float32(z)``,
+color the item's RGBA bytes) when $float32(z) < depth$.
 
-Line coverage (DDA over pixel centres along the major axis). For snapped ends a, b with ``dX = X_b − X_a``,
-``dY = Y_b − Y_a``: a zero-length line (``dX = dY = 0``) covers nothing. If ``|dX| >= |dY|`` (x-major),
-rename the ends so that ``X_a < X_b``; the line covers, for every column i whose centre ``c = 256·i + 128``
+Line coverage (DDA over pixel centres along the major axis). For snapped ends a, b with $dX = X_b − X_a$,
+$dY = Y_b − Y_a$: a zero-length line ($dX = dY = 0$) covers nothing. If $|dX| >= |dY|$ (x-major),
+rename the ends so that $X_a < X_b$; the line covers, for every column i whose centre $c = 256·i + 128$
 lies in the closed interval ``[X_a, X_b]``, the one pixel (i, j) of the row containing the line's exact
-(rational) height there, ``j = floor((Y_a·dX + dY·(c − X_a)) / (256·dX))``, with ``j = H`` (the line on the
-image's top edge) taken as ``H − 1``. Its depth is ``z = z_a + (z_b − z_a)·t``, ``t = (c − X_a) / dX``
+(rational) height there, $j = floor((Y_a·dX + dY·(c − X_a)) / (256·dX))$, with $j = H$ (the line on the
+image's top edge) taken as $H − 1$. Its depth is $z = z_a + (z_b − z_a)·t$, $t = (c − X_a) / dX$
 (float64; z_w is linear in screen space along the line). A y-major line is the same with x and y swapped
-(rows whose centres lie in ``[Y_a, Y_b]``, ``i = floor(...)`` with ``i = W`` taken as ``W − 1``). So every
+(rows whose centres lie in ``[Y_a, Y_b]``, $i = floor(...)$ with $i = W$ taken as $W − 1$). So every
 column (row) the line spans gets exactly one pixel, both ends included, independent of the drawing direction.
 
 Point coverage: a point at snapped ``(X, Y)`` covers the pixel containing it, ``(X // 256, Y // 256)``, with
-``W`` and ``H`` (the image's right and top edges) taken as ``W − 1`` and ``H − 1``.
+``W`` and ``H`` (the image's right and top edges) taken as $W − 1$ and $H − 1$.
 
 Style (``style`` (STYLE,) float64, built by ``line_style``): the RGBA bytes; a line width in pixels (w > 1 adds
-pixels across the line: offsets ``k − (⌊w⌋ − 1)//2``, k < ⌊w⌋, on the minor axis; points become w×w squares);
+pixels across the line: offsets $k − (⌊w⌋ − 1)//2$, k < ⌊w⌋, on the minor axis; points become w×w squares);
 ``write_depth``; a ``test`` mode: 0 = plain "less", 1 = hidden-line: a pixel is visible when
-``z − offset < max(depth at the pixel and its 4 neighbours)`` (the surfaces' depth buffer; the neighbours
+$z − offset < max(depth at the pixel and its 4 neighbours)$ (the surfaces' depth buffer; the neighbours
 absorb the half-pixel between the line and the pixel centre on grazing faces), and the hidden pixels are drawn
 in the hidden RGBA when ``hidden`` is 1 (solid) or 2 (dashes of ``dash`` pixels along the major axis);
-depth cueing ``f·c + (1 − f)·cue`` of the bytes with ``f`` of ``frustum.shading.DepthCue``, the view distance
+depth cueing $f·c + (1 − f)·cue$ of the bytes with ``f`` of ``frustum.shading.DepthCue``, the view distance
 interpolated perspective-correctly from the ends' ``view_depth`` (``d/w`` and ``1/w`` linear on screen).
 
 Determinism: both kernels are serial (no ``prange``), lines in the order of ``edges`` and points in vertex
@@ -56,7 +56,7 @@ def line_style(
     rgba, *, width: float = 1.0, write_depth: bool = True, hidden_line: bool = False, offset: float = 0.0,
     hidden: int = 0, hidden_rgba=(0, 0, 0, 0), dash: float = 6.0, cue=None,
 ) -> np.ndarray:  # fmt: skip
-    """The (STYLE,) float64 style vector of the module docstring; ``cue = (near, far, f_min, f_max, r, g, b)``
+    """The (STYLE,) float64 style vector of the module docstring; $cue = (near, far, f_min, f_max, r, g, b)$
     in bytes for the color, or None."""
     style = np.zeros(STYLE)
     style[S_RGBA : S_RGBA + 4] = rgba
@@ -127,7 +127,7 @@ def _draw_segment(
     """DDA of one snapped segment along its major axis (the module docstring's rule); a = the lower major end.
 
     For a y-major segment the caller passes y as "x" and x as "y" (``x_major`` False swaps them back at the
-    write). ``xa < xb`` is required. d and w at the ends give the cueing distance.
+    write). $xa < xb$ is required. d and w at the ends give the cueing distance.
     """
     height, width = depth.shape[0], depth.shape[1]
     major_size, minor_size = (width, height) if x_major else (height, width)
@@ -163,8 +163,8 @@ def draw_lines(
 ) -> None:  # fmt: skip
     """Clip (Liang–Barsky in clip space), divide, map, snap and draw every edge, serially in `edges` order.
 
-    Clipped ends are ``P1 + (P2 − P1)·u`` (an end with u = 0 or 1 is used bit for bit), as ``clip_segments``
-    computes them; clipping against ``w + z >= 0`` keeps every drawn point in front of the eye (w > 0), so a
+    Clipped ends are $P1 + (P2 − P1)·u$ (an end with u = 0 or 1 is used bit for bit), as ``clip_segments``
+    computes them; clipping against $w + z >= 0$ keeps every drawn point in front of the eye (w > 0), so a
     segment reaching behind the eye is cut, never wrapped through infinity.
     """
     for e in range(edges.shape[0]):

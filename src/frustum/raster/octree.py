@@ -19,7 +19,7 @@ TILE = 8
 
 @kernel
 def _octants(codes, start, stop, parent):
-    """Bit o set for each child ``8·parent + o`` present in the sorted slice codes[start:stop] (one binary search
+    """Bit o set for each child $8·parent + o$ present in the sorted slice codes[start:stop] (one binary search
     for the first child, then a scan of at most 8 entries)."""
     first = parent << np.uint64(3)
     lo, hi = start, stop

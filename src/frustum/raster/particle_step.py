@@ -1,14 +1,14 @@
-"""One fused particle step for the common forces: semi-implicit Euler under ``a = c − k·v``, then plane collisions.
+"""One fused particle step for the common forces: semi-implicit Euler under $a = c − k·v$, then plane collisions.
 
-Gravity, drag and wind are linear in the velocity: ``a = g + Σ k_w·w − (Σ k_d + Σ k_w)·v = c − k·v``. One pass per
+Gravity, drag and wind are linear in the velocity: $a = g + Σ k_w·w − (Σ k_d + Σ k_w)·v = c − k·v$. One pass per
 particle (parallel over particles; each row independent, so the result does not depend on the thread count):
-``previous ← x``, ``v ← v + (c − k·v)·dt``, ``x ← x + v·dt``, ``age ← age + dt``, then for each plane
-(point p, unit normal n, restitution e, friction μ) with ``d = (x − p)·n < 0``: ``x ← x − (1 + e)·d·n`` and, if
-``v·n < 0``, ``v ← (1 − μ)·(v − (v·n)·n) − e·(v·n)·n``. The same formulas as ``frustum.simulation`` (whole-array
+``previous ← x``, $v ← v + (c − k·v)·dt$, $x ← x + v·dt$, ``age ← age + dt``, then for each plane
+(point p, unit normal n, restitution e, friction μ) with $d = (x − p)·n < 0$: $x ← x − (1 + e)·d·n$ and, if
+$v·n < 0$, $v ← (1 − μ)·(v − (v·n)·n) − e·(v·n)·n$. The same formulas as ``frustum.simulation`` (whole-array
 numpy) to round-off.
 
 Contract (kernels never validate): positions, velocities, previous (N, 3) float64; ages (N,) float64; constant
-(3,) float64; planes (P, 8) float64 rows ``p (3), n (3), e, μ``. Returns the number of rows left non-finite.
+(3,) float64; planes (P, 8) float64 rows $p (3), n (3), e, μ$. Returns the number of rows left non-finite.
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ __all__ = ["step_linear"]
 @parallel_kernel
 def step_linear(positions: np.ndarray, velocities: np.ndarray, previous: np.ndarray, ages: np.ndarray,
                 constant: np.ndarray, damping: float, planes: np.ndarray, dt: float) -> int:  # fmt: skip
-    """Advance every particle by dt under ``a = constant − damping·v`` and resolve the planes (module docstring)."""
+    """Advance every particle by dt under $a = constant − damping·v$ and resolve the planes (module docstring)."""
     bad = 0
     for i in prange(positions.shape[0]):
         for c in range(3):

@@ -1,17 +1,17 @@
 """Particle kernels: round soft sprites, square points and streaks blended into a float color buffer.
 
-Each primitive is depth-tested against the (finished) depth buffer, ``z < depth[row, col]``, and never writes
+Each primitive is depth-tested against the (finished) depth buffer, $z < depth[row, col]$, and never writes
 depth. Colors accumulate in a float32 ``(H, W, 3)`` buffer in byte units (0–255): additive blending
-``C ← C + α·255·c`` (fire, sparks) or alpha blending ``C ← α·255·c + (1 − α)·C`` (smoke, in the caller's
+$C ← C + α·255·c$ (fire, sparks) or alpha blending $C ← α·255·c + (1 − α)·C$ (smoke, in the caller's
 back-to-front order). The caller converts the buffer to bytes once.
 
 Parallel work: primitives are binned into bands of rows (``count_bands`` / ``fill_bands``, a counting sort that
 keeps the primitive order inside each band); each band is drawn by one thread, which owns its rows, so there
 are no write races and the result does not depend on the thread count.
 
-Contract (kernels never validate): ``sprites`` (N, SPRITE_FIELDS) float64 rows ``x, y, z, radius, r, g, b, α``
+Contract (kernels never validate): ``sprites`` (N, SPRITE_FIELDS) float64 rows $x, y, z, radius, r, g, b, α$
 in window coordinates (y up, pixel centres at half-integers, z window depth in [0, 1]), radius in pixels
-> 0; ``streaks`` (N, STREAK_FIELDS) rows ``x0, y0, z0, x1, y1, z1, r, g, b, α``; ``rows`` (N, 2) int64 first and
+> 0; ``streaks`` (N, STREAK_FIELDS) rows $x0, y0, z0, x1, y1, z1, r, g, b, α$; ``rows`` (N, 2) int64 first and
 last frame row each primitive touches (clamped to the image); buffers C-contiguous.
 """
 
@@ -53,7 +53,7 @@ BAND_ROWS = 16
 
 @kernel
 def _clip_row(m: np.ndarray, k: int, x: float, y: float, z: float) -> float:
-    """Row k of ``M·[x, y, z, 1]``."""
+    """Row k of $M·[x, y, z, 1]$."""
     return ((m[k, 0] * x + m[k, 1] * y) + m[k, 2] * z) + m[k, 3]
 
 
@@ -63,10 +63,10 @@ def project_sprites(positions: np.ndarray, sizes: np.ndarray, colors: np.ndarray
                     rows: np.ndarray) -> int:  # fmt: skip
     """Project every particle and write the visible ones, in order, as sprite records; returns their number.
 
-    ``frame`` = (width, height, pixel scale |P₁₁|·H/2, minimum radius). A particle is kept when ``w > 0``,
-    ``−w <= z_clip <= w``, its disc of radius ``R = size·scale/w`` (at least the minimum, α scaled by
-    ``(R/minimum)²`` below it) touches the image and its α > 0. Window ``x = (x_c/w + 1)·W/2``,
-    ``y = (y_c/w + 1)·H/2``, depth ``(z_c/w + 1)/2`` (``viewport(0, 0, W, H)``).
+    ``frame`` = (width, height, pixel scale |P₁₁|·H/2, minimum radius). A particle is kept when $w > 0$,
+    $−w <= z_clip <= w$, its disc of radius $R = size·scale/w$ (at least the minimum, α scaled by
+    $(R/minimum)²$ below it) touches the image and its α > 0. Window $x = (x_c/w + 1)·W/2$,
+    $y = (y_c/w + 1)·H/2$, depth ``(z_c/w + 1)/2`` (``viewport(0, 0, W, H)``).
     """
     width, height, scale, minimum = frame[0], frame[1], frame[2], frame[3]
     last_row = int(height) - 1
@@ -105,7 +105,7 @@ def project_streaks(heads: np.ndarray, tails: np.ndarray, colors: np.ndarray, op
                     clip_from_world: np.ndarray, frame: np.ndarray, streaks: np.ndarray,
                     rows: np.ndarray) -> int:  # fmt: skip
     """Project both ends of every particle's streak (tail = previous position, head = current one) and write the
-    visible ones, in order; returns their number. Both ends must satisfy ``w > 0`` and ``−w <= z_clip <= w``."""
+    visible ones, in order; returns their number. Both ends must satisfy $w > 0$ and $−w <= z_clip <= w$."""
     width, height = frame[0], frame[1]
     last_row = int(height) - 1
     count = 0
@@ -182,7 +182,7 @@ def draw_sprites(sprites: np.ndarray, starts: np.ndarray, entries: np.ndarray, b
                  mode: int, depth: np.ndarray, accumulator: np.ndarray, start: int, stop: int) -> None:  # fmt: skip
     """Draw every sprite of every band (parallel over bands) into `accumulator`, depth-tested, depth unchanged.
 
-    Pixel (row, col) has its centre at window ``(col + ½, H − 1 − row + ½)``.
+    Pixel (row, col) has its centre at window $(col + ½, H − 1 − row + ½)$.
     """
     height, width = depth.shape
     for band in range(start, stop):
@@ -222,8 +222,8 @@ def draw_streaks(streaks: np.ndarray, starts: np.ndarray, entries: np.ndarray, b
                  depth: np.ndarray, accumulator: np.ndarray, start: int, stop: int) -> None:  # fmt: skip
     """Draw every streak (a 1-pixel DDA line from (x0, y0) to (x1, y1), depth linear along it) of every band.
 
-    The line is sampled at ``n + 1`` evenly spaced points, ``n = max(⌈max(|Δx|, |Δy|)⌉, 1)``; sample t = k/n
-    lands in the pixel containing it (``⌊x⌋, ⌊y⌋``) and blends with α once per sample.
+    The line is sampled at ``n + 1`` evenly spaced points, $n = max(⌈max(|Δx|, |Δy|)⌉, 1)$; sample t = k/n
+    lands in the pixel containing it ($⌊x⌋, ⌊y⌋$) and blends with α once per sample.
     """
     height, width = depth.shape
     for band in range(start, stop):

@@ -2,21 +2,21 @@
 
 Build (``build``): a binary bounding-volume hierarchy by the binned surface area heuristic [Wald 2007]: at each
 node the triangles' box centres are put into ``BINS`` bins along each of the three axes, and the plane between
-two bins with the least ``A_left·N_left + A_right·N_right`` (A: surface area of the side's bounding box, N: its
+two bins with the least $A_left·N_left + A_right·N_right$ (A: surface area of the side's bounding box, N: its
 triangle count) splits them; a range of at most ``LEAF_SIZE`` triangles is a leaf (shallow leaves: one
 triangle test per leaf), a range whose centres coincide is cut in the middle. Nodes hold the boxes of their
 two children (one node's boxes are one cache line: float32, rounded outward, so a box never shrinks), and a
 node over triangles ``[s, e)`` numbered ``k`` has its left child at ``k + 1`` and its right child at
-``k + (m − s)`` (m: the split), so every subtree owns a fixed range of node numbers: the top of the tree is
+$k + (m − s)$ (m: the split), so every subtree owns a fixed range of node numbers: the top of the tree is
 built on one thread, the subtrees below ``PARALLEL_CUTOFF`` triangles in parallel (``_jit.parallel_kernel``),
 and the result is the same bytes on any number of threads.
 
-Traversal: per ray, both child boxes of a node are tested (slab test, far bound widened by ``1 + 2γ₃`` so
+Traversal: per ray, both child boxes of a node are tested (slab test, far bound widened by $1 + 2γ₃$ so
 that rounding never loses a hit, PBRT 3.9.2); the nearer child is entered first and the farther one pushed with
 its entry distance, skipped when popped if a nearer hit has been found since; leaves are tested with the
 Möller–Trumbore ray–triangle test in float64 (the same arithmetic as ``raster.bvh``, so hits are the same).
 Closest hit (``closest_hits``): the least t in ``[t_min, t_max)``, ties to the lower triangle index (boxes are
-searched up to ``best·(1 + 2⁻⁴⁰)``, so a triangle whose t rounds a few ulps below its box's entry, or ties,
+searched up to $best·(1 + 2⁻⁴⁰)$, so a triangle whose t rounds a few ulps below its box's entry, or ties,
 is still found). Any hit
 (``any_hits``): stops at the first triangle met with t in ``[t_min, t_max)`` (shadow rays). Rays run in parallel
 over pieces of the ray array.
@@ -57,7 +57,7 @@ _TASKS = 4096
 
 class Index(NamedTuple):
     """``boxes`` (N, 12) float32: the boxes of each node's two children (left lo, left hi, right lo, right hi);
-    ``links`` (N, 2) int64: each child, a node number (>= 0) or a leaf ``~(start·8 + count)``; ``triangles``
+    ``links`` (N, 2) int64: each child, a node number (>= 0) or a leaf $~(start·8 + count)$; ``triangles``
     (F, 3, 3) float64 corners in leaf order; ``order`` (F,) int64 original index of each; ``depth`` the deepest
     node's depth (the traversal stack's size); ``nodes`` inner nodes built."""
 
@@ -291,7 +291,7 @@ def _closest(boxes, links, triangles, order, skip, ox, oy, oz, dx, dy, dz, t_min
 
     The least t in [t_min, t_max) over the triangles (ties: the lower original index ``order[row]``), skipping
     ``skip[order[row]] != 0`` (`skip` empty: none) and, when `cull`, back faces (Möller–Trumbore's determinant
-    ``e1·(d × e2) = −d·N`` negative). u, v: the weights of corners 1 and 2; back = 1 for a back face; a miss
+    $e1·(d × e2) = −d·N$ negative). u, v: the weights of corners 1 and 2; back = 1 for a back face; a miss
     is (inf, −1, …). Counts: box (slab) tests, nodes visited (inner nodes and leaves entered), ray–triangle
     tests. `stack`, `entry`: scratch of at least the index's depth + 1.
     """
@@ -539,7 +539,7 @@ def closest_hits(
     index: Index, origins: np.ndarray, directions: np.ndarray, t_min: float | np.ndarray = 0.0,
     t_max: float | np.ndarray = np.inf, skip: np.ndarray | None = None, cull: bool = False,
 ) -> Hits:  # fmt: skip
-    """The first hit of each ray ``origin + t·direction`` with t in [t_min, t_max) (scalars or one per ray)."""
+    """The first hit of each ray $origin + t·direction$ with t in [t_min, t_max) (scalars or one per ray)."""
     o = np.ascontiguousarray(origins, dtype=np.float64)
     d = np.ascontiguousarray(directions, dtype=np.float64)
     count = o.shape[0]
@@ -582,10 +582,10 @@ def cast_pixels(boxes, links, triangles, order, depth_max, skip, world_from_wind
     """A ray through the centre of every pixel of window rows [start, stop) (y up); the first hit's window depth,
     face code and barycentrics, as the depth buffer writes them.
 
-    Pixel (i, j) casts ``origin + t·(end − origin)``, t in [0, 1), from ``origin = unproject(i + ½, j + ½, 0)``
-    on the near plane to ``end = unproject(i + ½, j + ½, 1)`` on the far plane: hits inside the view volume
+    Pixel (i, j) casts $origin + t·(end − origin)$, t in [0, 1), from $origin = unproject(i + ½, j + ½, 0)$
+    on the near plane to $end = unproject(i + ½, j + ½, 1)$ on the far plane: hits inside the view volume
     only. At a hit, ``depth`` (H, W) float32 (top row first: row H − 1 − j) receives the window depth
-    ``z_w = (M₂·P)/(M₃·P)`` (M = `window_from_world`), ``codes`` ``2·face + back``, ``bary`` the weights of
+    $z_w = (M₂·P)/(M₃·P)$ (M = `window_from_world`), ``codes`` $2·face + back$, ``bary`` the weights of
     the face's corners 1 and 2; a depth that rounds to 1 is not written. ``stats`` (H, len(CAST_STATS)) int64
     receives each row's counts. `cull` != 0 skips back faces; `skip` (F,) uint8 marks triangles not drawn.
     """

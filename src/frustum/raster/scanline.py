@@ -1,10 +1,10 @@
 """Scan-line visible-surface kernel: edge table, active list sorted by x, span coherence, incremental edges.
 
-Per window row j (pixel centres ``Y = 256·j + 128``), triangles enter the active list from the edge table (the
+Per window row j (pixel centres $Y = 256·j + 128$), triangles enter the active list from the edge table (the
 triangles bucketed by their first row) and leave after their last row. Each active triangle's three edges give
-the row constants ``C_k(j) = dx_k·(Y − Y_a) − dy_k·(128 − X_a)`` (which grow by ``256·dx_k`` per row: the
+the row constants $C_k(j) = dx_k·(Y − Y_a) − dy_k·(128 − X_a)$ (which grow by $256·dx_k$ per row: the
 textbook's ``x += 1/m`` edge update, exact in integers): its span on the row is the exact top-left-rule interval
-``E_k = C_k − 256·dy_k·i >= bias_k`` — a left edge (dy < 0) bounds i from below, a right edge (dy > 0) from above.
+$E_k = C_k − 256·dy_k·i >= bias_k$ — a left edge (dy < 0) bounds i from below, a right edge (dy > 0) from above.
 The list is kept sorted by span start by insertion sort (coherence: the order hardly changes from row to row),
 and a second list by span end; merging them walks the row left to right through spans in which the set of
 covering triangles is constant:
@@ -15,7 +15,7 @@ covering triangles is constant:
   throughout and fills it (two depth tests per triangle); otherwise (surfaces cutting through each other
   inside the span) the nearest is found per pixel.
 
-Depth and barycentrics are stepped along the span with the edge functions (``E_k −= 256·dy_k`` per pixel) and
+Depth and barycentrics are stepped along the span with the edge functions ($E_k −= 256·dy_k$ per pixel) and
 written with the depth buffer's formulas (``window.pixel_values``). Ties on float32 depth go to the triangle
 drawn first, as in the depth buffer's test "less".
 

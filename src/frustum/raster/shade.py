@@ -1,6 +1,6 @@
 """Shading kernels: the illumination model of ``frustum.shading`` per vertex, per face or per pixel.
 
-Deferred: after the depth buffer is complete, each pixel holds ``code = 2·face + back`` (−1: background) and
+Deferred: after the depth buffer is complete, each pixel holds $code = 2·face + back$ (−1: background) and
 the perspective-correct weights (u1, u2) of its surface point with respect to the face's corners
 (u0 = 1 − u1 − u2). Every model writes, per channel,
 
@@ -12,11 +12,11 @@ the models differ only in where D and S are evaluated [HB 17] "Polygon Rendering
 - ``SHADE_FLAT``: once per face, with the face normal at the face centroid (constant-intensity shading);
 - ``SHADE_GOURAUD``: once per vertex with the vertex normal, D and S interpolated across the face;
 - ``SHADE_PHONG``: per pixel with the interpolated, renormalized normal (normal-vector interpolation);
-- ``SHADE_NONE``: base color only; ``SHADE_NORMALS``: ``0.5·N + 0.5`` (world normal); ``SHADE_DEPTH``: gray
-  ``(far − d)/(far − near)`` of the view distance d.
+- ``SHADE_NONE``: base color only; ``SHADE_NORMALS``: $0.5·N + 0.5$ (world normal); ``SHADE_DEPTH``: gray
+  $(far − d)/(far − near)$ of the view distance d.
 
 A back face drawn two-sided has its normal flipped toward the viewer. Depth cueing then blends
-``f·I + (1 − f)·cue``; the result is clamped to [0, 1] and stored as ``floor(I·255 + 0.5)``.
+$f·I + (1 − f)·cue$; the result is clamped to [0, 1] and stored as $floor(I·255 + 0.5)$.
 
 Array contracts (kernels never validate): params (PARAMS,) float64 laid out by the ``P_*`` indices below,
 lights (K, 16) float64 rows of ``frustum.shading.pack_lights``, item (ITEM,) int64 laid out by ``I_*``.
@@ -62,13 +62,13 @@ ITEM = 7
 
 @kernel
 def _to_byte(value: float) -> np.uint8:
-    """``floor(clamp(v, 0, 1)·255 + 0.5)``: round half up to 8 bits."""
+    """$floor(clamp(v, 0, 1)·255 + 0.5)$: round half up to 8 bits."""
     return np.uint8(math.floor(min(max(value, 0.0), 1.0) * 255.0 + 0.5))
 
 
 @kernel
 def _interpolate(u0: float, u1: float, u2: float, va: float, vb: float, vc: float) -> float:
-    """``(u0·va + u1·vb) + u2·vc`` (scalar arguments only: per-pixel helpers take no arrays, so they inline)."""
+    """$(u0·va + u1·vb) + u2·vc$ (scalar arguments only: per-pixel helpers take no arrays, so they inline)."""
     return (u0 * va + u1 * vb) + u2 * vc
 
 
@@ -163,7 +163,7 @@ def light_faces(
     lit: np.ndarray,
     start: int, stop: int,
 ) -> None:  # fmt: skip
-    """Flat: D and S of every face at its centroid with the unit face normal ``(v1 − v0)×(v2 − v0)``; lit (M, 6)."""
+    """Flat: D and S of every face at its centroid with the unit face normal $(v1 − v0)×(v2 − v0)$; lit (M, 6)."""
     for f in range(start, stop):
         a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
         e1x, e1y, e1z = world[b, 0] - world[a, 0], world[b, 1] - world[a, 1], world[b, 2] - world[a, 2]
@@ -283,7 +283,7 @@ def shade_point(
 
 @kernel
 def _cue(params: np.ndarray, r: float, g: float, b: float, d: float) -> tuple[float, float, float]:
-    """Depth cueing ``f·I + (1 − f)·cue`` per channel, f clamped to [f_min, f_max], at view distance d."""
+    """Depth cueing $f·I + (1 − f)·cue$ per channel, f clamped to [f_min, f_max], at view distance d."""
     low, high = params[P_CUE_MIN], params[P_CUE_MAX]
     f = low + (high - low) * (params[P_CUE_FAR] - d) / (params[P_CUE_FAR] - params[P_CUE_NEAR])
     f = min(max(f, low), high)
@@ -299,12 +299,12 @@ def shade_pixels(
     normal_out: np.ndarray, id_out: np.ndarray,
     start: int, stop: int,
 ) -> None:  # fmt: skip
-    """Shade the pixels of one scene item: those whose face ``code // 2 − face_offset`` lies in [0, M).
+    """Shade the pixels of one scene item: those whose face $code // 2 − face_offset$ lies in [0, M).
 
     depth (H, W) float32, codes (H, W) int32 or int64, bary (H, W, 2) float32, faces (M, 3) int64, world and
     normals (N, 3) float64 (unit normals), lit (N or M, 6) Gouraud or flat terms (any rows otherwise),
     vertex_colors (N, 3) or (0, 3), uvs (N, 2) and texture (Ht, Wt, 4) float32 or empty. color (H, W, 4) uint8 is
-    written at those pixels (opaque, or blended ``α·I + (1 − α)·under`` when ``item[I_BLEND]``); background
+    written at those pixels (opaque, or blended $α·I + (1 − α)·under$ when ``item[I_BLEND]``); background
     pixels (depth 1: nothing drawn, so their codes are never read and need no clearing) and codes < 0 are left
     alone. normal_out (H, W, 3) float32 and id_out (H, W) int32 are written when asked for.
     """
@@ -468,7 +468,7 @@ def _gather_chunk(
     n: int, s: np.ndarray, where: np.ndarray, corners: np.ndarray, faces: np.ndarray, world: np.ndarray,
     normals: np.ndarray,
 ) -> None:  # fmt: skip
-    """Interpolated normal ``(u0·na + u1·nb) + u2·nc`` and world point of the first n listed pixels, from their
+    """Interpolated normal $(u0·na + u1·nb) + u2·nc$ and world point of the first n listed pixels, from their
     weights (u1, u2 in the _X and _NDL rows). Corners first, then the vertex data, each in its own short loop:
     the loads of many pixels are in flight at once (one long loop per pixel waited on each cache miss in turn)."""
     for i in range(n):
@@ -495,7 +495,7 @@ def _shade_chunk(
     n: int, s: np.ndarray, where: np.ndarray, params: np.ndarray, lights: np.ndarray, words: np.ndarray
 ) -> None:  # fmt: skip
     """Shade the first n gathered pixels: the operations of ``_surface`` and ``_illuminate`` in the same order
-    (falloff 1, so ``k_d·(1·ndl) = k_d·ndl``), as passes over the chunk with selects for branches; then store
+    (falloff 1, so $k_d·(1·ndl) = k_d·ndl$), as passes over the chunk with selects for branches; then store
     each pixel's bytes (r, g, b, 255) as one little-endian word (words: color viewed as uint32)."""
     ex, ey, ez = params[P_EYE], params[P_EYE + 1], params[P_EYE + 2]
     ka, kd, ks, shininess = params[P_AMBIENT], params[P_DIFFUSE], params[P_SPECULAR], params[P_SHININESS]

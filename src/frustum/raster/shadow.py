@@ -11,7 +11,7 @@ Array contracts (kernels never validate):
 - a shadow map is (S, S) float32 window depth seen from the light (1.0 where nothing), top row first, with a
   ``view`` record (MAP_FIELDS,) float64 laid out by the ``M_*`` indices: window_from_world (16, row-major),
   projection kind (0 orthographic, 1 perspective), near, far, texel size (orthographic: world units per texel;
-  perspective: texel size per unit of distance, ``2·tan(fov/2)/S``), and the light's position or direction;
+  perspective: texel size per unit of distance, $2·tan(fov/2)/S$), and the light's position or direction;
 - ``lights`` (K, 16) float64 rows of ``frustum.shading.pack_lights``; ``visibility`` (H, W, K) float32 the
   fraction of light k reaching each pixel (1: lit, 0: shadowed).
 """
@@ -73,8 +73,8 @@ def surface_points(
     face_offset: int, points: np.ndarray, facing: np.ndarray,
     start: int, stop: int,
 ) -> None:  # fmt: skip
-    """World point ``(u0·Pa + u1·Pb) + u2·Pc`` and unit face normal (turned toward the viewer: flipped for a back
-    face drawn two-sided) of every pixel of one item (face ``code // 2 − face_offset`` in [0, M)).
+    """World point $(u0·Pa + u1·Pb) + u2·Pc$ and unit face normal (turned toward the viewer: flipped for a back
+    face drawn two-sided) of every pixel of one item (face $code // 2 − face_offset$ in [0, M)).
 
     depth (H, W) float32, codes (H, W) int, bary (H, W, 2) float32, faces (M, 3) int64 counter-clockwise seen from
     the front, world (N, 3) float; points and facing (H, W, 3) float64 written at those pixels only.
@@ -109,7 +109,7 @@ def surface_points(
 @kernel
 def _linear_depth(view: np.ndarray, z: float) -> float:
     """Distance along the light's axis of window depth z (orthographic: linear; perspective:
-    ``2nf/((f + n) − z_ndc·(f − n))``)."""
+    $2nf/((f + n) − z_ndc·(f − n))$)."""
     near, far = view[M_NEAR], view[M_FAR]
     if view[M_KIND] == KIND_ORTHOGRAPHIC:
         return near + z * (far - near)
@@ -125,7 +125,7 @@ def _lookup(
     """Fraction of the PCF taps around P's image in the map that see P (lit), or −1 if P lies outside the map.
 
     Normal offset (one texel along the drawn side's normal) and a slope-scaled depth bias
-    ``texel·(1 + (1 + softness)·min(tan θ, SLOPE_LIMIT))`` against acne; taps on a (2m + 1)² grid spanning
+    $texel·(1 + (1 + softness)·min(tan θ, SLOPE_LIMIT))$ against acne; taps on a (2m + 1)² grid spanning
     ±softness texels, each the nearest texel, m = ceil(softness).
     """
     size = shadow_map.shape[0]

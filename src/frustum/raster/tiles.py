@@ -63,7 +63,7 @@ def count_tiles(
     blocks of ``BLOCK`` faces (the same results): trivial reject or crossing by region codes and cull by the
     signed area (``_gather_block``), the pixel box, whether a face whose box holds one pixel centre covers it
     (most sub-pixel triangles of a fine mesh do not) and its tile (``_classify``, vectorized), then the lists and
-    counts. The chunk's drawn and crossing faces, in order, go to ``listed`` (M,) from ``c·chunk`` on,
+    counts. The chunk's drawn and crossing faces, in order, go to ``listed`` (M,) from $c·chunk$ on,
     ``listed_counts[c]`` of them: the fill visits only those (most faces of a fine mesh draw nothing, being back
     faces or falling between pixel centres). ``listed_tiles`` (M,) beside each: the one tile a drawn face touches
     (small faces, the many, are filled from these two sequential arrays alone), the box mark of a face touching a
@@ -106,7 +106,7 @@ def _gather_block(
     flat_faces: np.ndarray, codes: np.ndarray, flat_win: np.ndarray, first: int, stop: int, cull: int,
     block: np.ndarray,
 ) -> int:  # fmt: skip
-    """The faces [first, stop) that may draw, in order: returns their number m; ``block[j + k·BLOCK]`` is the
+    """The faces [first, stop) that may draw, in order: returns their number m; $block[j + k·BLOCK]$ is the
     j-th one's corners ``X0, Y0, X1, Y1, X2, Y2`` (k = 0..5; counter-clockwise, corners 1 and 2 swapped for a
     drawn back face; zeros for a crossing face), whether it crosses the view volume (k = 6) and its face (k = 7).
     Faces rejected by their region codes, of zero area, or culled back faces are left out."""
@@ -138,12 +138,12 @@ def _gather_block(
 
 @kernel
 def _classify(block: np.ndarray, m: int, width: int, height: int, bits: int, tiles_x: int, marks_fit: bool) -> int:
-    """The state ``block[j + 8·BLOCK]`` of the m faces of a ``_gather_block`` block, its ``listed_tiles`` entry
+    """The state $block[j + 8·BLOCK]$ of the m faces of a ``_gather_block`` block, its ``listed_tiles`` entry
     if it draws: the one tile a face touches, its box mark (``BOX_BITS``), ``SEVERAL``, ``triangles.CROSSING``, or
     ``_NOTHING`` (no pixel centre in its box, or misses its one centre); its tiles ``tx0, ty0, wide, tall``
     replace its corners X0, Y0, X1, Y1. Returns how many cross. No branch: every test is a value, so the loop is
     vectorized (8 faces an AVX-512 instruction). The pixel box is ``triangles._window_box``'s: the first centre
-    ``256·i + 128 >= min X`` is ``i = (min X + 127) >> 8``."""
+    $256·i + 128 >= min X$ is $i = (min X + 127) >> 8$."""
     crossed = 0
     for j in range(m):
         u = np.uint64(j)
@@ -186,7 +186,7 @@ def fill_tiles(
     record_starts: np.ndarray, tri_int: np.ndarray, tile_entries: np.ndarray,
     start: int, stop: int,
 ) -> None:  # fmt: skip
-    """Write each drawn face's index (and ``−1 − r`` for each record r of a clipped face) into the lists of the
+    """Write each drawn face's index (and $−1 − r$ for each record r of a clipped face) into the lists of the
     tiles it touches, in face order: the faces ``count_tiles`` listed, a one-tile face straight from
     ``listed_tiles``, a few-tile one from its box mark, a larger one from its vertices again (``_pixel_box``).
     offsets (C, tiles) C-contiguous is consumed (the current tile's offset stays in a register while consecutive
@@ -239,7 +239,7 @@ def fill_tiles(
 def _append_box(
     tile_entries: np.ndarray, flat_offsets: np.ndarray, first: int, columns: int, rows: int, tiles_x: int, entry: int
 ) -> None:  # fmt: skip
-    """Append `entry` to the lists of tiles ``first + ty·tiles_x + tx``, ty <= rows, tx <= columns, advancing their
+    """Append `entry` to the lists of tiles $first + ty·tiles_x + tx$, ty <= rows, tx <= columns, advancing their
     offsets (``flat_offsets``, indexed like ``first``)."""
     for ty in range(rows + 1):
         for tx in range(columns + 1):

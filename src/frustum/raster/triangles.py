@@ -1,39 +1,39 @@
 """Triangle kernels: the per-face box and cull, clipping of crossing faces, and the tile fill (edge functions, depth).
 
-Fixed point. Window x and y are snapped to 1/256 pixel: ``X = floor(x_w·256 + 0.5)`` (int64), and every
-edge function is evaluated exactly in int64 at pixel centres ``(256·i + 128, 256·j + 128)``. For the edge
-a → b, ``E_ab(p) = (X_b − X_a)(Y_p − Y_a) − (Y_b − Y_a)(X_p − X_a)``: positive on its left. Front faces are
+Fixed point. Window x and y are snapped to 1/256 pixel: $X = floor(x_w·256 + 0.5)$ (int64), and every
+edge function is evaluated exactly in int64 at pixel centres $(256·i + 128, 256·j + 128)$. For the edge
+a → b, $E_ab(p) = (X_b − X_a)(Y_p − Y_a) − (Y_b − Y_a)(X_p − X_a)$: positive on its left. Front faces are
 counter-clockwise in window coordinates (y up), so inside a front face all three edge functions are
-positive and ``E_12 + E_20 + E_01 = 2·area``.
+positive and $E_12 + E_20 + E_01 = 2·area$.
 
 Top-left rule (y up, counter-clockwise): the interior lies left of every directed edge, so a *top* edge
-(horizontal, interior below it) runs right to left (``dy = 0, dx < 0``) and a *left* edge (interior to its
-right) runs downward (``dy < 0``). A pixel centre exactly on an edge belongs to the triangle only for top and
-left edges: the test is ``E >= 0`` on those and ``E > 0`` (``E − 1 >= 0`` in integers) on the others. Two
+(horizontal, interior below it) runs right to left ($dy = 0, dx < 0$) and a *left* edge (interior to its
+right) runs downward ($dy < 0$). A pixel centre exactly on an edge belongs to the triangle only for top and
+left edges: the test is $E >= 0$ on those and $E > 0$ ($E − 1 >= 0$ in integers) on the others. Two
 triangles sharing an edge traverse it in opposite directions, so exactly one of them owns the centres on it.
 
 What the fill reads. A face whose three vertices lie inside the view volume (trivial accept) is drawn straight
 from its vertices' records of ``vertices.project_vertices`` (snapped ``X, Y``; ``z_w`` and ``1/w``): nothing per
 triangle is stored, the tile lists hold its face index. A face crossing the view volume is clipped
-(Sutherland–Hodgman) into a fan whose triangles get records (tile list entry ``−1 − r`` for record r):
-``tri_int`` (R, 11) int64: ``X0, Y0, X1, Y1, X2, Y2`` snapped corners, ``code = 2·face + back``, the pixel
+(Sutherland–Hodgman) into a fan whose triangles get records (tile list entry $−1 − r$ for record r):
+``tri_int`` (R, 11) int64: ``X0, Y0, X1, Y1, X2, Y2`` snapped corners, $code = 2·face + back$, the pixel
 bounding box ``i_min, i_max, j_min, j_max`` (inclusive, inside the image);
 ``tri_float`` (R, 3, 2) float64 per corner: window depth ``z_w`` and ``1/w_clip``;
 ``tri_weights`` (R, 3, 2) float64 per corner: its barycentric weights ``(u1, u2)`` with respect to the source
-face's corners 1 and 2 (``u0 = 1 − u1 − u2`` is never read). A trivially accepted face's corners are its own
+face's corners 1 and 2 ($u0 = 1 − u1 − u2$ is never read). A trivially accepted face's corners are its own
 corners 0, 1, 2 in drawing order (1 and 2 swapped when back = 1), so its weights are one-hot and the fill takes
 the pixel's own barycentrics instead, which is bit-identical to weighting by one-hot vectors
-(``(b0·0 + b1·1) + b2·0 = b1`` exactly for b_k >= 0).
+($(b0·0 + b1·1) + b2·0 = b1$ exactly for b_k >= 0).
 
 Depth and weights at a covered pixel centre P. Window depth is affine in screen space, so it is the plane through
 the snapped corners ``(X_k, Y_k, z_k)`` written from corner 0 with its gradients (``depth_gradients``):
-``z(P) = (z_0 + β·(Y_P − Y_0)) + α·(X_P − X_0)``, ``α = −Σ dy_k z_k · r``, ``β = Σ dx_k z_k · r``, ``r = 1/(2·area)``
-(edge k opposite corner k) — the depth-buffer method's incremental form ``z' = z − A/C`` per step along a scan
+$z(P) = (z_0 + β·(Y_P − Y_0)) + α·(X_P − X_0)$, $α = −Σ dy_k z_k · r$, $β = Σ dx_k z_k · r$, $r = 1/(2·area)$
+(edge k opposite corner k) — the depth-buffer method's incremental form $z' = z − A/C$ per step along a scan
 line [HB 9 "Depth-Buffer Method"], evaluated from the corner instead of accumulated, so every pixel's value is
 independent of the tiles and of the order pixels are visited in (no division per pixel). The perspective-correct
-weights: ``g_k = E_k(P)·(1/w_k)``, ``r = 1 / Σ g_k``, ``b_k = g_k·r``.
+weights: $g_k = E_k(P)·(1/w_k)$, $r = 1 / Σ g_k$, $b_k = g_k·r$.
 
-A clockwise triangle is culled, or (two-sided) drawn with corners 1 and 2 swapped and ``back = 1``; a triangle
+A clockwise triangle is culled, or (two-sided) drawn with corners 1 and 2 swapped and $back = 1$; a triangle
 of zero area, or whose box holds no pixel centre, is dropped.
 """
 
@@ -85,14 +85,14 @@ or crossing the view volume (to be clipped)."""
 
 @kernel
 def _first_centre(low: int) -> int:
-    """Smallest pixel index whose centre ``256·i + 128`` is >= `low` (fixed point): ``−floor((128 − low)/256)``."""
+    """Smallest pixel index whose centre $256·i + 128$ is >= `low` (fixed point): $−floor((128 − low)/256)$."""
     return -((HALF_SUBPIXEL - low) >> SUBPIXEL_BITS)
 
 
 @kernel
 def _span(e: int, step: int, bias: int, inverse: float, first: int, last: int) -> tuple[int, int]:
-    """``[first, last]`` narrowed to the columns k where ``e − step·k >= bias`` (an edge function stepped along a
-    row), exactly: k bound by ``(e − bias)/step`` estimated in float64 (``inverse = 1/step``; off by at most one
+    """``[first, last]`` narrowed to the columns k where $e − step·k >= bias$ (an edge function stepped along a
+    row), exactly: k bound by $(e − bias)/step$ estimated in float64 ($inverse = 1/step$; off by at most one
     for |E| < 2^51) and corrected by the integer test, no division and almost no mispredicted branch."""
     if step == 0:
         return (first, last) if e >= bias else (last + 1, last)
@@ -116,9 +116,9 @@ def _span(e: int, step: int, bias: int, inverse: float, first: int, last: int) -
 def depth_gradients(
     x0: int, y0: int, x1: int, y1: int, x2: int, y2: int, z0: float, z1: float, z2: float
 ) -> tuple[float, float]:  # fmt: skip
-    """``(α, β)``: change of window depth per 1/256 pixel in x and y on the plane through the snapped corners,
-    ``α = −((dy_0 z_0 + dy_1 z_1) + dy_2 z_2)·r``, ``β = ((dx_0 z_0 + dx_1 z_1) + dx_2 z_2)·r`` with
-    ``r = 1/(2·area)`` (module docstring; 2·area ≠ 0)."""
+    """$(α, β)$: change of window depth per 1/256 pixel in x and y on the plane through the snapped corners,
+    $α = −((dy_0 z_0 + dy_1 z_1) + dy_2 z_2)·r$, $β = ((dx_0 z_0 + dx_1 z_1) + dx_2 z_2)·r$ with
+    $r = 1/(2·area)$ (module docstring; 2·area ≠ 0)."""
     dx0, dy0 = x2 - x1, y2 - y1
     dx1, dy1 = x0 - x2, y0 - y2
     dx2, dy2 = x1 - x0, y1 - y0
@@ -153,7 +153,7 @@ def _window_box(
 @kernel
 def covers_centre(x0: int, y0: int, x1: int, y1: int, x2: int, y2: int, px: int, py: int) -> bool:
     """Whether the counter-clockwise triangle covers the centre (px, py) by the top-left rule: the fill's edge
-    functions ``E = dx·(Y − Y_a) − dy·(X − X_a)`` and biases (``_fill_tile``)."""
+    functions $E = dx·(Y − Y_a) − dy·(X − X_a)$ and biases (``_fill_tile``)."""
     dx0, dy0 = x2 - x1, y2 - y1
     dx1, dy1 = x0 - x2, y0 - y2
     dx2, dy2 = x1 - x0, y1 - y0
@@ -193,7 +193,7 @@ def list_crossing(
     start: int, stop: int,
 ) -> None:  # fmt: skip
     """The faces crossing the view volume, in order, picked from the faces ``tiles.count_tiles`` listed (those
-    marked ``CROSSING`` in ``listed_tiles``): chunk c (``listed[c·chunk : c·chunk + listed_counts[c]]``)
+    marked ``CROSSING`` in ``listed_tiles``): chunk c ($listed[c·chunk : c·chunk + listed_counts[c]]$)
     writes its crossing faces' indices into ``crossing`` from ``crossing_starts[c]`` on."""
     for c in range(start, stop):
         k = crossing_starts[c]
@@ -299,11 +299,11 @@ def _setup_entries(
     tri_int: np.ndarray, tri_float: np.ndarray, face_offset: int, block: np.ndarray, values: np.ndarray, last_slot: int,
     col0: int, col1: int, row0: int, row1: int,
 ) -> None:  # fmt: skip
-    """A block of ``_fill_tile``: tile entries [first, stop) (``tile_entries[last_slot − 1]`` the tile's last) into
+    """A block of ``_fill_tile``: tile entries [first, stop) ($tile_entries[last_slot − 1]$ the tile's last) into
     the work blocks (``_X0``…, ``_Z0``…), then set up without a branch.
 
     The gather, in order: corners as stored (a face's from its vertices' records, a clipped record's from
-    ``tri_int``/``tri_float``), code without the back bit (``2·face``; a record's whole code), the entry. The set
+    ``tri_int``/``tri_float``), code without the back bit ($2·face$; a record's whole code), the entry. The set
     up (vectorized by LLVM, 8 entries an AVX-512 instruction): a clockwise face's corners 1 and 2 swapped and its
     back bit added to the code, the pixel box clamped to the tile [col0, col1) × [row0, row1), the kind
     (``_GENERAL``; the 2 × 2 coverage mask) and the depth gradients (``depth_gradients``' formulas). The depths of
@@ -401,16 +401,16 @@ def _fill_tile(
     """Tile `tile` of ``rasterize_tiles``: edge-function fill of its triangles in order (depth and weights by the
     module docstring's formulas).
 
-    Image pixel (row, col) is element ``[row − origin_row, col − origin_col]`` of ``depth``, ``codes`` and
+    Image pixel (row, col) is element $[row − origin_row, col − origin_col]$ of ``depth``, ``codes`` and
     ``bary``: origin (0, 0) for image-sized buffers, the tile's top-left pixel for a tile's own (``raster.tiled``:
     contiguous, so the tile stays in L1 cache whatever the image's row stride).
 
     The tile owns the pixel columns [col0, col1) and window rows [row0, row1). Per triangle: top-left rule,
-    depth test "less"; each covered pixel whose depth ``z = (E_12·z_0 + E_20·z_1 + E_01·z_2) / (2·area)`` (affine
-    in screen space) is less than ``depth`` gets depth (float32), ``codes = 2·face + back`` and the
+    depth test "less"; each covered pixel whose depth $z = (E_12·z_0 + E_20·z_1 + E_01·z_2) / (2·area)$ (affine
+    in screen space) is less than ``depth`` gets depth (float32), $codes = 2·face + back$ and the
     perspective-correct barycentric weights (u1, u2) of the pixel with respect to the source face (float32).
     Coordinates are read as int64 (the edge-function products need 64 bits whatever their stored type).
-    Buffers are top row first: window row j is array row ``H − 1 − j``.
+    Buffers are top row first: window row j is array row $H − 1 − j$.
 
     The entries go in blocks of ``FILL_BLOCK`` through three passes (as ``tiles.count_tiles``): their corners
     gathered into work blocks (``_gather_entries``), everything per triangle that needs no order set up without a
@@ -545,10 +545,10 @@ def rasterize_tiles(
     """Each tile owns its pixels of ``depth``, ``codes`` and ``bary``: no write races, deterministic output.
 
     tiling = (tile_size, tiles_x, face_offset, width, height) int64; the buffers hold earlier items' results
-    (``render.clear_buffers`` first). Tile ``t`` covers columns ``[tx·s, tx·s + s)`` and window rows
-    ``[ty·s, ty·s + s)`` with ``tx = t % tiles_x``, ``ty = t // tiles_x``; its triangles, in drawing order, are
+    (``render.clear_buffers`` first). Tile ``t`` covers columns $[tx·s, tx·s + s)$ and window rows
+    $[ty·s, ty·s + s)$ with $tx = t % tiles_x$, $ty = t // tiles_x$; its triangles, in drawing order, are
     ``tile_entries[tile_starts[t]:tile_starts[t + 1]]`` (``raster.tiles``): a face index f >= 0 (drawn from
-    ``win_int``/``win_float`` of its vertices) or ``−1 − r`` for clipped record r.
+    ``win_int``/``win_float`` of its vertices) or $−1 − r$ for clipped record r.
     """
     for t in range(start, stop):
         _fill_tile(

@@ -35,19 +35,19 @@ __all__ = [
 
 @kernel
 def _affine_row(m: np.ndarray, k: int, x: float, y: float, z: float) -> float:
-    """Row k of ``M·[x, y, z, 1]``, summed left to right: ``((m0·x + m1·y) + m2·z) + m3``."""
+    """Row k of $M·[x, y, z, 1]$, summed left to right: $((m0·x + m1·y) + m2·z) + m3$."""
     return ((m[k, 0] * x + m[k, 1] * y) + m[k, 2] * z) + m[k, 3]
 
 
 @kernel
 def _linear_row(m: np.ndarray, k: int, x: float, y: float, z: float) -> float:
-    """Row k of ``A·[x, y, z]`` with A the 3x3 block of m: ``(a0·x + a1·y) + a2·z``."""
+    """Row k of $A·[x, y, z]$ with A the 3x3 block of m: $(a0·x + a1·y) + a2·z$."""
     return (m[k, 0] * x + m[k, 1] * y) + m[k, 2] * z
 
 
 @kernel
 def clip_vertex(vertices: np.ndarray, i: int, m: np.ndarray, out: np.ndarray) -> None:
-    """``out = clip_from_model·P_i`` (out (4,) float64): the clip coordinates ``transform_vertices`` writes."""
+    """$out = clip_from_model·P_i$ (out (4,) float64): the clip coordinates ``transform_vertices`` writes."""
     x, y, z = vertices[i, 0], vertices[i, 1], vertices[i, 2]
     for k in range(4):
         out[k] = _affine_row(m, k, x, y, z)
@@ -55,7 +55,7 @@ def clip_vertex(vertices: np.ndarray, i: int, m: np.ndarray, out: np.ndarray) ->
 
 @kernel
 def _region_code(planes: np.ndarray, cx: float, cy: float, cz: float, cw: float) -> int:
-    """Bit k set when the clip-space point is outside plane k (``planes[k]·clip < 0``)."""
+    """Bit k set when the clip-space point is outside plane k ($planes[k]·clip < 0$)."""
     code = 0
     for k in range(planes.shape[0]):
         distance = ((planes[k, 0] * cx + planes[k, 1] * cy) + planes[k, 2] * cz) + planes[k, 3] * cw
@@ -66,9 +66,9 @@ def _region_code(planes: np.ndarray, cx: float, cy: float, cz: float, cw: float)
 
 @kernel
 def view_volume_code(cx: float, cy: float, cz: float, cw: float) -> int:
-    """Region code against the six planes of ``clipping.VIEW_VOLUME_PLANES`` in their bit order: left ``w + x < 0``,
-    right ``w − x < 0``, bottom, top (y), near, far (z). Bit for bit ``_region_code`` with those planes (its
-    ``((±1·x + 0·y) + 0·z) + 1·w`` is exactly ``w ± x``), without the loads and the loop."""
+    """Region code against the six planes of ``clipping.VIEW_VOLUME_PLANES`` in their bit order: left $w + x < 0$,
+    right $w − x < 0$, bottom, top (y), near, far (z). Bit for bit ``_region_code`` with those planes (its
+    $((±1·x + 0·y) + 0·z) + 1·w$ is exactly ``w ± x``), without the loads and the loop."""
     code = 1 if cx + cw < 0.0 else 0
     code |= 2 if cw - cx < 0.0 else 0
     code |= 4 if cy + cw < 0.0 else 0
@@ -84,11 +84,11 @@ def project_vertices(
     win_int: np.ndarray, win_float: np.ndarray, codes: np.ndarray,
     start: int, stop: int,
 ) -> None:  # fmt: skip
-    """View-volume region code of ``clip = clip_from_model·P``; inside (code 0) also the window coordinates.
+    """View-volume region code of $clip = clip_from_model·P$; inside (code 0) also the window coordinates.
 
     view = (width/2, height/2). codes (N,) any integer type of 6 bits or more; win_int (N, 2) int32 or
-    int64 receives the snapped ``X = floor((x_c/w·W/2 + W/2)·256 + 0.5)``, Y alike; win_float (N, 2) float64 the
-    window depth ``z_w = (z_c/w)·0.5 + 0.5`` and ``1/w``. Rows of vertices outside (code != 0) are left
+    int64 receives the snapped $X = floor((x_c/w·W/2 + W/2)·256 + 0.5)$, Y alike; win_float (N, 2) float64 the
+    window depth $z_w = (z_c/w)·0.5 + 0.5$ and ``1/w``. Rows of vertices outside (code != 0) are left
     unwritten: their faces are clipped (from ``clip_vertex``) or rejected.
     """
     m = clip_from_model
@@ -108,7 +108,7 @@ def project_vertices(
 
 @parallel_kernel(lambda vertices, *_: vertices.shape[0], grain=4096)
 def world_points(vertices: np.ndarray, world_from_model: np.ndarray, world: np.ndarray, start: int, stop: int) -> None:
-    """``world = world_from_model·P`` per vertex (world (N, 3) float64, written)."""
+    """$world = world_from_model·P$ per vertex (world (N, 3) float64, written)."""
     for i in range(start, stop):
         x, y, z = vertices[i, 0], vertices[i, 1], vertices[i, 2]
         for k in range(3):
@@ -117,7 +117,7 @@ def world_points(vertices: np.ndarray, world_from_model: np.ndarray, world: np.n
 
 @parallel_kernel(lambda normals, *_: normals.shape[0], grain=4096)
 def transform_normals(normals: np.ndarray, normal_matrix: np.ndarray, out: np.ndarray, start: int, stop: int) -> None:
-    """``n' = N·n / |N·n|`` per vertex, N the 3x3 block of normal_matrix (out (N, 3) float64, written)."""
+    """$n' = N·n / |N·n|$ per vertex, N the 3x3 block of normal_matrix (out (N, 3) float64, written)."""
     for i in range(start, stop):
         nx = _linear_row(normal_matrix, 0, normals[i, 0], normals[i, 1], normals[i, 2])
         ny = _linear_row(normal_matrix, 1, normals[i, 0], normals[i, 1], normals[i, 2])
@@ -132,10 +132,10 @@ def transform_vertices(
     clip: np.ndarray, world: np.ndarray, world_normals: np.ndarray, codes: np.ndarray,
     start: int, stop: int,
 ) -> None:  # fmt: skip
-    """``clip = clip_from_model·P``, ``world = world_from_model·P``, ``n' = normalize(N·n)``, region code of clip.
+    """$clip = clip_from_model·P$, $world = world_from_model·P$, $n' = normalize(N·n)$, region code of clip.
 
     Written: clip (N, 4), world (N, 3), world_normals (N, 3) float64, codes (N,) int64. The region code has bit k
-    set when the clip-space point is outside plane k (``planes[k]·clip < 0``).
+    set when the clip-space point is outside plane k ($planes[k]·clip < 0$).
     """
     for i in range(start, stop):
         x, y, z = vertices[i, 0], vertices[i, 1], vertices[i, 2]

@@ -3,17 +3,17 @@ Representations for Scalar Fields" (volume rendering); Levoy, "Display of surfac
 
 Per pixel (window centre (x + ½, y + ½), y up), in grid-index coordinates u (voxel (i, j, k) at u = (i, j, k)):
 
-1. Ray: ``A = grid_from_window·(x, y, 0, 1)``, ``B = grid_from_window·(x, y, 1, 1)`` (divided by w), the points
-   on the near and far planes; ``u(s) = A + s·(B − A)``, s ∈ [0, 1]. This is every projection's ray: through the
+1. Ray: $A = grid_from_window·(x, y, 0, 1)$, $B = grid_from_window·(x, y, 1, 1)$ (divided by w), the points
+   on the near and far planes; $u(s) = A + s·(B − A)$, s ∈ [0, 1]. This is every projection's ray: through the
    eye for a perspective camera, along the projection direction for a parallel one.
-2. Entry and exit: s clipped by the box ``0 <= u <= n − 1`` (slabs), by each clip plane ``a·u + d >= 0``, and by
-   the opaque depth buffer: a pixel whose window depth is ``z < 1`` ends the ray at its point's s.
+2. Entry and exit: s clipped by the box $0 <= u <= n − 1$ (slabs), by each clip plane $a·u + d >= 0$, and by
+   the opaque depth buffer: a pixel whose window depth is $z < 1$ ends the ray at its point's s.
 3. Samples at the middles of segments of model length Δ (the last one shorter), trilinear; a segment of
-   model length δ uses the opacity ``α' = 1 − (1 − α)^(δ/Δ₀)``. With ``P_ANCHORED`` set (sampling "near"):
+   model length δ uses the opacity $α' = 1 − (1 − α)^(δ/Δ₀)$. With ``P_ANCHORED`` set (sampling "near"):
    at every whole multiple of Δ from the ray's point on the near plane (s = 0) instead, each standing for Δ.
-4. Modes: composite front to back ``C += (1 − A)·α'·c``, ``A += (1 − A)·α'``, stopped once A reaches the
+4. Modes: composite front to back $C += (1 − A)·α'·c$, $A += (1 − A)·α'$, stopped once A reaches the
    termination threshold (early ray termination); ``mip`` / ``minip`` the largest / smallest sample; ``average``
-   the length-weighted mean; ``isosurface`` the first sign change of ``value − level`` between two samples,
+   the length-weighted mean; ``isosurface`` the first sign change of $value − level$ between two samples,
    refined by bisection. The last three classify their value through the table and blend it over the buffer.
 5. Empty-space skipping: blocks of ``BLOCK`` cells carry (min, max, empty); a ray walks the blocks it crosses
    (3D DDA, Amanatides & Woo 1987) and skips the samples of a block whose value range the transfer function
@@ -23,7 +23,7 @@ Per pixel (window centre (x + ½, y + ½), y up), in grid-index coordinates u (v
 6. Several composite volumes: ``cast_composite_merged`` merges their sample sequences along each ray.
 
 Gradient shading uses ``frustum.shading``'s model with the base color of the transfer function and the normal
-``−∇f/|∇f|`` (central differences of the trilinear field, one voxel apart) turned toward the viewer.
+$−∇f/|∇f|$ (central differences of the trilinear field, one voxel apart) turned toward the viewer.
 
 Kernels take plain arrays only; ``frustum.volume_pass`` builds them.
 """
@@ -242,7 +242,7 @@ def _shade(data, matrices, params, lights, u, view_dir, r, g, b):  # pragma: no 
 def _samples(s0, s1, ds, anchored):  # pragma: no cover - compiled
     """Where the samples of the ray part [s0, s1] lie: (first, count, tail_s, tail).
 
-    Full samples k = 0 … count − 1 at ``first + k·ds`` each stand for a segment ds; when ``tail > 0`` one more at
+    Full samples k = 0 … count − 1 at $first + k·ds$ each stand for a segment ds; when $tail > 0$ one more at
     ``tail_s`` stands for a segment tail (<= ds). ``anchored`` false (sampling "entry"): the middles of segments
     ds from s0, the last one (the tail) shorter. True (sampling "near"): every whole multiple of ds from the
     ray's point on the near plane (s = 0) inside [s0, s1], no tail.
@@ -416,7 +416,7 @@ def cast_rays(mode, data, blocks, table, matrices, planes, params, lights, depth
     `data` (nx, ny, nz) float32; `blocks` (bx, by, bz, 3) float32 from ``block_ranges`` plus the empty flags;
     `table` (5, T) float64 rows r, g, b, α, α corrected for the step Δ (each row one contiguous run: the
     opacity lookups of every sample stay in one small array) over the scalar range
-    ``value = low + t / scale``; `matrices` (5, 4, 4) as the ``M_*`` constants; `planes` (P, 4) clip planes in
+    $value = low + t / scale$; `matrices` (5, 4, 4) as the ``M_*`` constants; `planes` (P, 4) clip planes in
     grid coordinates; `params` (PARAMS,) as the ``P_*`` constants; `lights` (K, 16) from
     ``shading.pack_lights``; `depth` (H, W) float32 window depth (read; the isosurface mode writes its hits).
     Rows of the buffers are stored top row first (row r is window y = H − 1 − r). Pieces of rows are taken by
@@ -752,7 +752,7 @@ def _pixel_ray(matrices, planes, shape, params, x, y, window_depth, origin, dire
 
 @kernel
 def _blend(color, row, column, out):  # pragma: no cover - compiled
-    """``out + (1 − out_α)·under`` into the pixel's bytes, ``floor(255·v + 0.5)``."""
+    """$out + (1 − out_α)·under$ into the pixel's bytes, $floor(255·v + 0.5)$."""
     under = 1.0 - out[3]
     for c in range(4):
         v = out[c] + under * (color[row, column, c] / 255.0)

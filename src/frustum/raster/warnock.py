@@ -1,6 +1,6 @@
 """Area-subdivision (Warnock) visible-surface kernel: an explicit stack of areas, quartered down to a pixel.
 
-An area is a rectangle of pixels ``[i0, i1) × [j0, j1)`` (window rows); its sample points are the pixel centres.
+An area is a rectangle of pixels $[i0, i1) × [j0, j1)$ (window rows); its sample points are the pixel centres.
 Each triangle of the parent's list is classified against it by its edge functions at the area's four corner
 centres (an edge function is affine, so the corners bound it over the whole area):
 

@@ -8,12 +8,12 @@ or a clipped triangle record, with counter-clockwise snapped corners. Arrays (T 
 * ``zq`` (T, 3, 2) float64: window depth ``z_w`` and ``1/w_clip`` per corner;
 * ``weights`` (T, 3, 2) float64: barycentric weights (u1, u2) of each corner with respect to the source face
   (one-hot for an accepted face: weighting by them is bit-identical to taking the pixel's own barycentrics);
-* ``code`` (T,) int64: ``2·face + back`` (face numbered across the scene's items, as the shading kernel reads it);
+* ``code`` (T,) int64: $2·face + back$ (face numbered across the scene's items, as the shading kernel reads it);
 * ``box`` (T, 4) int64: pixel bounding box ``i_min, i_max, j_min, j_max`` (inclusive, inside the image).
 
-Edge functions at a point ``(X, Y)`` (1/256 pixel): ``E_k = dx_k·(Y − Y_a) − dy_k·(X − X_a)`` for the edge
-opposite corner k, top-left rule by ``bias_k`` (``E_k >= bias_k``); depth on the plane through the corners,
-``z = (z_0 + β·(Y − Y_0)) + α·(X − X_0)`` (``plane_depth``), and the perspective-correct barycentrics, as in
+Edge functions at a point ``(X, Y)`` (1/256 pixel): $E_k = dx_k·(Y − Y_a) − dy_k·(X − X_a)$ for the edge
+opposite corner k, top-left rule by ``bias_k`` ($E_k >= bias_k$); depth on the plane through the corners,
+$z = (z_0 + β·(Y − Y_0)) + α·(X − X_0)$ (``plane_depth``), and the perspective-correct barycentrics, as in
 ``triangles._fill_tile`` (its module docstring).
 """
 
@@ -75,7 +75,7 @@ def gather_faces(
 
 @kernel
 def edge_setup(xy: np.ndarray, t: int) -> tuple[int, int, int, int, int, int, int, int, int, float]:
-    """``(dx0, dy0, dx1, dy1, dx2, dy2, bias0, bias1, bias2, 2·area)`` of triangle t (edge k opposite corner k)."""
+    """$(dx0, dy0, dx1, dy1, dx2, dy2, bias0, bias1, bias2, 2·area)$ of triangle t (edge k opposite corner k)."""
     x0, y0, x1, y1, x2, y2 = xy[t, 0], xy[t, 1], xy[t, 2], xy[t, 3], xy[t, 4], xy[t, 5]
     dx0, dy0 = x2 - x1, y2 - y1
     dx1, dy1 = x0 - x2, y0 - y2
@@ -108,7 +108,7 @@ def covers(xy: np.ndarray, t: int, px: int, py: int) -> bool:
 @kernel
 def plane_depth(xy: np.ndarray, zq: np.ndarray, t: int, px: int, py: int) -> float:
     """Window depth (float64) of triangle t's plane at the fixed-point point (px, py):
-    ``(z_0 + β·(py − Y_0)) + α·(px − X_0)`` with ``(α, β) = triangles.depth_gradients`` (the depth buffer's bits)."""
+    $(z_0 + β·(py − Y_0)) + α·(px − X_0)$ with ``(α, β) = triangles.depth_gradients`` (the depth buffer's bits)."""
     x0, y0 = xy[t, 0], xy[t, 1]
     z0 = zq[t, 0, 0]
     alpha, beta = depth_gradients(x0, y0, xy[t, 2], xy[t, 3], xy[t, 4], xy[t, 5], z0, zq[t, 1, 0], zq[t, 2, 0])

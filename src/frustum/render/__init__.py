@@ -8,7 +8,7 @@ particles over the surfaces); ``stages`` holds the per-item stages the surface p
 
 Fast path, per scene item (one compiled pass each, buffers shared between items):
 
-1. ``raster.vertices.project_vertices``: clip = clip_from_world·world_from_model·P, region codes and, for the
+1. ``raster.vertices.project_vertices``: $clip = clip_from_world·world_from_model·P$, region codes and, for the
    vertices inside the view volume, the perspective divide, viewport and snap to 1/256 pixel, once per vertex
    (parallel over vertices; clip coordinates are not stored).
 2. ``raster.tiles.count_tiles`` / ``fill_tiles`` (triangle setup and binning in one): per face trivial reject,
@@ -20,7 +20,7 @@ Fast path, per scene item (one compiled pass each, buffers shared between items)
 3. World positions and unit normals for shading (``raster.vertices.world_points``, ``transform_normals``), or
    the mesh's own arrays when the modeling transform leaves them unchanged.
 4. ``raster.triangles.rasterize_tiles``: edge functions with the top-left rule (rows of wide boxes visit only
-   their covered span), depth on the triangle's plane (``z = (z_0 + β·ΔY) + α·ΔX``, no division per pixel),
+   their covered span), depth on the triangle's plane ($z = (z_0 + β·ΔY) + α·ΔX$, no division per pixel),
    depth test "less" against a float32 buffer cleared to 1.0 (``clear_buffers``, NumPy fills, which also
    paint the background color), face code and perspective-correct barycentrics stored per drawn pixel
    (parallel over tiles).
@@ -35,7 +35,7 @@ and depth arrays are recycled once no Frame holds them (``FrameBuffers``), so an
 first-touch new pages every frame.
 6. Transparent items (``Material.opacity < 1``) after all opaque ones, back to front by the view distance of
    their centres: each rasterized alone against a copy of the opaque depth buffer (its nearest surface) and
-   blended ``α·I + (1 − α)·under``.
+   blended $α·I + (1 − α)·under$.
 7. Edges (``"surface+edges"``, ``"hidden-line"``): ``raster.lines`` against the finished depth buffer.
 
 ``mode="wireframe"`` and ``mode="points"`` replace stages 2–5 by one serial kernel per item
@@ -137,12 +137,12 @@ def render(
         Its width and height are the image size.
     shading : {"phong", "gouraud", "flat", "normals", "depth", "none"} or None
         Where the illumination model is evaluated: per pixel, per vertex (interpolated), or per face
-        (``raster/shade.py``); ``"normals"`` shows ``0.5·N + 0.5`` of the world normal, ``"depth"`` the gray
-        ``(far − d)/(far − near)`` of the view distance; ``"none"`` (or None): the base color, no lighting.
+        (``raster/shade.py``); ``"normals"`` shows $0.5·N + 0.5$ of the world normal, ``"depth"`` the gray
+        $(far − d)/(far − near)$ of the view distance; ``"none"`` (or None): the base color, no lighting.
     specular : {"blinn-phong", "phong"}
         The specular term: (N·H)^n or (R·V)^n.
     background : (4,) array_like
-        RGBA in [0, 1] for pixels nothing covers; stored as ``round(255·value)``. Not given, a scene with an
+        RGBA in [0, 1] for pixels nothing covers; stored as $round(255·value)$. Not given, a scene with an
         ``environment`` map shows the map there (``render.reflection``), else opaque black.
     cull_back_faces : bool
         True: drop triangles that are clockwise (or of zero area) in window coordinates. False: draw both

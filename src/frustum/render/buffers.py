@@ -214,7 +214,7 @@ def _shadow_buffers(options: RenderOptions) -> tuple[np.ndarray | None, np.ndarr
 
 def resolve_color(big: np.ndarray, factor: int) -> np.ndarray:
     """Box-filter resolve in integers: (H·s, W·s, 4) uint8 → (H, W, 4) uint8, each channel the rounded mean of
-    its s×s block, ``floor(Σ/s² + 1/2) = (2·Σ + s²) // (2·s²)`` (exactly the rounded mean)."""
+    its s×s block, $floor(Σ/s² + 1/2) = (2·Σ + s²) // (2·s²)$ (exactly the rounded mean)."""
     height, width = big.shape[0] // factor, big.shape[1] // factor
     area = factor * factor
     # Σ + ⌊s²/2⌋ ≤ 255·s² + s²/2 fits uint16 up to s = 16; the rounded mean is then (Σ + ⌊s²/2⌋) // s², the same
@@ -251,7 +251,7 @@ def block_min(values: np.ndarray, factor: int) -> np.ndarray:
 
 def downsample(values: np.ndarray, factor: int, kind: str) -> np.ndarray:
     """(H·s, W·s, C) → (H, W, C): the mean of each s×s block ("box"), or a separable tent of width 2s centred
-    on each block (weights ``s − |offset|`` for the 2s − 1 samples around it, edges clamped)."""
+    on each block (weights $s − |offset|$ for the 2s − 1 samples around it, edges clamped)."""
     height, width = values.shape[0] // factor, values.shape[1] // factor
     if kind == "box":
         return values.reshape(height, factor, width, factor, -1).mean(axis=(1, 3))

@@ -107,9 +107,9 @@ def draw_polylines(line_items: list[SceneItem], camera: Camera, options: RenderO
 
 def clip_vertices(points: np.ndarray, world_from_model: np.ndarray, camera: Camera):
     """Clip coordinates (N, 4), world positions (N, 3) and view-volume region codes (N,) int64 of model-space
-    points, in NumPy (lines and edges have few points; no kernel to compile): each row of ``M·[x, y, z, 1]``
-    summed left to right, ``((m0·x + m1·y) + m2·z) + m3``, and bit k of the code set when
-    ``((p0·x_c + p1·y_c) + p2·z_c) + p3·w_c < 0`` for plane k of ``VIEW_VOLUME_PLANES`` — the operations, in the
+    points, in NumPy (lines and edges have few points; no kernel to compile): each row of $M·[x, y, z, 1]$
+    summed left to right, $((m0·x + m1·y) + m2·z) + m3$, and bit k of the code set when
+    $((p0·x_c + p1·y_c) + p2·z_c) + p3·w_c < 0$ for plane k of ``VIEW_VOLUME_PLANES`` — the operations, in the
     order, of the kernels' vertex stage (``raster.vertices``), so the same bytes."""
     item = SceneItem(None, None, world_from_model)  # type: ignore[arg-type]
     matrices = item_matrices(item, camera)

@@ -221,7 +221,7 @@ def check_image_budget(camera: Camera, factor: int, buffers: tuple[str, ...], fi
                        where: str) -> None:  # fmt: skip
     """Refuse, before any buffer is allocated, an image whose buffers exceed the memory budget (``frustum.budgets``).
 
-    Per rendered pixel (``width·height·samples`` of them): color 4 + depth 4 bytes, about 4 bytes of the
+    Per rendered pixel ($width·height·samples$ of them): color 4 + depth 4 bytes, about 4 bytes of the
     renderer's work arrays (measured with tracemalloc: 12 bytes a pixel at 1024², surface mode), 12 for a
     ``normals`` buffer and 4 for ``object_id``; a float64 copy for the tent filter or sRGB (2 × 32 bytes).
     """

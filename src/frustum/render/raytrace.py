@@ -10,26 +10,26 @@ view volume, as ``method="ray-casting"``: back faces skipped when culling); at t
   Phong), where each positioned light's diffuse and specular terms are multiplied by its visibility: a shadow ray
   from the point toward the light (to a point or spot light's position, or along a directional light's to-light
   direction without end) blocked by any surface, when shadows are on (``shadows`` None or True) and the light
-  has ``cast_shadows``. Shadow rays are cast only where ``N·L > 0`` (elsewhere the light adds nothing anyway).
+  has ``cast_shadows``. Shadow rays are cast only where $N·L > 0$ (elsewhere the light adds nothing anyway).
   Every surface blocks light, transparent ones included;
-* a **reflected** ray ``R = I + 2(N·(−I))N`` when ``Material.reflectivity`` k_r > 0;
-* a **refracted** ray when ``Material.opacity`` α < 1, bent by Snell's law ``η₁ sin θ₁ = η₂ sin θ₂`` with
-  ``η = 1/ior`` entering a surface from its front and ``ior`` leaving through its back (the outside is air:
-  index 1; media are not nested), ``T = ηI + (η cos θ₁ − √(1 − η²(1 − cos² θ₁)))N``. Beyond the critical angle
-  (``η² sin² θ₁ > 1``) the light is **totally reflected**: the transmitted weight goes to the reflected ray.
+* a **reflected** ray $R = I + 2(N·(−I))N$ when ``Material.reflectivity`` k_r > 0;
+* a **refracted** ray when ``Material.opacity`` α < 1, bent by Snell's law $η₁ sin θ₁ = η₂ sin θ₂$ with
+  $η = 1/ior$ entering a surface from its front and ``ior`` leaving through its back (the outside is air:
+  index 1; media are not nested), $T = ηI + (η cos θ₁ − √(1 − η²(1 − cos² θ₁)))N$. Beyond the critical angle
+  ($η² sin² θ₁ > 1$) the light is **totally reflected**: the transmitted weight goes to the reflected ray.
 
 The contributions are weighted without a Fresnel term (the default and only weighting; the textbook's
-``I = I_local + k_r·I_r + k_t·I_t`` with the local part scaled so that weights sum to one)::
+$I = I_local + k_r·I_r + k_t·I_t$ with the local part scaled so that weights sum to one):
 
-    I = (1 − k_r)·(α·I_local + (1 − α)·I_t) + k_r·I_r
+$$I = (1 − k_r)·(α·I_local + (1 − α)·I_t) + k_r·I_r$$
 
-so that an opaque matte surface (k_r = 0, α = 1) gives the depth buffer's color, a perfect mirror (k_r = 1)
-only what it reflects, and a transparent surface of ``ior = 1`` the depth buffer's blend ``α·I + (1 − α)·behind``.
+so that an opaque matte surface ($k_r = 0$, $α = 1$) gives the depth buffer's color, a perfect mirror ($k_r = 1$)
+only what it reflects, and a transparent surface of $ior = 1$ the depth buffer's blend $α·I + (1 − α)·behind$.
 Rays that leave the scene see the ``background`` color, or the scene's environment map (``Scene(environment=)``)
 along their direction for reflected and refracted rays (primary rays that miss show it as the depth buffer
 does). After ``max_depth`` levels of reflected and refracted rays no more are spawned (their share of the color
 is black), and rays whose weight is below ``MIN_WEIGHT`` are not traced. The normal used to reflect and refract
-is the interpolated (shading) normal; rays start ``ε`` (1e-9 of the scene's size) off the surface along the
+is the interpolated (shading) normal; rays start $ε$ (1e-9 of the scene's size) off the surface along the
 geometric normal, on the side they leave to, so that they do not meet it again.
 
 The depth buffer receives the window depth of each primary hit, so volumes and particles are composited along

@@ -4,11 +4,11 @@
   along its own viewing ray (``Camera.ray`` through the pixel centre), when ``render`` was given no background.
   It runs right after the opaque surfaces, so volumes and transparent items are composited over it.
 * **Reflection mapping** (``reflect``): after an item with ``Material.reflectivity`` r > 0 is shaded, each of its
-  pixels becomes ``(1 − r)·I + r·env(R)`` with ``R = V − 2 (N·V) N``, V the unit viewing ray through the pixel and
+  pixels becomes $(1 − r)·I + r·env(R)$ with $R = V − 2 (N·V) N$, V the unit viewing ray through the pixel and
   N the interpolated unit normal (flipped for a back face drawn two-sided), per pixel with a bilinear lookup
   [HB "Environment Mapping"]. Only the surroundings are reflected, not the other objects (that is ray tracing).
 
-Colors are linear; bytes are ``floor(I·255 + 0.5)`` as the shading kernels store them.
+Colors are linear; bytes are $floor(I·255 + 0.5)$ as the shading kernels store them.
 """
 
 from __future__ import annotations

@@ -75,8 +75,8 @@ def item_matrices(item: SceneItem, camera: Camera | None) -> np.ndarray:
 
 
 def rows(points: np.ndarray, m: np.ndarray, count: int, affine: bool) -> np.ndarray:
-    """Rows 0..count−1 of ``M·[x, y, z, 1]`` summed left to right, ``((m0·x + m1·y) + m2·z) + m3`` (``affine``),
-    or of ``A·[x, y, z]``, ``(a0·x + a1·y) + a2·z`` — ``raster.vertices._affine_row`` / ``_linear_row`` in NumPy."""
+    """Rows 0..count−1 of $M·[x, y, z, 1]$ summed left to right, $((m0·x + m1·y) + m2·z) + m3$ (``affine``),
+    or of $A·[x, y, z]$, $(a0·x + a1·y) + a2·z$ — ``raster.vertices._affine_row`` / ``_linear_row`` in NumPy."""
     x, y, z = (np.asarray(points[:, k], dtype=np.float64) for k in range(3))
     summed = [(m[k, 0] * x + m[k, 1] * y) + m[k, 2] * z for k in range(count)]
     return np.stack([row + m[k, 3] for k, row in enumerate(summed)] if affine else summed, axis=1)
@@ -125,7 +125,7 @@ class Binned:
     ``win_int`` (N, 2) snapped window ``X, Y`` and ``win_float`` (N, 2) ``z_w, 1/w`` of the vertices inside the
     view volume (``vertex_codes == 0``; other rows are undefined); the clipped triangles' records ``tri_int``,
     ``tri_float``, ``tri_weights`` (``raster.triangles``) of the ``crossing`` faces; tile t's entries, in
-    drawing order, ``tile_entries[tile_starts[t]:tile_starts[t + 1]]``: a face index f >= 0 or ``−1 − r`` for
+    drawing order, ``tile_entries[tile_starts[t]:tile_starts[t + 1]]``: a face index f >= 0 or $−1 − r$ for
     record r; ``tiles_x`` tiles of ``TILE_SIZE`` pixels per row.
     """
 
@@ -396,7 +396,7 @@ def _shade_pixels(
 
 
 def back_to_front(items: list[SceneItem], indices: list[int], camera: Camera) -> list[int]:
-    """The items `indices` farthest first, by the view distance ``(eye − c)·n`` of their bounding-box centres c
+    """The items `indices` farthest first, by the view distance $(eye − c)·n$ of their bounding-box centres c
     (the per-object sort of transparent items: right when they do not interpenetrate or cyclically overlap)."""
     axis = np.asarray(camera.frame.n, dtype=np.float64)
     eye = np.asarray(camera.frame.eye, dtype=np.float64)

@@ -1,16 +1,16 @@
 """TOML scene files: a camera, lights, materials and a node hierarchy, validated with every error reported at once.
 
 A scene file is read with the standard library's ``tomllib`` and checked completely before anything is
-rendered: each problem becomes one line ``file:line: key = value problem; what is valid`` and all of them are
+rendered: each problem becomes one line $file:line: key = value problem; what is valid$ and all of them are
 raised together as one ``SceneFileError`` (its ``problems`` attribute lists the lines). ``tomllib`` reports no
 positions for keys, so ``report._key_lines`` scans the TOML text once and maps every key path (``nodes[1].transform[0]
 .rotate_y_deg``) to the line it is written on.
 
 Conventions of the format (``docs/topics.md`` has a tour, ``scene.schema.json`` the JSON Schema):
 
-- Angles are degrees, in keys ending ``_deg`` (``fovy_deg = 45``, ``rotate_y_deg = 30``); the Python API they
+- Angles are degrees, in keys ending ``_deg`` ($fovy_deg = 45$, $rotate_y_deg = 30$); the Python API they
   feed takes radians. Lengths are world units; colors are linear RGB(A) in [0, 1].
-- A node's ``transform`` is a list of named steps applied first to last (``world_from_model = compose(*steps)``,
+- A node's ``transform`` is a list of named steps applied first to last ($world_from_model = compose(*steps)$,
   column vectors): ``translate``, ``rotate_x_deg`` / ``rotate_y_deg`` / ``rotate_z_deg``, ``rotate_deg`` about
   ``axis`` through ``point``, ``scale`` (one factor or three) about ``fixed``, ``reflect`` (``"xy"``, ``"yz"``,
   ``"zx"`` or a normal) through ``point``, ``shear`` (axis with ``a``, ``b``, ``ref``), ``quaternion`` ``[w, x, y,

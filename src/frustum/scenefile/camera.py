@@ -125,7 +125,7 @@ def _camera(report: _Report, path: tuple, value: Any, size: tuple[int, int], sce
 
 
 def _fitted(report: _Report, path: tuple, params: dict, size: tuple[int, int], scene: Any) -> Any:
-    """``fit = true``: ``Camera.fit`` of the scene from `view`, from `azimuth_deg`/`elevation_deg`, or the 3/4 view;
+    """$fit = true$: ``Camera.fit`` of the scene from `view`, from `azimuth_deg`/`elevation_deg`, or the 3/4 view;
     perspective (``fovy_deg``) or orthographic, ``margin`` the free border (a fraction of the smaller side)."""
     fit = _boolean(report, (*path, "fit"), params["fit"])
     allowed = ("fit", "view", "azimuth_deg", "elevation_deg", "projection", "fovy_deg", "margin", "stereo")

@@ -156,7 +156,7 @@ def load_scene(
     one-line string ending in ``.toml`` or a mesh suffix (``MODEL_SUFFIXES``), goes to ``load_scene_file``.
 
     Every problem is collected first; then one ``SceneFileError`` lists them all, one per line, as
-    ``source:line: key = value problem; what is valid`` (no line numbers for a dictionary).
+    $source:line: key = value problem; what is valid$ (no line numbers for a dictionary).
 
     Parameters
     ----------
@@ -354,7 +354,7 @@ def _build(report: _Report, data: dict, base: Path, check_outputs: bool = True) 
 
 
 def _fits(data: dict) -> bool:
-    """Whether the file's camera (or first camera) is placed by ``fit = true``."""
+    """Whether the file's camera (or first camera) is placed by $fit = true$."""
     camera = data.get("camera", (data.get("cameras") or [None])[0] if isinstance(data.get("cameras"), list) else None)
     return isinstance(camera, dict) and camera.get("fit") is True
 
@@ -371,7 +371,7 @@ def load_scene_file(path: str | Path, *, up: str = "y") -> SceneFile:
     ------
     SceneFileError
         If the file cannot be read, is not valid TOML, or has invalid keys or values; the message lists every
-        problem as ``file:line: key = value problem; what is valid``.
+        problem as $file:line: key = value problem; what is valid$.
     GeometryError
         If a mesh file cannot be read.
     """

@@ -1,6 +1,6 @@
 """The key-line scanner and the error report of scene files: ``_key_lines`` maps every key path of valid TOML
 text to the line it is written on (``tomllib`` reports no positions), and ``_Report`` collects every problem as
-``file:line: key = value problem; what is valid``, raised together as one ``SceneFileError``."""
+$file:line: key = value problem; what is valid$, raised together as one ``SceneFileError``."""
 
 from __future__ import annotations
 
@@ -227,7 +227,7 @@ def _toml_text(value: Any) -> str:
 
 
 class _Report:
-    """Collects every problem as ``file:line: key = value problem; what is valid``."""
+    """Collects every problem as $file:line: key = value problem; what is valid$."""
 
     def __init__(self, source: str, lines: dict[tuple, int] | str | None) -> None:
         self.source = source
@@ -258,7 +258,7 @@ class _Report:
         return f"{source}:{line}" if line is not None else source
 
     def add(self, path: Sequence, value: Any, problem: str, valid: str) -> None:
-        """``key = value problem; valid``."""
+        """$key = value problem; valid$."""
         self.problems.append(f"{self._where(path)}: {_path_text(path)} = {_toml_text(value)} {problem}; {valid}")
 
     def missing(self, path: Sequence, valid: str) -> None:
@@ -267,7 +267,7 @@ class _Report:
     def refused(self, path: Sequence, value: Any, error: Exception) -> None:
         """A value the building function refused: its own message says what is valid.
 
-        When the message names one of the table's keys (``where: name = ...``), the problem points at that key.
+        When the message names one of the table's keys ($where: name = ...$), the problem points at that key.
         """
         message = _problem_text(error)
         named = re.match(r"[^:]*: (\w+)", message)

@@ -90,7 +90,7 @@ def _simulations(report: _Report, data: dict, scene: Scene, materials: dict) -> 
 
 
 def _warm_up(report: _Report, scene: Scene, animation: dict) -> None:
-    """Step the simulations ``[animation].warmup`` seconds (in steps of ``1/(fps·substeps)``) before any frame."""
+    """Step the simulations ``[animation].warmup`` seconds (in steps of $1/(fps·substeps)$) before any frame."""
     warmup = animation.get("warmup", 0.0)
     if not warmup or not (scene.particle_layers or scene.mass_springs):
         return

@@ -36,7 +36,7 @@ _TRANSFER_KEYS = ("preset", "colormap", "range", "opacity", "values", "colors", 
 
 
 def _volume(report: _Report, path: tuple, value: dict, base: Path, materials: dict, scene: Scene) -> None:
-    """One ``[[volumes]]`` table: ``source = { type = ..., ... }``, a transfer function, the mode and options,
+    """One ``[[volumes]]`` table: $source = { type = ..., ... }$, a transfer function, the mode and options,
     placed by ``Scene.add_volume``."""
     module = importlib.import_module("frustum.geometry.volume")
     _unknown_keys(report, path, value, _VOLUME_KEYS)
@@ -97,7 +97,7 @@ def _volume(report: _Report, path: tuple, value: dict, base: Path, materials: di
 
 def _transfer_function(report: _Report, path: tuple, value: Any, module: Any) -> Any:
     """``{ preset = "bone", range = [lo, hi], opacity = ... }``, ``{ colormap = "viridis", ... }`` or
-    ``{ values = [...], colors = [[r, g, b], ...], opacities = [...] }`` (range optional)."""
+    ${ values = [...], colors = [[r, g, b], ...], opacities = [...] }$ (range optional)."""
     params = _table(report, path, value)
     if params is _BAD:
         return _BAD

@@ -1,8 +1,8 @@
 """Particle emitters (Reeves' generation shapes): a point, a line, a disk, a sphere, the surface of a mesh.
 
-Each emitter places new particles on its shape and gives them a velocity ``speed·d`` with ``d`` drawn uniformly
+Each emitter places new particles on its shape and gives them a velocity $speed·d$ with ``d`` drawn uniformly
 from the spherical cap of half-angle `spread` around the emitter's direction (the "ejection angle" of Reeves'
-model), ``speed`` varying as ``speed + speed_variance·U(−1, 1)``. Random numbers come from the system's
+model), ``speed`` varying as $speed + speed_variance·U(−1, 1)$. Random numbers come from the system's
 ``numpy.random.Generator`` in a fixed order, so the same seed gives the same particles.
 
 References
@@ -40,7 +40,7 @@ def cone_directions(
 ) -> NDArray[np.float64]:  # fmt: skip
     """(N, 3) unit directions uniform on the cap of half-angle `spread` (radians) around each unit row of `axes`.
 
-    ``cos θ = 1 − u·(1 − cos spread)``, ``φ = 2π·v`` (area-uniform on the cap), around each axis.
+    $cos θ = 1 − u·(1 − cos spread)$, $φ = 2π·v$ (area-uniform on the cap), around each axis.
     `axes` is (N, 3); the generator draws u for all N, then v for all N.
     """
     count = axes.shape[0]
@@ -111,7 +111,7 @@ class PointEmitter(Emitter):
     spread : float
         Half-angle of the cone of directions in radians, in [0, π] (π: every direction).
     speed, speed_variance : float
-        Initial speed ``speed + speed_variance·U(−1, 1)`` (units per second).
+        Initial speed $speed + speed_variance·U(−1, 1)$ (units per second).
     """
 
     _where = "PointEmitter"
@@ -146,7 +146,7 @@ class LineEmitter(Emitter):
 
 class DiskEmitter(Emitter):
     """Particles start uniformly on the disk of `radius` around `center` perpendicular to `normal`
-    (``r = R·√u``, area-uniform); direction default the normal."""
+    ($r = R·√u$, area-uniform); direction default the normal."""
 
     _where = "DiskEmitter"
 
@@ -187,7 +187,7 @@ class SphereEmitter(Emitter):
 
 class MeshEmitter(Emitter):
     """Particles start uniformly on the surface of `mesh` (a face chosen with probability ∝ its area, then a
-    uniform point in it: ``√u`` barycentric sampling); direction default the face normal."""
+    uniform point in it: $√u$ barycentric sampling); direction default the face normal."""
 
     _where = "MeshEmitter"
 

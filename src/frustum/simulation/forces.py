@@ -2,10 +2,10 @@
 
 A force maps the state ``(x, v)`` of N particles to accelerations: either one (3,) vector shared by all
 (gravity) or an (N, 3) array. A collider moves particles that ended a step inside it back out along its normal
-and reflects the normal part of their velocity: with ``d < 0`` the signed distance and ``n`` the unit normal,
-``x' = x − (1 + e)·d·n`` (the mirror image scaled by the restitution e, so ``d' = −e·d ≥ 0``), and
-``v' = (1 − μ)·v_t − e·v_n`` when the particle moves into the surface (``v·n < 0``), with ``v_n = (v·n)·n``,
-``v_t = v − v_n``, e the restitution and μ the friction (a fraction of the tangential velocity removed per
+and reflects the normal part of their velocity: with $d < 0$ the signed distance and ``n`` the unit normal,
+$x' = x − (1 + e)·d·n$ (the mirror image scaled by the restitution e, so $d' = −e·d ≥ 0$), and
+$v' = (1 − μ)·v_t − e·v_n$ when the particle moves into the surface ($v·n < 0$), with $v_n = (v·n)·n$,
+$v_t = v − v_n$, e the restitution and μ the friction (a fraction of the tangential velocity removed per
 contact). With e = 1 and μ = 0 the speed is kept.
 
 References
@@ -61,7 +61,7 @@ class Gravity(Force):
 
 
 class Drag(Force):
-    """Linear (Stokes) drag ``a = −k·v`` with `coefficient` k >= 0 (1/s)."""
+    """Linear (Stokes) drag $a = −k·v$ with `coefficient` k >= 0 (1/s)."""
 
     def __init__(self, coefficient: float) -> None:
         self.coefficient = as_nonnegative(coefficient, "coefficient", "Drag")
@@ -71,7 +71,7 @@ class Drag(Force):
 
 
 class Wind(Force):
-    """Drag toward the air's `velocity`: ``a = k·(w − v)`` with `coefficient` k >= 0 (1/s)."""
+    """Drag toward the air's `velocity`: $a = k·(w − v)$ with `coefficient` k >= 0 (1/s)."""
 
     def __init__(self, velocity: ArrayLike, coefficient: float = 1.0) -> None:
         self.velocity = as_vector3(velocity, "velocity", where="Wind", error=SimulationError)
@@ -82,7 +82,7 @@ class Wind(Force):
 
 
 class Vortex(Force):
-    """A swirl about the line through `center` along `axis`: ``a = s·(â × r⊥)/(|r⊥|² + c²)``, r⊥ the offset
+    """A swirl about the line through `center` along `axis`: $a = s·(â × r⊥)/(|r⊥|² + c²)$, r⊥ the offset
     from the axis, `strength` s (counter-clockwise about â for s > 0) and `core` radius c > 0 (no singularity)."""
 
     def __init__(self, center: ArrayLike, axis: ArrayLike = (0.0, 1.0, 0.0), strength: float = 1.0,
@@ -100,7 +100,7 @@ class Vortex(Force):
 
 
 class Attractor(Force):
-    """A point attractor (negative `strength`: repeller): ``a = s·(p − x)/(|p − x|² + ε²)^{3/2}``, an inverse
+    """A point attractor (negative `strength`: repeller): $a = s·(p − x)/(|p − x|² + ε²)^{3/2}$, an inverse
     square law softened by `softening` ε > 0."""
 
     def __init__(self, position: ArrayLike, strength: float = 1.0, softening: float = 0.1) -> None:
@@ -152,7 +152,7 @@ class _Collider:
 class PlaneCollider(_Collider):
     """The half-space behind the plane through `point` with unit `normal` (particles stay on the normal's side).
 
-    Signed distance ``d = (x − p)·n``. See the module docstring for the response (`restitution` e and
+    Signed distance $d = (x − p)·n$. See the module docstring for the response (`restitution` e and
     `friction` μ, both in [0, 1]).
     """
 
@@ -170,8 +170,8 @@ class PlaneCollider(_Collider):
 
 
 class SphereCollider(_Collider):
-    """A solid ball of `radius` around `center`: signed distance ``d = |x − c| − r``, normal ``(x − c)/|x − c|``
-    (moving out along it puts a particle at ``r + e·|d|``, outside)."""
+    """A solid ball of `radius` around `center`: signed distance $d = |x − c| − r$, normal $(x − c)/|x − c|$
+    (moving out along it puts a particle at $r + e·|d|$, outside)."""
 
     def __init__(self, center: ArrayLike, radius: float, restitution: float = 0.5, friction: float = 0.0) -> None:
         super().__init__(restitution, friction, "SphereCollider")
@@ -192,7 +192,7 @@ class SphereCollider(_Collider):
 
 class MeshCollider(_Collider):
     """A closed (watertight) mesh as a solid obstacle: particles that end a step inside it are moved to the
-    nearest surface point ``c`` plus ``e·|d|`` along its outward normal ``n = (c − x)/|c − x|`` (``d`` the
+    nearest surface point ``c`` plus $e·|d|$ along its outward normal $n = (c − x)/|c − x|$ (``d`` the
     distance to c), and their velocities respond as for a plane with that normal.
 
     Inside tests and closest points come from trimesh (ray parity and an R-tree of the triangles), only for the

@@ -3,16 +3,16 @@
 One step of ``ParticleSystem.step(dt)``, in order (every stage a whole-array numpy operation, no per-particle
 Python loop):
 
-1. **Move** (semi-implicit, "symplectic" Euler): ``a = Σ forces(x, v)``, ``v ← v + a·dt``, ``x ← x + v·dt``,
+1. **Move** (semi-implicit, "symplectic" Euler): $a = Σ forces(x, v)$, $v ← v + a·dt$, $x ← x + v·dt$,
    ``age ← age + dt``; the previous positions are kept (streaks draw from them). Under constant gravity g this
-   gives ``x_n = x₀ + v₀·t_n + g·t_n²/2 + g·dt·t_n/2``: the parabola plus a known first-order term.
+   gives $x_n = x₀ + v₀·t_n + g·t_n²/2 + g·dt·t_n/2$: the parabola plus a known first-order term.
 2. **Collide**: each collider moves particles inside it back out and reflects their velocities
    (``frustum.simulation.forces``).
-3. **Die**: a particle whose ``age >= lifetime`` (or that left the `region` box) is removed; the survivors keep
+3. **Die**: a particle whose $age >= lifetime$ (or that left the `region` box) is removed; the survivors keep
    their order.
-4. **Generate** (Reeves §2.1): ``n = ⌊(rate + rate_variance·U(−1, 1))·dt + u⌋`` new particles with u uniform in
-   [0, 1) (stochastic rounding: ``E[n] = rate·dt`` exactly), placed by the emitter with age 0 and a lifetime
-   ``lifetime + lifetime_variance·U(−1, 1)``. Their ``Var[n] = (rate_variance·dt)²/3 + E[f·(1 − f)]``, f the
+4. **Generate** (Reeves §2.1): $n = ⌊(rate + rate_variance·U(−1, 1))·dt + u⌋$ new particles with u uniform in
+   [0, 1) (stochastic rounding: $E[n] = rate·dt$ exactly), placed by the emitter with age 0 and a lifetime
+   $lifetime + lifetime_variance·U(−1, 1)$. Their $Var[n] = (rate_variance·dt)²/3 + E[f·(1 − f)]$, f the
    fractional part of the real count (1/6 when the count spreads evenly over whole numbers).
 
 Attributes over life: `size`, `color` and `opacity` are constants or ramps over the normalized age
@@ -25,7 +25,7 @@ operations on one thread, so the same seed gives the same bytes on any machine t
 References
 ----------
 W. T. Reeves, "Particle Systems — a Technique for Modeling a Class of Fuzzy Objects", SIGGRAPH 1983, §2
-(generation ``NParts = MeanParts + Rand()·VarParts``, attributes, dynamics, extinction); [HB 15] "Particle
+(generation $NParts = MeanParts + Rand()·VarParts$, attributes, dynamics, extinction); [HB 15] "Particle
 Systems"; [seed] "Particle systems".
 """
 
@@ -77,9 +77,9 @@ class ParticleSystem:
     seed : int
         Seed of the random generator (>= 0).
     rate_variance : float
-        Reeves' ± variance of the rate: the rate of one step is ``rate + rate_variance·U(−1, 1)`` (clamped at 0).
+        Reeves' ± variance of the rate: the rate of one step is $rate + rate_variance·U(−1, 1)$ (clamped at 0).
     lifetime_variance : float
-        A lifetime is ``lifetime + lifetime_variance·U(−1, 1)``; must stay below `lifetime`.
+        A lifetime is $lifetime + lifetime_variance·U(−1, 1)$; must stay below `lifetime`.
     colliders : list
         ``PlaneCollider`` and ``SphereCollider`` obstacles.
     region : ((3,), (3,)) or None
@@ -257,7 +257,7 @@ class ParticleSystem:
         return count
 
     def _linear_forces(self) -> tuple[np.ndarray, float, np.ndarray] | None:
-        """(c, k, planes) when every force is gravity, drag or wind (``a = c − k·v``) and every collider a plane:
+        """(c, k, planes) when every force is gravity, drag or wind ($a = c − k·v$) and every collider a plane:
         the case ``raster.particle_step.step_linear`` runs in one fused pass. None otherwise."""
         if not all(type(f) in (Gravity, Drag, Wind) for f in self.forces):
             return None

@@ -1,24 +1,24 @@
 """Mass–spring systems: point masses joined by damped springs, stepped by five integrators; cloth, ropes, soft bodies.
 
-Spring s joins masses i and j with stiffness k, damping c and rest length L. With ``d = x_j − x_i``,
-``l = |d|`` and ``u = d/l``, the force on i is (Hooke's law plus damping along the spring)
+Spring s joins masses i and j with stiffness k, damping c and rest length L. With $d = x_j − x_i$,
+$l = |d|$ and $u = d/l$, the force on i is (Hooke's law plus damping along the spring)
 
-    f_i = k·(l − L)·u + c·((v_j − v_i)·u)·u,      f_j = −f_i,
+$$f_i = k·(l − L)·u + c·((v_j − v_i)·u)·u,   f_j = −f_i,$$
 
-plus gravity ``m·g`` and air drag ``−drag·m·v`` on every mass (drag per unit mass, so a finer mesh of the
+plus gravity $m·g$ and air drag $−drag·m·v$ on every mass (drag per unit mass, so a finer mesh of the
 same total mass falls the same way). Pinned masses never move. The energy
-``E = Σ ½·m·|v|² + Σ ½·k·(l − L)² − Σ m·g·x`` is conserved without damping and drag.
+$E = Σ ½·m·|v|² + Σ ½·k·(l − L)² − Σ m·g·x$ is conserved without damping and drag.
 
-Integrators, for ``ẋ = v``, ``v̇ = a(x, v) = f/m`` and a step h:
+Integrators, for $ẋ = v$, $v̇ = a(x, v) = f/m$ and a step h:
 
-- ``"explicit-euler"`` (forward): ``x' = x + h·v``, ``v' = v + h·a(x, v)``; order 1, energy grows.
-- ``"symplectic-euler"`` (semi-implicit): ``v' = v + h·a(x, v)``, ``x' = x + h·v'``; order 1, energy bounded.
-- ``"verlet"`` (velocity Verlet): ``x' = x + h·v + h²/2·a₀``, ``v' = v + h/2·(a₀ + a(x', v + h·a₀))``; order 2.
+- ``"explicit-euler"`` (forward): $x' = x + h·v$, $v' = v + h·a(x, v)$; order 1, energy grows.
+- ``"symplectic-euler"`` (semi-implicit): $v' = v + h·a(x, v)$, $x' = x + h·v'$; order 1, energy bounded.
+- ``"verlet"`` (velocity Verlet): $x' = x + h·v + h²/2·a₀$, $v' = v + h/2·(a₀ + a(x', v + h·a₀))$; order 2.
 - ``"rk4"``: classical Runge–Kutta on (x, v); order 4.
 - ``"implicit-euler"`` (backward, one Newton step as in Baraff & Witkin 1998): solve
-  ``(M − h·∂f/∂v − h²·∂f/∂x)·Δv = h·(f₀ + h·∂f/∂x·v)`` by SciPy's sparse conjugate gradient, then
-  ``v' = v + Δv``, ``x' = x + h·v'``; order 1, stable for any h (the stiffness term is kept positive
-  definite: ``max(0, 1 − L/l)`` in the transverse part, as in Choi & Ko 2002).
+  $(M − h·∂f/∂v − h²·∂f/∂x)·Δv = h·(f₀ + h·∂f/∂x·v)$ by SciPy's sparse conjugate gradient, then
+  $v' = v + Δv$, $x' = x + h·v'$; order 1, stable for any h (the stiffness term is kept positive
+  definite: $max(0, 1 − L/l)$ in the transverse part, as in Choi & Ko 2002).
 
 After a step, colliders (planes, spheres) push masses out and respond their velocities (``forces`` module).
 A state that stops being finite raises ``SimulationError`` naming the step.
@@ -78,7 +78,7 @@ class MassSpringSystem:
     integrator : str
         One of ``INTEGRATORS``.
     drag : float
-        Air drag coefficient >= 0 (1/s): force ``−drag·m·v`` on every mass.
+        Air drag coefficient >= 0 (1/s): force $−drag·m·v$ on every mass.
     colliders : list
         ``PlaneCollider`` / ``SphereCollider`` obstacles.
     faces : (M, 3) array_like of int, optional
@@ -181,7 +181,7 @@ class MassSpringSystem:
         return Mesh(self._x, self.faces, uvs=self.uvs)
 
     def energy(self) -> float:
-        """Total energy ``Σ ½·m·|v|² + Σ ½·k·(l − L)² − Σ m·g·x`` (kinetic + spring + gravity)."""
+        """Total energy $Σ ½·m·|v|² + Σ ½·k·(l − L)² − Σ m·g·x$ (kinetic + spring + gravity)."""
         kinetic = 0.5 * float((self.masses * (self._v * self._v).sum(axis=1)).sum())
         lengths = np.linalg.norm(self._x[self.springs[:, 1]] - self._x[self.springs[:, 0]], axis=1)
         spring = 0.5 * float((self.stiffness * (lengths - self.rest_lengths) ** 2).sum())
@@ -262,7 +262,7 @@ class MassSpringSystem:
         return self
 
     def _implicit_velocity_change(self, h: float) -> NDArray[np.float64]:
-        """Δv of backward Euler linearized once (Baraff–Witkin): ``A·Δv = b`` by sparse conjugate gradient."""
+        """Δv of backward Euler linearized once (Baraff–Witkin): $A·Δv = b$ by sparse conjugate gradient."""
         from scipy.sparse import coo_matrix, diags
         from scipy.sparse.linalg import cg
 
@@ -409,8 +409,8 @@ def cloth(
 ) -> MassSpringSystem:
     """A rectangular cloth of `nx` × `ny` masses with structural, shear and bend springs (Provot 1995).
 
-    Mass (r, c) (row r < ny, column c < nx) is number ``r·nx + c``, at ``center + (−width/2 + width·c/(nx − 1))·e₁
-    + (−height/2 + height·r/(ny − 1))·e₂`` with (e₁, e₂) = (x, z) for ``plane="xz"`` (horizontal, faces toward +y)
+    Mass (r, c) (row r < ny, column c < nx) is number $r·nx + c$, at $center + (−width/2 + width·c/(nx − 1))·e₁
+    + (−height/2 + height·r/(ny − 1))·e₂$ with (e₁, e₂) = (x, z) for ``plane="xz"`` (horizontal, faces toward +y)
     or (x, y) for ``plane="xy"`` (hanging, row 0 at the bottom, faces toward +z). Springs: structural between
     4-neighbours (`stiffness`), shear along both diagonals (`shear_stiffness`, default `stiffness`), bend between
     masses two apart (`bend_stiffness`, default `stiffness`/10). `mass` is the total, shared equally. The faces

@@ -2,8 +2,8 @@
 
 Each function runs the production clipper (``frustum.clipping.clip_line`` / ``clip_polygon``) with its
 ``record=`` hook and turns the events into ``Step`` records; ``Steps.result`` is what the production call
-returned. Points are clip-space ``(x, y, z, w)``; a Cartesian ``(x, y, z)`` is taken with ``w = 1`` (a point of
-the normalized view volume ``[−1, 1]³``).
+returned. Points are clip-space ``(x, y, z, w)``; a Cartesian ``(x, y, z)`` is taken with $w = 1$ (a point of
+the normalized view volume $[−1, 1]³$).
 
 References: [HB 10] "Three-Dimensional Point and Line Clipping", "Three-Dimensional Polygon Clipping";
 [seed] "Three-dimensional Region Codes", "3D Point and Line Clipping", "3D Polygon clipping".

@@ -27,7 +27,7 @@ def de_casteljau(control_points: ArrayLike, t: float = 0.5) -> Steps:
     """de Casteljau's construction at `t`, level by level, then the subdivision into two halves.
 
     Runs the production split (``BezierCurve.split``'s ``_split_batch`` with its ``record`` hook): level j holds
-    ``P_i^j = (1 − t)·P_i^{j−1} + t·P_{i+1}^{j−1}``; the last level is the point ``C(t)``. ``result`` is
+    $P_i^j = (1 − t)·P_i^{j−1} + t·P_{i+1}^{j−1}$; the last level is the point ``C(t)``. ``result`` is
     ``(C(t), (left, right))`` — the point (equal to ``BezierCurve.evaluate(t)``) and the two halves' control
     points (equal to ``BezierCurve.split(t)``). 2D or 3D control points (drawn in x, y).
     """
@@ -90,7 +90,7 @@ def b_spline_basis(knots: ArrayLike, order: int, u: float | None = None, samples
 
     Runs ``cox_de_boor(knots, i, order, grid, record=...)`` for every i (the production recursion; it computes
     the lower levels on the way up). ``result`` is the (count, samples) array of the ``order`` basis functions on
-    the sample grid, equal to ``cox_de_boor`` row by row. With `u`, the knot span ``x_s <= u < x_{s+1}`` and the
+    the sample grid, equal to ``cox_de_boor`` row by row. With `u`, the knot span $x_s <= u < x_{s+1}$ and the
     `order` functions non-zero there are shown.
     """
     where = "steps.b_spline_basis"
@@ -158,7 +158,7 @@ def b_spline_basis(knots: ArrayLike, order: int, u: float | None = None, samples
 def hermite(p0: ArrayLike, p1: ArrayLike, r0: ArrayLike, r1: ArrayLike, t: float = 0.5) -> Steps:
     """Hermite interpolation: the four blending functions, their weights at `t`, and the curve.
 
-    ``P(t) = P0·H1(t) + P1·H2(t) + R0·H3(t) + R1·H4(t)`` with ``[H1 H2 H3 H4] = hermite_blending(t)``.
+    $P(t) = P0·H1(t) + P1·H2(t) + R0·H3(t) + R1·H4(t)$ with $[H1 H2 H3 H4] = hermite_blending(t)$.
     ``result`` is ``HermiteCurve(p0, p1, r0, r1).evaluate(t)``; the last step's point is the blend of the four
     weighted vectors (equal up to round-off).
     """

@@ -48,7 +48,7 @@ HOUSE_FACES = np.array(
 def back_faces(
     vertices: ArrayLike | None = None, faces: ArrayLike | None = None, camera: Camera | None = None
 ) -> Steps:
-    """Back-face detection by the plane equation, face by face: ``A·x + B·y + C·z + D·w < 0`` at the viewer.
+    """Back-face detection by the plane equation, face by face: $A·x + B·y + C·z + D·w < 0$ at the viewer.
 
     Runs ``backface_mask(vertices, faces, camera, record=...)``; ``result`` is its (M,) bool mask (True = back
     face). Default: the house of ``viewing_pipeline`` and its camera.

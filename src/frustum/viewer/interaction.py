@@ -4,21 +4,21 @@ The Jupyter widget and ``frustum serve`` both move the camera through one ``Came
 and key events arrive in image pixels (x right, y **down**, as the browser gives them) and change the control
 exactly as written here:
 
-* **orbit** (left drag): ``azimuth −= ORBIT_RADIANS_PER_PIXEL·dx``, ``elevation += ORBIT_RADIANS_PER_PIXEL·dy``,
+* **orbit** (left drag): $azimuth −= ORBIT_RADIANS_PER_PIXEL·dx$, $elevation += ORBIT_RADIANS_PER_PIXEL·dy$,
   elevation clamped to [−π/2, π/2] (dragging right swings the eye to the left around the target, so the object
   turns right with the pointer; dragging down raises the eye);
 * **pan** (right or shift drag): the target moves in the view plane by what one pixel spans at the target,
-  ``target −= s·(dx·u − dy·v)`` with ``s = 2·distance·tan(fovy/2) / height`` (the point under the pointer
+  $target −= s·(dx·u − dy·v)$ with $s = 2·distance·tan(fovy/2) / height$ (the point under the pointer
   stays under it);
-* **zoom** (wheel): ``distance ·= ZOOM_PER_NOTCH^(delta/100)`` (one 100-unit notch toward the user,
+* **zoom** (wheel): $distance ·= ZOOM_PER_NOTCH^(delta/100)$ (one 100-unit notch toward the user,
   delta < 0, brings the eye 1.1 times closer); the zoom factor is ``home distance / distance``, kept in
   [1e−3, 1e3];
 * **presets** (keys): front, top, right and isometric set the orbit angles of the preset (``PRESETS``;
   isometric looks along −(1, 1, 1)) and an orthographic projection;
 * **reset**: back to the camera the viewer started with.
 
-The camera is ``Camera.look_at(eye, target, up)`` with ``eye = target + distance·(cos e·sin a, sin e,
-cos e·cos a)`` (``Camera.orbit``'s formula) and ``up = (−sin e·sin a, cos e, −sin e·cos a)``, the direction
+The camera is ``Camera.look_at(eye, target, up)`` with $eye = target + distance·(cos e·sin a, sin e,
+cos e·cos a)$ (``Camera.orbit``'s formula) and $up = (−sin e·sin a, cos e, −sin e·cos a)$, the direction
 of increasing elevation: it equals ``Camera.orbit``'s frame for |e| < π/2 and stays defined at the poles (the
 top view has up = −z, as ``MULTIVIEWS["top"]``).
 
@@ -238,7 +238,7 @@ class CameraControl:
 
     @property
     def eye(self) -> np.ndarray:
-        """(3,) float64: ``target + distance·(cos e·sin a, sin e, cos e·cos a)``."""
+        """(3,) float64: $target + distance·(cos e·sin a, sin e, cos e·cos a)$."""
         a, e = self.azimuth, self.elevation
         return self.target + self.distance * np.array(
             [math.cos(e) * math.sin(a), math.sin(e), math.cos(e) * math.cos(a)]
@@ -246,7 +246,7 @@ class CameraControl:
 
     @property
     def up(self) -> np.ndarray:
-        """(3,) float64 unit view-up ``(−sin e·sin a, cos e, −sin e·cos a)``."""
+        """(3,) float64 unit view-up $(−sin e·sin a, cos e, −sin e·cos a)$."""
         a, e = self.azimuth, self.elevation
         return np.array([-math.sin(e) * math.sin(a), math.cos(e), -math.sin(e) * math.cos(a)])
 

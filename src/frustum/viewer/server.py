@@ -7,7 +7,7 @@ page is binary: a 4-byte big-endian header length, the JSON header, then the fra
 
 The scene file is checked every ``POLL_SECONDS``; when its modification time or size changes it is loaded
 again. A file that does not exist or does not load leaves the last good scene on the page with the error
-(``file:line: key = value problem; valid``) above it; the next good save clears it.
+($file:line: key = value problem; valid$) above it; the next good save clears it.
 
 Other web pages cannot drive the viewer (cross-site WebSocket hijacking, DNS rebinding): every page and
 WebSocket request must name this server in its ``Host`` header (``127.0.0.1``, ``localhost`` or ``::1`` on a

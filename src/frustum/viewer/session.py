@@ -16,6 +16,9 @@ message                                                       effect
 ``{"type": "control", "name", "value"}``                      projection, shading, mode, depth_cue, shadows
 ``{"type": "reset"}``                                         back to the starting camera
 ``{"type": "pick", "x", "y"}``                                pick the surface point under pixel (x, y)
+``{"type": "steps", "algorithm"}``                            record a visible-surface method (``STEPS_METHODS``)
+                                                              on the current view, at most ``STEPS_SIZE`` pixels
+                                                              across: the steps panel's figures
 ============================================================  ================================================
 
 Frames go back as a header (``frame_header``, with the ``state()`` of the view it shows under ``"state"``) and
@@ -24,8 +27,8 @@ pointer drags, at half the width and height with one sample; at rest, at full si
 per pixel.
 
 Picking reads the depth buffer of a full-size frame: pixel (column c, row r from the top) is the window point
-``(c + 0.5, H − r − 0.5, depth[r, c])``, which ``Camera.unproject`` maps back to the world
-(``P = (window_from_world)⁻¹·(x, y, depth, 1)`` then divide by w); the frame's ``object_id`` buffer names the
+$(c + 0.5, H − r − 0.5, depth[r, c])$, which ``Camera.unproject`` maps back to the world
+($P = (window_from_world)⁻¹·(x, y, depth, 1)$ then divide by w); the frame's ``object_id`` buffer names the
 scene item, whose inverse modeling transformation gives the point in modeling coordinates, and
 ``frustum.trace`` follows it through every stage.
 
@@ -52,7 +55,16 @@ from frustum.shading import DepthCue
 from frustum.transforms import apply
 from frustum.viewer.interaction import PROJECTIONS, CameraControl
 
-__all__ = ["CONTROLS", "MODES", "SHADINGS", "ViewerSession", "frame_bytes", "scene_bounds"]
+__all__ = [
+    "CONTROLS",
+    "MODES",
+    "SHADINGS",
+    "STEPS_METHODS",
+    "STEPS_SIZE",
+    "ViewerSession",
+    "frame_bytes",
+    "scene_bounds",
+]
 
 _log = logging.getLogger("frustum.viewer")
 
@@ -69,6 +81,14 @@ CONTROLS: dict[str, tuple[Any, ...]] = {
 }
 """Each control's allowed values."""
 _SWITCHES = ("depth_cue", "shadows")
+STEPS_METHODS = ("depth-buffer", "scan-line", "warnock", "a-buffer", "ray-casting")
+"""Visible-surface methods the steps panel records on the current view (``frustum steps`` names)."""
+STEPS_SIZE = 64
+"""Longest side (pixels) of the steps panel's recording: the current camera, same view, this small; every pixel
+of the record is drawn in the figures (the notes' examples are this size)."""
+_STEPS_OPTIONS = ("specular", "background", "cull_back_faces", "color_space")
+"""The scene file's ``render`` keywords a recording keeps (beside the shading control); others (samples, mode,
+shadows, depth cue) do not apply to one method's record."""
 """Controls that are checkboxes (bool values)."""
 _REGIONS = (
     (REGION_LEFT, "left"),
@@ -253,6 +273,9 @@ class ViewerSession:
             if x is None or y is None or not (0.0 <= x < control.width and 0.0 <= y < control.height):
                 return None
             return "pick"
+        if kind == "steps":
+            algorithm = message.get("algorithm")
+            return "steps" if isinstance(algorithm, str) and algorithm in STEPS_METHODS else None
         return None
 
     # --- frames -------------------------------------------------------------------------------------------
@@ -316,6 +339,7 @@ class ViewerSession:
             },
             "controls": dict(self.controls),
             "choices": {name: list(values) for name, values in CONTROLS.items()},
+            "steps": {"methods": list(STEPS_METHODS), "size": STEPS_SIZE},
             "error": self.error,
         }
 
@@ -325,7 +349,8 @@ class ViewerSession:
 
         The messages are applied in order and the view is rendered once, at rest quality if any of them asks
         for it; the frame header carries the last ``seq`` seen (the page measures latency with it). Picks merge
-        like pointer moves: only the latest of a list is answered (each costs a full-size render). A message
+        like pointer moves: only the latest of a list is answered (each costs a full-size render); so do steps requests
+        (answered with ``steps``'s record, before the pick and the frame). A message
         whose handling raises is ignored (logged on the ``frustum.viewer`` logger), never raised.
         ``{"type": "hello"}`` (a page that has just opened) gets the state and a rest
         frame; if every message was ignored the answer is ``{"type": "ignored"}`` (the page then sends its next
@@ -338,6 +363,7 @@ class ViewerSession:
         seq = None
         ignored = False
         pick = None
+        record = None
         for message in batch:
             try:
                 hello = isinstance(message, Mapping) and message.get("type") == "hello"
@@ -350,10 +376,14 @@ class ViewerSession:
                 ignored = True
             elif action == "pick":
                 pick = message  # picks merge like pointer moves: the latest wins
+            elif action == "steps":
+                record = message["algorithm"]  # so do steps requests
             elif action:
                 quality = "rest" if "rest" in (quality, action) else action
                 if isinstance(message.get("seq"), int) and not isinstance(message.get("seq"), bool):
                     seq = message["seq"]
+        if record is not None:
+            out.append((self.steps(record), None))
         if pick is not None:
             try:
                 out.append((self.pick(pick["x"], pick["y"]), None))
@@ -370,6 +400,49 @@ class ViewerSession:
         elif ignored and not out:
             out.append(({"type": "ignored"}, None))
         return out
+
+    # --- the steps panel ----------------------------------------------------------------------------------
+
+    def steps_camera(self) -> Camera:
+        """The current view at most ``STEPS_SIZE`` pixels across (the image's aspect kept, each side ≥ 1)."""
+        control = self.control
+        scale = min(1.0, STEPS_SIZE / max(control.width, control.height))
+        return control.camera(max(1, round(control.width * scale)), max(1, round(control.height * scale)))
+
+    def steps(self, algorithm: str) -> dict[str, Any]:
+        """The steps panel's record: `algorithm` (one of ``STEPS_METHODS``) run by ``frustum.steps`` on the
+        scene and the current view (``steps_camera``), as JSON values.
+
+        Returns ``{"type": "steps", "algorithm", "size": [w, h], "camera"`` (the view's state),
+        ``"titles", "figures"`` (each step's SVG, ``Steps.figure``) ``}``; a record that cannot be made (over
+        the budget, nothing to show) gives ``"error"`` with the message instead of titles and figures.
+        """
+        from frustum.steps import visible_surfaces
+
+        record = {
+            "depth-buffer": visible_surfaces.depth_buffer,
+            "scan-line": visible_surfaces.scan_line,
+            "warnock": visible_surfaces.area_subdivision,
+            "a-buffer": visible_surfaces.a_buffer,
+            "ray-casting": visible_surfaces.ray_casting,
+        }.get(algorithm)
+        camera = self.steps_camera()
+        answer: dict[str, Any] = {"type": "steps", "algorithm": algorithm, "size": [camera.width, camera.height],
+                                  "camera": self.control.state()}  # fmt: skip
+        if record is None:
+            answer["error"] = f"steps: algorithm = {algorithm!r} is not one of {', '.join(STEPS_METHODS)}"
+            return answer
+        options = {key: value for key, value in self.options.items() if key in _STEPS_OPTIONS}
+        options["shading"] = self.controls["shading"]
+        try:
+            with self._work(camera, 1, f"{algorithm} steps"):
+                recorded = record(self.scene, camera, **options)
+                figures = [recorded.figure(i) for i in range(len(recorded))]
+        except FrustumError as error:
+            answer["error"] = str(error)
+            return answer
+        answer.update(titles=[step.title for step in recorded], figures=figures)
+        return answer
 
     # --- picking ------------------------------------------------------------------------------------------
 

@@ -46,9 +46,10 @@ class Viewer(anywidget.AnyWidget):
 
     Left drag orbits, right (or shift) drag pans, the wheel zooms, a click picks the surface point and shows
     its ``frustum.trace``; keys f, t, r, i (or 1, 7, 3, 5) look from the front, top, right and isometric
-    presets and 0 resets (``frustum.viewer.interaction`` gives the formulas). While dragging, frames are
-    rendered at half size with one sample; at rest, at full size with `rest_samples`. Without a widget
-    front end (a static notebook render, GitHub, nbconvert) the output shows the rest frame as a PNG.
+    presets and 0 resets (``frustum.viewer.interaction`` gives the formulas). The steps panel below records a
+    visible-surface method on the current view (``ViewerSession.steps``) and steps through its figures. While
+    dragging, frames are rendered at half size with one sample; at rest, at full size with `rest_samples`. Without
+    a widget front end (a static notebook render, GitHub, nbconvert) the output shows the rest frame as a PNG.
 
     Parameters
     ----------

@@ -3,13 +3,13 @@
 Two ways to find the back faces of a polyhedron, as the seed gives them:
 
 * **Object space, the plane equation.** A face with corners P0, P1, P2 (counter-clockwise seen from the front)
-  lies in the plane ``Ax + By + Cz + D = 0`` with ``(A, B, C) = (P1 − P0) × (P2 − P0)`` (pointing to the front)
-  and ``D = −(A, B, C)·P0``. A point is behind the face when ``Ax + By + Cz + D < 0``; the face is a back face
+  lies in the plane $Ax + By + Cz + D = 0$ with $(A, B, C) = (P1 − P0) × (P2 − P0)$ (pointing to the front)
+  and $D = −(A, B, C)·P0$. A point is behind the face when $Ax + By + Cz + D < 0$; the face is a back face
   when the viewing position is behind it. For a parallel projection the viewing position is the point at
-  infinity ``(d, 0)`` toward the viewer, and the test ``A·dx + B·dy + C·dz < 0`` is the same formula with w = 0.
+  infinity ``(d, 0)`` toward the viewer, and the test $A·dx + B·dy + C·dz < 0$ is the same formula with w = 0.
   ``viewing_position`` finds that homogeneous point for any camera.
 * **Window space, the signed area.** After projection, a front face is counter-clockwise in window
-  coordinates (y up): twice its signed area ``(x1 − x0)(y2 − y0) − (x2 − x0)(y1 − y0)`` is positive; a
+  coordinates (y up): twice its signed area $(x1 − x0)(y2 − y0) − (x2 − x0)(y1 − y0)$ is positive; a
   back face has a negative (and an edge-on face a zero) area.
 
 For faces in front of the eye both agree (the renderer uses the window test, on its snapped coordinates,
@@ -36,7 +36,7 @@ __all__ = ["backface_mask", "plane_equations", "signed_window_areas", "viewing_p
 
 
 def plane_equations(vertices: ArrayLike, faces: ArrayLike) -> NDArray[np.float64]:
-    """(M, 4) plane coefficients ``(A, B, C, D)`` of each face: normal ``(P1 − P0) × (P2 − P0)``, ``D = −N·P0``.
+    """(M, 4) plane coefficients ``(A, B, C, D)`` of each face: normal $(P1 − P0) × (P2 − P0)$, $D = −N·P0$.
 
     Not normalized (the normal's length is twice the face area); a zero-area face gives (0, 0, 0, 0).
     """
@@ -82,7 +82,7 @@ def backface_mask(
 ) -> NDArray[np.bool_]:
     """(M,) bool: True for the back faces of a mesh (world coordinates) seen by `camera`.
 
-    ``method="plane"``: ``A·x + B·y + C·z + D·w < 0`` for the viewing position ``(x, y, z, w)``
+    ``method="plane"``: $A·x + B·y + C·z + D·w < 0$ for the viewing position ``(x, y, z, w)``
     (``viewing_position``), in object (world) space. ``method="window"``: signed window area <= 0 after
     ``camera.project`` (clockwise or edge-on); a face with a corner on or behind the eye plane has no window
     image and is reported by the plane test instead. ``record``, if given, is called as

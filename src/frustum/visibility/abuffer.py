@@ -3,8 +3,8 @@
 Each triangle leaves in every pixel it touches a fragment: which of the pixel's 16 subsamples it covers (the
 depth buffer's top-left rule at each subsample) and the shading inputs at the centroid of those subsamples (the
 renderer shades each fragment once, with the one illumination model). Resolving composites, per subsample, the
-fragments covering it in order of their plane's depth there: ``C = Σ_k T_k·α_k·c_k + T·under`` with
-``T_k = Π_{m<k}(1 − α_m)``; the pixel is the mean of its subsamples.
+fragments covering it in order of their plane's depth there: $C = Σ_k T_k·α_k·c_k + T·under$ with
+$T_k = Π_{m<k}(1 − α_m)$; the pixel is the mean of its subsamples.
 
 What that buys: transparency that is exact whatever the order of the surfaces (two transparent surfaces that cut
 through each other, or overlap cyclically, are composited right on each side of the cut), and anti-aliased
@@ -58,7 +58,7 @@ FRAGMENT_BYTES = 8 + 2 + 4 + 8 + 8 + 4
 class Fragments:
     """N fragments, pixel by pixel (row-major, top row first): pixel p's are ``starts[p]:starts[p + 1]``.
 
-    ``triangle`` (N,) int64 and ``mask`` (N,) uint16 (bit ``4·b + a`` for subsample column a, row b from the
+    ``triangle`` (N,) int64 and ``mask`` (N,) uint16 (bit $4·b + a$ for subsample column a, row b from the
     bottom); the shading column image ``depth`` (N, 1) float32, ``code`` (N, 1) int64, ``bary`` (N, 1, 2) float32.
     """
 
@@ -121,7 +121,7 @@ def resolve_fragments(
     """Composite every pixel's fragments over `under` (module docstring) into `color`; the nearest opaque
     fragment's depth at each pixel centre into `depth` (a triangle that covers the centre but none of the 16
     subsamples makes no fragment, as it would not show in 16× supersampling either). premultiplied (N, 4) uint8:
-    ``α·c`` and ``α`` per fragment (what the shading kernel writes blending over transparent black).
+    $α·c$ and $α$ per fragment (what the shading kernel writes blending over transparent black).
 
     Returns the counts ``fragments``, ``fragments_per_pixel`` (mean over pixels with any), ``max_fragments``
     (in one pixel), ``pixels_with_fragments``, ``sample_composites`` (fragment–subsample pairs blended).

@@ -53,7 +53,7 @@ def octree_face_colors(
     octree: Octree, material: Material, lights: list[Light], world_from_model: np.ndarray, eye: ArrayLike
 ) -> np.ndarray:
     """(6, 4) uint8 RGBA of the faces facing +x, −x, +y, −y, +z, −z: ``illuminate`` once per orientation, at the
-    octree's centre, with the world normal ``(M⁻¹)ᵀ·n`` of the face's model normal n."""
+    octree's centre, with the world normal $(M⁻¹)ᵀ·n$ of the face's model normal n."""
     normal_matrix = np.linalg.inv(world_from_model[:3, :3]).T
     center = world_from_model[:3, :3] @ octree.bounds.mean(axis=0) + world_from_model[:3, 3]
     colors = np.empty((6, 4), dtype=np.uint8)

@@ -2,7 +2,7 @@
 
 ``frustum.bsp`` orders polygons back to front (splitting where no order exists) for vector output. Here the
 same two methods order the scene's *window triangles* (the triangles the depth buffer draws, after clipping to
-the view volume), given to them in window coordinates ``(x, y, −S·z_w)`` with S the larger image side: the
+the view volume), given to them in window coordinates $(x, y, −S·z_w)$ with S the larger image side: the
 projection is already applied, so every camera becomes a parallel view along −z (a perspective divide maps
 planes to planes), and no polygon reaches behind the eye. The fragments are then painted back to front
 (``raster.painter``): each covers the pixels of its triangle (top-left rule) inside the fragment.
@@ -24,7 +24,7 @@ _MAX_CORNERS = 8
 
 
 def window_polygons(triangles: WindowTriangles) -> np.ndarray:
-    """(T, 3, 3) float64: the triangles as ``(x, y, −S·z_w)`` polygons (pixels; S = the larger image side)."""
+    """(T, 3, 3) float64: the triangles as $(x, y, −S·z_w)$ polygons (pixels; S = the larger image side)."""
     scale = float(max(triangles.width, triangles.height))
     polygons = np.empty((triangles.count, 3, 3))
     polygons[:, :, 0] = triangles.xy[:, 0::2] / 256.0

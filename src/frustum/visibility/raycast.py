@@ -11,7 +11,7 @@ between pixels).
 
 The hit is taken within the view volume (t in [0, 1) between the near and far planes: the side planes hold
 every pixel centre's ray), back faces are skipped when culling (the ray goes on to what lies behind, as the depth
-buffer never draws them) and otherwise hit with the two-sided code ``2·face + 1``. Each pixel gets the depth
+buffer never draws them) and otherwise hit with the two-sided code $2·face + 1$. Each pixel gets the depth
 buffer's window depth, face code and the hit's barycentrics (world barycentrics are the perspective-correct
 ones), and the one shading kernel colors them. Kernel: ``raster.rays.cast_pixels``.
 
@@ -45,7 +45,7 @@ def ray_casting(
     depth : (H, W) float32
         Cleared to 1.0 (far); written where a ray hits (top row first).
     codes : (H, W) int32 or int64
-        ``2·face + back``, faces numbered across ``scene.items`` as the shading kernel reads them.
+        $2·face + back$, faces numbered across ``scene.items`` as the shading kernel reads them.
     bary : (H, W, 2) float32
         Weights of the face's corners 1 and 2 at the hit.
 

@@ -31,7 +31,7 @@ __all__ = ["WindowTriangles", "window_triangles"]
 class WindowTriangles:
     """T drawn triangles in window coordinates (layout of ``raster.window``): ``xy`` (T, 6) int64 snapped
     counter-clockwise corners, ``zq`` (T, 3, 2) float64 ``z_w, 1/w``, ``weights`` (T, 3, 2) float64 barycentric
-    weights onto the source face, ``code`` (T,) int64 ``2·face + back``, ``box`` (T, 4) int64 pixel box, ``item``
+    weights onto the source face, ``code`` (T,) int64 $2·face + back$, ``box`` (T, 4) int64 pixel box, ``item``
     (T,) int64 index of the scene item; ``width``, ``height`` of the image."""
 
     xy: np.ndarray

@@ -21,7 +21,7 @@ M_B: FloatArray = read_only(
 
 
 def bernstein(n: int, i: int, t: ArrayLike) -> FloatArray | float:
-    """The Bernstein polynomial ``b_{n,i}(t) = C(n, i) · tⁱ · (1 − t)ⁿ⁻ⁱ`` (the Bézier blending function).
+    """The Bernstein polynomial $b_{n,i}(t) = C(n, i) · tⁱ · (1 − t)ⁿ⁻ⁱ$ (the Bézier blending function).
 
     Parameters
     ----------
@@ -48,14 +48,14 @@ def bernstein(n: int, i: int, t: ArrayLike) -> FloatArray | float:
 
 
 def bezier_matrix_form(t: ArrayLike, G: ArrayLike) -> FloatArray:
-    """The cubic Bézier curve in matrix form, ``C(t) = [t³ t² t 1] · M_B · G_B``.
+    """The cubic Bézier curve in matrix form, $C(t) = [t³ t² t 1] · M_B · G_B$.
 
     Parameters
     ----------
     t : float or (N,) array_like
         Parameters in [0, 1].
     G : (4, d) array_like
-        The geometry vector ``G_B = [P0; P1; P2; P3]`` (d = 2 or 3).
+        The geometry vector $G_B = [P0; P1; P2; P3]$ (d = 2 or 3).
 
     Returns
     -------
@@ -197,7 +197,7 @@ def _flatten_pieces(
 
 
 class BezierCurve:
-    """A Bézier curve of any degree n in 2D or 3D: ``C(t) = Σ_{i=0}^{n} b_{n,i}(t) · P_i``, t in [0, 1].
+    """A Bézier curve of any degree n in 2D or 3D: $C(t) = Σ_{i=0}^{n} b_{n,i}(t) · P_i$, t in [0, 1].
 
     Parameters
     ----------
@@ -248,7 +248,7 @@ class BezierCurve:
         return (0.0, 1.0)
 
     def evaluate(self, t: ArrayLike) -> FloatArray:
-        """Points ``C(t)`` by de Casteljau's recursion ``P_i^j = (1 − t)·P_i^{j−1} + t·P_{i+1}^{j−1}``.
+        """Points ``C(t)`` by de Casteljau's recursion $P_i^j = (1 − t)·P_i^{j−1} + t·P_{i+1}^{j−1}$.
 
         Parameters
         ----------
@@ -265,7 +265,7 @@ class BezierCurve:
     __call__ = evaluate
 
     def derivative(self) -> BezierCurve:
-        """The hodograph ``C'(t) = n · Σ b_{n−1,i}(t) · (P_{i+1} − P_i)``, a Bézier curve of degree n − 1."""
+        """The hodograph $C'(t) = n · Σ b_{n−1,i}(t) · (P_{i+1} − P_i)$, a Bézier curve of degree n − 1."""
         if self.degree == 0:
             return BezierCurve._from_parts(np.zeros_like(self.control_points))
         return BezierCurve._from_parts(self.degree * np.diff(self.control_points, axis=0))
@@ -288,7 +288,7 @@ class BezierCurve:
         return BezierCurve._from_parts(left[0]), BezierCurve._from_parts(right[0])
 
     def elevate(self) -> BezierCurve:
-        """The same curve with degree n + 1: ``Q_i = i/(n+1)·P_{i−1} + (1 − i/(n+1))·P_i``, i = 0..n+1."""
+        """The same curve with degree n + 1: $Q_i = i/(n+1)·P_{i−1} + (1 − i/(n+1))·P_i$, i = 0..n+1."""
         P, n = self.control_points, self.degree
         alpha = (np.arange(1, n + 1) / (n + 1))[:, None]
         middle = alpha * P[:-1] + (1.0 - alpha) * P[1:]
@@ -321,7 +321,7 @@ class BezierCurve:
         return _de_casteljau(self.control_points, t)
 
     def length(self) -> float:
-        """Arc length ``∫₀¹ |C'(t)| dt`` by adaptive Gauss–Kronrod quadrature (scipy ``quad``, ~1e-13)."""
+        """Arc length $∫₀¹ |C'(t)| dt$ by adaptive Gauss–Kronrod quadrature (scipy ``quad``, ~1e-13)."""
         from scipy.integrate import quad
 
         hodograph = self.derivative().control_points

@@ -27,7 +27,7 @@ from frustum.geometry.curves.piecewise import PiecewiseBezier
 def open_uniform_knots(count: int, degree: int) -> FloatArray:
     """The seed's open-uniform (clamped) knot vector for `count` = n + 1 control points and order k = degree + 1.
 
-    ``x_i = 0 if i < k;  x_i = i − k + 1 if k <= i <= n;  x_i = n − k + 2 if i > n``, for i = 0..n+k. The
+    $x_i = 0 if i < k;  x_i = i − k + 1 if k <= i <= n;  x_i = n − k + 2 if i > n$, for i = 0..n+k. The
     domain is [0, n − k + 2]; every end knot is repeated k times, so the curve starts at P0 and ends at Pn.
 
     References
@@ -96,7 +96,7 @@ def _find_spans(knots: FloatArray, degree: int, count: int, u: FloatArray) -> ND
 
 
 def _de_boor(knots: FloatArray, degree: int, points: FloatArray, u: FloatArray) -> FloatArray:
-    """de Boor's algorithm for every u at once: (N, d) points of ``Σ P_i · N_{i,p}(u)``."""
+    """de Boor's algorithm for every u at once: (N, d) points of $Σ P_i · N_{i,p}(u)$."""
     p = degree
     spans = _find_spans(knots, p, points.shape[0], u)
     d = [points[spans - p + j] for j in range(p + 1)]  # contiguous (N, dim) arrays
@@ -123,8 +123,8 @@ def _basis_matrix(knots: FloatArray, degree: int, count: int, u: FloatArray, ord
 def cox_de_boor(knots: ArrayLike, i: int, k: int, u: ArrayLike, *, record: Any = None) -> FloatArray | float:
     """The B-spline basis function of order k (degree k − 1) by the seed's Cox–de Boor recursion.
 
-    ``N_{i,k}(u) = (u − x_i)·N_{i,k−1}(u) / (x_{i+k−1} − x_i) + (x_{i+k} − u)·N_{i+1,k−1}(u) / (x_{i+k} − x_{i+1})``
-    with a term whose denominator is 0 taken as 0 (0/0 = 0). ``N_{i,1}(u) = 1`` if ``x_i <= u < x_{i+1}``, else
+    $N_{i,k}(u) = (u − x_i)·N_{i,k−1}(u) / (x_{i+k−1} − x_i) + (x_{i+k} − u)·N_{i+1,k−1}(u) / (x_{i+k} − x_{i+1})$
+    with a term whose denominator is 0 taken as 0 (0/0 = 0). $N_{i,1}(u) = 1$ if $x_i <= u < x_{i+1}$, else
     0; the seed prints ``<=`` on both sides, which counts a knot twice, so the half-open interval is used, and at
     the last knot the last non-empty interval is closed so that the basis sums to 1 there too.
 
@@ -185,7 +185,7 @@ def _cox_de_boor(x: FloatArray, i: int, k: int, u: FloatArray, last: int, record
 
 
 class BSpline:
-    """A B-spline curve ``C(u) = Σ_{i=0}^{n} P_i · N_{i,k}(u)`` of degree p = k − 1, evaluated by de Boor's algorithm.
+    """A B-spline curve $C(u) = Σ_{i=0}^{n} P_i · N_{i,k}(u)$ of degree $p = k − 1$, evaluated by de Boor's algorithm.
 
     Parameters
     ----------
@@ -255,7 +255,7 @@ class BSpline:
         return (float(self.knots[self.degree]), float(self.knots[self.count]))
 
     def evaluate(self, u: ArrayLike) -> FloatArray:
-        """Points by de Boor's algorithm ``d_j ← (1 − α)·d_{j−1} + α·d_j``, ``α = (u − t_i)/(t_{i+p+1−r} − t_i)``."""
+        """Points by de Boor's algorithm $d_j ← (1 − α)·d_{j−1} + α·d_j$, $α = (u − t_i)/(t_{i+p+1−r} − t_i)$."""
         s, scalar = _as_parameters(u, "u", *self.domain, where="BSpline.evaluate")
         return _shape_result(_de_boor(self.knots, self.degree, self.control_points, s), scalar)
 
@@ -274,7 +274,7 @@ class BSpline:
         return (float(self.knots[i]), float(self.knots[i + self.order]))
 
     def derivative(self, order: int = 1) -> BSpline:
-        """The derivative curve: degree p − 1, ``Q_i = p·(P_{i+1} − P_i)/(t_{i+p+1} − t_{i+1})`` (0/0 = 0)."""
+        """The derivative curve: degree p − 1, $Q_i = p·(P_{i+1} − P_i)/(t_{i+p+1} − t_{i+1})$ (0/0 = 0)."""
         order = as_count(order, "order", 0, where="BSpline.derivative")
         curve = self
         for _ in range(order):
@@ -293,7 +293,7 @@ class BSpline:
     def insert_knot(self, u: float, times: int = 1) -> BSpline:
         """The same curve with knot u inserted `times` times (Boehm's algorithm).
 
-        ``Q_i = (1 − a_i)·P_{i−1} + a_i·P_i``, ``a_i = (u − t_i)/(t_{i+p} − t_i)`` for s − p + 1 <= i <= s.
+        $Q_i = (1 − a_i)·P_{i−1} + a_i·P_i$, $a_i = (u − t_i)/(t_{i+p} − t_i)$ for s − p + 1 <= i <= s.
         """
         where = "BSpline.insert_knot"
         value = as_scalar(u, "u", where=where, error=GeometryError)
@@ -366,7 +366,7 @@ class BSpline:
 
 
 class NURBSCurve:
-    """A rational B-spline ``C(u) = Σ w_i·P_i·N_{i,p}(u) / Σ w_i·N_{i,p}(u)``: exact conics, circles included.
+    """A rational B-spline $C(u) = Σ w_i·P_i·N_{i,p}(u) / Σ w_i·N_{i,p}(u)$: exact conics, circles included.
 
     Evaluated as a B-spline in homogeneous coordinates (w·P, w), then divided by w.
 
@@ -419,7 +419,7 @@ class NURBSCurve:
         return self._homogeneous.domain
 
     def evaluate(self, u: ArrayLike) -> FloatArray:
-        """``C(u) = A(u)/w(u)`` with ``(A, w)`` the homogeneous B-spline."""
+        """$C(u) = A(u)/w(u)$ with ``(A, w)`` the homogeneous B-spline."""
         s, scalar = _as_parameters(u, "u", *self.domain, where="NURBSCurve.evaluate")
         h = _de_boor(self.knots, self.degree, self._homogeneous.control_points, s)
         return _shape_result(h[:, :-1] / h[:, -1:], scalar)
@@ -427,7 +427,7 @@ class NURBSCurve:
     __call__ = evaluate
 
     def tangent(self, u: ArrayLike) -> FloatArray:
-        """``C'(u) = (A'(u) − w'(u)·C(u)) / w(u)`` (quotient rule)."""
+        """$C'(u) = (A'(u) − w'(u)·C(u)) / w(u)$ (quotient rule)."""
         s, scalar = _as_parameters(u, "u", *self.domain, where="NURBSCurve.tangent")
         h = _de_boor(self.knots, self.degree, self._homogeneous.control_points, s)
         d = self._homogeneous.derivative()
@@ -464,8 +464,8 @@ class NURBSCurve:
     ) -> NURBSCurve:
         """The exact circular arc from angle `start` to `end` (radians, counter-clockwise, sweep in (0, 2π]).
 
-        Quadratic, one segment per started quarter turn; segment of sweep Δ: middle weight ``cos(Δ/2)``, middle
-        control point at distance ``r/cos(Δ/2)`` on the bisector. In the plane z = center z for a 3-D center.
+        Quadratic, one segment per started quarter turn; segment of sweep Δ: middle weight $cos(Δ/2)$, middle
+        control point at distance $r/cos(Δ/2)$ on the bisector. In the plane z = center z for a 3-D center.
         """
         where = "NURBSCurve.arc"
         r = as_scalar(radius, "radius", where=where, error=GeometryError)
@@ -486,7 +486,7 @@ class NURBSCurve:
 
     @classmethod
     def ellipse(cls, a: float = 1.0, b: float = 0.5, center: ArrayLike = (0.0, 0.0, 0.0)) -> NURBSCurve:
-        """The exact ellipse (x/a)² + (y/b)² = 1 about `center`: the circle's net scaled (weights unchanged)."""
+        """The exact ellipse $(x/a)² + (y/b)² = 1$ about `center`: the circle's net scaled (weights unchanged)."""
         where = "NURBSCurve.ellipse"
         sa = as_scalar(a, "a", where=where, error=GeometryError)
         sb = as_scalar(b, "b", where=where, error=GeometryError)

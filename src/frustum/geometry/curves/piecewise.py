@@ -173,7 +173,7 @@ class PiecewiseBezier:
     ) -> PiecewiseBezier:
         """The C¹ cubic through `points` with the given derivatives there (piecewise Hermite in Bézier form).
 
-        Piece k is ``[P_k, P_k + h_k·R_k/3, P_{k+1} − h_k·R_{k+1}/3, P_{k+1}]`` with h_k the width of its
+        Piece k is $[P_k, P_k + h_k·R_k/3, P_{k+1} − h_k·R_{k+1}/3, P_{k+1}]$ with h_k the width of its
         parameter interval, so the first derivative is the same on both sides of every join (C¹).
         """
         where = "PiecewiseBezier.from_tangents"
@@ -223,7 +223,7 @@ def continuity(curve: PiecewiseBezier, at: int | None = None, tolerance: float =
     - C⁰: the last point of one section is the first point of the next; C¹: the first derivatives are equal;
       C²: the first and second derivatives are equal.
     - Gⁿ: the derivatives are only proportional. G¹: same unit tangent. G²: G¹ and the same curvature vector
-      ``(C'' − (C''·T)T) / |C'|²`` ([HB 14] "Geometric Continuity Conditions": under G² the curvatures match).
+      $(C'' − (C''·T)T) / |C'|²$ ([HB 14] "Geometric Continuity Conditions": under G² the curvatures match).
 
     Parameters
     ----------

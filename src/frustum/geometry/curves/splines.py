@@ -23,9 +23,9 @@ constraint matrix (and [HB 14] "Hermite Interpolation") gives ``[1 0 0 0]``.
 
 
 def hermite_blending(t: ArrayLike) -> FloatArray:
-    """The four Hermite blending functions ``[H1 H2 H3 H4] = [t³ t² t 1] · M_H``.
+    """The four Hermite blending functions $[H1 H2 H3 H4] = [t³ t² t 1] · M_H$.
 
-    ``H1 = 2t³ − 3t² + 1``, ``H2 = −2t³ + 3t²``, ``H3 = t³ − 2t² + t``, ``H4 = t³ − t²`` (weights of P0, P1,
+    $H1 = 2t³ − 3t² + 1$, $H2 = −2t³ + 3t²$, $H3 = t³ − 2t² + t$, $H4 = t³ − t²$ (weights of P0, P1,
     R0, R1).
 
     Returns
@@ -42,7 +42,7 @@ def hermite_blending(t: ArrayLike) -> FloatArray:
 
 
 class HermiteCurve:
-    """The cubic Hermite curve from P0 to P1 with end tangents R0, R1: ``P(t) = [t³ t² t 1] · M_H · G_H``.
+    """The cubic Hermite curve from P0 to P1 with end tangents R0, R1: $P(t) = [t³ t² t 1] · M_H · G_H$.
 
     Parameters
     ----------
@@ -73,7 +73,7 @@ class HermiteCurve:
         return (0.0, 1.0)
 
     def evaluate(self, t: ArrayLike) -> FloatArray:
-        """``[t³ t² t 1] · M_H · G_H`` = H1·P0 + H2·P1 + H3·R0 + H4·R1."""
+        """$[t³ t² t 1] · M_H · G_H$ = H1·P0 + H2·P1 + H3·R0 + H4·R1."""
         s, scalar = _as_parameters(t, "t", 0.0, 1.0, where="HermiteCurve.evaluate")
         T = np.stack([s**3, s**2, s, np.ones_like(s)], axis=1)
         return _shape_result(T @ M_H @ self.geometry, scalar)
@@ -81,19 +81,19 @@ class HermiteCurve:
     __call__ = evaluate
 
     def tangent(self, t: ArrayLike) -> FloatArray:
-        """``P'(t) = [3t² 2t 1 0] · M_H · G_H``."""
+        """$P'(t) = [3t² 2t 1 0] · M_H · G_H$."""
         s, scalar = _as_parameters(t, "t", 0.0, 1.0, where="HermiteCurve.tangent")
         T = np.stack([3 * s**2, 2 * s, np.ones_like(s), np.zeros_like(s)], axis=1)
         return _shape_result(T @ M_H @ self.geometry, scalar)
 
     def to_bezier(self) -> BezierCurve:
-        """The same cubic as a Bézier curve: ``[P0, P0 + R0/3, P1 − R1/3, P1]``."""
+        """The same cubic as a Bézier curve: $[P0, P0 + R0/3, P1 − R1/3, P1]$."""
         p0, p1, r0, r1 = self.geometry
         return BezierCurve._from_parts(np.stack([p0, p0 + r0 / 3.0, p1 - r1 / 3.0, p1]))
 
 
 def cardinal_spline(points: ArrayLike, tension: float = 0.0) -> PiecewiseBezier:
-    """The cardinal spline through points[1:-1]: Hermite pieces with tangents ``R_k = (1 − c)/2 · (P_{k+1} − P_{k−1})``.
+    """The cardinal spline through points[1:-1]: Hermite pieces with tangents $R_k = (1 − c)/2 · (P_{k+1} − P_{k−1})$.
 
     As in [HB 14] "Cardinal Splines", the first and last points only shape the end tangents; piece k − 1 runs
     from P_k to P_{k+1} on the global parameter interval [k − 1, k]. Tension c = 0 gives Catmull–Rom.
@@ -120,7 +120,7 @@ def cardinal_spline(points: ArrayLike, tension: float = 0.0) -> PiecewiseBezier:
 
 
 def catmull_rom(points: ArrayLike) -> PiecewiseBezier:
-    """The Catmull–Rom spline through points[1:-1]: ``cardinal_spline(points, 0)``, ``R_k = (P_{k+1} − P_{k−1})/2``."""
+    """The Catmull–Rom spline through points[1:-1]: ``cardinal_spline(points, 0)``, $R_k = (P_{k+1} − P_{k−1})/2$."""
     return cardinal_spline(points, 0.0)
 
 
@@ -133,8 +133,8 @@ _PARAMETERIZATIONS = ("uniform", "chordal", "centripetal")
 class CubicSpline:
     """The C² cubic spline through n + 1 points, with per-segment coefficients (a, b, c, d) as the seed writes them.
 
-    Segment k (k = 0..n−1) is ``P(u) = a_k·u³ + b_k·u² + c_k·u + d_k`` for the local parameter u in [0, 1],
-    ``u = (s − s_k)/(s_{k+1} − s_k)``, where s is the global parameter (the knots s_k).
+    Segment k (k = 0..n−1) is $P(u) = a_k·u³ + b_k·u² + c_k·u + d_k$ for the local parameter u in [0, 1],
+    $u = (s − s_k)/(s_{k+1} − s_k)$, where s is the global parameter (the knots s_k).
 
     Parameters
     ----------
@@ -146,7 +146,7 @@ class CubicSpline:
         ``periodic``: a closed curve, C² across points[0]; the first point is appended at the end unless the
         last point already equals it. ``not-a-knot``: P''' continuous at the second and second-to-last knot.
     parameterization : {"uniform", "chordal", "centripetal"}
-        Knot spacing s_{k+1} − s_k = 1, |P_{k+1} − P_k| or |P_{k+1} − P_k|^(1/2); s_0 = 0.
+        Knot spacing $s_{k+1} − s_k = 1$, $|P_{k+1} − P_k|$ or $|P_{k+1} − P_k|^(1/2)$; $s_0 = 0$.
     end_tangents : (2, d) array_like, optional
         Required for ``clamped``.
 
@@ -243,15 +243,15 @@ class CubicSpline:
     __call__ = evaluate
 
     def to_bezier(self) -> PiecewiseBezier:
-        """The spline as piecewise cubic Bézier with breakpoints at the knots (``G_B = M_B⁻¹ · [a; b; c; d]``)."""
+        """The spline as piecewise cubic Bézier with breakpoints at the knots ($G_B = M_B⁻¹ · [a; b; c; d]$)."""
         return PiecewiseBezier(np.einsum("ij,kjd->kid", np.linalg.inv(M_B), self.coefficients), self.knots)
 
 
 def _spline_slopes(P: FloatArray, h: FloatArray, end: str, tangents: FloatArray | None) -> FloatArray:
     """Derivatives m_k = dP/ds at the knots from the C² conditions (a tridiagonal or cyclic linear system).
 
-    Interior knot k: ``h_k·m_{k−1} + 2(h_{k−1} + h_k)·m_k + h_{k−1}·m_{k+1} = 3(h_k·Δ_{k−1} + h_{k−1}·Δ_k)``,
-    ``Δ_k = (P_{k+1} − P_k)/h_k``.
+    Interior knot k: $h_k·m_{k−1} + 2(h_{k−1} + h_k)·m_k + h_{k−1}·m_{k+1} = 3(h_k·Δ_{k−1} + h_{k−1}·Δ_k)$,
+    $Δ_k = (P_{k+1} − P_k)/h_k$.
     """
     from scipy.sparse import lil_matrix
     from scipy.sparse.linalg import spsolve

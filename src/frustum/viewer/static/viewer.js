@@ -27,7 +27,22 @@ function mountViewer(el, transport) {
         <div class="fv-matrices"></div>
         <div class="fv-trace"><em>click the picture to trace a surface point</em></div>
       </div>
-    </div>`;
+    </div>
+    <details class="fv-steps">
+      <summary>steps: watch a visible-surface method work on this view</summary>
+      <div class="fv-steps-bar">
+        <label>method <select class="fv-steps-method"></select></label>
+        <button class="fv-steps-record">record this view</button>
+        <span class="fv-steps-status"></span>
+      </div>
+      <div class="fv-steps-nav" hidden>
+        <button class="fv-steps-prev" title="previous step">&#9664;</button>
+        <input type="range" class="fv-steps-slider" min="0" max="0" value="0" step="1" aria-label="step">
+        <button class="fv-steps-next" title="next step">&#9654;</button>
+        <span class="fv-steps-counter"></span>
+      </div>
+      <div class="fv-steps-figure"></div>
+    </details>`;
   const q = (s) => el.querySelector(s);
   const canvas = q(".fv-canvas");
   const context = canvas.getContext("2d");
@@ -131,6 +146,55 @@ function mountViewer(el, transport) {
   }
   rowForm.addEventListener("change", () => { showMatrices(); showTrace(); });
 
+  // The steps panel: Python records the chosen method on the current view (a small copy of it) and sends every
+  // step's SVG figure at once; the slider and the buttons then step through them here, with no further message.
+  const stepsMethod = q(".fv-steps-method"), stepsStatus = q(".fv-steps-status"), stepsNav = q(".fv-steps-nav");
+  const stepsSlider = q(".fv-steps-slider"), stepsFigure = q(".fv-steps-figure");
+  api.steps = null;
+  api.stepIndex = null;
+  function stepsStale() {
+    return !!(api.steps && api.state && JSON.stringify(api.steps.camera) !== JSON.stringify(api.state.camera));
+  }
+  function showStepsStatus() {
+    const record = api.steps;
+    if (!record) return;
+    if (record.error) { stepsStatus.textContent = record.algorithm + ": " + record.error; return; }
+    stepsStatus.textContent = `${record.algorithm}: ${record.figures.length} steps at ${record.size.join("×")} pixels` +
+      (stepsStale() ? " (recorded on an earlier view: record again to follow the camera)" : "");
+    stepsStatus.dataset.stale = String(stepsStale());
+  }
+  function showStep(i) {
+    const record = api.steps;
+    if (!record || !record.figures) return;
+    i = Math.max(0, Math.min(record.figures.length - 1, i));
+    api.stepIndex = i;
+    stepsSlider.value = String(i);
+    q(".fv-steps-counter").textContent = `${i + 1} / ${record.figures.length}: ${record.titles[i]}`;
+    stepsFigure.innerHTML = record.figures[i];
+    stepsFigure.dataset.step = String(i);
+  }
+  function showSteps(record) {
+    api.steps = record;
+    stepsNav.hidden = !record.figures;
+    stepsFigure.innerHTML = "";
+    delete stepsFigure.dataset.step;
+    q(".fv-steps-record").disabled = false;
+    if (record.figures) {
+      stepsSlider.max = String(record.figures.length - 1);
+      showStep(0);
+    }
+    showStepsStatus();
+  }
+  q(".fv-steps-record").addEventListener("click", () => {
+    if (!stepsMethod.value) return;
+    q(".fv-steps-record").disabled = true;
+    stepsStatus.textContent = "recording " + stepsMethod.value + " ...";
+    send({ type: "steps", algorithm: stepsMethod.value });
+  });
+  stepsSlider.addEventListener("input", () => showStep(parseInt(stepsSlider.value, 10)));
+  q(".fv-steps-prev").addEventListener("click", () => showStep(api.stepIndex - 1));
+  q(".fv-steps-next").addEventListener("click", () => showStep(api.stepIndex + 1));
+
   function formatNumber(v) {
     if (v === null || v === undefined) return "";
     const r = Math.round(v);
@@ -182,9 +246,13 @@ function mountViewer(el, transport) {
       }
       if (input.type === "checkbox") input.checked = !!state.controls[name]; else input.value = state.controls[name];
     }
+    if (state.steps && stepsMethod.options.length === 0) {
+      for (const value of state.steps.methods) stepsMethod.add(new Option(value, value));
+    }
     errorBox.hidden = !state.error;
     errorBox.textContent = state.error || "";
     showMatrices();
+    showStepsStatus();
   }
 
   function drawFrame(header, bytes) {
@@ -224,12 +292,16 @@ function mountViewer(el, transport) {
     } else if (header.type === "pick") {
       api.pick = header;
       showTrace();
+    } else if (header.type === "steps") {
+      showSteps(header);
     } else if (header.type === "error") {
+      q(".fv-steps-record").disabled = false;
       errorBox.hidden = !header.message;
       errorBox.textContent = header.message || "";
       inFlight = false;
       flushPending();
     } else if (header.type === "ignored") {
+      q(".fv-steps-record").disabled = false;
       inFlight = false;
       flushPending();
     }
