@@ -49,6 +49,7 @@ __all__ = [
     "EXECUTORS",
     "RAY_BATCH",
     "RAY_BYTES_IN_FLIGHT",
+    "RAY_INLINE_BYTES",
     "RAY_TASK_BYTES",
     "RAY_TASK_RETRIES",
     "render_many",
