@@ -355,7 +355,7 @@ def test_driver_memory_stays_flat_over_2000_views(cluster, scene_path, tmp_path)
           f"{mib['peak']['RssAnon']:.1f}, object-store pages {mib['peak']['RssShmem']:.1f}), "
           f"{report['views_per_s']:.1f} views/s")  # fmt: skip
     assert report["ok"] == 2000
-    # the issue's bound. Measured at load 6-7 (2 cores): +2.3 and +8.8 MiB (peak +13.8). Before the views' files came
-    # in pieces inside Ray's task replies (RAY_INLINE_BYTES), the driver read 16 views a task from the object store
-    # and every store page it read stayed in its RSS: +54 MiB on a quiet machine, +83 MiB at load 5
+    # the issue's bound. Measured at load 4-7 (2 cores): +7, +11 and +20 MiB, no object-store pages. Before the views'
+    # files came in pieces inside Ray's task replies (RAY_INLINE_BYTES), the driver read 16 views a task from the
+    # object store and every store page it read stayed in its RSS: +54 MiB on a quiet machine, +83 MiB at load 5
     assert report["peak_mib"] - report["base_mib"] <= 50.0
