@@ -12,13 +12,14 @@ is left half written) and re-raises KeyboardInterrupt.
 
 Ray clusters whose nodes share no disk: where the files go is the ``collect`` mode. ``"workers"``: each actor
 writes its views' files itself (a URL every node reaches, or a folder on a one-node cluster). ``"driver"``: each
-actor renders and *encodes* its views and returns the files' bytes through Ray's object store; the driver
-writes them (atomically, as a worker would) before it counts the view, so a view in the run log is a view on
-the driver's disk. The driver keeps at most ``RAY_BYTES_IN_FLIGHT`` bytes of views handed out and not yet
-written, so its memory stays flat whatever the number of views. The default picks ``"driver"`` for a local
-folder on a cluster of more than one node (and for ``memory://``, which lives in one process), ``"workers"``
-otherwise. A worker or a node lost mid-run (its actor dies) hands its batches to the actors left, up to
-``RAY_TASK_RETRIES`` times each.
+actor renders and *encodes* its views and returns the files' bytes to the driver, cut into pieces small enough
+for Ray to send inside the task's reply (``RAY_INLINE_BYTES``; the driver then maps no page of the object store);
+the driver writes them (atomically, as a worker would) before it counts the view, so a view in the run log is a
+view on the driver's disk. The driver keeps at most ``RAY_BYTES_IN_FLIGHT`` bytes of views handed out and not yet
+written, and a task carries at most ``RAY_TASK_BYTES``, so its memory stays flat whatever the number of views.
+The default picks ``"driver"`` for a local folder on a cluster of more than one node (and for ``memory://``,
+which lives in one process), ``"workers"`` otherwise. A worker or a node lost mid-run (its actor dies) hands its
+batches to the actors left, up to ``RAY_TASK_RETRIES`` times each.
 
 A killed caller (SIGKILL, an out-of-memory kill) leaves no orphans: each pool worker checks every
 ``PARENT_CHECK_SECONDS`` whether its parent is still the process that started it and exits when it is not,
@@ -61,7 +62,7 @@ EXECUTORS = ("serial", "process", "ray")
 RAY_BATCH = 16
 """Most views per Ray task: one task per view would make the driver's loop the limit on a large cluster."""
 COLLECT = ("driver", "workers")
-"""Where a Ray run's files are written: by the driver (bytes through the object store) or by the workers."""
+"""Where a Ray run's files are written: by the driver (bytes sent back with the tasks) or by the workers."""
 RAY_BYTES_IN_FLIGHT = 256 * 2**20
 """collect="driver": most bytes of encoded views handed out and not yet written (an upper bound per view:
 4 + 4 + 12 + 2 + 1 bytes per pixel for color, depth, normals, ids, mask)."""
@@ -522,11 +523,11 @@ def render_many(
         ``ray.init(address=...)`` for an existing cluster (e.g. ``"auto"``).
     collect : {"driver", "workers"} or None
         Ray only: who writes the files (module docstring). ``"driver"``: the workers return the encoded bytes
-        through the object store and this process writes them, at most ``RAY_BYTES_IN_FLIGHT`` bytes of views
-        outstanding. ``"workers"``: each worker writes its own (refused for a local path on a cluster of more
-        than one node, whose nodes do not see each other's disks). None: ``"driver"`` for local paths on more
-        than one node and for ``memory://``, else ``"workers"``. The serial and process executors write in this
-        machine either way.
+        (in pieces inside the tasks' replies) and this process writes them, at most ``RAY_BYTES_IN_FLIGHT``
+        bytes of views outstanding. ``"workers"``: each worker writes its own (refused for a local path on a
+        cluster of more than one node, whose nodes do not see each other's disks). None: ``"driver"`` for local
+        paths on more than one node and for ``memory://``, else ``"workers"``. The serial and process executors
+        write in this machine either way.
 
     Returns
     -------
