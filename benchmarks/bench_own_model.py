@@ -4,7 +4,10 @@ empty Numba cache) and warm, beside F3D's headless render of the same files, in 
 Each timing is a whole process, as a user runs it: ``frustum render FILE -o out.png`` against a Python one-liner
 that opens F3D offscreen (``f3d.Engine.create(True)``), adds the file, renders 480x360 and saves the PNG. Warm
 timings are medians of `--repeat` runs; cold is one run of the first file with an empty ``NUMBA_CACHE_DIR``.
-F3D is the anchor: the ratio frustum / F3D per file is what this reports (target: warm <= 1).
+F3D is the anchor: the ratio frustum / F3D per file is what this reports (target: warm <= 1), in wall time and in
+CPU time (user + system of the whole process: steadier than wall time on a shared machine). Warm means the kernel
+cache and Python's bytecode cache are filled (``PYTHONDONTWRITEBYTECODE`` is dropped for the runs: a source
+checkout under that setting compiles frustum's ~40 modules from source on every run, ~0.1 s).
 
     python benchmarks/bench_own_model.py [--repeat 3] [--no-cold]
 
@@ -16,6 +19,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import resource
 import shutil
 import statistics
 import subprocess
@@ -65,9 +69,21 @@ def make_files(folder: Path) -> dict[str, tuple[Path, str]]:
 
 
 def timed(command: list[str], env: dict[str, str] | None = None) -> float:
+    return timed_cpu(command, env)[0]
+
+
+def timed_cpu(command: list[str], env: dict[str, str] | None = None) -> tuple[float, float]:
+    """Wall seconds and CPU seconds (user + system) of one whole process."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
     subprocess.run(command, check=True, env=env, capture_output=True)
-    return time.perf_counter() - start
+    wall = time.perf_counter() - start
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+
+
+def _medians(runs: list[tuple[float, float]]) -> tuple[float, float]:
+    return statistics.median(r[0] for r in runs), statistics.median(r[1] for r in runs)
 
 
 def main() -> None:
@@ -77,6 +93,7 @@ def main() -> None:
     args = parser.parse_args()
     frustum_cli = [sys.executable, "-m", "frustum"]
     env = {**os.environ, "PYTHONPATH": str(ROOT / "src") + os.pathsep + os.environ.get("PYTHONPATH", "")}
+    env.pop("PYTHONDONTWRITEBYTECODE", None)  # warm = bytecode cached too, as pip install leaves a package
     try:
         import f3d  # noqa: F401
 
@@ -92,20 +109,23 @@ def main() -> None:
             cold_env = {**env, "NUMBA_CACHE_DIR": str(folder / "empty_cache")}
             cold = timed([*frustum_cli, "render", str(first), "-o", str(folder / "cold.png"), "--up", up], cold_env)
             print(f"cold (empty NUMBA_CACHE_DIR), {first_name}: {cold:.2f} s")
-        timed([*frustum_cli, "render", str(first), "-o", str(folder / "warm.png")], env)  # the cache is warm
-        print(f"{'file':<14} {'frustum warm s':>15} {'F3D s':>8} {'ratio':>7}")
+        for path, up in files.values():  # every kernel the six files use is in the cache before timing
+            timed([*frustum_cli, "render", str(path), "-o", str(folder / "warm.png"), "--up", up], env)
+        print(f"{'file':<14} {'frustum warm s':>15} {'F3D s':>8} {'ratio':>7}   {'CPU s: frustum':>15} {'F3D':>6} "
+              f"{'ratio':>6}")  # fmt: skip
         for name, (path, up) in files.items():
-            ours = statistics.median(
-                timed([*frustum_cli, "render", str(path), "-o", str(folder / "ours.png"), "--up", up], env)
+            ours, ours_cpu = _medians([
+                timed_cpu([*frustum_cli, "render", str(path), "-o", str(folder / "ours.png"), "--up", up], env)
                 for _ in range(args.repeat)
-            )
+            ])  # fmt: skip
             line = f"{name:<14} {ours:>15.2f}"
             if have_f3d:
-                theirs = statistics.median(
-                    timed([sys.executable, "-c", F3D_SCRIPT, str(path), str(folder / "f3d.png")], env)
+                theirs, theirs_cpu = _medians([
+                    timed_cpu([sys.executable, "-c", F3D_SCRIPT, str(path), str(folder / "f3d.png")], env)
                     for _ in range(args.repeat)
-                )
-                line += f" {theirs:>8.2f} {ours / theirs:>7.2f}"
+                ])  # fmt: skip
+                line += (f" {theirs:>8.2f} {ours / theirs:>7.2f}   {ours_cpu:>15.2f} {theirs_cpu:>6.2f} "
+                         f"{ours_cpu / theirs_cpu:>6.2f}")  # fmt: skip
             print(line, flush=True)
 
 

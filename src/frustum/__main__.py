@@ -1,5 +1,5 @@
 """``python -m frustum`` runs the ``frustum`` command."""
 
-from frustum.cli import main
+from frustum._program import main
 
 main()

@@ -16,9 +16,7 @@ from __future__ import annotations
 
 import gc
 import math
-import os
 import sys
-import threading
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -31,6 +29,19 @@ from rich.console import Console
 import frustum.raster
 from frustum import __version__
 from frustum._arrays import escape_control
+from frustum._program import (  # noqa: F401 - shared with the program's own plain-render path, kept as names here
+    _STATE,
+    GC_PAUSE_S,
+    INTERRUPTED_STATUS,
+    MAX_SIZE,
+    REPORTED,
+    UsageError,
+    _resume_gc_when_due,
+    _run_interruptible,
+    failure,
+    render_files,
+)
+from frustum._program import image_size as _image_size
 from frustum.camera import Camera
 from frustum.errors import FrustumError, GeometryError, OutputError
 from frustum.geometry import Mesh
@@ -62,11 +73,6 @@ console = Console()
 error_console = Console(stderr=True, highlight=False, soft_wrap=True)
 
 
-class UsageError(FrustumError):
-    """A command-line argument that frustum cannot read (exit status 2)."""
-
-
-_STATE: dict[str, Any] = {"debug": False, "resume_gc_at": None}
 
 
 def _numbers(text: str, counts: tuple[int, ...], step: str) -> list[float]:
@@ -200,6 +206,27 @@ def compose_command(
         console.print(f"M · ({', '.join(f'{v:g}' for v in p)}, 1) = ({', '.join(f'{v:.6g}' for v in moved)}, 1)")
 
 
+def _check_up(up: str) -> None:
+    """A mesh file's ``--up`` axis: y or z (the message ``load_scene_file`` gives for a mesh file)."""
+    from frustum.scenefile.models import MODEL_UP_AXES
+
+    if up not in MODEL_UP_AXES:
+        from frustum.errors import SceneFileError
+
+        raise SceneFileError(f"up = {up!r} is not an axis; give 'y' or 'z'")
+
+
+def _model_scene_file(path: Path, up: str) -> Any:
+    """A mesh file loaded with its `up` axis (a ``SceneFile``), or the path of any other file as it is."""
+    from frustum.scenefile.loader import MODEL_SUFFIXES
+
+    if path.suffix.lower() not in MODEL_SUFFIXES:
+        return path
+    from frustum.scenefile import load_scene_file
+
+    return load_scene_file(path, up=up)
+
+
 # --- trace ----------------------------------------------------------------------------------------------------
 
 
@@ -212,27 +239,6 @@ def _vector3(text: str, option: str) -> list[float]:
     if len(values) != 3:
         raise UsageError(f"{option} = {text!r} has {len(values)} numbers; expected 3, written x,y,z")
     return values
-
-
-MAX_SIZE = 8192
-"""Largest --size width or height (the scene files' ``[render] size`` limit)."""
-
-
-def _image_size(text: str) -> tuple[int, int]:
-    """``WxH`` (e.g. 640x480) as two positive integers, or a UsageError."""
-    width, sep, height = text.lower().partition("x")
-    try:
-        size = (int(width), int(height)) if sep else None
-    except ValueError:
-        size = None
-    if size is None or min(size) <= 0:
-        raise UsageError(f"--size = {text!r} is not WIDTHxHEIGHT; write two positive integers, e.g. 640x480")
-    if max(size) > MAX_SIZE:
-        raise UsageError(
-            f"--size = {text!r} is over the limit of {MAX_SIZE} pixels a side; give width and height in "
-            f"[1, {MAX_SIZE}]"
-        )
-    return size
 
 
 @app.command("trace")
@@ -421,17 +427,7 @@ def render_command(
 ) -> None:
     """Render a scene file or a mesh file (framed from a 3/4 view, default lights, the file's materials); without
     -o, the outputs the file names (or out/<name>.png beside it)."""
-    from frustum.scenefile import render_scene_file
-    from frustum.warmup import compile_in_background
-
-    compile_in_background()  # a cold cache: a second process compiles part of the kernels meanwhile
-
-    choices = {None: None, "on": True, "off": False, "ray": "ray"}
-    if shadows not in choices:
-        raise FrustumError(f"render: --shadows {shadows!r} is unknown; expected on, off or ray")
-    written = render_scene_file(scene, output or None, size=_image_size(size) if size else None,
-                                shadows=choices[shadows], up=up)  # fmt: skip
-    for path in written if isinstance(written, list) else [written]:
+    for path in render_files(scene, output or None, size, up, shadows):  # also run without Typer: frustum._program
         console.print(f"wrote {path}", markup=False, highlight=False, soft_wrap=True)
 
 
@@ -445,17 +441,18 @@ def explain_command(
         str | None,
         typer.Option(help="A visible-surface method (scan-line, area-subdivision, a-buffer, ...): print its counts."),
     ] = None,
+    up: Annotated[str, typer.Option(help="A mesh file's up axis, y or z (glTF is always y).")] = "y",
 ) -> None:
     """Print every stage of the pipeline (matrices in column- and row-vector form) for the scene's camera; with
     --method, what that visible-surface method counted drawing the scene (spans, areas per level, fragments …)."""
     from frustum.scenefile import explain_method, explain_scene_file
 
     if method is not None:
-        for key, value in explain_method(scene, method).items():
+        for key, value in explain_method(scene, method, up=up).items():
             console.print(f"{key:>24}  {value}", markup=False, highlight=False, soft_wrap=True)
         return
 
-    trace = explain_scene_file(scene, _vector3(point, "--point") if point else None)
+    trace = explain_scene_file(scene, _vector3(point, "--point") if point else None, up=up)
     if markdown or latex:
         console.print(trace.to_markdown() if markdown else trace.to_latex(), markup=False, highlight=False)
     else:
@@ -484,6 +481,7 @@ def view_command(
     author: Annotated[str | None, typer.Option(help="Title block: drawn by.")] = None,
     tolerance: Annotated[str | None, typer.Option(help="Title block: general tolerances (ISO 2768-m).")] = None,
     units: Annotated[str | None, typer.Option(help="Title block: model units (mm).")] = None,
+    up: Annotated[str, typer.Option(help="A mesh file's up axis, y or z (glTF is always y).")] = "y",
 ) -> None:
     """Draw the scene as an engineering sheet: orthographic views at the largest standard scale that fits, with
     hidden lines, dimensions, title block and scale bar (the scene file's \\[sheet] table sets the defaults)."""
@@ -493,7 +491,7 @@ def view_command(
               "author": author, "tolerance": tolerance, "units": units}  # fmt: skip
     written = render_view_sheet(
         scene, output, tuple(v.strip() for v in views.split(",") if v.strip()) if views is not None else None,
-        paper=paper, orientation=orientation, projection_angle=angle,
+        up=up, paper=paper, orientation=orientation, projection_angle=angle,
         dimensions=False if dimensions == "none" else dimensions,
         title_block={key: value for key, value in fields.items() if value is not None},
     )  # fmt: skip
@@ -553,6 +551,7 @@ def dataset_command(
     overwrite: Annotated[bool, typer.Option("--overwrite", help="Start again over a different configuration.")] = False,
     retries: Annotated[int, typer.Option(help="Tries again for failed views before listing them.")] = 1,
     progress: Annotated[bool, typer.Option("--progress/--no-progress", help="Show the progress bar.")] = True,
+    up: Annotated[str, typer.Option(help="A mesh file's up axis, y or z (glTF is always y).")] = "y",
 ) -> None:
     """Render a multi-view dataset: color, metric depth, normals, object ids, masks and the cameras of a format.
 
@@ -561,7 +560,8 @@ def dataset_command(
     from frustum.batch import render_dataset
 
     result = render_dataset(
-        scene, out, views=views if views is not None or layout == "file" else 100, layout=layout, format=format_,
+        _model_scene_file(scene, up), out,
+        views=views if views is not None or layout == "file" else 100, layout=layout, format=format_,
         size=_image_size(size) if size else None, seed=seed, cameras_file=cameras, depth_format=depth_format,
         executor=executor, workers=workers, progress=progress, overwrite=overwrite, retries=retries,
         address=address, collect=collect,
@@ -592,9 +592,12 @@ def serve_command(
     no_token: Annotated[
         bool, typer.Option("--no-token", help="Serve a non-loopback --host without the random URL token.")
     ] = False,
+    up: Annotated[str, typer.Option(help="A mesh file's up axis, y or z (glTF is always y).")] = "y",
 ) -> None:
     """Open an interactive viewer of a scene file in the browser (orbit, pan, zoom, the pipeline beside it)."""
     from frustum.viewer.server import serve
+
+    _check_up(up)  # before serving: the page would show it only after the first connection
 
     def ready(url: str) -> None:
         console.print(f"frustum serve: {scene} at {url}", markup=False, highlight=False, soft_wrap=True)
@@ -606,7 +609,8 @@ def serve_command(
                           markup=False, highlight=False, soft_wrap=True)  # fmt: skip
         console.file.flush()
 
-    serve(scene, host, port, ready=ready, allow_origins=tuple(allow_origin or ()), token=False if no_token else None)
+    serve(scene, host, port, ready=ready, allow_origins=tuple(allow_origin or ()), token=False if no_token else None,
+          up=up)  # fmt: skip
 
 
 @app.command("steps")
@@ -629,6 +633,7 @@ def steps_command(
     u: Annotated[str | None, typer.Option("--u", help="B-spline parameter whose knot span is shown.")] = None,
     seed: Annotated[str | None, typer.Option(help="Random seed.")] = None,
     fps: Annotated[float, typer.Option(help="Animation frames (steps) per second.")] = 1.0,
+    up: Annotated[str, typer.Option(help="A mesh file's up axis, y or z (glTF is always y).")] = "y",
 ) -> None:
     """Record an algorithm of the lecture notes step by step and write its figures, animation, page or table."""
     from frustum.steps.catalog import build, describe_algorithms
@@ -644,7 +649,7 @@ def steps_command(
     if scene_file is not None:
         from frustum.scenefile import load_scene_file
 
-        loaded = load_scene_file(scene_file)
+        loaded = load_scene_file(scene_file, up=up)
         camera = loaded.camera or loaded.cameras[0]
         if size is not None:
             width, height = _image_size(size)
@@ -671,6 +676,7 @@ def radiosity_command(
     hemicube: Annotated[int | None, typer.Option(help="Hemicube pixels a side (default 128).")] = None,
     tolerance: Annotated[float | None, typer.Option(help="Stop at this unshot / emitted power (default 1e-3).")] = None,
     size: Annotated[str | None, typer.Option(help="Image size WIDTHxHEIGHT, overriding the file's.")] = None,
+    up: Annotated[str, typer.Option(help="A mesh file's up axis, y or z (glTF is always y).")] = "y",
 ) -> None:
     """Light a scene file by radiosity (diffuse light bouncing between surfaces, hemicube form factors, progressive
     refinement) and render the lit scene from the file's camera: each pixel the interpolated radiosity."""
@@ -682,7 +688,7 @@ def radiosity_command(
 
     if output.suffix.lower() != ".png":
         raise OutputError(f"radiosity: output = {str(output)!r} is not a .png file; radiosity writes a PNG picture")
-    scene_file = load_scene_file(scene)
+    scene_file = load_scene_file(scene, up=up)
     if size:
         scene_file = scene_file.resized(_image_size(size))
     settings = dict(getattr(scene_file, "radiosity", None) or {})
@@ -721,61 +727,10 @@ def _fail(message: str, status: int) -> None:
     raise SystemExit(status)
 
 
-INTERRUPTED_STATUS = 130
-"""Exit status after Ctrl-C (128 + SIGINT), as shells report it."""
-
-
-def _run_interruptible(work: Callable[[], Any]) -> Any:
-    """Run `work` on a worker thread while the main thread waits in short timeouts, so Ctrl-C is honoured at once.
-
-    Python delivers SIGINT to the main thread only; a Numba kernel (nogil) or an import that catches
-    ``BaseException`` (trimesh's optional imports) on the worker cannot swallow or delay it. On Ctrl-C the
-    output files still being written (temporaries, ``frustum._files``) are removed, one line is printed and
-    the process exits with status 130 at once, abandoning the worker.
-    """
-    outcome: dict[str, Any] = {}
-
-    def target() -> None:
-        try:
-            outcome["value"] = work()
-        except BaseException as error:  # handed to the main thread, which re-raises it
-            outcome["error"] = error
-
-    worker = threading.Thread(target=target, name="frustum-work", daemon=True)
-    try:
-        worker.start()
-        while worker.is_alive():
-            worker.join(0.1)
-            _resume_gc_when_due()
-    except KeyboardInterrupt:
-        from frustum._files import remove_partial_files
-
-        remove_partial_files()
-        error_console.print("error: interrupted (Ctrl-C); no output file was written or changed", markup=False)
-        sys.stdout.flush()
-        sys.stderr.flush()
-        os._exit(INTERRUPTED_STATUS)
-    if "error" in outcome:
-        raise outcome["error"]
-    return outcome.get("value")
-
-
 def _compile_notice() -> None:
     """Told by the kernels once they have been compiling for a second (a first run in a new environment)."""
     error_console.print("compiling render kernels, first run only (`frustum warmup` does it ahead of time) ...",
                         markup=False, highlight=False)  # fmt: skip
-
-
-GC_PAUSE_S = 3.0
-"""Seconds the ``frustum`` program runs with Python's cyclic garbage collector paused (``main``)."""
-
-
-def _resume_gc_when_due() -> None:
-    """Re-enable the garbage collector once the program has run ``GC_PAUSE_S`` (checked by the waiting main thread)."""
-    due = _STATE.get("resume_gc_at")
-    if due is not None and time.monotonic() >= due:
-        _STATE["resume_gc_at"] = None
-        gc.enable()
 
 
 def main(arguments: Sequence[str] | None = None) -> None:
@@ -814,24 +769,15 @@ def _main(argv: list[str]) -> None:
         _fail(message, 2)
     except typer.Abort:
         _fail("aborted", 1)
-    except RecursionError:
+    except RecursionError as error:
         if _STATE["debug"]:
             raise
-        _fail("the input is nested too deeply to process", 1)
+        _fail(*failure(error))
     except _CLICK_EXCEPTION as error:
         _fail(" ".join(error.format_message().split()), error.exit_code)
-    except UsageError as error:
+    except REPORTED as error:
         if _STATE["debug"]:
             raise
-        _fail(str(error), 2)
-    except FrustumError as error:
-        if _STATE["debug"]:
-            raise
-        _fail(str(error), 1)
-    except (OSError, ValueError, TypeError, RuntimeError, MemoryError) as error:
-        if _STATE["debug"]:
-            raise
-        text = " ".join(str(error).split()) or "no details"
-        _fail(f"{type(error).__name__}: {text}", 1)
+        _fail(*failure(error))
     if isinstance(status, int) and status:
         raise SystemExit(status)

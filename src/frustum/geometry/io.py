@@ -1,13 +1,17 @@
 """Mesh files: load and save OBJ, STL (ASCII and binary), PLY, OFF and glTF/GLB through trimesh.
 
-frustum writes no parser of its own: trimesh reads and writes the formats, and this module turns its objects
-into frozen ``Mesh`` objects (and back), keeping vertex normals, UVs, vertex colors and texture images where
-the format has them. Every failure (missing file, unknown suffix, truncated or corrupt data) is raised as a
-``GeometryError`` naming the path and the reason, never as an exception from inside the parser.
+trimesh reads and writes the formats, and this module turns its objects into frozen ``Mesh`` objects (and
+back), keeping vertex normals, UVs, vertex colors and texture images where the format has them. Every failure
+(missing file, unknown suffix, truncated or corrupt data) is raised as a ``GeometryError`` naming the path and
+the reason, never as an exception from inside the parser.
 
 Files are read without trimesh's "processing" (no vertex merging, no reordering), so vertex and face counts are
 those of the file, except that vertices are split where a vertex carries several UVs or normals (OBJ) and
 polygons are triangulated. Use ``Mesh.welded()`` to merge the seam copies again.
+
+The plain, well-formed cases of each format (binary STL, triangle PLY/OFF/OBJ, glTF without extensions; see
+``frustum.geometry.readers``) are read by frustum's own readers, giving exactly what trimesh gives, without
+importing trimesh (0.7-1.1 s of a one-command render); everything else goes through trimesh.
 
 References
 ----------
@@ -120,8 +124,6 @@ def load_parts(path: str | Path, texture: str | Path | None = None) -> list[Mesh
     GeometryError
         As for ``load``.
     """
-    import trimesh
-
     file = _checked_path(path, "load")
     explicit = None if texture is None else _read_image(Path(texture), "load")
     if file.suffix.lower() == ".stl":
@@ -130,6 +132,11 @@ def load_parts(path: str | Path, texture: str | Path | None = None) -> list[Mesh
         _check_glb_chunks(file)
     _check_file_memory(file)
     text = _text_bytes(file)
+    native = _native_parts(file, text)
+    if native is not None:
+        return _with_textures(native, file, explicit)
+    import trimesh
+
     try:
         if text is not None:
             scene = trimesh.load_scene(io.BytesIO(text), file_type=file.suffix.lower()[1:], process=False,
@@ -150,8 +157,6 @@ def load_parts(path: str | Path, texture: str | Path | None = None) -> list[Mesh
             if not isinstance(geometry, trimesh.Trimesh) or len(geometry.faces) == 0:
                 continue
             mesh, image, color = _from_trimesh(geometry, file)
-            if image is None and mesh.uvs is not None:
-                image = explicit if explicit is not None else _sibling_texture(file)
             matrix = np.array(world_from_model, dtype=np.float64)
             emissive, alpha_mode = _emission_and_alpha(geometry)
             parts.append(MeshPart(str(node), mesh, matrix, image, color, _normal_texture(geometry), emissive,
@@ -166,6 +171,43 @@ def load_parts(path: str | Path, texture: str | Path | None = None) -> list[Mesh
         raise GeometryError(
             f"load: path = {str(file)!r} contains no triangles; give a file with at least one triangle mesh"
         )
+    return _with_textures(parts, file, explicit)
+
+
+def _with_textures(parts: list[MeshPart], file: Path, explicit: NDArray[np.uint8] | None) -> list[MeshPart]:
+    """`parts` with the `explicit` texture, or the one beside the file, on each part with UVs and no image."""
+    missing = [i for i, part in enumerate(parts) if part.texture is None and part.mesh.uvs is not None]
+    if not missing:
+        return parts
+    image = explicit if explicit is not None else _sibling_texture(file)
+    return [part._replace(texture=image) if i in missing else part for i, part in enumerate(parts)]
+
+
+def _native_parts(file: Path, text: bytes | None) -> list[MeshPart] | None:
+    """The parts read by frustum's own readers (``frustum.geometry.readers``: the plain cases of each format,
+    without importing trimesh), or None when trimesh must read the file."""
+    from frustum.geometry.readers import read_parts
+
+    raw = read_parts(file, text)
+    if raw is None:
+        return None
+    parts = []
+    try:
+        for part in raw:
+            mesh = Mesh(part.vertices, part.faces, part.normals, part.uvs)
+            image = None if part.image is None else _pil_array(part.image)
+            color = part.color
+            if part.image is not None and image is None:  # a placeholder image: trimesh drops the colour too
+                color = None
+            normal_map = None
+            if part.normal_image is not None and part.uvs is not None:
+                normal_map = np.asarray(part.normal_image.convert("RGB"), dtype=np.uint8)
+            parts.append(MeshPart(part.name, mesh, np.asarray(part.world_from_model, dtype=np.float64), image, color,
+                                  normal_map, part.emissive, part.alpha_mode))  # fmt: skip
+    except MemoryError:
+        raise
+    except Exception:  # invalid geometry or an unreadable image: trimesh's path says what is wrong
+        return None
     return parts
 
 
@@ -470,6 +512,11 @@ def _material_image(material: Any) -> NDArray[np.uint8] | None:
         image = getattr(material, "baseColorTexture", None)
     if image is None:
         return None
+    return _pil_array(image)
+
+
+def _pil_array(image: Any) -> NDArray[np.uint8] | None:
+    """A PIL image's pixels as RGB or RGBA bytes; None for trimesh's placeholder image."""
     array = np.asarray(image.convert("RGBA" if "A" in image.mode else "RGB"), dtype=np.uint8)
     if _is_placeholder(array):
         return None

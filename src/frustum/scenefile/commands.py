@@ -117,14 +117,16 @@ def render_scene_file(
     return written[0] if single else written
 
 
-def render_view_sheet(path: str | Path, output: str | Path, views: Sequence[str] | None = None, **options: Any) -> Path:
+def render_view_sheet(path: str | Path, output: str | Path, views: Sequence[str] | None = None, *, up: str = "y",
+                      **options: Any) -> Path:  # fmt: skip
     """An engineering drawing sheet (``drawing_sheet``) of the scene file's scene: SVG, or PDF/PNG/DXF by suffix.
 
     ``views`` accepts "iso" for "isometric" (default: the file's ``[sheet] views``, else front, top, right and
-    isometric). Other keywords go to ``drawing_sheet`` (scale, paper, title, title_block, ...) and override the
-    file's ``[sheet]`` table; ``title_block`` fields are merged over the file's.
+    isometric). `up` is a mesh file's up axis ("y" or "z", ``load_scene_file``). Other keywords go to
+    ``drawing_sheet`` (scale, paper, title, title_block, ...) and override the file's ``[sheet]`` table;
+    ``title_block`` fields are merged over the file's.
     """
-    scene_file = load_scene_file(path)
+    scene_file = load_scene_file(path, up=up)
     try:
         sheet = importlib.import_module("frustum.output.sheet")
         svg = importlib.import_module("frustum.output.svg")
@@ -145,15 +147,16 @@ def render_view_sheet(path: str | Path, output: str | Path, views: Sequence[str]
     return Path(svg.save_svg(text, target))
 
 
-def explain_scene_file(path: str | Path, point: Sequence[float] | None = None) -> Any:
-    """``frustum.trace`` of `point` (world coordinates) or, without one, of every vertex, through the file's camera.
+def explain_scene_file(path: str | Path, point: Sequence[float] | None = None, *, up: str = "y") -> Any:
+    """``frustum.trace`` of `point` (world coordinates) or, without one, of every vertex, through the file's camera
+    (`up`: a mesh file's up axis, ``load_scene_file``).
 
     Returns
     -------
     frustum.trace.Trace
         Every stage's matrix and coordinates; ``str()``, ``to_markdown()``, ``to_latex()`` print it.
     """
-    scene_file = load_scene_file(path)
+    scene_file = load_scene_file(path, up=up)
     try:
         trace = importlib.import_module("frustum.trace").trace
     except (ImportError, AttributeError):
@@ -164,10 +167,11 @@ def explain_scene_file(path: str | Path, point: Sequence[float] | None = None) -
     return trace(np.asarray(point, dtype=float), camera)
 
 
-def explain_method(path: str | Path, method: str) -> dict:
+def explain_method(path: str | Path, method: str, *, up: str = "y") -> dict:
     """Render the scene file's first camera with the visible-surface `method` (``render(..., method=...)``, with
     the file's render options) and return ``Frame.stats``: what the method counted (spans and edge updates,
     areas per level, depth tests, fragments per pixel …) and, under ``"seconds"``, how long the render took.
+    `up` is a mesh file's up axis (``load_scene_file``).
 
     Raises
     ------
@@ -178,7 +182,7 @@ def explain_method(path: str | Path, method: str) -> dict:
     """
     import time
 
-    scene_file = load_scene_file(path)
+    scene_file = load_scene_file(path, up=up)
     render = importlib.import_module("frustum.render").render
     options = {key: value for key, value in scene_file.options.items() if key not in ("method", "stats")}
     start = time.perf_counter()

@@ -335,8 +335,8 @@ def _build(report: _Report, data: dict, base: Path, check_outputs: bool = True) 
             cameras.append(camera)
     else:
         report.missing(("camera",), "add a [camera] table with eye and target (or [[cameras]])")
-    if cameras and _fits(data) and not scene.world_lights() and "environment" not in data and "radiosity" not in data:
-        for light in default_lights(cameras[0]):  # a fitted camera and no lights named: the default three-point set
+    if cameras and _wants_default_lights(data, scene, options):
+        for light in default_lights(cameras[0]):  # no lights named: the default three-point set around the camera
             scene.root.add_light(light)
     outputs, animation, svg = _outputs(report, data, base, check_outputs)
     _check_image_memory(report, options, size, max(len(cameras), 1))
@@ -351,6 +351,25 @@ def _build(report: _Report, data: dict, base: Path, check_outputs: bool = True) 
     single = cameras[0] if "camera" in data else None
     return SceneFile(scene, single, options, outputs, tuple(cameras), stereo, animation, svg, size, columns, title,
                      sheet=sheet, radiosity=radiosity)  # fmt: skip
+
+
+_LIT_SHADINGS = ("phong", "gouraud", "flat")
+"""``[render] shading`` values whose pictures depend on the lights."""
+
+
+def _wants_default_lights(data: dict, scene: Scene, options: dict) -> bool:
+    """Whether a scene file gets ``default_lights``: it names no lights anywhere (no ``[[lights]]`` key, not even
+    ``lights = []``, which keeps a scene unlit on purpose; no lights in nodes), has no ``[environment]`` and no
+    ``[radiosity]`` (they light it), and draws lit surfaces: meshes, in mode "surface" or "surface+edges" with
+    shading "phong", "gouraud" or "flat". Otherwise the picture would not depend on lights, or is meant to be unlit:
+    wireframes, hidden-line drawings, volumes, radiosity, shading "none", "normals" or "depth". A fitted camera
+    (``fit = true``) gets them as before."""
+    if "lights" in data or scene.world_lights() or "environment" in data or "radiosity" in data:
+        return False
+    if _fits(data):
+        return True
+    lit_mode = options.get("mode", "surface") in ("surface", "surface+edges")
+    return bool(scene.items) and lit_mode and options.get("shading", "phong") in _LIT_SHADINGS
 
 
 def _fits(data: dict) -> bool:

@@ -1,6 +1,8 @@
 """A mesh file where a scene file goes: the scene a ``[[nodes]] geometry = { type = "mesh", path = ... }`` file
 gives, with the file's own materials (base colours, textures, normal maps), a camera framing the model from a 3/4
-view (``Camera.fit``) and the default lights (``default_lights``) when nothing else names lights.
+view (``Camera.fit``) and the default lights (``default_lights``) when nothing else names lights. Scene files
+that name no lights get the same default lights around their camera when they draw lit surfaces (see
+``frustum.scenefile.loader._wants_default_lights``; ``lights = []`` keeps a scene unlit on purpose).
 
 Default lights (a three-point setup placed relative to the camera, so every view of a fitted model reads well):
 

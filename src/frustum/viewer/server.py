@@ -131,8 +131,9 @@ class SceneSource:
     failed load (None when the latest version loaded), ``version`` counts the changes seen.
     """
 
-    def __init__(self, path: str | Path) -> None:
+    def __init__(self, path: str | Path, *, up: str = "y") -> None:
         self.path = Path(path)
+        self.up = up  # a mesh file's up axis (load_scene_file)
         self.scene_file: SceneFile | None = None
         self.error: str | None = None
         self.version = 0
@@ -154,7 +155,7 @@ class SceneSource:
                 return False
             self._stamp = stamp
             try:
-                scene_file = load_scene_file(self.path)
+                scene_file = load_scene_file(self.path, up=self.up)
                 if scene_file.camera is None:
                     raise FrustumError(
                         f"{self.path}: has [[cameras]] (several views); frustum serve shows one [camera]"
@@ -578,6 +579,7 @@ def serve(
     allow_origins: Any = (),
     token: str | bool | None = None,
     started: Callable[[Any], None] | None = None,
+    up: str = "y",
 ) -> None:
     """Serve the viewer of scene file `path` at http://host:port/ until interrupted.
 
@@ -599,6 +601,8 @@ def serve(
         True always a random one; False none (``--no-token``); a string that token.
     started : callable, optional
         Called with the ``uvicorn.Server`` before it runs (its ``should_exit = True`` stops it).
+    up : "y" or "z"
+        A mesh file's up axis (``load_scene_file``; glTF is always y-up).
 
     Raises
     ------
@@ -615,7 +619,7 @@ def serve(
     if isinstance(allow_origins, str):
         allow_origins = (allow_origins,)
     choose_token(host, token if isinstance(token, str) else False)  # a bad token string fails before binding
-    source = SceneSource(path)
+    source = SceneSource(path, up=up)
     sock = open_socket(host, port)
     bound = sock.getsockname()
     url_token = choose_token(bound[0] if is_loopback(bound[0]) else host, token)  # e.g. a name for 127.0.1.1

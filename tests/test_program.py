@@ -1,0 +1,112 @@
+"""The ``frustum`` program's own path for a plain ``frustum render FILE -o OUT`` (``frustum._program``, issue 36's
+warm one-command render): it accepts exactly the plain command lines, gives the same files, output, messages and
+exit statuses as the Typer command line, and imports neither Typer, Rich, Pydantic nor trimesh."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from frustum._program import plain_render
+from testdata import DATA
+
+ROOT = Path(__file__).resolve().parents[1]
+BUNNY = DATA / "bunny" / "bun_zipper_res4.ply"
+TYPER = "import sys; sys.argv[0] = 'frustum'; from frustum.cli import main; main()"
+
+
+@pytest.mark.parametrize(
+    ("argv", "expected"),
+    [
+        (["render", "a.ply"], {"scene": "a.ply", "output": [], "size": None, "up": None, "shadows": None}),
+        (["render", "a.glb", "-o", "x.png", "--up", "z"], {"scene": "a.glb", "output": [Path("x.png")], "up": "z"}),
+        (["render", "-o", "x.png", "a.toml", "--output=y.svg", "--size=64x48", "--shadows", "off"],
+         {"scene": "a.toml", "output": [Path("x.png"), Path("y.svg")], "size": "64x48", "shadows": "off"}),
+    ],
+)  # fmt: skip
+def test_plain_render_command_lines_are_taken(argv, expected):
+    found = plain_render(argv)
+    assert found is not None
+    assert {key: found[key] for key in expected} == expected
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        [], ["view", "a.ply", "-o", "x.svg"], ["render"], ["render", "a.ply", "b.ply"], ["render", "a.ply", "--help"],
+        ["--debug", "render", "a.ply"], ["render", "a.ply", "-o"], ["render", "a.ply", "-o", "-x.png"],
+        ["render", "a.ply", "--up", "z", "--up", "y"], ["render", "a.ply", "--quality", "high"],
+        ["render", "a.ply", "-o=x.png"], ["render", "", "-o", "x.png"], ["render", "a.ply", "--", "-b.ply"],
+        ["render", "a.ply", "--size="],
+    ],
+)  # fmt: skip
+def test_other_command_lines_go_to_typer(argv):
+    assert plain_render(argv) is None
+
+
+def _both(tmp_path: Path, *arguments: str) -> tuple[subprocess.CompletedProcess[str], ...]:
+    """The command line run as the program (its own path) and through Typer, each writing into its own folder."""
+    results = []
+    for name, command in (("program", ["-m", "frustum"]), ("typer", ["-c", TYPER])):
+        folder = tmp_path / name
+        folder.mkdir()
+        results.append(subprocess.run([sys.executable, *command, *arguments], cwd=folder, capture_output=True,
+                                      text=True, timeout=300, check=False))  # fmt: skip
+    return tuple(results)
+
+
+def _quiet(stderr: str) -> str:
+    """stderr without the compile notice (only the first process after a kernel changed compiles)."""
+    return "".join(line for line in stderr.splitlines(keepends=True) if not line.startswith("compiling render"))
+
+
+@pytest.mark.parametrize(
+    "arguments",
+    [
+        (str(BUNNY), "-o", "out.png", "--size", "64x48"),
+        (str(DATA / "teapot_n10.obj"), "--output=a.png", "-o", "b.svg", "--up", "z", "--size=48x32"),
+        (str(ROOT / "examples" / "teapot.toml"), "-o", "t.png", "--size", "40x30", "--shadows", "off"),
+    ],
+)
+def test_the_program_writes_what_typer_writes(tmp_path, arguments):
+    program, typer = _both(tmp_path, "render", *arguments)
+    assert program.returncode == typer.returncode == 0, program.stderr + typer.stderr
+    assert (program.stdout, _quiet(program.stderr)) == (typer.stdout, _quiet(typer.stderr))
+    written = sorted(p.name for p in (tmp_path / "program").iterdir())
+    assert written == sorted(p.name for p in (tmp_path / "typer").iterdir()) and written
+    for name in written:
+        assert (tmp_path / "program" / name).read_bytes() == (tmp_path / "typer" / name).read_bytes()
+
+
+@pytest.mark.parametrize(
+    ("arguments", "status", "fragment"),
+    [
+        (("missing.ply", "-o", "x.png"), 1, "does not exist"),
+        ((str(BUNNY), "-o", "x.png", "--size", "64"), 2, "is not WIDTHxHEIGHT"),
+        ((str(BUNNY), "-o", "x.png", "--size", "9000x10"), 2, "over the limit of 8192"),
+        ((str(BUNNY), "-o", "x.png", "--shadows", "maybe"), 1, "--shadows 'maybe' is unknown"),
+        ((str(BUNNY), "-o", "x.png", "--up", "x"), 1, "up = 'x' is not an axis"),
+        ((str(BUNNY), "-o", "x.bmp"), 1, "has suffix '.bmp'"),
+    ],
+)
+def test_the_program_fails_as_typer_does(tmp_path, arguments, status, fragment):
+    program, typer = _both(tmp_path, "render", *arguments)
+    assert program.returncode == typer.returncode == status
+    assert program.stderr == typer.stderr and program.stderr.startswith("error: ") and fragment in program.stderr
+    assert program.stderr.count("\n") == 1 and program.stdout == typer.stdout == ""
+
+
+def test_a_plain_render_imports_no_command_line_library_and_no_trimesh(tmp_path):
+    code = (
+        "import sys\nfrom frustum._program import main\n"
+        f"sys.argv = ['frustum', 'render', {str(BUNNY)!r}, '-o', 'out.png', '--size', '32x24']\nmain()\n"
+        "print(sorted({m.split('.')[0] for m in sys.modules} & {'typer', 'click', 'rich', 'pydantic', 'trimesh'}))\n"
+    )
+    result = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True, timeout=300,
+                            check=False)  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.splitlines() == ["wrote out.png", "[]"]
+    assert (tmp_path / "out.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
