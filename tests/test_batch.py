@@ -612,6 +612,36 @@ def test_render_many_rejects_unknown_collect_modes_and_memory_urls_in_a_pool(tmp
         render_many([RenderJob("a", scene, camera, {"color": "memory://x/a.png"})], progress=False)
 
 
+def test_driver_collect_pieces_rebuild_every_file(scene_path, tmp_path, monkeypatch) -> None:
+    """collect="driver": a task returns its files cut into pieces small enough to travel inside Ray's reply (not
+    through the object store the driver would map); written piece by piece they are encode_view's bytes, also
+    when the pieces are tiny and when the files outgrow the values planned (the rest comes as one list)."""
+    from frustum.batch import executors
+    from frustum.batch.jobs import encode_view, write_view
+
+    camera = load_scene_file(scene_path).cameras[0]
+    kinds = {"color": ".png", "depth": ".npy", "normals": ".n.npy", "mask": ".m.png"}
+    jobs = [RenderJob(key, str(scene_path), c, {kind: f"{tmp_path}/{key}{end}" for kind, end in kinds.items()})
+            for key, c in dataset_cameras(camera, 3, "sphere")]  # fmt: skip
+    scenes, plain = executors._prepare(jobs, "test")
+    expected = {job.key: encode_view(scenes[0][0], job, scenes[0][1])[1] for job in plain}
+    actor = object.__new__(executors._RayRenderer)  # the actor's class, here in this process
+    actor.scenes = scenes
+    for step, planned in ((96 * 1024, None), (1000, None), (1000, 5)):
+        monkeypatch.setattr(executors, "RAY_INLINE_BYTES", step)
+        parts = planned or executors._parts(plain)
+        values = actor.encode(plain, parts)
+        assert len(values) == parts  # the task's num_returns
+        pieces = [v for v in values[1:-1] if v is not None] + values[-1]
+        assert all(len(piece) <= step for piece in pieces)
+        assert (values[-1] == []) == (planned is None)  # the plan holds every piece unless cut short on purpose
+        for result, encoded in executors._pieced(values):
+            assert {kind: b"".join(p) for kind, p in encoded.items()} == expected[result.key]
+            job = next(j for j in plain if j.key == result.key)
+            assert write_view(job, result, encoded).ok
+            assert {k: Path(job.outputs[k]).read_bytes() for k in encoded} == expected[result.key]
+
+
 # --- URL outputs (fsspec) -------------------------------------------------------------------------------------
 
 

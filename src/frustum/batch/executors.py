@@ -12,13 +12,14 @@ is left half written) and re-raises KeyboardInterrupt.
 
 Ray clusters whose nodes share no disk: where the files go is the ``collect`` mode. ``"workers"``: each actor
 writes its views' files itself (a URL every node reaches, or a folder on a one-node cluster). ``"driver"``: each
-actor renders and *encodes* its views and returns the files' bytes through Ray's object store; the driver
-writes them (atomically, as a worker would) before it counts the view, so a view in the run log is a view on
-the driver's disk. The driver keeps at most ``RAY_BYTES_IN_FLIGHT`` bytes of views handed out and not yet
-written, so its memory stays flat whatever the number of views. The default picks ``"driver"`` for a local
-folder on a cluster of more than one node (and for ``memory://``, which lives in one process), ``"workers"``
-otherwise. A worker or a node lost mid-run (its actor dies) hands its batches to the actors left, up to
-``RAY_TASK_RETRIES`` times each.
+actor renders and *encodes* its views and returns the files' bytes to the driver, cut into pieces small enough
+for Ray to send inside the task's reply (``RAY_INLINE_BYTES``; the driver then maps no page of the object store);
+the driver writes them (atomically, as a worker would) before it counts the view, so a view in the run log is a
+view on the driver's disk. The driver keeps at most ``RAY_BYTES_IN_FLIGHT`` bytes of views handed out and not yet
+written, and a task carries at most ``RAY_TASK_BYTES``, so its memory stays flat whatever the number of views.
+The default picks ``"driver"`` for a local folder on a cluster of more than one node (and for ``memory://``,
+which lives in one process), ``"workers"`` otherwise. A worker or a node lost mid-run (its actor dies) hands its
+batches to the actors left, up to ``RAY_TASK_RETRIES`` times each.
 
 A killed caller (SIGKILL, an out-of-memory kill) leaves no orphans: each pool worker checks every
 ``PARENT_CHECK_SECONDS`` whether its parent is still the process that started it and exits when it is not,
@@ -44,7 +45,16 @@ from frustum.batch.progress import ViewProgress
 from frustum.batch.storage import is_url
 from frustum.errors import FrustumError
 
-__all__ = ["COLLECT", "EXECUTORS", "RAY_BATCH", "RAY_BYTES_IN_FLIGHT", "RAY_TASK_RETRIES", "render_many"]
+__all__ = [
+    "COLLECT",
+    "EXECUTORS",
+    "RAY_BATCH",
+    "RAY_BYTES_IN_FLIGHT",
+    "RAY_INLINE_BYTES",
+    "RAY_TASK_BYTES",
+    "RAY_TASK_RETRIES",
+    "render_many",
+]
 
 EXECUTORS = ("serial", "process", "ray")
 """Executors ``render_many`` accepts."""
@@ -52,10 +62,24 @@ EXECUTORS = ("serial", "process", "ray")
 RAY_BATCH = 16
 """Most views per Ray task: one task per view would make the driver's loop the limit on a large cluster."""
 COLLECT = ("driver", "workers")
-"""Where a Ray run's files are written: by the driver (bytes through the object store) or by the workers."""
+"""Where a Ray run's files are written: by the driver (bytes sent back with the tasks) or by the workers."""
 RAY_BYTES_IN_FLIGHT = 256 * 2**20
 """collect="driver": most bytes of encoded views handed out and not yet written (an upper bound per view:
-4 + 4 + 12 + 2 + 1 bytes per pixel for color, depth, normals, ids, mask), and a task's views at most 1/8 of it."""
+4 + 4 + 12 + 2 + 1 bytes per pixel for color, depth, normals, ids, mask)."""
+RAY_TASK_BYTES = 2**20
+"""collect="driver": most bytes of encoded views per Ray task (same bound; at least one view per task): a task's
+reply stays far below Ray's 10 MiB limit of values sent inline with it (``task_rpc_inlined_bytes_limit``), and the
+driver's heap holds little of it at a time (2,000 views at 256²: +7 and +11 MiB of RSS after the first 100 views
+with one view a task, +2 to +32 MiB with three)."""
+RAY_INLINE_BYTES = 96 * 1024
+"""collect="driver": a task returns its views' files cut into pieces of at most this size, each a value of its
+own, below Ray's 100 KiB limit (``max_direct_call_object_size``) for values sent to the driver inside the task's
+reply instead of through the object store; the driver writes a file piece by piece. So the driver never maps
+the object store's shared memory (read there, every page of the head node's store it touched counted in its RSS
+for the rest of the run: +21 to +83 MiB over 2,000 views at 256² with 16 views a task in one value) and never
+holds a large buffer (freed, one would raise glibc's mmap threshold and leave a fragmented heap: +19 to +24 MiB
+with the pieces joined per task). Pieces beyond the values planned (a file larger than its bound) still arrive,
+in one list through the object store."""
 RAY_TASK_RETRIES = 3
 """How often a batch whose actor was lost (a dead worker or node) is handed to another actor."""
 RAY_NO_WORKER_SECONDS = 120.0
@@ -177,13 +201,51 @@ class _RayRenderer:
         self.scenes = scenes
         set_threads(threads)
 
-    def render(self, jobs: list[RenderJob], collect: bool = False) -> list[Any]:
-        """ViewResults (files written here), or with `collect` (ViewResult, {kind: bytes}) pairs to write."""
-        results: list[Any] = []
+    def render(self, jobs: list[RenderJob]) -> list[ViewResult]:
+        """Render and write a batch of views here; their ViewResults."""
+        results = []
         for job in jobs:
             scene, options = self.scenes[job.scene]
-            results.append(encode_view(scene, job, options) if collect else render_view(scene, job, options))
+            results.append(render_view(scene, job, options))
         return results
+
+    def encode(self, jobs: list[RenderJob], parts: int) -> list[Any]:
+        """Render and encode a batch of views for the driver to write: `parts` values (the task's returns). The
+        first is ``[(ViewResult, [(kind, pieces), ...]), ...]``; then each file cut into pieces of at most
+        ``RAY_INLINE_BYTES``, one value each (None once all are out); the last value is the list of any pieces
+        beyond the values planned (a file larger than ``_encoded_bytes`` says)."""
+        step = RAY_INLINE_BYTES
+        views, pieces = [], []
+        for job in jobs:
+            scene, options = self.scenes[job.scene]
+            result, encoded = encode_view(scene, job, options)
+            counts = []
+            for kind, data in encoded.items():
+                cut = [data[at : at + step] for at in range(0, len(data), step)]
+                counts.append((kind, len(cut)))
+                pieces.extend(cut)
+            views.append((result, counts))
+        slots = parts - 2
+        return [views, *pieces[:slots], *[None] * (slots - len(pieces)), pieces[slots:]]
+
+
+def _parts(batch: list[RenderJob]) -> int:
+    """How many values an ``encode`` task of this batch returns: its metadata, the pieces of its files, the rest."""
+    return 2 + sum(_encoded_bytes(job) // RAY_INLINE_BYTES + len(job.outputs) for job in batch)
+
+
+def _pieced(values: list[Any]) -> list[tuple[ViewResult, dict[str, list[bytes]]]]:
+    """(ViewResult, {kind: [pieces of the file]}) pairs of the values an ``encode`` task returned."""
+    views, *pieces, rest = values
+    pieces = [piece for piece in pieces if piece is not None] + rest
+    pairs, at = [], 0
+    for result, counts in views:
+        encoded = {}
+        for kind, count in counts:
+            encoded[kind] = pieces[at : at + count]
+            at += count
+        pairs.append((result, encoded))
+    return pairs
 
 
 def _batch_size(views: int, workers: int) -> int:
@@ -308,7 +370,7 @@ class _RayRun:
         self.view_limit = len(jobs)
         if self.to_driver:  # a bounded number of views handed out and not yet written
             per_view = _encoded_bytes(jobs[0])
-            size = max(1, min(size, RAY_BYTES_IN_FLIGHT // (8 * per_view)))
+            size = max(1, min(size, RAY_TASK_BYTES // per_view))
             self.view_limit = max(size, RAY_BYTES_IN_FLIGHT // per_view)
         self.wanted = max(1, min(self.wanted, -(-len(jobs) // size), -(-self.view_limit // size)))
         self.pending = deque(jobs[i : i + size] for i in range(0, len(jobs), size))
@@ -317,7 +379,7 @@ class _RayRun:
         self.scenes_ref = ray.put(scenes)  # once into the object store; each actor fetches it once
         self.actors: list = []
         self.load: dict = {}
-        self.in_flight: dict = {}  # ref -> (actor, batch)
+        self.in_flight: dict = {}  # first ref -> (actor, batch, every ref of the task)
         self.views_in_flight = 0
 
     def _add_actors(self, count: int) -> None:
@@ -342,19 +404,23 @@ class _RayRun:
             if self.load[actor] >= 2 or over:
                 return
             self.pending.popleft()
-            self.in_flight[actor.render.remote(batch, self.to_driver)] = (actor, batch)
+            if self.to_driver:
+                refs = actor.encode.options(num_returns=_parts(batch)).remote(batch, _parts(batch))
+            else:
+                refs = [actor.render.remote(batch)]
+            self.in_flight[refs[0]] = (actor, batch, refs)
             self.load[actor] += 1
             self.views_in_flight += len(batch)
 
     def _finish(self, ref: Any) -> None:
         """Collect one batch: write (driver mode) and count its views, or hand it on when its actor was lost."""
         ray = self.ray
-        actor, batch = self.in_flight.pop(ref)
+        actor, batch, refs = self.in_flight.pop(ref)
         self.views_in_flight -= len(batch)
         if actor in self.load:
             self.load[actor] -= 1
         try:
-            results = ray.get(ref)
+            values = ray.get(refs)
         except ray.exceptions.RayTaskError as error:  # the batch itself raised (not a view: those are caught)
             message = " ".join(str(error).split())[:500]
             for job in batch:
@@ -369,11 +435,13 @@ class _RayRun:
             else:
                 self.pending.appendleft(batch)
             return
-        for item in results:
-            if self.to_driver:
-                result, encoded = item
-                item = write_view(self.jobs[result.key], result, encoded)
-            self.on_result(item)
+        del refs  # the task's values are freed as soon as they are read
+        if not self.to_driver:
+            for result in values[0]:
+                self.on_result(result)
+            return
+        for result, encoded in _pieced(values):
+            self.on_result(write_view(self.jobs[result.key], result, encoded))
 
     def _replace_lost(self) -> None:
         """Every actor was lost: start new ones on the CPUs free now, or wait for one a while.
@@ -455,11 +523,11 @@ def render_many(
         ``ray.init(address=...)`` for an existing cluster (e.g. ``"auto"``).
     collect : {"driver", "workers"} or None
         Ray only: who writes the files (module docstring). ``"driver"``: the workers return the encoded bytes
-        through the object store and this process writes them, at most ``RAY_BYTES_IN_FLIGHT`` bytes of views
-        outstanding. ``"workers"``: each worker writes its own (refused for a local path on a cluster of more
-        than one node, whose nodes do not see each other's disks). None: ``"driver"`` for local paths on more
-        than one node and for ``memory://``, else ``"workers"``. The serial and process executors write in this
-        machine either way.
+        (in pieces inside the tasks' replies) and this process writes them, at most ``RAY_BYTES_IN_FLIGHT``
+        bytes of views outstanding. ``"workers"``: each worker writes its own (refused for a local path on a
+        cluster of more than one node, whose nodes do not see each other's disks). None: ``"driver"`` for local
+        paths on more than one node and for ``memory://``, else ``"workers"``. The serial and process executors
+        write in this machine either way.
 
     Returns
     -------

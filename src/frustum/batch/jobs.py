@@ -237,8 +237,10 @@ def _failed(job: RenderJob, error: Exception, render_seconds: float, worker: str
     return ViewResult(job.key, {}, f"{type(error).__name__}: {message}", render_seconds, 0.0, worker)
 
 
-def write_view(job: RenderJob, result: ViewResult, encoded: Mapping[str, bytes]) -> ViewResult:
+def write_view(job: RenderJob, result: ViewResult, encoded: Mapping[str, Any]) -> ViewResult:
     """Write the bytes ``encode_view`` returned to the job's outputs, each atomically; the result, timed.
+
+    A file's bytes may also come as a list of pieces, written one after the other (a Ray driver's ``collect``).
 
     A failed write (a full disk, a refused URL) comes back as the view's error, not raised.
     """
@@ -250,7 +252,8 @@ def write_view(job: RenderJob, result: ViewResult, encoded: Mapping[str, bytes])
     try:
         for kind, path in job.outputs.items():
             data = encoded[kind]
-            write_atomically(path, lambda file, data=data: file.write(data))
+            pieces = data if isinstance(data, list) else [data]
+            write_atomically(path, lambda file, pieces=pieces: [file.write(piece) for piece in pieces])
     except Exception as error:  # reported with the view, as a rendering failure is
         return _failed(job, error, result.render_seconds, result.worker)
     return replace(result, write_seconds=result.write_seconds + time.perf_counter() - start)
