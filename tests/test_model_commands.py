@@ -247,3 +247,15 @@ def test_no_example_changes_its_lights(monkeypatch):
     assert sum(1 for named in now.values() if named) >= len(examples) - 5
     monkeypatch.setattr(loader, "default_lights", lambda camera: [])
     assert now == {path.name: lights(path) for path in examples}
+
+
+def test_dataset_resume_refuses_another_up_axis(tower, tmp_path):
+    """The up axis turns the model: resuming a mesh file's dataset with another --up would mix two scenes."""
+    args = ["dataset", str(tower), "--out", str(tmp_path / "d"), "--views", "2", "--size", "16x12",
+            "--executor", "serial", "--no-progress", "--format", "files"]  # fmt: skip
+    main([*args, "--up", "z"])
+    manifest = json.loads((tmp_path / "d" / "manifest.jsonl").read_text().splitlines()[0])
+    assert manifest["config"]["up"] == "z"
+    main([*args, "--up", "z"])  # the same axis resumes: nothing to do
+    result = subprocess.run([sys.executable, "-m", "frustum", *args, "--up", "y"], capture_output=True, text=True)
+    assert result.returncode != 0 and "another configuration (up = 'z' → 'y')" in result.stderr

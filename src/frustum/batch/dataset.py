@@ -527,6 +527,8 @@ def render_dataset(
         "depth_format": depth_format,
         "cameras_sha256": _sha256(Path(cameras_file)) if layout == "file" and cameras_file else None,
     }
+    if scene_file.up is not None:  # a mesh file: its up axis turns the model, so a resume must match it
+        config["up"] = scene_file.up
     manifest = out / _MANIFEST
     old_config, finished = _read_manifest(out)
     if old_config is not None and old_config != config and not overwrite:

@@ -78,6 +78,8 @@ class SceneFile:
     radiosity : dict or None
         ``[radiosity]`` (``frustum.radiosity`` keywords): when given, ``render`` lights the scene by radiosity first
         and draws the lit scene with ``shading="none"``.
+    up : str or None
+        A mesh file's up axis as it was loaded ("y" or "z"; ``load_scene_file(..., up=)``); None for a TOML scene.
     """
 
     scene: Scene
@@ -94,6 +96,7 @@ class SceneFile:
     path: Path | None = None
     sheet: dict = field(default_factory=dict)
     radiosity: dict | None = None
+    up: str | None = None
 
     def resized(self, size: tuple[int, int]) -> SceneFile:
         """The same scene file with every camera's image `size` = (width, height) replaced."""
@@ -425,4 +428,4 @@ def _model_scene_file(file: Path, up: str) -> SceneFile:
     from frustum.scenefile.models import model_scene
 
     scene, camera = model_scene(file, up=up, size=_DEFAULT_SIZE)
-    return SceneFile(scene, camera, {}, (), (camera,), size=_DEFAULT_SIZE, title=file.stem, path=file)
+    return SceneFile(scene, camera, {}, (), (camera,), size=_DEFAULT_SIZE, title=file.stem, path=file, up=up)
