@@ -424,5 +424,5 @@ def test_steps_panel_is_served_over_the_guarded_socket_only(tmp_path):
                 ws.send(json.dumps({"type": "steps", "algorithm": "depth-buffer"}))
                 refused_record = _until(ws, "steps")[-1]
             assert "figures" not in refused_record and "budget" in refused_record["error"]
-            ws.send(json.dumps({"type": "steps", "algorithm": "../etc/passwd"}))
+            ws.send(json.dumps({"type": "steps", "algorithm": "../etc/passwd"}))  # outside: refused
             assert _until(ws, "ignored")[-1] == {"type": "ignored"}
