@@ -201,3 +201,18 @@ def test_rendering_a_plain_file_does_not_import_trimesh(tmp_path):
     )
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert result.stdout.strip() == "[]"
+
+
+def test_running_out_of_memory_in_a_native_reader_is_the_load_error(tmp_path, monkeypatch):
+    """A MemoryError inside frustum's own readers is said as on trimesh's path: a GeometryError naming the file."""
+    import frustum.geometry.readers as readers
+    from frustum.errors import GeometryError
+
+    path = prim.box().save(tmp_path / "box.stl")
+
+    def exhausted(file, data):
+        raise MemoryError
+
+    monkeypatch.setitem(readers._READERS, ".stl", exhausted)
+    with pytest.raises(GeometryError, match=r"box\.stl.*ran out of memory while loading"):
+        load_parts(path)

@@ -132,7 +132,10 @@ def load_parts(path: str | Path, texture: str | Path | None = None) -> list[Mesh
         _check_glb_chunks(file)
     _check_file_memory(file)
     text = _text_bytes(file)
-    native = _native_parts(file, text)
+    try:
+        native = _native_parts(file, text)
+    except MemoryError:
+        raise _memory_error(file) from None
     if native is not None:
         return _with_textures(native, file, explicit)
     import trimesh
