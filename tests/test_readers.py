@@ -216,3 +216,19 @@ def test_running_out_of_memory_in_a_native_reader_is_the_load_error(tmp_path, mo
     monkeypatch.setitem(readers._READERS, ".stl", exhausted)
     with pytest.raises(GeometryError, match=r"box\.stl.*ran out of memory while loading"):
         load_parts(path)
+
+
+def test_a_large_obj_goes_to_trimesh_with_the_same_result(monkeypatch):
+    """OBJ files over OBJ_NATIVE_BYTES are read by trimesh (its parser is faster there); the parts are the same."""
+    import frustum.geometry.readers as readers
+
+    path = DATA / "teapot_n10.obj"
+    native = load_parts(path)
+    assert read_parts(path) is not None
+    monkeypatch.setattr(readers, "OBJ_NATIVE_BYTES", path.stat().st_size - 1)
+    assert read_parts(path) is None
+    through_trimesh = load_parts(path)
+    assert len(native) == len(through_trimesh)
+    for ours, theirs in zip(native, through_trimesh, strict=True):
+        np.testing.assert_array_equal(ours.mesh.vertices, theirs.mesh.vertices)
+        np.testing.assert_array_equal(ours.mesh.faces, theirs.mesh.faces)
