@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-from frustum.raster._jit import fence, kernel, parallel_kernel, stream
+from frustum.raster._jit import fence, kernel, parallel_kernel, prefetch, stream
 from frustum.raster.shade import (
     _CHUNK,
     _DB,
@@ -223,6 +223,10 @@ def _fractions(
             s[_DR + i], s[_DG + i] = x, y
             s[_DB + i] = receiver - texel * (1.0 + (1.0 + softness) * tan_theta)  # bias taken off
             s[_SR + i] = 1.0
+            fc, fr = int(math.floor(x - 0.5)), size - 1 - int(math.floor(y - 0.5))
+            if 1 <= fr < size and 0 <= fc < size:
+                prefetch(shadow_map, np.uint64(fr), np.uint64(fc))
+                prefetch(shadow_map, np.uint64(fr - 1), np.uint64(fc))
         if not 0.0 < softness <= 1.0:  # hard, or a wider grid: the general filter
             for i in range(n):
                 if s[_SR + i] != 0.0:
