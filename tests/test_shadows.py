@@ -764,3 +764,138 @@ def _binned_fill_arguments(item, camera, depth):
     tiling = np.array([1 << TILED_BITS, binned.tiles_x, 0, depth.shape[1], depth.shape[0]], dtype=np.int64)
     return (binned.faces, binned.win_int, binned.win_float, binned.tri_int, binned.tri_float, binned.tile_starts,
             binned.tile_entries, tiling, depth)  # fmt: skip
+
+
+# --- shadow maps reused across frames (shadow_pass.kept_maps) -------------------------------------------------------
+
+
+def _spy_fills(monkeypatch) -> list:
+    """Record each depth-only map fill (a shadow map drawn, not reused)."""
+    from frustum.raster import shadow
+
+    fills = []
+    fill = shadow.fill_depth_tiles
+
+    def spy(*args):
+        fills.append(args[8].shape)
+        return fill(*args)
+
+    monkeypatch.setattr(shadow, "fill_depth_tiles", spy)
+    return fills
+
+
+def _redrawn(scene: fr.Scene, camera: fr.Camera, **options) -> fr.Frame:
+    """The frame with every shadow map drawn for it (reuse off)."""
+    from frustum import shadow_pass
+
+    previous = shadow_pass.set_map_reuse(False)
+    try:
+        return fr.render(scene, camera, shadows=True, **options)
+    finally:
+        shadow_pass.set_map_reuse(previous)
+
+
+def _orbit(angle: float) -> fr.Camera:
+    return fr.Camera.look_at((8.0 * math.cos(angle), 5.0, 8.0 * math.sin(angle)), (0.0, 0.5, 0.0), (0.0, 1.0, 0.0),
+                             width=200, height=160)  # fmt: skip
+
+
+def _small_teapot_on_plane(light) -> fr.Scene:
+    """The teapot on a 3 × 3 ground, as one mesh: ``_orbit``'s cameras see all of it."""
+    scene = fr.Scene(lights=[fr.AmbientLight(intensity=0.2), light])
+    _ground(scene, 3.0)
+    teapot = _teapot_on_plane(light).items[1]
+    scene.add(teapot.mesh, teapot.material, transform=teapot.world_from_model)
+    return _one_mesh(scene)
+
+
+def test_a_reused_shadow_map_gives_the_bytes_of_a_redrawn_one(monkeypatch):
+    """A turntable (the camera orbits a model it sees whole, the light fixed): the one-mesh tile pipeline draws the
+    map once and reuses it for every view (the map is fitted to what the camera sees, here all of the model);
+    every frame has the bytes of the same frame with its map drawn for it."""
+    from frustum import shadow_pass
+
+    shadow_pass.release_memory()
+    scene = _small_teapot_on_plane(LIGHTS["directional"])
+    fills = _spy_fills(monkeypatch)
+    calls = _spy_tiled(monkeypatch)
+    drawn = []
+    for angle in np.linspace(0.0, 2.0 * math.pi, 5, endpoint=False):
+        camera = _orbit(angle)
+        count = len(fills)
+        frame = fr.render(scene, camera, shadows=True, cull_back_faces=False)
+        drawn.append(len(fills) - count)
+        assert np.array_equal(frame.color, _redrawn(scene, camera, cull_back_faces=False).color), angle
+    assert drawn == [1, 0, 0, 0, 0]  # drawn for the first view only
+    assert len(fills) == 6 and len(calls) == 10  # the five reference frames drew their own maps
+    plain = fr.render(scene, _orbit(0.0), cull_back_faces=False).color
+    assert not np.array_equal(frame.color, plain)  # there are shadows to get right
+
+
+def test_a_changed_mesh_light_or_map_size_draws_the_map_again(monkeypatch):
+    """The kept map is not reused once anything it depends on changes: the vertices changed in place (a mesh made
+    with copy=False shares the caller's array), the faces, the light's direction, the map's size or softness (its
+    fitted margin), the modeling transform; each frame equals the frame drawn without reuse."""
+    from frustum import shadow_pass
+
+    shadow_pass.release_memory()
+    merged = _small_teapot_on_plane(LIGHTS["directional"]).items[0].mesh
+    vertices = np.array(merged.vertices)
+    faces = np.array(merged.faces, dtype=np.int32)
+    mesh = fr.Mesh(vertices, faces, vertex_normals=merged.vertex_normals, copy=False)
+    light = LIGHTS["directional"]
+
+    def scene_of(mesh, light, transform=None):
+        scene = fr.Scene(lights=[fr.AmbientLight(intensity=0.2), light])
+        scene.add(mesh, fr.Material(color=(0.9, 0.8, 0.3)), transform=transform)
+        return scene
+
+    fills = _spy_fills(monkeypatch)
+    camera = _orbit(0.7)
+    steps = []
+
+    def frame(scene, **options):
+        count = len(fills)
+        picture = fr.render(scene, camera, shadows=True, cull_back_faces=False, **options)
+        steps.append(len(fills) - count)
+        assert np.array_equal(picture.color, _redrawn(scene, camera, cull_back_faces=False, **options).color)
+        return picture
+
+    first = frame(scene_of(mesh, light))
+    frame(scene_of(mesh, light))  # the same: reused
+    lifted = vertices[:, 1] > 1.0  # the teapot's upper part moves: its shadow moves
+    vertices[lifted, 0] += 0.4
+    moved = frame(scene_of(mesh, light))
+    assert not np.array_equal(moved.color, first.color)
+    frame(scene_of(mesh, light))  # reused again
+    faces[:, [1, 2]] = faces[:, [2, 1]]  # the faces turned over (in place)
+    frame(scene_of(mesh, light))
+    faces[:, [1, 2]] = faces[:, [2, 1]]
+    frame(scene_of(mesh, dataclasses.replace(light, direction=(1.0, -0.9, -0.3))))
+    frame(scene_of(mesh, light), shadow_map_size=1024)
+    frame(scene_of(mesh, light), shadow_softness=3.0)
+    frame(scene_of(mesh, light, transform=translate(0.0, 1e-3, 0.0)))
+    assert steps == [1, 0, 1, 0, 1, 1, 1, 1, 1], steps
+
+
+def test_map_reuse_can_be_turned_off_and_memory_released(monkeypatch):
+    """``set_map_reuse(False)`` draws every frame's map; ``release_memory`` frees the kept ones (the next frame
+    draws its map again)."""
+    from frustum import shadow_pass
+
+    scene = _one_mesh(_teapot_on_plane(LIGHTS["directional"]))
+    fills = _spy_fills(monkeypatch)
+    fr.render(scene, CAMERA, shadows=True)
+    fr.render(scene, CAMERA, shadows=True)
+    drawn = len(fills)
+    assert drawn <= 1
+    assert fr.release_memory() >= 2048 * 2048 * 4
+    fr.render(scene, CAMERA, shadows=True)
+    assert len(fills) == drawn + 1
+    assert shadow_pass.set_map_reuse(False) is True
+    try:
+        fr.render(scene, CAMERA, shadows=True)
+        fr.render(scene, CAMERA, shadows=True)
+        assert len(fills) == drawn + 3
+    finally:
+        assert shadow_pass.set_map_reuse(True) is False

@@ -9,7 +9,8 @@ shadow-casting light in one of two ways.
   ``shadow_map_size``² texels; both sides of an open surface, the front faces of a closed one). A directional
   light gets an orthographic map fitted to what the camera sees (the light-space box of the drawn points, widened
   by the filter's reach; a frame of one mesh drawn tile by tile, ``render.shadows.draw_tiled``, fits it before
-  drawing: ``view_map``) and
+  drawing: ``view_map``, and reuses the map of an earlier frame when the casters' bytes, their transform, the
+  light camera and the size are the same: ``kept_maps``, ``set_map_reuse``) and
   deep enough toward the light to hold every caster (the scene's box); a spot light a perspective map over its
   cone; a point light a cube of six perspective maps (each a little wider than 90° so filter taps near a cube
   edge stay on their face). A point is lit where its distance along the light's axis, less a bias, is not beyond
@@ -57,8 +58,9 @@ from frustum.scene import Scene, SceneItem
 from frustum.shading import AmbientLight, DirectionalLight, PointLight, SpotLight
 
 __all__ = [
-    "SHADOW_METHODS", "ShadowOptions", "check_shadows", "give_back", "light_fractions", "map_record", "occluded",
-    "release_memory", "shadow_lights", "surface_points", "take_array", "view_map",
+    "SHADOW_METHODS", "ShadowOptions", "casters_key", "check_shadows", "give_back", "keep_maps", "kept_maps",
+    "light_fractions", "map_key", "map_record", "occluded", "release_memory", "set_map_reuse", "shadow_lights",
+    "surface_points", "take_array", "view_map",
 ]  # fmt: skip
 
 SHADOW_METHODS = (None, False, True, "ray")
@@ -91,11 +93,101 @@ def give_back(*arrays: np.ndarray) -> None:
 
 
 def release_memory() -> int:
-    """Free the work arrays the shadow pass keeps between frames; return their bytes."""
+    """Free the work arrays the shadow pass keeps between frames and the shadow maps kept for reuse; return their
+    bytes."""
     with _POOL_LOCK:
         released = sum(a.nbytes for arrays in _POOL.values() for a in arrays)
+        released += sum(maps.nbytes for _, maps in _KEPT)
         _POOL.clear()
+        _KEPT.clear()
     return released
+
+
+_KEPT: list[tuple[tuple, np.ndarray]] = []
+"""Shadow maps kept for reuse, ``(key, maps)``, the most recently used last (``kept_maps``, ``keep_maps``)."""
+KEPT_MAPS = 2
+"""How many drawn map sets (one frame's maps) are kept for reuse."""
+KEPT_BYTES = 256 << 20
+"""The most bytes of shadow maps kept for reuse (a set larger than this is drawn every frame: 4096² maps of four
+lights are 256 MiB)."""
+_REUSE = [True]
+
+
+def set_map_reuse(enabled: bool) -> bool:
+    """Whether ``render`` may reuse a shadow map drawn for an earlier frame when nothing it depends on has changed
+    (on by default; off: every frame draws its maps, as a benchmark of the map pass wants); returns the previous
+    setting. The maps kept so far stay kept (``release_memory`` frees them)."""
+    previous = _REUSE[0]
+    _REUSE[0] = bool(enabled)
+    return previous
+
+
+def casters_key(item: SceneItem, cull: bool) -> tuple | None:
+    """What a shadow map of one placed mesh depends on besides the light's camera: fingerprints of the bytes of its
+    vertices and faces (``raster.shadow.fingerprint``, ~0.1 ms for 10⁵ faces: a vertex array changed in place,
+    which a ``Mesh(copy=False)`` would allow, changes the key too), its modeling transform and whether back faces
+    are skipped; None where maps are not reused (``set_map_reuse``)."""
+    if not _REUSE[0]:
+        return None
+    from frustum.raster import shadow
+
+    mesh = item.mesh
+    return (
+        int(shadow.fingerprint(_words(mesh.vertices), np.uint64(mesh.vertices.dtype.itemsize))),
+        int(shadow.fingerprint(_words(mesh.faces), np.uint64(mesh.faces.dtype.itemsize))),
+        mesh.vertices.shape,
+        mesh.faces.shape,
+        np.asarray(item.world_from_model, dtype=np.float64).tobytes(),
+        bool(cull),
+    )
+
+
+def _words(array: np.ndarray) -> np.ndarray:
+    """The bytes of `array` as (n,) uint64 words, the last one zero-padded (a view where the size allows)."""
+    data = np.ascontiguousarray(array).reshape(-1).view(np.uint8)
+    whole = data.size // 8 * 8
+    if whole == data.size and data.ctypes.data % 8 == 0:
+        return data.view(np.uint64)
+    words = np.zeros(-(-data.size // 8), dtype=np.uint64)
+    words.view(np.uint8)[: data.size] = data
+    return words
+
+
+def map_key(casters: tuple | None, cameras: list[Camera], records: np.ndarray) -> tuple | None:
+    """The key of one frame's map set: the casters' key (``casters_key``) and each light camera's matrices, size
+    and record; None where maps are not reused."""
+    if casters is None:
+        return None
+    lights = tuple((np.asarray(c.clip_from_world, dtype=np.float64).tobytes(), c.width, c.height) for c in cameras)
+    return casters, lights, records.tobytes()
+
+
+def kept_maps(key: tuple | None, shape: tuple[int, ...]) -> np.ndarray | None:
+    """The map set drawn earlier under `key` (``keep_maps``), or None."""
+    if key is None:
+        return None
+    with _POOL_LOCK:
+        for at, (kept, maps) in enumerate(_KEPT):
+            if kept == key and maps.shape == shape:
+                _KEPT.append(_KEPT.pop(at))
+                return maps
+    return None
+
+
+def keep_maps(key: tuple | None, maps: np.ndarray) -> None:
+    """Keep the map set `maps` just drawn under `key` for later frames (``kept_maps``); the least recently used set
+    beyond ``KEPT_MAPS`` sets or ``KEPT_BYTES`` goes back to the work-array pool. Without a key (reuse off) or too
+    large, `maps` goes straight back to the pool."""
+    if key is None or maps.nbytes > KEPT_BYTES:
+        give_back(maps)
+        return
+    with _POOL_LOCK:
+        _KEPT[:] = [(kept, m) for kept, m in _KEPT if kept != key]
+        _KEPT.append((key, maps))
+        evicted = []
+        while len(_KEPT) > KEPT_MAPS or sum(m.nbytes for _, m in _KEPT) > KEPT_BYTES:
+            evicted.append(_KEPT.pop(0)[1])
+    give_back(*evicted)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -362,17 +454,24 @@ def view_map(
     camera's view volume (their intersection, a convex polytope, clipped exactly), cut down to the light-view box
     of the vertices. (The stage-by-stage path fits its map to the drawn points themselves, ``light_fractions``:
     the one-mesh tile pipeline shades as it draws.) None where the mesh's box misses the view volume."""
-    columns = np.ascontiguousarray(np.asarray(world, dtype=np.float64).T)  # (3, N): fast reductions, no BLAS
-    box = np.array([columns.min(axis=1), columns.max(axis=1)])
+    from frustum.raster import shadow
+
+    to_light = -np.asarray(light.direction, dtype=np.float64)
+    view = ViewFrame(np.zeros(3), normal=to_light, up=_up_for(to_light)).matrix[:3, :3]
+    points = np.asarray(world)
+    if points.dtype not in (np.float32, np.float64) or not points.flags.c_contiguous:
+        points = np.ascontiguousarray(points, dtype=np.float64)
+    if points.shape[0] == 0:
+        return None
+    bounds = np.empty((4, 3))
+    shadow.fit_points(points, np.ascontiguousarray(view), bounds)  # one pass: the box and the light-view box
+    box = bounds[:2]
     polytope = _box_in_view(box, camera)
     if polytope.shape[0] == 0:
         return None
-    to_light = -np.asarray(light.direction, dtype=np.float64)
-    view = ViewFrame(np.zeros(3), normal=to_light, up=_up_for(to_light)).matrix[:3, :3]
     inside = polytope @ view.T
-    seen = [(columns[0] * r[0] + columns[1] * r[1]) + columns[2] * r[2] for r in view]
-    low = np.maximum(inside.min(axis=0), [axis.min() for axis in seen])
-    high = np.minimum(inside.max(axis=0), [axis.max() for axis in seen])
+    low = np.maximum(inside.min(axis=0), bounds[2])
+    high = np.minimum(inside.max(axis=0), bounds[3])
     if (low > high).any():
         return None
     return _directional_camera(to_light, low, high, box, size, (softness + _MARGIN_TEXELS) / size)

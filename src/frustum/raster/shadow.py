@@ -539,3 +539,64 @@ def _fill_depth_tile(
                     z = np.float32(z_row + alpha * float(px0 - x0 + SUBPIXEL * k))
                     inside = (e0 - step0 * k >= bias0) & (e1 - step1 * k >= bias1) & (e2 - step2 * k >= bias2)
                     depth[at_row, at] = z if inside & (z < d) else d
+
+
+@kernel
+def fit_points(points: np.ndarray, view: np.ndarray, bounds: np.ndarray) -> None:
+    """One pass over the (N >= 1, 3) points: ``bounds`` (4, 3) float64 gets their box (rows 0, 1: lowest and
+    highest x, y, z) and the box of their light-view coordinates (rows 2, 3), the coordinate along row r of the
+    (3, 3) `view` being $(p_0·v_{r0} + p_1·v_{r1}) + p_2·v_{r2}$ (``shadow_pass.view_map``'s order)."""
+    for a in range(3):
+        bounds[0, a], bounds[1, a] = math.inf, -math.inf
+        bounds[2, a], bounds[3, a] = math.inf, -math.inf
+    v00, v01, v02 = view[0, 0], view[0, 1], view[0, 2]
+    v10, v11, v12 = view[1, 0], view[1, 1], view[1, 2]
+    v20, v21, v22 = view[2, 0], view[2, 1], view[2, 2]
+    lx, ly, lz, hx, hy, hz = math.inf, math.inf, math.inf, -math.inf, -math.inf, -math.inf
+    la, lb, lc, ha, hb, hc = math.inf, math.inf, math.inf, -math.inf, -math.inf, -math.inf
+    for i in range(points.shape[0]):
+        x, y, z = float(points[i, 0]), float(points[i, 1]), float(points[i, 2])
+        lx, ly, lz = min(lx, x), min(ly, y), min(lz, z)
+        hx, hy, hz = max(hx, x), max(hy, y), max(hz, z)
+        a = (x * v00 + y * v01) + z * v02
+        b = (x * v10 + y * v11) + z * v12
+        c = (x * v20 + y * v21) + z * v22
+        la, lb, lc = min(la, a), min(lb, b), min(lc, c)
+        ha, hb, hc = max(ha, a), max(hb, b), max(hc, c)
+    bounds[0, 0], bounds[0, 1], bounds[0, 2] = lx, ly, lz
+    bounds[1, 0], bounds[1, 1], bounds[1, 2] = hx, hy, hz
+    bounds[2, 0], bounds[2, 1], bounds[2, 2] = la, lb, lc
+    bounds[3, 0], bounds[3, 1], bounds[3, 2] = ha, hb, hc
+
+
+_MIX = np.uint64(0x9E3779B97F4A7C15)
+_MIX2 = np.uint64(0xBF58476D1CE4E5B9)
+
+
+@kernel
+def fingerprint(words: np.ndarray, seed: np.uint64) -> np.uint64:
+    """A 64-bit fingerprint of the 1-D uint64 `words` (an array's bytes): four interleaved multiply–xorshift lanes
+    (every bit of every word reaches the result; not cryptographic), folded with the count. Used to tell a shadow
+    map's casters apart from the last frame's (``shadow_pass``), ~0.05 ms per MiB."""
+    h0, h1 = seed ^ _MIX, seed ^ _MIX2
+    h2, h3 = (seed + _MIX) * _MIX2, (seed + _MIX2) * _MIX
+    n = words.shape[0]
+    quads = n // 4
+    for q in range(quads):
+        at = 4 * q
+        h0 = (h0 ^ words[at]) * _MIX
+        h1 = (h1 ^ words[at + 1]) * _MIX
+        h2 = (h2 ^ words[at + 2]) * _MIX
+        h3 = (h3 ^ words[at + 3]) * _MIX
+        h0 ^= h0 >> np.uint64(29)
+        h1 ^= h1 >> np.uint64(29)
+        h2 ^= h2 >> np.uint64(29)
+        h3 ^= h3 >> np.uint64(29)
+    for at in range(4 * quads, n):
+        h0 = (h0 ^ words[at]) * _MIX
+        h0 ^= h0 >> np.uint64(29)
+    h = h0 ^ (h1 * _MIX2) ^ ((h2 ^ (h2 >> np.uint64(31))) * _MIX) ^ ((h3 ^ (h3 >> np.uint64(27))) * _MIX2)
+    h ^= np.uint64(n)
+    h = (h ^ (h >> np.uint64(30))) * _MIX2
+    h = (h ^ (h >> np.uint64(27))) * _MIX
+    return h ^ (h >> np.uint64(31))

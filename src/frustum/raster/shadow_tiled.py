@@ -223,7 +223,7 @@ def _fractions(
             s[_DR + i], s[_DG + i] = x, y
             s[_DB + i] = receiver - texel * (1.0 + (1.0 + softness) * tan_theta)  # bias taken off
             s[_SR + i] = 1.0
-            fc, fr = int(math.floor(x - 0.5)), size - 1 - int(math.floor(y - 0.5))
+            fc, fr = int(math.floor(x - 0.5)), size - 1 - int(math.floor(y - 0.5))  # noqa: RUF046
             if 1 <= fr < size and 0 <= fc < size:
                 prefetch(shadow_map, np.uint64(fr), np.uint64(fc))
                 prefetch(shadow_map, np.uint64(fr - 1), np.uint64(fc))

@@ -161,8 +161,11 @@ def draw_tiled(
 ) -> None:  # fmt: skip
     """Stages 1–5 of a frame of one opaque mesh with shadow maps, tile by tile (``raster.shadow_tiled``): each
     shadow-casting (directional) light's map is fitted to what the camera can see of the mesh before anything is
-    drawn (``shadow_pass.view_map``) and filled; then each tile is filled and shaded, the map lookups made per
-    pixel inside the shading (no image-sized world points, normals or fractions)."""
+    drawn (``shadow_pass.view_map``) and filled, or taken as it is from an earlier frame where nothing it depends
+    on changed (``shadow_pass.kept_maps``: the same vertex and face bytes, modeling transform, light camera and
+    size, as in a turntable of a model the camera sees whole under a fixed sun); then each tile is filled and
+    shaded, the map lookups made per pixel inside the shading (no image-sized world points, normals or
+    fractions)."""
     from frustum import shadow_pass
     from frustum.raster import shadow, shadow_tiled
 
@@ -175,13 +178,21 @@ def draw_tiled(
     records = [(row, found) for row, found in zip(rows, fitted, strict=True) if found is not None]
     check_memory(len(records) * size * size * 4, where="render",
                  cause=f"shadow_map_size = {size} with {len(records)} shadow-casting light(s)")  # fmt: skip
-    maps = shadow_pass.take_array((max(len(records), 1), size, size), np.float32)
-    views = np.zeros((max(len(records), 1), shadow.MAP_FIELDS))
+    shape = (max(len(records), 1), size, size)
+    views = np.zeros((shape[0], shadow.MAP_FIELDS))
     map_of = np.full(lights.shape[0], -1, dtype=np.int64)
     for m, (row, (light_camera, texel)) in enumerate(records):
-        draw_depth(item, light_camera, maps[m], True)
         views[m] = shadow_pass.map_record(light_camera, texel, None)
         map_of[row] = m
+    cull = bool(item.mesh.is_watertight)
+    key = None
+    if records:  # the maps depend on the casters, the light cameras and nothing else: reused while those stay
+        key = shadow_pass.map_key(shadow_pass.casters_key(item, cull), [found[0] for _, found in records], views)
+    maps = shadow_pass.kept_maps(key, shape)
+    if maps is None:
+        maps = shadow_pass.take_array(shape, np.float32)
+        for m, (_, (light_camera, _)) in enumerate(records):
+            draw_depth(item, light_camera, maps[m], True)
     tiling = np.array([1 << TILED_BITS, binned.tiles_x, 0, camera.width, camera.height], dtype=np.int64)
     params = shading_parameters(item, camera, options, lighting.ambient)
     flags = item_flags(0, 0, options, False, False, False)
@@ -190,4 +201,4 @@ def draw_tiled(
         binned.tile_starts, binned.tile_entries, tiling, buffers.depth, world, normals, params, lights,
         flags, options.background, buffers.color, maps, views, map_of, softness,
     )  # fmt: skip
-    shadow_pass.give_back(maps)
+    shadow_pass.keep_maps(key, maps)
