@@ -427,11 +427,14 @@ def _light_cameras(
 
 
 def _directional_camera(
-    to_light: np.ndarray, low: np.ndarray, high: np.ndarray, box: np.ndarray, size: int, reach: float
+    to_light: np.ndarray, low: np.ndarray, high: np.ndarray, box: np.ndarray, size: int, reach: float,
+    frame: ViewFrame | None = None,
 ) -> tuple[Camera, float]:  # fmt: skip
     """The orthographic map over the light-view box [low, high] of the receivers (``_light_cameras``), deep enough
-    toward the light for the casters' box, widened by `reach` (a fraction of its side) on each side."""
-    frame = ViewFrame(np.zeros(3), normal=to_light, up=_up_for(to_light))
+    toward the light for the casters' box, widened by `reach` (a fraction of its side) on each side. `frame`: the
+    light's view frame at the origin, where the caller has it."""
+    if frame is None:
+        frame = ViewFrame(np.zeros(3), normal=to_light, up=_up_for(to_light))
     view = frame.matrix[:3, :3]
     corners = np.array(np.meshgrid(*box.T, indexing="ij")).reshape(3, -1).T
     side = float(max(high[0] - low[0], high[1] - low[1]))
@@ -457,7 +460,8 @@ def view_map(
     from frustum.raster import shadow
 
     to_light = -np.asarray(light.direction, dtype=np.float64)
-    view = ViewFrame(np.zeros(3), normal=to_light, up=_up_for(to_light)).matrix[:3, :3]
+    frame = ViewFrame(np.zeros(3), normal=to_light, up=_up_for(to_light))
+    view = frame.matrix[:3, :3]
     points = np.asarray(world)
     if points.dtype not in (np.float32, np.float64) or not points.flags.c_contiguous:
         points = np.ascontiguousarray(points, dtype=np.float64)
@@ -474,7 +478,7 @@ def view_map(
     high = np.minimum(inside.max(axis=0), bounds[3])
     if (low > high).any():
         return None
-    return _directional_camera(to_light, low, high, box, size, (softness + _MARGIN_TEXELS) / size)
+    return _directional_camera(to_light, low, high, box, size, (softness + _MARGIN_TEXELS) / size, frame)
 
 
 def _box_in_view(box: np.ndarray, camera: Camera) -> np.ndarray:
@@ -482,16 +486,23 @@ def _box_in_view(box: np.ndarray, camera: Camera) -> np.ndarray:
     where they do not meet): every face of each solid clipped by the other's planes (Sutherland–Hodgman, in
     Python floats: a few hundred small steps)."""
     clip = np.asarray(camera.clip_from_world, dtype=np.float64)
-    view_planes = [tuple(clip[3] + clip[i]) for i in range(3)] + [tuple(clip[3] - clip[i]) for i in range(3)]
+    cube = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], dtype=np.float64)
+    inside = box[0] + cube * (box[1] - box[0])
+    planes = np.concatenate([clip[3] + clip[:3], clip[3] - clip[:3]])
+    values = (planes[:, :1] * inside[:, 0] + planes[:, 1:2] * inside[:, 1]) + (
+        planes[:, 2:3] * inside[:, 2] + planes[:, 3:]
+    )  # _clip_polygon's values of each corner (columns) for each plane (rows)
+    if (values > 0.0).all():  # the box strictly inside the view volume: the intersection is the box (a turntable)
+        return inside
+    view_planes = [tuple(plane) for plane in planes]
     box_planes = []
     for axis in range(3):
         low, high = [0.0] * 4, [0.0] * 4
         low[axis], low[3] = 1.0, -float(box[0, axis])
         high[axis], high[3] = -1.0, float(box[1, axis])
         box_planes += [tuple(low), tuple(high)]
-    cube = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], dtype=np.float64)
     quads = [[0, 1, 3, 2], [4, 5, 7, 6], [0, 1, 5, 4], [2, 3, 7, 6], [0, 2, 6, 4], [1, 3, 7, 5]]
-    box_corners = (box[0] + cube * (box[1] - box[0])).tolist()
+    box_corners = inside.tolist()
     ndc = np.hstack([2.0 * cube - 1.0, np.ones((8, 1))]) @ np.linalg.inv(clip).T
     view_corners = (ndc[:, :3] / ndc[:, 3:]).tolist()
     found: list = []
