@@ -1,19 +1,28 @@
 """Benchmark: shadows in ``frustum.render`` against shadows off, Mesa llvmpipe's shadow mapping and Embree's rays.
 
-    python benchmarks/bench_shadows.py [--scene bunny_like_100k] [--frames 5] [--warmup 1] [--scene-dir DIR]
+    python benchmarks/bench_shadows.py [--scenes bunny_like_100k ...] [--frames 5] [--warmup 1] [--scene-dir DIR]
+                                       [--views 8] [--json PATH]
 
-On a standard scene of ``../shared/bench`` (default ``bunny_like_100k``, 1024², its directional light; the torus
-knot shadows itself), in one run, medians of ``--frames`` frames after ``--warmup``:
+On the standard scenes of ``../shared/bench`` (default ``bunny_like_100k`` first, then ``bunny_like_100k_4k``,
+``sphere_1m``, ``terrain_2m``; each with its own size and directional light), in one run per scene, medians of
+``--frames`` frames after ``--warmup``, the variants of a frame interleaved (off, redrawn, reused, off, ...):
 
-- frustum: shadows off, shadow maps (``shadows=True``, 2048² map, 2×2 bilinear PCF), shadow rays (``shadows="ray"``),
-  with the scene's directional light and with one point light (shadows off and on); ratio shadowed / unshadowed
-  (target: <= 1.5 for the directional light);
+- frustum with the scene's directional light: shadows off; shadow maps (``shadows=True``, 2048² map, 2×2 bilinear
+  PCF) **redrawn every frame** (``shadow_pass.set_map_reuse(False)``: fit, bin and fill the map, then the frame);
+  shadow maps **reused** (the same scene, light and view: the map drawn for an earlier frame is taken as it is,
+  ``shadow_pass.kept_maps``); ratios shadowed / unshadowed for both (target: <= 1.5, directional);
+- a turntable: ``--views`` cameras orbiting the scene's target at the scene camera's height and at least the
+  distance at which the whole model is in view (the map is fitted to what the camera sees: only a view that
+  sees all of the model can reuse it), frames with shadows off and with maps reused; ratio and how many of the
+  views drew their map;
+- the scene with one point light (shadows off and on: a cube of six maps drawn every frame, the stage-by-stage
+  path);
 - llvmpipe (``benchmarks/anchor_moderngl_shadows.py``, a child process): the same scene without and with a
-  2048² depth-texture shadow map, ``sampler2DShadow`` with 2×2 PCF taps; ratio frustum shadowed / llvmpipe
-  shadowed (target: <= 0.6);
-- the shadow-ray pass alone: the rays from every drawn pixel toward the light through frustum's any-hit query
-  (``shadow_pass.occluded``) and through Embree (``embreex`` OCCLUDED query, same origins, directions and
-  distances); ratio frustum / Embree (target: <= 3). Index builds are reported apart.
+  2048² depth-texture shadow map drawn every frame, ``sampler2DShadow`` with 2×2 PCF taps; ratio frustum
+  shadowed (map redrawn: like for like) / llvmpipe shadowed (target: <= 0.6);
+- the first scene only: the shadow-ray pass alone, the rays from every drawn pixel toward the light through
+  frustum's any-hit query (``shadow_pass.occluded``) and through Embree (``embreex`` OCCLUDED query, same
+  origins, directions and distances); ratio frustum / Embree (target: <= 3). Index builds are reported apart.
 
 Timings on a shared machine are noisy: read the ratios, measured in the same run.
 """
@@ -22,6 +31,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import statistics
 import subprocess
 import sys
@@ -34,6 +44,7 @@ HERE = Path(__file__).resolve().parent
 BENCH_DIR = HERE.parents[0].parent / "shared" / "bench"
 if not BENCH_DIR.is_dir():
     BENCH_DIR = Path("/work/shared/bench")
+DEFAULT_SCENES = ["bunny_like_100k", "bunny_like_100k_4k", "sphere_1m", "terrain_2m"]
 
 
 def _median_ms(work, frames: int, warmup: int) -> float:
@@ -47,25 +58,64 @@ def _median_ms(work, frames: int, warmup: int) -> float:
     return statistics.median(times)
 
 
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--scene", default="bunny_like_100k")
-    parser.add_argument("--frames", type=int, default=5)
-    parser.add_argument("--warmup", type=int, default=1)
-    parser.add_argument("--scene-dir", default="/tmp/frustum-bench/scenes")
-    parser.add_argument("--json", default=None)
-    args = parser.parse_args(argv)
+def _interleaved_ms(variants: dict, frames: int, warmup: int) -> dict[str, float]:
+    """Median ms of each variant (a callable), one frame of each in turn per round (drift in the machine's load
+    reaches every variant alike)."""
+    times: dict[str, list[float]] = {name: [] for name in variants}
+    for round_ in range(warmup + frames):
+        for name, work in variants.items():
+            t0 = time.perf_counter()
+            work()
+            if round_ >= warmup:
+                times[name].append((time.perf_counter() - t0) * 1e3)
+    return {name: statistics.median(values) for name, values in times.items()}
 
+
+def _turntable(frustum, sc, views: int) -> list:
+    """`views` cameras around the scene's target, at the scene camera's height above it and a distance at least
+    that at which the model's bounding sphere fits the field of view."""
+    eye, target = np.asarray(sc["eye"], dtype=np.float64), np.asarray(sc["target"], dtype=np.float64)
+    up = np.asarray(sc["up"], dtype=np.float64)
+    up = up / np.linalg.norm(up)
+    vertices = np.asarray(sc["vertices"], dtype=np.float64)
+    centre = 0.5 * (vertices.min(axis=0) + vertices.max(axis=0))
+    radius = float(np.linalg.norm(vertices - centre, axis=1).max())
+    width, height = int(sc["width"]), int(sc["height"])
+    fovy = math.radians(float(sc["fovy_deg"]))
+    half = min(fovy, 2.0 * math.atan(math.tan(fovy / 2.0) * width / height)) / 2.0
+    offset = eye - target
+    rise = float(offset @ up)
+    across = offset - rise * up
+    reach = radius + float(np.linalg.norm(centre - target))  # the model's sphere around the target
+    distance = max(float(np.linalg.norm(offset)), 1.1 * reach / math.sin(half))
+    scale = distance / float(np.linalg.norm(offset))
+    side = np.cross(up, across)
+    cameras = []
+    for k in range(views):
+        angle = 2.0 * math.pi * k / views
+        turned = math.cos(angle) * across + math.sin(angle) * side
+        position = target + scale * (turned + rise * up)
+        far = max(float(sc["far"]), 2.0 * (distance + radius))
+        cameras.append(frustum.Camera.look_at(
+            position, target, up, projection=frustum.Perspective(fovy, float(sc["near"]), far),
+            width=width, height=height,
+        ))  # fmt: skip
+    return cameras
+
+
+def bench_scene(name: str, args, first_scene: bool) -> dict:
+    """One standard scene's rows (see the module docstring)."""
     sys.path.insert(0, str(BENCH_DIR))
     import scenes
 
-    path = Path(args.scene_dir) / f"{args.scene}.npz"
+    path = Path(args.scene_dir) / f"{name}.npz"
     if not path.exists():
-        scenes.main(["--only", args.scene, "--out", str(args.scene_dir)])
+        scenes.main(["--only", name, "--out", str(args.scene_dir)])
     sc = scenes.load_scene(str(path))
 
     import frustum
     from frustum import shadow_pass
+    from frustum.raster import shadow
 
     width, height = int(sc["width"]), int(sc["height"])
     mesh = frustum.Mesh(sc["vertices"], sc["faces"], vertex_normals=sc["normals"], copy=False)
@@ -85,28 +135,99 @@ def main(argv: list[str] | None = None) -> int:
         "point": frustum.PointLight(position=centre + 2.5 * radius * to_light),
     }
     background = tuple(float(c) for c in sc["background"])
-    results: dict = {"scene": args.scene, "width": width, "height": height}
-    for name, light in lights.items():
-        scene = frustum.Scene(lights=[light])
-        scene.add(mesh, material=material)
-        variants = {"off": {}, "maps": {"shadows": True}}
-        if name == "directional":
-            variants["ray"] = {"shadows": "ray"}
-        first = {}
-        for variant, extra in variants.items():
-            t0 = time.perf_counter()
-            frustum.render(scene, camera, background=background, **extra)
-            first[variant] = time.perf_counter() - t0
-            results[f"{name}_{variant}_ms"] = _median_ms(
-                lambda extra=extra, scene=scene: frustum.render(scene, camera, background=background, **extra),
-                args.frames, args.warmup,
-            )  # fmt: skip
-        results[f"{name}_first_call_s"] = first
-        print(f"frustum {name}: " + ", ".join(f"{v} {results[f'{name}_{v}_ms']:.1f} ms" for v in variants), flush=True)
-
-    # the shadow-ray pass alone, against Embree on the same rays
+    results: dict = {"scene": name, "width": width, "height": height, "triangles": int(sc["faces"].shape[0])}
     scene = frustum.Scene(lights=[lights["directional"]])
     scene.add(mesh, material=material)
+
+    def frame(camera=camera, reuse=True, **extra):
+        shadow_pass.set_map_reuse(reuse)
+        try:
+            frustum.render(scene, camera, background=background, **extra)
+        finally:
+            shadow_pass.set_map_reuse(True)
+
+    first = {}
+    for variant, extra in (("off", {}), ("redrawn", {"shadows": True, "reuse": False})):
+        t0 = time.perf_counter()
+        frame(**extra)
+        first[variant] = time.perf_counter() - t0
+    results["directional_first_call_s"] = first
+    fills = []
+    fill = shadow.fill_depth_tiles
+
+    def counted(*arguments):
+        fills.append(1)
+        return fill(*arguments)
+
+    shadow.fill_depth_tiles = counted
+    try:
+        timed = _interleaved_ms({
+            "off": lambda: frame(),
+            "redrawn": lambda: frame(shadows=True, reuse=False),
+            "reused": lambda: frame(shadows=True),
+        }, args.frames, args.warmup)  # fmt: skip
+        frames_drawn = args.frames + args.warmup
+        results["directional_maps_drawn_when_reused"] = len(fills) - frames_drawn  # the redrawn variant's excluded
+        for variant, ms in timed.items():
+            results[f"directional_{variant}_ms"] = ms
+        # the turntable: every view sees the whole model, so one map serves all
+        cameras = _turntable(frustum, sc, args.views)
+        shadow_pass.release_memory()
+        fills.clear()
+        spins = {"off": [], "reused": []}
+        for round_ in range(args.warmup + args.frames):
+            for variant, extra in (("off", {}), ("reused", {"shadows": True})):
+                t0 = time.perf_counter()
+                for view in cameras:
+                    frame(view, **extra)
+                if round_ >= args.warmup:
+                    spins[variant].append((time.perf_counter() - t0) * 1e3 / len(cameras))
+        results["turntable_views"] = len(cameras)
+        results["turntable_maps_drawn"] = len(fills)
+        results["turntable_frames"] = len(cameras) * (args.warmup + args.frames)
+        for variant, values in spins.items():
+            results[f"turntable_{variant}_ms"] = statistics.median(values)
+    finally:
+        shadow.fill_depth_tiles = fill
+    print(f"{name} directional: " + ", ".join(f"{v} {results[f'directional_{v}_ms']:.1f} ms" for v in timed)
+          + f"; turntable of {len(cameras)} views: off {results['turntable_off_ms']:.1f}, reused "
+          f"{results['turntable_reused_ms']:.1f} ms ({results['turntable_maps_drawn']} maps drawn in "
+          f"{results['turntable_frames']} frames)", flush=True)  # fmt: skip
+    point = frustum.Scene(lights=[lights["point"]])
+    point.add(mesh, material=material)
+    timed = _interleaved_ms({
+        "off": lambda: frustum.render(point, camera, background=background),
+        "maps": lambda: frustum.render(point, camera, background=background, shadows=True),
+    }, args.frames, args.warmup)  # fmt: skip
+    results["point_off_ms"], results["point_maps_ms"] = timed["off"], timed["maps"]
+    print(f"{name} point: off {timed['off']:.1f} ms, maps {timed['maps']:.1f} ms", flush=True)
+    if first_scene:
+        results.update(_rays(frustum, shadow_pass, sc, scene, camera, to_light, args))
+    # llvmpipe's shadow mapping (a child process: its own GL context)
+    anchor = subprocess.run(
+        [sys.executable, str(HERE / "anchor_moderngl_shadows.py"), "--scene", str(path), "--frames",
+         str(args.frames), "--warmup", str(args.warmup)], capture_output=True, text=True, timeout=1800,
+    )  # fmt: skip
+    if anchor.returncode == 0:
+        gl = json.loads(anchor.stdout.strip().splitlines()[-1])
+        results["llvmpipe"] = gl
+        results["ratio_vs_llvmpipe_shadowed"] = results["directional_redrawn_ms"] / gl["frame_shadowed_ms"]
+    else:
+        print(f"llvmpipe skipped: {anchor.stderr.strip().splitlines()[-1:]}")
+    off = results["directional_off_ms"]
+    results["ratio_redrawn_vs_unshadowed"] = results["directional_redrawn_ms"] / off
+    results["ratio_reused_vs_unshadowed"] = results["directional_reused_ms"] / off
+    results["ratio_turntable_reused_vs_unshadowed"] = results["turntable_reused_ms"] / results["turntable_off_ms"]
+    results["ratio_point_vs_unshadowed"] = results["point_maps_ms"] / results["point_off_ms"]
+    return results
+
+
+def _rays(frustum, shadow_pass, sc, scene, camera, to_light, args) -> dict:
+    """The shadow-ray pass alone, frustum's any-hit query against Embree's on the same rays."""
+    results: dict = {}
+    results["directional_ray_ms"] = _median_ms(
+        lambda: frustum.render(scene, camera, shadows="ray"), args.frames, args.warmup
+    )
     frame = frustum.render(scene, camera, buffers=("position", "normals"))
     drawn = np.isfinite(frame.position[..., 0])
     span = float(np.ptp(sc["vertices"], axis=0).max())
@@ -138,32 +259,46 @@ def main(argv: list[str] | None = None) -> int:
         results["ray_ratio_vs_embree"] = results["frustum_rays_ms"] / results["embree_rays_ms"]
     except ImportError as error:
         print(f"embree skipped: {error}")
+    return results
 
-    # llvmpipe's shadow mapping (a child process: its own GL context)
-    anchor = subprocess.run(
-        [sys.executable, str(HERE / "anchor_moderngl_shadows.py"), "--scene", str(path), "--frames",
-         str(args.frames), "--warmup", str(args.warmup)], capture_output=True, text=True, timeout=900,
-    )  # fmt: skip
-    if anchor.returncode == 0:
-        gl = json.loads(anchor.stdout.strip().splitlines()[-1])
-        results["llvmpipe"] = gl
-        results["ratio_vs_llvmpipe_shadowed"] = results["directional_maps_ms"] / gl["frame_shadowed_ms"]
-    else:
-        print(f"llvmpipe skipped: {anchor.stderr.strip().splitlines()[-1:]}")
-    results["ratio_shadowed_vs_unshadowed_directional"] = results["directional_maps_ms"] / results["directional_off_ms"]
-    results["ratio_shadowed_vs_unshadowed_point"] = results["point_maps_ms"] / results["point_off_ms"]
-    print(json.dumps(results, indent=1, default=float))
-    print(
-        f"directional shadow maps / no shadows = {results['ratio_shadowed_vs_unshadowed_directional']:.2f} "
-        f"(target <= 1.5); point: {results['ratio_shadowed_vs_unshadowed_point']:.2f}"
-    )
-    if "ratio_vs_llvmpipe_shadowed" in results:
-        print(f"frustum shadowed / llvmpipe shadowed = {results['ratio_vs_llvmpipe_shadowed']:.2f} (target <= 0.6)")
-    if "ray_ratio_vs_embree" in results:
-        print(f"shadow rays frustum / Embree = {results['ray_ratio_vs_embree']:.2f} (target <= 3), "
-              f"agreement {results['rays_agree']:.5f}")  # fmt: skip
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--scenes", nargs="+", default=DEFAULT_SCENES)
+    parser.add_argument("--scene", help="one scene (the --scenes of earlier versions)")
+    parser.add_argument("--frames", type=int, default=5)
+    parser.add_argument("--warmup", type=int, default=1)
+    parser.add_argument("--views", type=int, default=8, help="cameras of the turntable")
+    parser.add_argument("--scene-dir", default="/tmp/frustum-bench/scenes")
+    parser.add_argument("--json", default=None)
+    args = parser.parse_args(argv)
+    names = [args.scene] if args.scene else args.scenes
+    rows = [bench_scene(name, args, number == 0) for number, name in enumerate(names)]
+    print(json.dumps(rows, indent=1, default=float))
+    print("scene | off ms | redrawn ms (/off) | reused ms (/off) | turntable off / reused ms (/off, maps drawn) | "
+          "point off / maps ms (/off) | llvmpipe off / shadowed ms | frustum redrawn / llvmpipe shadowed")
+    for r in rows:
+        gl = r.get("llvmpipe", {})
+        vs = f"{r['ratio_vs_llvmpipe_shadowed']:.2f}" if "ratio_vs_llvmpipe_shadowed" in r else "-"
+        print(f"{r['scene']} | {r['directional_off_ms']:.1f} | {r['directional_redrawn_ms']:.1f} "
+              f"({r['ratio_redrawn_vs_unshadowed']:.2f}) | {r['directional_reused_ms']:.1f} "
+              f"({r['ratio_reused_vs_unshadowed']:.2f}) | {r['turntable_off_ms']:.1f} / {r['turntable_reused_ms']:.1f} "
+              f"({r['ratio_turntable_reused_vs_unshadowed']:.2f}, {r['turntable_maps_drawn']} of "
+              f"{r['turntable_frames']}) | {r['point_off_ms']:.1f} / {r['point_maps_ms']:.1f} "
+              f"({r['ratio_point_vs_unshadowed']:.2f}) | {gl.get('frame_ms', float('nan')):.1f} / "
+              f"{gl.get('frame_shadowed_ms', float('nan')):.1f} | {vs}")  # fmt: skip
+    first = rows[0]
+    print(f"{first['scene']}: directional shadow maps / no shadows = {first['ratio_redrawn_vs_unshadowed']:.2f} map "
+          f"redrawn every frame, {first['ratio_reused_vs_unshadowed']:.2f} map reused (same scene/light, a view "
+          f"that sees the whole fitted region), turntable {first['ratio_turntable_reused_vs_unshadowed']:.2f} "
+          "(target <= 1.5)")  # fmt: skip
+    if "ratio_vs_llvmpipe_shadowed" in first:
+        print(f"frustum shadowed / llvmpipe shadowed = {first['ratio_vs_llvmpipe_shadowed']:.2f} (target <= 0.6)")
+    if "ray_ratio_vs_embree" in first:
+        print(f"shadow rays frustum / Embree = {first['ray_ratio_vs_embree']:.2f} (target <= 3), "
+              f"agreement {first['rays_agree']:.5f}")  # fmt: skip
     if args.json:
-        Path(args.json).write_text(json.dumps(results, indent=1, default=float))
+        Path(args.json).write_text(json.dumps(rows, indent=1, default=float))
     return 0
 
 
