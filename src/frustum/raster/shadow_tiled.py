@@ -161,8 +161,26 @@ def _finish_chunk(
 ) -> None:  # fmt: skip
     """Gather, find the lights' fractions, shade and store the first n listed pixels."""
     _gather_chunk(n, scratch, where, corners, faces, world, normals)
+    _unit_normals(n, scratch)
     _fractions(n, scratch, corners, world, lights, maps, views, map_of, softness)
     _shade_chunk_shadowed(n, scratch, where, params, lights, words)
+
+
+@kernel
+def _unit_normals(n: int, s: np.ndarray) -> None:
+    """The interpolated normals of the first n gathered pixels made unit and turned to the drawn side, in place
+    (the first step of ``shade._shade_chunk``, the same operations): ``_fractions`` reads them to skip the
+    lookups of pixels that turn away from a light."""
+    for i in range(n):
+        nx, ny, nz = s[_NX + i], s[_NY + i], s[_NZ + i]
+        length = math.sqrt((nx * nx + ny * ny) + nz * nz)
+        zero = length == 0.0
+        nx = 0.0 if zero else nx
+        ny = 0.0 if zero else ny
+        nz = 1.0 if zero else nz
+        length = 1.0 if zero else length
+        sign = s[_SIGN + i]
+        s[_NX + i], s[_NY + i], s[_NZ + i] = sign * nx / length, sign * ny / length, sign * nz / length
 
 
 @kernel
@@ -206,7 +224,9 @@ def _fractions(
             nx, ny, nz = s[_VX + i], s[_VY + i], s[_VZ + i]
             cos_theta = (nx * lx + ny * ly) + nz * lz
             s[_SR + i] = 0.0
-            if cos_theta <= 0.0:
+            # 0 where the face looks away from the light; and where the pixel's shading normal does (the shading
+            # adds nothing of this light there, whatever the fraction: no lookup)
+            if cos_theta <= 0.0 or (s[_NX + i] * lx + s[_NY + i] * ly) + s[_NZ + i] * lz <= 0.0:
                 s[row_k + i] = 0.0
                 continue
             cos_theta = min(cos_theta, 1.0)
@@ -311,16 +331,7 @@ def _shade_chunk_shadowed(
     ex, ey, ez = params[P_EYE], params[P_EYE + 1], params[P_EYE + 2]
     ka, kd, ks, shininess = params[P_AMBIENT], params[P_DIFFUSE], params[P_SPECULAR], params[P_SHININESS]
     ar, ag, ab = ka * params[P_LIGHT_AMBIENT], ka * params[P_LIGHT_AMBIENT + 1], ka * params[P_LIGHT_AMBIENT + 2]
-    for i in range(n):
-        nx, ny, nz = s[_NX + i], s[_NY + i], s[_NZ + i]
-        length = math.sqrt((nx * nx + ny * ny) + nz * nz)
-        zero = length == 0.0
-        nx = 0.0 if zero else nx
-        ny = 0.0 if zero else ny
-        nz = 1.0 if zero else nz
-        length = 1.0 if zero else length
-        sign = s[_SIGN + i]
-        s[_NX + i], s[_NY + i], s[_NZ + i] = sign * nx / length, sign * ny / length, sign * nz / length
+    for i in range(n):  # the normals are unit already (_unit_normals)
         vx, vy, vz = ex - s[_PX + i], ey - s[_PY + i], ez - s[_PZ + i]
         length = math.sqrt((vx * vx + vy * vy) + vz * vz)
         positive = length > 0.0
