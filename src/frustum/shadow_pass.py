@@ -100,7 +100,27 @@ def release_memory() -> int:
         released += sum(maps.nbytes for _, maps in _KEPT)
         _POOL.clear()
         _KEPT.clear()
+        _MEMO.clear()
     return released
+
+
+_MEMO: dict[tuple, Any] = {}
+"""Small results of the map fit kept by their inputs (``_memo``): the casters' bounds, the light cameras."""
+
+
+def _memo(key: tuple | None, make: Callable[[], Any]) -> Any:
+    """``make()``, kept under `key` for later calls (the 32 most recent keys; none kept where `key` is None)."""
+    if key is None:
+        return make()
+    with _POOL_LOCK:
+        found = _MEMO.get(key)
+    if found is None:
+        found = make()
+        with _POOL_LOCK:
+            while len(_MEMO) >= 32:
+                _MEMO.pop(next(iter(_MEMO)))
+            _MEMO[key] = found
+    return found
 
 
 _KEPT: list[tuple[tuple, np.ndarray]] = []
@@ -450,16 +470,32 @@ def _directional_camera(
 
 
 def view_map(
-    light: DirectionalLight, world: np.ndarray, camera: Camera, size: int, softness: float
+    light: DirectionalLight, world: np.ndarray, camera: Camera, size: int, softness: float,
+    casters: tuple | None = None,
 ) -> tuple[Camera, float] | None:  # fmt: skip
     """The orthographic map of a directional light fitted, before anything is drawn, to what the camera can see
     of one mesh (world vertex positions `world`): the light-view box of the part of the mesh's box inside the
     camera's view volume (their intersection, a convex polytope, clipped exactly), cut down to the light-view box
     of the vertices. (The stage-by-stage path fits its map to the drawn points themselves, ``light_fractions``:
-    the one-mesh tile pipeline shades as it draws.) None where the mesh's box misses the view volume."""
+    the one-mesh tile pipeline shades as it draws.) None where the mesh's box misses the view volume. `casters`:
+    the mesh's ``casters_key``, where known: the vertices' boxes are then kept for the next frame under it and the
+    light's direction (a turntable refits only to the view). The light camera of the same fit is the same
+    ``Camera`` (kept by its inputs)."""
+    to_light = -np.asarray(light.direction, dtype=np.float64)
+    clip = np.asarray(camera.clip_from_world, dtype=np.float64)
+    key = None
+    if casters is not None:  # the same casters, light and view: the same map camera as last time
+        key = ("view_map", casters, to_light.tobytes(), clip.tobytes(), camera.width, camera.height, size, softness)
+    return _memo(key, lambda: _view_map(to_light, clip, world, camera, size, softness, casters))
+
+
+def _view_map(
+    to_light: np.ndarray, clip: np.ndarray, world: np.ndarray, camera: Camera, size: int, softness: float,
+    casters: tuple | None,
+) -> tuple[Camera, float] | None:  # fmt: skip
+    """``view_map``'s work."""
     from frustum.raster import shadow
 
-    to_light = -np.asarray(light.direction, dtype=np.float64)
     frame = ViewFrame(np.zeros(3), normal=to_light, up=_up_for(to_light))
     view = frame.matrix[:3, :3]
     points = np.asarray(world)
@@ -467,10 +503,16 @@ def view_map(
         points = np.ascontiguousarray(points, dtype=np.float64)
     if points.shape[0] == 0:
         return None
-    bounds = np.empty((4, 3))
-    shadow.fit_points(points, np.ascontiguousarray(view), bounds)  # one pass: the box and the light-view box
+
+    def fit() -> np.ndarray:
+        bounds = np.empty((4, 3))
+        shadow.fit_points(points, np.ascontiguousarray(view), bounds)  # one pass: the box and the light-view box
+        bounds.setflags(write=False)
+        return bounds
+
+    bounds = _memo(None if casters is None else ("bounds", casters, to_light.tobytes()), fit)
     box = bounds[:2]
-    polytope = _box_in_view(box, camera)
+    polytope = _memo(("polytope", box.tobytes(), clip.tobytes()), lambda: _box_in_view(box, camera))
     if polytope.shape[0] == 0:
         return None
     inside = polytope @ view.T
@@ -478,7 +520,9 @@ def view_map(
     high = np.minimum(inside.max(axis=0), bounds[3])
     if (low > high).any():
         return None
-    return _directional_camera(to_light, low, high, box, size, (softness + _MARGIN_TEXELS) / size, frame)
+    reach = (softness + _MARGIN_TEXELS) / size
+    key = ("camera", to_light.tobytes(), low.tobytes(), high.tobytes(), box.tobytes(), size, reach)
+    return _memo(key, lambda: _directional_camera(to_light, low, high, box, size, reach, frame))
 
 
 def _box_in_view(box: np.ndarray, camera: Camera) -> np.ndarray:

@@ -174,7 +174,9 @@ def draw_tiled(
     lights = lighting.lights
     size, softness = options.shadow.map_size, float(options.shadow.softness)
     rows, casting = shadow_pass.shadow_lights(scene)
-    fitted = [shadow_pass.view_map(light, world, camera, size, softness) for light in casting]
+    cull = bool(item.mesh.is_watertight)
+    casters = shadow_pass.casters_key(item, cull) if casting else None
+    fitted = [shadow_pass.view_map(light, world, camera, size, softness, casters) for light in casting]
     records = [(row, found) for row, found in zip(rows, fitted, strict=True) if found is not None]
     check_memory(len(records) * size * size * 4, where="render",
                  cause=f"shadow_map_size = {size} with {len(records)} shadow-casting light(s)")  # fmt: skip
@@ -184,10 +186,9 @@ def draw_tiled(
     for m, (row, (light_camera, texel)) in enumerate(records):
         views[m] = shadow_pass.map_record(light_camera, texel, None)
         map_of[row] = m
-    cull = bool(item.mesh.is_watertight)
     key = None
     if records:  # the maps depend on the casters, the light cameras and nothing else: reused while those stay
-        key = shadow_pass.map_key(shadow_pass.casters_key(item, cull), [found[0] for _, found in records], views)
+        key = shadow_pass.map_key(casters, [found[0] for _, found in records], views)
     maps = shadow_pass.kept_maps(key, shape)
     if maps is None:
         maps = shadow_pass.take_array(shape, np.float32)
