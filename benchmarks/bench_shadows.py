@@ -5,7 +5,7 @@
 
 On the standard scenes of ``../shared/bench`` (default ``bunny_like_100k`` first, then ``bunny_like_100k_4k``,
 ``sphere_1m``, ``terrain_2m``; each with its own size and directional light), in one run per scene, medians of
-``--frames`` frames after ``--warmup``, the variants of a frame interleaved (off, redrawn, reused, off, ...):
+``--frames`` frames after ``--warmup``, each variant in its own block of frames:
 
 - frustum with the scene's directional light: shadows off; shadow maps (``shadows=True``, 2048² map, 2×2 bilinear
   PCF) **redrawn every frame** (``shadow_pass.set_map_reuse(False)``: fit, bin and fill the map, then the frame);
@@ -58,17 +58,11 @@ def _median_ms(work, frames: int, warmup: int) -> float:
     return statistics.median(times)
 
 
-def _interleaved_ms(variants: dict, frames: int, warmup: int) -> dict[str, float]:
-    """Median ms of each variant (a callable), one frame of each in turn per round (drift in the machine's load
-    reaches every variant alike)."""
-    times: dict[str, list[float]] = {name: [] for name in variants}
-    for round_ in range(warmup + frames):
-        for name, work in variants.items():
-            t0 = time.perf_counter()
-            work()
-            if round_ >= warmup:
-                times[name].append((time.perf_counter() - t0) * 1e3)
-    return {name: statistics.median(values) for name, values in times.items()}
+def _blocks_ms(variants: dict, frames: int, warmup: int) -> dict[str, float]:
+    """Median ms of each variant (a callable), each timed in its own block of frames after its own warmup (a
+    variant's frame does not follow another's: a shadowed frame's map would leave the caches cold for an
+    unshadowed one)."""
+    return {name: _median_ms(work, frames, warmup) for name, work in variants.items()}
 
 
 def _turntable(frustum, sc, views: int) -> list:
@@ -161,7 +155,7 @@ def bench_scene(name: str, args, first_scene: bool) -> dict:
 
     shadow.fill_depth_tiles = counted
     try:
-        timed = _interleaved_ms({
+        timed = _blocks_ms({
             "off": lambda: frame(),
             "redrawn": lambda: frame(shadows=True, reuse=False),
             "reused": lambda: frame(shadows=True),
@@ -175,8 +169,8 @@ def bench_scene(name: str, args, first_scene: bool) -> dict:
         shadow_pass.release_memory()
         fills.clear()
         spins = {"off": [], "reused": []}
-        for round_ in range(args.warmup + args.frames):
-            for variant, extra in (("off", {}), ("reused", {"shadows": True})):
+        for variant, extra in (("off", {}), ("reused", {"shadows": True})):
+            for round_ in range(args.warmup + args.frames):
                 t0 = time.perf_counter()
                 for view in cameras:
                     frame(view, **extra)
@@ -195,7 +189,7 @@ def bench_scene(name: str, args, first_scene: bool) -> dict:
           f"{results['turntable_frames']} frames)", flush=True)  # fmt: skip
     point = frustum.Scene(lights=[lights["point"]])
     point.add(mesh, material=material)
-    timed = _interleaved_ms({
+    timed = _blocks_ms({
         "off": lambda: frustum.render(point, camera, background=background),
         "maps": lambda: frustum.render(point, camera, background=background, shadows=True),
     }, args.frames, args.warmup)  # fmt: skip
