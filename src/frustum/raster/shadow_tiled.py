@@ -206,7 +206,6 @@ def _fractions(
         length = 1.0 if zero else length
         sign = s[_SIGN + i]
         s[_VX + i], s[_VY + i], s[_VZ + i] = sign * nx / length, sign * ny / length, sign * nz / length
-    size = maps.shape[1]
     for k in range(lights.shape[0]):
         row_k = (_FIELDS + k) * _CHUNK
         at = map_of[k]
@@ -218,69 +217,126 @@ def _fractions(
         v = views[np.uint64(at)]
         lx, ly, lz = lights[k, 7], lights[k, 8], lights[k, 9]
         texel, near, depth_range = v[M_TEXEL], v[M_NEAR], v[M_FAR] - v[M_NEAR]
-        # first where each point falls on the map (the _DR… rows: free until _shade_chunk_shadowed), its texel rows
-        # prefetched; then the filters, their loads in flight meanwhile
-        for i in range(n):
-            nx, ny, nz = s[_VX + i], s[_VY + i], s[_VZ + i]
-            cos_theta = (nx * lx + ny * ly) + nz * lz
-            s[_SR + i] = 0.0
-            # 0 where the face looks away from the light; and where the pixel's shading normal does (the shading
-            # adds nothing of this light there, whatever the fraction: no lookup)
-            if cos_theta <= 0.0 or (s[_NX + i] * lx + s[_NY + i] * ly) + s[_NZ + i] * lz <= 0.0:
-                s[row_k + i] = 0.0
-                continue
-            cos_theta = min(cos_theta, 1.0)
-            sine = math.sqrt(1.0 - cos_theta * cos_theta)
-            tan_theta = SLOPE_LIMIT if cos_theta * SLOPE_LIMIT <= sine else sine / cos_theta
-            px, py, pz = s[_PX + i] + texel * nx, s[_PY + i] + texel * ny, s[_PZ + i] + texel * nz
-            x = ((v[0] * px + v[1] * py) + v[2] * pz) + v[3]
-            y = ((v[4] * px + v[5] * py) + v[6] * pz) + v[7]
-            z = ((v[8] * px + v[9] * py) + v[10] * pz) + v[11]
-            if not (0.0 <= x < size and 0.0 <= y < size):
-                s[row_k + i] = 1.0
-                continue
-            receiver = near + min(max(z, 0.0), 1.0) * depth_range
-            s[_DR + i], s[_DG + i] = x, y
-            s[_DB + i] = receiver - texel * (1.0 + (1.0 + softness) * tan_theta)  # bias taken off
-            s[_SR + i] = 1.0
-            fc, fr = int(math.floor(x - 0.5)), size - 1 - int(math.floor(y - 0.5))  # noqa: RUF046
-            if 1 <= fr < size and 0 <= fc < size:
-                prefetch(shadow_map, np.uint64(fr), np.uint64(fc))
-                prefetch(shadow_map, np.uint64(fr - 1), np.uint64(fc))
         if not 0.0 < softness <= 1.0:  # hard, or a wider grid: the general filter
-            for i in range(n):
-                if s[_SR + i] != 0.0:
-                    found = _filter(shadow_map, s[_DR + i], s[_DG + i], s[_DB + i], near, depth_range, softness)
-                    s[row_k + i] = float(np.float32(found))
+            _fractions_general(n, s, row_k, shadow_map, v, lx, ly, lz, texel, near, depth_range, softness)
             continue
-        # the default, 2 × 2 texels bilinearly weighted (_filter's first case), inline: a call taking the map
-        # costs its reference counting per pixel
-        ramp = 1.0 / softness
-        for i in range(n):
-            if s[_SR + i] == 0.0:
-                continue
-            gx, gy, limit = s[_DR + i] - 0.5, s[_DG + i] - 0.5, s[_DB + i]
-            fx, fy = math.floor(gx), math.floor(gy)
-            wx = min(max((gx - fx - 0.5) * ramp + 0.5, 0.0), 1.0)
-            wy = min(max((gy - fy - 0.5) * ramp + 0.5, 0.0), 1.0)
-            col, row = int(fx), size - 1 - int(fy)  # texel columns col, col + 1; rows row (lower), row − 1
-            t00, t10, t01, t11 = 1.0, 1.0, 1.0, 1.0
-            if 0 <= row < size:
-                if 0 <= col < size:
-                    stored = shadow_map[np.uint64(row), np.uint64(col)]
-                    t00 = 1.0 if stored >= 1.0 or limit <= near + stored * depth_range else 0.0
-                if 0 <= col + 1 < size:
-                    stored = shadow_map[np.uint64(row), np.uint64(col + 1)]
-                    t10 = 1.0 if stored >= 1.0 or limit <= near + stored * depth_range else 0.0
-            if 0 <= row - 1 < size:
-                if 0 <= col < size:
-                    stored = shadow_map[np.uint64(row - 1), np.uint64(col)]
-                    t01 = 1.0 if stored >= 1.0 or limit <= near + stored * depth_range else 0.0
-                if 0 <= col + 1 < size:
-                    stored = shadow_map[np.uint64(row - 1), np.uint64(col + 1)]
-                    t11 = 1.0 if stored >= 1.0 or limit <= near + stored * depth_range else 0.0
-            taps = (1.0 - wy) * ((1.0 - wx) * t00 + wx * t10) + wy * ((1.0 - wx) * t01 + wx * t11)
-            s[row_k + i] = float(np.float32(taps))
+        _fractions_bilinear(n, s, row_k, shadow_map, v, lx, ly, lz, texel, near, depth_range, softness)
+
+
+@kernel
+def _fractions_general(
+    n: int, s: np.ndarray, row_k: int, shadow_map: np.ndarray, v: np.ndarray, lx: float, ly: float, lz: float,
+    texel: float, near: float, depth_range: float, softness: float,
+) -> None:  # fmt: skip
+    """``_fractions`` of one light with the general filter (``_filter``): hard, or a grid wider than 2 × 2."""
+    size = shadow_map.shape[0]
+    for i in range(n):
+        nx, ny, nz = s[_VX + i], s[_VY + i], s[_VZ + i]
+        cos_theta = (nx * lx + ny * ly) + nz * lz
+        if cos_theta <= 0.0 or (s[_NX + i] * lx + s[_NY + i] * ly) + s[_NZ + i] * lz <= 0.0:
+            s[row_k + i] = 0.0
+            continue
+        cos_theta = min(cos_theta, 1.0)
+        sine = math.sqrt(1.0 - cos_theta * cos_theta)
+        tan_theta = SLOPE_LIMIT if cos_theta * SLOPE_LIMIT <= sine else sine / cos_theta
+        px, py, pz = s[_PX + i] + texel * nx, s[_PY + i] + texel * ny, s[_PZ + i] + texel * nz
+        x = ((v[0] * px + v[1] * py) + v[2] * pz) + v[3]
+        y = ((v[4] * px + v[5] * py) + v[6] * pz) + v[7]
+        z = ((v[8] * px + v[9] * py) + v[10] * pz) + v[11]
+        if not (0.0 <= x < size and 0.0 <= y < size):
+            s[row_k + i] = 1.0
+            continue
+        receiver = near + min(max(z, 0.0), 1.0) * depth_range
+        limit = receiver - texel * (1.0 + (1.0 + softness) * tan_theta)  # bias taken off
+        s[row_k + i] = float(np.float32(_filter(shadow_map, x, y, limit, near, depth_range, softness)))
+
+
+_LOOKUP, _LIT, _UNLIT, _EDGE = 2.0, 1.0, 0.0, 3.0
+
+
+@kernel
+def _fractions_bilinear(
+    n: int, s: np.ndarray, row_k: int, shadow_map: np.ndarray, v: np.ndarray, lx: float, ly: float, lz: float,
+    texel: float, near: float, depth_range: float, softness: float,
+) -> None:  # fmt: skip
+    """``_fractions`` of one light with the default filter: 2 × 2 texels bilinearly weighted (``_filter``'s first
+    case, the same operations). Three passes over the chunk: where each point falls on the map, its weights and
+    the test's limit, without a branch (vectorized); the texel rows prefetched; the four taps, without a branch
+    for points whose taps all lie on the map (a point at the map's border: ``_filter``)."""
+    size = shadow_map.shape[0]
+    extent = float(size)
+    ramp = 1.0 / softness
+    slope = 1.0 + softness
+    v0, v1, v2, v3, v4, v5, v6, v7 = v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7]
+    v8, v9, v10, v11 = v[8], v[9], v[10], v[11]
+    # scratch rows free until _shade_chunk_shadowed: _DR, _DG the weights, _DB the limit, _SR what to do
+    # (_UNLIT, _LIT, _LOOKUP, _EDGE), _SG, _SB the texel column and row
+    for i in range(n):
+        nx, ny, nz = s[_VX + i], s[_VY + i], s[_VZ + i]
+        cos_theta = (nx * lx + ny * ly) + nz * lz
+        facing = (cos_theta > 0.0) & ((s[_NX + i] * lx + s[_NY + i] * ly) + s[_NZ + i] * lz > 0.0)
+        cos_theta = min(cos_theta, 1.0) if cos_theta > 0.0 else 1.0
+        sine = math.sqrt(1.0 - cos_theta * cos_theta)
+        tan_theta = SLOPE_LIMIT if cos_theta * SLOPE_LIMIT <= sine else sine / cos_theta
+        px, py, pz = s[_PX + i] + texel * nx, s[_PY + i] + texel * ny, s[_PZ + i] + texel * nz
+        x = ((v0 * px + v1 * py) + v2 * pz) + v3
+        y = ((v4 * px + v5 * py) + v6 * pz) + v7
+        z = ((v8 * px + v9 * py) + v10 * pz) + v11
+        inside = (x >= 0.0) & (x < extent) & (y >= 0.0) & (y < extent)
+        receiver = near + min(max(z, 0.0), 1.0) * depth_range
+        gx, gy = x - 0.5, y - 0.5
+        fx, fy = math.floor(gx), math.floor(gy)
+        s[_DR + i] = min(max((gx - fx - 0.5) * ramp + 0.5, 0.0), 1.0)
+        s[_DG + i] = min(max((gy - fy - 0.5) * ramp + 0.5, 0.0), 1.0)
+        s[_DB + i] = receiver - texel * (1.0 + slope * tan_theta)  # bias taken off
+        row = (extent - 1.0) - fy  # texel columns col, col + 1; rows row (lower), row − 1
+        interior = (fx >= 0.0) & (fx < extent - 1.0) & (row >= 1.0) & (row < extent)
+        state = (_LOOKUP if interior else _EDGE) if inside else _LIT
+        s[_SR + i] = state if facing else _UNLIT
+        s[_X + i], s[_NDL + i] = x, y  # (free until the shading) for a point at the border
+        s[_SG + i] = fx if interior else 0.0
+        s[_SB + i] = row if interior else 1.0
+    for i in range(n):
+        if s[_SR + i] == _LOOKUP:
+            at_row, at = np.uint64(s[_SB + i]), np.uint64(s[_SG + i])
+            prefetch(shadow_map, at_row, at)
+            prefetch(shadow_map, at_row - np.uint64(1), at)
+    for i in range(n):  # every point's taps (clamped onto the map where not looked up), selects for the tests
+        wx, wy, limit = s[_DR + i], s[_DG + i], s[_DB + i]
+        lower, left = np.uint64(s[_SB + i]), np.uint64(s[_SG + i])
+        upper, right = lower - np.uint64(1), left + np.uint64(1)
+        a, b = shadow_map[lower, left], shadow_map[lower, right]
+        c, d = shadow_map[upper, left], shadow_map[upper, right]
+        t00 = 1.0 if (a >= 1.0) | (limit <= near + a * depth_range) else 0.0
+        t10 = 1.0 if (b >= 1.0) | (limit <= near + b * depth_range) else 0.0
+        t01 = 1.0 if (c >= 1.0) | (limit <= near + c * depth_range) else 0.0
+        t11 = 1.0 if (d >= 1.0) | (limit <= near + d * depth_range) else 0.0
+        taps = (1.0 - wy) * ((1.0 - wx) * t00 + wx * t10) + wy * ((1.0 - wx) * t01 + wx * t11)
+        state = s[_SR + i]
+        s[row_k + i] = float(np.float32(taps)) if state == _LOOKUP else (1.0 if state == _LIT else 0.0)
+    for i in range(n):  # points at the map's border: the filter with its bounds tests
+        if s[_SR + i] == _EDGE:
+            found = _edge_taps(shadow_map, s[_X + i], s[_NDL + i], s[_DB + i], near, depth_range, ramp)
+            s[row_k + i] = float(np.float32(found))
+
+
+@kernel
+def _edge_taps(
+    shadow_map: np.ndarray, x: float, y: float, limit: float, near: float, depth_range: float, ramp: float
+) -> float:  # fmt: skip
+    """The 2 × 2 bilinear filter at window point (x, y) of a point at the map's border: taps off the map count as
+    lit (``_tap``); the weights ramp over 1 / `ramp` texels."""
+    size = shadow_map.shape[0]
+    gx, gy = x - 0.5, y - 0.5
+    fx, fy = math.floor(gx), math.floor(gy)
+    wx = min(max((gx - fx - 0.5) * ramp + 0.5, 0.0), 1.0)
+    wy = min(max((gy - fy - 0.5) * ramp + 0.5, 0.0), 1.0)
+    col, row = int(fx), size - 1 - int(fy)  # texel columns col, col + 1; rows row (lower), row − 1
+    t00 = _tap(shadow_map, row, col, limit, near, depth_range)
+    t10 = _tap(shadow_map, row, col + 1, limit, near, depth_range)
+    t01 = _tap(shadow_map, row - 1, col, limit, near, depth_range)
+    t11 = _tap(shadow_map, row - 1, col + 1, limit, near, depth_range)
+    return (1.0 - wy) * ((1.0 - wx) * t00 + wx * t10) + wy * ((1.0 - wx) * t01 + wx * t11)
 
 
 @kernel
