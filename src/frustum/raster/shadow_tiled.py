@@ -194,6 +194,13 @@ def _fractions(
     outside it and for a light without a map. The unit face normals, turned toward the viewer, go to the ``_VX``
     rows (``_shade_chunk_shadowed`` writes them later)."""
     for i in range(n):
+        needed = False  # only a pixel whose shading normal faces a light with a map is looked up
+        for k in range(lights.shape[0]):
+            ndl = (s[_NX + i] * lights[k, 7] + s[_NY + i] * lights[k, 8]) + s[_NZ + i] * lights[k, 9]
+            needed = needed or (map_of[k] >= 0 and ndl > 0.0)
+        if not needed:
+            s[_VX + i], s[_VY + i], s[_VZ + i] = 0.0, 0.0, 0.0
+            continue
         a, b, c = np.uint64(corners[i]), np.uint64(corners[_CHUNK + i]), np.uint64(corners[2 * _CHUNK + i])
         e1x, e1y, e1z = world[b, 0] - world[a, 0], world[b, 1] - world[a, 1], world[b, 2] - world[a, 2]
         e2x, e2y, e2z = world[c, 0] - world[a, 0], world[c, 1] - world[a, 1], world[c, 2] - world[a, 2]
