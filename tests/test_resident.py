@@ -190,10 +190,10 @@ def test_the_fingerprint_follows_sources_and_settings(tmp_path):
     package = tmp_path / "frustum"
     package.mkdir()
     (package / "a.py").write_text("x = 1\n")
-    environ = {"NUMBA_NUM_THREADS": "2", "HOME": "/root"}
+    environ = {"NUMBA_NUM_THREADS": "2", "HOME": "home-a"}
     first = resident.fingerprint(package, environ)
     assert len(first) == 16 and first == resident.fingerprint(package, dict(environ))
-    assert resident.fingerprint(package, {**environ, "HOME": "/else", "FRUSTUM_RESIDENT_IDLE_S": "5"}) == first
+    assert resident.fingerprint(package, {**environ, "HOME": "home-b", "FRUSTUM_RESIDENT_IDLE_S": "5"}) == first
     assert resident.fingerprint(package, {**environ, "NUMBA_NUM_THREADS": "1"}) != first
     assert resident.fingerprint(package, {**environ, "FRUSTUM_MAX_BYTES": "1e9"}) != first
     (package / "a.py").write_text("x = 22\n")
