@@ -198,3 +198,24 @@ def test_the_fingerprint_follows_sources_and_settings(tmp_path):
     assert resident.fingerprint(package, {**environ, "FRUSTUM_MAX_BYTES": "1e9"}) != first
     (package / "a.py").write_text("x = 22\n")
     assert resident.fingerprint(package, environ) != first
+
+
+def _rss_mib(pid: int) -> float:
+    for line in Path(f"/proc/{pid}/status").read_text().splitlines():
+        if line.startswith("VmRSS:"):
+            return int(line.split()[1]) / 1024
+    raise AssertionError("no VmRSS")
+
+
+def test_memory_does_not_grow_from_request_to_request(runtime, tmp_path):
+    _started(tmp_path)
+    pid = resident.status()[0]["pid"]
+    spot = DATA / "spot" / "spot_triangulated.obj"
+    sizes = []
+    for _ in range(16):
+        result = _program("render", str(spot), "-o", "spot.png", "--size", "800x600", cwd=tmp_path)
+        assert result.returncode == 0, result.stderr
+        assert _wait_for(lambda: len(resident.status()) == 1)  # answered: the request's memory is released
+        sizes.append(_rss_mib(pid))
+    assert _served() == 16
+    assert max(sizes[8:]) - sizes[4] < 24, f"resident memory grows: {sizes} MiB"

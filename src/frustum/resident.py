@@ -428,6 +428,7 @@ class _Server:
             sys.stdout, sys.stderr = saved
             os.chdir(self.home)
             _files.allow_new_files()
+            _release_memory()
 
     def watch(self, connection: socket.socket, lines: _Lines, worker: threading.Thread, done: socket.socket) -> bool:
         """Wait for `worker` (it writes to `done` when it ends); True when the client cancelled (Ctrl-C) or went
@@ -451,6 +452,21 @@ class _Server:
                     _send(connection, {"exit": INTERRUPTED_STATUS})
                 return True
         return False
+
+
+def _release_memory() -> None:
+    """Between requests: free the work arrays ``render`` keeps between calls and give the freed heap back to the
+    system (glibc keeps it otherwise: a resident process serving pictures of changing sizes would grow by the
+    largest of them on every thread that drew one)."""
+    import ctypes
+    import gc
+
+    from frustum.render import release_memory
+
+    gc.collect()  # the request's cycles (frames, meshes) first, so their arrays are free to give back
+    release_memory()
+    with contextlib.suppress(OSError, AttributeError):
+        ctypes.CDLL("libc.so.6").malloc_trim(0)
 
 
 def _request(fields: Any) -> dict[str, Any]:
