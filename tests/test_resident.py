@@ -219,3 +219,15 @@ def test_memory_does_not_grow_from_request_to_request(runtime, tmp_path):
         sizes.append(_rss_mib(pid))
     assert _served() == 16
     assert max(sizes[8:]) - sizes[4] < 24, f"resident memory grows: {sizes} MiB"
+
+
+def test_the_fingerprint_follows_installed_packages(tmp_path, monkeypatch):
+    site = tmp_path / "lib" / "site-packages"
+    site.mkdir(parents=True)
+    monkeypatch.setattr(sys, "path", [*sys.path, str(site)])
+    package = tmp_path / "frustum"
+    package.mkdir()
+    before = resident.fingerprint(package, {})
+    (site / "numba-9.9.dist-info").mkdir()  # what pip install leaves
+    os.utime(site, ns=(time.time_ns(), time.time_ns() + 10**9))
+    assert resident.fingerprint(package, {}) != before

@@ -11,9 +11,10 @@ answers, the program renders in its own process as before and then starts one in
 How it stays private, exact and out of the way:
 
 - **One per installation and environment.** The socket's name is a fingerprint of the Python executable,
-  frustum's source files (name, size, modification time) and the environment variables that change a render
-  (``NUMBA_*``, ``FRUSTUM_*``, ``PYTHONPATH``): an edited source file or another variable means another
-  resident process; an old one is never asked again and exits when idle.
+  frustum's source files (name, size, modification time), the site-packages folders (a package installed or
+  upgraded changes their time) and the environment variables that change a render (``NUMBA_*``, ``FRUSTUM_*``,
+  ``PYTHONPATH``): an edited source file, another package version or another variable means another resident
+  process; an old one is never asked again and exits when idle.
 - **Private.** The socket lives in a folder only the user can enter (``$XDG_RUNTIME_DIR/frustum``, else
   ``<temporary folder>/frustum-<uid>``; mode 0700, refused when it belongs to someone else or is open to others),
   and a connection is served only when the process at the other end runs as the same user (``SO_PEERCRED``).
@@ -96,6 +97,9 @@ def fingerprint(package: Path | None = None, environ: dict[str, str] | None = No
             if name.endswith(".py"):
                 info = os.stat(os.path.join(folder, name))
                 digest.update(f"{folder}/{name}\0{info.st_size}\0{info.st_mtime_ns}\0".encode())
+    for entry in sys.path:  # installing or upgrading a package (NumPy, Numba, Pillow) changes its folder's time
+        if os.path.basename(entry) in ("site-packages", "dist-packages") and os.path.isdir(entry):
+            digest.update(f"{entry}\0{os.stat(entry).st_mtime_ns}\0".encode())
     for name in sorted(environ):
         if (name.startswith(_ENV_PREFIXES) or name in _ENV_NAMES) and name not in _OWN_ENV:
             value = environ[name]
