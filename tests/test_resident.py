@@ -231,3 +231,18 @@ def test_the_fingerprint_follows_installed_packages(tmp_path, monkeypatch):
     (site / "numba-9.9.dist-info").mkdir()  # what pip install leaves
     os.utime(site, ns=(time.time_ns(), time.time_ns() + 10**9))
     assert resident.fingerprint(package, {}) != before
+
+
+def test_the_warm_up_loads_what_the_program_used_from_the_cache(runtime, tmp_path):
+    import frustum
+    from frustum.raster import _background
+
+    scene = frustum.Scene(lights=[frustum.DirectionalLight(direction=(0, 0, -1))])
+    scene.add(frustum.icosphere(subdivisions=1))
+    frustum.render(scene, frustum.Camera.look_at(eye=(0, 0, 4), target=(0, 0, 0), width=32, height=24))
+    plan = resident._kernels_in_use()
+    assert {"rasterize_tiles", "count_tiles"} <= {name for _, name, _ in plan}
+    for module, name, text in plan:
+        assert _background._cached(_background.dispatcher(module, name), _background.parse_signature(text))
+    _started(tmp_path)
+    assert [path.read_text() for path in runtime.glob("frustum/*.log")] == [""], "the warm-up reported a problem"

@@ -252,6 +252,7 @@ def start() -> bool:
     if existing is not None:
         existing.close()
         return False
+    _write_plan(paths[0].with_suffix(".plan"))
     package_root = str(_package_dir().parent)
     environ = dict(os.environ)
     search = [package_root] + [os.path.abspath(entry) for entry in environ.get("PYTHONPATH", "").split(os.pathsep)
@@ -270,6 +271,34 @@ def start() -> bool:
     except OSError:
         return False
     return True
+
+
+def _kernels_in_use() -> list[list[str]]:
+    """[module, name, signature] of every frustum kernel this process has compiled or loaded: what a resident
+    process started now should load (from the cache) before its first request."""
+    if "numba" not in sys.modules:
+        return []
+    from numba.core.dispatcher import Dispatcher
+
+    found = []
+    for module_name, module in list(sys.modules.items()):
+        if not module_name.startswith("frustum.raster") or module is None:
+            continue
+        for name, value in list(vars(module).items()):
+            kernel = value if isinstance(value, Dispatcher) else getattr(value, "__dict__", {}).get("kernel")
+            if isinstance(kernel, Dispatcher) and getattr(kernel, "__module__", None) == module_name:
+                texts = [repr(tuple(signature)) for signature in list(kernel.overloads)]
+                # literal arguments mark helpers compiled into their callers (no call from Python loads them)
+                found += [[module_name, name, text] for text in texts if "Literal[" not in text]
+    return found
+
+
+def _write_plan(path: Path) -> None:
+    """Write ``_kernels_in_use`` to `path` (atomically: two programs may start a resident process at once)."""
+    with contextlib.suppress(OSError):
+        temporary = path.with_name(f"{path.name}.{os.getpid()}")
+        temporary.write_text(json.dumps(_kernels_in_use()))
+        os.replace(temporary, path)
 
 
 def status() -> list[dict[str, Any]]:
@@ -496,22 +525,29 @@ def _same_user(connection: socket.socket) -> bool:
     return uid == os.getuid()
 
 
-def _warm_up(folder: Path) -> None:
-    """Render a tetrahedron once through the program's own path, so the kernels are loaded before a request."""
-    from frustum import _program
+def _warm_up(plan_path: Path) -> None:
+    """Import what a plain render uses and load, from Numba's cache, the kernels the program that started this
+    process used (its plan, ``_kernels_in_use``): the first request then runs as warm as the next. A kernel the
+    cache does not hold is left alone: compiling is the request's business, never the warm-up's."""
+    import importlib
 
-    mesh = folder / f"warmup-{os.getpid()}.obj"
-    picture = folder / f"warmup-{os.getpid()}.png"
-    mesh.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n")
+    importlib.import_module("frustum.scenefile")
+    importlib.import_module("PIL.PngImagePlugin")
     try:
-        with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
-            _program.render_files(mesh, [picture], "64x48", "y", None)
-    except Exception as error:  # a request will report the same problem to its client
-        print(f"warm-up failed: {error!r}", file=sys.__stderr__)
-    finally:
-        for path in (mesh, picture):
-            with contextlib.suppress(OSError):
-                path.unlink()
+        plan = json.loads(plan_path.read_text())
+    except (OSError, ValueError):
+        return
+    from frustum.raster import _background
+
+    for entry in plan if isinstance(plan, list) else []:
+        try:
+            module, name, text = entry
+            kernel = _background.dispatcher(module, name)
+            signature = _background.parse_signature(text)
+            if _background._cached(kernel, signature):
+                kernel.compile(signature)
+        except Exception as error:  # a stale or odd plan entry: the request will load or compile the kernel
+            print(f"warm-up: {entry!r}: {error!r}", file=sys.__stderr__)
 
 
 def serve(socket_path: str, lock_path: str, package: str) -> None:
@@ -536,7 +572,7 @@ def serve(socket_path: str, lock_path: str, package: str) -> None:
         listener.bind(socket_path)
         listener.listen(64)
         identity = os.stat(socket_path).st_ino
-        _warm_up(Path(socket_path).parent)
+        _warm_up(Path(socket_path).with_suffix(".plan"))
         gc.collect()
         gc.freeze()
         _Server(listener, package).loop()
