@@ -241,7 +241,7 @@ def test_the_warm_up_loads_what_the_program_used_from_the_cache(runtime, tmp_pat
     scene.add(frustum.icosphere(subdivisions=1))
     frustum.render(scene, frustum.Camera.look_at(eye=(0, 0, 4), target=(0, 0, 0), width=32, height=24))
     plan = resident._kernels_in_use()
-    assert {"rasterize_tiles", "count_tiles"} <= {name for _, name, _ in plan}
+    assert {"project_vertices", "count_tiles"} <= {name for _, name, _ in plan}
     for module, name, text in plan:
         assert _background._cached(_background.dispatcher(module, name), _background.parse_signature(text))
     _started(tmp_path)
