@@ -149,7 +149,7 @@ def test_it_exits_when_idle_and_on_stop(runtime, tmp_path, monkeypatch):
     assert listed.returncode == 0 and "0 renders served" in listed.stdout
     stopped = _program("resident", "stop", cwd=tmp_path)
     assert stopped.stdout == "stopped 1 resident render process(es)\n"
-    assert _wait_for(lambda: not list(runtime.glob("frustum/*.sock")), 30)
+    assert _wait_for(lambda: not list((runtime / "frustum").iterdir()), 30), "left files behind"
     assert _program("resident", "status", cwd=tmp_path).stdout == "no resident render process is running\n"
 
 

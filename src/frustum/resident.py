@@ -581,4 +581,14 @@ def serve(socket_path: str, lock_path: str, package: str) -> None:
         with contextlib.suppress(OSError):
             if identity is not None and os.stat(socket_path).st_ino == identity:
                 os.unlink(socket_path)
+                _tidy(Path(socket_path))
         os.close(lock)
+
+
+def _tidy(socket_path: Path) -> None:
+    """Remove what a resident process leaves beside its socket: the plan, the lock, an empty log."""
+    for suffix in (".plan", ".lock", ".log"):
+        path = socket_path.with_suffix(suffix)
+        with contextlib.suppress(OSError):
+            if suffix != ".log" or path.stat().st_size == 0:
+                path.unlink()
