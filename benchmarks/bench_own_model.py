@@ -86,47 +86,81 @@ def _medians(runs: list[tuple[float, float]]) -> tuple[float, float]:
     return statistics.median(r[0] for r in runs), statistics.median(r[1] for r in runs)
 
 
+def _resident_cpu(env: dict[str, str]) -> float:
+    """CPU seconds (user + system) the resident render processes of `env`'s runtime folder have used so far."""
+    script = "from frustum import resident; print(' '.join(str(e['pid']) for e in resident.status()))"
+    pids = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True).stdout.split()
+    total = 0.0
+    for pid in pids:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+        total += (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+    return total
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--no-cold", action="store_true")
     args = parser.parse_args()
     frustum_cli = [sys.executable, "-m", "frustum"]
-    env = {**os.environ, "PYTHONPATH": str(ROOT / "src") + os.pathsep + os.environ.get("PYTHONPATH", "")}
-    env.pop("PYTHONDONTWRITEBYTECODE", None)  # warm = bytecode cached too, as pip install leaves a package
-    try:
-        import f3d  # noqa: F401
-
-        have_f3d = True
-    except ImportError:
-        have_f3d = False
-        print("f3d is not installed (pip install f3d): frustum's times only")
-    with tempfile.TemporaryDirectory() as temp:
+    with tempfile.TemporaryDirectory(prefix="fr-bench-") as temp:
         folder = Path(temp)
-        files = make_files(folder)
-        first_name, (first, up) = next(iter(files.items()))
-        if not args.no_cold:
-            cold_env = {**env, "NUMBA_CACHE_DIR": str(folder / "empty_cache")}
-            cold = timed([*frustum_cli, "render", str(first), "-o", str(folder / "cold.png"), "--up", up], cold_env)
-            print(f"cold (empty NUMBA_CACHE_DIR), {first_name}: {cold:.2f} s")
-        for path, up in files.values():  # every kernel the six files use is in the cache before timing
-            timed([*frustum_cli, "render", str(path), "-o", str(folder / "warm.png"), "--up", up], env)
-        print(f"{'file':<14} {'frustum warm s':>15} {'F3D s':>8} {'ratio':>7}   {'CPU s: frustum':>15} {'F3D':>6} "
-              f"{'ratio':>6}")  # fmt: skip
-        for name, (path, up) in files.items():
-            ours, ours_cpu = _medians([
-                timed_cpu([*frustum_cli, "render", str(path), "-o", str(folder / "ours.png"), "--up", up], env)
+        (folder / "run").mkdir(mode=0o700)
+        env = {**os.environ, "PYTHONPATH": str(ROOT / "src") + os.pathsep + os.environ.get("PYTHONPATH", ""),
+               "XDG_RUNTIME_DIR": str(folder / "run"), "FRUSTUM_RESIDENT": "1"}  # fmt: skip
+        env.pop("PYTHONDONTWRITEBYTECODE", None)  # warm = bytecode cached too, as pip install leaves a package
+        own_env = {**env, "FRUSTUM_RESIDENT": "0"}
+        try:
+            import f3d  # noqa: F401
+
+            have_f3d = True
+        except ImportError:
+            have_f3d = False
+            print("f3d is not installed (pip install f3d): frustum's times only")
+        try:
+            _compare(args, frustum_cli, folder, env, own_env, have_f3d)
+        finally:
+            subprocess.run([*frustum_cli, "resident", "stop"], env=env, capture_output=True)
+
+
+def _compare(args: argparse.Namespace, frustum_cli: list[str], folder: Path, env: dict[str, str],
+             own_env: dict[str, str], have_f3d: bool) -> None:  # fmt: skip
+    files = make_files(folder)
+    first_name, (first, up) = next(iter(files.items()))
+    if not args.no_cold:
+        cold_env = {**own_env, "NUMBA_CACHE_DIR": str(folder / "empty_cache")}
+        cold = timed([*frustum_cli, "render", str(first), "-o", str(folder / "cold.png"), "--up", up], cold_env)
+        print(f"cold (empty NUMBA_CACHE_DIR), {first_name}: {cold:.2f} s")
+    for path, up in files.values():  # every kernel the six files use is in the cache before timing
+        timed([*frustum_cli, "render", str(path), "-o", str(folder / "warm.png"), "--up", up], own_env)
+    # the first plain render leaves the resident process behind; wait until it answers
+    timed([*frustum_cli, "render", str(first), "-o", str(folder / "warm.png"), "--up", up], env)
+    for _ in range(200):
+        if _resident_cpu(env) > 0:
+            break
+        time.sleep(0.05)
+    print("warm: 'resident' = the command handed to the resident render process (CPU: client + resident);"
+          " 'own' = FRUSTUM_RESIDENT=0, the whole render in the command's own process")
+    print(f"{'file':<14} {'resident s':>10} {'own s':>7} {'F3D s':>7} {'ratio':>7} {'own ratio':>9}   "
+          f"{'CPU s: resident':>15} {'own':>6} {'F3D':>6} {'ratio':>6}")  # fmt: skip
+    for name, (path, up) in files.items():
+        command = [*frustum_cli, "render", str(path), "-o", str(folder / "ours.png"), "--up", up]
+        handed = []
+        for _ in range(args.repeat):
+            before = _resident_cpu(env)
+            wall, cpu = timed_cpu(command, env)
+            handed.append((wall, cpu + _resident_cpu(env) - before))
+        ours, ours_cpu = _medians(handed)
+        own, own_cpu = _medians([timed_cpu(command, own_env) for _ in range(args.repeat)])
+        line = f"{name:<14} {ours:>10.2f} {own:>7.2f}"
+        if have_f3d:
+            theirs, theirs_cpu = _medians([
+                timed_cpu([sys.executable, "-c", F3D_SCRIPT, str(path), str(folder / "f3d.png")], env)
                 for _ in range(args.repeat)
             ])  # fmt: skip
-            line = f"{name:<14} {ours:>15.2f}"
-            if have_f3d:
-                theirs, theirs_cpu = _medians([
-                    timed_cpu([sys.executable, "-c", F3D_SCRIPT, str(path), str(folder / "f3d.png")], env)
-                    for _ in range(args.repeat)
-                ])  # fmt: skip
-                line += (f" {theirs:>8.2f} {ours / theirs:>7.2f}   {ours_cpu:>15.2f} {theirs_cpu:>6.2f} "
-                         f"{ours_cpu / theirs_cpu:>6.2f}")  # fmt: skip
-            print(line, flush=True)
+            line += (f" {theirs:>7.2f} {ours / theirs:>7.2f} {own / theirs:>9.2f}   {ours_cpu:>15.2f} "
+                     f"{own_cpu:>6.2f} {theirs_cpu:>6.2f} {ours_cpu / theirs_cpu:>6.2f}")  # fmt: skip
+        print(line, flush=True)
 
 
 if __name__ == "__main__":

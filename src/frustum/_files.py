@@ -23,7 +23,7 @@ from typing import Any
 
 from frustum.errors import FrustumError, OutputError
 
-__all__ = ["atomic_path", "os_reason", "remove_partial_files", "track_process"]
+__all__ = ["allow_new_files", "atomic_path", "os_reason", "remove_partial_files", "track_process"]
 
 _lock = threading.Lock()
 _open: set[str] = set()
@@ -150,6 +150,14 @@ def remove_partial_files() -> list[str]:
                 os.unlink(name)
         _open.clear()
     return names
+
+
+def allow_new_files() -> None:
+    """Accept new temporary files again after :func:`remove_partial_files` (the resident render process, between
+    one cancelled request and the next)."""
+    global _closed
+    with _lock:
+        _closed = False
 
 
 def _quoted(path: Path) -> str:

@@ -197,8 +197,10 @@ def main(arguments: Sequence[str] | None = None) -> None:
     """Entry point of the ``frustum`` console script and ``python -m frustum``: a plain ``render`` command line
     (``plain_render``) runs here; every other one runs through ``frustum.cli.main`` (Typer).
 
-    As the program (`arguments` None) the cyclic garbage collector is paused for ``GC_PAUSE_S`` seconds and every
-    object is frozen on the way out (see ``frustum.cli.main``)."""
+    As the program (`arguments` None) a plain render goes to the resident render process when one answers
+    (``frustum.resident``: the same work without the start-up); otherwise it runs here, with the cyclic garbage
+    collector paused for ``GC_PAUSE_S`` seconds and every object frozen on the way out (see ``frustum.cli.main``),
+    and leaves a resident process behind for the next command."""
     argv = list(sys.argv[1:] if arguments is None else arguments)
     request = plain_render(argv)
     if request is None:
@@ -209,12 +211,18 @@ def main(arguments: Sequence[str] | None = None) -> None:
     if arguments is not None:
         _render(request)
         return
+    from frustum import resident
+
+    status = resident.handed(request)
+    if status is not None:
+        raise SystemExit(status)
     gc.disable()
     _STATE["resume_gc_at"] = time.monotonic() + GC_PAUSE_S
     try:
         _render(request)
     finally:
         gc.freeze()
+        resident.start()  # for the next command (``frustum.resident``); nothing when one runs or it is off
 
 
 def _render(request: dict[str, Any]) -> None:

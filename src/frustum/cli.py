@@ -509,6 +509,28 @@ def warmup_command(
     console.print(str(warmup(processes)), markup=False, highlight=False)
 
 
+@app.command("resident")
+def resident_command(
+    action: Annotated[str, typer.Argument(help="status: list the resident render processes; stop: end them.")],
+) -> None:
+    """The resident render process that plain `frustum render FILE -o OUT` commands hand their work to, so they
+    skip Python's and Numba's start-up (FRUSTUM_RESIDENT=0 turns it off; it exits after 10 idle minutes)."""
+    from frustum import resident
+
+    if action == "status":
+        running = resident.status()
+        for entry in running:
+            console.print(f"pid {entry.get('pid')}: {entry.get('requests')} renders served, idle "
+                          f"{entry.get('idle_s')} s, frustum at {entry.get('package')}", markup=False,
+                          highlight=False, soft_wrap=True)  # fmt: skip
+        if not running:
+            console.print("no resident render process is running", markup=False, highlight=False)
+    elif action == "stop":
+        console.print(f"stopped {resident.stop()} resident render process(es)", markup=False, highlight=False)
+    else:
+        raise FrustumError(f"resident: action {action!r} is unknown; expected status or stop")
+
+
 @app.command("examples")
 def examples_command(
     out: Annotated[Path, typer.Option(help="Folder for the pictures.")] = Path("examples/out"),
