@@ -13,8 +13,8 @@ On the standard scenes of ``../shared/bench`` (default ``bunny_like_100k`` first
   ``shadow_pass.kept_maps``); ratios shadowed / unshadowed for both (target: <= 1.5, directional);
 - a turntable: ``--views`` cameras orbiting the scene's target at the scene camera's height and at least the
   distance at which the whole model is in view (the map is fitted to what the camera sees: only a view that
-  sees all of the model can reuse it), frames with shadows off and with maps reused; ratio and how many of the
-  views drew their map;
+  sees all of the model can reuse it), each round of frames turned on by a fraction of a step (no view comes
+  twice), frames with shadows off and with maps reused; ratio and how many of the frames drew their map;
 - the scene with one point light (shadows off and on: a cube of six maps drawn every frame, the stage-by-stage
   path);
 - llvmpipe (``benchmarks/anchor_moderngl_shadows.py``, a child process): the same scene without and with a
@@ -65,9 +65,10 @@ def _blocks_ms(variants: dict, frames: int, warmup: int) -> dict[str, float]:
     return {name: _median_ms(work, frames, warmup) for name, work in variants.items()}
 
 
-def _turntable(frustum, sc, views: int) -> list:
-    """`views` cameras around the scene's target, at the scene camera's height above it and a distance at least
-    that at which the model's bounding sphere fits the field of view."""
+def _turntable(frustum, sc, views: int, turn: float = 0.0) -> list:
+    """`views` cameras around the scene's target (the first `turn` of a step past the scene camera's side), at the
+    scene camera's height above it and a distance at least that at which the model's bounding sphere fits the
+    field of view."""
     eye, target = np.asarray(sc["eye"], dtype=np.float64), np.asarray(sc["target"], dtype=np.float64)
     up = np.asarray(sc["up"], dtype=np.float64)
     up = up / np.linalg.norm(up)
@@ -86,7 +87,7 @@ def _turntable(frustum, sc, views: int) -> list:
     side = np.cross(up, across)
     cameras = []
     for k in range(views):
-        angle = 2.0 * math.pi * k / views
+        angle = 2.0 * math.pi * (k + turn) / views
         turned = math.cos(angle) * across + math.sin(angle) * side
         position = target + scale * (turned + rise * up)
         far = max(float(sc["far"]), 2.0 * (distance + radius))
@@ -165,14 +166,16 @@ def bench_scene(name: str, args, first_scene: bool) -> dict:
         for variant, ms in timed.items():
             results[f"directional_{variant}_ms"] = ms
         # the turntable: every view sees the whole model, so one map serves all
-        cameras = _turntable(frustum, sc, args.views)
+        rounds = args.warmup + args.frames  # every frame a view not seen before (nothing of its fit kept)
+        orbits = [_turntable(frustum, sc, args.views, turn / rounds) for turn in range(rounds)]
+        cameras = orbits[0]
         shadow_pass.release_memory()
         fills.clear()
         spins = {"off": [], "reused": []}
         for variant, extra in (("off", {}), ("reused", {"shadows": True})):
-            for round_ in range(args.warmup + args.frames):
+            for round_ in range(rounds):
                 t0 = time.perf_counter()
-                for view in cameras:
+                for view in orbits[round_]:
                     frame(view, **extra)
                 if round_ >= args.warmup:
                     spins[variant].append((time.perf_counter() - t0) * 1e3 / len(cameras))
