@@ -899,3 +899,28 @@ def test_map_reuse_can_be_turned_off_and_memory_released(monkeypatch):
         assert len(fills) == drawn + 3
     finally:
         assert shadow_pass.set_map_reuse(True) is False
+
+
+def test_a_kept_map_set_is_held_by_one_frame_at_a_time():
+    """``kept_maps`` hands a kept set to one caller until ``keep_maps`` takes it back (a frame drawing on another
+    thread meanwhile draws its own, so a set in use never goes back to the work-array pool); past ``KEPT_MAPS``
+    sets the least recently used one goes to the pool."""
+    from frustum import shadow_pass
+
+    shadow_pass.release_memory()
+    shape = (1, 64, 64)
+    first, second, third = (np.full(shape, value, dtype=np.float32) for value in (0.25, 0.5, 0.75))
+    shadow_pass.keep_maps(("a",), first)
+    held = shadow_pass.kept_maps(("a",), shape)
+    assert held is first
+    assert shadow_pass.kept_maps(("a",), shape) is None  # in use
+    assert shadow_pass.kept_maps(("a",), (1, 32, 32)) is None
+    shadow_pass.keep_maps(("a",), held)
+    shadow_pass.keep_maps(("b",), second)
+    shadow_pass.keep_maps(("c",), third)  # "a" is the least recently used of three: back to the pool
+    assert shadow_pass.kept_maps(("a",), shape) is None
+    assert shadow_pass.take_array(shape, np.float32) is first
+    assert shadow_pass.kept_maps(("b",), shape) is second
+    assert shadow_pass.set_map_reuse(True) is True
+    assert shadow_pass.map_key(None, [], np.zeros((1, 1))) is None
+    shadow_pass.release_memory()

@@ -183,28 +183,31 @@ def map_key(casters: tuple | None, cameras: list[Camera], records: np.ndarray) -
 
 
 def kept_maps(key: tuple | None, shape: tuple[int, ...]) -> np.ndarray | None:
-    """The map set drawn earlier under `key` (``keep_maps``), or None."""
+    """The map set drawn earlier under `key` (``keep_maps``), or None. The caller holds it alone until it hands it
+    back with ``keep_maps`` (a frame drawn meanwhile on another thread with the same key draws its own), so a set
+    in use is never evicted to the work-array pool."""
     if key is None:
         return None
     with _POOL_LOCK:
         for at, (kept, maps) in enumerate(_KEPT):
             if kept == key and maps.shape == shape:
-                _KEPT.append(_KEPT.pop(at))
+                del _KEPT[at]
                 return maps
     return None
 
 
 def keep_maps(key: tuple | None, maps: np.ndarray) -> None:
-    """Keep the map set `maps` just drawn under `key` for later frames (``kept_maps``); the least recently used set
-    beyond ``KEPT_MAPS`` sets or ``KEPT_BYTES`` goes back to the work-array pool. Without a key (reuse off) or too
-    large, `maps` goes straight back to the pool."""
+    """Keep the map set `maps` drawn (or taken with ``kept_maps``) under `key` for later frames, the most recently
+    used last; the least recently used set beyond ``KEPT_MAPS`` sets or ``KEPT_BYTES`` goes back to the work-array
+    pool (as does one kept under the same key meanwhile). Without a key (reuse off) or too large, `maps` goes
+    straight back to the pool."""
     if key is None or maps.nbytes > KEPT_BYTES:
         give_back(maps)
         return
     with _POOL_LOCK:
+        evicted = [m for kept, m in _KEPT if kept == key]
         _KEPT[:] = [(kept, m) for kept, m in _KEPT if kept != key]
         _KEPT.append((key, maps))
-        evicted = []
         while len(_KEPT) > KEPT_MAPS or sum(m.nbytes for _, m in _KEPT) > KEPT_BYTES:
             evicted.append(_KEPT.pop(0)[1])
     give_back(*evicted)
