@@ -573,6 +573,10 @@ def serve(socket_path: str, lock_path: str, package: str) -> None:
         listener.listen(64)
         identity = os.stat(socket_path).st_ino
         _warm_up(Path(socket_path).with_suffix(".plan"))
+        import frustum.raster
+        from frustum import _program
+
+        frustum.raster.compile_notice = _program._compile_notice  # the program's words, should a request compile
         gc.collect()
         gc.freeze()
         _Server(listener, package).loop()
