@@ -30,8 +30,9 @@ ROOT = Path(__file__).resolve().parents[1]
 
 @pytest.fixture
 def runtime(monkeypatch):
-    """A private runtime folder of its own (short: a socket's path holds < 108 bytes) with resident processes on;
-    every resident process started in it is stopped at the end."""
+    """A private runtime folder of its own, with resident processes on; every resident process started in it is
+    stopped at the end. A scratch folder directly in the system's temporary folder, not pytest's deeper tmp_path:
+    a socket's path holds < 108 bytes (nothing is read from it but what the test's programs write)."""
     folder = Path(tempfile.mkdtemp(prefix="fr-"))
     monkeypatch.setenv("XDG_RUNTIME_DIR", str(folder))
     monkeypatch.setenv("FRUSTUM_RESIDENT", "1")
@@ -46,12 +47,12 @@ def runtime(monkeypatch):
 
 def _pids(folder: Path) -> list[int]:
     """Processes whose command line names `folder` (resident processes started there)."""
+    import psutil
+
     found = []
-    for entry in Path("/proc").iterdir():
-        if entry.name.isdigit():
-            with contextlib.suppress(OSError):
-                if str(folder).encode() in (entry / "cmdline").read_bytes():
-                    found.append(int(entry.name))
+    for process in psutil.process_iter(["cmdline"]):
+        if any(str(folder) in part for part in process.info["cmdline"] or ()):
+            found.append(process.pid)
     return found
 
 
@@ -201,10 +202,9 @@ def test_the_fingerprint_follows_sources_and_settings(tmp_path):
 
 
 def _rss_mib(pid: int) -> float:
-    for line in Path(f"/proc/{pid}/status").read_text().splitlines():
-        if line.startswith("VmRSS:"):
-            return int(line.split()[1]) / 1024
-    raise AssertionError("no VmRSS")
+    import psutil
+
+    return psutil.Process(pid).memory_info().rss / 2**20
 
 
 def test_memory_does_not_grow_from_request_to_request(runtime, tmp_path):
