@@ -167,20 +167,25 @@ def _finish_chunk(
 
 
 @kernel
+def _unit_toward(nx: float, ny: float, nz: float, sign: float) -> tuple[float, float, float]:
+    """(nx, ny, nz) made unit and turned to the drawn side (`sign` ±1); a zero vector gives (0, 0, sign) — the
+    operations of ``shade._shade_chunk``'s first step, in its order (the same bytes)."""
+    length = math.sqrt((nx * nx + ny * ny) + nz * nz)
+    zero = length == 0.0
+    nx = 0.0 if zero else nx
+    ny = 0.0 if zero else ny
+    nz = 1.0 if zero else nz
+    length = 1.0 if zero else length
+    return sign * nx / length, sign * ny / length, sign * nz / length
+
+
+@kernel
 def _unit_normals(n: int, s: np.ndarray) -> None:
     """The interpolated normals of the first n gathered pixels made unit and turned to the drawn side, in place
     (the first step of ``shade._shade_chunk``, the same operations): ``_fractions`` reads them to skip the
     lookups of pixels that turn away from a light."""
     for i in range(n):
-        nx, ny, nz = s[_NX + i], s[_NY + i], s[_NZ + i]
-        length = math.sqrt((nx * nx + ny * ny) + nz * nz)
-        zero = length == 0.0
-        nx = 0.0 if zero else nx
-        ny = 0.0 if zero else ny
-        nz = 1.0 if zero else nz
-        length = 1.0 if zero else length
-        sign = s[_SIGN + i]
-        s[_NX + i], s[_NY + i], s[_NZ + i] = sign * nx / length, sign * ny / length, sign * nz / length
+        s[_NX + i], s[_NY + i], s[_NZ + i] = _unit_toward(s[_NX + i], s[_NY + i], s[_NZ + i], s[_SIGN + i])
 
 
 @kernel
@@ -205,14 +210,7 @@ def _fractions(
         e1x, e1y, e1z = world[b, 0] - world[a, 0], world[b, 1] - world[a, 1], world[b, 2] - world[a, 2]
         e2x, e2y, e2z = world[c, 0] - world[a, 0], world[c, 1] - world[a, 1], world[c, 2] - world[a, 2]
         nx, ny, nz = e1y * e2z - e1z * e2y, e1z * e2x - e1x * e2z, e1x * e2y - e1y * e2x
-        length = math.sqrt((nx * nx + ny * ny) + nz * nz)
-        zero = length == 0.0
-        nx = 0.0 if zero else nx
-        ny = 0.0 if zero else ny
-        nz = 1.0 if zero else nz
-        length = 1.0 if zero else length
-        sign = s[_SIGN + i]
-        s[_VX + i], s[_VY + i], s[_VZ + i] = sign * nx / length, sign * ny / length, sign * nz / length
+        s[_VX + i], s[_VY + i], s[_VZ + i] = _unit_toward(nx, ny, nz, s[_SIGN + i])
     for k in range(lights.shape[0]):
         row_k = (_FIELDS + k) * _CHUNK
         at = map_of[k]
