@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import frustum as fr
-from frustum.environment import EnvironmentMap, cube_coordinates, read_hdr
+from frustum.shading.environment import EnvironmentMap, cube_coordinates, read_hdr
 from frustum.errors import FrustumError, ShadingError
 
 OCTANT_COLORS = np.array([[(i >> 2) & 1, (i >> 1) & 1, i & 1] for i in range(8)], dtype=float) * 0.8 + 0.1

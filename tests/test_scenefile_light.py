@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import frustum as fr
-from frustum.environment import EnvironmentMap
+from frustum.shading.environment import EnvironmentMap
 from frustum.errors import SceneFileError
 from frustum.scenefile import load_scene, load_scene_file
 

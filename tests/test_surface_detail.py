@@ -10,7 +10,7 @@ import pytest
 
 import frustum as fr
 from frustum.errors import ShadingError
-from frustum.surface_detail import bumped_normals, height_gradient, mapped_normals, tangent_frames
+from frustum.shading.surface_detail import bumped_normals, height_gradient, mapped_normals, tangent_frames
 
 LIGHT = [fr.DirectionalLight((0.3, -0.4, -1.0), intensity=0.45), fr.PointLight((0.5, 0.8, 2.0), intensity=0.3)]
 

@@ -71,7 +71,7 @@ from .clipping import (
     trivially_accepted as trivially_accepted,
     trivially_rejected as trivially_rejected,
 )
-from .environment import (
+from .shading.environment import (
     EnvironmentMap as EnvironmentMap,
 )
 from .errors import (

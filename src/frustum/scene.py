@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from frustum._arrays import Matrix4, as_matrix, as_scalar, as_vector3, describe
-from frustum.environment import EnvironmentMap
+from frustum.shading.environment import EnvironmentMap
 from frustum.errors import FrustumError, GeometryError
 from frustum.geometry import Mesh, Polyline
 from frustum.shading import LIGHT_TYPES, Light, Material

@@ -2,12 +2,12 @@
 
 For an item whose material has a bump or normal map and whose mesh has UVs, in Phong shading: each of its pixels
 gets its interpolated position, UV and unit normal from the face code and barycentrics the depth buffer stored,
-the normal is perturbed (``frustum.surface_detail``: Blinn's formula for a height map, the tangent frame for a
+the normal is perturbed (``frustum.shading.surface_detail``: Blinn's formula for a height map, the tangent frame for a
 normal map), and the pixels are shaded by the same kernel as every other pixel (``raster.shade.shade_pixels``)
 as a one-row image of one small face per pixel whose corners all carry that pixel's point, normal, UV and color:
 the same illumination model, texture lookup, depth cue, blending and extra outputs, with nothing new to compile.
 Flat and Gouraud shading evaluate lighting per face or per vertex and leave the maps unused (documented in
-``frustum.surface_detail``).
+``frustum.shading.surface_detail``).
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ import numpy as np
 
 from frustum.raster import shade
 from frustum.scene import SceneItem
-from frustum.surface_detail import _bilinear_wrapped, bumped_normals, height_gradient, mapped_normals, tangent_frames
+from frustum.shading.surface_detail import _bilinear_wrapped, bumped_normals, height_gradient, mapped_normals, tangent_frames
 
 
 def has_detail(item: SceneItem) -> bool:

@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from frustum.camera import Camera
-from frustum.environment import reflect_directions
+from frustum.shading.environment import reflect_directions
 from frustum.render.buffers import Buffers
 from frustum.render.options import RenderOptions
 

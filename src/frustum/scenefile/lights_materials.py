@@ -8,7 +8,7 @@ from typing import Any
 import numpy as np
 
 from frustum.budgets import format_bytes, get_budget
-from frustum.environment import ENVIRONMENT_KINDS, EnvironmentMap
+from frustum.shading.environment import ENVIRONMENT_KINDS, EnvironmentMap
 from frustum.errors import FrustumError
 from frustum.scenefile.checks import _call, _choice, _table, _table_list, _unknown_keys
 from frustum.scenefile.report import _BAD, _Report

@@ -138,7 +138,7 @@ class Material:
     scene's environment map in the depth-buffer pipeline: $(1 − r)·I + r·env(R)$).
     ``bump`` an (H, W[, 3|4]) height image (gray, in [0, 1], times ``bump_scale`` world units) and ``normal_map``
     an (H, W, 3|4) tangent-space normal image (OpenGL convention, +y up): both perturb the shading normal per pixel
-    in Phong shading, from the mesh's UVs (``frustum.surface_detail``; flat and Gouraud shading ignore them).
+    in Phong shading, from the mesh's UVs (``frustum.shading.surface_detail``; flat and Gouraud shading ignore them).
     ``hatch`` (vector output only): the spacing of 45° section lines drawn over the faces in filled SVG/PDF,
     in drawing units, as engineering drawings mark cut surfaces (``cutaway`` sets it on section caps).
     With ``render(..., method="ray-tracing")`` ``reflectivity`` is the weight of the traced mirror-reflected ray
