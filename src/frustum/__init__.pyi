@@ -181,6 +181,13 @@ from .geometry.lsystem import (
     parse_rules as parse_rules,
     tube_mesh as tube_mesh,
 )
+from .geometry.points import (
+    PointCloud as PointCloud,
+    load_points as load_points,
+)
+from .geometry.splats import (
+    GaussianSplats as GaussianSplats,
+)
 from .geometry.octree import (
     Octree as Octree,
     OctreeHits as OctreeHits,

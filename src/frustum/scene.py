@@ -36,6 +36,7 @@ __all__ = [
     "ParticleLayer",
     "Pick",
     "Placed",
+    "PointItem",
     "RayHits",
     "Scene",
     "SceneItem",
@@ -49,6 +50,14 @@ def _is_octree(value: Any) -> bool:
     """``isinstance(value, Octree)`` without importing ``frustum.geometry.octree``: no Octree exists before it is."""
     module = sys.modules.get("frustum.geometry.octree")
     return module is not None and isinstance(value, module.Octree)
+
+
+def _is_points(value: Any) -> bool:
+    """A ``PointCloud`` or ``GaussianSplats`` (without importing their modules: none exists before they are)."""
+    points, splats = sys.modules.get("frustum.geometry.points"), sys.modules.get("frustum.geometry.splats")
+    return (points is not None and isinstance(value, points.PointCloud)) or (
+        splats is not None and isinstance(value, splats.GaussianSplats)
+    )
 
 
 PARTICLE_STYLES = ("sprites", "points", "streaks")
@@ -127,6 +136,16 @@ class ParticleLayer(NamedTuple):
     system: ParticleSystem
     style: str
     blending: str
+
+
+class PointItem(NamedTuple):
+    """One placed point cloud or set of Gaussian splats: $world = world_from_model · model$, drawn with
+    ``material`` (its color multiplies the points' colors) in ``style`` (``frustum.geometry.points.PointStyle``)."""
+
+    geometry: Any
+    material: Material
+    world_from_model: Matrix4
+    style: Any
 
 
 class Placed(NamedTuple):
@@ -221,7 +240,8 @@ class Node:
         where = f"Node({name!r})"
         if not isinstance(name, str) or "/" in name:
             raise FrustumError(f"{where}: name = {describe(name)} is not a string without '/'; '/' separates paths")
-        if geometry is not None and not (isinstance(geometry, Mesh | Polyline) or _is_octree(geometry)):
+        if geometry is not None and not (isinstance(geometry, Mesh | Polyline) or _is_octree(geometry)
+                                         or _is_points(geometry)):  # fmt: skip
             raise FrustumError(
                 f"{where}: geometry = {describe(geometry)} is not a Mesh or Polyline; build one with Mesh(vertices, "
                 "faces) or a primitive, tessellate a surface, or draw a curve as Polyline(points)"
@@ -234,6 +254,7 @@ class Node:
         self.material = material
         self.children: list[Node] = []
         self.lights: list[Light] = []
+        self.point_style: Any = None  # a PointCloud's drawing style (``frustum.geometry.points.PointStyle``) or None
         for child in children:
             self.add(child)
         for light in lights:
@@ -276,15 +297,19 @@ class Node:
 
     def copy(self) -> Node:
         """A deep copy of the hierarchy (meshes and materials are immutable and shared)."""
-        return Node(
+        node = Node(
             self.name, self.transform, self.geometry, self.material, [c.copy() for c in self.children], self.lights
         )
+        node.point_style = self.point_style
+        return node
 
     def __repr__(self) -> str:
         if isinstance(self.geometry, Mesh):
             kind = f"{self.geometry.face_count} faces"
         elif _is_octree(self.geometry):
             kind = f"octree of depth {self.geometry.depth}"
+        elif _is_points(self.geometry):
+            kind = repr(self.geometry)
         else:
             kind = "group" if self.geometry is None else f"polyline of {self.geometry.vertex_count} points"
         return f"Node({self.name!r}, {kind}, {len(self.children)} children)"
@@ -331,12 +356,17 @@ class Scene:
         *,
         name: str = "",
         parent: Node | str | None = None,
+        style: str | None = None,
+        point_size: float | None = None,
+        radius: float | None = None,
     ) -> Node:
-        """Place `geometry` (a Mesh, a Polyline, or a whole Node subtree) under `parent` (default the root);
-        returns the node.
+        """Place `geometry` (a Mesh, a Polyline, a ``PointCloud``, ``GaussianSplats`` or a whole Node subtree) under
+        `parent` (default the root); returns the node.
 
         For a Mesh or Polyline, a new ``Node(name, transform, geometry, material)`` is made; for a Node,
-        `material` and `transform` must be left out (set them on the node).
+        `material` and `transform` must be left out (set them on the node). A PointCloud is drawn in `style`
+        ``"square"`` (default), ``"disk"``, ``"sphere"`` or ``"surfel"`` with `point_size` pixels or `radius` world
+        units (``frustum.render.points``).
         """
         where = "Scene.add"
         host = self.root if parent is None else self.find(parent) if isinstance(parent, str) else parent
@@ -344,6 +374,12 @@ class Scene:
             if material is not None or transform is not None:
                 raise FrustumError(f"{where}: give material and transform on the Node itself, not with a Node")
             return host.add(geometry)
+        if _is_points(geometry) or (style, point_size, radius) != (None, None, None):
+            from frustum.geometry.points import point_style
+
+            node = Node(name, transform, geometry, material)
+            node.point_style = point_style(geometry, style, point_size, radius, where)
+            return host.add(node)
         if not (isinstance(geometry, Mesh | Polyline) or _is_octree(geometry)):
             raise FrustumError(
                 f"{where}: geometry = {describe(geometry)} is not a Mesh, Polyline or Node; build one with "
@@ -471,6 +507,29 @@ class Scene:
         """Placed meshes in drawing order, each with its (inherited) material and world transform; a placed
         Octree counts as its cell faces (``Octree.surface``), as the depth buffer draws it."""
         return self._placed(Mesh)
+
+    @property
+    def point_clouds(self) -> list[PointItem]:
+        """Placed point clouds and Gaussian splats in drawing order, with their styles (``PointItem``)."""
+        from frustum.geometry.points import point_style
+
+        result: list[PointItem] = []
+        for node, world, material in self._walk_materials():
+            if _is_points(node.geometry):
+                style = node.point_style or point_style(node.geometry, None, None, None, "Scene.point_clouds")
+                result.append(PointItem(node.geometry, material, world, style))
+        return result
+
+    def _walk_materials(self) -> Iterator[tuple[Node, Matrix4, Material]]:
+        """Every node (root excluded) with its world transform and inherited material, depth-first."""
+        stack = [(child, _IDENTITY, Material() if self.root.material is None else self.root.material)
+                 for child in reversed(self.root.children)]  # fmt: skip
+        while stack:
+            node, parent, inherited = stack.pop()
+            world = parent @ node.transform
+            material = node.material if node.material is not None else inherited
+            yield node, world, material
+            stack.extend((child, world, material) for child in reversed(node.children))
 
     @property
     def polylines(self) -> list[SceneItem]:

@@ -85,6 +85,10 @@ from .octree import (
     Octree as Octree,
     OctreeHits as OctreeHits,
 )
+from .points import (
+    PointCloud as PointCloud,
+    load_points as load_points,
+)
 from .polyline import (
     Polyline as Polyline,
 )
@@ -112,6 +116,9 @@ from .quadrics import (
     superellipsoid_implicit as superellipsoid_implicit,
     supertoroid as supertoroid,
     supertoroid_implicit as supertoroid_implicit,
+)
+from .splats import (
+    GaussianSplats as GaussianSplats,
 )
 from .surfaces import (
     BSplineSurface as BSplineSurface,

@@ -57,7 +57,7 @@ from typing import Any
 
 from frustum.camera import Camera
 from frustum.frame import Frame
-from frustum.render import composite, lines, methods, reflection, surfaces
+from frustum.render import composite, eye_dome, lines, methods, points, reflection, splats, surfaces
 from frustum.render.buffers import Buffers, resolve
 from frustum.render.buffers import FrameBuffers as FrameBuffers
 from frustum.render.buffers import Scratch as Scratch
@@ -126,6 +126,8 @@ def render(
     shadows: bool | str | None = None,
     shadow_map_size: int = 2048,
     shadow_softness: float = 1.0,
+    eye_dome: bool = False,
+    eye_dome_strength: float = 1.0,
 ) -> Frame:
     """Render `scene` seen by `camera` into a ``Frame`` (color (H, W, 4) uint8 and depth (H, W) float32).
 
@@ -217,6 +219,9 @@ def render(
     shadow_softness : float
         Percentage-closer filter width in texels, in [0, 16]; 0: hard edges; up to 1 (default): the 2 × 2 texels
         around the point, bilinearly weighted (``frustum.shadow_pass``).
+    eye_dome, eye_dome_strength : bool, float
+        Eye-dome lighting, a post-pass that darkens each pixel by how far its neighbours stand in front of it
+        (``render.eye_dome``): shape for unlit point clouds (scans); the strength (> 0) scales the darkening.
 
     Raises
     ------
@@ -238,6 +243,7 @@ def render(
         hidden_color=hidden_color, line_width=line_width, depth_cue=depth_cue, samples=samples, filter=filter,
         color_space=color_space, buffers=buffers, method=method, transparency=transparency, stats=stats,
         max_depth=max_depth, shadows=shadows, shadow_map_size=shadow_map_size, shadow_softness=shadow_softness,
+        eye_dome=eye_dome, eye_dome_strength=eye_dome_strength,
     )  # fmt: skip
     if options.factor == 1:
         return resolve(_draw(scene, camera, options), options)
@@ -252,9 +258,12 @@ def _draw(scene: Scene, camera: Camera, options: RenderOptions) -> Buffers:
         buffers.start(camera, options)
         lines.draw_edges(scene.items, camera, options, buffers)
         lines.draw_polylines(scene.polylines, camera, options, buffers)
+        points.draw_point_clouds(scene, camera, options, buffers)
         reflection.paint_background(camera, options, buffers)
         composite.draw_volumes(scene, camera, buffers)  # each ray stopped at the depth the lines wrote
+        splats.draw_splats(scene, camera, options, buffers)
         composite.draw_particles(scene, camera, buffers)
+        eye_dome.shade(camera, options, buffers)
         return buffers
     _draw_surfaces(scene, camera, options, buffers)
     buffers.scratch.release()
@@ -268,6 +277,7 @@ def _draw(scene: Scene, camera: Camera, options: RenderOptions) -> Buffers:
         if not options.volumes_with_surfaces:  # "hidden-line": rays stopped at the (invisible) surfaces
             composite.draw_volumes(scene, camera, buffers)
     composite.draw_particles(scene, camera, buffers)
+    eye_dome.shade(camera, options, buffers)
     return buffers
 
 
@@ -276,6 +286,7 @@ def _draw_surfaces(scene: Scene, camera: Camera, options: RenderOptions, buffers
     over them, then the transparent items."""
 
     def between() -> None:
+        points.draw_point_clouds(scene, camera, options, buffers)  # opaque, like the surfaces
         reflection.paint_background(camera, options, buffers)  # the environment where no opaque surface is
         # every volume ray cast after the opaque surfaces (rays stop at their depth), before the transparent items;
         # the edges and polylines first, so the part of a cloud in front of a line covers it (polylines write
@@ -285,6 +296,7 @@ def _draw_surfaces(scene: Scene, camera: Camera, options: RenderOptions, buffers
                 lines.draw_edges(scene.items, camera, options, buffers)
             lines.draw_polylines(scene.polylines, camera, options, buffers)
             composite.draw_volumes(scene, camera, buffers)
+        splats.draw_splats(scene, camera, options, buffers)  # over the opaque surfaces, composited by depth
 
     if options.method == "ray-tracing":
         from frustum.render import raytrace

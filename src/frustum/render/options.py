@@ -82,6 +82,8 @@ DEFAULTS: dict[str, Any] = {
     "shadows": None,
     "shadow_map_size": 2048,
     "shadow_softness": 1.0,
+    "eye_dome": False,
+    "eye_dome_strength": 1.0,
 }
 """``render``'s keyword arguments and their defaults (a test holds them equal to ``render``'s signature)."""
 
@@ -119,6 +121,7 @@ class RenderOptions:
     environment_background: bool = False  # no background given: the environment map is the background
     max_depth: int = 5
     shadows: bool = False  # method="ray-tracing": cast shadow rays (the other methods: ``shadow`` above)
+    eye_dome: float = 0.0  # eye-dome lighting strength (``render.eye_dome``); 0: off
 
     @classmethod
     def from_keywords(cls, scene: Any, camera: Any, where: str = "render", **keywords: Any) -> RenderOptions:
@@ -145,13 +148,14 @@ class RenderOptions:
         choice(k["filter"], FILTERS, "filter", where)
         choice(k["color_space"], COLOR_SPACES, "color_space", where)
         depth, shadows = ray_options(options, k["max_depth"], k["shadows"], k["depth_cue"], k["shading"], where)
+        eye_dome = eye_dome_strength(k["eye_dome"], k["eye_dome_strength"], where)
         check_image_budget(camera, factor, options.buffers, k["filter"], k["color_space"], where)
         environment = getattr(scene, "environment", None)
         return dataclasses.replace(options, factor=factor, filter=k["filter"], color_space=k["color_space"],
                                    environment=environment,
                                    environment_background=environment is not None
                                    and k["background"] is DEFAULT_BACKGROUND,
-                                   max_depth=depth, shadows=shadows)  # fmt: skip
+                                   max_depth=depth, shadows=shadows, eye_dome=eye_dome)  # fmt: skip
 
     def supersampled(self) -> RenderOptions:
         """The options for the √samples-times larger image: lines √samples times as wide (the same counts dict)."""
@@ -182,6 +186,16 @@ def shadow_options(options: RenderOptions, shadows: Any, map_size: Any, softness
         )
     wanted = shadow is not None or "position" in options.buffers
     return dataclasses.replace(options, shadow=shadow, outputs={} if wanted else None)
+
+
+def eye_dome_strength(on: Any, strength: Any, where: str) -> float:
+    """The eye-dome lighting strength (> 0) where `on`, else 0."""
+    if not isinstance(on, bool | np.bool_):
+        raise FrustumError(f"{where}: eye_dome = {describe(on)} is not a bool; give True or False")
+    value = as_scalar(strength, "eye_dome_strength", where=where, error=FrustumError)
+    if not value > 0.0:
+        raise FrustumError(f"{where}: eye_dome_strength = {value!r} is not positive; give a strength > 0 (1: default)")
+    return value if on else 0.0
 
 
 def choice(value: Any, valid: tuple, name: str, where: str) -> Any:

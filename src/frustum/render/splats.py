@@ -1,0 +1,105 @@
+"""The splat pass of ``render``: every placed ``GaussianSplats`` composited over the opaque surfaces by the 3DGS
+method (``raster.splats``: EWA projection, 3σ bounds, 16 × 16 tiles, a front-to-back sort, alpha compositing).
+
+All placed splat sets are projected (``project_splats``, parallel over splats), sorted together by the window depth
+of their centres (a stable sort: equal depths keep scene and file order), binned into tiles in that order
+(``count_tiles`` / ``fill_tiles``) and blended per tile (``blend_tiles``, parallel over tiles) against the depth
+buffer of the opaque surfaces. The frame's pixel becomes
+
+$$C = Σ cᵢ·αᵢ·Tᵢ + T·C_under,   A = (1 − T) + T·A_under$$
+
+with C_under, A_under what the surfaces (or the background) left there. Splat colours are display values, as 3DGS
+files store them: written as they are (no lighting, no tone map; ``color_space="srgb"`` still encodes the frame).
+``Frame.depth`` where splats contribute is their expected window depth $Σ wᵢ zᵢ / Σ wᵢ$ ($wᵢ = αᵢ·Tᵢ$, zᵢ the
+window depth of splat i's centre), in front of whatever was there; elsewhere it is unchanged. Object ids and normals
+are not written for splats (they have no surface).
+
+References
+----------
+Kerbl et al., "3D Gaussian Splatting for Real-Time Radiance Field Rendering" (2023) §6 (the tile rasterizer).
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from frustum.camera import Camera
+from frustum.render.buffers import Buffers
+from frustum.render.options import RenderOptions
+from frustum.scene import PointItem, Scene
+
+__all__ = ["SplatLayer", "draw_splats", "project", "splat_layer"]
+
+
+class SplatLayer(NamedTuple):
+    """What the splats of a frame add: premultiplied ``color`` (H, W, 3), ``transmittance`` (H, W) (1: nothing),
+    expected window ``depth`` (H, W) (NaN where no splat contributes), all float32, rows top first."""
+
+    color: np.ndarray
+    transmittance: np.ndarray
+    depth: np.ndarray
+
+
+def project(items: list[PointItem], camera: Camera) -> np.ndarray:
+    """(N, SPLAT_FIELDS) float64 records of every splat of `items` (``raster.splats``), in item order."""
+    from frustum.raster import splats as kernels
+
+    parts = []
+    frame = np.array([camera.width, camera.height, *camera.frame.eye], dtype=np.float64)
+    clip_from_view = np.asarray(camera.projection_matrix, dtype=np.float64)
+    for item in items:
+        splats = item.geometry
+        world_from_model = np.asarray(item.world_from_model, dtype=np.float64)
+        matrices = np.ascontiguousarray(np.stack([
+            camera.view_matrix @ world_from_model, clip_from_view, np.linalg.inv(world_from_model), world_from_model,
+        ]))  # fmt: skip
+        records = np.empty((splats.count, kernels.SPLAT_FIELDS))
+        kernels.project_splats(np.ascontiguousarray(splats.positions), np.ascontiguousarray(splats.scales),
+                               np.ascontiguousarray(splats.rotations), np.ascontiguousarray(splats.opacities),
+                               np.ascontiguousarray(splats.sh), matrices, frame, records)  # fmt: skip
+        parts.append(records)
+    return np.concatenate(parts) if parts else np.empty((0, kernels.SPLAT_FIELDS))
+
+
+def splat_layer(items: list[PointItem], camera: Camera, depth: np.ndarray | None = None) -> SplatLayer:
+    """The splats of `items` seen by `camera` in front of `depth` ((H, W) float32 window depth; None: nothing
+    opaque), as a ``SplatLayer``."""
+    from frustum.raster import splats as kernels
+
+    height, width = camera.height, camera.width
+    if depth is None:
+        depth = np.ones((height, width), dtype=np.float32)
+    records = project(items, camera)
+    kept = np.flatnonzero(records[:, kernels.F_RADIUS] > 0.0)
+    order = kept[np.argsort(records[kept, kernels.F_Z], kind="stable")]
+    tiles_x, tiles_y = -(-width // kernels.TILE), -(-height // kernels.TILE)
+    counts = np.zeros(tiles_x * tiles_y, dtype=np.int64)
+    kernels.count_tiles(records, order, height, tiles_x, tiles_y, counts)
+    starts = np.zeros(counts.size + 1, dtype=np.int64)
+    np.cumsum(counts, out=starts[1:])
+    entries = np.empty(int(starts[-1]), dtype=np.int64)
+    kernels.fill_tiles(records, order, height, tiles_x, tiles_y, starts, entries)
+    layer = np.empty((height, width, 6), dtype=np.float32)
+    kernels.blend_tiles(records, starts, entries, tiles_x, np.ascontiguousarray(depth, dtype=np.float32), layer)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        expected = np.where(layer[..., 4] > 0.0, layer[..., 5] / layer[..., 4], np.nan).astype(np.float32)
+    return SplatLayer(layer[..., :3], layer[..., 3], expected)
+
+
+def draw_splats(scene: Scene, camera: Camera, options: RenderOptions, buffers: Buffers) -> None:
+    """Composite every placed splat set of `scene` over `buffers` (the module docstring's equations)."""
+    items = [item for item in scene.point_clouds if item.style.style == "splats" and item.geometry.count]
+    if not items:
+        return
+    layer = splat_layer(items, camera, buffers.depth)
+    color = buffers.color
+    under = color.astype(np.float32) / 255.0
+    t = layer.transmittance[..., None]
+    rgb = layer.color + t * under[..., :3]
+    alpha = (1.0 - layer.transmittance) + layer.transmittance * under[..., 3]
+    color[..., :3] = np.floor(np.clip(rgb, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
+    color[..., 3] = np.floor(np.clip(alpha, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
+    seen = ~np.isnan(layer.depth)
+    buffers.depth[seen] = layer.depth[seen]
