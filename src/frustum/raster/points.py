@@ -154,11 +154,11 @@ def project_impostors(centers: np.ndarray, radii: np.ndarray, normals: np.ndarra
 @kernel
 def _shade(params: np.ndarray, lights: np.ndarray, item: np.ndarray, colors: np.ndarray, k: int,
            px: float, py: float, pz: float, nx: float, ny: float, nz: float) -> tuple[float, float, float]:  # fmt: skip
-    """Linear RGB of point k: base = material color × point color; lit by ``raster.shade``'s model at world point
-    P with unit world normal N when ``item[I_LIT]``, else the base color."""
+    """Linear RGB of point k: base = the point's color (the material color for a cloud without colors); lit by
+    ``raster.shade``'s model at world point P with unit world normal N when ``item[I_LIT]``, else the base color."""
     r, g, b = params[P_COLOR], params[P_COLOR + 1], params[P_COLOR + 2]
     if colors.shape[0] > 0:
-        r, g, b = r * colors[k, 0], g * colors[k, 1], b * colors[k, 2]
+        r, g, b = colors[k, 0], colors[k, 1], colors[k, 2]
     if item[I_LIT] == 0:
         return r, g, b
     dr, dg, db, sr, sg, sb = _illuminate(params, lights, item[I_SPECULAR_MODEL], px, py, pz, nx, ny, nz)

@@ -9,7 +9,8 @@ Per cloud (``Scene.point_clouds``, styles of ``frustum.geometry.points.PointStyl
 3. ``raster.points.draw_points`` / ``draw_impostors``, parallel over bands: depth test "less", depth, color,
    normal and object id written where a point wins.
 
-Colors: the material's color times the point's. Squares and disks are lit by the scene's lights (the one model of
+Colors: the points' own colors (a cloud without colors: the material's color), which the material's coefficients
+light. Squares and disks are lit by the scene's lights (the one model of
 ``frustum.shading``, ``raster.shade._illuminate``) with their normals when the cloud has normals, else drawn in their
 colors (a scan: see ``render(..., eye_dome=True)``); spheres with the true normal of the hit point, surfels with
 their disk normal turned toward the viewer (``shading="none"``: colors only). Sizes in pixels are multiplied by
