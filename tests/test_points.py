@@ -295,7 +295,7 @@ def test_point_file_errors_name_the_problem(tmp_path):
     with pytest.raises(GeometryError, match="does not exist"):
         load_points(tmp_path / "missing.ply")
     (tmp_path / "x.obj").write_text("v 0 0 0\n")
-    with pytest.raises(GeometryError, match="unknown suffix '.obj'"):
+    with pytest.raises(GeometryError, match=r"unknown suffix '\.obj'"):
         load_points(tmp_path / "x.obj")
     (tmp_path / "bad.xyz").write_text("0 0 0\n1 1\n")
     with pytest.raises(GeometryError, match="rows of different lengths"):
@@ -305,8 +305,8 @@ def test_point_file_errors_name_the_problem(tmp_path):
                                          + b"\0" * 24)  # fmt: skip
     with pytest.raises(GeometryError, match="truncated"):
         load_points(tmp_path / "short.ply")
-    (tmp_path / "huge.ply").write_bytes(b"ply\nformat binary_little_endian 1.0\nelement vertex 100000000\n"
-                                        b"property float x\nproperty float y\nproperty float z\nend_header\n")  # fmt: skip
+    header = b"ply\nformat binary_little_endian 1.0\nelement vertex 100000000\n"
+    (tmp_path / "huge.ply").write_bytes(header + b"property float x\nproperty float y\nproperty float z\nend_header\n")
     with pytest.raises(GeometryError, match="over the memory budget"):
         load_points(tmp_path / "huge.ply")
 
