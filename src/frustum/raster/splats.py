@@ -5,10 +5,13 @@
    splat's centre (EWA: $Σ′ = J V Σ Vᵀ Jᵀ + 0.3·I$, the 0.3-pixel low-pass dilation). For a perspective camera J
    is 3DGS's $[[f_x/z, 0, −f_x·x/z²], [0, f_y/z, −f_y·y/z²]]$; here it is taken from the projection matrix P
    for any camera: row i of J is $(W_i/2)·(P_i/w − c_i·P₃/w²)$ with c = P·v, w = c₃, $W_0 = W$, $W_1 = H$.
-   Its inverse (the conic), a square bound of half side $⌈3·√λ_max⌉$ pixels (3σ along the major axis) and the
+   Its inverse (the conic), a square bound of half side $⌈k·√λ_max⌉$ pixels and the
    view-dependent colour $max(0.5 + Σ_lm SH_lm(d)·k_lm, 0)$ (d: the unit direction from the eye to the centre,
    in model axes; the real SH basis and constants of the 3DGS code, degree 0–3) complete the record. A splat is
-   culled unless its centre lies between the near and far planes ($w > 0$, $−w <= z_c <= w$).
+   culled unless its centre lies between the near and far planes ($w > 0$, $−w <= z_c <= w$). The bound is the
+   3DGS 3σ box tightened to where the splat can be drawn at all: $k = √(2·ln(255·o))$ standard deviations along
+   the major axis, where $o·exp(−½k²) = 1/255$ (gsplat's opacity-aware radius; k ≤ 3.33 as o ≤ 1, k < 3 for
+   o < 0.35), so no pixel with α ≥ 1/255 lies outside it and the tiles change no pixel.
 2. ``count_tiles`` / ``fill_tiles``: each splat's bound is binned into 16 × 16-pixel tiles, visited in the
    caller's order (sorted by depth), so every tile's list is sorted front to back.
 3. ``blend_tiles`` (parallel over tiles): per pixel, front to back, $α = min(0.99, o·exp(−½ dᵀΣ′⁻¹d))$ at the
@@ -136,6 +139,9 @@ def project_splats(positions: np.ndarray, scales: np.ndarray, rotations: np.ndar
         det = a * c - b * b
         if not det > 0.0:
             continue
+        if not opacities[k] * 255.0 > 1.0:  # α = o·G < 1/255 everywhere: never drawn
+            continue
+        extent = math.sqrt(2.0 * math.log(255.0 * opacities[k]))  # σ where o·exp(−½k²) = 1/255
         mid = 0.5 * (a + c)
         largest = mid + math.sqrt(max(0.1, mid * mid - det))
         records[k, F_X] = (c0 / w + 1.0) * (width / 2.0)
@@ -156,7 +162,7 @@ def project_splats(positions: np.ndarray, scales: np.ndarray, rotations: np.ndar
             dx, dy, dz = dx / length, dy / length, dz / length
         for channel in range(3):
             records[k, F_COLOR + channel] = sh_color(sh, k, channel, dx, dy, dz)
-        records[k, F_RADIUS] = math.ceil(3.0 * math.sqrt(largest))
+        records[k, F_RADIUS] = math.ceil(extent * math.sqrt(largest))
 
 
 @kernel
