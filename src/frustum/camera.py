@@ -676,6 +676,10 @@ def _fit_points(value: object, where: str) -> NDArray[np.float64]:
     scene = getattr(value, "scene", value)  # a SceneFile holds its scene
     if hasattr(scene, "items") and not isinstance(scene, np.ndarray):
         chunks = [apply(item.world_from_model, item.mesh.vertices) for item in scene.items if item.mesh.vertex_count]
+        for placed in getattr(scene, "point_clouds", ()):  # point clouds and splats: the corners of their boxes
+            low, high = placed.geometry.bounds
+            corners = np.array([[(low, high)[i >> k & 1][k] for k in range(3)] for i in range(8)])
+            chunks.append(apply(placed.world_from_model, corners))
         if not chunks:
             raise CameraError(f"{where}: the scene has no vertices; add a mesh before framing it")
         points = np.concatenate(chunks)

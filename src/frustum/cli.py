@@ -366,14 +366,16 @@ def _triple_text(values: Sequence[float]) -> str:
 
 @app.command("info")
 def info_command(mesh: Annotated[Path, typer.Argument(help="A mesh file (.ply, .obj, .stl, .off, .glb).")]) -> None:
-    """Print a mesh file's counts, bounds, watertightness and normals."""
+    """Print a mesh file's counts, bounds, watertightness and normals (a point cloud's or splat file's counts)."""
     from rich.table import Table
 
-    loaded = _load_mesh(mesh, "info")
+    from frustum.geometry.points import point_file_facts
+
+    facts = point_file_facts(mesh)
     table = Table(title=str(mesh), show_header=False, title_justify="left")
     table.add_column(style="bold")
     table.add_column()
-    for name, value in _mesh_facts(loaded):
+    for name, value in facts if facts is not None else _mesh_facts(_load_mesh(mesh, "info")):
         table.add_row(name, value)
     console.print(table)
 
@@ -395,18 +397,19 @@ def turntable_command(
 ) -> None:
     """Render a mesh from a camera orbiting it once and write the frames as a looping GIF or an MP4 (the file's
     materials and textures, the default lights of frustum.scenefile.models)."""
+    from frustum.geometry.points import point_file_kind
     from frustum.output.animation import framing_camera, turntable
-    from frustum.scenefile.models import model_scene
+    from frustum.scenefile.models import model_options, model_scene
 
     width, height = _image_size(size)
     if not 0 <= abs(elevation_deg) < 90:
         raise UsageError(f"--elevation-deg = {elevation_deg!r} is out of range; give an angle in (-90, 90)")
-    _load_mesh(mesh, "turntable")  # the CLI's checks and messages for a bad mesh file
+    if point_file_kind(mesh) is None:
+        _load_mesh(mesh, "turntable")  # the CLI's checks and messages for a bad mesh file
     scene, _ = model_scene(mesh, up=up, size=(width, height))
     camera = framing_camera(scene, width, height, elevation=math.radians(elevation_deg))
-    count = turntable(
-        scene, camera, frames, axis, output, fps, progress=error_console, cull_back_faces=False, mode=mode
-    )
+    count = turntable(scene, camera, frames, axis, output, fps, progress=error_console, cull_back_faces=False,
+                      mode=mode, **model_options(scene))  # fmt: skip
     console.print(f"wrote {output} ({count} frames, {width}x{height})", markup=False, highlight=False, soft_wrap=True)
 
 

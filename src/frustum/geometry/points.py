@@ -36,8 +36,8 @@ from frustum.errors import GeometryError
 from frustum.transforms import apply, apply_to_normals
 
 __all__ = [
-    "DEFAULT_POINT_SIZE", "POINT_STYLES", "POINT_SUFFIXES", "PointCloud", "PointStyle", "load_points", "point_style",
-    "read_ply_header", "read_ply_vertices",
+    "DEFAULT_POINT_SIZE", "POINT_STYLES", "POINT_SUFFIXES", "PointCloud", "PointStyle", "load_points",
+    "point_file_facts", "point_file_kind", "point_style", "read_ply_header", "read_ply_vertices",
 ]  # fmt: skip
 
 POINT_SUFFIXES = (".ply", ".xyz", ".txt", ".csv", ".pts")
@@ -240,6 +240,59 @@ def point_style(geometry: Any, style: Any, point_size: Any, radius: Any, where: 
         diagonal = float(np.linalg.norm(high - low))
         world = 0.5 * diagonal / max(geometry.point_count, 1) ** (1.0 / 3.0) if diagonal > 0 else 0.5
     return PointStyle(name, size, world)
+
+
+def point_file_kind(path: str | Path) -> str | None:
+    """What a file holds for the commands that take "a model file": ``"splats"`` (a PLY with the 3DGS vertex
+    properties), ``"points"`` (a PLY without faces, a text point file, a COLMAP model folder) or None (a mesh file,
+    or something unreadable: the mesh loader reports it)."""
+    file = Path(path)
+    if file.is_dir():
+        return "points" if (file / "points3D.txt").is_file() or (file / "points3D.bin").is_file() else None
+    suffix = file.suffix.lower()
+    if suffix in (".xyz", ".pts", ".csv") or file.name in ("points3D.txt", "points3D.bin"):
+        return "points"
+    if suffix != ".ply" or not file.is_file():
+        return None
+    try:
+        header = read_ply_header(file, "point_file_kind")
+    except (GeometryError, OSError):
+        return None
+    vertex = header.element("vertex")
+    if vertex is None:
+        return None
+    names = {p[-1] for p in vertex[2]}
+    if {"f_dc_0", "opacity", "scale_0", "rot_0"} <= names:
+        return "splats"
+    face = header.element("face")
+    return "points" if face is None or face[1] == 0 else None
+
+
+def point_file_facts(path: str | Path) -> list[tuple[str, str]] | None:
+    """(name, value) rows for ``frustum info`` of a point or splat file (None for a mesh file)."""
+    kind = point_file_kind(path)
+    if kind is None:
+        return None
+    if kind == "splats":
+        from frustum.geometry.splats import GaussianSplats
+
+        splats = GaussianSplats.load(path)
+        low, high = splats.bounds
+        return [("kind", "3D Gaussian splats (3DGS PLY)"), ("splats", f"{splats.count}"),
+                ("spherical-harmonic degree", f"{splats.degree}"), ("bounds min", _triple(low)),
+                ("bounds max", _triple(high)),
+                ("opacity", f"mean {float(splats.opacities.mean()):.3g}" if splats.count else "none")]  # fmt: skip
+    cloud = load_points(path)
+    low, high = cloud.bounds
+    return [("kind", "point cloud"), ("points", f"{cloud.point_count}"), ("bounds min", _triple(low)),
+            ("bounds max", _triple(high)), ("size", _triple(high - low)),
+            ("colors", "yes" if cloud.colors is not None else "no"),
+            ("normals", "yes" if cloud.normals is not None else "no"),
+            ("radii", "yes" if cloud.radii is not None else "no")]  # fmt: skip
+
+
+def _triple(values: Any) -> str:
+    return "(" + ", ".join(f"{float(v):.6g}" for v in values) + ")"
 
 
 # --- files ----------------------------------------------------------------------------------------------------

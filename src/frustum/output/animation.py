@@ -22,7 +22,7 @@ from numpy.typing import ArrayLike, NDArray
 from frustum._arrays import as_direction, as_scalar, describe
 from frustum._files import atomic_path, os_reason, track_process
 from frustum.budgets import check_operations
-from frustum.camera import Camera, ViewFrame
+from frustum.camera import Camera, ViewFrame, _fit_points
 from frustum.errors import CameraError, OutputError
 from frustum.frame import Frame
 from frustum.projection import Perspective
@@ -366,10 +366,7 @@ def framing_camera(scene: Scene, width: int = 480, height: int = 480, elevation:
     """A perspective camera (fovy 40°) looking at the center of the scene's bounding box from the +z side, y up,
     raised by `elevation`, far enough that the bounding sphere fits the image."""
     where = "framing_camera"
-    corners = [apply(item.world_from_model, item.mesh.vertices) for item in scene.items if item.mesh.vertex_count]
-    if not corners:
-        raise CameraError(f"{where}: scene has no vertices; add a mesh before framing it")
-    points = np.concatenate(corners)
+    points = _fit_points(scene, where)  # the meshes' vertices and the point clouds' boxes
     low, high = points.min(axis=0), points.max(axis=0)
     center = (low + high) / 2
     radius = max(float(np.linalg.norm(high - low)) / 2, 1e-9)

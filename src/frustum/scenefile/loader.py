@@ -420,12 +420,13 @@ def _load_scene_file(path: str | Path, check_outputs: bool = True, *, up: str = 
     return dataclasses.replace(scene_file, path=file)
 
 
-MODEL_SUFFIXES = (".obj", ".stl", ".ply", ".off", ".gltf", ".glb")
+MODEL_SUFFIXES = (".obj", ".stl", ".ply", ".off", ".gltf", ".glb", ".xyz", ".pts")
 """Suffixes ``load_scene_file`` reads as a mesh file (a model) instead of a TOML scene file."""
 
 
 def _model_scene_file(file: Path, up: str) -> SceneFile:
-    from frustum.scenefile.models import model_scene
+    from frustum.scenefile.models import model_options, model_scene
 
     scene, camera = model_scene(file, up=up, size=_DEFAULT_SIZE)
-    return SceneFile(scene, camera, {}, (), (camera,), size=_DEFAULT_SIZE, title=file.stem, path=file, up=up)
+    return SceneFile(scene, camera, model_options(scene), (), (camera,), size=_DEFAULT_SIZE, title=file.stem,
+                     path=file, up=up)  # fmt: skip

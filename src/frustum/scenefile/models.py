@@ -96,10 +96,38 @@ def model_scene(path: str | Path, *, up: str = "y", size: tuple[int, int] = (640
     file = Path(path)
     turn = _Z_UP_TO_Y_UP if up == "z" and file.suffix.lower() not in (".glb", ".gltf") else None
     scene = Scene()
-    for node in part_nodes(load_parts(file), turn):
-        scene.add(node)
+    if not _add_points(scene, file, turn):
+        for node in part_nodes(load_parts(file), turn):
+            scene.add(node)
     width, height = size
     camera = Camera.fit(scene, width=width, height=height)
     for light in default_lights(camera):
         scene.root.add_light(light)
     return scene, camera
+
+
+def _add_points(scene: Scene, file: Path, turn: np.ndarray | None) -> bool:
+    """Place the point cloud or Gaussian splats of `file` in `scene` (squares of 2 pixels; white where the cloud has
+    no colors); False for a mesh file."""
+    from frustum.geometry.points import point_file_kind
+
+    kind = point_file_kind(file)
+    if kind is None:
+        return False
+    if kind == "splats":
+        from frustum.geometry.splats import GaussianSplats
+
+        scene.add(GaussianSplats.load(file), transform=turn, name=file.stem)
+        return True
+    from frustum.geometry.points import load_points
+
+    scene.add(load_points(file), Material(color=(1.0, 1.0, 1.0), specular=0.2), turn, name=file.stem)
+    return True
+
+
+def model_options(scene: Scene) -> dict[str, Any]:
+    """Render options of a model file's scene: eye-dome lighting for a point cloud without normals (a scan, drawn
+    unlit in its colors: EDL gives it shape)."""
+    clouds = scene.point_clouds
+    unlit = [p for p in clouds if p.style.style in ("square", "disk") and p.geometry.normals is None]
+    return {"eye_dome": True} if unlit else {}
