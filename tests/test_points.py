@@ -336,3 +336,38 @@ def test_point_cloud_is_immutable_and_transforms():
     np.testing.assert_allclose(moved.points, [[2.0, 0.0, 0.0]])
     np.testing.assert_allclose(moved.normals, [[0.0, 0.0, 1.0]])
     np.testing.assert_allclose(moved.radii, [1.0])
+
+
+# --- commands --------------------------------------------------------------------------------------------------
+
+
+def test_commands_render_and_describe_point_and_splat_files(tmp_path):
+    import subprocess
+    import sys
+
+    from tests.testdata import DATA
+
+    rng = np.random.default_rng(2)
+    points = rng.normal(size=(3000, 3)) * (1.0, 0.6, 0.4)
+    (tmp_path / "scan.xyz").write_text("\n".join(" ".join(f"{v:.6f}" for v in p) + " 200 120 40" for p in points))
+
+    def run(*arguments: str) -> subprocess.CompletedProcess[str]:
+        return subprocess.run([sys.executable, "-m", "frustum", *arguments], capture_output=True, text=True,
+                              timeout=600, check=False, cwd=tmp_path)  # fmt: skip
+
+    result = run("render", "scan.xyz", "-o", "scan.png", "--size", "96x72")
+    assert result.returncode == 0, result.stderr
+    from PIL import Image
+
+    image = np.asarray(Image.open(tmp_path / "scan.png"))
+    drawn = (image[..., :3] != 0).any(axis=2)
+    assert 0.05 < drawn.mean() < 0.9  # framed: the cloud fills part of the picture
+    assert len(np.unique(image[drawn][:, 0])) > 5  # eye-dome lighting shades the one color of the scan
+    result = run("render", str(DATA / "splats" / "torus.ply"), "-o", "torus.png", "--size", "96x72")
+    assert result.returncode == 0, result.stderr
+    info = run("info", str(DATA / "splats" / "torus.ply"))
+    assert "3D Gaussian splats" in info.stdout and "512" in info.stdout
+    info = run("info", "scan.xyz")
+    assert "point cloud" in info.stdout and "3000" in info.stdout
+    missing = run("render", "nothing.xyz", "-o", "x.png")
+    assert missing.returncode != 0 and "Traceback" not in missing.stderr
