@@ -32,7 +32,7 @@ import math
 
 import numpy as np
 
-from frustum.raster._jit import kernel, parallel_kernel
+from frustum.raster._jit import kernel, parallel_kernel, prefetch
 from frustum.raster.shade import P_COLOR, P_EMISSIVE, _illuminate, _to_byte
 
 __all__ = [
@@ -46,6 +46,8 @@ POINT_FIELDS = 4
 IMPOSTOR_FIELDS = 12
 """Sphere/surfel record: window box x_low, x_high, y_low, y_high; view centre (3), radius, view normal (3),
 clip w of the centre."""
+PREFETCH_AHEAD = 32
+"""Entries ahead whose record and color ``draw_points`` prefetches."""
 # item layout
 I_STYLE, I_LIT, I_SPECULAR_MODEL, I_OBJECT_ID, I_WRITE_NORMALS, I_WRITE_IDS = 0, 1, 2, 3, 4, 5
 ITEM = 6
@@ -183,7 +185,13 @@ def draw_points(records: np.ndarray, starts: np.ndarray, entries: np.ndarray, ba
     for band in range(start, stop):
         first_row = band * band_rows
         last_row = min(first_row + band_rows, height) - 1
-        for e in range(starts[band], starts[band + 1]):
+        end = starts[band + 1]
+        for e in range(starts[band], end):
+            if e + PREFETCH_AHEAD < end:  # records and colors are gathered at random: start the loads early
+                ahead = entries[e + PREFETCH_AHEAD]
+                prefetch(records, ahead, 0)
+                if colors.shape[0] > 0:
+                    prefetch(colors, ahead, 0)
             k = entries[e]
             x, y, z, half = records[k, 0], records[k, 1], records[k, 2], records[k, 3]
             low_y = max(math.ceil(y - half - 0.5), height - 1 - last_row)

@@ -1,0 +1,146 @@
+"""Point clouds and Gaussian splats at 1080p (issue 47).
+
+    python benchmarks/bench_points.py                 # both, medians of 3 warm frames
+    python benchmarks/bench_points.py --only points   # (a) only
+
+(a) 1 M coloured points drawn as 1-pixel squares (``style="square", point_size=1``, unlit) at 1920 × 1080 by
+``frustum.render``, against Mesa llvmpipe's ``GL_POINTS`` (moderngl, ``gl_PointSize = 1``, depth test, the same
+points and camera) measured in the same run. Both frames count the same work: clear, draw, finish and read colour
+(RGBA8) and depth back (frustum returns them as its Frame). Target: frustum / llvmpipe <= 0.5.
+
+(b) 1 M generated Gaussian splats (random positions in a 2 × 2 × 2 box seen from 4 units, log-scales uniform in
+[−5.5, −3.5] (σ 4–30 mm, a few pixels on screen), random rotations, opacities uniform in [0.2, 1], SH degree 1)
+at 1920 × 1080, seconds per warm frame. Target: <= 2 s per frame on the 2-core machine.
+
+Compile time is reported separately (the first frame of each). Prints one line per measurement and the ratio.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import statistics
+import time
+
+import numpy as np
+
+WIDTH, HEIGHT = 1920, 1080
+COUNT = 1_000_000
+
+
+def camera():
+    from frustum import Camera, Perspective
+
+    return Camera.look_at((0.0, 0.0, 4.0), (0, 0, 0), (0, 1, 0), projection=Perspective(math.radians(45), 0.5, 20.0),
+                          width=WIDTH, height=HEIGHT)  # fmt: skip
+
+
+def median_time(function, frames: int = 3) -> tuple[float, float]:
+    """(first call seconds, median of `frames` later calls)."""
+    start = time.perf_counter()
+    function()
+    first = time.perf_counter() - start
+    times = []
+    for _ in range(frames):
+        start = time.perf_counter()
+        function()
+        times.append(time.perf_counter() - start)
+    return first, statistics.median(times)
+
+
+def bench_points() -> None:
+    from frustum import PointCloud, Scene, render
+
+    rng = np.random.default_rng(0)
+    points = rng.uniform(-1.0, 1.0, size=(COUNT, 3)) * (1.5, 0.8, 1.0)
+    colors = rng.integers(0, 256, size=(COUNT, 3), dtype=np.uint8)
+    scene = Scene()
+    scene.add(PointCloud(points, colors), style="square", point_size=1)
+    cam = camera()
+    first, ours = median_time(lambda: render(scene, cam, shading="none"))
+    print(f"(a) frustum 1M points 1px 1080p: first {first * 1e3:.0f} ms, warm median {ours * 1e3:.1f} ms")
+    theirs = gl_points(points, colors, cam)
+    if theirs is not None:
+        print(f"(a) llvmpipe GL_POINTS 1M 1px 1080p: warm median {theirs * 1e3:.1f} ms (clear+draw+finish+readback)")
+        print(f"(a) ratio frustum / llvmpipe = {ours / theirs:.2f} (target <= 0.5)")
+
+
+def gl_points(points: np.ndarray, colors: np.ndarray, cam) -> float | None:
+    try:
+        import moderngl
+
+        ctx = moderngl.create_standalone_context(require=330, backend="egl")
+    except Exception as error:  # no moderngl or no EGL here
+        print(f"(a) llvmpipe: not available ({error})")
+        return None
+    print(f"(a) GL_RENDERER: {ctx.info['GL_RENDERER']}")
+    program = ctx.program(
+        vertex_shader="""
+        #version 330 core
+        uniform mat4 u_clip_from_world;
+        in vec3 in_position;
+        in vec3 in_color;
+        out vec3 v_color;
+        void main() { gl_Position = u_clip_from_world * vec4(in_position, 1.0); gl_PointSize = 1.0; v_color = in_color; }
+        """,
+        fragment_shader="""
+        #version 330 core
+        in vec3 v_color;
+        out vec4 f_color;
+        void main() { f_color = vec4(v_color, 1.0); }
+        """,
+    )
+    program["u_clip_from_world"].write(np.asarray(cam.clip_from_world, dtype="f4").T.tobytes())
+    vao = ctx.vertex_array(program, [(ctx.buffer(points.astype("f4")), "3f", "in_position"),
+                                     (ctx.buffer(colors), "3f1", "in_color")])  # fmt: skip
+    fbo = ctx.framebuffer(color_attachments=[ctx.renderbuffer((WIDTH, HEIGHT), 4, dtype="f1")],
+                          depth_attachment=ctx.depth_renderbuffer((WIDTH, HEIGHT)))  # fmt: skip
+    fbo.use()
+    ctx.enable(moderngl.DEPTH_TEST | moderngl.PROGRAM_POINT_SIZE)
+    color = np.empty((HEIGHT, WIDTH, 4), dtype=np.uint8)
+    depth = np.empty((HEIGHT, WIDTH), dtype=np.float32)
+
+    def frame() -> None:
+        fbo.clear(0.0, 0.0, 0.0, 1.0, depth=1.0)
+        vao.render(moderngl.POINTS)
+        ctx.finish()
+        fbo.read_into(color, components=4, dtype="f1")
+        fbo.read_into(depth, components=1, attachment=-1, dtype="f4")
+
+    frame()
+    _, median = median_time(frame)
+    ctx.release()
+    return median
+
+
+def bench_splats() -> None:
+    from frustum import GaussianSplats, Scene, render
+
+    rng = np.random.default_rng(1)
+    sh = np.zeros((COUNT, 4, 3), dtype=np.float32)
+    sh[:, 0, :] = rng.normal(size=(COUNT, 3)) * 1.2
+    sh[:, 1:, :] = rng.normal(size=(COUNT, 3, 3)) * 0.2
+    splats = GaussianSplats(rng.uniform(-1.0, 1.0, size=(COUNT, 3)), np.exp(rng.uniform(-5.5, -3.5, size=(COUNT, 3))),
+                            rng.normal(size=(COUNT, 4)), rng.uniform(0.2, 1.0, size=COUNT), sh)  # fmt: skip
+    scene = Scene()
+    scene.add(splats)
+    cam = camera()
+    first, median = median_time(lambda: render(scene, cam))
+    print(f"(b) frustum 1M splats 1080p: first {first:.2f} s, warm median {median:.2f} s/frame (target <= 2 s)")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--only", choices=("points", "splats"))
+    args = parser.parse_args()
+    print(f"load average {os.getloadavg()}, cores {os.cpu_count()}")
+    if args.only != "splats":
+        bench_points()
+    if args.only != "points":
+        bench_splats()
+    print(f"load average {os.getloadavg()}")
+
+
+if __name__ == "__main__":
+    main()
