@@ -21,8 +21,10 @@
    of the centre) is written where $Σ wᵢ > 0$.
 
 Records (``SPLAT_FIELDS`` float64): window x, y (y up), window depth z of the centre, bound half side r (pixels,
-0: culled), conic (A, B, C) of $Σ′⁻¹$ in window axes, opacity o, colour (3), and Σ′ in image axes (x right,
-y down, 3DGS's convention; a, b, c) for testing. Kernels never validate (arrays contiguous, shapes as stated).
+0: culled), conic (A, B, C) of $Σ′⁻¹$ in window axes, opacity o, colour (3), Σ′ in image axes (x right,
+y down, 3DGS's convention; a, b, c) for testing, and the half sides $k·√Σ′ₓₓ$, $k·√Σ′ᵧᵧ$ of the box around the
+ellipse $dᵀΣ′⁻¹d <= k²$ (inside the square bound: the pixels and tiles actually visited). Kernels never validate
+(arrays contiguous, shapes as stated).
 
 References
 ----------
@@ -37,7 +39,7 @@ import math
 
 import numpy as np
 
-from frustum.raster._jit import kernel, parallel_kernel
+from frustum.raster._jit import kernel, parallel_kernel, prefetch
 
 __all__ = [
     "SPLAT_FIELDS", "TILE", "blend_tiles", "count_tiles", "fill_tiles", "project_splats", "sh_color",
@@ -46,7 +48,9 @@ __all__ = [
 SPLAT_FIELDS = 16
 TILE = 16
 """Tile side in pixels."""
-F_X, F_Y, F_Z, F_RADIUS, F_CONIC, F_OPACITY, F_COLOR, F_COV = 0, 1, 2, 3, 4, 7, 8, 11
+F_X, F_Y, F_Z, F_RADIUS, F_CONIC, F_OPACITY, F_COLOR, F_COV, F_EXTENT = 0, 1, 2, 3, 4, 7, 8, 11, 14
+PREFETCH_AHEAD = 8
+"""Tile entries ahead whose records ``blend_tiles`` prefetches."""
 DILATION = 0.3
 """Pixels² added to the screen covariance's diagonal (the low-pass filter)."""
 ALPHA_MAX = 0.99
@@ -163,18 +167,20 @@ def project_splats(positions: np.ndarray, scales: np.ndarray, rotations: np.ndar
         for channel in range(3):
             records[k, F_COLOR + channel] = sh_color(sh, k, channel, dx, dy, dz)
         records[k, F_RADIUS] = math.ceil(extent * math.sqrt(largest))
+        # the box around the ellipse dᵀΣ′⁻¹d <= k² (half sides k·√Σ′ₓₓ, k·√Σ′ᵧᵧ): inside the square, and tight
+        records[k, F_EXTENT], records[k, F_EXTENT + 1] = extent * math.sqrt(a), extent * math.sqrt(c)
 
 
 @kernel
 def _tile_box(records: np.ndarray, k: int, height: int, tiles_x: int,
               tiles_y: int) -> tuple[int, int, int, int]:  # fmt: skip
     """Tile columns and rows [x0, x1] × [y0, y1] that splat k's bound touches (frame rows, top first)."""
-    radius = records[k, F_RADIUS]
+    half_x, half_y = records[k, F_EXTENT], records[k, F_EXTENT + 1]
     x, row = records[k, F_X], height - records[k, F_Y]  # the centre in column and frame-row coordinates
-    x0 = max(math.floor((x - radius) / TILE), 0)
-    x1 = min(math.floor((x + radius) / TILE), tiles_x - 1)
-    y0 = max(math.floor((row - radius) / TILE), 0)
-    y1 = min(math.floor((row + radius) / TILE), tiles_y - 1)
+    x0 = max(math.floor((x - half_x) / TILE), 0)
+    x1 = min(math.floor((x + half_x) / TILE), tiles_x - 1)
+    y0 = max(math.floor((row - half_y) / TILE), 0)
+    y1 = min(math.floor((row + half_y) / TILE), tiles_y - 1)
     return x0, x1, y0, y1
 
 
@@ -219,7 +225,7 @@ def blend_tiles(records: np.ndarray, starts: np.ndarray, entries: np.ndarray, ti
     transmittance = np.empty((TILE, TILE))
     weight = np.empty((TILE, TILE))
     weighted_z = np.empty((TILE, TILE))
-    done = np.empty((TILE, TILE), dtype=np.bool_)
+    opaque = np.empty((TILE, TILE), dtype=np.float32)
     for tile in range(start, stop):
         row0, col0 = (tile // tiles_x) * TILE, (tile % tiles_x) * TILE
         rows, cols = min(TILE, height - row0), min(TILE, width - col0)
@@ -227,32 +233,40 @@ def blend_tiles(records: np.ndarray, starts: np.ndarray, entries: np.ndarray, ti
         transmittance[:] = 1.0
         weight[:] = 0.0
         weighted_z[:] = 0.0
-        done[:] = False
+        for i in range(rows):
+            for j in range(cols):
+                opaque[i, j] = depth[row0 + i, col0 + j]
         remaining = rows * cols
-        for e in range(starts[tile], starts[tile + 1]):
+        end = starts[tile + 1]
+        for e in range(starts[tile], end):
             if remaining == 0:
                 break
+            if e + PREFETCH_AHEAD < end:  # the records are gathered in depth order: start their loads early
+                ahead = entries[e + PREFETCH_AHEAD]
+                prefetch(records, ahead, 0)
+                prefetch(records, ahead, F_COLOR)
             k = entries[e]
-            x, y, z, radius = records[k, F_X], records[k, F_Y], records[k, F_Z], records[k, F_RADIUS]
+            x, y, z = records[k, F_X], records[k, F_Y], records[k, F_Z]
+            half_x, half_y = records[k, F_EXTENT], records[k, F_EXTENT + 1]
             ca, cb, cc = records[k, F_CONIC], records[k, F_CONIC + 1], records[k, F_CONIC + 2]
             opacity = records[k, F_OPACITY]
+            faint = -math.log(255.0 * opacity)  # power below this: α < 1/255 (exp not needed to know)
             row_c = height - y
-            i0 = max(math.ceil(row_c - radius - 0.5) - row0, 0)
-            i1 = min(math.floor(row_c + radius - 0.5) - row0, rows - 1)
-            j0 = max(math.ceil(x - radius - 0.5) - col0, 0)
-            j1 = min(math.floor(x + radius - 0.5) - col0, cols - 1)
+            i0 = max(math.ceil(row_c - half_y - 0.5) - row0, 0)
+            i1 = min(math.floor(row_c + half_y - 0.5) - row0, rows - 1)
+            j0 = max(math.ceil(x - half_x - 0.5) - col0, 0)
+            j1 = min(math.floor(x + half_x - 0.5) - col0, cols - 1)
             for i in range(i0, i1 + 1):
                 dy = (height - (row0 + i) - 0.5) - y  # window y of the pixel centre minus the splat's
                 for j in range(j0, j1 + 1):
-                    if done[i, j]:
-                        continue
-                    if not z < depth[row0 + i, col0 + j]:  # at or behind an opaque surface: this and all later
-                        done[i, j] = True
-                        remaining -= 1
+                    if not z < opaque[i, j]:  # at or behind an opaque surface (this and all later), or done
+                        if opaque[i, j] >= 0.0:
+                            opaque[i, j] = -1.0
+                            remaining -= 1
                         continue
                     dx = (col0 + j + 0.5) - x
                     power = -0.5 * ((ca * dx * dx + cc * dy * dy) + 2.0 * cb * dx * dy)
-                    if power > 0.0:
+                    if power > 0.0 or power < faint - 1e-9:
                         continue
                     alpha = min(ALPHA_MAX, opacity * math.exp(power))
                     if alpha < ALPHA_MIN:
@@ -260,7 +274,7 @@ def blend_tiles(records: np.ndarray, starts: np.ndarray, entries: np.ndarray, ti
                     t = transmittance[i, j]
                     after = t * (1.0 - alpha)
                     if after < T_MIN:
-                        done[i, j] = True
+                        opaque[i, j] = -1.0  # done: no later splat passes the depth test
                         remaining -= 1
                         continue
                     w = alpha * t
@@ -272,6 +286,6 @@ def blend_tiles(records: np.ndarray, starts: np.ndarray, entries: np.ndarray, ti
                     transmittance[i, j] = after
         for i in range(rows):
             for j in range(cols):
-                out = layer[row0 + i, col0 + j]
-                out[0], out[1], out[2] = color[i, j, 0], color[i, j, 1], color[i, j, 2]
-                out[3], out[4], out[5] = transmittance[i, j], weight[i, j], weighted_z[i, j]
+                r, c = row0 + i, col0 + j
+                layer[r, c, 0], layer[r, c, 1], layer[r, c, 2] = color[i, j, 0], color[i, j, 1], color[i, j, 2]
+                layer[r, c, 3], layer[r, c, 4], layer[r, c, 5] = transmittance[i, j], weight[i, j], weighted_z[i, j]

@@ -90,8 +90,8 @@ def draw_points(item: PointItem, object_id: int, camera: Camera, options: Render
     params = shading_parameters(SceneItem(None, item.material, world_from_model), camera, options, lighting.ambient)
     colors = np.zeros((0, 3)) if cloud.colors is None else np.ascontiguousarray(cloud.colors)
     if impostor:
-        records = np.empty((count, kernels.IMPOSTOR_FIELDS))
-        rows = np.empty((count, 2), dtype=np.int64)
+        records = buffers.scratch.empty((count, kernels.IMPOSTOR_FIELDS))
+        rows = buffers.scratch.empty((count, 2), np.int64)
         view_from_model = np.ascontiguousarray(camera.view_matrix @ world_from_model)
         clip_from_view = np.ascontiguousarray(camera.projection_matrix, dtype=np.float64)
         normals = np.zeros((0, 3)) if style.style == "sphere" else np.ascontiguousarray(cloud.normals)
@@ -105,8 +105,8 @@ def draw_points(item: PointItem, object_id: int, camera: Camera, options: Render
                                item_array, buffers.depth, buffers.color, normals_out, ids_out)  # fmt: skip
         return
     clip_from_model = np.ascontiguousarray(camera.clip_from_world @ world_from_model, dtype=np.float64)
-    records = np.empty((count, kernels.POINT_FIELDS))
-    rows = np.empty((count, 2), dtype=np.int64)
+    records = buffers.scratch.empty((count, kernels.POINT_FIELDS))  # recycled: an animation's next frame reuses them
+    rows = buffers.scratch.empty((count, 2), np.int64)
     if style.point_size is not None:
         sizes = np.array([style.point_size * options.factor])
         frame = np.array([width, height, 0.0])

@@ -26,7 +26,7 @@ from typing import NamedTuple
 import numpy as np
 
 from frustum.camera import Camera
-from frustum.render.buffers import Buffers
+from frustum.render.buffers import Buffers, Scratch
 from frustum.render.options import RenderOptions
 from frustum.scene import PointItem, Scene
 
@@ -42,11 +42,15 @@ class SplatLayer(NamedTuple):
     depth: np.ndarray
 
 
-def project(items: list[PointItem], camera: Camera) -> np.ndarray:
-    """(N, SPLAT_FIELDS) float64 records of every splat of `items` (``raster.splats``), in item order."""
+def project(items: list[PointItem], camera: Camera, scratch: Scratch | None = None) -> np.ndarray:
+    """(N, SPLAT_FIELDS) float64 records of every splat of `items` (``raster.splats``), in item order (arrays from
+    `scratch` when given: a frame of an animation reuses the last frame's)."""
     from frustum.raster import splats as kernels
 
-    parts = []
+    empty = np.empty if scratch is None else scratch.empty
+    total = sum(item.geometry.count for item in items)
+    records = empty((total, kernels.SPLAT_FIELDS))
+    first = 0
     frame = np.array([camera.width, camera.height, *camera.frame.eye], dtype=np.float64)
     clip_from_view = np.asarray(camera.projection_matrix, dtype=np.float64)
     for item in items:
@@ -55,23 +59,25 @@ def project(items: list[PointItem], camera: Camera) -> np.ndarray:
         matrices = np.ascontiguousarray(np.stack([
             camera.view_matrix @ world_from_model, clip_from_view, np.linalg.inv(world_from_model), world_from_model,
         ]))  # fmt: skip
-        records = np.empty((splats.count, kernels.SPLAT_FIELDS))
+        part = records[first : first + splats.count]
         kernels.project_splats(np.ascontiguousarray(splats.positions), np.ascontiguousarray(splats.scales),
                                np.ascontiguousarray(splats.rotations), np.ascontiguousarray(splats.opacities),
-                               np.ascontiguousarray(splats.sh), matrices, frame, records)  # fmt: skip
-        parts.append(records)
-    return np.concatenate(parts) if parts else np.empty((0, kernels.SPLAT_FIELDS))
+                               np.ascontiguousarray(splats.sh), matrices, frame, part)  # fmt: skip
+        first += splats.count
+    return records
 
 
-def splat_layer(items: list[PointItem], camera: Camera, depth: np.ndarray | None = None) -> SplatLayer:
+def splat_layer(items: list[PointItem], camera: Camera, depth: np.ndarray | None = None,
+                scratch: Scratch | None = None) -> SplatLayer:  # fmt: skip
     """The splats of `items` seen by `camera` in front of `depth` ((H, W) float32 window depth; None: nothing
-    opaque), as a ``SplatLayer``."""
+    opaque), as a ``SplatLayer`` (work arrays from `scratch` when given)."""
     from frustum.raster import splats as kernels
 
     height, width = camera.height, camera.width
     if depth is None:
         depth = np.ones((height, width), dtype=np.float32)
-    records = project(items, camera)
+    empty = np.empty if scratch is None else scratch.empty
+    records = project(items, camera, scratch)
     kept = np.flatnonzero(records[:, kernels.F_RADIUS] > 0.0)
     order = kept[np.argsort(records[kept, kernels.F_Z], kind="stable")]
     tiles_x, tiles_y = -(-width // kernels.TILE), -(-height // kernels.TILE)
@@ -81,7 +87,7 @@ def splat_layer(items: list[PointItem], camera: Camera, depth: np.ndarray | None
     np.cumsum(counts, out=starts[1:])
     entries = np.empty(int(starts[-1]), dtype=np.int64)
     kernels.fill_tiles(records, order, height, tiles_x, tiles_y, starts, entries)
-    layer = np.empty((height, width, 6), dtype=np.float32)
+    layer = empty((height, width, 6), np.float32)
     kernels.blend_tiles(records, starts, entries, tiles_x, np.ascontiguousarray(depth, dtype=np.float32), layer)
     with np.errstate(invalid="ignore", divide="ignore"):
         expected = np.where(layer[..., 4] > 0.0, layer[..., 5] / layer[..., 4], np.nan).astype(np.float32)
@@ -93,7 +99,7 @@ def draw_splats(scene: Scene, camera: Camera, options: RenderOptions, buffers: B
     items = [item for item in scene.point_clouds if item.style.style == "splats" and item.geometry.count]
     if not items:
         return
-    layer = splat_layer(items, camera, buffers.depth)
+    layer = splat_layer(items, camera, buffers.depth, buffers.scratch)
     color = buffers.color
     under = color.astype(np.float32) / 255.0
     t = layer.transmittance[..., None]
