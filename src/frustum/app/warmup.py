@@ -176,6 +176,24 @@ def _volumes() -> None:
         fr.render(scene, camera)
 
 
+def _points_and_splats() -> None:
+    fr = _api()
+
+    camera = _camera()
+    rng = np.random.default_rng(0)
+    points = rng.uniform(-1, 1, size=(50, 3))
+    for style in ("square", "disk", "sphere", "surfel"):
+        scene = fr.Scene(lights=[fr.DirectionalLight(direction=(0, -1, -1))])
+        cloud = fr.PointCloud(points, rng.random((50, 3)), normals=rng.normal(size=(50, 3)))
+        scene.add(cloud, style=style, **({"radius": 0.05} if style in ("sphere", "surfel") else {}))
+        fr.render(scene, camera, eye_dome=style == "square")
+    splats = fr.GaussianSplats(points, np.full((50, 3), 0.05), rng.normal(size=(50, 4)), np.full(50, 0.5),
+                               np.zeros((50, 4, 3), dtype=np.float32))  # fmt: skip
+    scene = fr.Scene()
+    scene.add(splats)
+    fr.render(scene, camera)
+
+
 TASKS: dict[str, Callable[[], None]] = {
     "surfaces (general shader)": _surfaces_general,
     "surfaces (fast path, supersampling, clipping)": _surfaces_fast,
@@ -185,6 +203,7 @@ TASKS: dict[str, Callable[[], None]] = {
     "fractals": _fractals,
     "visible-surface methods (scan-line, area subdivision, painter, ray casting, A-buffer)": _visibility_methods,
     "volume ray casting (composite, merged, MIP, isosurface)": _volumes,
+    "point clouds and Gaussian splats": _points_and_splats,
 }
 """The families of kernels ``warmup`` compiles, each by running small examples of what uses them."""
 
