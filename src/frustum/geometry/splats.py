@@ -31,7 +31,7 @@ from frustum._arrays import Points, as_points, describe, read_only
 from frustum.errors import GeometryError
 from frustum.geometry.points import read_ply_vertices
 
-__all__ = ["SH_C0", "GaussianSplats"]
+__all__ = ["SH_C0", "GaussianSplats", "load_splats"]
 
 SH_C0 = 0.28209479177387814
 """$Y_0^0 = 1/(2√π)$: a 3DGS file's base colour is $0.5 + SH_C0·f_dc$."""
@@ -192,6 +192,11 @@ class GaussianSplats:
         header += "".join(f"property float {name}\n" for name in names) + "end_header\n"
         file.write_bytes(header.encode("ascii") + table.tobytes())
         return file
+
+
+def load_splats(path: str | Path) -> GaussianSplats:
+    """``GaussianSplats.load(path)`` as a function (the scene files' ``type = "splats"``)."""
+    return GaussianSplats.load(path)
 
 
 def _rows(value: ArrayLike, shape: tuple[int, ...], name: str, where: str) -> NDArray[np.float64]:

@@ -86,6 +86,9 @@ GEOMETRY_TYPES: dict[str, tuple[str, str, str]] = {
     "union": ("csg", "frustum.geometry.csg", "union"),
     "difference": ("csg", "frustum.geometry.csg", "difference"),
     "intersection": ("csg", "frustum.geometry.csg", "intersection"),
+    # point clouds (path, style, point_size, radius) and 3D Gaussian splats (path) from files
+    "point_cloud": ("point_file", "frustum.geometry.points", "load_points"),
+    "splats": ("file", "frustum.geometry.splats", "load_splats"),
     # a solid as an octree of the cells of another geometry table (drawn by [render] method = "octree")
     "octree": ("octree", "frustum.geometry.octree", "Octree"),
 }
@@ -238,6 +241,9 @@ def _geometry(report: _Report, path: tuple, value: Any, base: Path, materials: d
         return _lsystem(report, path, params, builder), []
     if kind == "octree":
         return _octree(report, path, params, builder, base, materials), []
+    if kind == "point_file":
+        node = _point_cloud(report, path, params, base, builder)
+        return (_BAD, []) if node is _BAD else (None, [node])
     # curves and point fractals: sampled into a polyline, drawn as a tube or line
     options = _curve_options(report, path, params)
     rest = {k: v for k, v in params.items() if k not in _CURVE_KEYS}
@@ -390,6 +396,25 @@ def _mesh_file(report: _Report, path: tuple, params: dict, base: Path, loader: C
     except (OSError, ValueError, TypeError, IndexError, KeyError) as error:
         report.refused((*path, "path"), name, error)
     return _BAD
+
+
+def _point_cloud(report: _Report, path: tuple, params: dict, base: Path, loader: Callable) -> Any:
+    """A point file (``load_points``) drawn in ``style`` with ``point_size`` pixels or ``radius`` world units: one
+    child node holding the cloud and its style (the node's transform and material apply to it)."""
+    from frustum.geometry.points import point_style
+
+    style = {key: params.pop(key) for key in ("style", "point_size", "radius") if key in params}
+    cloud = _mesh_file(report, path, params, base, loader)
+    if cloud is _BAD:
+        return _BAD
+    try:
+        node = Node("points", None, cloud)
+        node.point_style = point_style(cloud, style.get("style"), style.get("point_size"), style.get("radius"),
+                                       "point_cloud")  # fmt: skip
+    except FrustumError as error:
+        report.refused(path, style, error)
+        return _BAD
+    return node
 
 
 def _terrain(report: _Report, path: tuple, params: dict, fbm_terrain: Callable) -> Any:

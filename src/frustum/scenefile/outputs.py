@@ -41,7 +41,7 @@ _MAX_PIXELS = 8192
 _RENDER_KEYS = (
     "size", "shading", "specular", "background", "cull_back_faces", "mode", "edges", "crease_angle_deg", "edge_color",
     "hidden", "hidden_color", "line_width", "depth_cue", "samples", "filter", "color_space", "columns", "method",
-    "transparency", "max_depth", "shadows", "shadow_map_size", "shadow_softness",
+    "transparency", "max_depth", "shadows", "shadow_map_size", "shadow_softness", "eye_dome", "eye_dome_strength",
 )  # fmt: skip
 
 
@@ -96,6 +96,8 @@ def _render_options(report: _Report, path: tuple, value: Any) -> tuple[dict, tup
         "shadows": lambda p, v: _shadows(report, p, v),
         "shadow_map_size": lambda p, v: _number(report, p, v, low=64, high=16384, integer=True),
         "shadow_softness": lambda p, v: _number(report, p, v, low=0.0, high=16.0),
+        "eye_dome": lambda p, v: _boolean(report, p, v),
+        "eye_dome_strength": lambda p, v: _number(report, p, v, low=0.0, low_open=True),
     }
     for key, check in simple.items():
         if key in params:
