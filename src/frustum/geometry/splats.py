@@ -6,7 +6,7 @@ colour given by real spherical-harmonic coefficients of degree 0–3: $c(d) = 0.
 at 0, d the unit direction from the eye to μ. ``frustum.render.splats`` draws them.
 
 The PLY layout (what the 3DGS training code writes): vertex properties ``x y z``, ``nx ny nz`` (unused),
-``f_dc_0..2`` (degree-0 coefficient per channel), ``f_rest_0..3(K−1)−1`` (the other K − 1 coefficients,
+``f_dc_0..2`` (degree-0 coefficient per channel), ``f_rest_*`` (3(K − 1) values: the other K − 1 coefficients,
 **channel-major**: all of red's, then green's, then blue's; K = (degree + 1)²), ``opacity`` (a logit: o =
 1/(1 + e^−v)), ``scale_0..2`` (natural logarithms) and ``rot_0..3`` (a quaternion w, x, y, z, not necessarily
 unit). ``GaussianSplats.load`` checks the fields and the memory budget from the header before it reads any data.

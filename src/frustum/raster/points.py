@@ -231,7 +231,7 @@ def draw_points(records: np.ndarray, starts: np.ndarray, entries: np.ndarray, ba
 @kernel
 def _view_ray(view_from_clip: np.ndarray, xn: float, yn: float) -> tuple[float, float, float, float, float, float]:
     """(origin, direction) in view space of the ray through NDC (xn, yn): from the near plane point
-    ``view_from_clip·(xn, yn, −1, 1)`` to the far plane point ``view_from_clip·(xn, yn, 1, 1)`` (after division)."""
+    $V·(xn, yn, −1, 1)$ to the far plane point $V·(xn, yn, 1, 1)$ (after division; V = ``view_from_clip``)."""
     w0 = (view_from_clip[3, 0] * xn + view_from_clip[3, 1] * yn) - view_from_clip[3, 2] + view_from_clip[3, 3]
     w1 = (view_from_clip[3, 0] * xn + view_from_clip[3, 1] * yn) + view_from_clip[3, 2] + view_from_clip[3, 3]
     ox = ((view_from_clip[0, 0] * xn + view_from_clip[0, 1] * yn) - view_from_clip[0, 2] + view_from_clip[0, 3]) / w0

@@ -2,7 +2,7 @@
 
 1. ``project_splats`` (parallel over splats): the world covariance $Σ = A R S Sᵀ Rᵀ Aᵀ$ (A the modeling matrix's
    3x3 part) goes to view space ($V Σ Vᵀ$) and to the screen with the Jacobian J of the window mapping at the
-   splat's centre (EWA: $Σ′ = J V Σ Vᵀ Jᵀ + 0.3·I$, the 0.3-pixel low-pass dilation). For a perspective camera J
+   splat's centre (EWA: $Σ' = J V Σ Vᵀ Jᵀ + 0.3·I$, the 0.3-pixel low-pass dilation). For a perspective camera J
    is 3DGS's $[[f_x/z, 0, −f_x·x/z²], [0, f_y/z, −f_y·y/z²]]$; here it is taken from the projection matrix P
    for any camera: row i of J is $(W_i/2)·(P_i/w − c_i·P₃/w²)$ with c = P·v, w = c₃, $W_0 = W$, $W_1 = H$.
    Its inverse (the conic), a square bound of half side $⌈k·√λ_max⌉$ pixels and the
@@ -14,16 +14,16 @@
    o < 0.35), so no pixel with α ≥ 1/255 lies outside it and the tiles change no pixel.
 2. ``count_tiles`` / ``fill_tiles``: each splat's bound is binned into 16 × 16-pixel tiles, visited in the
    caller's order (sorted by depth), so every tile's list is sorted front to back.
-3. ``blend_tiles`` (parallel over tiles): per pixel, front to back, $α = min(0.99, o·exp(−½ dᵀΣ′⁻¹d))$ at the
+3. ``blend_tiles`` (parallel over tiles): per pixel, front to back, $α = min(0.99, o·exp(−½ dᵀΣ'⁻¹d))$ at the
    pixel centre (d from the projected centre), skipped below 1/255; $C += c·α·T$, $T ← T·(1 − α)$, stopping
    before T would fall below 1e-4 (that splat not drawn); a splat at or behind the depth already in the depth
    buffer (an opaque surface) ends the pixel. The expected depth $Σ wᵢ zᵢ / Σ wᵢ$ ($wᵢ = αᵢ·Tᵢ$, z window depth
    of the centre) is written where $Σ wᵢ > 0$.
 
 Records (``SPLAT_FIELDS`` float64): window x, y (y up), window depth z of the centre, bound half side r (pixels,
-0: culled), conic (A, B, C) of $Σ′⁻¹$ in window axes, opacity o, colour (3), Σ′ in image axes (x right,
-y down, 3DGS's convention; a, b, c) for testing, and the half sides $k·√Σ′ₓₓ$, $k·√Σ′ᵧᵧ$ of the box around the
-ellipse $dᵀΣ′⁻¹d <= k²$ (inside the square bound: the pixels and tiles actually visited). Kernels never validate
+0: culled), conic (A, B, C) of $Σ'⁻¹$ in window axes, opacity o, colour (3), Σ' in image axes (x right,
+y down, 3DGS's convention; a, b, c) for testing, and the half sides $k·√Σ'_{xx}$, $k·√Σ'_{yy}$ of the box around the
+ellipse $dᵀΣ'⁻¹d <= k²$ (inside the square bound: the pixels and tiles actually visited). Kernels never validate
 (arrays contiguous, shapes as stated).
 
 References
@@ -131,7 +131,7 @@ def project_splats(positions: np.ndarray, scales: np.ndarray, rotations: np.ndar
         j10 = (height / 2.0) * (clip[1, 0] / w - c1 * clip[3, 0] / (w * w))
         j11 = (height / 2.0) * (clip[1, 1] / w - c1 * clip[3, 1] / (w * w))
         j12 = (height / 2.0) * (clip[1, 2] / w - c1 * clip[3, 2] / (w * w))
-        a, b, c = 0.0, 0.0, 0.0  # Σ′ = (J V R S)(J V R S)ᵀ
+        a, b, c = 0.0, 0.0, 0.0  # Σ' = (J V R S)(J V R S)ᵀ
         for j in range(3):
             t0 = (j00 * sigma[0, j] + j01 * sigma[1, j]) + j02 * sigma[2, j]
             t1 = (j10 * sigma[0, j] + j11 * sigma[1, j]) + j12 * sigma[2, j]
@@ -167,7 +167,7 @@ def project_splats(positions: np.ndarray, scales: np.ndarray, rotations: np.ndar
         for channel in range(3):
             records[k, F_COLOR + channel] = sh_color(sh, k, channel, dx, dy, dz)
         records[k, F_RADIUS] = math.ceil(extent * math.sqrt(largest))
-        # the box around the ellipse dᵀΣ′⁻¹d <= k² (half sides k·√Σ′ₓₓ, k·√Σ′ᵧᵧ): inside the square, and tight
+        # the box around the ellipse dᵀΣ'⁻¹d <= k² (half sides k·√Σ'_{xx}, k·√Σ'_{yy}): inside the square, and tight
         records[k, F_EXTENT], records[k, F_EXTENT + 1] = extent * math.sqrt(a), extent * math.sqrt(c)
 
 
