@@ -169,7 +169,7 @@ def _shade(params: np.ndarray, lights: np.ndarray, item: np.ndarray, colors: np.
     ]
 
 
-@parallel_kernel(lambda records, starts, *_: starts.size - 1)
+@parallel_kernel(lambda records, starts, *_: starts.size - 1, pieces_per_thread=32)
 def draw_points(records: np.ndarray, starts: np.ndarray, entries: np.ndarray, band_rows: int,
                 world: np.ndarray, colors: np.ndarray, normals: np.ndarray, params: np.ndarray, lights: np.ndarray,
                 item: np.ndarray, depth: np.ndarray, color: np.ndarray, normal_out: np.ndarray,
@@ -243,7 +243,7 @@ def _view_ray(view_from_clip: np.ndarray, xn: float, yn: float) -> tuple[float, 
     return ox, oy, oz, fx - ox, fy - oy, fz - oz
 
 
-@parallel_kernel(lambda records, starts, *_: starts.size - 1)
+@parallel_kernel(lambda records, starts, *_: starts.size - 1, pieces_per_thread=32)
 def draw_impostors(records: np.ndarray, starts: np.ndarray, entries: np.ndarray, band_rows: int,
                    matrices: np.ndarray, colors: np.ndarray, params: np.ndarray, lights: np.ndarray,
                    item: np.ndarray, depth: np.ndarray, color: np.ndarray, normal_out: np.ndarray,

@@ -215,7 +215,8 @@ def fill_tiles(records: np.ndarray, order: np.ndarray, height: int, tiles_x: int
                 cursor[t] += 1
 
 
-@parallel_kernel(lambda records, starts, *_: starts.size - 1)
+# many small pieces: tiles differ in cost by orders of magnitude (empty sky, dense surfaces), so threads balance
+@parallel_kernel(lambda records, starts, *_: starts.size - 1, pieces_per_thread=32)
 def blend_tiles(records: np.ndarray, starts: np.ndarray, entries: np.ndarray, tiles_x: int, depth: np.ndarray,
                 layer: np.ndarray, start: int, stop: int) -> None:  # fmt: skip
     """Tiles [start, stop): ``layer`` (H, W, 6) float32 ← premultiplied colour $Σ cᵢ·αᵢ·Tᵢ$ (3), the final
