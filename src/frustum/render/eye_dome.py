@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from frustum.camera import Camera
-from frustum.render.buffers import Buffers
+from frustum.render.context import FrameContext
 from frustum.render.options import RenderOptions
 
 __all__ = ["RADIUS", "obscurance", "shade"]
@@ -54,7 +54,7 @@ def obscurance(depth: np.ndarray, clip_from_view: np.ndarray, radius: int = RADI
     return total / 8.0
 
 
-def shade(camera: Camera, options: RenderOptions, buffers: Buffers) -> None:
+def shade(camera: Camera, options: RenderOptions, buffers: FrameContext) -> None:
     """Multiply the drawn pixels' colors by $exp(−300·strength·R)$ (in place), when ``options.eye_dome`` > 0."""
     if not options.eye_dome > 0.0:
         return

@@ -28,7 +28,7 @@ from __future__ import annotations
 import numpy as np
 
 from frustum.camera import Camera
-from frustum.render.buffers import Buffers
+from frustum.render.context import FrameContext
 from frustum.render.options import RenderOptions
 from frustum.render.stages import Lighting, shading_parameters
 from frustum.scene import PointItem, Scene, SceneItem
@@ -37,7 +37,7 @@ from frustum.transforms import apply, apply_to_normals
 __all__ = ["draw_point_clouds", "draw_points"]
 
 
-def draw_point_clouds(scene: Scene, camera: Camera, options: RenderOptions, buffers: Buffers) -> None:
+def draw_point_clouds(scene: Scene, camera: Camera, options: RenderOptions, buffers: FrameContext) -> None:
     """Every placed PointCloud of `scene` into `buffers` (splats: ``render.splats``)."""
     placed = scene.point_clouds
     clouds = [(i, p) for i, p in enumerate(placed) if p.style.style != "splats"]
@@ -64,7 +64,7 @@ def _bands(rows: np.ndarray, height: int) -> tuple[np.ndarray, np.ndarray, int]:
 
 
 def draw_points(item: PointItem, object_id: int, camera: Camera, options: RenderOptions, lighting: Lighting,
-                buffers: Buffers) -> None:  # fmt: skip
+                buffers: FrameContext) -> None:  # fmt: skip
     """One placed cloud into `buffers` (the module docstring's steps)."""
     from frustum.raster import points as kernels
     from frustum.raster import shade

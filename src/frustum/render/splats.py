@@ -26,7 +26,8 @@ from typing import NamedTuple
 import numpy as np
 
 from frustum.camera import Camera
-from frustum.render.buffers import Buffers, Scratch
+from frustum.render.buffers import Scratch
+from frustum.render.context import FrameContext
 from frustum.render.options import RenderOptions
 from frustum.scene import PointItem, Scene
 
@@ -94,7 +95,7 @@ def splat_layer(items: list[PointItem], camera: Camera, depth: np.ndarray | None
     return SplatLayer(layer[..., :3], layer[..., 3], expected)
 
 
-def draw_splats(scene: Scene, camera: Camera, options: RenderOptions, buffers: Buffers) -> None:
+def draw_splats(scene: Scene, camera: Camera, options: RenderOptions, buffers: FrameContext) -> None:
     """Composite every placed splat set of `scene` over `buffers` (the module docstring's equations)."""
     items = [item for item in scene.point_clouds if item.style.style == "splats" and item.geometry.count]
     if not items:
