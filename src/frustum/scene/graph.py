@@ -519,7 +519,7 @@ class Scene:
 
     def _walk_materials(self) -> Iterator[tuple[Node, Matrix4, Material]]:
         """Every node (root excluded) with its world transform and inherited material, depth-first."""
-        stack = [(child, _IDENTITY, Material() if self.root.material is None else self.root.material)
+        stack = [(child, IDENTITY, Material() if self.root.material is None else self.root.material)
                  for child in reversed(self.root.children)]  # fmt: skip
         while stack:
             node, parent, inherited = stack.pop()
