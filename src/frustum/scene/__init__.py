@@ -14,6 +14,7 @@ from frustum.scene.graph import (
     ParticleLayer,
     Pick,
     Placed,
+    PointItem,
     RayHits,
     Scene,
     SceneItem,
@@ -21,6 +22,6 @@ from frustum.scene.graph import (
 )
 
 __all__ = [
-    "PARTICLE_BLENDING", "PARTICLE_STYLES", "Node", "ParticleLayer", "Pick", "Placed", "RayHits", "Scene",
+    "PARTICLE_BLENDING", "PARTICLE_STYLES", "Node", "ParticleLayer", "Pick", "Placed", "PointItem", "RayHits", "Scene",
     "SceneItem", "VolumeItem", "cutaway", "exploded",
 ]  # fmt: skip
