@@ -1020,7 +1020,8 @@ _MINIMAL_GEOMETRY = {
 }
 
 
-@pytest.mark.parametrize("kind", sorted(set(GEOMETRY_TYPES) - {"mesh"}))
+# file types need a file: mesh here elsewhere, point_cloud and splats through examples/points_*.toml and splats.toml
+@pytest.mark.parametrize("kind", sorted(set(GEOMETRY_TYPES) - {"mesh", "point_cloud", "splats"}))
 def test_every_geometry_type_builds_and_renders(kind: str) -> None:
     geometry = {"type": kind, **_MINIMAL_GEOMETRY.get(kind, {})}
     scene_file = load_scene({"camera": {"eye": [2.0, 3.0, 6.0]}, "nodes": [{"geometry": geometry}]})
