@@ -156,6 +156,61 @@ def test_shadow_rays_agree_with_embree(kind, light_name):
     assert agreement >= 0.999
 
 
+def _slats_and_items(light) -> fr.Scene:
+    """Several items (issue 50): five thin slats 2 units above a ground plane, a box and a sphere on the ground."""
+    scene = fr.Scene(lights=[fr.AmbientLight(intensity=0.2), light])
+    _ground(scene)
+    for k in range(5):
+        scene.add(box((0.2, 0.05, 3.0), center=(-1.0 + 0.5 * k, 2.0, 0.0)), fr.Material(color=(0.4, 0.4, 0.4)))
+    scene.add(box((1, 1, 1), center=(1.5, 0.5, 1.5)), fr.Material(color=(0.9, 0.3, 0.2)))
+    scene.add(uv_sphere(0.6, segments=48, rings=24), fr.Material(color=(0.2, 0.5, 0.9)),
+              transform=translate(-1.8, 0.6, 1.2))  # fmt: skip
+    return scene
+
+
+SLAT_LIGHTS = {
+    "directional": fr.DirectionalLight((0.3, -1.0, -0.2)),
+    "point": fr.PointLight((0.3, 5.0, 0.5)),
+    "point_close": fr.PointLight((0.3, 2.6, 0.5)),
+    "spot": fr.SpotLight((0.0, 5.0, 0.5), (0.0, -1.0, -0.1), inner_angle=0.5, outer_angle=0.7),
+    "spot_close": fr.SpotLight((0.3, 2.8, 0.5), (0.1, -1.0, 0.0), inner_angle=0.9, outer_angle=1.1),
+}
+
+
+def _issue_mask(frame: fr.Frame, light) -> np.ndarray:
+    """The pixels issue 50 compares: drawn, not grazing (|n·l| >= 0.1), inside a spot light's inner cone."""
+    points = frame.position.astype(np.float64)
+    drawn = np.isfinite(points[..., 0])
+    if isinstance(light, fr.DirectionalLight):
+        to_light = np.broadcast_to(-np.asarray(light.direction) / np.linalg.norm(light.direction), points.shape)
+    else:
+        to_light = np.asarray(light.position) - points
+        to_light = to_light / np.linalg.norm(to_light, axis=2, keepdims=True)
+    with np.errstate(invalid="ignore"):
+        mask = drawn & (np.abs((frame.normals * to_light).sum(axis=2)) >= 0.1)
+        if isinstance(light, fr.SpotLight):
+            axis = np.asarray(light.direction) / np.linalg.norm(light.direction)
+            mask &= -(to_light @ axis) > math.cos(light.inner_angle)
+    return mask
+
+
+@pytest.mark.parametrize("light_name", SLAT_LIGHTS)
+def test_maps_and_rays_hold_every_caster_of_a_scene_of_several_items(light_name):
+    """Shadow maps hold every caster that can shade a point in the light's reach: a spot map's (and a cube face's)
+    near plane lies before every caster in its pyramid, not only before the nearest one on the axis (the far half
+    of each slat's shadow was missing: 89 % agreement for "spot", 91 % for "spot_close")."""
+    light = SLAT_LIGHTS[light_name]
+    scene = _slats_and_items(light)
+    for method, needed in ((True, 0.99), ("ray", 0.999)):
+        frame = fr.render(scene, CAMERA, shadows=method, buffers=("position", "normals", "shadow"))
+        oracle = embree_lit(scene, frame, light)
+        mask = _issue_mask(frame, light)
+        agreement = 1.0 - (mask & ((frame.shadow[..., 0] >= 0.5) != oracle)).sum() / mask.sum()
+        print(f"{light_name} shadows={method}: {agreement:.4%} of {mask.sum()} pixels")
+        assert (mask & ~oracle).sum() > 300  # shadows fall inside the compared pixels
+        assert agreement >= needed, (method, agreement)
+
+
 def test_no_acne_on_a_plane_lit_at_80_degrees():
     """A lit plane facing the light at 80° from its normal has no shadowed pixel (slope-scaled bias)."""
     for light in (

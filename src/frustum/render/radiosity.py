@@ -308,12 +308,23 @@ def _delta_cache(resolution: int) -> tuple[np.ndarray, np.ndarray]:
     return _DELTAS[resolution]
 
 
+class _Column(NamedTuple):
+    """One shooting group's form factors: ``far`` (P,) from each patch centre to the group's area, 0 for the
+    ``near`` receivers (R,), which keep ``per_member`` (R, M) factors to each of the group's ``members`` (M,)."""
+
+    far: np.ndarray
+    near: np.ndarray
+    per_member: np.ndarray
+    members: np.ndarray
+
+
 class _RayFactors:
     """Form factors from every patch centre to a shooting group's area (``form_factors="ray"``), one column per group
     computed on its first shot and kept: the unoccluded factor to each quarter of the group (exact, per triangle,
     ``raster.form_factors``) times whether a shadow ray from the receiver reaches that quarter's representative
     point (the member centroid nearest the quarter's centre) — Wallace, Elmquist & Haines' receiver-side factors
-    with four samples of the source."""
+    with four samples of the source. Receivers nearer the group than its size keep one factor per member, so they
+    receive each member's own unshot radiosity rather than the group's mean (grouping errs only near the group)."""
 
     def __init__(self, patches: Patches, members: list[np.ndarray]) -> None:
         from frustum.raster import rays
@@ -325,17 +336,23 @@ class _RayFactors:
         size = float(np.linalg.norm(patches.vertices.max(axis=0) - patches.vertices.min(axis=0)))
         self.offset = 1e-6 * size
         self.origins = patches.centre + patches.normal * self.offset
-        self.columns: dict[int, np.ndarray] = {}
+        self.columns: dict[int, _Column] = {}
 
-    def column(self, group: int) -> np.ndarray:
-        """(P,) form factor from each patch centre to the area of `group` (0 for its members' own plane)."""
+    def gain(self, group: int, unshot: np.ndarray) -> np.ndarray:
+        """(P, 3) $Σ_j F_k,j ΔB_j$ over the group's members j: what each patch k receives (before ρ_k) when the
+        group shoots the unshot radiosity `unshot` (P, 3)."""
         if group not in self.columns:
             self.columns[group] = self._compute(self.members[group])
-        return self.columns[group]
+        far, near, per_member, members = self.columns[group]
+        area = self.patches.area[members]
+        mean = (unshot[members] * area[:, None]).sum(axis=0) / area.sum()
+        received = far[:, None] * mean
+        received[near] += per_member @ unshot[members]
+        return received
 
-    def _compute(self, members: np.ndarray) -> np.ndarray:
+    def _compute(self, members: np.ndarray) -> _Column:
         from frustum.raster import rays
-        from frustum.raster.form_factors import point_group_factors
+        from frustum.raster.form_factors import point_group_factors, point_triangle_factors
 
         patches = self.patches
         quarter, representative = _quarters(patches, members)
@@ -350,13 +367,26 @@ class _RayFactors:
         planes = _planes(patches, members, first)
         point_group_factors(patches.centre, patches.normal, triangles, facing, first,
                             np.ascontiguousarray(patches.vertices[edges]), edge_first, planes, unoccluded)  # fmt: skip
-        receiver, piece = np.nonzero(unoccluded > 0.0)
+        visible = unoccluded > 0.0
+        receiver, piece = np.nonzero(visible)
         if receiver.size:
             target = patches.centre[representative] + patches.normal[representative] * self.offset
             origins = self.origins[receiver]
-            blocked = rays.any_hits(self.index, origins, target[piece] - origins, 0.0, 1.0)
-            unoccluded[receiver[blocked], piece[blocked]] = 0.0
-        return unoccluded.sum(axis=1)
+            visible[receiver, piece] = ~rays.any_hits(self.index, origins, target[piece] - origins, 0.0, 1.0)
+        far = (unoccluded * visible).sum(axis=1)
+        corners = triangles.reshape(-1, 3)
+        low, high = corners.min(axis=0), corners.max(axis=0)
+        reach = float(np.linalg.norm(high - low))
+        gap = np.linalg.norm(np.maximum(np.maximum(low - patches.centre, patches.centre - high), 0.0), axis=1)
+        near = np.flatnonzero((gap < reach) & visible.any(axis=1))
+        per_member = np.zeros((near.shape[0], members.shape[0]))
+        if near.size:
+            point_triangle_factors(np.ascontiguousarray(patches.centre[near]),
+                                   np.ascontiguousarray(patches.normal[near]), triangles,
+                                   np.arange(members.shape[0], dtype=np.int64), per_member)  # fmt: skip
+            per_member *= visible[near][:, quarter]
+            far[near] = 0.0
+        return _Column(far, near, per_member, members)
 
 
 def _planes(patches: Patches, members: np.ndarray, first: np.ndarray) -> np.ndarray:
@@ -616,7 +646,7 @@ def radiosity(
         shooting = members[source]
         shot = (unshot[shooting] * area[shooting, None]).sum(axis=0)  # (3,) unshot power of the group
         if receiving is not None:  # F_k,group at each receiver: B_k += ρ_k F_k,group ΔB_group
-            gain = receiving.column(source)[:, None] * (shot / weight[source]) * reflectance
+            gain = receiving.gain(source, unshot) * reflectance
             unshot[shooting] = 0.0
         else:  # F_group,k by the hemicube and reciprocity: B_k += ρ_k F_group,k ΔB_group A_group / A_k
             factors = hemicube_form_factors(patches, centre[source], normal[source], hemicube, raster)

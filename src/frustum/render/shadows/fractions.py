@@ -355,20 +355,29 @@ def _light_cameras(
     position = np.asarray(light.position, dtype=np.float64)
     distances = np.linalg.norm(corners - position, axis=1)
     far = float(distances.max()) * 1.01 + 1e-9
-    nearest = np.clip(position, box[0], box[1])
-    near = max(0.99 * float(np.linalg.norm(nearest - position)), 1e-3 * far)
+    nearest = float(np.linalg.norm(np.clip(position, box[0], box[1]) - position))
     if isinstance(light, SpotLight):
         axis = np.asarray(light.direction, dtype=np.float64)
         half = min(light.outer_angle, math.radians(85.0))
         fovy = 2.0 * math.atan(math.tan(half) * (1.0 + 2.0 * reach))
         frame = ViewFrame(position, normal=-axis, up=_up_for(axis))
+        near = _near_plane(nearest, fovy, far)
         return [(Camera(frame, Perspective(fovy, near, far), size, size), 2.0 * math.tan(fovy / 2.0) / size)]
     cameras = []
     fovy = 2.0 * math.atan(1.0 + 2.0 * reach)
+    near = _near_plane(nearest, fovy, far)
     for axis in np.array([[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]], dtype=np.float64):
         frame = ViewFrame(position, normal=-axis, up=_up_for(axis))
         cameras.append((Camera(frame, Perspective(fovy, near, far), size, size), 2.0 * math.tan(fovy / 2.0) / size))
     return cameras
+
+
+def _near_plane(nearest: float, fovy: float, far: float) -> float:
+    """The near plane of a square perspective map from a light `nearest` from the casters' box: every caster inside
+    the map's pyramid lies beyond it. A point at distance r from the light and angle θ off the map's axis lies at
+    depth r·cos θ, and θ reaches the pyramid's corner rays, $tan θ_max = √2 · tan(fovy / 2)$: so
+    $near = 0.99 · nearest / √(1 + 2 tan²(fovy / 2))$ (at least $10⁻³ · far$)."""
+    return max(0.99 * nearest / math.sqrt(1.0 + 2.0 * math.tan(fovy / 2.0) ** 2), 1e-3 * far)
 
 
 def _directional_camera(
