@@ -280,12 +280,12 @@ def test_cornell_box_per_pixel_agrees_with_mitsuba():
     size = 64
     view = camera(size)
     image, wall = _display_radiance(result, view)
+    shapes = _mitsuba_shapes(scene)  # sets the scalar_rgb variant
     sensor = {"type": "perspective", "fov_axis": "y", "fov": 39.0, "near_clip": 0.1, "far_clip": 10.0,
               "to_world": mi.ScalarTransform4f().look_at(origin=[0.5, 0.5, 2.4], target=[0.5, 0.5, 0.0], up=[0, 1, 0]),
               "film": {"type": "hdrfilm", "width": size, "height": size, "rfilter": {"type": "box"},
                        "pixel_format": "rgb"},
               "sampler": {"type": "ldsampler", "sample_count": 1024}}  # fmt: skip
-    shapes = _mitsuba_shapes(scene)
     mitsuba_scene = mi.load_dict({"type": "scene", "integrator": {"type": "path", "max_depth": 64}, "sensor": sensor,
                                   **shapes})  # fmt: skip
     reference = np.asarray(mi.render(mitsuba_scene, spp=1024))
