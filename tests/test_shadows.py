@@ -979,3 +979,65 @@ def test_a_kept_map_set_is_held_by_one_frame_at_a_time():
     assert shadow_pass.set_map_reuse(True) is True
     assert shadow_pass.map_key(None, [], np.zeros((1, 1))) is None
     shadow_pass.release_memory()
+
+
+def _sphere_items_scene(subdivisions: int) -> fr.Scene:
+    """Issue 50's scene for vector shadows: a ground plane, five slats, a box and an icosphere of 20·4^k faces."""
+    scene = fr.Scene(lights=[fr.AmbientLight(intensity=0.2), fr.DirectionalLight((0.3, -1.0, -0.2)),
+                             fr.PointLight((0.3, 5.0, 0.5))])  # fmt: skip
+    _ground(scene)
+    for k in range(5):
+        scene.add(box((0.2, 0.05, 3.0), center=(-1.0 + 0.5 * k, 2.0, 0.0)), fr.Material(color=(0.4, 0.4, 0.4)))
+    scene.add(box((1, 1, 1), center=(1.5, 0.5, 1.5)), fr.Material(color=(0.9, 0.3, 0.2)))
+    scene.add(fr.icosphere(0.6, subdivisions), fr.Material(color=(0.2, 0.5, 0.9)), transform=translate(-1.8, 0.6, 1.2))
+    return scene
+
+
+def _same_polygons(ours: list, reference: list) -> None:
+    """Same regions: per (light, item, kind), the same area (to 1e-9 relative) and the same outline corners (each
+    corner of one within 1e-6 pixel of a corner of the other)."""
+
+    def by_key(polygons):
+        grouped: dict[tuple, list] = {}
+        for p in polygons:
+            grouped.setdefault((p.light, p.item, p.kind), []).append(p)
+        return grouped
+
+    mine, theirs = by_key(ours), by_key(reference)
+    assert mine.keys() == theirs.keys()
+    for key in mine:
+        area = sum(p.area for p in mine[key])
+        assert area == pytest.approx(sum(p.area for p in theirs[key]), rel=1e-9, abs=1e-9), key
+        a = np.concatenate([loop for p in mine[key] for loop in p.loops])
+        b = np.concatenate([loop for p in theirs[key] for loop in p.loops])
+        distance = np.abs(a[:, None, :] - b[None, :, :]).max(axis=2)
+        assert distance.min(axis=1).max() <= 1e-6 and distance.min(axis=0).max() <= 1e-6, key
+
+
+def test_shadow_polygons_through_the_grids_equal_all_pairs_on_a_5120_face_sphere_scene(monkeypatch):
+    """The candidate search (grids of boxes in the light's projection and the window) and the faces skipped on
+    closed items change no polygon: on a subset of receiving faces (ground faces in the sphere's and the slats'
+    shadows, sphere and box faces, slats), the polygons equal those of every face tried against every face."""
+    from frustum.output import svg_shadows
+
+    scene = _sphere_items_scene(4)
+    faces = svg_shadows._scene_faces(scene, CAMERA)
+    assert faces.corners.shape[0] > 5120
+    rng = np.random.default_rng(50)
+    subset = np.zeros(faces.corners.shape[0], dtype=bool)
+    for item in np.unique(faces.item)[1:]:
+        mine = np.flatnonzero(faces.item == item)
+        subset[rng.choice(mine, size=min(mine.size, 2), replace=False)] = True
+    ground = np.flatnonzero(faces.item == 0)
+    middle = np.linalg.norm(faces.corners[ground].mean(axis=1) - [-0.5, 0.0, 0.5], axis=1)
+    subset[ground[np.argsort(middle)[:4]]] = True  # the ground faces under the slats and the sphere
+    fast = svg_shadows._shadow_polygons(scene, CAMERA, subset)
+    assert len(fast) >= 8
+
+    class AllPairs(svg_shadows._Grid):
+        def query(self, box):
+            return np.arange(self.boxes.shape[0])
+
+    monkeypatch.setattr(svg_shadows, "_Grid", AllPairs)
+    monkeypatch.setattr(svg_shadows, "_turned_away", lambda faces, *_: np.zeros(faces.corners.shape[0], bool))
+    _same_polygons(fast, svg_shadows._shadow_polygons(scene, CAMERA, subset))

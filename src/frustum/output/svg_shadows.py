@@ -526,18 +526,13 @@ def _shadow_polygons(scene: Scene, camera: Camera, receivers: NDArray | None) ->
                 hit = _overlapping(boxes, np.array(_box(cover)))
                 if hit.size == 0:
                     continue
-                kept, kept_boxes = [], []
-                chosen = set(hit.tolist())
-                for k, piece in enumerate(pieces):
-                    if k not in chosen:
-                        kept.append(piece)
-                        kept_boxes.append(boxes[k])
+                for k in hit[::-1].tolist():  # from the end: the earlier indices stay valid
+                    rests = _subtract(pieces[k], cover, tiny)
+                    if len(rests) == 1 and rests[0] is pieces[k]:
                         continue
-                    for rest in _subtract(piece, cover, tiny):
-                        kept.append(rest)
-                        kept_boxes.append(boxes[k] if rest is piece else np.array(_box(rest)))
-                pieces = kept
-                boxes = np.array(kept_boxes).reshape(-1, 4)
+                    pieces[k : k + 1] = rests
+                    boxes = np.concatenate([boxes[:k], np.array([_box(r) for r in rests]).reshape(-1, 4),
+                                            boxes[k + 1 :]])  # fmt: skip
             key = (faces.item[f], kind, *np.round(np.append(n, c / span), 9))
             groups.setdefault(key, []).extend(pieces)
         for (item, kind, *_), pieces in groups.items():
