@@ -693,7 +693,7 @@ def radiosity_command(
     size: Annotated[str | None, typer.Option(help="Image size WIDTHxHEIGHT, overriding the file's.")] = None,
     up: Annotated[str, typer.Option(help="A mesh file's up axis, y or z (glTF is always y).")] = "y",
 ) -> None:
-    """Light a scene file by radiosity (diffuse light bouncing between surfaces, hemicube form factors, progressive
+    """Light a scene file by radiosity (diffuse light bouncing between surfaces, ray-cast form factors, progressive
     refinement) and render the lit scene from the file's camera: each pixel the interpolated radiosity."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 

@@ -9,11 +9,19 @@ $$B_k = E_k + ρ_k Σ_j B_j F_jk$$
 with the form factor $F_jk$, the fraction of the light leaving patch j that arrives at patch k. Reciprocity
 $A_j F_jk = A_k F_kj$ gives the shooting form $B_k += ρ_k ΔB_j F_jk A_j / A_k$.
 
-* **Form factors by the hemicube** (Cohen & Greenberg 1985): a half cube of side 2 centred on the shooting patch,
-  its top face at height 1 along the patch normal, is rasterized face by face (five faces: the top and the upper
-  halves of the four sides) with frustum's own depth-buffer kernels (``raster.tiles`` / ``raster.triangles``
-  through the render package's item pass), writing the code of the nearest patch into each pixel. Each pixel adds
-  its *delta form factor* to the patch it shows, at (x, y, 1) on the top face and at (x, 1, z) on a side face
+* **Form factors by ray casting** (``form_factors="ray"``, the default; Wallace, Elmquist & Haines 1989): at
+  each receiving patch's centre, the exact point-to-area form factor to the shooting group, by Lambert's contour
+  formula [Baum, Rushmeier & Winget 1989] (``raster.form_factors``; over a flat piece's boundary edges alone, the
+  shared edges cancelling), times whether a shadow ray reaches each quarter of the group; shot as
+  $B_k += ρ_k F_k,group ΔB_group$ with no division by the receiver's area, so a small receiver is as exact as a
+  large one. Receivers nearer a group than its size take each member's factor and own unshot radiosity.
+
+* **Form factors by the hemicube** (``form_factors="hemicube"``; Cohen & Greenberg 1985): a half cube of side 2
+  centred on the shooting patch, its top face at height 1 along the patch normal, is rasterized face by face (five
+  faces: the top and the upper halves of the four sides) with frustum's own depth-buffer kernels
+  (``raster.tiles`` / ``raster.triangles`` through the render package's item pass), writing the code of the
+  nearest patch into each pixel. Each pixel adds its *delta form factor* to the patch it shows, at (x, y, 1) on
+  the top face and at (x, 1, z) on a side face
 
     $$ΔF = ΔA / (π (x² + y² + 1)²)$$
 
@@ -41,7 +49,9 @@ References
 ----------
 [HB] "Radiosity Lighting Model" (the radiosity equation, form factors, the hemicube, progressive refinement).
 Cohen & Greenberg, "The Hemi-Cube", SIGGRAPH 1985; Cohen, Chen, Wallace & Greenberg, "A Progressive Refinement
-Approach to Fast Radiosity Image Generation", SIGGRAPH 1988.
+Approach to Fast Radiosity Image Generation", SIGGRAPH 1988; Wallace, Elmquist & Haines, "A Ray Tracing Algorithm
+for Progressive Radiosity", SIGGRAPH 1989; Baum, Rushmeier & Winget, "Improving Radiosity Solutions Through the
+Use of Analytically Determined Form-Factors", SIGGRAPH 1989.
 """
 
 from __future__ import annotations
@@ -556,8 +566,10 @@ def radiosity(
         closed scene with ρ ≤ 0.9 or an open one).
     shooter : float
         Patches shoot in groups of about $shooter × patch_size$ (those of one item facing the same way in one
-        grid cell), from the group's area-weighted centre; every patch receives on its own. 1 shoots from every
-        patch alone (the plain method, several times slower); the default 4 keeps wall means within 1 % of it.
+        grid cell); every patch receives on its own. With ray form factors a group shoots from its whole area,
+        and receivers nearer than its size take each member's own unshot radiosity (exact per patch in a closed
+        box at any grouping); with the hemicube it shoots from its area-weighted centre. 1 shoots from every patch
+        alone (several times slower).
     progress : callable(shots, residual), optional
         Called after each shot (the CLI draws a Rich bar with it).
     form_factors : {"ray", "hemicube"}
