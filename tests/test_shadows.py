@@ -1041,3 +1041,31 @@ def test_shadow_polygons_through_the_grids_equal_all_pairs_on_a_5120_face_sphere
     monkeypatch.setattr(svg_shadows, "_Grid", AllPairs)
     monkeypatch.setattr(svg_shadows, "_turned_away", lambda faces, *_: np.zeros(faces.corners.shape[0], bool))
     _same_polygons(fast, svg_shadows._shadow_polygons(scene, CAMERA, subset))
+
+
+@pytest.mark.parametrize("light_name", ["point", "spot"])
+def test_maps_of_a_scene_of_several_items_are_reused_across_views(monkeypatch, light_name):
+    """A scene of several items (the stage-by-stage path) under a point light (a cube of six maps) or a spot light:
+    the maps follow the light and the casters' box, not the view, so a turntable draws them once; every frame has
+    the bytes of the same frame with its maps drawn for it; another item in the scene draws them again."""
+    from frustum.render.shadows import fractions as shadow_pass
+
+    shadow_pass.release_memory()
+    light = SLAT_LIGHTS[light_name]
+    scene = _slats_and_items(light)
+    fills = _spy_fills(monkeypatch)
+    drawn = []
+    for angle in np.linspace(0.0, 2.0 * math.pi, 4, endpoint=False):
+        camera = _orbit(angle)
+        count = len(fills)
+        frame = fr.render(scene, camera, shadows=True)
+        drawn.append(len(fills) - count)
+        assert np.array_equal(frame.color, _redrawn(scene, camera).color), angle
+    per_set = (6 if light_name == "point" else 1) * len(scene.items)
+    assert drawn == [per_set, 0, 0, 0]
+    assert not np.array_equal(frame.color, fr.render(scene, _orbit(0.0)).color)  # there are shadows
+    moved = _slats_and_items(light)
+    moved.add(box((0.3, 0.3, 0.3), center=(0.0, 0.15, 0.0)), fr.Material())
+    count = len(fills)
+    fr.render(moved, _orbit(0.0), shadows=True)
+    assert len(fills) - count == (6 if light_name == "point" else 1) * len(moved.items)

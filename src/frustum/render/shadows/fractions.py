@@ -272,19 +272,27 @@ def light_fractions(
         f"{cube_count} of them point lights (a cube of six maps each, {format_bytes(6 * size * size * 4)})",
     )
     seen_points = points[drawn]
+    # a light's maps depend on every caster's bytes and transform and on the light cameras alone: kept and reused
+    # while those stay (a point or spot light's cameras follow the light and the casters' box, not the view)
+    keys = [casters_key(item, bool(item.mesh.is_watertight)) for item in casters]
+    every = None if any(key is None for key in keys) else tuple(keys)
     for channel, light in zip(rows, casting, strict=True):
         cameras = _light_cameras(light, seen_points, box, size, options.softness)
         if not cameras:
             continue
-        maps = take_array((len(cameras), size, size), np.float32)
         views = np.zeros((len(cameras), shadow.MAP_FIELDS))
         for face, (light_camera, texel) in enumerate(cameras):
-            for number, item in enumerate(casters):
-                draw_depth(item, light_camera, maps[face], number == 0)
             views[face] = map_record(light_camera, texel, light)
+        key = map_key(every, [light_camera for light_camera, _ in cameras], views)
+        maps = kept_maps(key, (len(cameras), size, size))
+        if maps is None:
+            maps = take_array((len(cameras), size, size), np.float32)
+            for face, (light_camera, _) in enumerate(cameras):
+                for number, item in enumerate(casters):
+                    draw_depth(item, light_camera, maps[face], number == 0)
         shadow.map_visibility(depth, points, facing, maps, views, np.ascontiguousarray(lights[channel]),
                               float(options.softness), seen, channel)  # fmt: skip
-        give_back(maps)
+        keep_maps(key, maps)
     return seen
 
 
