@@ -15,7 +15,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from frustum.app.runtime import REPORTED, as_program, fail, failure, install_compile_notice, run_interruptible, say
+from frustum.app.runtime import as_program
 
 __all__ = ["main", "plain_render"]
 
@@ -66,10 +66,13 @@ def main(arguments: Sequence[str] | None = None) -> None:
     """Entry point of the ``frustum`` console script and ``python -m frustum``: a plain ``render`` command line
     (``plain_render``) runs here; every other one runs through ``frustum.app.cli.main`` (Typer).
 
-    As the program (`arguments` None) a plain render goes to the resident render process when one answers
-    (``frustum.app.resident``: the same work without the start-up); otherwise it runs here as a short-lived
-    program (``runtime.as_program``: the garbage collector paused, every object frozen on the way out), and leaves
-    a resident process behind for the next command."""
+    As the program (`arguments` None) a plain render goes to the resident render process when one was started on
+    purpose and takes it (``frustum.app.resident``: the same work without the start-up); otherwise it runs here as
+    a short-lived program (``runtime.as_program``). Only with ``FRUSTUM_RESIDENT=1`` and only after a successful
+    render does it start a resident process for the next command (and says so); by default nothing is left
+    behind."""
+    from frustum.app.work import run_render
+
     argv = list(sys.argv[1:] if arguments is None else arguments)
     request = plain_render(argv)
     if request is None:
@@ -78,28 +81,14 @@ def main(arguments: Sequence[str] | None = None) -> None:
         typer_main(arguments)
         return
     if arguments is not None:
-        _render(request)
-        return
-    from frustum.app import resident
+        status = run_render(request)
+    else:
+        from frustum.app import resident
 
-    status = resident.handed(request)
-    if status is not None:
+        status = resident.handed(request)
+        if status is None:
+            status = as_program(lambda: run_render(request))
+            if status == 0 and resident.wanted():
+                resident.start()
+    if status:
         raise SystemExit(status)
-    try:
-        as_program(lambda: _render(request))
-    finally:
-        resident.start()  # for the next command (``frustum.app.resident``); nothing when one runs or it is off
-
-
-def _render(request: dict[str, Any]) -> None:
-    from frustum.app.work import render_files
-
-    install_compile_notice()
-    try:
-        written = run_interruptible(lambda: render_files(Path(request["scene"]), request["output"] or None,
-                                                         request["size"], request["up"] or "y",
-                                                         request["shadows"]))  # fmt: skip
-    except REPORTED as error:
-        fail(*failure(error))
-    for path in written:
-        say(f"wrote {path}")

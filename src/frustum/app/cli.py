@@ -504,16 +504,28 @@ def warmup_command(
 
 @app.command("resident")
 def resident_command(
-    action: Annotated[str, typer.Argument(help="status: list the resident render processes; stop: end them.")],
+    action: Annotated[str, typer.Argument(help="start: start one; status: list the running ones; stop: end them.")],
 ) -> None:
-    """The resident render process that plain `frustum render FILE -o OUT` commands hand their work to, so they
-    skip Python's and Numba's start-up (FRUSTUM_RESIDENT=0 turns it off; it exits after 10 idle minutes)."""
+    """The resident render process, started on purpose: plain `frustum render FILE -o OUT` commands hand it their
+    work and skip Python's and Numba's start-up (or FRUSTUM_RESIDENT=1: the first successful render starts it;
+    FRUSTUM_RESIDENT=0: commands ignore it). It exits after 10 idle minutes."""
     from frustum.app import resident
 
-    if action == "status":
+    if action == "start":
+        if not resident.enabled():
+            raise FrustumError("resident: a resident render process needs Linux (SO_PEERCRED and fork)")
+        if resident.start(wait=True) is None:
+            entry = resident.running()
+            if entry is None:
+                raise FrustumError("resident: no resident render process could be started (is the runtime folder "
+                                   "private to you?)")  # fmt: skip
+            console.print(f"a resident render process is already running (pid {entry.get('pid')})", markup=False,
+                          highlight=False, soft_wrap=True)  # fmt: skip
+    elif action == "status":
         running = resident.status()
         for entry in running:
-            console.print(f"pid {entry.get('pid')}: {entry.get('requests')} renders served, idle "
+            busy = ", rendering now" if entry.get("busy") else ""
+            console.print(f"pid {entry.get('pid')}: {entry.get('requests')} renders served{busy}, idle "
                           f"{entry.get('idle_s')} s, frustum at {entry.get('package')}", markup=False,
                           highlight=False, soft_wrap=True)  # fmt: skip
         if not running:
@@ -521,7 +533,7 @@ def resident_command(
     elif action == "stop":
         console.print(f"stopped {resident.stop()} resident render process(es)", markup=False, highlight=False)
     else:
-        raise FrustumError(f"resident: action {action!r} is unknown; expected status or stop")
+        raise FrustumError(f"resident: action {action!r} is unknown; expected start, status or stop")
 
 
 @app.command("examples")

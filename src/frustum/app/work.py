@@ -4,13 +4,23 @@
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
-from frustum.app.runtime import UsageError
+from frustum.app.runtime import (
+    REPORTED,
+    UsageError,
+    error_line,
+    failure,
+    install_compile_notice,
+    run_interruptible,
+    say,
+)
 from frustum.errors import FrustumError
 
-__all__ = ["MAX_SIZE", "image_size", "render_files"]
+__all__ = ["MAX_SIZE", "image_size", "render_files", "run_render"]
 
 MAX_SIZE = 8192
 """Largest --size width or height (the scene files' ``[render] size`` limit)."""
@@ -47,3 +57,20 @@ def render_files(scene: Path, output: Sequence[Path] | None, size: str | None, u
     written = render_scene_file(scene, list(output) if output else None, size=image_size(size) if size else None,
                                 shadows=choices[shadows], up=up)  # fmt: skip
     return written if isinstance(written, list) else [written]
+
+
+def run_render(request: dict[str, Any]) -> int:
+    """Run a plain render `request` (``frustum.app._program.plain_render``) as the program does: ``wrote PATH``
+    lines on stdout, a failure as one ``error:`` line on stderr; the exit status."""
+    install_compile_notice()
+    try:
+        written = run_interruptible(lambda: render_files(Path(request["scene"]), request["output"] or None,
+                                                         request["size"], request["up"] or "y",
+                                                         request["shadows"]))  # fmt: skip
+    except REPORTED as error:
+        text, status = failure(error)
+        say(error_line(text), sys.stderr)
+        return status
+    for path in written:
+        say(f"wrote {path}")
+    return 0
