@@ -26,8 +26,9 @@ _RENDER_OPTIONS = {"-o": "output", "--output": "output", "--size": "size", "--up
 def plain_render(argv: Sequence[str]) -> dict[str, Any] | None:
     """The arguments of a ``render`` command line in the plain form ``main`` runs itself, or None.
 
-    Plain: ``render``, one file, and only ``-o/--output`` (repeatable), ``--size``, ``--up`` and ``--shadows``
-    (each at most once), as ``--name value`` or ``--name=value``, no value starting with "-"."""
+    Plain: ``render``, one file (not a folder or a glob pattern), and only ``-o/--output`` (repeatable, no
+    ``{field}`` of an output pattern), ``--size``, ``--up`` and ``--shadows`` (each at most once), as ``--name
+    value`` or ``--name=value``, no value starting with "-"."""
     if not argv or argv[0] != "render":
         return None
     found: dict[str, Any] = {"output": [], "size": None, "up": None, "shadows": None, "scene": None}
@@ -57,8 +58,11 @@ def plain_render(argv: Sequence[str]) -> dict[str, Any] | None:
             return None
         else:
             found[key] = value
-    if found["scene"] is None:
-        return None
+    scene = found["scene"]
+    if scene is None or Path(scene).is_dir() or (set(scene) & set("*?[") and not Path(scene).exists()):
+        return None  # a folder or a pattern: several inputs (``frustum.app.many``)
+    if any("{" in str(path) for path in found["output"]):
+        return None  # an output pattern
     return found
 
 

@@ -835,7 +835,13 @@ def serve(socket_path: str, lock_path: str, package: str) -> None:
         install_compile_notice()  # the program's words, should a request compile
         gc.collect()
         gc.freeze()
-        _Server(listener, package).loop()
+        server = _Server(listener, package)
+        signal.signal(signal.SIGTERM, lambda number, frame: sys.exit(0))  # ends the work and tidies up too
+        try:
+            server.loop()
+        finally:
+            if server.child is not None:
+                server.child.stop()
     finally:
         listener.close()
         with contextlib.suppress(OSError):
