@@ -125,7 +125,7 @@ def test_frustum_profile_times_each_stage_and_changes_nothing(tmp_path):
     assert plain.returncode == profiled.returncode == 0, profiled.stderr
     assert profiled.stdout == "wrote timed.png\n" and "profile:" not in plain.stderr
     line = _quiet(profiled.stderr).strip()
-    stages = ["python start-up", "import numpy, numba", "numba target setup", "import frustum", "file reading",
+    stages = ["python start-up", "import numpy and numba", "numba target setup", "import frustum", "file reading",
               "kernel loading", "render", "png write"]  # fmt: skip
     assert line.startswith("profile: ") and all(f"{stage} " in line for stage in stages), line
     seconds = [float(part.rsplit(" s", 1)[0].split()[-1]) for part in line.split(";")[0].split(", ")]

@@ -653,6 +653,11 @@ class _Server:
 
     def fork(self, connection: socket.socket, request: dict[str, Any], message: dict[str, Any]) -> None:
         connection.setblocking(True)
+        try:  # before the child exists: its output must come after this on the connection
+            _send(connection, {"accepted": os.getpid()})
+        except OSError:
+            connection.close()
+            return
         read_end, write_end = os.pipe()
         pid = os.fork()
         if pid == 0:  # the child: one request, then exit (never back into the loop)
@@ -674,8 +679,6 @@ class _Server:
         self.requests += 1
         self.last = time.monotonic()
         self.child = _Child(pid, connection, read_end)
-        with contextlib.suppress(OSError):
-            _send(connection, {"accepted": pid})
 
     def finish(self) -> None:
         """The child reported its status (or died): reap it, tell the client."""

@@ -113,7 +113,7 @@ class Profile:
 
 def profiled(work: Callable[[], Any], profile: Profile) -> Any:
     """Run a plain render's `work` with its stages timed (``frustum.app.work.run_render``)."""
-    with profile.stage("import numpy, numba"):
+    with profile.stage("import numpy and numba"):
         import numba  # noqa: F401 - its import is a stage of its own
     with profile.stage("numba target setup"):
         from numba.core.registry import cpu_target
