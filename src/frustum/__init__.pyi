@@ -222,6 +222,7 @@ from .output.sheet import (
 from .output.simulate import (
     simulate as simulate,
 )
+from .output.annotations import annotate as annotate
 from .output.stereo import (
     ANAGLYPH_METHODS as ANAGLYPH_METHODS,
     STEREO_LAYOUTS as STEREO_LAYOUTS,

@@ -20,7 +20,7 @@ pixel never carries a blend of two objects and every id in a mask is an item of 
   $p' = π(camera', M'·X)$ (items matched by node path, ``Scene.item_paths``); NaN on the background, for items
   absent from the next scene and for points behind the next camera. ``flow_occluded`` (H, W) bool: the point is
   outside the next image, behind its camera, or farther than the next frame's depth buffer at the pixel holding
-  it by more than ``FLOW_DEPTH_TOLERANCE`` of its view distance.
+  it by more than ``DEPTH_TOLERANCE`` of its view distance.
 """
 
 from __future__ import annotations
@@ -38,14 +38,15 @@ from frustum.render.options import GROUND_TRUTH_BUFFERS
 from frustum.scene import Scene, SceneItem
 
 __all__ = [
-    "FLOW_DEPTH_TOLERANCE", "amodal_masks", "check_next", "class_ids", "finish", "flow", "nocs",
+    "DEPTH_TOLERANCE", "amodal_masks", "check_next", "class_ids", "finish", "flow", "nocs",
     "object_coordinates", "visibility",
 ]  # fmt: skip
 
-FLOW_DEPTH_TOLERANCE = 1e-2
-"""``flow_occluded``: a point counts as hidden in the next frame when its view distance exceeds the next depth
-buffer's (at the pixel that holds it) by more than this fraction (1 cm at 1 m): the buffer holds the surface at
-the pixel's centre, not at the point, so a relative margin keeps sloped surfaces from hiding themselves."""
+DEPTH_TOLERANCE = 1e-2
+"""``flow_occluded`` and the visible flags of ``frustum.annotate``: a point counts as hidden when its view distance
+exceeds the depth buffer's (at the pixel that holds it) by more than this fraction (1 cm at 1 m): the buffer holds
+the surface at the pixel's centre, not at the point, so a relative margin keeps sloped surfaces from hiding
+themselves."""
 
 
 def check_next(buffers: tuple[str, ...], next: Any, where: str) -> tuple[Scene, Camera] | None:
@@ -152,6 +153,25 @@ def view_distance(camera: Camera, window_depth: np.ndarray) -> np.ndarray:
         return -(p[2, 3] - z_ndc * p[3, 3]) / (z_ndc * p[3, 2] - p[2, 2])
 
 
+def hidden_points(camera: Camera, depth: np.ndarray, world: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Window coordinates (N, 3) of world points (NaN rows behind a perspective camera) and whether each is hidden
+    from `camera` whose window depth buffer is `depth`: outside the image or the depth range, behind the camera, or
+    farther than the buffer at the pixel holding it by more than ``DEPTH_TOLERANCE`` of its view distance."""
+    window, w = _window(camera, world)
+    window[w <= 0.0] = np.nan
+    height, width = depth.shape
+    column = np.floor(window[:, 0])
+    row = height - 1 - np.floor(window[:, 1])
+    inside = (w > 0.0) & (column >= 0) & (column < width) & (row >= 0) & (row < height)
+    inside &= (window[:, 2] >= 0.0) & (window[:, 2] <= 1.0)
+    hidden = ~inside
+    c, r = column[inside].astype(np.int64), row[inside].astype(np.int64)
+    surface = view_distance(camera, depth[r, c])
+    point = view_distance(camera, window[inside, 2])
+    hidden[inside] = point > surface * (1.0 + DEPTH_TOLERANCE)
+    return window, hidden
+
+
 def _depth_of(scene: Scene, camera: Camera, cull: bool) -> np.ndarray:
     """The window depth buffer of `scene`'s meshes seen by `camera` (depth-only fills, 1.0 where none)."""
     from frustum.raster import shadow
@@ -220,19 +240,10 @@ def flow(
         here = np.asarray(items[k].world_from_model, dtype=np.float64)
         there = np.asarray(next_items[matched[k]].world_from_model, dtype=np.float64)
         now, _ = _window(camera, model @ here[:3, :3].T + here[:3, 3])
-        later, w = _window(next_camera, model @ there[:3, :3].T + there[:3, 3])
-        ahead = w > 0.0
+        later, hidden = hidden_points(next_camera, next_depth, model @ there[:3, :3].T + there[:3, 3])
+        ahead = ~np.isnan(later[:, 0])
         step = np.where(ahead[:, None], np.stack([later[:, 0] - now[:, 0], now[:, 1] - later[:, 1]], axis=1), np.nan)
         result[rows] = step
-        column = np.floor(later[:, 0])
-        row = next_camera.height - 1 - np.floor(later[:, 1])
-        inside = ahead & (column >= 0) & (column < next_camera.width) & (row >= 0) & (row < next_camera.height)
-        inside &= (later[:, 2] >= 0.0) & (later[:, 2] <= 1.0)
-        hidden = ~inside
-        c, r = column[inside].astype(np.int64), row[inside].astype(np.int64)
-        surface = view_distance(next_camera, next_depth[r, c])
-        point = view_distance(next_camera, later[inside, 2])
-        hidden[inside] = point > surface * (1.0 + FLOW_DEPTH_TOLERANCE)
         occluded[rows] = hidden
     return result, occluded
 
