@@ -86,7 +86,7 @@ geometry = { type = "uv_sphere" }
 
 @pytest.mark.parametrize("label", [3, "", ["mug"]])
 def test_a_label_that_is_not_a_string_is_refused(label):
-    with pytest.raises(FrustumError, match="label = .* is not a class name"):
+    with pytest.raises(FrustumError, match=r"label = .* is not a class name"):
         Node("x", label=label)
     with pytest.raises(FrustumError, match="label"):
         Scene().add(icosphere(0.5, 1), label=label)
@@ -203,7 +203,7 @@ def _moved(scene: Scene, rng: np.random.Generator) -> Scene:
 def test_flow_is_the_reprojection_of_the_object_coordinates(seed):
     rng = np.random.default_rng(seed)
     scene, camera = _scene(), _camera()
-    following, next_camera = _moved(scene, rng), _camera(eye=(0.3, 0.8, 3.2) + rng.uniform(-0.3, 0.3, 3))
+    following, next_camera = _moved(scene, rng), _camera(eye=np.add((0.3, 0.8, 3.2), rng.uniform(-0.3, 0.3, 3)))
     frame = render(scene, camera, buffers=("instance", "object_coords", "flow"), next=(following, next_camera))
     nxt = render(following, next_camera)
     next_depth = metric_depth(nxt.depth, next_camera)
@@ -256,7 +256,7 @@ def test_next_scenes_that_cannot_be_matched_are_refused():
         render(scene, camera, buffers=("flow",), next=(twins, camera))
     stranger = Scene()
     stranger.add(icosphere(0.45, 2), name="pebble")
-    with pytest.raises(FrustumError, match="no item at the node paths.*'ball'.*'pebble'"):
+    with pytest.raises(FrustumError, match=r"no item at the node paths.*'ball'.*'pebble'"):
         render(scene, camera, buffers=("flow",), next=(stranger, camera))
     with pytest.raises(FrustumError, match="without next"):
         render(scene, camera, buffers=("flow",))
@@ -277,7 +277,7 @@ def test_annotations_project_keypoints_like_opencv():
     assert [r["name"] for r in records] == ["ball", "cube", "shelf/ring"]
     assert [r["class_id"] for r in records] == [1, 2, 3]
     k_matrix, camera_from_world = _opencv(camera)
-    for k, (record, item, given) in enumerate(zip(records, scene.items, (points, points[:2] * 0.5, None), strict=True)):
+    for k, (record, item, model) in enumerate(zip(records, scene.items, (points, points[:2] * 0.5, None), strict=True)):
         expected_pose = camera_from_world @ item.world_from_model
         np.testing.assert_allclose(record["pose"], expected_pose, atol=1e-12)
         low, high = item.mesh.bounds
@@ -288,10 +288,10 @@ def test_annotations_project_keypoints_like_opencv():
         np.testing.assert_allclose(record["bbox_3d"], projected.reshape(-1, 2), atol=1e-3)
         assert record["px_count_visible"] == (frame.instance == k).sum()
         assert record["px_count_all"] == frame.amodal[k].sum()
-        if given is None:
+        if model is None:
             assert "keypoints" not in record
             continue
-        projected, _ = cv2.projectPoints(given, rvec, expected_pose[:3, 3], k_matrix, None)
+        projected, _ = cv2.projectPoints(model, rvec, expected_pose[:3, 3], k_matrix, None)
         np.testing.assert_allclose(record["keypoints"][:, :2], projected.reshape(-1, 2), atol=1e-3)
     flags = records[0]["keypoints"][:, 2]
     assert flags[1] == 2 and flags[3] == 1  # the front of the ball is seen, its back hidden

@@ -77,7 +77,7 @@ def bop_models(scene: Any, where: str = "render_dataset") -> dict[int, tuple[np.
     if not labels:
         raise OutputError(
             f"{where}: format = 'bop' needs labels on the scene's objects (obj_id is the label's class id) and the "
-            "scene has none; give label= to Scene.add or Node, or label = \"...\" on a scene file's node"
+            'scene has none; give label= to Scene.add or Node, or label = "..." on a scene file\'s node'
         )
     models: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
     owners: dict[int, tuple[str, Any, np.ndarray]] = {}

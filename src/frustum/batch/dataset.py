@@ -657,8 +657,7 @@ def render_dataset(
             if key in finished and finished[key].get("files") == files_of(key)
             and all(p in existing if remote else (out / p).is_file() for p in files_of(key).values())}  # fmt: skip
     jobs = [
-        RenderJob(key, scene_file.scene, camera, _paths(out, files_of(key)), scene_file.options, depth_scale,
-                  keypoints)
+        RenderJob(key, scene_file.scene, camera, _paths(out, files_of(key)), scene_file.options, depth_scale, keypoints)
         for key, camera in cameras
         if key not in done
     ]

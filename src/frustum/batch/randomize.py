@@ -55,7 +55,7 @@ def _edges(mesh: Mesh) -> np.ndarray:
 
 def _crossing(first: tuple[Node, np.ndarray, np.ndarray], second: tuple[Node, np.ndarray, np.ndarray]) -> bool:
     """Whether an edge of one placed mesh (node, world vertices, edges) meets a triangle of the other."""
-    for (node, _, _), (other, points, edges) in ((first, second), (second, first)):
+    for (node, _, _), (_, points, edges) in ((first, second), (second, first)):
         probe = Scene()
         probe.add(node.geometry, transform=node.transform)
         origins = points[edges[:, 0]]
@@ -138,7 +138,7 @@ def _inside(a: np.ndarray, b: np.ndarray) -> bool:
 
 def cameras_on_shell(
     rng: np.random.Generator, count: int, target: Any = (0.0, 0.0, 0.0), *, radius: Any = (0.5, 0.8),
-    elevation: Any = (math.radians(15.0), math.radians(75.0)), width: int = 640, height: int = 480,
+    elevation: Any = (0.25, 1.3), width: int = 640, height: int = 480,
     projection: Any = None,
 ) -> list[Camera]:  # fmt: skip
     """`count` cameras looking at `target` from eyes drawn uniformly in a spherical shell (module docstring).
@@ -148,7 +148,8 @@ def cameras_on_shell(
     radius : float or (r0, r1)
         The shell's radii (one number: a sphere).
     elevation : (e0, e1)
-        Elevations in radians above the horizontal plane through the target, in [−π/2, π/2].
+        Elevations in radians above the horizontal plane through the target, in [−π/2, π/2] (default about
+        14° to 74°).
     projection : Projection or None
         The cameras' projection (``Camera.look_at``'s default when None).
     """
