@@ -286,10 +286,8 @@ class Node:
 
     def copy(self) -> Node:
         """A deep copy of the hierarchy (meshes and materials are immutable and shared)."""
-        return Node(
-            self.name, self.transform, self.geometry, self.material, [c.copy() for c in self.children], self.lights,
-            label=self.label,
-        )
+        children = [c.copy() for c in self.children]
+        return Node(self.name, self.transform, self.geometry, self.material, children, self.lights, label=self.label)
 
     def __repr__(self) -> str:
         if isinstance(self.geometry, Mesh):
