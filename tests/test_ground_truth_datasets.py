@@ -99,15 +99,12 @@ def _read_bop(root: Path) -> dict:
     for im_id in data["scene_camera"]:
         number = int(im_id)
         count = len(data["scene_gt"][im_id])
+        masks = {sub: [np.asarray(Image.open(scene_dir / sub / f"{number:06d}_{g:06d}.png")) > 0 for g in range(count)]
+                 for sub in ("mask", "mask_visib")}  # fmt: skip
         data["images"][number] = {
             "rgb": np.asarray(Image.open(scene_dir / "rgb" / f"{number:06d}.png")),
             "depth": np.asarray(Image.open(scene_dir / "depth" / f"{number:06d}.png")).astype(np.float64),
-            "mask": [
-                np.asarray(Image.open(scene_dir / "mask" / f"{number:06d}_{g:06d}.png")) > 0 for g in range(count)
-            ],
-            "mask_visib": [
-                np.asarray(Image.open(scene_dir / "mask_visib" / f"{number:06d}_{g:06d}.png")) > 0 for g in range(count)
-            ],  # fmt: skip
+            **masks,
         }
     return data
 
@@ -158,7 +155,7 @@ def test_a_bop_dataset_needs_labels(tmp_path):
     scene = Scene()
     scene.add(icosphere(0.05, 2), name="ball")
     camera = Camera.look_at((0, 0.2, 0.5), (0, 0, 0), width=32, height=24)
-    with pytest.raises(OutputError, match="format = 'bop' needs labels.*has none"):
+    with pytest.raises(OutputError, match=r"format = 'bop' needs labels.*has none"):
         render_dataset(scene, tmp_path, cameras=[camera], format="bop", executor="serial", progress=False)
     assert not (tmp_path / "manifest.jsonl").exists()  # refused before any view
 
@@ -210,10 +207,41 @@ def test_placed_objects_do_not_intersect(seed):
 
 
 def test_randomisation_refuses_bad_input():
-    with pytest.raises(FrustumError, match="not a numpy.random.Generator"):
+    with pytest.raises(FrustumError, match=r"not a numpy\.random\.Generator"):
         cameras_on_shell(np.random.RandomState(0), 3)
     with pytest.raises(FrustumError, match="not a shell"):
         cameras_on_shell(np.random.default_rng(0), 3, radius=(1.0, 0.5))
     crowded = [Node(f"cube{i}", geometry=box((0.2, 0.2, 0.2))) for i in range(4)]
     with pytest.raises(FrustumError, match="node 'cube1' found no pose"):
         drop_on_plane(Scene(), crowded, np.random.default_rng(0), area=((0, 0), (0.05, 0.05)), attempts=20)
+
+
+_LABELLED_SCENE = """
+[camera]
+eye = [0.3, 0.25, 0.4]
+target = [0, 0, 0]
+[[nodes]]
+name = "ball"
+label = "ball"
+geometry = { type = "uv_sphere", radius = 0.05 }
+"""
+
+
+def test_the_dataset_command_writes_coco_and_refuses_bop_without_labels(tmp_path):
+    import subprocess
+    import sys
+
+    scene_file = tmp_path / "scene.toml"
+    scene_file.write_text(_LABELLED_SCENE)
+    command = [sys.executable, "-m", "frustum", "dataset", str(scene_file), "--views", "2", "--size", "48x36",
+               "--executor", "serial", "--no-progress"]  # fmt: skip
+    done = subprocess.run([*command, "--out", str(tmp_path / "coco"), "--format", "coco"], capture_output=True,
+                          text=True, timeout=300, check=False)  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    coco = coco_module.COCO(str(tmp_path / "coco" / "annotations.json"))
+    assert len(coco.getAnnIds()) == 2
+    scene_file.write_text(_LABELLED_SCENE.replace('label = "ball"\n', ""))
+    refused = subprocess.run([*command, "--out", str(tmp_path / "bop"), "--format", "bop"], capture_output=True,
+                             text=True, timeout=300, check=False)  # fmt: skip
+    assert refused.returncode != 0 and "Traceback" not in refused.stderr
+    assert "needs labels" in refused.stderr and len(refused.stderr.strip().splitlines()) == 1
