@@ -330,3 +330,14 @@ def test_annotate_needs_the_masks():
     scene, camera = _scene(), _camera()
     with pytest.raises(FrustumError, match="buffers=\\('instance', 'amodal'\\)"):
         annotate(render(scene, camera), scene, camera)
+
+
+def test_ids_filled_beside_the_fast_kernels_equal_the_general_kernels():
+    """Object ids alone keep the fast shading kernels (ids filled from the face codes); with normals the general
+    kernel writes them: the same ids and the same color bytes."""
+    scene, camera = _scene(), _camera()
+    fast = render(scene, camera, buffers=("object_id",))
+    general = render(scene, camera, buffers=("object_id", "normals"))
+    np.testing.assert_array_equal(fast.object_id, general.object_id)
+    np.testing.assert_array_equal(fast.color, general.color)
+    assert set(np.unique(fast.object_id)) == {-1, 0, 1, 2}

@@ -181,7 +181,6 @@ def annotate(frame: Frame, scene: Scene, camera: Camera, keypoints: Any = None) 
 def _project(camera: Camera, depth: np.ndarray, world_from_model: np.ndarray,
              model: np.ndarray) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
     """(N, 2) OpenCV pixel coordinates of model points (NaN behind the camera) and whether each is hidden."""
-    world = model @ world_from_model[:3, :3].T + world_from_model[:3, 3]
-    window, hidden = hidden_points(camera, depth, world)
+    window, hidden = hidden_points(camera, depth, model, world_from_model)
     pixels = np.column_stack([window[:, 0] - 0.5, camera.height - window[:, 1] - 0.5])
     return pixels, hidden

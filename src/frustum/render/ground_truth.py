@@ -107,40 +107,68 @@ def visibility(instance: np.ndarray, amodal: np.ndarray) -> np.ndarray:
 
 def object_coordinates(items: list[SceneItem], instance: np.ndarray, position: np.ndarray) -> np.ndarray:
     """(H, W, 3) float64 model coordinates $(world\\_from\\_model)^{-1}·P$ of each pixel's world point, per item;
-    NaN where nothing is drawn."""
-    result = np.full(position.shape, np.nan)
-    for k in np.unique(instance[instance >= 0]):
-        rows = instance == k
-        model_from_world = np.linalg.inv(np.asarray(items[k].world_from_model, dtype=np.float64))
-        points = position[rows].astype(np.float64)
-        result[rows] = points @ model_from_world[:3, :3].T + model_from_world[:3, 3]
-    return result
+    NaN where nothing is drawn (``raster.ground_truth.model_points``)."""
+    from frustum.raster import ground_truth
+
+    model_from_world = np.zeros((max(1, len(items)), 12))
+    for k, item in enumerate(items):
+        model_from_world[k] = np.linalg.inv(np.asarray(item.world_from_model, dtype=np.float64))[:3].ravel()
+    out = np.empty((*instance.shape, 3))
+    ground_truth.model_points(np.ascontiguousarray(instance, dtype=np.int32),
+                              np.ascontiguousarray(position, dtype=np.float32), model_from_world, out)  # fmt: skip
+    return out
 
 
 def nocs(items: list[SceneItem], instance: np.ndarray, coordinates: np.ndarray) -> np.ndarray:
-    """(H, W, 3) NOCS (module docstring): $(X − c)/‖b_{max} − b_{min}‖ + ½$ per item, NaN where nothing is drawn."""
-    result = np.full(coordinates.shape, np.nan)
-    for k in np.unique(instance[instance >= 0]):
-        rows = instance == k
-        low, high = np.asarray(items[k].mesh.bounds, dtype=np.float64)
+    """(H, W, 3) NOCS (module docstring): $(X − c)/‖b_{max} − b_{min}‖ + ½$ per item, NaN where nothing is drawn
+    (``raster.ground_truth.nocs_points``)."""
+    from frustum.raster import ground_truth
+
+    boxes = np.zeros((max(1, len(items)), 4))
+    for k, item in enumerate(items):
+        low, high = np.asarray(item.mesh.bounds, dtype=np.float64)
         diagonal = float(np.linalg.norm(high - low))
-        result[rows] = (coordinates[rows] - 0.5 * (low + high)) / (diagonal if diagonal > 0 else 1.0) + 0.5
-    return result
+        boxes[k] = (*(0.5 * (low + high)), 1.0 / diagonal if diagonal > 0 else 1.0)
+    out = np.empty(coordinates.shape)
+    ground_truth.nocs_points(np.ascontiguousarray(instance, dtype=np.int32), coordinates, boxes, out)
+    return out
 
 
-def _window(camera: Camera, world: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(N, 3) window coordinates (x right, y up, depth in [0, 1]) of world points and their clip w (> 0: in front
-    of a perspective camera)."""
-    clip_from_world = np.asarray(camera.projection_matrix) @ np.asarray(camera.view_matrix)
-    clip = world @ clip_from_world[:3, :3].T + clip_from_world[:3, 3]
-    w = world @ clip_from_world[3, :3] + clip_from_world[3, 3]
+def _window(camera: Camera, points: np.ndarray, world_from_points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(N, 3) window coordinates (x right, y up, depth in [0, 1]) of points placed by `world_from_points`, and
+    their clip w (> 0: in front of a perspective camera)."""
+    clip_from_points = np.asarray(camera.projection_matrix) @ np.asarray(camera.view_matrix) @ world_from_points
+    clip = points @ clip_from_points[:, :3].T + clip_from_points[:, 3]
+    w = clip[:, 3].copy()
     with np.errstate(invalid="ignore", divide="ignore"):
-        ndc = clip / w[:, None]
-    window = np.empty_like(ndc)
-    window[:, 0] = (ndc[:, 0] + 1.0) * 0.5 * camera.width
-    window[:, 1] = (ndc[:, 1] + 1.0) * 0.5 * camera.height
-    window[:, 2] = (ndc[:, 2] + 1.0) * 0.5
+        clip[:, :3] /= w[:, None]
+    window = clip[:, :3]
+    window[:, 0] = (window[:, 0] + 1.0) * (0.5 * camera.width)
+    window[:, 1] = (window[:, 1] + 1.0) * (0.5 * camera.height)
+    window[:, 2] = (window[:, 2] + 1.0) * 0.5
     return window, w
+
+
+def hidden_points(camera: Camera, depth: np.ndarray, points: np.ndarray,
+                  world_from_points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """Window coordinates (N, 3) of points placed by `world_from_points` (NaN rows behind a perspective camera) and
+    whether each is hidden from `camera` whose window depth buffer is `depth`: outside the image or the depth range,
+    behind the camera, or farther than the buffer at the pixel holding it by more than ``DEPTH_TOLERANCE`` of its
+    view distance."""
+    window, w = _window(camera, points, world_from_points)
+    window[w <= 0.0] = np.nan
+    height, width = depth.shape
+    column = np.floor(window[:, 0])
+    row = height - 1 - np.floor(window[:, 1])
+    with np.errstate(invalid="ignore"):
+        inside = (w > 0.0) & (column >= 0) & (column < width) & (row >= 0) & (row < height)
+        inside &= (window[:, 2] >= 0.0) & (window[:, 2] <= 1.0)
+    hidden = ~inside
+    c, r = column[inside].astype(np.int64), row[inside].astype(np.int64)
+    surface = view_distance(camera, depth[r, c])
+    point = view_distance(camera, window[inside, 2])
+    hidden[inside] = point > surface * (1.0 + DEPTH_TOLERANCE)
+    return window, hidden
 
 
 def view_distance(camera: Camera, window_depth: np.ndarray) -> np.ndarray:
@@ -151,25 +179,6 @@ def view_distance(camera: Camera, window_depth: np.ndarray) -> np.ndarray:
     z_ndc = 2.0 * np.asarray(window_depth, dtype=np.float64) - 1.0
     with np.errstate(invalid="ignore", divide="ignore"):
         return -(p[2, 3] - z_ndc * p[3, 3]) / (z_ndc * p[3, 2] - p[2, 2])
-
-
-def hidden_points(camera: Camera, depth: np.ndarray, world: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Window coordinates (N, 3) of world points (NaN rows behind a perspective camera) and whether each is hidden
-    from `camera` whose window depth buffer is `depth`: outside the image or the depth range, behind the camera, or
-    farther than the buffer at the pixel holding it by more than ``DEPTH_TOLERANCE`` of its view distance."""
-    window, w = _window(camera, world)
-    window[w <= 0.0] = np.nan
-    height, width = depth.shape
-    column = np.floor(window[:, 0])
-    row = height - 1 - np.floor(window[:, 1])
-    inside = (w > 0.0) & (column >= 0) & (column < width) & (row >= 0) & (row < height)
-    inside &= (window[:, 2] >= 0.0) & (window[:, 2] <= 1.0)
-    hidden = ~inside
-    c, r = column[inside].astype(np.int64), row[inside].astype(np.int64)
-    surface = view_distance(camera, depth[r, c])
-    point = view_distance(camera, window[inside, 2])
-    hidden[inside] = point > surface * (1.0 + DEPTH_TOLERANCE)
-    return window, hidden
 
 
 def _depth_of(scene: Scene, camera: Camera, cull: bool) -> np.ndarray:
@@ -222,29 +231,26 @@ def flow(
 ) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
     """(H, W, 2) forward optical flow in pixels (x right, y down) and (H, W) bool occlusion in the next frame
     (module docstring)."""
+    from frustum.raster import ground_truth
+
     matched = matched_items(scene, next_scene, where)
     items, next_items = scene.items, next_scene.items
-    height, width = instance.shape
-    result = np.full((height, width, 2), np.nan)
-    occluded = np.zeros((height, width), dtype=bool)
-    drawn = instance >= 0
-    if not drawn.any():
-        return result, occluded
+    result = np.empty((*instance.shape, 2))
+    occluded = np.empty(instance.shape, dtype=bool)
     next_depth = _depth_of(next_scene, next_camera, cull)
-    for k in np.unique(instance[drawn]):
-        rows = instance == k
-        if matched[k] < 0:
-            occluded[rows] = True
-            continue
-        model = coordinates[rows]
-        here = np.asarray(items[k].world_from_model, dtype=np.float64)
-        there = np.asarray(next_items[matched[k]].world_from_model, dtype=np.float64)
-        now, _ = _window(camera, model @ here[:3, :3].T + here[:3, 3])
-        later, hidden = hidden_points(next_camera, next_depth, model @ there[:3, :3].T + there[:3, 3])
-        ahead = ~np.isnan(later[:, 0])
-        step = np.where(ahead[:, None], np.stack([later[:, 0] - now[:, 0], now[:, 1] - later[:, 1]], axis=1), np.nan)
-        result[rows] = step
-        occluded[rows] = hidden
+    clip_from_world = np.asarray(camera.projection_matrix) @ np.asarray(camera.view_matrix)
+    next_clip_from_world = np.asarray(next_camera.projection_matrix) @ np.asarray(next_camera.view_matrix)
+    now, later = np.zeros((max(1, len(items)), 16)), np.zeros((max(1, len(items)), 16))
+    for k, item in enumerate(items):
+        now[k] = (clip_from_world @ np.asarray(item.world_from_model, dtype=np.float64)).ravel()
+        if matched[k] >= 0:
+            later[k] = (next_clip_from_world @ np.asarray(next_items[matched[k]].world_from_model, float)).ravel()
+    p = np.asarray(next_camera.projection_matrix)
+    setup = np.array([camera.width, camera.height, next_camera.width, next_camera.height, p[2, 2], p[2, 3], p[3, 2],
+                      p[3, 3]], dtype=np.float64)  # fmt: skip
+    ground_truth.flow_pixels(np.ascontiguousarray(instance, dtype=np.int32), np.ascontiguousarray(coordinates), now,
+                             later, np.array(matched, dtype=np.int64), next_depth, setup, DEPTH_TOLERANCE, result,
+                             occluded)  # fmt: skip
     return result, occluded
 
 
