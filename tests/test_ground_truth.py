@@ -341,3 +341,17 @@ def test_ids_filled_beside_the_fast_kernels_equal_the_general_kernels():
     np.testing.assert_array_equal(fast.object_id, general.object_id)
     np.testing.assert_array_equal(fast.color, general.color)
     assert set(np.unique(fast.object_id)) == {-1, 0, 1, 2}
+
+
+@pytest.mark.parametrize("method", ["scan-line", "bsp", "ray-casting", "ray-tracing"])
+def test_every_method_with_object_ids_gives_the_ground_truth(method):
+    scene, camera = _scene(), _camera()
+    wanted = ("instance", "semantic", "amodal", "object_coords")
+    reference = render(scene, camera, buffers=wanted)
+    frame = render(scene, camera, method=method, buffers=wanted)
+    same = frame.instance == reference.instance
+    assert same.mean() > 0.99
+    np.testing.assert_array_equal(frame.amodal, reference.amodal)
+    both = same & (frame.instance >= 0) & ~np.isnan(frame.object_coords[..., 0])
+    assert both.sum() > 0.9 * (frame.instance >= 0).sum()
+    np.testing.assert_allclose(frame.object_coords[both], reference.object_coords[both], atol=5e-3)

@@ -9,7 +9,7 @@ the same order, and ``render_dataset(..., seed=seed)`` writes the seed into the 
   ``Scene.occluded``) or whose bounding box holds or sits inside another's is rejected and drawn again.
 - ``cameras_on_shell``: eyes uniform in the volume of a spherical shell $r ∈ [r_0, r_1]$ (radius
   $r = (r_0^3 + u·(r_1^3 − r_0^3))^{1/3}$), directions uniform on the sphere's band of elevations
-  ($\\sin e$ uniform), each looking at the target; a sphere when $r_0 = r_1$.
+  ($sin(e)$ uniform), each looking at the target; a sphere when $r_0 = r_1$.
 - ``jitter_lights``, ``jitter_materials``: intensities scaled by $1 + U(−a, a)$, directions and positions moved by
   Gaussian noise, material colors moved by $U(−a, a)$ per channel and clipped to [0, 1].
 """

@@ -109,8 +109,8 @@ def flow_pixels(instance: np.ndarray, coordinates: np.ndarray, now: np.ndarray, 
 @parallel_kernel(lambda depth, *_: depth.shape[0], work=lambda depth, *_: depth.size, grain=32768)
 def item_ids(depth: np.ndarray, codes: np.ndarray, face_offset: int, face_count: int, index: int, ids: np.ndarray,
              start: int, stop: int) -> None:  # fmt: skip
-    """``ids[r, c] = index`` at the drawn pixels whose face code belongs to the item (faces ``face_offset`` …
-    ``face_offset + face_count − 1``; code = 2·face + side, as ``raster.shade`` reads it)."""
+    """``ids[r, c] = index`` at the drawn pixels whose face code belongs to the item (its `face_count` faces from
+    `face_offset` on; $code = 2·face + side$, as ``raster.shade`` reads it)."""
     for r in range(start, stop):
         for c in range(depth.shape[1]):
             if depth[r, c] >= 1.0:

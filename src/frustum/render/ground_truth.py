@@ -254,6 +254,22 @@ def flow(
     return result, occluded
 
 
+def cast_positions(scene: Scene, camera: Camera, instance: np.ndarray, factor: int) -> np.ndarray:
+    """(H, W, 3) float32 world points of the drawn pixels by casting each one's ray through the sample its id came
+    from (``Scene.intersect``; the middle sample of its factor × factor block): for the methods that keep no
+    per-pixel positions (``"ray-tracing"``). NaN elsewhere."""
+    height, width = instance.shape
+    rows, columns = np.nonzero(instance >= 0)
+    offset = (factor // 2 + 0.5) / factor
+    window = np.column_stack([columns + offset, height - rows - offset])
+    result = np.full((height, width, 3), np.nan, dtype=np.float32)
+    if rows.size:
+        ray = camera.ray(window)
+        hits = scene.intersect(ray.origin, ray.direction)
+        result[rows, columns] = hits.point
+    return result
+
+
 def finish(frame: Frame, scene: Scene, camera: Camera, options: Any, asked: tuple[str, ...],
            next: tuple[Scene, Camera] | None, where: str = "render") -> Frame:  # fmt: skip
     """`frame` with the asked-for ground-truth buffers (``Frame.instance`` …) added, and the ``object_id`` and
@@ -277,7 +293,9 @@ def finish(frame: Frame, scene: Scene, camera: Camera, options: Any, asked: tupl
         fields["amodal"] = masks
         fields["visibility"] = visibility(instance, masks)
     if any(name in wanted for name in ("object_coords", "nocs", "flow")):
-        coordinates = object_coordinates(items, instance, frame.position)
+        position = frame.position if frame.position is not None else cast_positions(scene, camera, instance,
+                                                                                     options.factor)  # fmt: skip
+        coordinates = object_coordinates(items, instance, position)
         if "object_coords" in wanted:
             fields["object_coords"] = coordinates.astype(np.float32)
         if "nocs" in wanted:
