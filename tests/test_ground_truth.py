@@ -355,3 +355,14 @@ def test_every_method_with_object_ids_gives_the_ground_truth(method):
     both = same & (frame.instance >= 0) & ~np.isnan(frame.object_coords[..., 0])
     assert both.sum() > 0.9 * (frame.instance >= 0).sum()
     np.testing.assert_allclose(frame.object_coords[both], reference.object_coords[both], atol=5e-3)
+
+
+def test_amodal_masks_are_held_to_the_memory_budget():
+    from frustum import budget
+
+    scene, camera = Scene(), _camera()
+    ball = icosphere(0.1, 1)
+    for i in range(40):
+        scene.add(ball, transform=translate(0.05 * i - 1.0, 0.0, 0.0), name=f"ball{i}")
+    with budget(bytes=100_000), pytest.raises(FrustumError, match="amodal masks of 40 items at 64 x 48"):
+        render(scene, camera, buffers=("amodal",))

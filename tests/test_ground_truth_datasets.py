@@ -245,3 +245,25 @@ def test_the_dataset_command_writes_coco_and_refuses_bop_without_labels(tmp_path
                              text=True, timeout=300, check=False)  # fmt: skip
     assert refused.returncode != 0 and "Traceback" not in refused.stderr
     assert "needs labels" in refused.stderr and len(refused.stderr.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize(("format", "where"), [("bop", "process"), ("coco", "url")])
+def test_process_workers_and_urls_write_the_same_bytes(format, where, tmp_path):
+    """The serial run's files, byte for byte, from worker processes (BOP) and at an fsspec URL (COCO)."""
+    fsspec = pytest.importorskip("fsspec")
+    scene, cameras = _table(5)
+    url = f"memory://h45-{format}/data"
+    serial = tmp_path / "serial"
+    other = url if where == "url" else tmp_path / "process"
+    for out, executor in ((serial, "serial"), (other, "process" if where == "process" else "serial")):
+        result = render_dataset(scene, out, cameras=cameras[:2], format=format, progress=False, seed=5,
+                                executor=executor, workers=2)  # fmt: skip
+        assert result.ok, result.failed
+    files = sorted(p.relative_to(serial).as_posix() for p in serial.rglob("*") if p.is_file())
+    assert any(name.endswith(("annotations.json", "scene_gt.json")) for name in files)
+    memory = fsspec.filesystem("memory")
+    for name in files:
+        if name == "manifest.jsonl":
+            continue
+        written = memory.cat_file(f"/h45-{format}/data/{name}") if where == "url" else (other / name).read_bytes()
+        assert written == (serial / name).read_bytes(), name

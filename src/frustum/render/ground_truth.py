@@ -289,6 +289,10 @@ def finish(frame: Frame, scene: Scene, camera: Camera, options: Any, asked: tupl
         table = np.concatenate([[0], class_ids(scene)]).astype(np.int32)
         fields["semantic"] = table[instance + 1]
     if "amodal" in wanted:
+        from frustum.budgets import check_memory
+
+        cause = f"amodal masks of {len(items)} items at {camera.width} x {camera.height}"
+        check_memory(len(items) * camera.width * camera.height, where=where, cause=cause)
         masks = amodal_masks(items, camera, options.cull, options.factor)
         fields["amodal"] = masks
         fields["visibility"] = visibility(instance, masks)
