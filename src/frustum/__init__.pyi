@@ -32,6 +32,8 @@ from .batch.randomize import (
 )
 from .visibility.bsp import (
     BSPTree as BSPTree,
+)
+from .visibility.depth_sort import (
     DepthOrder as DepthOrder,
     depth_sort as depth_sort,
 )
