@@ -645,7 +645,9 @@ def dataset_command(
     out: Annotated[str, typer.Option("--out", help="Output folder or URL (s3://bucket/prefix); rerun to resume.")],
     views: Annotated[int | None, typer.Option(help="Number of views (default 100; --layout file: the file's).")] = None,
     layout: Annotated[str, typer.Option(help="orbit, sphere, random or file.")] = "orbit",
-    format_: Annotated[str, typer.Option("--format", help="nerf, nerfstudio, colmap, files or webdataset.")] = "nerf",
+    format_: Annotated[
+        str, typer.Option("--format", help="nerf, nerfstudio, colmap, files, webdataset, coco or bop.")
+    ] = "nerf",
     size: Annotated[str | None, typer.Option(help="Image size WIDTHxHEIGHT, overriding the file's.")] = None,
     seed: Annotated[int, typer.Option(help="Base seed; each view's seed derives from it and the view's key.")] = 0,
     cameras: Annotated[Path | None, typer.Option(help="--layout file: a JSON list of {eye, target, up}.")] = None,
