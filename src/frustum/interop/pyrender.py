@@ -39,7 +39,7 @@ import numpy as np
 
 from frustum._arrays import describe
 from frustum.camera import Camera, ViewFrame
-from frustum.camera_conventions import metric_depth, view_from_pose
+from frustum.camera_conventions import view_from_pose
 from frustum.errors import FrustumError
 from frustum.geometry import Mesh
 from frustum.interop import pyrender_shading
@@ -103,19 +103,23 @@ def _srgb_to_linear(rgb: np.ndarray) -> np.ndarray:
     return np.where(rgb < 0.04045, rgb / 12.92, ((rgb + 0.055) / 1.055) ** 2.4)
 
 
-class _Item:
-    """What the pixel shader needs of one placed primitive, indexed by frustum's object id."""
+def _record(material: Any, primitive: Any) -> np.ndarray:
+    """The pixel shader's row of one placed primitive (``pyrender_shading.shade``'s `items`)."""
+    if primitive.color_0 is not None:
+        mode = pyrender_shading.MODE_VERTEX
+    elif material.baseColorTexture is not None:
+        mode = pyrender_shading.MODE_TEXTURED
+    else:
+        mode = pyrender_shading.MODE_CONSTANT
+    return np.array([
+        *np.asarray(material.baseColorFactor, dtype=np.float64)[:3], float(material.metallicFactor),
+        float(material.roughnessFactor), *np.asarray(material.emissiveFactor, dtype=np.float64)[:3], mode,
+        1.0 if primitive.normals is not None else 0.0,
+    ])  # fmt: skip
 
-    __slots__ = ("base", "constant_base", "emissive", "has_normals", "metallic", "roughness", "vertex_colors")
 
-    def __init__(self, material: Any, has_normals: bool, vertex_colors: bool, textured: bool) -> None:
-        self.base = np.asarray(material.baseColorFactor, dtype=np.float64)[:3]
-        self.metallic = float(material.metallicFactor)
-        self.roughness = float(material.roughnessFactor)
-        self.emissive = np.asarray(material.emissiveFactor, dtype=np.float64)[:3]
-        self.has_normals = has_normals
-        self.vertex_colors = vertex_colors
-        self.constant_base = not vertex_colors and not textured
+def _item_table(items: list[tuple[Any, np.ndarray]]) -> np.ndarray:
+    return np.array([record for _, record in items]).reshape(-1, 10)
 
 
 class OffscreenRenderer:
@@ -198,27 +202,24 @@ class OffscreenRenderer:
         background = (0.0, 0.0, 0.0, 1.0) if seg else np.clip(np.asarray(scene.bg_color, dtype=np.float64), 0, 1)
         frame = render(built, camera, shading="none", buffers=buffers, cull_back_faces=cull, background=background,
                        shadows=True if shadows else None)  # fmt: skip
-        depth = metric_depth(frame.depth, camera)
+        color, depth = pyrender_shading.shade(frame, camera, _item_table(items), [shading for _, shading in lights],
+                                              scene.ambient_light, lit)  # fmt: skip
         if flags & RenderFlags.DEPTH_ONLY:
             return depth
-        color = np.array(frame.color)
         if seg:
             color[:, :, :3] = _segmentation(frame.object_id, items, seg_node_map, where)
-        elif lit:
-            covered = frame.depth < 1.0
-            color[covered, :3] = self._shade(frame, camera, covered, items, lights, scene)
         if not flags & RenderFlags.RGBA:
-            color = np.ascontiguousarray(color[:, :, :3])
+            return np.ascontiguousarray(color[:, :, :3]), depth
         return color, depth
 
     # --- reading the scene ----------------------------------------------------------------------------------
 
     def _scene(self, pyrender: Any, scene: Any, flags: int, seg_nodes: dict | None, lit: bool,
-               where: str) -> tuple[Scene, list[tuple[Any, _Item]], bool]:  # fmt: skip
+               where: str) -> tuple[Scene, list[tuple[Any, np.ndarray]], bool]:  # fmt: skip
         """frustum's Scene of the visible mesh nodes (only `seg_nodes` for SEG), the per-item records in
         ``Scene.items`` order, and whether back faces are culled."""
         built = Scene()
-        items: list[tuple[Any, _Item]] = []
+        items: list[tuple[Any, np.ndarray]] = []
         double_sided: set[bool] = set()
         for node in sorted(scene.mesh_nodes, key=_node_order):
             mesh = node.mesh
@@ -245,7 +246,7 @@ class OffscreenRenderer:
 
     def _primitive(
         self, pyrender: Any, primitive: Any, flags: int, where: str
-    ) -> tuple[Mesh, Material, Material, _Item]:
+    ) -> tuple[Mesh, Material, Material, np.ndarray]:
         """The frustum Mesh, its lit and flat Materials and the shading record of a primitive (cached while its
         arrays and material factors stay the same objects and values)."""
         material = primitive.material
@@ -290,40 +291,6 @@ class OffscreenRenderer:
         self._meshes[id(primitive)] = (primitive, key, mesh, lit, flat)
         return mesh, lit, flat, _record(material, primitive)
 
-    # --- shading ---------------------------------------------------------------------------------------------
-
-    def _shade(self, frame: Any, camera: Camera, covered: np.ndarray, items: list[tuple[Any, _Item]],
-               lights: list[tuple], scene: Any) -> np.ndarray:  # fmt: skip
-        """pyrender's colour bytes of the covered pixels (``interop.pyrender_shading``)."""
-        ids = frame.object_id[covered]
-        records = [record for _, record in items]
-        table = np.array([r.base for r in records]).reshape(-1, 3)
-        constant = np.array([r.constant_base for r in records], dtype=bool)
-        with_colors = np.array([r.vertex_colors for r in records], dtype=bool)
-        has_normals = np.array([r.has_normals for r in records], dtype=bool)
-        drawn = frame.color[covered, :3].astype(np.float64) / 255.0
-        # the base colour C: the factor, times the sRGB-decoded texture frustum drew (in white) for textured
-        # primitives; vertex colours (drawn in white) multiply the lit colour afterwards
-        textured = ~constant[ids] & ~with_colors[ids]
-        base = table[ids] * np.where(textured[:, None], _srgb_to_linear(drawn), 1.0)
-        multiplier = np.where(with_colors[ids, None], drawn, 1.0)
-        normal = frame.normals[covered].astype(np.float64)
-        normal[~has_normals[ids]] = np.nan
-        rows, columns = np.nonzero(covered)
-        window = np.column_stack([columns + 0.5, camera.height - rows - 0.5, frame.depth[covered]])
-        point = camera.unproject(window)
-        visibility = None
-        if frame.shadow is not None:
-            visibility = _visibility(frame.shadow[covered], lights)
-        rgb = pyrender_shading.shade(
-            base, multiplier,
-            np.array([r.metallic for r in records])[ids], np.array([r.roughness for r in records])[ids],
-            np.array([r.emissive for r in records]).reshape(-1, 3)[ids], normal, point,
-            np.asarray(camera.frame.eye), [light[1] for light in lights], np.asarray(scene.ambient_light, float),
-            visibility,
-        )  # fmt: skip
-        return np.floor(rgb * 255.0 + 0.5).astype(np.uint8)
-
 
 def _size(value: Any, name: str) -> int:
     if isinstance(value, bool) or not isinstance(value, int | np.integer) or value <= 0:
@@ -363,11 +330,6 @@ def _material_key(material: Any) -> tuple:
         tuple(np.asarray(material.emissiveFactor, dtype=float).tolist()), material.alphaMode, material.doubleSided,
         material.wireframe,
     )  # fmt: skip
-
-
-def _record(material: Any, primitive: Any) -> _Item:
-    return _Item(material, primitive.normals is not None, primitive.color_0 is not None,
-                 material.baseColorTexture is not None)  # fmt: skip
 
 
 def _check_primitive(pyrender: Any, primitive: Any, flags: int, where: str) -> None:
@@ -481,6 +443,7 @@ def _lights(pyrender: Any, scene: Any, built: Scene, shadow_kinds: tuple[type, .
     """pyrender's lights in world coordinates, each as (frustum light, shading tuple); the frustum lights (which
     only cast the shadow maps: the colour is pyrender's model) are added to `built`."""
     lights = []
+    columns = 0  # the shadow buffer holds the shadow-casting lights in order
     for node in sorted(scene.light_nodes, key=_node_order):
         light, pose = node.light, scene.get_pose(node)
         position, direction = pose[:3, 3], -pose[:3, 2] / np.linalg.norm(pose[:3, 2])
@@ -499,23 +462,15 @@ def _lights(pyrender: Any, scene: Any, built: Scene, shadow_kinds: tuple[type, .
             shading = (pyrender_shading.LIGHT_DIRECTIONAL, energy, position, direction, 0.0, 0.0)
             ours = DirectionalLight(direction, cast_shadows=DirectionalLight in shadow_kinds)
         built.add_light(ours)
-        lights.append((ours, shading))
+        column = -1
+        if ours.cast_shadows:
+            column, columns = columns, columns + 1
+        lights.append((ours, (*shading, column)))
     return lights
 
 
-def _visibility(shadow: np.ndarray, lights: list[tuple]) -> np.ndarray:
-    """(K, L) fraction of each light reaching each pixel: the shadow buffer's columns (shadow-casting lights, in
-    order) spread over all lights, 1 for lights that cast none."""
-    visibility = np.ones((shadow.shape[0], len(lights)))
-    column = 0
-    for index, (light, _) in enumerate(lights):
-        if light.cast_shadows:
-            visibility[:, index] = shadow[:, column]
-            column += 1
-    return np.nan_to_num(visibility, nan=1.0)
-
-
-def _segmentation(object_id: np.ndarray, items: list[tuple[Any, _Item]], seg_node_map: dict, where: str) -> np.ndarray:
+def _segmentation(object_id: np.ndarray, items: list[tuple[Any, np.ndarray]], seg_node_map: dict,
+                  where: str) -> np.ndarray:  # fmt: skip
     """(H, W, 3) uint8: each item's node colour from `seg_node_map` (a gray int or (r, g, b)), black elsewhere."""
     table = np.zeros((len(items) + 1, 3), dtype=np.uint8)
     for index, (node, _) in enumerate(items):

@@ -23,98 +23,51 @@ metallic–roughness model; [HB 17] "Basic Illumination Models" for the terms' r
 
 from __future__ import annotations
 
-import math
+from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
-__all__ = ["LIGHT_DIRECTIONAL", "LIGHT_POINT", "LIGHT_SPOT", "shade"]
+__all__ = ["LIGHT_DIRECTIONAL", "LIGHT_POINT", "LIGHT_SPOT", "MODE_CONSTANT", "MODE_TEXTURED", "MODE_VERTEX", "shade"]
 
 LIGHT_DIRECTIONAL, LIGHT_POINT, LIGHT_SPOT = 0, 1, 2
-_MIN_ROUGHNESS = 0.04  # pyrender's min_roughness, also its dielectric f0
+MODE_CONSTANT, MODE_TEXTURED, MODE_VERTEX = 0, 1, 2
+"""Where an item's base colour comes from: its factor alone, the factor times the texture frustum drew (its sRGB
+bytes), or the factor with the vertex colours frustum drew multiplying the lit colour."""
 
 
-def _unit(vectors: NDArray[np.float64]) -> NDArray[np.float64]:
-    length = np.sqrt(np.einsum("ij,ij->i", vectors, vectors))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return vectors / length[:, None]
+def shade(frame: Any, camera: Any, items: np.ndarray, lights: list[tuple], ambient: Any,
+          lit: bool) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """(color (H, W, 4) uint8, metric depth (H, W) float32) of a frame frustum drew unlit (``shading="none"``).
 
-
-def _dot(a: NDArray[np.float64], b: NDArray[np.float64]) -> NDArray[np.float64]:
-    return np.einsum("ij,ij->i", a, b)
-
-
-def shade(
-    base: NDArray[np.float64],
-    multiplier: NDArray[np.float64],
-    metallic: NDArray[np.float64],
-    roughness: NDArray[np.float64],
-    emissive: NDArray[np.float64],
-    normal: NDArray[np.float64],
-    point: NDArray[np.float64],
-    eye: NDArray[np.float64],
-    lights: list[tuple],
-    ambient: NDArray[np.float64],
-    visibility: NDArray[np.float64] | None,
-) -> NDArray[np.float64]:
-    """Gamma-encoded RGB in [0, 1] of K pixels by the model of this module's docstring.
+    Colour: where `lit`, pyrender's model of the module docstring at every covered pixel, else the frame's own
+    bytes. Depth: $−z_view$ from the window depth through clip_from_view's z rows, 0 where nothing was drawn
+    (``camera_conventions.metric_depth``'s formula, in the same pass).
 
     Parameters
     ----------
-    base, multiplier, emissive : (K, 3) float64
-        C, the vertex-colour multiplier (ones without vertex colours) and the emissive factor e.
-    metallic, roughness : (K,) float64
-    normal : (K, 3) float64
-        Unit normals (rows of NaN where the primitive has none: N = V there).
-    point : (K, 3) float64
-        World points; `eye` (3,) the camera position.
-    lights : list of (kind, E (3,), position (3,), direction (3,), scale s, offset o)
-        ``direction`` is where the light shines (pyrender's −z of the light's pose).
-    ambient : (3,) float64
-        ``Scene.ambient_light``.
-    visibility : (K, L) float64 or None
-        The fraction of each light reaching each pixel (frustum's shadow maps), or None (all lit).
+    items : (I, 10) float64
+        Per item of ``Scene.items``: base colour factor (3), metallic, roughness, emissive factor (3), mode
+        (``MODE_*``), whether the primitive has normals (0 or 1).
+    lights : list of (kind, E (3,), position (3,), direction (3,), scale s, offset o, shadow column)
+        ``direction`` is where the light shines; the column indexes the frame's ``shadow`` buffer, −1 for none.
     """
-    m = np.clip(metallic, 0.0, 1.0)[:, None]
-    r = np.clip(roughness, _MIN_ROUGHNESS, 1.0)[:, None]
-    c_diff = base * (1.0 - _MIN_ROUGHNESS) * (1.0 - m)
-    f0 = _MIN_ROUGHNESS * (1.0 - m) + base * m
-    view = _unit(eye[None, :] - point)
-    n = np.where(np.isnan(normal[:, :1]), view, normal)
-    nv = np.clip(np.abs(_dot(n, view)), 0.001, 1.0)[:, None]
-    k = (r + 1.0) ** 2 / 8.0
-    g_view = nv / (nv * (1.0 - k) + k)
-    a2 = (r * r) ** 2
-    color = np.zeros_like(base)
-    for index, (kind, energy, position, direction, scale, offset) in enumerate(lights):
-        if kind == LIGHT_DIRECTIONAL:
-            to_light = np.broadcast_to(-np.asarray(direction), point.shape)
-            radiance = np.broadcast_to(np.asarray(energy), point.shape)
-        else:
-            offset_to_light = np.asarray(position)[None, :] - point
-            distance2 = _dot(offset_to_light, offset_to_light)[:, None]
-            to_light = offset_to_light / np.sqrt(distance2)
-            attenuation = 1.0 / distance2
-            if kind == LIGHT_SPOT:
-                cos_axis = np.clip(to_light @ -np.asarray(direction), 0.0, 1.0)[:, None]
-                attenuation = attenuation * np.clip(cos_axis * scale + offset, 0.0, 1.0) ** 2
-            radiance = attenuation * np.asarray(energy)[None, :]
-        half = _unit(to_light + view)
-        nl = np.clip(_dot(n, to_light), 0.001, 1.0)[:, None]
-        nh = np.clip(_dot(n, half), 0.0, 1.0)[:, None]
-        vh = np.clip(_dot(view, half), 0.0, 1.0)[:, None]
-        fresnel = f0 + (1.0 - f0) * np.clip(1.0 - vh, 0.0, 1.0) ** 5
-        geometry = g_view * (nl / (nl * (1.0 - k) + k))
-        denominator = nh * nh * (a2 - 1.0) + 1.0
-        distribution = a2 / (math.pi * denominator * denominator)
-        diffuse = (1.0 - fresnel) * c_diff / math.pi
-        specular = fresnel * geometry * distribution / (4.0 * nl * nv + 0.001)
-        contribution = nl * radiance * (diffuse + specular)
-        if visibility is not None:
-            contribution = contribution * visibility[:, index : index + 1]
-        color += contribution
-    color += base * np.asarray(ambient)[None, :]
-    color += emissive * emissive  # pyrender: emissive = emissive_factor; color += emissive * emissive_factor
-    color *= multiplier
-    with np.errstate(invalid="ignore"):
-        return np.clip(np.power(np.maximum(color, 0.0), 1.0 / 2.2), 0.0, 1.0)
+    from frustum.raster.pyrender_shade import CAMERA_FIELDS, shade_pixels
+
+    clip_from_view = camera.projection.matrix(camera.aspect)
+    packed = np.zeros(CAMERA_FIELDS)
+    packed[:16] = np.asarray(camera.world_from_window, dtype=np.float64).ravel()
+    packed[16:19] = camera.frame.eye
+    packed[19:22] = np.asarray(ambient, dtype=np.float64)[:3]
+    packed[22:26] = clip_from_view[2, 2], clip_from_view[2, 3], clip_from_view[3, 2], clip_from_view[3, 3]
+    packed[26] = 1.0 if lit else 0.0
+    rows = np.zeros((max(len(lights), 0), 13))
+    for index, (kind, energy, position, direction, scale, offset, column) in enumerate(lights):
+        rows[index] = (kind, *energy, *position, *direction, scale, offset, column)
+    color = np.array(frame.color)  # writable (the kernel writes the lit bytes into it)
+    normals = frame.normals if frame.normals is not None else np.zeros((1, 1, 3), np.float32)
+    ids = frame.object_id if frame.object_id is not None else np.zeros((1, 1), np.int32)
+    visibility = frame.shadow if frame.shadow is not None else np.ones((1, 1, 1), np.float32)
+    metric = np.empty(frame.depth.shape, dtype=np.float32)
+    shade_pixels(frame.depth, color, normals, ids, np.ascontiguousarray(items, dtype=np.float64).reshape(-1, 10),
+                 rows, np.ascontiguousarray(visibility), packed, metric)  # fmt: skip
+    return color, metric
