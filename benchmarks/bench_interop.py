@@ -31,8 +31,11 @@ from pathlib import Path
 import numpy as np
 
 # ../shared/bench beside the repository (the nearest ancestor that has one: a git worktree sits deeper)
-BENCH_DIR = next((p / "shared" / "bench" for p in Path(__file__).resolve().parents if (p / "shared" / "bench").is_dir()),
-                 Path(__file__).resolve().parents[1].parent / "shared" / "bench")  # fmt: skip
+_HERE = Path(__file__).resolve()
+BENCH_DIR = next(
+    (p / "shared" / "bench" for p in _HERE.parents if (p / "shared" / "bench").is_dir()),
+    _HERE.parents[1].parent / "shared" / "bench",
+)
 SCENES = ("bunny_like_100k", "objects_20")
 TARGET_RATIO = 0.7
 
@@ -93,8 +96,10 @@ def build_scene(name: str, scene_dir: Path, width: int, height: int):
         row, column = divmod(index, 5)
         mesh = makers[index % 4]()
         hue = index / 20.0
-        material = pyrender.MetallicRoughnessMaterial(baseColorFactor=[0.3 + 0.6 * hue, 0.8 - 0.5 * hue, 0.5, 1.0],
-                                                      metallicFactor=0.1 * (index % 3), roughnessFactor=0.5)  # fmt: skip
+        rgba = [0.3 + 0.6 * hue, 0.8 - 0.5 * hue, 0.5, 1.0]
+        material = pyrender.MetallicRoughnessMaterial(
+            baseColorFactor=rgba, metallicFactor=0.1 * (index % 3), roughnessFactor=0.5
+        )
         pose = trimesh.transformations.translation_matrix([1.3 * column - 2.6, 1.3 * row - 1.95, 0.0])
         scene.add(pyrender.Mesh.from_trimesh(mesh, material=material), pose=pose)
     scene.add(pyrender.DirectionalLight(intensity=3.0), pose=_light_pose([0.3, 0.8, 0.5]))
@@ -161,7 +166,8 @@ def main(argv: list[str] | None = None) -> int:
             runs = []
             for _ in range(args.runs):
                 command = [sys.executable, __file__, "--child", renderer, name, "--frames", str(args.frames),
-                           "--warmup", str(args.warmup), "--size", args.size, "--scene-dir", args.scene_dir]  # fmt: skip
+                           "--warmup", str(args.warmup), "--size", args.size,
+                           "--scene-dir", args.scene_dir]  # fmt: skip
                 done = subprocess.run(command, capture_output=True, text=True, env=environment, check=False)
                 if done.returncode != 0:
                     print(f"{name} {renderer}: failed\n{done.stderr[-2000:]}", file=sys.stderr)

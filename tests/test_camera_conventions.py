@@ -18,8 +18,8 @@ from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
 from frustum import Camera, CameraError, Mesh, Perspective, Scene
+from frustum.app.cli import main
 from frustum.camera_conventions import OPENCV_FROM_OPENGL
-from frustum.cli import main
 
 cv2 = pytest.importorskip("cv2")
 

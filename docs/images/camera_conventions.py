@@ -8,8 +8,8 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-from matplotlib.patches import FancyArrowPatch, Polygon, Rectangle  # noqa: E402
+import matplotlib.pyplot as plt
+from matplotlib.patches import FancyArrowPatch, Polygon, Rectangle
 
 OUT = Path(__file__).with_suffix(".svg")
 # a fixed oblique drawing of 3-D axes: x to the right, y up, z toward the viewer (down-left on the page)
