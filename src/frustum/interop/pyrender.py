@@ -23,7 +23,9 @@ BRDF, its light units, its gamma 1/2.2). Outputs as pyrender's: ``color`` (H, W,
 orthographic cameras, where pyrender 0.1.45 linearizes the depth as if the projection were perspective).
 
 Differences that remain: frustum does not multisample (pyrender draws colour with 4× MSAA, so silhouette
-pixels blend there) and samples textures without mipmaps. Everything pyrender draws that frustum cannot is a
+pixels blend there, and reads depth from sample 0 at (0.375, 0.875) of the pixel), samples textures without
+mipmaps, and lights the back faces it draws (``SKIP_CULL_FACES``, ``doubleSided``) with the normal turned toward
+the viewer, where pyrender keeps the front face's normal. Everything pyrender draws that frustum cannot is a
 ``FrustumError`` naming the feature (normal, occlusion, emissive and metallic–roughness textures, alpha
 blending and masking, wireframes, points and lines, specular–glossiness materials, the normal-drawing flags).
 
@@ -96,11 +98,6 @@ def _pyrender() -> Any:
             "pip install 'frustum[pyrender]' (pyrender itself need not be able to render: no display or GPU)"
         ) from None
     return pyrender
-
-
-def _srgb_to_linear(rgb: np.ndarray) -> np.ndarray:
-    """pyrender's ``srgb_to_linear``: c/12.92 below 0.04045, ((c + 0.055)/1.055)^2.4 above."""
-    return np.where(rgb < 0.04045, rgb / 12.92, ((rgb + 0.055) / 1.055) ** 2.4)
 
 
 def _record(material: Any, primitive: Any) -> np.ndarray:
