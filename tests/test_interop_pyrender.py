@@ -326,6 +326,28 @@ def test_shadows_fall_where_rays_to_the_light_are_blocked(kind: str) -> None:
     assert agree >= 0.98, f"shadow agrees with the rays on {agree:.4f} of the floor"
 
 
+def test_skip_cull_faces_draws_back_faces_as_pyrender_does(single_sample) -> None:
+    """A quad turned away from the camera: culled by default, drawn with SKIP_CULL_FACES (coverage and depth as
+    pyrender's; its back is lit differently: frustum turns the normal toward the viewer)."""
+    quad = trimesh.Trimesh([[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], [[0, 2, 1], [0, 3, 2]], process=False)
+    scene = pyrender.Scene()
+    node = scene.add(pyrender.Mesh.from_trimesh(quad, material=_material((0.8, 0.8, 0.8))))
+    scene.add(_intrinsics(), pose=tf.translation_matrix([0.1, 0.0, 3.0]))
+    _, culled = _frustum(scene)
+    _, culled_ref = _pyrender(scene)
+    assert not (culled > 0).any() and not (culled_ref > 0).any()
+    _, both_sides = _frustum(scene, RenderFlags.SKIP_CULL_FACES)
+    _, both_sides_ref = _pyrender(scene, pyrender.RenderFlags.SKIP_CULL_FACES)
+    _coverage_and_depth(both_sides_ref, both_sides)
+    scene.add(pyrender.Mesh.from_trimesh(trimesh.creation.box(), material=pyrender.MetallicRoughnessMaterial(
+        doubleSided=True)), pose=tf.translation_matrix([0, 0, -2]))  # fmt: skip
+    with pytest.raises(FrustumError, match=r"some primitives are doubleSided and others are not"):
+        _frustum(scene)
+    node.mesh.primitives[0].material.doubleSided = True
+    _, double_sided = _frustum(scene)
+    assert (double_sided > 0).sum() > (both_sides > 0).sum() * 0.5
+
+
 def test_renderer_matches_pyrender_signature_and_deletes() -> None:
     renderer = OffscreenRenderer(32, 24, point_size=2.0)
     assert (renderer.viewport_width, renderer.viewport_height, renderer.point_size) == (32, 24, 2.0)
