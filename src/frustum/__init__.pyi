@@ -26,8 +26,16 @@ from .batch import (
     render_dataset as render_dataset,
     render_many as render_many,
 )
+from .batch.randomize import (
+    cameras_on_shell as cameras_on_shell,
+    drop_on_plane as drop_on_plane,
+    jitter_lights as jitter_lights,
+    jitter_materials as jitter_materials,
+)
 from .visibility.bsp import (
     BSPTree as BSPTree,
+)
+from .visibility.depth_sort import (
     DepthOrder as DepthOrder,
     depth_sort as depth_sort,
 )
@@ -224,6 +232,7 @@ from .output.sheet import (
 from .output.simulate import (
     simulate as simulate,
 )
+from .output.annotations import annotate as annotate
 from .output.stereo import (
     ANAGLYPH_METHODS as ANAGLYPH_METHODS,
     STEREO_LAYOUTS as STEREO_LAYOUTS,
