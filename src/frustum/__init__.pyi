@@ -6,10 +6,12 @@ __version__: str
 from . import (
     budgets as budgets,
     camera as camera,
+    camera_conventions as camera_conventions,
     clipping as clipping,
     errors as errors,
     frame as frame,
     geometry as geometry,
+    interop as interop,
     projection as projection,
     quaternion as quaternion,
     scene as scene,
@@ -23,6 +25,12 @@ from .batch import (
     ViewResult as ViewResult,
     render_dataset as render_dataset,
     render_many as render_many,
+)
+from .batch.randomize import (
+    cameras_on_shell as cameras_on_shell,
+    drop_on_plane as drop_on_plane,
+    jitter_lights as jitter_lights,
+    jitter_materials as jitter_materials,
 )
 from .visibility.bsp import (
     BSPTree as BSPTree,
@@ -231,6 +239,7 @@ from .output.sheet import (
 from .output.simulate import (
     simulate as simulate,
 )
+from .output.annotations import annotate as annotate
 from .output.stereo import (
     ANAGLYPH_METHODS as ANAGLYPH_METHODS,
     STEREO_LAYOUTS as STEREO_LAYOUTS,
@@ -290,6 +299,9 @@ from .render.radiosity import (
     RadiosityError as RadiosityError,
     RadiosityResult as RadiosityResult,
     radiosity as radiosity,
+)
+from .interop.trimesh import (
+    render_trimesh as render_trimesh,
 )
 from .raster import (
     set_compile_notice as set_compile_notice,

@@ -35,7 +35,7 @@ from frustum.errors import GeometryError
 from frustum.geometry.mesh import Mesh
 from frustum.geometry.mesh_writer import SUPPORTED_SUFFIXES, _suffix, write_mesh
 
-__all__ = ["SUPPORTED_SUFFIXES", "MeshPart", "load", "load_parts", "save"]
+__all__ = ["SUPPORTED_SUFFIXES", "MeshPart", "load", "load_parts", "save", "scene_parts"]
 
 _IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg")
 
@@ -150,20 +150,8 @@ def load_parts(path: str | Path, texture: str | Path | None = None) -> list[Mesh
         raise _memory_error(file) from None
     except Exception as error:  # trimesh raises many types (ValueError, KeyError, struct.error, ...)
         raise _read_error(file, error) from None
-    parts: list[MeshPart] = []
     try:
-        placements = _world_placements(scene.graph)
-        nodes = sorted(scene.graph.nodes_geometry)
-        for node in nodes:
-            world_from_model, geometry_name = placements[node] if node in placements else scene.graph[node]
-            geometry = scene.geometry.get(geometry_name)
-            if not isinstance(geometry, trimesh.Trimesh) or len(geometry.faces) == 0:
-                continue
-            mesh, image, color = _from_trimesh(geometry, file)
-            matrix = np.array(world_from_model, dtype=np.float64)
-            emissive, alpha_mode = _emission_and_alpha(geometry)
-            parts.append(MeshPart(str(node), mesh, matrix, image, color, _normal_texture(geometry), emissive,
-                                  alpha_mode))  # fmt: skip
+        parts = scene_parts(scene)
     except GeometryError as error:
         raise GeometryError(f"load: path = {str(file)!r} holds invalid geometry ({error}); check the file") from None
     except MemoryError:
@@ -175,6 +163,27 @@ def load_parts(path: str | Path, texture: str | Path | None = None) -> list[Mesh
             f"load: path = {str(file)!r} contains no triangles; give a file with at least one triangle mesh"
         )
     return _with_textures(parts, file, explicit)
+
+
+def scene_parts(scene: Any) -> list[MeshPart]:
+    """Every non-empty triangle mesh of a ``trimesh.Scene`` as a ``MeshPart``, placed by its graph node (world
+    transform from one walk of the graph), sorted by node name: what ``load_parts`` returns for a file's scene and
+    ``Scene.from_trimesh`` for a scene in memory. Other geometry (point clouds, paths) is left out."""
+    import trimesh
+
+    parts: list[MeshPart] = []
+    placements = _world_placements(scene.graph)
+    for node in sorted(scene.graph.nodes_geometry):
+        world_from_model, geometry_name = placements[node] if node in placements else scene.graph[node]
+        geometry = scene.geometry.get(geometry_name)
+        if not isinstance(geometry, trimesh.Trimesh) or len(geometry.faces) == 0:
+            continue
+        mesh, image, color = _from_trimesh(geometry)
+        matrix = np.array(world_from_model, dtype=np.float64)
+        emissive, alpha_mode = _emission_and_alpha(geometry)
+        parts.append(MeshPart(str(node), mesh, matrix, image, color, _normal_texture(geometry), emissive,
+                              alpha_mode))  # fmt: skip
+    return parts
 
 
 def _with_textures(parts: list[MeshPart], file: Path, explicit: NDArray[np.uint8] | None) -> list[MeshPart]:
@@ -458,7 +467,7 @@ def _read_error(file: Path, error: BaseException) -> GeometryError:
     )
 
 
-def _from_trimesh(geometry: Any, file: Path) -> tuple[Mesh, NDArray[np.uint8] | None, tuple | None]:
+def _from_trimesh(geometry: Any) -> tuple[Mesh, NDArray[np.uint8] | None, tuple | None]:
     vertices = np.asarray(geometry.vertices, dtype=np.float64)
     faces = np.asarray(geometry.faces, dtype=np.int64)
     normals = None

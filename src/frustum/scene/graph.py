@@ -10,6 +10,7 @@ Why one module: the Scene and what it places (nodes, items, volumes, particles, 
 
 from __future__ import annotations
 
+import importlib
 import sys
 from collections.abc import Iterable, Iterator
 from typing import TYPE_CHECKING, Any, NamedTuple
@@ -222,7 +223,9 @@ class Node:
 
     ``transform`` (4x4 affine, default identity) maps this node's coordinates into its parent's;
     ``geometry`` is a ``Mesh`` or a ``Polyline`` (or None for a pure group); ``material`` None inherits the
-    nearest ancestor's (``Material()`` at the top); ``lights`` ride the node (they move with its world transform).
+    nearest ancestor's (``Material()`` at the top); ``lights`` ride the node (they move with its world transform);
+    ``label`` (a non-empty string, or None to inherit the nearest ancestor's) is the semantic class of the meshes
+    at and below the node (``Scene.labels``, ``render(..., buffers=("semantic",))``).
     """
 
     def __init__(
@@ -233,10 +236,17 @@ class Node:
         material: Material | None = None,
         children: Iterable[Node] = (),
         lights: Iterable[Light] = (),
+        *,
+        label: str | None = None,
     ) -> None:
         where = f"Node({name!r})"
         if not isinstance(name, str) or "/" in name:
             raise FrustumError(f"{where}: name = {describe(name)} is not a string without '/'; '/' separates paths")
+        if label is not None and (not isinstance(label, str) or not label):
+            raise FrustumError(
+                f"{where}: label = {describe(label)} is not a class name; give a non-empty string such as 'mug', "
+                "or None to inherit the parent's"
+            )
         if geometry is not None and not (isinstance(geometry, Mesh | Polyline) or is_octree(geometry)
                                          or _is_points(geometry)):  # fmt: skip
             raise FrustumError(
@@ -249,6 +259,7 @@ class Node:
         self.transform = modeling_transform(transform, where)
         self.geometry = geometry
         self.material = material
+        self.label = label
         self.children: list[Node] = []
         self.lights: list[Light] = []
         self.point_style: Any = None  # a PointCloud's drawing style (``frustum.geometry.points.PointStyle``) or None
@@ -294,9 +305,9 @@ class Node:
 
     def copy(self) -> Node:
         """A deep copy of the hierarchy (meshes and materials are immutable and shared)."""
-        node = Node(
-            self.name, self.transform, self.geometry, self.material, [c.copy() for c in self.children], self.lights
-        )
+        children = [c.copy() for c in self.children]
+        node = Node(self.name, self.transform, self.geometry, self.material, children, self.lights,
+                    label=self.label)
         node.point_style = self.point_style
         return node
 
@@ -335,6 +346,15 @@ class Scene:
         for light in lights:
             self.add_light(light)
 
+    @classmethod
+    def from_trimesh(cls, scene_or_mesh: Any, *, resolution: Any = None) -> tuple[Scene, Any]:
+        """``(Scene, Camera)`` of a ``trimesh.Scene`` or ``Trimesh``: its graph, visuals and camera
+        (``frustum.interop.trimesh.scene_from_trimesh``; without a camera, ``Camera.fit``)."""
+        # the adapter lives in the interface layer above the scene (import-linter layers): looked up by name
+        return importlib.import_module("frustum.interop.trimesh").scene_from_trimesh(
+            scene_or_mesh, resolution=resolution
+        )
+
     @property
     def lights(self) -> list[Light]:
         """The lights attached to the root (world coordinates)."""
@@ -356,25 +376,27 @@ class Scene:
         style: str | None = None,
         point_size: float | None = None,
         radius: float | None = None,
+        label: str | None = None,
     ) -> Node:
         """Place `geometry` (a Mesh, a Polyline, a ``PointCloud``, ``GaussianSplats`` or a whole Node subtree) under
         `parent` (default the root); returns the node.
 
-        For a Mesh or Polyline, a new ``Node(name, transform, geometry, material)`` is made; for a Node,
-        `material` and `transform` must be left out (set them on the node). A PointCloud is drawn in `style`
-        ``"square"`` (default), ``"disk"``, ``"sphere"`` or ``"surfel"`` with `point_size` pixels or `radius` world
-        units (``frustum.render.points``).
+        For a Mesh or Polyline, a new ``Node(name, transform, geometry, material, label=label)`` is made; for a
+        Node, `material`, `transform` and `label` must be left out (set them on the node). `label`: the semantic
+        class (``Node``; ``Scene.labels``).
+        A PointCloud is drawn in `style` ``"square"`` (default), ``"disk"``, ``"sphere"`` or ``"surfel"`` with
+        `point_size` pixels or `radius` world units (``frustum.render.points``).
         """
         where = "Scene.add"
         host = self.root if parent is None else self.find(parent) if isinstance(parent, str) else parent
         if isinstance(geometry, Node):
-            if material is not None or transform is not None:
-                raise FrustumError(f"{where}: give material and transform on the Node itself, not with a Node")
+            if material is not None or transform is not None or label is not None:
+                raise FrustumError(f"{where}: give material, transform and label on the Node itself, not with a Node")
             return host.add(geometry)
         if _is_points(geometry) or (style, point_size, radius) != (None, None, None):
             from frustum.geometry.points import point_style
 
-            node = Node(name, transform, geometry, material)
+            node = Node(name, transform, geometry, material, label=label)
             node.point_style = point_style(geometry, style, point_size, radius, where)
             return host.add(node)
         if not (isinstance(geometry, Mesh | Polyline) or is_octree(geometry)):
@@ -382,7 +404,7 @@ class Scene:
                 f"{where}: geometry = {describe(geometry)} is not a Mesh, Polyline or Node; build one with "
                 "Mesh(vertices, faces)"
             )
-        return host.add(Node(name, transform, geometry, material))
+        return host.add(Node(name, transform, geometry, material, label=label))
 
     def add_volume(
         self,
@@ -527,6 +549,41 @@ class Scene:
             material = node.material if node.material is not None else inherited
             yield node, world, material
             stack.extend((child, world, material) for child in reversed(node.children))
+
+    @property
+    def labels(self) -> list[str]:
+        """The semantic classes of the placed meshes in first-seen order (``items`` order; a node without a label
+        inherits its nearest ancestor's). Class id $c$ of a label is its 1-based position here; 0 is the
+        background (``render(..., buffers=("semantic",))``)."""
+        seen: dict[str, None] = {}
+        for label in self.item_labels():
+            if label is not None:
+                seen.setdefault(label)
+        return list(seen)
+
+    def item_labels(self) -> list[str | None]:
+        """Each item's label (``items`` order), inherited from the nearest labelled ancestor; None where none is."""
+        return [label for _, label in self._item_nodes()]
+
+    def item_paths(self) -> list[str]:
+        """Each item's node path (``items`` order): the names from the root down, '/'-separated, an unnamed node
+        written as ``#i`` (its position among its parent's children), so that ``next`` scenes of
+        ``render(..., buffers=("flow",), next=...)`` and datasets match items across scenes."""
+        return [path for path, _ in self._item_nodes()]
+
+    def _item_nodes(self) -> list[tuple[str, str | None]]:
+        """(path, label) of each placed mesh, in ``_placed(Mesh)``'s order."""
+        result: list[tuple[str, str | None]] = []
+
+        def visit(node: Node, path: str, inherited: str | None) -> None:
+            label = node.label if node.label is not None else inherited
+            if isinstance(node.geometry, Mesh) or is_octree(node.geometry):
+                result.append((path, label))
+            for i, child in enumerate(node.children):
+                visit(child, f"{path}/{child.name or f'#{i}'}".lstrip("/"), label)
+
+        visit(self.root, "", self.root.label)
+        return result
 
     @property
     def polylines(self) -> list[SceneItem]:
