@@ -60,7 +60,16 @@ from typing import Any
 from frustum.camera import Camera
 from frustum.frame import Frame
 from frustum.render import (
-    eye_dome, ground_truth, lines, methods, particles, points, reflection, splats, surfaces, volumes,
+    eye_dome,
+    ground_truth,
+    lines,
+    methods,
+    particles,
+    points,
+    reflection,
+    splats,
+    surfaces,
+    volumes,
 )
 from frustum.render.buffers import FrameBuffers as FrameBuffers
 from frustum.render.buffers import Scratch as Scratch
