@@ -48,7 +48,6 @@ Model for Shaded Display", CACM 23(6), 1980.
 
 from __future__ import annotations
 
-import math
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -57,11 +56,11 @@ from numpy.typing import NDArray
 from frustum.budgets import check_operations
 from frustum.camera import Camera
 from frustum.errors import FrustumError
-from frustum.raster.power import textbook_power
 from frustum.render.context import FrameContext
 from frustum.render.options import RenderOptions
 from frustum.scene import Scene
-from frustum.shading import AmbientLight, DirectionalLight, SpotLight, pack_lights
+from frustum.shading import AmbientLight, DirectionalLight, pack_lights
+from frustum.shading.light import specular_terms, toward_light
 
 __all__ = ["MIN_WEIGHT", "RaySegment", "draw_surfaces", "ray_path"]
 
@@ -207,22 +206,7 @@ def _local(data: _Scene, hit: _Hits, counts: dict, record: list | None, parents:
     view = -hit.incoming
     for number, light in data.positioned:
         intensity = np.asarray(light.color, dtype=np.float64) * light.intensity
-        if isinstance(light, DirectionalLight):
-            to_light = np.broadcast_to(-np.asarray(light.direction, dtype=np.float64), n.shape)
-            falloff = np.ones(n.shape[0])
-        else:
-            offset = np.asarray(light.position, dtype=np.float64) - hit.point
-            distance = np.sqrt(np.einsum("ij,ij->i", offset, offset))
-            to_light = offset / np.maximum(distance, 1e-300)[:, None]
-            a0, a1, a2 = light.attenuation
-            falloff = 1.0 / (a0 + a1 * distance + a2 * distance * distance)
-            if isinstance(light, SpotLight):
-                cos_inner, cos_outer = math.cos(light.inner_angle), math.cos(light.outer_angle)
-                cos_alpha = -(to_light @ np.asarray(light.direction, dtype=np.float64))
-                if cos_inner > cos_outer:
-                    falloff = falloff * np.clip((cos_alpha - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0)
-                else:
-                    falloff = falloff * (cos_alpha >= cos_outer)
+        to_light, falloff = toward_light(light, hit.point)  # the light model's attenuation and spot cone
         cosine = np.einsum("ij,ij->i", n, to_light)
         ndl = np.maximum(cosine, 0.0)
         lit = ndl > 0.0
@@ -242,41 +226,11 @@ def _local(data: _Scene, hit: _Hits, counts: dict, record: list | None, parents:
                         "shadow", depth, int(parents[row]), origins[j], directions[j], np.inf, -1, -1,
                         np.full(3, np.nan), np.full(3, np.nan), 0.0, number, bool(blocked[j]),
                     ))  # fmt: skip
-        spec = np.zeros(n.shape[0])
-        on = lit
-        if on.any():
-            if data.specular_phong:
-                reflected = 2.0 * cosine[on, None] * n[on] - to_light[on]
-                x = np.maximum(np.einsum("ij,ij->i", reflected, view[on]), 0.0)
-            else:
-                half = to_light[on] + view[on]
-                half = half / np.sqrt(np.einsum("ij,ij->i", half, half))[:, None]
-                x = np.maximum(np.einsum("ij,ij->i", n[on], half), 0.0)
-            spec[on] = [textbook_power(float(a), float(b)) for a, b in zip(x, shininess[on], strict=True)] \
-                if x.shape[0] < 64 else _power(x, shininess[on])  # fmt: skip
+        spec = specular_terms(to_light, cosine, n, view, shininess, data.specular_phong, lit)  # where lit, unshadowed
         shade = np.where(lit, falloff * ndl, 0.0)
         diffuse_sum = diffuse_sum + (kd * shade)[:, None] * intensity
         specular_sum = specular_sum + (ks * falloff * spec)[:, None] * intensity
     return np.clip(base * diffuse_sum + specular_sum + data.emissive[k], 0.0, 1.0)
-
-
-def _power(x: np.ndarray, n: np.ndarray) -> np.ndarray:
-    """``textbook_power`` over arrays: repeated squaring for integral exponents in its range, else ``x**n``."""
-    from frustum.raster.power import SQUARING_MAX
-
-    out = np.empty_like(x)
-    integral = (n == np.floor(n)) & (n >= 0.0) & (n <= SQUARING_MAX)
-    out[~integral] = x[~integral] ** n[~integral]
-    for value in np.unique(n[integral]):
-        chosen = integral & (n == value)
-        base, result, e = x[chosen].copy(), np.ones(int(chosen.sum())), int(value)
-        while e > 0:
-            if e & 1:
-                result = result * base
-            base = base * base
-            e >>= 1
-        out[chosen] = result
-    return out
 
 
 def _primary(camera: Camera, rows: np.ndarray, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:

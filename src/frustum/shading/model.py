@@ -19,7 +19,7 @@ with
 
 Colors are linear RGB in [0, 1]; the result is clamped to [0, 1] and stored as $floor(I·255 + 0.5)$.
 With one white directional light of intensity 1 and no ambient light this is exactly the formula of
-``../shared/bench/README.md``, bit for bit. ``illuminate`` below is the readable one-point version; the
+``../shared/bench/README.md``, bit for bit. ``shading.light.illuminate`` is the readable one-point version; the
 kernels are in ``raster/shade.py``.
 
 Depth cueing [HB 10] "Depth Cueing" blends each color toward a cue color by its distance d from the viewing
@@ -45,7 +45,6 @@ from numpy.typing import ArrayLike, NDArray
 
 from frustum._arrays import Matrix4, Vector3, as_direction, as_scalar, as_vector3, describe, read_only
 from frustum.errors import ShadingError
-from frustum.raster.power import textbook_power as power
 from frustum.transforms import apply, apply_to_directions
 
 __all__ = [
@@ -57,8 +56,6 @@ __all__ = [
     "Material",
     "PointLight",
     "SpotLight",
-    "blinn_phong",
-    "illuminate",
     "pack_lights",
 ]
 
@@ -414,76 +411,3 @@ def pack_lights(lights: list[Light]) -> tuple[NDArray[np.float64], NDArray[np.fl
     return ambient, np.array(rows, dtype=np.float64).reshape(-1, LIGHT_FIELDS)
 
 
-def _light_terms(light: Light, point: NDArray, normal: NDArray, view: NDArray, shininess: float, specular: str):
-    """(f·ndl, f·spec): the attenuated diffuse and specular factors of one light at one point."""
-    if isinstance(light, DirectionalLight):
-        to_light, falloff = light.to_light, 1.0
-    else:
-        offset = light.position - point
-        distance = math.sqrt(float(offset @ offset))
-        to_light = offset / distance
-        a0, a1, a2 = light.attenuation
-        falloff = 1.0 / (a0 + a1 * distance + a2 * distance * distance)
-        if isinstance(light, SpotLight):
-            cos_inner, cos_outer = math.cos(light.inner_angle), math.cos(light.outer_angle)
-            cos_alpha = float(-to_light @ light.direction)
-            if cos_inner > cos_outer:
-                falloff *= min(max((cos_alpha - cos_outer) / (cos_inner - cos_outer), 0.0), 1.0)
-            else:
-                falloff *= 1.0 if cos_alpha >= cos_outer else 0.0
-    ndl = max(float(normal @ to_light), 0.0)
-    spec = 0.0
-    if ndl > 0.0:
-        if specular == "phong":
-            reflected = 2.0 * float(normal @ to_light) * normal - to_light
-            spec = power(max(float(reflected @ view), 0.0), shininess)
-        else:
-            half = to_light + view
-            half = half / math.sqrt(float(half @ half))
-            spec = power(max(float(normal @ half), 0.0), shininess)
-    return falloff * ndl, falloff * spec
-
-
-def illuminate(
-    material: Material,
-    lights: list[Light],
-    point: ArrayLike,
-    normal: ArrayLike,
-    eye: ArrayLike,
-    *,
-    base_color: ArrayLike | None = None,
-    specular: str = "blinn-phong",
-) -> NDArray[np.float64]:
-    """Linear RGB (3,) in [0, 1] of one surface point by the formula of this module's docstring (slow, readable).
-
-    `normal` need not be unit length. `base_color` replaces the material color (for vertex colors or a
-    texture sample already multiplied in).
-    """
-    if specular not in SPECULAR_MODELS:
-        raise ShadingError(f"illuminate: specular = {specular!r} is unknown; expected one of {SPECULAR_MODELS}")
-    n = np.asarray(normal, dtype=np.float64)
-    n = n / math.sqrt(float(n @ n))
-    p = np.asarray(point, dtype=np.float64)
-    view = np.asarray(eye, dtype=np.float64) - p
-    view = view / math.sqrt(float(view @ view))
-    color = material.color if base_color is None else np.asarray(base_color, dtype=np.float64)
-    ambient, _ = pack_lights(lights)
-    diffuse_sum = material.ambient * ambient
-    specular_sum = np.zeros(3)
-    for light in lights:
-        if isinstance(light, AmbientLight):
-            continue
-        ndl, spec = _light_terms(light, p, n, view, material.shininess, specular)
-        intensity = light.color * light.intensity
-        diffuse_sum = diffuse_sum + material.diffuse * ndl * intensity
-        specular_sum = specular_sum + material.specular * spec * intensity
-    return np.clip(color * diffuse_sum + specular_sum + material.emissive, 0.0, 1.0)
-
-
-def blinn_phong(
-    material: Material, light: DirectionalLight, normal: ArrayLike, point: ArrayLike, eye: ArrayLike
-) -> tuple[int, int, int]:
-    """8-bit RGB of one point lit by one directional light: $floor(illuminate(...)·255 + 0.5)$ (the bench formula)."""
-    rgb = illuminate(material, [light], point, normal, eye)
-    r, g, b = np.floor(rgb * 255.0 + 0.5).astype(int).tolist()
-    return r, g, b
