@@ -472,28 +472,9 @@ def render_dataset(
     """
     where = "render_dataset"
     from frustum import __version__
-    from frustum.scenefile import SceneFile, load_scene_file
 
-    if format not in CAMERA_WRITERS:
-        raise OutputError(f"{where}: format = {format!r} is unknown; expected one of {', '.join(FORMATS)}")
-    if layout not in LAYOUTS:
-        raise CameraError(f"{where}: layout = {layout!r} is unknown; expected one of {', '.join(LAYOUTS)}")
-    if depth_format not in DEPTH_FORMATS:
-        raise OutputError(f"{where}: depth_format = {depth_format!r} is unknown; expected one of "
-                          f"{', '.join(DEPTH_FORMATS)}")  # fmt: skip
-    if executor not in EXECUTORS:
-        raise FrustumError(f"{where}: executor = {executor!r} is unknown; expected one of {', '.join(EXECUTORS)}")
-    if isinstance(retries, bool) or not isinstance(retries, int) or retries < 0:
-        raise FrustumError(f"{where}: retries = {describe(retries)} must be an integer >= 0")
-    scene_path = None
-    if isinstance(scene, SceneFile):
-        scene_file = scene
-        scene_path = scene.path
-    elif isinstance(scene, str | os.PathLike):
-        scene_path = Path(scene)
-        scene_file = load_scene_file(scene_path)  # a scene that does not load fails here, once
-    else:
-        raise FrustumError(f"{where}: scene = {describe(scene)} is not a scene file path or a SceneFile")
+    _check_choices(format, layout, depth_format, executor, retries, where)
+    scene_file, scene_path = _scene_file(scene, where)
     if size is not None:
         scene_file = scene_file.resized(tuple(size))
     base = scene_file.cameras[0]
@@ -529,7 +510,6 @@ def render_dataset(
     }
     if scene_file.up is not None:  # a mesh file: its up axis turns the model, so a resume must match it
         config["up"] = scene_file.up
-    manifest = out / _MANIFEST
     old_config, finished = _read_manifest(out)
     if old_config is not None and old_config != config and not overwrite:
         raise OutputError(
@@ -538,15 +518,7 @@ def render_dataset(
             + "); rerun with overwrite=True (--overwrite) to start again, or give another folder"
         )
     if overwrite and (old_config is not None or finished):
-        for entry in finished.values():
-            for relative in entry.get("files", {}).values():
-                with contextlib.suppress(OSError):
-                    (out / relative).unlink()
-        parts = _log_parts(out) if remote else []
-        for path in [*(out / name for name in _SHARED_FILES), *out.glob("shards/shard-*.tar"), *parts]:
-            with contextlib.suppress(OSError):
-                path.unlink()
-        manifest.unlink()
+        _start_over(out, finished, remote)
         old_config, finished = None, {}
     _remove_partial_files(out)
     kinds = dict(_SUFFIXES)
@@ -595,3 +567,43 @@ def render_dataset(
     written = [str(path) if remote else path for path in (*written, out / "README.txt")]  # URLs as strings
     return DatasetResult(str(out) if remote else out, tuple(sorted(rendered)), tuple(sorted(done)), failed,
                          tuple(written))  # fmt: skip
+
+
+def _check_choices(format: Any, layout: Any, depth_format: Any, executor: Any, retries: Any, where: str) -> None:
+    """``render_dataset``'s named choices and retry count checked (the message lists the valid names)."""
+    if format not in CAMERA_WRITERS:
+        raise OutputError(f"{where}: format = {format!r} is unknown; expected one of {', '.join(FORMATS)}")
+    if layout not in LAYOUTS:
+        raise CameraError(f"{where}: layout = {layout!r} is unknown; expected one of {', '.join(LAYOUTS)}")
+    if depth_format not in DEPTH_FORMATS:
+        raise OutputError(f"{where}: depth_format = {depth_format!r} is unknown; expected one of "
+                          f"{', '.join(DEPTH_FORMATS)}")  # fmt: skip
+    if executor not in EXECUTORS:
+        raise FrustumError(f"{where}: executor = {executor!r} is unknown; expected one of {', '.join(EXECUTORS)}")
+    if isinstance(retries, bool) or not isinstance(retries, int) or retries < 0:
+        raise FrustumError(f"{where}: retries = {describe(retries)} must be an integer >= 0")
+
+
+def _scene_file(scene: Any, where: str) -> tuple[Any, Path | None]:
+    """(the SceneFile, its path or None): `scene` as given, or loaded from its path (a scene that does not load
+    fails here, once)."""
+    from frustum.scenefile import SceneFile, load_scene_file
+
+    if isinstance(scene, SceneFile):
+        return scene, scene.path
+    if isinstance(scene, str | os.PathLike):
+        return load_scene_file(Path(scene)), Path(scene)
+    raise FrustumError(f"{where}: scene = {describe(scene)} is not a scene file path or a SceneFile")
+
+
+def _start_over(out: Any, finished: dict, remote: bool) -> None:
+    """``overwrite=True``: remove the files of the finished views, the shared files, the shards and the manifest."""
+    for entry in finished.values():
+        for relative in entry.get("files", {}).values():
+            with contextlib.suppress(OSError):
+                (out / relative).unlink()
+    parts = _log_parts(out) if remote else []
+    for path in [*(out / name for name in _SHARED_FILES), *out.glob("shards/shard-*.tar"), *parts]:
+        with contextlib.suppress(OSError):
+            path.unlink()
+    (out / _MANIFEST).unlink()

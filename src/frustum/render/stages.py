@@ -17,6 +17,7 @@ from frustum.raster._jit import threads
 from frustum.raster.vertices import project_vertices, transform_normals, world_points
 from frustum.render import bumps, reflection
 from frustum.render.buffers import Scratch
+from frustum.render.context import FrameContext
 from frustum.render.options import RenderOptions
 from frustum.scene import Scene, SceneItem
 from frustum.shading import pack_lights
@@ -420,3 +421,25 @@ def code_type(items: list[SceneItem]) -> type:
 def face_offsets(items: list[SceneItem]) -> list[int]:
     """Each item's first face code: the face counts of the items before it, summed."""
     return [int(n) for n in np.cumsum([0] + [item.mesh.face_count for item in items])[:-1]]
+
+
+def draw_transparent(scene: Scene, items: list[SceneItem], camera: Camera, options: RenderOptions,
+                     context: FrameContext) -> None:  # fmt: skip
+    """Stage 6: the transparent items of `items` back to front by the view distance of their centres, each
+    rasterized alone against a copy of the finished depth buffer and blended over ``context.color``."""
+    clear_items = [i for i, item in enumerate(items) if item.material.opacity < 1.0]
+    if not clear_items:
+        return
+    height, width = camera.height, camera.width
+    codes_dtype = code_type(items)
+    lighting = Lighting.of(scene)
+    offsets = face_offsets(items)
+    extra = context.extra()
+    bary = context.scratch.empty((height, width, 2), np.float32)
+    for index in back_to_front(items, clear_items, camera):
+        item = items[index]
+        layer = Pixels(context.depth.copy(), np.full((height, width), -1, dtype=codes_dtype), bary, context.color,
+                       extra)  # fmt: skip
+        world, normals, band = draw_item(item, camera, options.cull, offsets[index], layer, context.scratch)
+        shade_item(item, index, offsets[index], camera, options, lighting, (world, normals), layer, band,
+                   blend=True)  # fmt: skip

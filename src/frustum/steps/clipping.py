@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from frustum import clipping
+from frustum.clipping.codes import point4
 from frustum.errors import ClippingError
 from frustum.steps._draw import PLANE_NAMES, bounds_of, cartesian, draw_cube, oblique
 from frustum.steps._record import Step, Steps, _Canvas, format_value
@@ -28,7 +29,7 @@ def _homogeneous(value: ArrayLike, name: str, where: str) -> NDArray[np.float64]
     array = np.asarray(value, dtype=float) if np.ndim(value) else None
     if array is not None and array.shape == (3,):
         return np.append(array, 1.0)
-    return clipping._point4(value, name, where)
+    return point4(value, name, where)
 
 
 def _polygon(value: ArrayLike, where: str) -> NDArray[np.float64]:
