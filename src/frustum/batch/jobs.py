@@ -17,12 +17,14 @@ Output kinds (``RenderJob.outputs`` keys):
 | ``normals`` | ``.npy`` | float32 (H, W, 3) unit world normals, 0 on background |
 | ``object_id`` | ``.png`` | uint16 index of the scene item + 1, 0 on background |
 | ``mask`` | ``.png`` | uint8 255 where a surface was drawn, 0 on background |
+| ``rgb`` | ``.png`` | RGB 8-bit (the color without alpha: COCO and BOP images) |
+| ``annotations`` | ``.json`` | ``frustum.batch.coco.view_annotations``: per-item boxes, pose, masks as RLE |
 """
 
 from __future__ import annotations
 
-import contextlib
 import io
+import json
 import os
 import time
 from collections.abc import Mapping
@@ -33,7 +35,7 @@ from typing import Any
 import numpy as np
 
 from frustum._arrays import describe
-from frustum.batch.storage import TEMPORARY_MARK, RemotePath, is_url
+from frustum.batch.storage import is_url, write_atomically
 from frustum.errors import FrustumError, OutputError
 
 __all__ = ["OUTPUT_KINDS", "RenderJob", "ViewResult", "encode_view", "render_view", "write_atomically", "write_view"]
@@ -46,6 +48,8 @@ OUTPUT_KINDS = {
     "mask": (".png",),
     "position": (".npy",),
     "shadow": (".npy",),
+    "rgb": (".png",),
+    "annotations": (".json",),
 }
 """Output kinds a job may ask for, with the file suffixes each accepts."""
 _MAX_UINT16 = 65535
@@ -74,6 +78,8 @@ class RenderJob:
         the outputs.
     depth_scale : float
         World units per step of a 16-bit depth PNG (only for a ``depth`` output ending in ``.png``).
+    keypoints : None or as ``frustum.annotate``'s
+        Model keypoints for an ``annotations`` output.
     """
 
     key: str
@@ -82,6 +88,7 @@ class RenderJob:
     outputs: Mapping[str, Any] = field(default_factory=dict)
     options: Mapping[str, Any] = field(default_factory=dict)
     depth_scale: float = 1e-3
+    keypoints: Any = None
 
 
 @dataclass(frozen=True)
@@ -126,31 +133,6 @@ def check_job(job: Any, index: int, where: str) -> None:
         raise FrustumError(f"{where}: jobs[{index}].depth_scale = {describe(job.depth_scale)} must be a number > 0")
 
 
-def write_atomically(path: str | os.PathLike, write: Any) -> None:
-    """Call ``write(file)`` on a temporary file beside `path`, then rename it to `path`.
-
-    Readers never see a partly written `path`: it appears whole or not at all (``os.replace`` is atomic on
-    one file system). On any exception, Ctrl-C included, the temporary file is removed. A URL (a string with
-    ``scheme://`` or a ``RemotePath``) is written through fsspec, whole or not at all (``RemotePath.write_bytes``).
-    """
-    if is_url(path):
-        buffer = io.BytesIO()
-        write(buffer)
-        (path if isinstance(path, RemotePath) else RemotePath(path)).write_bytes(buffer.getbuffer())
-        return
-    target = Path(path)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    temporary = target.with_name(f".{target.name}{TEMPORARY_MARK}{os.getpid()}")
-    try:
-        with open(temporary, "wb") as file:
-            write(file)
-        os.replace(temporary, target)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.remove(temporary)
-        raise
-
-
 def _png_writer(array: np.ndarray) -> Any:
     from PIL import Image
 
@@ -169,6 +151,8 @@ def _encoded(kind: str, suffix: str, frame: Any, camera: Any, depth_scale: float
     drawn = frame.depth < 1.0
     if kind == "color":
         return _png_writer(frame.color)
+    if kind == "rgb":
+        return _png_writer(frame.color[..., :3])
     if kind == "depth":
         depth = metric_depth(frame.depth, camera)
         if suffix == ".npy":
@@ -215,6 +199,8 @@ def encode_view(
     render_seconds = 0.0
     try:
         buffers = tuple(b for b in ("normals", "object_id", "position", "shadow") if b in job.outputs)
+        if "annotations" in job.outputs:
+            buffers += ("instance", "amodal")
         merged = {**(options or {}), **job.options, "buffers": buffers}
         frame = render(scene, job.camera, **merged)
         render_seconds = time.perf_counter() - start
@@ -224,12 +210,23 @@ def encode_view(
         for kind, path in job.outputs.items():
             suffix = Path(str(path)).suffix.lower()
             buffer = io.BytesIO()
-            _encoded(kind, suffix, frame, job.camera, job.depth_scale)(buffer)
+            if kind == "annotations":
+                from frustum.batch.coco import view_annotations
+
+                record = view_annotations(frame, _scene_of(scene), job.camera, job.keypoints)
+                buffer.write((json.dumps(record) + "\n").encode("utf-8"))
+            else:
+                _encoded(kind, suffix, frame, job.camera, job.depth_scale)(buffer)
             encoded[kind] = buffer.getvalue()
             files[kind] = _path_text(path)
         return ViewResult(job.key, files, None, render_seconds, time.perf_counter() - encoding, worker), encoded
     except Exception as error:  # every failure of one view is reported with the view, not raised
         return _failed(job, error, render_seconds, worker), {}
+
+
+def _scene_of(scene: Any) -> Any:
+    """The Scene of a worker's scene (a loaded scene file holds one)."""
+    return getattr(scene, "scene", scene)
 
 
 def _failed(job: RenderJob, error: Exception, render_seconds: float, worker: str) -> ViewResult:
