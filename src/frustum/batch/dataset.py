@@ -44,9 +44,9 @@ from frustum.batch.bop import BOP_SCENE, bop_models, bop_paths
 from frustum.batch.cameras import camera_record
 from frustum.batch.executors import EXECUTORS, render_many
 from frustum.batch.formats import CAMERA_WRITERS, SHARD_SIZE, check_format_camera
-from frustum.batch.jobs import TEMPORARY_MARK, RenderJob, write_atomically
+from frustum.batch.jobs import RenderJob
 from frustum.batch.progress import ViewProgress
-from frustum.batch.storage import RemotePath, to_location
+from frustum.batch.storage import TEMPORARY_MARK, RemotePath, to_location, write_atomically
 from frustum.camera import Camera
 from frustum.errors import CameraError, FrustumError, OutputError
 from frustum.scene import Scene

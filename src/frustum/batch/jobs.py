@@ -35,6 +35,7 @@ from typing import Any
 import numpy as np
 
 from frustum._arrays import describe
+from frustum.batch.storage import TEMPORARY_MARK as TEMPORARY_MARK
 from frustum.batch.storage import is_url, write_atomically
 from frustum.errors import FrustumError, OutputError
 
