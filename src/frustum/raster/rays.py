@@ -866,8 +866,9 @@ def _closest4(wide_boxes, wide_links, triangles, order, skip, ox, oy, oz, dx, dy
 
 @kernel
 def _any4(wide_boxes, wide_links, triangles, ox, oy, oz, dx, dy, dz, t_min, t_max, stack, near):
-    """``_any`` on the wide tree: whether one ray meets a triangle at t in [t_min, t_max); the children met
-    pushed in their order, the traversal stops at the first triangle found."""
+    """``_any`` on the wide tree: whether one ray meets a triangle at t in [t_min, t_max): the inner children
+    met are pushed in their order, the leaves met tested at once; the traversal stops at the first triangle
+    found."""
     ix = 1.0 / dx if dx != 0.0 else np.inf
     iy = 1.0 / dy if dy != 0.0 else np.inf
     iz = 1.0 / dz if dz != 0.0 else np.inf
@@ -881,15 +882,17 @@ def _any4(wide_boxes, wide_links, triangles, ox, oy, oz, dx, dy, dz, t_min, t_ma
             _slab4(wide_boxes, node, nx, ny, nz, ox, oy, oz, ix, iy, iz, t_min, t_max, near)
             for c in range(WIDTH):
                 if near[c] < np.inf:
-                    stack[top] = wide_links[node, c]
-                    top += 1
-        else:
-            code = ~node
-            first = code >> 3
-            for row in range(first, first + (code & 7)):
-                t, _, _, det = _triangle(triangles, row, ox, oy, oz, dx, dy, dz)
-                if det != 0.0 and t >= t_min and t < t_max:
-                    return True
+                    child = wide_links[node, c]
+                    if child >= 0:
+                        stack[top] = child
+                        top += 1
+                        continue
+                    code = ~child  # a leaf: its triangles now, not pushed
+                    first = code >> 3
+                    for row in range(first, first + (code & 7)):
+                        t, _, _, det = _triangle(triangles, row, ox, oy, oz, dx, dy, dz)
+                        if det != 0.0 and t >= t_min and t < t_max:
+                            return True
         if top == 0:
             return False
         top -= 1
