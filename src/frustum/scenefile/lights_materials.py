@@ -2,14 +2,13 @@
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from frustum.budgets import format_bytes, get_budget
 from frustum.errors import FrustumError
-from frustum.scenefile.checks import _call, _choice, _table, _table_list, _unknown_keys
+from frustum.scenefile.checks import _call, _choice, _input_file, _table, _table_list, _unknown_keys
 from frustum.scenefile.report import _BAD, _Report
 from frustum.shading import AmbientLight, DirectionalLight, Material, PointLight, SpotLight
 from frustum.shading.environment import ENVIRONMENT_KINDS, EnvironmentMap
@@ -37,13 +36,8 @@ def _image(report: _Report, path: tuple, value: Any) -> Any:
     """The image file `value` names (relative to the scene file's folder) as an (H, W, 3|4) uint8 array."""
     from PIL import Image
 
-    if not isinstance(value, str) or not value:
-        report.add(path, value, "is not a file name", "give the path of a PNG or JPEG image, relative to the file")
-        return _BAD
-    file = Path(getattr(report, "base", ".")) / value
-    if not file.is_file():
-        problem = "does not exist" if not file.exists() else "is not a regular file"
-        report.add(path, value, problem, f"give an image file (looked for {str(file)!r})")
+    file = _input_file(report, path, value, what="a PNG or JPEG image")
+    if file is _BAD:
         return _BAD
     try:
         with Image.open(file) as image:
@@ -72,9 +66,8 @@ def _environment(report: _Report, path: tuple, value: Any) -> Any:
         return _BAD
     kind = _choice(report, (*path, "kind"), params.get("kind", "equirect"), ENVIRONMENT_KINDS)
     image = params["image"]
-    file = Path(getattr(report, "base", ".")) / image if isinstance(image, str) else None
-    if file is None or not file.is_file():
-        report.add((*path, "image"), image, "is not an image file", "give the path of an image, relative to the file")
+    file = _input_file(report, (*path, "image"), image, what="an image of the surroundings")
+    if file is _BAD:
         return _BAD
     if kind is _BAD:
         return _BAD

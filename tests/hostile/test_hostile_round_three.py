@@ -1,0 +1,241 @@
+"""Hostile input, round three (issue 52): one test per finding, each failing on the main of before the fix.
+
+1 a dataset resume that deleted files outside its folder; 2 a quadratic pattern in the scene-file check;
+3 a damaged run log taken for a torn line; 4 budgets of ``frustum steps`` and radiosity's tolerance; 5 scene
+files that read inputs from anywhere; 6 glTF counts and buffer views, 7 unreadable MTL textures, 8 ffmpeg and
+image sizes; 9 Ray tests that joined a cluster found on the machine."""
+
+from __future__ import annotations
+
+import json
+import os
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from frustum.batch import render_dataset
+from frustum.errors import OutputError, SceneFileError
+from frustum.scenefile import load_scene, load_scene_file
+
+SCENE = """
+title = "round three"
+[render]
+size = [32, 24]
+[camera]
+eye = [0.3, 1.0, 4.0]
+target = [0.0, 0.0, 0.0]
+fovy_deg = 45
+near = 1.0
+far = 10.0
+[[lights]]
+type = "directional"
+direction = [-0.5, -1.0, -0.6]
+[[nodes]]
+name = "ball"
+geometry = { type = "icosphere", subdivisions = 1 }
+"""
+
+
+@pytest.fixture
+def dataset(tmp_path: Path) -> tuple[Path, Path]:
+    """A finished 3-view dataset of a small scene: (scene file, output folder)."""
+    scene = tmp_path / "scene.toml"
+    scene.write_text(SCENE)
+    out = tmp_path / "out"
+    result = render_dataset(scene, out, views=3, format="files", executor="serial", progress=False)
+    assert result.ok and len(result.rendered) == 3
+    return scene, out
+
+
+def _append(manifest: Path, entry: object) -> None:
+    with open(manifest, "a", encoding="utf-8") as file:
+        file.write(json.dumps(entry) + "\n")
+
+
+# --- 1. a resume never deletes or writes outside the output folder ----------------------------------------------
+
+
+@pytest.mark.parametrize("forged", ["absolute", "parent"])
+def test_overwrite_never_deletes_a_file_a_forged_manifest_names_outside_the_folder(dataset, tmp_path, forged):
+    scene, out = dataset
+    victim = tmp_path / "victim.txt"
+    victim.write_text("keep me")
+    relative = str(victim) if forged == "absolute" else "../victim.txt"
+    _append(out / "manifest.jsonl", {"view": "evil", "files": {"color": relative}})
+    with pytest.raises(OutputError, match=r"manifest\.jsonl, line 5: the path .* is not a file of this dataset"):
+        render_dataset(scene, out, views=3, format="files", executor="serial", progress=False, overwrite=True)
+    assert victim.read_text() == "keep me"
+
+
+def test_a_manifest_path_through_a_symlinked_folder_is_refused(dataset, tmp_path):
+    scene, out = dataset
+    outside = tmp_path / "outside"
+    outside.mkdir()
+    (outside / "victim.png").write_text("keep me")
+    (out / "images").rename(tmp_path / "images_moved")
+    (out / "images").symlink_to(outside, target_is_directory=True)
+    with pytest.raises(OutputError, match="leads outside .* through a symbolic link"):
+        render_dataset(scene, out, views=3, format="files", executor="serial", progress=False, overwrite=True)
+    assert (outside / "victim.png").read_text() == "keep me"
+
+
+def test_a_manifest_that_is_a_symlink_is_never_written_through(dataset, tmp_path):
+    scene, out = dataset
+    target = tmp_path / "elsewhere.txt"
+    target.write_text("")
+    (out / "manifest.jsonl").unlink()
+    (out / "manifest.jsonl").symlink_to(target)
+    with pytest.raises(OutputError, match="is a symbolic link"):
+        render_dataset(scene, out, views=3, format="files", executor="serial", progress=False)
+    assert target.read_text() == ""
+
+
+# --- 3. a damaged run log is refused, naming the file and the line ------------------------------------------------
+
+
+def test_a_changed_byte_in_the_config_line_is_not_taken_for_a_torn_line(dataset):
+    scene, out = dataset
+    manifest = out / "manifest.jsonl"
+    lines = manifest.read_text().splitlines(keepends=True)
+    lines[0] = lines[0].replace('"size"', '"si#e"', 1) if '"size"' in lines[0] else "x" + lines[0]
+    lines[0] = lines[0].replace("{", "{{", 1)  # no longer JSON, but it ends with a newline: not torn
+    manifest.write_text("".join(lines))
+    with pytest.raises(OutputError, match=r"manifest\.jsonl, line 1: not a JSON line"):
+        render_dataset(scene, out, views=3, size=(64, 48), format="files", executor="serial", progress=False)
+
+
+def test_a_resume_with_another_size_names_the_difference(dataset):
+    scene, out = dataset
+    with pytest.raises(OutputError, match=r"size = \[32, 24\] → \[64, 48\]"):
+        render_dataset(scene, out, views=3, size=(64, 48), format="files", executor="serial", progress=False)
+
+
+@pytest.mark.parametrize("line", ["5", '{"view": [1]}', '{"view": "a", "files": {"color": 3}}', "[]"])
+def test_a_manifest_line_of_the_wrong_shape_names_the_file_and_line(dataset, line):
+    scene, out = dataset
+    with open(out / "manifest.jsonl", "a", encoding="utf-8") as file:
+        file.write(line + "\n")
+    with pytest.raises(OutputError, match=r"manifest\.jsonl, line 5: expected a configuration line or a view line"):
+        render_dataset(scene, out, views=3, format="files", executor="serial", progress=False)
+
+
+def test_a_torn_last_line_is_still_ignored(dataset):
+    scene, out = dataset
+    with open(out / "manifest.jsonl", "a", encoding="utf-8") as file:
+        file.write('{"view": "0003", "fi')  # a run killed in the middle of a line: no newline after it
+    result = render_dataset(scene, out, views=3, format="files", executor="serial", progress=False)
+    assert result.ok and len(result.skipped) == 3
+
+
+# --- 2. the scene-file check is linear ----------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("text", [
+    "a" * 1_000_000 + " = 1\n",
+    "x = " + "1" * 1_000_000 + "\n",
+    'x = "' + "a" * 1_000_000 + '"\n',
+    "x" + " " * 1_000_000 + "= 1\n",
+    "[" + "a" * 1_000_000 + "]\n",
+])  # fmt: skip
+def test_a_megabyte_key_or_value_is_checked_in_under_a_second(text):
+    start = time.perf_counter()
+    with pytest.raises(SceneFileError):
+        load_scene(text)
+    assert time.perf_counter() - start < 1.0
+
+
+def test_a_number_of_40000_digits_is_a_scene_file_error():
+    with pytest.raises(SceneFileError, match="a number in the text is too long to read"):
+        load_scene("[render]\nsamples = " + "1" * 40_000 + "\n")
+
+
+def test_a_dotted_key_deeper_than_the_nesting_limit_is_still_refused():
+    with pytest.raises(SceneFileError, match="a dotted key has more than 64 parts"):
+        load_scene(" . ".join(["a"] * 100) + " = 1\n")
+    with pytest.raises(SceneFileError, match="is not a known key"):  # 64 parts are fine for the shape check
+        load_scene(".".join(["a"] * 64) + " = 1\n")
+
+
+# --- 5. inputs are confined like outputs --------------------------------------------------------------------------
+
+_MESH_SCENE = """
+[camera]
+eye = [0.0, 0.0, 4.0]
+target = [0.0, 0.0, 0.0]
+[[nodes]]
+geometry = {{ type = "mesh", path = "{path}" }}
+"""
+_ENVIRONMENT_SCENE = """
+[camera]
+eye = [0.0, 0.0, 4.0]
+target = [0.0, 0.0, 0.0]
+[environment]
+image = "{path}"
+"""
+_TEXTURE_SCENE = """
+[camera]
+eye = [0.0, 0.0, 4.0]
+target = [0.0, 0.0, 0.0]
+[materials.m]
+texture = "{path}"
+[[nodes]]
+geometry = {{ type = "box" }}
+material = "m"
+"""
+
+
+def _outside_files(tmp_path: Path) -> dict[str, Path]:
+    from PIL import Image
+
+    secret = tmp_path / "secret"
+    secret.mkdir()
+    (secret / "mesh.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    Image.fromarray(np.full((8, 16, 3), 200, np.uint8)).save(secret / "image.png")
+    return {"mesh": secret / "mesh.obj", "environment": secret / "image.png", "texture": secret / "image.png"}
+
+
+@pytest.mark.parametrize("kind", ["mesh", "environment", "texture"])
+@pytest.mark.parametrize("how", ["parent", "absolute", "symlink"])
+def test_a_scene_file_reads_no_input_outside_its_folder(tmp_path, kind, how):
+    files = _outside_files(tmp_path)
+    folder = tmp_path / "scene"
+    folder.mkdir()
+    target = files[kind]
+    if how == "parent":
+        path = f"../secret/{target.name}"
+    elif how == "absolute":
+        path = str(target)
+    else:
+        (folder / "link").symlink_to(target.parent, target_is_directory=True)
+        path = f"link/{target.name}"
+    template = {"mesh": _MESH_SCENE, "environment": _ENVIRONMENT_SCENE, "texture": _TEXTURE_SCENE}[kind]
+    (folder / "scene.toml").write_text(template.format(path=path))
+    with pytest.raises(SceneFileError, match="lies outside the scene file's folder"):
+        load_scene_file(folder / "scene.toml")
+    # the user may allow a folder: then it loads
+    assert load_scene_file(folder / "scene.toml", allow_read=[target.parent]).scene is not None
+
+
+def test_inputs_inside_the_folder_still_load(tmp_path):
+    folder = tmp_path / "scene"
+    (folder / "models").mkdir(parents=True)
+    (folder / "models" / "mesh.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    (folder / "scene.toml").write_text(_MESH_SCENE.format(path="models/mesh.obj"))
+    assert len(load_scene_file(folder / "scene.toml").scene.items) == 1
+
+
+def test_allow_read_that_is_not_a_path_is_refused(tmp_path):
+    with pytest.raises(SceneFileError, match="allow_read = 3 is not a folder path"):
+        load_scene("[camera]\neye = [0, 0, 4]\n", allow_read=[3])
+
+
+@pytest.mark.skipif(os.name != "posix", reason="symbolic links")
+def test_the_dataset_executor_loads_with_the_same_rule(tmp_path):
+    files = _outside_files(tmp_path)
+    folder = tmp_path / "scene"
+    folder.mkdir()
+    (folder / "scene.toml").write_text(_MESH_SCENE.format(path=str(files["mesh"])))
+    with pytest.raises(SceneFileError, match="lies outside the scene file's folder"):
+        render_dataset(folder / "scene.toml", tmp_path / "out", views=1, executor="serial", progress=False)
