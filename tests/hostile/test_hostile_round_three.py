@@ -76,7 +76,7 @@ def test_a_manifest_path_through_a_symlinked_folder_is_refused(dataset, tmp_path
     (outside / "victim.png").write_text("keep me")
     (out / "images").rename(tmp_path / "images_moved")
     (out / "images").symlink_to(outside, target_is_directory=True)
-    with pytest.raises(OutputError, match="leads outside .* through a symbolic link"):
+    with pytest.raises(OutputError, match=r"leads outside .* through a symbolic link"):
         render_dataset(scene, out, views=3, format="files", executor="serial", progress=False, overwrite=True)
     assert (outside / "victim.png").read_text() == "keep me"
 

@@ -264,8 +264,9 @@ def _check_inside(out: Any, relative: str, where: str) -> None:
     parts = relative.replace("\\", "/").split("/")
     if (relative.startswith(("/", "\\")) or ".." in parts or ":" in parts[0] or len(parts) < 2
             or parts[0] not in _FOLDERS.values()):  # fmt: skip
-        raise OutputError(f"{where}: the path {relative!r} is not a file of this dataset's folders "
-                          f"({', '.join(sorted(set(_FOLDERS.values())))}); the run log is damaged or forged")  # fmt: skip
+        folders = ", ".join(sorted(set(_FOLDERS.values())))
+        raise OutputError(f"{where}: the path {relative!r} is not a file of this dataset's folders ({folders}); "
+                          "the run log is damaged or forged")  # fmt: skip
     if not isinstance(out, RemotePath):
         root = Path(out).resolve()
         if not Path(out, relative).resolve().is_relative_to(root):
