@@ -239,3 +239,86 @@ def test_the_dataset_executor_loads_with_the_same_rule(tmp_path):
     (folder / "scene.toml").write_text(_MESH_SCENE.format(path=str(files["mesh"])))
     with pytest.raises(SceneFileError, match="lies outside the scene file's folder"):
         render_dataset(folder / "scene.toml", tmp_path / "out", views=1, executor="serial", progress=False)
+
+
+# --- 9. the Ray tests start a cluster of their own ----------------------------------------------------------------
+
+
+def test_the_ray_tests_never_join_a_cluster_found_on_the_machine(tmp_path):
+    """With RAY_ADDRESS naming a cluster that is not there (as a stale ``ray_current_cluster`` file would), the
+    suite's Ray test still starts its own local instance and passes."""
+    import subprocess
+    import sys
+
+    pytest.importorskip("ray")
+    tests = Path(__file__).resolve().parents[1]
+    env = {**os.environ, "RAY_ADDRESS": "127.0.0.1:9", "RAY_USAGE_STATS_ENABLED": "0"}
+    process = subprocess.run(
+        [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "--rootdir", str(tests.parent),
+         f"{tests / 'test_batch.py'}::test_ray_executor_writes_the_same_bytes"],
+        env=env, cwd=tmp_path, capture_output=True, text=True, timeout=600,
+    )  # fmt: skip
+    assert process.returncode == 0, process.stdout[-3000:] + process.stderr[-2000:]
+
+
+# --- 4. budgets of every `frustum steps` algorithm, in log space and within 2x of the cost -------------------------
+
+
+def _zigzag(count: int) -> str:
+    return ";".join(f"{4 * k / count:.4f},{(k % 3) * 0.5:.4f}" for k in range(count))
+
+
+def _ring(count: int) -> str:
+    angles = np.linspace(0.0, 2 * np.pi, count, endpoint=False)
+    return ";".join(f"{1.5 * np.cos(a):.4f},{1.5 * np.sin(a):.4f},{0.3 * np.sin(3 * a):.4f}" for a in angles)
+
+
+# (algorithm, options) of a small and a medium recording of every algorithm whose size the user sets; the others
+# record a fixed worked example (or one pixel's story) and have nothing to budget
+_SIZED = [
+    ("koch", {"level": "5"}), ("koch", {"level": "7"}),
+    ("midpoint-displacement", {"level": "10"}), ("midpoint-displacement", {"level": "13"}),
+    ("de-casteljau", {"points": _zigzag(12)}), ("de-casteljau", {"points": _zigzag(40)}),
+    ("sutherland-hodgman", {"points": _ring(100)}), ("sutherland-hodgman", {"points": _ring(2000)}),
+]  # fmt: skip
+
+
+@pytest.mark.parametrize(("algorithm", "options"), _SIZED, ids=[f"{a}-{i % 2}" for i, (a, _) in enumerate(_SIZED)])
+def test_a_steps_budget_estimate_is_within_2x_of_the_measured_peak(algorithm, options, monkeypatch):
+    import tracemalloc
+
+    from frustum.budgets import budget
+    from frustum.steps import _record
+    from frustum.steps.catalog import build
+
+    estimates = []
+    monkeypatch.setattr(_record, "check_memory", lambda nbytes, **_: estimates.append(nbytes))
+    build(algorithm, options).sheet()  # warm: lazy imports and caches are not the recording's cost
+    estimates.clear()
+    tracemalloc.start()
+    try:
+        build(algorithm, options).sheet()
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert len(estimates) == 1
+    assert 0.5 <= estimates[0] / peak <= 2.0, (estimates[0], peak)
+    monkeypatch.undo()
+    with budget(bytes=int(estimates[0] * 0.9)), pytest.raises(OutputError, match="over the memory budget"):
+        build(algorithm, options)
+
+
+@pytest.mark.parametrize(("algorithm", "option", "value"), [
+    ("koch", "level", "512"), ("koch", "level", "13"), ("midpoint-displacement", "level", "100000"),
+    ("de-casteljau", "points", _zigzag(1000)),
+])  # fmt: skip
+def test_a_huge_steps_request_is_refused_by_the_budget_in_one_line(tmp_path, algorithm, option, value):
+    import subprocess
+    import sys
+
+    start = time.perf_counter()
+    process = subprocess.run([sys.executable, "-m", "frustum", "steps", algorithm, f"--{option}", value, "-o",
+                              str(tmp_path / "x.svg")], capture_output=True, text=True, timeout=120)  # fmt: skip
+    assert process.returncode == 1 and "Traceback" not in process.stderr
+    assert "over the memory budget" in process.stderr and len(process.stderr.strip().splitlines()) == 1
+    assert time.perf_counter() - start < 60 and not (tmp_path / "x.svg").exists()
