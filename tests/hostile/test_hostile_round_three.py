@@ -322,3 +322,120 @@ def test_a_huge_steps_request_is_refused_by_the_budget_in_one_line(tmp_path, alg
     assert process.returncode == 1 and "Traceback" not in process.stderr
     assert "over the memory budget" in process.stderr and len(process.stderr.strip().splitlines()) == 1
     assert time.perf_counter() - start < 60 and not (tmp_path / "x.svg").exists()
+
+
+# --- 6. glTF counts, views and buffers -------------------------------------------------------------------------
+
+
+def _glb(path: Path, *, count: int = 3, view_length: int = 36, uri: str | None = None) -> Path:
+    """A GLB of one triangle: accessor 0 the positions, accessor 1 the indices (counts and lengths forgeable)."""
+    import struct
+
+    blob = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32).tobytes() + np.array([0, 1, 2, 0], np.uint16).tobytes()
+    gltf = {
+        "asset": {"version": "2.0"},
+        "buffers": [{"byteLength": len(blob)} if uri is None else {"byteLength": len(blob), "uri": uri}],
+        "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": view_length},
+                        {"buffer": 0, "byteOffset": 36, "byteLength": 6}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                       "min": [0, 0, 0], "max": [1, 1, 0]},
+                      {"bufferView": 1, "componentType": 5123, "count": count, "type": "SCALAR"}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+        "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}], "scene": 0,
+    }  # fmt: skip
+    text = json.dumps(gltf).encode()
+    text += b" " * (-len(text) % 4)
+    chunks = struct.pack("<I4s", len(text), b"JSON") + text
+    if uri is None:
+        chunks += struct.pack("<I4s", len(blob), b"BIN\x00") + blob
+    path.write_bytes(struct.pack("<4sII", b"glTF", 2, 12 + len(chunks)) + chunks)
+    return path
+
+
+def test_a_negative_gltf_count_is_refused_naming_the_accessor(tmp_path):
+    from frustum.errors import GeometryError
+    from frustum.geometry.io import load
+
+    assert load(_glb(tmp_path / "ok.glb")).face_count == 1
+    with pytest.raises(GeometryError, match=r"accessor 1 has count = -5, not an integer >= 1; the file is corrupt"):
+        load(_glb(tmp_path / "negative.glb", count=-5))
+    with pytest.raises(GeometryError, match=r"accessor 1 reads bytes 0…8 of bufferView 1, which holds 6"):
+        load(_glb(tmp_path / "long.glb", count=4))
+
+
+def test_a_buffer_view_past_the_bin_chunk_names_its_byte_offsets(tmp_path):
+    from frustum.errors import GeometryError
+    from frustum.geometry.io import load
+
+    with pytest.raises(GeometryError, match=r"bufferView 0 spans bytes 0…4000 of buffer 0, which holds 44 bytes "
+                                            r"\(the BIN chunk at byte \d+ of the file\)"):  # fmt: skip
+        load(_glb(tmp_path / "past.glb", view_length=4000))
+
+
+def test_a_gltf_buffer_outside_the_folder_is_named_as_such(tmp_path):
+    from frustum.errors import GeometryError
+    from frustum.geometry.io import load
+
+    (tmp_path / "model").mkdir()
+    with pytest.raises(GeometryError, match=r"buffer 0 names '\.\./data\.bin', outside the glTF file's folder"):
+        load(_glb(tmp_path / "model" / "outside.glb", uri="../data.bin"))
+
+
+# --- 7. unreadable MTL textures are named ------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(("texture", "problem"), [
+    ("missing.png", "does not exist"), ("../outside.png", "lies outside the model's folder"),
+    ("folder", "is not a regular file"),
+])  # fmt: skip
+def test_an_unreadable_mtl_texture_is_a_warning_naming_it(tmp_path, texture, problem):
+    from PIL import Image
+
+    from frustum.errors import FrustumWarning
+    from frustum.geometry.io import load_parts
+
+    model = tmp_path / "model"
+    (model / "folder").mkdir(parents=True)
+    Image.fromarray(np.zeros((4, 4, 3), np.uint8)).save(tmp_path / "outside.png")
+    (model / "m.mtl").write_text(f"newmtl a\nKd 1 0 0\nmap_Kd {texture}\n")
+    (model / "m.obj").write_text("mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl a\n"
+                                 "f 1/1 2/2 3/3\n")  # fmt: skip
+    with pytest.warns(FrustumWarning, match=rf"m\.mtl \(map_Kd\) names the texture {texture.split('/')[-1]!r}"
+                                            rf"|names the texture '{texture}', which {problem}"):  # fmt: skip
+        parts = load_parts(model / "m.obj")
+    assert parts[0].texture is None
+
+
+# --- 8. ffmpeg's own failure and images under the budget ---------------------------------------------------------
+
+
+def test_a_missing_ffmpeg_program_is_named_not_the_folder(tmp_path, monkeypatch):
+    pytest.importorskip("imageio_ffmpeg")
+    from frustum.output.animation import write_animation
+
+    monkeypatch.setenv("IMAGEIO_FFMPEG_EXE", "/nonexistent/ffmpeg")
+    frames = [np.zeros((8, 8, 3), np.uint8)] * 2
+    with pytest.raises(OutputError, match=r"the ffmpeg program '/nonexistent/ffmpeg' \(IMAGEIO_FFMPEG_EXE\) is not "
+                                          "an executable file"):  # fmt: skip
+        write_animation(frames, tmp_path / "a.mp4", fps=2)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_texture_over_the_budget_is_refused_before_decoding_without_pillows_warning(tmp_path, monkeypatch):
+    import warnings
+
+    from PIL import Image
+
+    from frustum.budgets import budget
+    from frustum.errors import GeometryError
+    from frustum.geometry.io import load_parts
+
+    Image.fromarray(np.full((600, 800, 3), 90, np.uint8)).save(tmp_path / "big.png")
+    (tmp_path / "m.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n")
+    monkeypatch.setattr(Image, "MAX_IMAGE_PIXELS", 300_000)  # Pillow would warn at 480,000 pixels now
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with budget(bytes=800 * 600 * 10), pytest.raises(GeometryError, match=r"\(800 x 600 pixels\) needs about"):
+            load_parts(tmp_path / "m.obj", texture=tmp_path / "big.png")
+        parts = load_parts(tmp_path / "m.obj", texture=tmp_path / "big.png")  # within the default budget
+    assert parts[0].texture.shape == (600, 800, 3)
