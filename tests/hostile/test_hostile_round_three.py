@@ -331,7 +331,8 @@ def _glb(path: Path, *, count: int = 3, view_length: int = 36, uri: str | None =
     """A GLB of one triangle: accessor 0 the positions, accessor 1 the indices (counts and lengths forgeable)."""
     import struct
 
-    blob = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32).tobytes() + np.array([0, 1, 2, 0], np.uint16).tobytes()
+    points = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32)
+    blob = points.tobytes() + np.array([0, 1, 2, 0], np.uint16).tobytes()
     gltf = {
         "asset": {"version": "2.0"},
         "buffers": [{"byteLength": len(blob)} if uri is None else {"byteLength": len(blob), "uri": uri}],
