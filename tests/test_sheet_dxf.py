@@ -200,7 +200,7 @@ def test_dxf_is_deterministic(tmp_path):
 
 
 def test_view_command_writes_dxf_and_reads_the_sheet_table(tmp_path):
-    from frustum.cli import main
+    from frustum.app.cli import main
 
     dxf, svg = tmp_path / "sheet.dxf", tmp_path / "sheet.svg"
     arguments = ["view", str(EXAMPLES / "exploded_assembly.toml")]

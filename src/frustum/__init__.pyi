@@ -401,6 +401,6 @@ from .visibility import (
 from .visibility.octree import (
     render_octree as render_octree,
 )
-from .warmup import (
+from .app.warmup import (
     warmup as warmup,
 )
