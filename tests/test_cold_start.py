@@ -66,7 +66,9 @@ NOT_ON_THE_RENDER_PATH = (
     "frustum.visibility.bsp", "frustum.geometry.csg", "frustum.geometry.dimension", "frustum.geometry.escape_time",
     "frustum.geometry.fractals", "frustum.geometry.io", "frustum.geometry.lsystem", "frustum.geometry.octree",
     "frustum.geometry.volume", "frustum.output.sheet", "frustum.output.svg", "frustum.simulation", "frustum.stereo",
-    "frustum.trace", "frustum.visibility",
+    "frustum.trace", "frustum.visibility.depth_sort", "frustum.visibility.painter", "frustum.visibility.scanline",
+    "frustum.visibility.warnock", "frustum.visibility.abuffer", "frustum.visibility.raycast",
+    "frustum.render.radiosity", "frustum.render.raytrace", "frustum.render.shadows.fractions",
 )  # fmt: skip
 
 

@@ -1,4 +1,4 @@
-"""DXF sheets (``drawing_sheet(..., path="*.dxf")``, ``output/sheet_dxf.py``) read back by ezdxf.
+"""DXF sheets (``drawing_sheet(..., path="*.dxf")``, ``output/sheet/dxf.py``) read back by ezdxf.
 
 Oracles: ``ezdxf.readfile`` and ``doc.audit()``; the SVG sheet of the same scene (entity counts per layer); the
 model's radii and part extents; ezdxf's own drawing add-on (matplotlib backend) rendering the DXF, compared

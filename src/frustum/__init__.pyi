@@ -26,6 +26,8 @@ from .batch import (
 )
 from .visibility.bsp import (
     BSPTree as BSPTree,
+)
+from .visibility.depth_sort import (
     DepthOrder as DepthOrder,
     depth_sort as depth_sort,
 )
