@@ -59,7 +59,7 @@ from typing import Any
 
 from frustum.camera import Camera
 from frustum.frame import Frame
-from frustum.render import lines, methods, particles, reflection, surfaces, volumes
+from frustum.render import ground_truth, lines, methods, particles, reflection, surfaces, volumes
 from frustum.render.buffers import FrameBuffers as FrameBuffers
 from frustum.render.buffers import Scratch as Scratch
 from frustum.render.buffers import block_min as block_min
@@ -127,6 +127,7 @@ def render(
     shadows: bool | str | None = None,
     shadow_map_size: int = 2048,
     shadow_softness: float = 1.0,
+    next: tuple[Scene, Camera] | None = None,
 ) -> Frame:
     """Render `scene` seen by `camera` into a ``Frame`` (color (H, W, 4) uint8 and depth (H, W) float32).
 
@@ -179,11 +180,15 @@ def render(
         are drawn √samples times as wide, so they come out anti-aliased. Depth keeps each block's nearest.
     color_space : {"linear", "srgb"}
         Output encoding; "srgb" applies the sRGB transfer curve to the linear result.
-    buffers : tuple of {"normals", "object_id", "position", "shadow"}
+    buffers : tuple of {"normals", "object_id", "position", "shadow", "instance", "semantic", "amodal",
+            "object_coords", "nocs", "flow"}
         Extra per-pixel outputs on the Frame: unit world normals (0 on background), the index of the item
         in ``scene.items`` (−1 on background), the world point of the nearest opaque surface ((H, W, 3) float32,
         NaN on background) and, with `shadows` on, the fraction of each shadow-casting light reaching it ((H, W,
-        L) float32, NaN on background; lights in ``Scene.world_lights`` order, ``frustum.render.shadows.fractions``).
+        L) float32, NaN on background; lights in ``Scene.world_lights`` order, ``frustum.render.shadows.fractions``);
+        the ground truth of ``frustum.render.ground_truth``: instance and semantic ids, amodal masks with
+        ``Frame.visibility``, object coordinates, NOCS and optical flow to `next` with ``Frame.flow_occluded``.
+        Ids and points come from one sample per pixel (never a blend of two objects).
     method : str
         The visible-surface method (``RENDER_METHODS``, docs/visibility.md). For the meshes
         (``VISIBILITY_METHODS``): ``"depth-buffer"`` (the default), ``"scan-line"``, ``"area-subdivision"``
@@ -218,6 +223,9 @@ def render(
     shadow_softness : float
         Percentage-closer filter width in texels, in [0, 16]; 0: hard edges; up to 1 (default): the 2 × 2 texels
         around the point, bilinearly weighted (``frustum.render.shadows.fractions``).
+    next : (Scene, Camera) or None
+        With ``"flow"`` in `buffers`: the scene and camera of the next frame (items matched by node path,
+        ``Scene.item_paths``). Backward flow: swap the two frames.
 
     Raises
     ------
@@ -231,6 +239,7 @@ def render(
     [seed] "Back-face detection", "Depth-buffer method", "wire-frame displays".
     """
     check_method(method, "render")
+    following = ground_truth.check_next(tuple(buffers) if isinstance(buffers, tuple | list) else (), next, "render")
     if RENDER_METHODS[method] is not None:
         return RENDER_METHODS[method](scene, camera, background=background)
     options = RenderOptions.from_keywords(
@@ -241,9 +250,11 @@ def render(
         max_depth=max_depth, shadows=shadows, shadow_map_size=shadow_map_size, shadow_softness=shadow_softness,
     )  # fmt: skip
     if options.factor == 1:
-        return _draw(scene, camera, options).to_frame(options)
-    big = dataclasses.replace(camera, width=camera.width * options.factor, height=camera.height * options.factor)
-    return _draw(scene, big, options.supersampled()).to_frame(options)
+        frame = _draw(scene, camera, options).to_frame(options)
+    else:
+        big = dataclasses.replace(camera, width=camera.width * options.factor, height=camera.height * options.factor)
+        frame = _draw(scene, big, options.supersampled()).to_frame(options)
+    return ground_truth.finish(frame, scene, camera, options, tuple(buffers), following)  # the ground-truth pass
 
 
 def _draw(scene: Scene, camera: Camera, options: RenderOptions) -> FrameContext:
