@@ -443,3 +443,22 @@ def test_a_texture_over_the_budget_is_refused_before_decoding_without_pillows_wa
             load_parts(tmp_path / "m.obj", texture=tmp_path / "big.png")
         parts = load_parts(tmp_path / "m.obj", texture=tmp_path / "big.png")  # within the default budget
     assert parts[0].texture.shape == (600, 800, 3)
+
+
+def test_the_command_line_confines_inputs_unless_allow_read_names_the_folder(tmp_path):
+    import subprocess
+    import sys
+
+    files = _outside_files(tmp_path)
+    folder = tmp_path / "scene"
+    folder.mkdir()
+    (folder / "scene.toml").write_text(_MESH_SCENE.format(path="../secret/mesh.obj"))
+    command = [sys.executable, "-m", "frustum"]
+    refused = subprocess.run([*command, "render", str(folder / "scene.toml"), "-o", str(tmp_path / "a.png")],
+                             capture_output=True, text=True, timeout=300)  # fmt: skip
+    assert refused.returncode == 1 and "Traceback" not in refused.stderr
+    assert "lies outside the scene file's folder" in refused.stderr and not (tmp_path / "a.png").exists()
+    allowed = subprocess.run([*command, "--allow-read", str(files["mesh"].parent), "render", str(folder / "scene.toml"),
+                              "-o", str(tmp_path / "b.png")], capture_output=True, text=True, timeout=300)  # fmt: skip
+    assert allowed.returncode == 0, allowed.stderr
+    assert (tmp_path / "b.png").is_file()

@@ -4,6 +4,7 @@ built with all problems reported at once (``_build``), and the ``SceneFile`` it 
 from __future__ import annotations
 
 import dataclasses
+import os
 import re
 import sys
 import tomllib
@@ -448,10 +449,17 @@ def load_scene_file(path: str | Path, *, up: str = "y", allow_read: Sequence[str
     return _load_scene_file(path, up=up, allow_read=allow_read)
 
 
+ALLOW_READ_VARIABLE = "FRUSTUM_ALLOW_READ"
+"""Folders (``os.pathsep``-separated) every scene file may read besides its own: what ``frustum --allow-read PATH``
+sets, so that worker processes and the viewer's server follow the same rule."""
+
+
 def _as_folders(allow_read: Any) -> list[Path]:
-    """`allow_read` as a list of folders (a single path is one folder); names that are not paths are refused."""
+    """`allow_read` as a list of folders (a single path is one folder), with those of ``FRUSTUM_ALLOW_READ``; names
+    that are not paths are refused."""
     if isinstance(allow_read, (str, Path)):
         allow_read = [allow_read]
+    allow_read = [*allow_read, *filter(None, os.environ.get(ALLOW_READ_VARIABLE, "").split(os.pathsep))]
     folders = []
     for entry in allow_read:
         if not isinstance(entry, (str, Path)) or not str(entry) or "\0" in str(entry):
