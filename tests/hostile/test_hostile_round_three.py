@@ -462,3 +462,39 @@ def test_the_command_line_confines_inputs_unless_allow_read_names_the_folder(tmp
                               "-o", str(tmp_path / "b.png")], capture_output=True, text=True, timeout=300)  # fmt: skip
     assert allowed.returncode == 0, allowed.stderr
     assert (tmp_path / "b.png").is_file()
+
+
+# --- 4. radiosity's tolerance --------------------------------------------------------------------------------------
+
+
+def test_radiosity_tolerance_zero_is_a_one_line_error(tmp_path):
+    import subprocess
+    import sys
+
+    examples = Path(__file__).resolve().parents[2] / "examples"
+    process = subprocess.run([sys.executable, "-m", "frustum", "radiosity", str(examples / "cornell_box.toml"),
+                              "--tolerance", "0", "-o", str(tmp_path / "x.png")],
+                             capture_output=True, text=True, timeout=300)  # fmt: skip
+    assert process.returncode == 1 and "Traceback" not in process.stderr, process.stderr
+    assert "tolerance = 0.0 is not in (0, 1)" in process.stderr and len(process.stderr.strip().splitlines()) == 1
+
+
+def test_radiosity_work_estimate_grows_with_the_tolerance(monkeypatch):
+    from frustum.render import radiosity as module
+    from frustum.scenefile import load_scene_file
+
+    class Estimated(Exception):
+        pass
+
+    counts = []
+
+    def record(count, **_):
+        counts.append(count)
+        raise Estimated
+
+    monkeypatch.setattr(module, "check_operations", record)
+    scene = load_scene_file(Path(__file__).resolve().parents[2] / "examples" / "cornell_box.toml").scene
+    for tolerance in (1e-3, 1e-6, 1e-300):
+        with pytest.raises(Estimated):
+            module.radiosity(scene, tolerance=tolerance)
+    assert counts[1] == pytest.approx(2 * counts[0]) and counts[2] == pytest.approx(10 * counts[0])

@@ -817,7 +817,9 @@ def radiosity_command(
     for name, value in (("patch_size", patch_size), ("hemicube", hemicube), ("tolerance", tolerance)):
         if value is not None:
             settings[name] = value
-    goal = -math.log10(float(settings.get("tolerance", 1e-3)))
+    tolerance_value = settings.get("tolerance", 1e-3)
+    # the progress bar's goal; a tolerance outside (0, 1) is left for radiosity() to refuse with its message
+    goal = -math.log10(tolerance_value) if isinstance(tolerance_value, float | int) and 0 < tolerance_value < 1 else 3.0
     columns = (TextColumn("radiosity"), BarColumn(), TextColumn("{task.fields[shots]} shots, residual "
                "{task.fields[residual]:.1e}"), TimeElapsedColumn())  # fmt: skip
     with Progress(*columns, console=error_console, transient=True) as bar:
