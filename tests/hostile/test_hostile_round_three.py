@@ -483,18 +483,18 @@ def test_radiosity_work_estimate_grows_with_the_tolerance(monkeypatch):
     from frustum.render import radiosity as module
     from frustum.scenefile import load_scene_file
 
-    class Estimated(Exception):
+    class EstimatedError(Exception):
         pass
 
     counts = []
 
     def record(count, **_):
         counts.append(count)
-        raise Estimated
+        raise EstimatedError
 
     monkeypatch.setattr(module, "check_operations", record)
     scene = load_scene_file(Path(__file__).resolve().parents[2] / "examples" / "cornell_box.toml").scene
     for tolerance in (1e-3, 1e-6, 1e-300):
-        with pytest.raises(Estimated):
+        with pytest.raises(EstimatedError):
             module.radiosity(scene, tolerance=tolerance)
     assert counts[1] == pytest.approx(2 * counts[0]) and counts[2] == pytest.approx(10 * counts[0])
