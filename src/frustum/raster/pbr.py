@@ -131,7 +131,7 @@ def prefiltered(maps: np.ndarray, roughness: float, x: float, y: float, z: float
     """The prefiltered radiance along R, linear between the two levels around ``roughness·(levels − 1)``."""
     top = maps.shape[0] - 1
     level = min(max(roughness, 0.0), 1.0) * top
-    low = min(int(math.floor(level)), top - 1)
+    low = min(math.floor(level), top - 1)
     t = level - low
     r0, g0, b0 = _equirect(maps, low, x, y, z)
     r1, g1, b1 = _equirect(maps, low + 1, x, y, z)
@@ -144,8 +144,8 @@ def split_sum(table: np.ndarray, n_dot_v: float, roughness: float) -> tuple[floa
     size = table.shape[0]
     x = min(max(n_dot_v * size - 0.5, 0.0), size - 1.0)
     y = min(max(roughness * (size - 1), 0.0), size - 1.0)
-    i0 = min(int(math.floor(x)), size - 2)
-    j0 = min(int(math.floor(y)), size - 2)
+    i0 = min(math.floor(x), size - 2)
+    j0 = min(math.floor(y), size - 2)
     fx, fy = x - i0, y - j0
     a = ((1 - fx) * (1 - fy) * table[i0, j0, 0] + fx * (1 - fy) * table[i0 + 1, j0, 0]
          + (1 - fx) * fy * table[i0, j0 + 1, 0] + fx * fy * table[i0 + 1, j0 + 1, 0])  # fmt: skip
