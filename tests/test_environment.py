@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 import frustum as fr
-from frustum.shading.environment import EnvironmentMap, cube_coordinates, read_hdr
 from frustum.errors import FrustumError, ShadingError
+from frustum.shading.environment import EnvironmentMap, cube_coordinates, read_hdr
 
 OCTANT_COLORS = np.array([[(i >> 2) & 1, (i >> 1) & 1, i & 1] for i in range(8)], dtype=float) * 0.8 + 0.1
 """Octant (x > 0, y > 0, z > 0 as bits 2, 1, 0) → color, all eight distinct."""

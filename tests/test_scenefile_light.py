@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 import frustum as fr
-from frustum.shading.environment import EnvironmentMap
 from frustum.errors import SceneFileError
 from frustum.scenefile import load_scene, load_scene_file
+from frustum.shading.environment import EnvironmentMap
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 

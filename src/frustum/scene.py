@@ -18,10 +18,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from frustum._arrays import Matrix4, as_matrix, as_scalar, as_vector3, describe
-from frustum.shading.environment import EnvironmentMap
 from frustum.errors import FrustumError, GeometryError
 from frustum.geometry import Mesh, Polyline
 from frustum.shading import LIGHT_TYPES, Light, Material
+from frustum.shading.environment import EnvironmentMap
 from frustum.transforms import translate
 
 if TYPE_CHECKING:  # imported where they are used: a scene of meshes and lines never loads these modules

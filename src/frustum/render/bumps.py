@@ -16,7 +16,13 @@ import numpy as np
 
 from frustum.raster import shade
 from frustum.scene import SceneItem
-from frustum.shading.surface_detail import _bilinear_wrapped, bumped_normals, height_gradient, mapped_normals, tangent_frames
+from frustum.shading.surface_detail import (
+    _bilinear_wrapped,
+    bumped_normals,
+    height_gradient,
+    mapped_normals,
+    tangent_frames,
+)
 
 
 def has_detail(item: SceneItem) -> bool:

@@ -16,9 +16,9 @@ from __future__ import annotations
 import numpy as np
 
 from frustum.camera import Camera
-from frustum.shading.environment import reflect_directions
 from frustum.render.buffers import Buffers
 from frustum.render.options import RenderOptions
+from frustum.shading.environment import reflect_directions
 
 
 def _to_bytes(values: np.ndarray) -> np.ndarray:

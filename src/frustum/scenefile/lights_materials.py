@@ -8,11 +8,11 @@ from typing import Any
 import numpy as np
 
 from frustum.budgets import format_bytes, get_budget
-from frustum.shading.environment import ENVIRONMENT_KINDS, EnvironmentMap
 from frustum.errors import FrustumError
 from frustum.scenefile.checks import _call, _choice, _table, _table_list, _unknown_keys
 from frustum.scenefile.report import _BAD, _Report
 from frustum.shading import AmbientLight, DirectionalLight, Material, PointLight, SpotLight
+from frustum.shading.environment import ENVIRONMENT_KINDS, EnvironmentMap
 
 IMAGE_KEYS = ("texture", "bump", "normal_map")
 """Material keys that name an image file (relative to the scene file's folder): PNG, JPEG, anything Pillow reads."""

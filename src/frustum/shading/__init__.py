@@ -22,6 +22,8 @@ from frustum.shading.model import (
 )
 
 __all__ = [
+    "LIGHT_FIELDS",
+    "LIGHT_TYPES",
     "SPECULAR_MODELS",
     "AmbientLight",
     "DepthCue",
@@ -33,4 +35,5 @@ __all__ = [
     "blinn_phong",
     "illuminate",
     "pack_lights",
+    "sun_45",
 ]
