@@ -69,6 +69,16 @@ class MeshPart(NamedTuple):
     """A glTF material's ``emissiveFactor`` (linear RGB), when not black: ``Material(emissive=)``."""
     alpha_mode: str | None = None
     """A glTF material's ``alphaMode`` ("OPAQUE", "MASK" or "BLEND"); None for other formats."""
+    metallic: float | None = None
+    """A glTF material's ``metallicFactor`` (None when the file gives none: the specification's default is 1)."""
+    roughness: float | None = None
+    """A glTF material's ``roughnessFactor`` (None when the file gives none: the specification's default is 1)."""
+    metallic_roughness_texture: NDArray[np.uint8] | None = None
+    """A glTF material's ``metallicRoughnessTexture`` as (H, W, 3) bytes: B metallic, G roughness."""
+    occlusion_texture: NDArray[np.uint8] | None = None
+    """A glTF material's ``occlusionTexture`` as (H, W, 3) bytes: R the occlusion."""
+    physical: bool = False
+    """Whether the file describes the material by glTF's metallic–roughness model (a glTF or GLB file)."""
 
     def __repr__(self) -> str:
         def image(array: Any) -> str:
@@ -76,7 +86,9 @@ class MeshPart(NamedTuple):
 
         return (f"MeshPart(name={self.name!r}, mesh={self.mesh!r}, texture={image(self.texture)}, "
                 f"color={self.color!r}, normal_map={image(self.normal_map)}, emissive={self.emissive!r}, "
-                f"alpha_mode={self.alpha_mode!r})")  # fmt: skip
+                f"alpha_mode={self.alpha_mode!r}, metallic={self.metallic!r}, roughness={self.roughness!r}, "
+                f"metallic_roughness_texture={image(self.metallic_roughness_texture)}, "
+                f"occlusion_texture={image(self.occlusion_texture)}, physical={self.physical!r})")  # fmt: skip
 
 
 def load(path: str | Path, texture: str | Path | None = None) -> Mesh:
@@ -163,7 +175,7 @@ def load_parts(path: str | Path, texture: str | Path | None = None) -> list[Mesh
             matrix = np.array(world_from_model, dtype=np.float64)
             emissive, alpha_mode = _emission_and_alpha(geometry)
             parts.append(MeshPart(str(node), mesh, matrix, image, color, _normal_texture(geometry), emissive,
-                                  alpha_mode))  # fmt: skip
+                                  alpha_mode, *_metallic_roughness(geometry, file)))  # fmt: skip
     except GeometryError as error:
         raise GeometryError(f"load: path = {str(file)!r} holds invalid geometry ({error}); check the file") from None
     except MemoryError:
@@ -205,8 +217,13 @@ def _native_parts(file: Path, text: bytes | None) -> list[MeshPart] | None:
             normal_map = None
             if part.normal_image is not None and part.uvs is not None:
                 normal_map = np.asarray(part.normal_image.convert("RGB"), dtype=np.uint8)
+            physical = [None, None]
+            for k, texture_image in enumerate((part.metallic_roughness_image, part.occlusion_image)):
+                if texture_image is not None and part.uvs is not None:
+                    physical[k] = np.asarray(texture_image.convert("RGB"), dtype=np.uint8)
             parts.append(MeshPart(part.name, mesh, np.asarray(part.world_from_model, dtype=np.float64), image, color,
-                                  normal_map, part.emissive, part.alpha_mode))  # fmt: skip
+                                  normal_map, part.emissive, part.alpha_mode, part.metallic, part.roughness,
+                                  *physical, file.suffix.lower() in (".glb", ".gltf")))  # fmt: skip
     except MemoryError:
         raise
     except Exception:  # invalid geometry or an unreadable image: trimesh's path says what is wrong
@@ -492,6 +509,24 @@ def _normal_texture(geometry: Any) -> NDArray[np.uint8] | None:
     if image is None or getattr(geometry.visual, "uv", None) is None:
         return None
     return np.asarray(image.convert("RGB"), dtype=np.uint8)
+
+
+def _metallic_roughness(geometry: Any, file: Path) -> tuple[Any, ...]:
+    """A glTF material's (metallicFactor, roughnessFactor, metallicRoughnessTexture, occlusionTexture, True), the
+    textures as (H, W, 3) bytes (None without UVs); (None, None, None, None, False) for other formats."""
+    if file.suffix.lower() not in (".glb", ".gltf"):
+        return None, None, None, None, False
+    material = getattr(geometry.visual, "material", None)
+    factors = []
+    for name in ("metallicFactor", "roughnessFactor"):
+        value = getattr(material, name, None)
+        factors.append(None if value is None else float(np.clip(float(value), 0.0, 1.0)))
+    images = []
+    for name in ("metallicRoughnessTexture", "occlusionTexture"):
+        image = getattr(material, name, None)
+        has_uvs = getattr(geometry.visual, "uv", None) is not None
+        images.append(None if image is None or not has_uvs else np.asarray(image.convert("RGB"), dtype=np.uint8))
+    return (*factors, *images, True)
 
 
 def _emission_and_alpha(geometry: Any) -> tuple[tuple[float, float, float] | None, str | None]:

@@ -49,7 +49,9 @@ def default_lights(camera: Camera) -> list[Any]:
 def part_material(part: Any) -> Material:
     """The ``Material`` a loaded ``MeshPart`` carries: its base colour (white under a texture, which it multiplies),
     its texture, its normal map, glTF's emissive factor, its alpha as opacity (not for glTF's alphaMode OPAQUE);
-    a part with none of them gets a light neutral gray."""
+    a part with none of them gets a light neutral gray. A glTF part's material is ``model="pbr"`` with the file's
+    metallic and roughness factors (the specification's default 1 where it gives none), its metallic–roughness and
+    occlusion textures, and its base colour texture decoded from sRGB (``Material(base_color_texture=)``)."""
     color = part.color
     texture = part.texture
     normal_map = getattr(part, "normal_map", None)
@@ -60,6 +62,12 @@ def part_material(part: Any) -> Material:
     if getattr(part, "alpha_mode", None) == "OPAQUE":  # glTF: alpha is ignored unless the mode is BLEND (or MASK)
         opacity = 1.0
     emissive = getattr(part, "emissive", None) or (0.0, 0.0, 0.0)
+    if getattr(part, "physical", False):
+        return Material(color=rgb, base_color_texture=texture, normal_map=normal_map, opacity=opacity, specular=0.2,
+                        emissive=emissive, model="pbr", metallic=1.0 if part.metallic is None else part.metallic,
+                        roughness=1.0 if part.roughness is None else part.roughness,
+                        metallic_roughness_texture=part.metallic_roughness_texture,
+                        occlusion_texture=part.occlusion_texture)  # fmt: skip
     return Material(color=rgb, texture=texture, normal_map=normal_map, opacity=opacity, specular=0.2,
                     emissive=emissive)  # fmt: skip
 
