@@ -425,7 +425,8 @@ MODEL_SUFFIXES = (".obj", ".stl", ".ply", ".off", ".gltf", ".glb")
 
 
 def _model_scene_file(file: Path, up: str) -> SceneFile:
-    from frustum.scenefile.models import model_scene
+    from frustum.scenefile.models import model_scene, physical_options
 
     scene, camera = model_scene(file, up=up, size=_DEFAULT_SIZE)
-    return SceneFile(scene, camera, {}, (), (camera,), size=_DEFAULT_SIZE, title=file.stem, path=file, up=up)
+    return SceneFile(scene, camera, physical_options(scene), (), (camera,), size=_DEFAULT_SIZE, title=file.stem,
+                     path=file, up=up)  # fmt: skip
