@@ -18,8 +18,8 @@ The metallic–roughness BRDF then reflects, for specular weight $S = f0·A + B$
 $S·P(R) + (1 − metallic)·(1 − (0.04·A + B))·base·E(n)/π$, times the occlusion $1 + k·(occlusion − 1)$: for a
 white dielectric in a uniform environment of radiance L this is exactly L (the white furnace). A metal loses the
 energy single-scattering GGX loses (no multiple bounces between microfacets): the white furnace of a white
-metal returns $(A + B)·L$, about 0.98 L at roughness 0.25, 0.93 at 0.5, 0.85 at 0.75 and 0.77 at 1 (averaged
-over the visible sphere); Mitsuba's ``roughconductor`` loses the same.
+metal returns $(A + B)·L$, about 0.99 L at roughness 0.25, 0.87 at 0.5, 0.63 at 0.75 and 0.41 at 1 (averaged
+over the visible sphere, weighted by n·v); Mitsuba's ``roughconductor`` loses the same.
 
 The maps are latitude–longitude, in the layout of ``EnvironmentMap`` (``kind="equirect"``: u from
 atan2(x, −z), v from acos(y)), whatever the map's own kind.
