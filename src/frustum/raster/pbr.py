@@ -243,8 +243,12 @@ def radiance(
     spec_r, spec_g, spec_b = ar, ag, ab
     irr_r, irr_g, irr_b = ar, ag, ab
     if pbr[Q_ENVIRONMENT] != 0.0:
-        d = 2.0 * n_dot_v
-        pr, pg, pb = prefiltered(maps, roughness, d * nx - vx, d * ny - vy, d * nz - vz)
+        d = 2.0 * n_dot_v  # the lobe's dominant direction: R = 2(n·v)n − v turned toward n (ibl's docstring)
+        smooth = 1.0 - alpha
+        t = smooth * (math.sqrt(smooth) + alpha)
+        rx, ry, rz = t * (d * nx - vx) + (1.0 - t) * nx, t * (d * ny - vy) + (1.0 - t) * ny, (
+            t * (d * nz - vz) + (1.0 - t) * nz)
+        pr, pg, pb = prefiltered(maps, roughness, rx, ry, rz)
         spec_r, spec_g, spec_b = spec_r + pr, spec_g + pg, spec_b + pb
         irr_r += max(sh_irradiance(sh, 0, nx, ny, nz), 0.0)
         irr_g += max(sh_irradiance(sh, 1, nx, ny, nz), 0.0)

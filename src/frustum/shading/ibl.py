@@ -5,10 +5,12 @@ lookups [Karis 2013, "Real Shading in Unreal Engine 4"; Ramamoorthi & Hanrahan 2
 * **Diffuse**: the irradiance $E(n) = ∫ L(l)·max(n·l, 0) dω$ from the map's first nine spherical harmonics,
   $E(n) = Σ_{l ≤ 2} Â_l Σ_m L_{lm} Y_{lm}(n)$ with $Â_0 = π$, $Â_1 = 2π/3$, $Â_2 = π/4$; a Lambertian surface of
   colour c reflects $c·E(n)/π$ (``irradiance_sh`` stores the coefficients already times $Â_l/π$).
-* **Specular** by the split sum: $∫ L·f·(n·l) dω ≈ prefiltered(R, roughness)·(f0·A + B)$, R the mirror direction
-  of v about n. ``prefiltered`` is the map convolved with the GGX lobe around R (n = v = R assumed), weighted by
-  n·l: $P(R) = Σ_l L(l)·D(h)·(n·l)·Δω / Σ_l D(h)·(n·l)·Δω$ summed exactly over the texels of a resampled map
-  (no sampling noise; each row a circular correlation by FFT), one latitude–longitude map per roughness of
+* **Specular** by the split sum: $∫ L·f·(n·l) dω ≈ prefiltered(R_d, roughness)·(f0·A + B)$, with R = 2(n·v)n − v
+  the mirror direction of v about n turned toward n as the lobe of a rough surface is,
+  $R_d = t·R + (1 − t)·n$, $t = s(√s + α)$, $s = 1 − α$ (the dominant direction of Lagarde & de Rousiers,
+  "Moving Frostbite to PBR", 2014). ``prefiltered`` is the map convolved with the GGX lobe around R (n = v = R
+  assumed), weighted by n·l: $P(R) = Σ_l L(l)·D(h)·(n·l)·Δω / Σ_l D(h)·(n·l)·Δω$ summed exactly over the
+  texels of a resampled map (no sampling noise; each row a circular correlation by FFT), one latitude–longitude map per roughness of
   ``ROUGHNESS_LEVELS`` (roughness 0: the map itself); between levels the shader interpolates linearly. A and B
   (``brdf_table``) are the scale and bias to f0 of the directional albedo of the GGX specular lobe with the
   height-correlated Smith term, $A = ∫ (1 − F_c)·G_vis$, $B = ∫ F_c·G_vis$, $F_c = (1 − v·h)⁵$, over
@@ -247,7 +249,10 @@ def image_radiance(
     diffuse_light = specular_light.copy()
     if lighting is not None:
         reflected = 2.0 * (n * v).sum(axis=1, keepdims=True) * n - v
-        specular_light += prefiltered_lookup(lighting.prefiltered, reflected, roughness)
+        smooth = 1.0 - (roughness * roughness)[:, None]
+        t = smooth * (np.sqrt(smooth) + 1.0 - smooth)
+        dominant = t * reflected + (1.0 - t) * n
+        specular_light += prefiltered_lookup(lighting.prefiltered, dominant, roughness)
         diffuse_light += np.maximum(sh_basis(n) @ lighting.sh, 0.0)
     occlusion = np.asarray(occlusion, dtype=np.float64)
     return (specular_weight * specular_light + diffuse_weight * diffuse_light) * (occlusion[..., None]
