@@ -109,8 +109,8 @@ def bench_scene(name: str, args, first_scene: bool) -> dict:
     sc = scenes.load_scene(str(path))
 
     import frustum
-    from frustum import shadow_pass
     from frustum.raster import shadow
+    from frustum.render.shadows import fractions as shadow_pass
 
     width, height = int(sc["width"]), int(sc["height"])
     mesh = frustum.Mesh(sc["vertices"], sc["faces"], vertex_normals=sc["normals"], copy=False)

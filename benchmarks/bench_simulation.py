@@ -114,7 +114,7 @@ camera = fr.Camera.look_at((0, 0, 5), (0, 0, 0), (0, 1, 0), None, 64, 48)
 scene = fr.Scene()
 scene.add_particles(system)
 scene.add_particles(system, style="streaks")
-from frustum.particle_pass import draw_particles
+from frustum.render.particles import draw_particles
 depth = np.ones((48, 64), np.float32); color = np.zeros((48, 64, 4), np.uint8)
 start = time.perf_counter()
 draw_particles(scene.particle_layers, camera, depth, color)

@@ -63,7 +63,7 @@ def test_lazy_pipeline_names_resolve_and_the_function_render_survives_its_module
 
 # modules the README's render (a teapot scene file to a PNG) has no use for: they load on first use of their names
 NOT_ON_THE_RENDER_PATH = (
-    "frustum.bsp", "frustum.geometry.csg", "frustum.geometry.dimension", "frustum.geometry.escape_time",
+    "frustum.visibility.bsp", "frustum.geometry.csg", "frustum.geometry.dimension", "frustum.geometry.escape_time",
     "frustum.geometry.fractals", "frustum.geometry.io", "frustum.geometry.lsystem", "frustum.geometry.octree",
     "frustum.geometry.volume", "frustum.output.sheet", "frustum.output.svg", "frustum.simulation", "frustum.stereo",
     "frustum.trace", "frustum.visibility",

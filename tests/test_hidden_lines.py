@@ -1,4 +1,4 @@
-"""Object-space hidden-line removal (``frustum.hidden_lines``) against hand-computed cases and independent oracles.
+"""Object-space hidden-line removal (``visibility.hidden_lines``) against hand-computed cases and independent oracles.
 
 Oracles: hand-computed visible segments (a cube from a corner, two boxes, an edge behind a square under a
 perspective camera); trimesh's ray–triangle intersector (``trimesh.ray.ray_triangle``, pure numpy, no code
@@ -31,7 +31,7 @@ from frustum import (
     translate,
 )
 from frustum.geometry import Mesh, Polyline
-from frustum.hidden_lines import (
+from frustum.visibility.hidden_lines import (
     EDGE_BOUNDARY,
     EDGE_CREASE,
     EDGE_LINE,

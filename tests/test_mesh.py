@@ -373,7 +373,7 @@ def test_edge_keys_of_int32_faces_do_not_overflow_with_large_vertex_counts():
     expected = sorted({tuple(sorted((int(f[a]), int(f[b])))) for f in faces for a, b in ((0, 1), (1, 2), (2, 0))})
     assert mesh.edges.dtype == np.int64
     assert [tuple(e) for e in mesh.edges.tolist()] == expected
-    from frustum.hidden_lines import edge_adjacency
+    from frustum.visibility.hidden_lines import edge_adjacency
 
     adjacency = edge_adjacency(mesh.faces, n)
     assert adjacency.edges.dtype == np.int64 and [tuple(e) for e in adjacency.edges.tolist()] == expected

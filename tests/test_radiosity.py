@@ -16,7 +16,7 @@ import pytest
 import frustum as fr
 from cornell import WALLS, camera, cornell_box, quad
 from frustum.errors import ShadingError
-from frustum.radiosity import (
+from frustum.render.radiosity import (
     RadiosityError,
     _Rasterizer,
     form_factors,

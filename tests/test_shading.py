@@ -16,7 +16,6 @@ from tests.reference_raster import placed
 from frustum import Camera, FrustumError, Orthographic, Perspective
 from frustum.errors import ShadingError
 from frustum.geometry import Mesh, Polyline
-from frustum.hidden_lines import feature_edges
 from frustum.render import render
 from frustum.scene import Node, Scene
 from frustum.shading import (
@@ -29,6 +28,7 @@ from frustum.shading import (
     illuminate,
 )
 from frustum.transforms import rotate_x, translate
+from frustum.visibility.hidden_lines import feature_edges
 from testdata import DATA
 
 SIZE = 33  # odd: the centre pixel's centre is the world origin under ``ortho_camera``

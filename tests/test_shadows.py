@@ -1,4 +1,4 @@
-"""Shadows (``render(..., shadows=...)``, ``frustum.shadow_pass``): shadow maps and shadow rays against Embree.
+"""Shadows (``render(..., shadows=...)``, ``render.shadows.fractions``): shadow maps and shadow rays against Embree.
 
 Oracle: Embree through ``embreex`` (ORACLES.md): from each drawn pixel's ``Frame.position``, moved off the surface
 along ``Frame.normals``, a ray toward the light; the pixel is in shadow where Embree finds a hit nearer than the
@@ -786,7 +786,7 @@ def _spy_fills(monkeypatch) -> list:
 
 def _redrawn(scene: fr.Scene, camera: fr.Camera, **options) -> fr.Frame:
     """The frame with every shadow map drawn for it (reuse off)."""
-    from frustum import shadow_pass
+    from frustum.render.shadows import fractions as shadow_pass
 
     previous = shadow_pass.set_map_reuse(False)
     try:
@@ -813,7 +813,7 @@ def test_a_reused_shadow_map_gives_the_bytes_of_a_redrawn_one(monkeypatch):
     """A turntable (the camera orbits a model it sees whole, the light fixed): the one-mesh tile pipeline draws the
     map once and reuses it for every view (the map is fitted to what the camera sees, here all of the model);
     every frame has the bytes of the same frame with its map drawn for it."""
-    from frustum import shadow_pass
+    from frustum.render.shadows import fractions as shadow_pass
 
     shadow_pass.release_memory()
     scene = _small_teapot_on_plane(LIGHTS["directional"])
@@ -836,7 +836,7 @@ def test_a_changed_mesh_light_or_map_size_draws_the_map_again(monkeypatch):
     """The kept map is not reused once anything it depends on changes: the vertices changed in place (a mesh made
     with copy=False shares the caller's array), the faces, the light's direction, the map's size or softness (its
     fitted margin), the modeling transform; each frame equals the frame drawn without reuse."""
-    from frustum import shadow_pass
+    from frustum.render.shadows import fractions as shadow_pass
 
     shadow_pass.release_memory()
     merged = _small_teapot_on_plane(LIGHTS["directional"]).items[0].mesh
@@ -881,7 +881,7 @@ def test_a_changed_mesh_light_or_map_size_draws_the_map_again(monkeypatch):
 def test_map_reuse_can_be_turned_off_and_memory_released(monkeypatch):
     """``set_map_reuse(False)`` draws every frame's map; ``release_memory`` frees the kept ones (the next frame
     draws its map again)."""
-    from frustum import shadow_pass
+    from frustum.render.shadows import fractions as shadow_pass
 
     scene = _one_mesh(_teapot_on_plane(LIGHTS["directional"]))
     fills = _spy_fills(monkeypatch)
@@ -905,7 +905,7 @@ def test_a_kept_map_set_is_held_by_one_frame_at_a_time():
     """``kept_maps`` hands a kept set to one caller until ``keep_maps`` takes it back (a frame drawing on another
     thread meanwhile draws its own, so a set in use never goes back to the work-array pool); past ``KEPT_MAPS``
     sets the least recently used one goes to the pool."""
-    from frustum import shadow_pass
+    from frustum.render.shadows import fractions as shadow_pass
 
     shadow_pass.release_memory()
     shape = (1, 64, 64)

@@ -34,8 +34,8 @@ from frustum import (
     translate,
 )
 from frustum.geometry import Mesh, Polyline
-from frustum.hidden_lines import remove_hidden_lines
 from frustum.output.svg import _placed_meshes, render_svg, save_svg, svg_path_from_bezier, svg_path_from_polyline
+from frustum.visibility.hidden_lines import remove_hidden_lines
 
 SVG = "{http://www.w3.org/2000/svg}"
 NUMBER = re.compile(r"-?\d+(?:\.\d+)?(?:e-?\d+)?")

@@ -14,7 +14,7 @@ import frustum as f
 from frustum.errors import FrustumError, GeometryError
 from frustum.geometry.quadrics import sphere_implicit
 from frustum.geometry.volume import TransferFunction, Volume, blobby_volume, fbm_cloud, quaternion_julia_volume
-from frustum.volume_pass import TERMINATE
+from frustum.render.volumes import TERMINATE
 
 # --- an independent per-pixel reference ---------------------------------------------------------------------
 

@@ -24,7 +24,7 @@ from .batch import (
     render_dataset as render_dataset,
     render_many as render_many,
 )
-from .bsp import (
+from .visibility.bsp import (
     BSPTree as BSPTree,
     DepthOrder as DepthOrder,
     depth_sort as depth_sort,
@@ -196,7 +196,7 @@ from .geometry.volume import (
     head_phantom as head_phantom,
     quaternion_julia_volume as quaternion_julia_volume,
 )
-from .hidden_lines import (
+from .visibility.hidden_lines import (
     EDGE_BOUNDARY as EDGE_BOUNDARY,
     EDGE_CREASE as EDGE_CREASE,
     EDGE_KINDS as EDGE_KINDS,
@@ -277,7 +277,7 @@ from .quaternion import (
     Quaternion as Quaternion,
     slerp as slerp,
 )
-from .radiosity import (
+from .render.radiosity import (
     RadiosityError as RadiosityError,
     RadiosityResult as RadiosityResult,
     radiosity as radiosity,

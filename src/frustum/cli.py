@@ -704,8 +704,8 @@ def radiosity_command(
     refinement) and render the lit scene from the file's camera: each pixel the interpolated radiosity."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
-    from frustum.radiosity import radiosity
     from frustum.render import render
+    from frustum.render.radiosity import radiosity
     from frustum.scenefile import load_scene_file
 
     if output.suffix.lower() != ".png":

@@ -429,7 +429,7 @@ class Scene:
         """Draw `system` (a ``ParticleSystem``, world coordinates) as `style` with `blending`; returns its layer.
 
         Particles are drawn after the opaque surfaces, depth-tested against them without writing depth
-        (``frustum.particle_pass``); ``frustum.simulate`` steps the system between frames.
+        (``frustum.render.particles``); ``frustum.simulate`` steps the system between frames.
         """
         from frustum.simulation import ParticleSystem
 

@@ -324,7 +324,7 @@ from frustum import Camera, Scene, Volume
 from frustum.render import render
 
 checked = []
-for name in ("frustum.geometry.volume", "frustum.volume_pass", "frustum.render", "frustum.render.options"):
+for name in ("frustum.geometry.volume", "frustum.render.volumes", "frustum.render", "frustum.render.options"):
     try:
         module = importlib.import_module(name)
     except ImportError:

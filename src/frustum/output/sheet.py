@@ -43,12 +43,6 @@ from frustum._arrays import as_scalar, describe
 from frustum.camera import Camera, ViewFrame
 from frustum.errors import OutputError
 from frustum.geometry import Mesh, Polyline
-from frustum.hidden_lines import (
-    DEFAULT_CREASE_ANGLE,
-    EDGE_SILHOUETTE,
-    HiddenLines,
-    remove_hidden_lines,
-)
 from frustum.output.svg import (
     _HIDDEN_GRAY,
     _check_common,
@@ -62,6 +56,12 @@ from frustum.output.svg import (
 from frustum.output.true_curves import Circle, EllipseArc, circle_arcs, find_circles, svg_arc_elements
 from frustum.projection import ISOMETRIC_ROTATION_X, MULTIVIEWS, Axonometric, Orthographic, multiview
 from frustum.scene import Scene
+from frustum.visibility.hidden_lines import (
+    DEFAULT_CREASE_ANGLE,
+    EDGE_SILHOUETTE,
+    HiddenLines,
+    remove_hidden_lines,
+)
 
 __all__ = [
     "DIMENSION_MODES",

@@ -1,9 +1,9 @@
 """Exact vector drawings: hidden-line SVG (and PDF or PNG through cairosvg) of a scene seen by a camera.
 
-``render_svg`` draws the edges that ``frustum.hidden_lines.remove_hidden_lines`` finds, visible solid and hidden
+``render_svg`` draws the edges that ``visibility.hidden_lines.remove_hidden_lines`` finds, visible solid and hidden
 dashed (or dimmed), in window coordinates with **y down** as SVG wants it ($y_svg = height − y_window$), one
 SVG user unit per pixel. With ``fill=True`` it first paints the faces as flat-shaded polygons back to front (a
-BSP tree, ``frustum.bsp``, or a plain depth sort), so filled drawings are correct where a painter's algorithm
+BSP tree, ``frustum.visibility.bsp``, or a plain depth sort), so filled drawings are correct where a painter's algorithm
 on whole faces is not. Curves: under a parallel projection the window image of a Bézier control polygon is
 the control polygon of the image curve (an affine map commutes with de Casteljau), so ``svg_path_from_bezier``
 writes it as an exact SVG Bézier path.
@@ -28,15 +28,15 @@ from numpy.typing import ArrayLike, NDArray
 
 from frustum._arrays import as_scalar, describe
 from frustum._files import atomic_path, os_reason
-from frustum.bsp import BSPTree
 from frustum.camera import Camera
 from frustum.clipping import clip_polygon
 from frustum.errors import FrustumError, OutputError
 from frustum.geometry import Mesh
 from frustum.geometry.curves import BezierCurve, PiecewiseBezier
-from frustum.hidden_lines import DEFAULT_CREASE_ANGLE, EDGE_LINE, HiddenLines, remove_hidden_lines
 from frustum.scene import Scene, SceneItem
 from frustum.shading import DirectionalLight
+from frustum.visibility.bsp import BSPTree
+from frustum.visibility.hidden_lines import DEFAULT_CREASE_ANGLE, EDGE_LINE, HiddenLines, remove_hidden_lines
 
 __all__ = [
     "FILL_ORDERS",
@@ -468,7 +468,7 @@ def render_svg(
         Paint every face as a flat-shaded polygon (Lambert with the scene's directional lights, or a headlight),
         back to front, under the lines.
     fill_order : {"bsp", "depth"}
-        ``"bsp"``: ``frustum.bsp.BSPTree`` order, splitting faces where no order exists (exact; cost grows
+        ``"bsp"``: ``frustum.visibility.bsp.BSPTree`` order, splitting faces where no order exists (exact; cost grows
         faster than linearly, fine to some ten thousand faces). ``"depth"``: sort faces by their farthest
         corner (fast; may be wrong where faces overlap cyclically or interpenetrate).
     stroke_width : float

@@ -1,7 +1,7 @@
 """Particles in SVG line drawings: sprites and points as dots (``<circle>``), streaks as line segments.
 
 Each particle layer of the scene becomes one group ``particles<k>``, drawn over the mesh drawing in the order of
-``frustum.particle_pass`` (back to front for alpha blending): a dot of the projected radius R (pixels) filled
+``frustum.render.particles`` (back to front for alpha blending): a dot of the projected radius R (pixels) filled
 with the particle's color at its opacity, or a segment from the previous to the current position stroked
 1 pixel wide. Additive layers ask the viewer for ``mix-blend-mode: plus-lighter`` (browsers honour it; cairosvg
 draws them as ordinary alpha). SVG particles are not hidden by the faces: object-space hidden-line removal
@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from frustum.camera import Camera
-from frustum.particle_pass import project_particles, project_streaks
+from frustum.render.particles import project_particles, project_streaks
 from frustum.scene import Scene
 
 __all__ = ["particle_elements"]

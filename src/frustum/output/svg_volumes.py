@@ -1,7 +1,7 @@
 """Volumes in SVG drawings: the ray-cast picture of every placed volume as one raster ``<image>`` layer.
 
 A volume has no vector form, so ``render_svg`` embeds what ``render`` would composite: the volumes ray cast
-(``frustum.volume_pass.draw_volumes``, the same kernels and bytes) into a transparent image of the camera's
+(``frustum.render.volumes.draw_volumes``, the same kernels and bytes) into a transparent image of the camera's
 size, one pixel per SVG user unit, as a PNG data URI in the group ``volumes``, drawn over the faces and the
 lines and under the particles. Each ray stops at the nearest of
 
@@ -71,7 +71,7 @@ def volume_image(
     """(H, W, 4) uint8 premultiplied RGBA: every volume of `scene` ray cast over transparent black, each ray
     stopped at the faces of `scene` and at the window `segments` (K, 2, 2) of window depth `segment_depth` (K, 2)
     drawn `stroke_width` pixels wide (the module docstring)."""
-    from frustum.volume_pass import draw_volumes
+    from frustum.render.volumes import draw_volumes
 
     segments = np.zeros((0, 2, 2)) if segments is None else np.asarray(segments, dtype=np.float64)
     segment_depth = np.zeros((0, 2)) if segment_depth is None else np.asarray(segment_depth, dtype=np.float64)

@@ -54,7 +54,7 @@ from numpy.typing import NDArray
 
 from frustum.camera import Camera
 from frustum.geometry import Mesh, Polyline
-from frustum.hidden_lines import (
+from frustum.visibility.hidden_lines import (
     DEFAULT_CREASE_ANGLE,
     EDGE_BOUNDARY,
     EDGE_CREASE,

@@ -2,7 +2,7 @@
 pixels with a visibility factor per light (shadow rays go through ``Scene.occluded``, ``raster.rays``).
 
 None of these runs on an ordinary render: they compile only when ``render(..., shadows=...)`` or the
-``"position"``/``"shadow"`` buffers ask for them (``frustum.shadow_pass`` drives them).
+``"position"``/``"shadow"`` buffers ask for them (``frustum.render.shadows.fractions`` drives them).
 
 Array contracts (kernels never validate):
 

@@ -25,7 +25,7 @@ Per pixel (window centre (x + ½, y + ½), y up), in grid-index coordinates u (v
 Gradient shading uses ``frustum.shading``'s model with the base color of the transfer function and the normal
 $−∇f/|∇f|$ (central differences of the trilinear field, one voxel apart) turned toward the viewer.
 
-Kernels take plain arrays only; ``frustum.volume_pass`` builds them.
+Kernels take plain arrays only; ``frustum.render.volumes`` builds them.
 """
 
 from __future__ import annotations

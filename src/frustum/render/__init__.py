@@ -3,8 +3,10 @@
 The passes, one module each (``_draw`` lists them in order; a new pass is a module and a line there):
 ``options`` (the checked options, one frozen object), ``buffers`` (frame buffers, scratch, clear, resolve),
 ``surfaces`` (the depth buffer's opaque and transparent surfaces), ``methods`` (the other visible-surface methods,
-dispatched to ``visibility/``), ``lines`` (edges, wireframes, points, polylines), ``composite`` (volumes and
-particles over the surfaces); ``stages`` holds the per-item stages the surface passes share.
+dispatched to ``visibility/``), ``lines`` (edges, wireframes, points, polylines), ``volumes`` (volumes ray cast over
+the surfaces, each ray stopped at the depth there), ``particles`` (particle layers, depth-tested, depth not
+written), ``shadows`` (shadow maps and rays, a sub-package), ``raytrace`` and ``radiosity``; ``stages`` holds
+the per-item stages the surface passes share.
 
 Fast path, per scene item (one compiled pass each, buffers shared between items):
 
@@ -57,7 +59,7 @@ from typing import Any
 
 from frustum.camera import Camera
 from frustum.frame import Frame
-from frustum.render import composite, lines, methods, reflection, surfaces
+from frustum.render import lines, methods, particles, reflection, surfaces, volumes
 from frustum.render.buffers import Buffers, resolve
 from frustum.render.buffers import FrameBuffers as FrameBuffers
 from frustum.render.buffers import Scratch as Scratch
@@ -94,8 +96,8 @@ def release_memory() -> int:
     frames goes on to other work.
     """
     released = Scratch.release_pool() + FrameBuffers.release()
-    if "frustum.shadow_pass" in sys.modules:  # the shadow maps and per-pixel arrays of the shadow pass
-        released += sys.modules["frustum.shadow_pass"].release_memory()
+    if "frustum.render.shadows.fractions" in sys.modules:  # the shadow maps and per-pixel arrays of the shadow pass
+        released += sys.modules["frustum.render.shadows.fractions"].release_memory()
     return released
 
 
@@ -188,7 +190,7 @@ def render(
         Extra per-pixel outputs on the Frame: unit world normals (0 on background), the index of the item
         in ``scene.items`` (−1 on background), the world point of the nearest opaque surface ((H, W, 3) float32,
         NaN on background) and, with `shadows` on, the fraction of each shadow-casting light reaching it ((H, W,
-        L) float32, NaN on background; lights in ``Scene.world_lights`` order, ``frustum.shadow_pass``).
+        L) float32, NaN on background; lights in ``Scene.world_lights`` order, ``frustum.render.shadows.fractions``).
     method : str
         The visible-surface method (``RENDER_METHODS``, docs/visibility.md). For the meshes
         (``VISIBILITY_METHODS``): ``"depth-buffer"`` (the default), ``"scan-line"``, ``"area-subdivision"``
@@ -217,12 +219,12 @@ def render(
         shadow rays through the scene's BVH (``method="ray-casting"`` always uses rays). Lights with
         ``cast_shadows=False`` and ambient light cast none. Surface modes only; not with ``method="octree"`` or
         ``"a-buffer"``. What casts, what receives and how each shading mode uses the result:
-        ``frustum.shadow_pass`` (pass: ``render.shadows``).
+        ``frustum.render.shadows.fractions`` (pass: ``render.shadows``).
     shadow_map_size : int
         Texels on a side of each shadow map, a power of two in [64, 16384] (a point light has six).
     shadow_softness : float
         Percentage-closer filter width in texels, in [0, 16]; 0: hard edges; up to 1 (default): the 2 × 2 texels
-        around the point, bilinearly weighted (``frustum.shadow_pass``).
+        around the point, bilinearly weighted (``frustum.render.shadows.fractions``).
     tone_map : {"none", "aces", "khronos-neutral"}
         The metallic–roughness model's output transform after `exposure` and before `color_space`
         (``frustum.shading.tone``): ``"none"`` (default: the radiance, clamped, as the classical model's), the
@@ -266,8 +268,9 @@ def _draw(scene: Scene, camera: Camera, options: RenderOptions) -> Buffers:
         lines.draw_edges(scene.items, camera, options, buffers)
         lines.draw_polylines(scene.polylines, camera, options, buffers)
         reflection.paint_background(camera, options, buffers)
-        composite.draw_volumes(scene, camera, buffers)  # each ray stopped at the depth the lines wrote
-        composite.draw_particles(scene, camera, buffers)
+        # each ray stopped at the depth the lines wrote
+        volumes.draw_volumes(scene, camera, buffers.depth, buffers.color)
+        particles.draw_particles(scene.particle_layers, camera, buffers.depth, buffers.color)
         return buffers
     _draw_surfaces(scene, camera, options, buffers)
     buffers.scratch.release()
@@ -279,8 +282,8 @@ def _draw(scene: Scene, camera: Camera, options: RenderOptions) -> Buffers:
             lines.draw_edges(scene.items, camera, options, buffers)
         lines.draw_polylines(scene.polylines, camera, options, buffers)
         if not options.volumes_with_surfaces:  # "hidden-line": rays stopped at the (invisible) surfaces
-            composite.draw_volumes(scene, camera, buffers)
-    composite.draw_particles(scene, camera, buffers)
+            volumes.draw_volumes(scene, camera, buffers.depth, buffers.color)
+    particles.draw_particles(scene.particle_layers, camera, buffers.depth, buffers.color)
     return buffers
 
 
@@ -297,7 +300,7 @@ def _draw_surfaces(scene: Scene, camera: Camera, options: RenderOptions, buffers
             if options.mode == "surface+edges":
                 lines.draw_edges(scene.items, camera, options, buffers)
             lines.draw_polylines(scene.polylines, camera, options, buffers)
-            composite.draw_volumes(scene, camera, buffers)
+            volumes.draw_volumes(scene, camera, buffers.depth, buffers.color)
 
     if options.method == "ray-tracing":
         from frustum.render import raytrace

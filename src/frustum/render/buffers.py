@@ -206,8 +206,6 @@ def _shadow_buffers(options: RenderOptions) -> tuple[np.ndarray | None, np.ndarr
     if "shadow" in options.buffers:
         seen = options.outputs["seen"][..., options.outputs["casting"]]
         shadow = np.where(np.isnan(points[..., :1]), np.float32(np.nan), seen).astype(np.float32)
-    from frustum.shadow_pass import give_back
-
     give_back(points)  # copied out above: the next frame may have it
     return position, shadow
 
@@ -272,3 +270,33 @@ def downsample(values: np.ndarray, factor: int, kind: str) -> np.ndarray:
         return total
 
     return along(along(values, 0, height), 1, width)
+
+
+_POOL: dict[tuple, list[np.ndarray]] = {}
+_POOL_LOCK = threading.Lock()
+
+
+def take_array(shape: tuple[int, ...], dtype: Any) -> np.ndarray:
+    """An uninitialized work array, one a previous frame gave back where shape and dtype match (no first-touch
+    page faults for the maps and per-pixel arrays of an animation's every frame)."""
+    key = (tuple(shape), np.dtype(dtype).str)
+    with _POOL_LOCK:
+        arrays = _POOL.get(key)
+        if arrays:
+            return arrays.pop()
+    return np.empty(shape, dtype=dtype)
+
+
+def give_back(*arrays: np.ndarray) -> None:
+    """Keep `arrays` for the next frame (only the last frame's: the pool holds one array per shape)."""
+    with _POOL_LOCK:
+        for array in arrays:
+            _POOL[(array.shape, array.dtype.str)] = [array]
+
+
+def release_work_arrays() -> int:
+    """Free the arrays ``take_array`` keeps between frames; return their bytes."""
+    with _POOL_LOCK:
+        released = sum(a.nbytes for arrays in _POOL.values() for a in arrays)
+        _POOL.clear()
+    return released

@@ -11,12 +11,18 @@ import numpy as np
 from frustum.camera import Camera
 from frustum.clipping import VIEW_VOLUME_PLANES
 from frustum.geometry import Mesh
-from frustum.hidden_lines import EdgeAdjacency, classify_edges, edge_adjacency, front_facing, welded_adjacency
 from frustum.raster import lines
 from frustum.render.buffers import Buffers
 from frustum.render.options import EDGE_MODES, RenderOptions
 from frustum.render.stages import cue_color, item_matrices, rows, world_faces
 from frustum.scene import SceneItem
+from frustum.visibility.hidden_lines import (
+    EdgeAdjacency,
+    classify_edges,
+    edge_adjacency,
+    front_facing,
+    welded_adjacency,
+)
 
 EDGE_OFFSET = 1e-5
 """Window-depth offset of the hidden-line test (``raster.lines``), against stitching of edges into faces."""

@@ -16,9 +16,9 @@ import numpy as np
 from frustum.camera import Camera
 from frustum.frame import Frame, background_bytes
 from frustum.geometry import Mesh
-from frustum.render import shadows
 from frustum.render.buffers import Buffers, Scratch, clear_buffers
 from frustum.render.options import METHOD_NAMES, RenderOptions, check_arguments
+from frustum.render.shadows import passes as shadows
 from frustum.render.stages import (
     Lighting,
     Pixels,
@@ -64,7 +64,7 @@ def render_octrees(scene: Scene, camera: Camera, *, background: Any) -> Frame:
         nearer = written & (item_depth < depth)
         color[nearer], depth[nearer] = item_color[nearer], item_depth[nearer]
     if scene.volumes:  # ray cast over the octrees, each ray stopped at their depth
-        from frustum.volume_pass import draw_volumes
+        from frustum.render.volumes import draw_volumes
 
         draw_volumes(scene, camera, depth, color)
     return Frame(color=color, depth=depth)

@@ -56,6 +56,10 @@ MAX_DEPTH = 64
 MAX_LINE_WIDTH = 256.0
 """Widest line (and largest point) ``render`` draws, in output pixels."""
 
+SHADOW_METHODS = (None, False, True, "ray")
+"""``render(..., shadows=...)``: the method's own (off for every method of today), off, shadow maps, rays."""
+MIN_MAP_SIZE, MAX_MAP_SIZE = 64, 16384
+
 DEFAULT_BACKGROUND = (0.0, 0.0, 0.0, 1.0)
 """``render``'s default background (opaque black). Left at this very object, a scene's environment map is shown
 instead (``frustum.render.reflection``)."""
@@ -117,7 +121,7 @@ class RenderOptions:
     factor: int = 1
     filter: str = "box"
     color_space: str = "linear"
-    shadow: Any = None  # shadow_pass.ShadowOptions, or None: no shadows
+    shadow: Any = None  # ShadowOptions, or None: no shadows
     outputs: dict | None = None  # "position", "seen", "casting" (render.shadows), filled while drawing
     environment: Any = None  # the scene's EnvironmentMap, for reflections (and the background, below)
     environment_background: bool = False  # no background given: the environment map is the background
@@ -174,10 +178,8 @@ class RenderOptions:
 
 
 def shadow_options(options: RenderOptions, shadows: Any, map_size: Any, softness: Any, where: str) -> RenderOptions:
-    """Check the shadow arguments (``frustum.shadow_pass.check_shadows``); the options with the shadow settings and
+    """Check the shadow arguments (``check_shadows``); the options with the shadow settings and
     an outputs dict where the shadow pass runs (shadows on, or the "position" buffer asked for)."""
-    from frustum.shadow_pass import check_shadows
-
     shadow = check_shadows(shadows, map_size, softness, options.method, options.mode, where)
     if "shadow" in options.buffers and shadow is None:
         raise FrustumError(
@@ -393,3 +395,57 @@ def ray_options(options: RenderOptions, max_depth: Any, shadows: Any, depth_cue:
                 f"{shading!r}, depth_cue = {describe(depth_cue)}, transparency = {options.transparency!r}"
             )
     return int(max_depth), bool(tracing if shadows is None else shadows)
+
+
+@dataclasses.dataclass(frozen=True)
+class ShadowOptions:
+    """What ``render`` was asked for: ``"map"`` or ``"ray"``, the map size in texels and the PCF radius."""
+
+    method: str
+    map_size: int = 2048
+    softness: float = 1.0
+
+
+def check_shadows(
+    shadows: Any, shadow_map_size: Any, shadow_softness: Any, method: str, mode: str, where: str
+) -> ShadowOptions | None:  # fmt: skip
+    """The ``shadows``/``shadow_map_size``/``shadow_softness`` arguments checked; None where shadows are off."""
+    if not (shadows is None or isinstance(shadows, bool | np.bool_) or shadows == "ray"):
+        raise FrustumError(
+            f"{where}: shadows = {describe(shadows)} is unknown; expected None (the method's own), False, True "
+            "(shadow maps) or 'ray' (shadow rays)"
+        )
+    if isinstance(shadow_map_size, bool) or not isinstance(shadow_map_size, int | np.integer):
+        raise FrustumError(
+            f"{where}: shadow_map_size = {describe(shadow_map_size)} is not an integer; give a power of two in "
+            f"[{MIN_MAP_SIZE}, {MAX_MAP_SIZE}]"
+        )
+    size = int(shadow_map_size)
+    if not (MIN_MAP_SIZE <= size <= MAX_MAP_SIZE and size & (size - 1) == 0):
+        raise FrustumError(
+            f"{where}: shadow_map_size = {size} is not a power of two in [{MIN_MAP_SIZE}, {MAX_MAP_SIZE}]; give "
+            "e.g. 1024, 2048 or 4096"
+        )
+    try:
+        softness = float(shadow_softness)
+    except (TypeError, ValueError):
+        softness = math.nan
+    if isinstance(shadow_softness, bool) or not (0.0 <= softness <= 16.0):
+        raise FrustumError(
+            f"{where}: shadow_softness = {describe(shadow_softness)} is not a number in [0, 16]; give the "
+            "filter radius in shadow-map texels (0: hard edges)"
+        )
+    if shadows is None or shadows is False or (isinstance(shadows, np.bool_) and not shadows):
+        return None
+    if mode not in ("surface", "surface+edges"):
+        raise FrustumError(
+            f"{where}: shadows = {shadows!r} with mode = {mode!r}: shadows fall on shaded surfaces; use mode "
+            "'surface' or 'surface+edges', or shadows=False"
+        )
+    if method in ("octree", "a-buffer"):
+        raise FrustumError(
+            f"{where}: shadows = {shadows!r} is not available with method = {method!r}; use another method, "
+            "or shadows=False"
+        )
+    kind = "ray" if shadows == "ray" or method == "ray-casting" else "map"
+    return ShadowOptions(kind, size, softness)

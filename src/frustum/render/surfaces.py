@@ -9,9 +9,9 @@ from collections.abc import Callable
 import numpy as np
 
 from frustum.camera import Camera
-from frustum.render import shadows
 from frustum.render.buffers import Buffers, FrameBuffers, clear_buffers
 from frustum.render.options import RenderOptions
+from frustum.render.shadows import passes as shadows
 from frustum.render.stages import (
     TILED_BITS,
     Lighting,

@@ -128,7 +128,7 @@ class SceneFile:
                                  **self.options)  # fmt: skip
         scene, options = self.scene, self.options
         if self.radiosity is not None:
-            from frustum.radiosity import radiosity
+            from frustum.render.radiosity import radiosity
 
             scene, options = radiosity(self.scene, **self.radiosity).scene, {**self.options, "shading": "none"}
         frames = [render(scene, camera, **options) for camera in self.cameras]

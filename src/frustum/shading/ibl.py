@@ -5,16 +5,16 @@ lookups [Karis 2013, "Real Shading in Unreal Engine 4"; Ramamoorthi & Hanrahan 2
 * **Diffuse**: the irradiance $E(n) = ∫ L(l)·max(n·l, 0) dω$ from the map's first nine spherical harmonics,
   $E(n) = Σ_{l ≤ 2} Â_l Σ_m L_{lm} Y_{lm}(n)$ with $Â_0 = π$, $Â_1 = 2π/3$, $Â_2 = π/4$; a Lambertian surface of
   colour c reflects $c·E(n)/π$ (``irradiance_sh`` stores the coefficients already times $Â_l/π$).
-* **Specular** by the split sum: $∫ L·f·(n·l) dω ≈ prefiltered(R_d, roughness)·(f0·A + B)$, with R = 2(n·v)n − v
-  the mirror direction of v about n turned toward n as the lobe of a rough surface is,
-  $R_d = t·R + (1 − t)·n$, $t = s(√s + α)$, $s = 1 − α$ (the dominant direction of Lagarde & de Rousiers,
-  "Moving Frostbite to PBR", 2014). ``prefiltered`` is the map convolved with the GGX lobe around R (n = v = R
-  assumed), weighted by n·l: $P(R) = Σ_l L(l)·D(h)·(n·l)·Δω / Σ_l D(h)·(n·l)·Δω$ summed exactly over the
-  texels of a resampled map (no sampling noise; each row a circular correlation by FFT), one latitude–longitude map per roughness of
-  ``ROUGHNESS_LEVELS`` (roughness 0: the map itself); between levels the shader interpolates linearly. A and B
-  (``brdf_table``) are the scale and bias to f0 of the directional albedo of the GGX specular lobe with the
-  height-correlated Smith term, $A = ∫ (1 − F_c)·G_vis$, $B = ∫ F_c·G_vis$, $F_c = (1 − v·h)⁵$, over
-  (n·v, roughness), by importance sampling once (Hammersley points) and cached for the process.
+* **Specular** by the split sum: $∫ L·f·(n·l) dω ≈ prefiltered(R_d, roughness)·(f0·A + B)$, with R = 2(n·v)n − v the
+  mirror direction of v about n turned toward n as the lobe of a rough surface is, $R_d = t·R + (1 − t)·n$, $t = s(√s
+  + α)$, $s = 1 − α$ (the dominant direction of Lagarde & de Rousiers, "Moving Frostbite to PBR", 2014).
+  ``prefiltered`` is the map convolved with the GGX lobe around R (n = v = R assumed), weighted by n·l: $P(R) = Σ_l
+  L(l)·D(h)·(n·l)·Δω / Σ_l D(h)·(n·l)·Δω$ summed exactly over the texels of a resampled map (no sampling noise; each
+  row a circular correlation by FFT), one latitude–longitude map per roughness of ``ROUGHNESS_LEVELS`` (roughness 0:
+  the map itself); between levels the shader interpolates linearly. A and B (``brdf_table``) are the scale and bias to
+  f0 of the directional albedo of the GGX specular lobe with the height-correlated Smith term, $A = ∫ (1 −
+  F_c)·G_vis$, $B = ∫ F_c·G_vis$, $F_c = (1 − v·h)⁵$, over (n·v, roughness), by importance sampling once (Hammersley
+  points) and cached for the process.
 
 The metallic–roughness BRDF then reflects, for specular weight $S = f0·A + B$ (f0 = mix(0.04, base, metallic)),
 $S·P(R) + (1 − metallic)·(1 − (0.04·A + B))·base·E(n)/π$, times the occlusion $1 + k·(occlusion − 1)$: for a

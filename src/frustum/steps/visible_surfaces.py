@@ -16,7 +16,6 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from frustum._arrays import as_faces, as_points, as_vector3
-from frustum.bsp import BSPTree
 from frustum.budgets import check_memory, check_operations
 from frustum.camera import Camera
 from frustum.errors import CameraError, FrustumError, GeometryError, OutputError
@@ -26,6 +25,7 @@ from frustum.steps._record import Step, Steps, _Canvas, format_value
 from frustum.steps.modeling import HOUSE_POINTS
 from frustum.steps.viewing import _camera
 from frustum.visibility import backface_mask
+from frustum.visibility.bsp import BSPTree
 
 __all__ = [
     "HOUSE_FACES",
@@ -532,10 +532,10 @@ def depth_sort(polygons: ArrayLike | None = None, camera: Camera | None = None) 
     """The depth-sorting (painter's) method: the list by greatest depth, the overlap tests 1–4 of each P against
     the Q it might hide, moves to the head of the list, splits of cyclic overlaps, then each polygon painted.
 
-    Runs ``frustum.bsp.depth_sort(polygons, camera, record=...)``; ``result`` is its ``DepthOrder``. Default: three
+    Runs ``visibility.bsp.depth_sort(polygons, camera, record=...)``; ``result`` is its ``DepthOrder``. Default: three
     triangles that overlap cyclically, which only a split can order.
     """
-    from frustum.bsp import depth_sort as production
+    from frustum.visibility.bsp import depth_sort as production
 
     where = "steps.depth_sort"
     if polygons is None:

@@ -1,6 +1,6 @@
 """Object-space ordering drawn as a raster frame: the depth sort and the BSP tree paint filled, shaded fragments.
 
-``frustum.bsp`` orders polygons back to front (splitting where no order exists) for vector output. Here the
+``frustum.visibility.bsp`` orders polygons back to front (splitting where no order exists) for vector output. Here the
 same two methods order the scene's *window triangles* (the triangles the depth buffer draws, after clipping to
 the view volume), given to them in window coordinates $(x, y, −S·z_w)$ with S the larger image side: the
 projection is already applied, so every camera becomes a parallel view along −z (a perspective divide maps
@@ -56,14 +56,14 @@ def _paint(
 
 
 def depth_sort(triangles: WindowTriangles, depth: np.ndarray, codes: np.ndarray, bary: np.ndarray) -> dict:
-    """Newell–Newell–Sancha depth sort (``frustum.bsp.depth_sort``) of the window triangles, painted back to front.
+    """Newell–Newell–Sancha depth sort (``visibility.bsp.depth_sort``) of the window triangles, painted back to front.
 
     Buffers as ``scanline.scan_line``. Returns ``fragments`` painted, ``pixels_painted`` (overdraw included),
     ``splits`` (cyclic overlaps and piercing triangles cut), ``unresolved``, ``triangles``.
     """
-    from frustum.bsp import depth_sort as sort
     from frustum.camera import Camera, ViewFrame
     from frustum.projection import Orthographic
+    from frustum.visibility.bsp import depth_sort as sort
 
     if triangles.count == 0:
         return {"fragments": 0, "pixels_painted": 0, "splits": 0, "unresolved": 0, "triangles": 0}
@@ -79,12 +79,12 @@ def depth_sort(triangles: WindowTriangles, depth: np.ndarray, codes: np.ndarray,
 
 
 def bsp_tree(triangles: WindowTriangles, depth: np.ndarray, codes: np.ndarray, bary: np.ndarray) -> dict:
-    """BSP tree (``frustum.bsp.BSPTree``) of the window triangles, read back to front and painted.
+    """BSP tree (``frustum.visibility.bsp.BSPTree``) of the window triangles, read back to front and painted.
 
     Buffers as ``scanline.scan_line``. Returns ``fragments`` painted, ``pixels_painted``, ``nodes``, ``splits``,
     ``triangles``.
     """
-    from frustum.bsp import BSPTree
+    from frustum.visibility.bsp import BSPTree
 
     if triangles.count == 0:
         return {"fragments": 0, "pixels_painted": 0, "nodes": 0, "splits": 0, "triangles": 0}

@@ -121,6 +121,8 @@ def _spatial_order(primitives: np.ndarray, rows: np.ndarray, width: int) -> np.n
 
 def draw_particles(layers: list[ParticleLayer], camera: Camera, depth: np.ndarray, color: np.ndarray) -> None:
     """Blend every layer's particles into `color` ((H, W, 4) uint8, in place), depth-tested against `depth`."""
+    if not layers:
+        return
     from frustum.raster import particles as kernels
 
     height = depth.shape[0]

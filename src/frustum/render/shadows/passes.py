@@ -1,6 +1,6 @@
 """The shadow pass's place in the surface passes: between filling the depth buffer with the opaque items and shading
 them, ``prepare`` finds each drawn pixel's world point and, with shadows on, the fraction of each light reaching
-it (``frustum.shadow_pass``: shadow maps drawn by ``draw_depth``, the renderer's own binning and tile fill from
+it (``render.shadows.fractions``: shadow maps drawn by ``draw_depth``, the renderer's own binning and tile fill from
 the light, or shadow rays); ``shade_item`` then shades with those fractions (``raster.shadow``) or, where there
 are none, exactly as ``stages.shade_item`` does. Off the ordinary path: nothing here runs, and no kernel of
 ``raster.shadow`` compiles, unless ``render`` is asked for shadows or the "position" buffer."""
@@ -60,7 +60,7 @@ def prepare(
     without an outputs dict (no shadows, no "position" buffer)."""
     if options.outputs is None:
         return
-    from frustum import shadow_pass
+    from frustum.render.shadows import fractions as shadow_pass
 
     points, facing = shadow_pass.surface_points(items, drawn, pixels.depth, pixels.codes, pixels.bary)
     options.outputs["position"] = points
@@ -171,8 +171,8 @@ def draw_tiled(
     size, as in a turntable of a model the camera sees whole under a fixed sun); then each tile is filled and
     shaded, the map lookups made per pixel inside the shading (no image-sized world points, normals or
     fractions)."""
-    from frustum import shadow_pass
     from frustum.raster import shadow, shadow_tiled
+    from frustum.render.shadows import fractions as shadow_pass
 
     binned = bin_item(item, camera, options.cull, 0, buffers.scratch, tile_bits=TILED_BITS)
     world, normals = world_attributes(item, buffers.scratch)
