@@ -128,7 +128,7 @@ def _equirect(maps: np.ndarray, level: int, x: float, y: float, z: float) -> tup
 
 @kernel
 def prefiltered(maps: np.ndarray, roughness: float, x: float, y: float, z: float) -> tuple[float, float, float]:
-    """The prefiltered radiance along R, linear between the two levels around ``roughness·(levels − 1)``."""
+    """The prefiltered radiance along R, linear between the two levels around $roughness·(levels − 1)$."""
     top = maps.shape[0] - 1
     level = min(max(roughness, 0.0), 1.0) * top
     low = min(math.floor(level), top - 1)

@@ -10,7 +10,7 @@ $$f(l, v) = mix(f_dielectric, f_metal, metallic)$$
 $$f_dielectric = mix(base/π, V·D, F(0.04)),  f_metal = V·D·F(base)$$
 
 with D the Trowbridge–Reitz (GGX) distribution, V the height-correlated Smith visibility (G/(4|n·l||n·v|) folded
-in) and F(f0) = f0 + (1 − f0)(1 − |v·h|)⁵ the Schlick Fresnel term; ``mix(a, b, t) = (1 − t)·a + t·b``.
+in) and F(f0) = f0 + (1 − f0)(1 − |v·h|)⁵ the Schlick Fresnel term; $mix(a, b, t) = (1 − t)·a + t·b$.
 
 Lights (KHR_lights_punctual units) add, per light, $f(l, v)·E·(n·l)$ to the outgoing linear radiance, where E is
 the illuminance at the point: a directional light's ``intensity`` in lux (lm/m²); a point or spot light's in
