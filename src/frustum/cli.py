@@ -396,7 +396,7 @@ def turntable_command(
     """Render a mesh from a camera orbiting it once and write the frames as a looping GIF or an MP4 (the file's
     materials and textures, the default lights of frustum.scenefile.models)."""
     from frustum.output.animation import framing_camera, turntable
-    from frustum.scenefile.models import model_scene
+    from frustum.scenefile.models import model_scene, physical_options
 
     width, height = _image_size(size)
     if not 0 <= abs(elevation_deg) < 90:
@@ -405,7 +405,8 @@ def turntable_command(
     scene, _ = model_scene(mesh, up=up, size=(width, height))
     camera = framing_camera(scene, width, height, elevation=math.radians(elevation_deg))
     count = turntable(
-        scene, camera, frames, axis, output, fps, progress=error_console, cull_back_faces=False, mode=mode
+        scene, camera, frames, axis, output, fps, progress=error_console, cull_back_faces=False, mode=mode,
+        **physical_options(scene),
     )
     console.print(f"wrote {output} ({count} frames, {width}x{height})", markup=False, highlight=False, soft_wrap=True)
 
