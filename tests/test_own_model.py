@@ -29,10 +29,12 @@ TEAPOT = DATA / "teapot_n10.obj"
 
 
 def _spot_glb(folder: Path) -> Path:
-    """Spot as a GLB with its texture embedded (base colour factor white, so the texture shows as it is)."""
+    """Spot as a GLB with its texture embedded (base colour factor white, so the texture shows as it is; a
+    dielectric: without a metallic factor glTF's default is a metal, dark without an environment)."""
     mesh = trimesh.load(SPOT, process=False)
     image = Image.open(TEXTURE)
-    material = trimesh.visual.material.PBRMaterial(baseColorTexture=image, baseColorFactor=[255, 255, 255, 255])
+    material = trimesh.visual.material.PBRMaterial(baseColorTexture=image, baseColorFactor=[255, 255, 255, 255],
+                                                   metallicFactor=0.0, roughnessFactor=0.6)  # fmt: skip
     mesh.visual = trimesh.visual.TextureVisuals(uv=mesh.visual.uv, material=material)
     path = folder / "spot.glb"
     mesh.export(path)

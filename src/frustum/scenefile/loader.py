@@ -339,7 +339,8 @@ def _build(report: _Report, data: dict, base: Path, check_outputs: bool = True) 
     else:
         report.missing(("camera",), "add a [camera] table with eye and target (or [[cameras]])")
     if cameras and _wants_default_lights(data, scene, options):
-        for light in default_lights(cameras[0]):  # no lights named: the default three-point set around the camera
+        physical = any(item.material.model == "pbr" for item in scene.items)  # lights in lux for those materials
+        for light in default_lights(cameras[0], physical):  # no lights named: the three-point set around the camera
             scene.root.add_light(light)
     outputs, animation, svg = _outputs(report, data, base, check_outputs)
     _check_image_memory(report, options, size, max(len(cameras), 1))
