@@ -103,13 +103,10 @@ def sh_irradiance(sh: np.ndarray, channel: int, x: float, y: float, z: float) ->
 
 
 @kernel
-def _equirect(maps: np.ndarray, level: int, x: float, y: float, z: float) -> tuple[float, float, float]:
-    """Bilinear lookup of map `level` along the unit direction (x, y, z): $u = 1/2 + atan2(x, −z)/2π$,
-    $v = acos(y)/π$ (``EnvironmentMap``'s equirect layout; u wraps, v clamps)."""
+def _texel(maps: np.ndarray, level: int, fx: float, fy: float) -> tuple[float, float, float]:
+    """Bilinear lookup of map `level` at continuous texel coordinates (fx, fy) (centres at integers; columns wrap,
+    rows clamp)."""
     height, width = maps.shape[1], maps.shape[2]
-    u = 0.5 + math.atan2(x, -z) / (2.0 * math.pi)
-    v = math.acos(min(max(y, -1.0), 1.0)) / math.pi
-    fx, fy = u * width - 0.5, v * height - 0.5
     x0, y0 = math.floor(fx), math.floor(fy)
     tx, ty = fx - x0, fy - y0
     i0 = int(x0) % width
@@ -128,13 +125,18 @@ def _equirect(maps: np.ndarray, level: int, x: float, y: float, z: float) -> tup
 
 @kernel
 def prefiltered(maps: np.ndarray, roughness: float, x: float, y: float, z: float) -> tuple[float, float, float]:
-    """The prefiltered radiance along R, linear between the two levels around $roughness·(levels − 1)$."""
+    """The prefiltered radiance along the unit direction (x, y, z) (``EnvironmentMap``'s equirect layout:
+    $u = 1/2 + atan2(x, −z)/2π$, $v = acos(y)/π$), linear between the two levels around $roughness·(levels − 1)$."""
     top = maps.shape[0] - 1
     level = min(max(roughness, 0.0), 1.0) * top
     low = min(math.floor(level), top - 1)
     t = level - low
-    r0, g0, b0 = _equirect(maps, low, x, y, z)
-    r1, g1, b1 = _equirect(maps, low + 1, x, y, z)
+    fx = (0.5 + math.atan2(x, -z) / (2.0 * math.pi)) * maps.shape[2] - 0.5
+    fy = math.acos(min(max(y, -1.0), 1.0)) / math.pi * maps.shape[1] - 0.5
+    r0, g0, b0 = _texel(maps, low, fx, fy)
+    if t == 0.0:
+        return r0, g0, b0
+    r1, g1, b1 = _texel(maps, low + 1, fx, fy)
     return (1.0 - t) * r0 + t * r1, (1.0 - t) * g0 + t * g1, (1.0 - t) * b0 + t * b1
 
 
