@@ -88,7 +88,7 @@ def _medians(runs: list[tuple[float, float]]) -> tuple[float, float]:
 
 def _resident_cpu(env: dict[str, str]) -> float:
     """CPU seconds (user + system) the resident render processes of `env`'s runtime folder have used so far."""
-    script = "from frustum import resident; print(' '.join(str(e['pid']) for e in resident.status()))"
+    script = "from frustum.app import resident; print(' '.join(str(e['pid']) for e in resident.status()))"
     pids = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True).stdout.split()
     total = 0.0
     for pid in pids:

@@ -9,7 +9,7 @@ machine) of every kernel (outermost compilations only: a kernel's callees compil
 inside it), the total, and the wall time of the whole render. A second run in a new
 process with the same cache directory gives the warm time.
 
-``frustum render`` starts a second compiler on a cold cache (``frustum.warmup.FIRST_PICTURE``, compiled by
+``frustum render`` starts a second compiler on a cold cache (``frustum.app.warmup.FIRST_PICTURE``, compiled by
 ``frustum.raster._background`` in a child process): the table lists what the render compiled itself; the child's
 CPU seconds, its reports and how long the render waited for it are printed below the table. On a quiet machine
 the cold wall time is about the render's own CPU time plus that wait. ``FRUSTUM_BACKGROUND_COMPILE=0`` measures
@@ -45,7 +45,7 @@ class Listener(event.Listener):
                         "signature": str(ev.data["args"])[:200]})
 
 event.register("numba:compile", Listener())
-from frustum.cli import main
+from frustum.app.cli import main
 sys.argv[0] = "frustum"
 try:
     main()  # as the console script runs it (the program's garbage-collector settings apply)

@@ -27,10 +27,10 @@ from scipy.spatial.transform import Rotation
 
 import frustum
 from frustum import Camera, CameraError, Frustum, FrustumError, Orthographic, OutputError, Perspective, SceneFileError
+from frustum.app.cli import main
 from frustum.batch import RenderJob, dataset_cameras, render_dataset, render_many
 from frustum.batch.cameras import colmap_pose, intrinsics, metric_depth
 from frustum.batch.jobs import TEMPORARY_MARK, write_atomically
-from frustum.cli import main
 from frustum.scene import Scene
 from frustum.scenefile import load_scene_file
 
@@ -686,7 +686,7 @@ def test_url_resume_after_sigkill_reads_the_parts_of_the_run_log(scene_path, tmp
     url = f"file://{tmp_path}/killed"
     environment = {**os.environ, "PYTHONPATH": os.pathsep.join([str(SRC), os.environ.get("PYTHONPATH", "")])}
     program = ("import sys; import frustum.batch.dataset as d; d.URL_LOG_SECONDS = 0.05; "
-               "from frustum.cli import main; sys.argv[0] = 'frustum'; main()")  # fmt: skip
+               "from frustum.app.cli import main; sys.argv[0] = 'frustum'; main()")  # fmt: skip
     process = subprocess.Popen([sys.executable, "-c", program, "dataset", str(scene_path), "--out", url,
                                 *arguments], env=environment, stdout=subprocess.DEVNULL,
                                stderr=subprocess.DEVNULL)  # fmt: skip

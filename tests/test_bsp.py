@@ -21,7 +21,8 @@ from hypothesis import strategies as st
 
 from frustum import Camera, CameraError, GeometryError, Mesh, Oblique, Orthographic, Perspective
 from frustum.transforms import apply, translate
-from frustum.visibility.bsp import BSPTree, DepthOrder, depth_sort
+from frustum.visibility.bsp import BSPTree
+from frustum.visibility.depth_sort import DepthOrder, depth_sort
 from testdata import DATA
 
 WIDTH, HEIGHT = 120, 90

@@ -12,7 +12,7 @@ import pytest
 import trimesh
 
 from frustum import Camera, Perspective, __version__, compose, rotate_z, translate
-from frustum.cli import main, parse_step
+from frustum.app.cli import main, parse_step
 from frustum.trace import trace
 from testdata import DATA
 
@@ -300,7 +300,7 @@ _GC_PROBE = """
 import atexit, gc, sys
 seen = {}
 atexit.register(lambda: print("enabled-at-exit", seen.get("enabled"), "frozen", gc.get_freeze_count() > 0))
-import frustum.cli as cli
+import frustum.app.cli as cli
 original = cli._main
 def probe(argv):
     seen["enabled"] = gc.isenabled()  # inside the command
@@ -332,15 +332,15 @@ def test_the_collector_resumes_after_the_pause(monkeypatch):
     import gc
     import time
 
-    from frustum import cli
+    from frustum.app import runtime
 
     gc.disable()
     try:
-        monkeypatch.setitem(cli._STATE, "resume_gc_at", time.monotonic() + 60.0)
-        cli._resume_gc_when_due()
+        monkeypatch.setitem(runtime._STATE, "resume_gc_at", time.monotonic() + 60.0)
+        runtime._resume_gc_when_due()
         assert not gc.isenabled()  # not yet due
-        monkeypatch.setitem(cli._STATE, "resume_gc_at", time.monotonic() - 0.01)
-        cli._resume_gc_when_due()
-        assert gc.isenabled() and cli._STATE["resume_gc_at"] is None
+        monkeypatch.setitem(runtime._STATE, "resume_gc_at", time.monotonic() - 0.01)
+        runtime._resume_gc_when_due()
+        assert gc.isenabled() and runtime._STATE["resume_gc_at"] is None
     finally:
         gc.enable()

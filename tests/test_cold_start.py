@@ -66,14 +66,16 @@ NOT_ON_THE_RENDER_PATH = (
     "frustum.visibility.bsp", "frustum.geometry.csg", "frustum.geometry.dimension", "frustum.geometry.escape_time",
     "frustum.geometry.fractals", "frustum.geometry.io", "frustum.geometry.lsystem", "frustum.geometry.octree",
     "frustum.geometry.volume", "frustum.output.sheet", "frustum.output.svg", "frustum.simulation", "frustum.stereo",
-    "frustum.trace", "frustum.visibility",
+    "frustum.trace", "frustum.visibility.depth_sort", "frustum.visibility.painter", "frustum.visibility.scanline",
+    "frustum.visibility.warnock", "frustum.visibility.abuffer", "frustum.visibility.raycast",
+    "frustum.render.radiosity", "frustum.render.raytrace", "frustum.render.shadows.fractions",
 )  # fmt: skip
 
 
 def test_the_readme_render_path_loads_only_what_it_uses():
     # the CLI, the renderer and the scene file (parsed, the teapot tessellated): everything but the kernel calls
     code = (
-        "import sys, frustum, frustum.cli, frustum.render\n"
+        "import sys, frustum, frustum.app.cli, frustum.render\n"
         "from frustum.scenefile import load_scene_file\n"
         "scene = load_scene_file('examples/teapot.toml')\n"
         "assert scene.scene.items, 'the teapot was not built'\n"
@@ -232,11 +234,11 @@ class Listener(event.Listener):
 
 event.register("numba:compile", Listener())
 from frustum.raster import _background
-from frustum.warmup import compile_in_background
+from frustum.app.warmup import compile_in_background
 if sys.argv[2] == "kill":  # the second compiler dies at once: the render compiles everything itself
     helper = compile_in_background()
     helper.process.kill()
-from frustum.cli import main
+from frustum.app.cli import main
 main(["render", "examples/teapot.toml", "-o", sys.argv[1]])
 helper = _background._started
 print("@@" + json.dumps({"compiled": compiled, "reported": helper and helper.reported}))
@@ -267,7 +269,7 @@ def warm_readme_picture(tmp_path_factory) -> bytes:
 @pytest.mark.slow
 @pytest.mark.skipif(len(os.sched_getaffinity(0)) < 2, reason="the second compiler starts only with two cores")
 def test_cold_readme_render_with_a_second_compiler_is_the_same_picture(tmp_path, warm_readme_picture):
-    from frustum.warmup import FIRST_PICTURE
+    from frustum.app.warmup import FIRST_PICTURE
 
     result, picture = _cold_readme_render(tmp_path, "background")
     planned = [name for _, name, _ in FIRST_PICTURE]
@@ -355,7 +357,7 @@ def test_the_child_reports_a_kernel_it_cannot_compile_and_goes_on(tmp_path):
 def test_no_child_without_the_jit_or_when_switched_off(tmp_path):
     for variable, value in (("NUMBA_DISABLE_JIT", "1"), ("FRUSTUM_BACKGROUND_COMPILE", "0")):
         env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"), **{variable: value})
-        code = "from frustum.warmup import compile_in_background; print(compile_in_background())"
+        code = "from frustum.app.warmup import compile_in_background; print(compile_in_background())"
         proc = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=env, capture_output=True, text=True,
                               timeout=300)  # fmt: skip
         assert proc.returncode == 0, proc.stderr

@@ -14,7 +14,7 @@ import pytest
 
 import frustum.scenefile
 import frustum.scenefile.commands
-from frustum.cli import main
+from frustum.app.cli import main
 from frustum.geometry import Mesh
 from frustum.geometry import primitives as prim
 from frustum.scenefile import explain_scene_file, load_scene_file, render_view_sheet

@@ -17,7 +17,7 @@ from PIL import Image
 
 import frustum
 from frustum import Camera
-from frustum.cli import main
+from frustum.app.cli import main
 from frustum.errors import CameraError, SceneFileError
 from frustum.scenefile import load_scene, load_scene_file
 

@@ -1,4 +1,4 @@
-"""The ``frustum`` program's own path for a plain ``frustum render FILE -o OUT`` (``frustum._program``, issue 36's
+"""The ``frustum`` program's own path for a plain ``frustum render FILE -o OUT`` (``frustum.app._program``, issue 36's
 warm one-command render): it accepts exactly the plain command lines, gives the same files, output, messages and
 exit statuses as the Typer command line, and imports neither Typer, Rich, Pydantic nor trimesh."""
 
@@ -10,12 +10,12 @@ from pathlib import Path
 
 import pytest
 
-from frustum._program import plain_render
+from frustum.app._program import plain_render
 from testdata import DATA
 
 ROOT = Path(__file__).resolve().parents[1]
 BUNNY = DATA / "bunny" / "bun_zipper_res4.ply"
-TYPER = "import sys; sys.argv[0] = 'frustum'; from frustum.cli import main; main()"
+TYPER = "import sys; sys.argv[0] = 'frustum'; from frustum.app.cli import main; main()"
 
 
 @pytest.mark.parametrize(
@@ -101,7 +101,7 @@ def test_the_program_fails_as_typer_does(tmp_path, arguments, status, fragment):
 
 def test_a_plain_render_imports_no_command_line_library_and_no_trimesh(tmp_path):
     code = (
-        "import sys\nfrom frustum._program import main\n"
+        "import sys\nfrom frustum.app._program import main\n"
         f"sys.argv = ['frustum', 'render', {str(BUNNY)!r}, '-o', 'out.png', '--size', '32x24']\nmain()\n"
         "print(sorted({m.split('.')[0] for m in sys.modules} & {'typer', 'click', 'rich', 'pydantic', 'trimesh'}))\n"
     )

@@ -125,14 +125,14 @@ def test_the_stub_lists_every_public_name_once(package):
 
 @pytest.mark.parametrize(
     "first",
-    ["import frustum.render", "import frustum.trace", "import frustum.warmup", "import frustum.geometry.teapot",
+    ["import frustum.render", "import frustum.trace", "import frustum.app.warmup", "import frustum.geometry.teapot",
      "from frustum.render import surfaces", "import frustum"],
 )  # fmt: skip
 def test_a_submodule_import_never_hides_the_function_of_its_name(first):
     """``frustum.render``, ``trace``, ``warmup`` and ``geometry.teapot`` are functions, whatever was imported first."""
     code = (
         f"{first}\n"
-        "import inspect, frustum, frustum.render, frustum.trace, frustum.warmup, frustum.geometry.teapot\n"
+        "import inspect, frustum, frustum.render, frustum.trace, frustum.app.warmup, frustum.geometry.teapot\n"
         "names = [frustum.render, frustum.trace, frustum.warmup, frustum.teapot, frustum.geometry.teapot]\n"
         "assert all(inspect.isfunction(f) for f in names), names\n"
         "assert frustum.render.__module__ == 'frustum.render' and frustum.geometry.teapot is frustum.teapot\n"

@@ -262,7 +262,7 @@ def test_empty_scene_and_background() -> None:
 def test_scene_file_and_explain(tmp_path, capsys) -> None:
     from pathlib import Path
 
-    from frustum.cli import main
+    from frustum.app.cli import main
     from frustum.errors import SceneFileError
     from frustum.scenefile import load_scene_file
 

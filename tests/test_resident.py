@@ -18,7 +18,7 @@ from pathlib import Path
 
 import pytest
 
-from frustum import resident
+from frustum.app import resident
 from testdata import DATA
 
 pytestmark = pytest.mark.skipif(not hasattr(socket, "SO_PEERCRED") or sys.platform != "linux",

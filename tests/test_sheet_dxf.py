@@ -1,4 +1,4 @@
-"""DXF sheets (``drawing_sheet(..., path="*.dxf")``, ``output/sheet_dxf.py``) read back by ezdxf.
+"""DXF sheets (``drawing_sheet(..., path="*.dxf")``, ``output/sheet/dxf.py``) read back by ezdxf.
 
 Oracles: ``ezdxf.readfile`` and ``doc.audit()``; the SVG sheet of the same scene (entity counts per layer); the
 model's radii and part extents; ezdxf's own drawing add-on (matplotlib backend) rendering the DXF, compared
@@ -200,7 +200,7 @@ def test_dxf_is_deterministic(tmp_path):
 
 
 def test_view_command_writes_dxf_and_reads_the_sheet_table(tmp_path):
-    from frustum.cli import main
+    from frustum.app.cli import main
 
     dxf, svg = tmp_path / "sheet.dxf", tmp_path / "sheet.svg"
     arguments = ["view", str(EXAMPLES / "exploded_assembly.toml")]

@@ -511,7 +511,7 @@ def test_ray_casting_steps_follow_one_ray_and_end_in_the_render(pixel):
     assert np.array_equal(recorded.result.depth, frame.depth)
     # the traced Python twin returns what the compiled kernel returns for this ray
     _items, index, _starts = scene._triangle_index()
-    ray = fs.visible_surfaces._pixel_ray(camera, *pixel)
+    ray = fs.visible_surfaces.rays._pixel_ray(camera, *pixel)
     twin, events = fs.visible_surfaces.traced_closest(index, np.empty(0, np.uint8), ray, 1)
     stack, entry = np.empty(index.depth + 2, dtype=np.int64), np.empty(index.depth + 2)
     compiled = rays._closest(index.boxes, index.links, index.triangles, index.order, np.empty(0, np.uint8), *ray,

@@ -361,7 +361,7 @@ def test_port_in_use_is_a_clear_error(capsys):
     try:
         with pytest.raises(FrustumError, match=rf"port = {port} on 127\.0\.0\.1 is already in use; choose another"):
             open_socket("127.0.0.1", port)
-        from frustum.cli import main
+        from frustum.app.cli import main
 
         with pytest.raises(SystemExit) as exit_info:
             main(["serve", str(TEAPOT_FILE), "--port", str(port)])

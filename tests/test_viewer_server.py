@@ -204,7 +204,7 @@ def test_access_rules_for_a_wildcard_and_a_named_address():
 
 def test_cli_passes_allow_origin_and_no_token(monkeypatch, tmp_path):
     import frustum.viewer.server as server_module
-    from frustum.cli import main
+    from frustum.app.cli import main
 
     calls = []
     monkeypatch.setattr(server_module, "serve", lambda *args, **kwargs: calls.append((args, kwargs)))

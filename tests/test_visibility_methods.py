@@ -472,7 +472,7 @@ geometry = { type = "torus", major_radius = 1.0, minor_radius = 0.3, major_segme
 
 
 def test_explain_method_prints_the_counts(tmp_path, capsys) -> None:
-    from frustum.cli import main
+    from frustum.app.cli import main
 
     path = tmp_path / "ball.toml"
     path.write_text(SCENE_FILE)

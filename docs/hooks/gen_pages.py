@@ -292,11 +292,11 @@ def cli_page() -> str:
     import typer
 
     _frustum()
-    from frustum.cli import app
+    from frustum.app.cli import app
 
     command = typer.main.get_command(app)
     lines = ["# Command line", "",
-             "Generated at build time from the Typer app (`frustum.cli`): the `--help` of every command. "
+             "Generated at build time from the Typer app (`frustum.app.cli`): the `--help` of every command. "
              "Errors print one line and exit non-zero.", ""]
 
     from typer.testing import CliRunner

@@ -26,6 +26,8 @@ from .batch import (
 )
 from .visibility.bsp import (
     BSPTree as BSPTree,
+)
+from .visibility.depth_sort import (
     DepthOrder as DepthOrder,
     depth_sort as depth_sort,
 )
@@ -400,6 +402,6 @@ from .visibility import (
 from .visibility.octree import (
     render_octree as render_octree,
 )
-from .warmup import (
+from .app.warmup import (
     warmup as warmup,
 )

@@ -1,5 +1,5 @@
 """``python -m frustum`` runs the ``frustum`` command."""
 
-from frustum._program import main
+from frustum.app._program import main
 
 main()

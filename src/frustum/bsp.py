@@ -1,4 +1,7 @@
-"""Moved to ``frustum.visibility.bsp`` (docs/architecture.md): this path re-exports it."""
+"""Moved to ``frustum.visibility.bsp`` and ``frustum.visibility.depth_sort`` (docs/architecture.md): this path
+re-exports them."""
 
-from frustum.visibility.bsp import *  # noqa: F403
-from frustum.visibility.bsp import __all__ as __all__
+from frustum.visibility.bsp import BSPTree
+from frustum.visibility.depth_sort import DepthOrder, depth_sort
+
+__all__ = ["BSPTree", "DepthOrder", "depth_sort"]

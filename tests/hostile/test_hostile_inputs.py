@@ -45,7 +45,7 @@ def run_case(code: str, *, env: dict[str, str] | None = None, cwd: Path | None =
 
 def run_cli(*arguments: str, env: dict[str, str] | None = None, cwd: Path | None = None):
     """The frustum command in a subprocess under the memory cap and timeout."""
-    code = f"import sys; sys.argv = ['frustum', *{list(arguments)!r}]; from frustum.cli import main; main()"
+    code = f"import sys; sys.argv = ['frustum', *{list(arguments)!r}]; from frustum.app.cli import main; main()"
     environment = {**os.environ, **(env or {})}
     return subprocess.run(
         [sys.executable, "-c", f"import resource; resource.setrlimit(resource.RLIMIT_AS, ({MEMORY_CAP}, "

@@ -1,7 +1,8 @@
 """The pipeline driver: ``render(scene, camera)`` runs the passes in order and returns a ``Frame``.
 
 The passes, one module each (``_draw`` lists them in order; a new pass is a module and a line there):
-``options`` (the checked options, one frozen object), ``buffers`` (frame buffers, scratch, clear, resolve),
+``options`` (the checked options, one frozen object: configuration only), ``context`` (what one image's passes
+draw into and hand on: buffers, counts, outputs; the Frame made of them), ``buffers`` (recycled arrays, filters),
 ``surfaces`` (the depth buffer's opaque and transparent surfaces), ``methods`` (the other visible-surface methods,
 dispatched to ``visibility/``), ``lines`` (edges, wireframes, points, polylines), ``volumes`` (volumes ray cast over
 the surfaces, each ray stopped at the depth there), ``particles`` (particle layers, depth-tested, depth not
@@ -54,18 +55,17 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import sys
 from typing import Any
 
 from frustum.camera import Camera
 from frustum.frame import Frame
 from frustum.render import lines, methods, particles, reflection, surfaces, volumes
-from frustum.render.buffers import Buffers, resolve
 from frustum.render.buffers import FrameBuffers as FrameBuffers
 from frustum.render.buffers import Scratch as Scratch
 from frustum.render.buffers import block_min as block_min
 from frustum.render.buffers import clear_buffers as clear_buffers
 from frustum.render.buffers import resolve_color as resolve_color
+from frustum.render.context import FrameContext
 from frustum.render.lines import mesh_edges as mesh_edges
 from frustum.render.methods import RENDER_METHODS as RENDER_METHODS
 from frustum.render.methods import VISIBILITY_METHODS as VISIBILITY_METHODS
@@ -74,6 +74,7 @@ from frustum.render.options import HIDDEN_STYLES as HIDDEN_STYLES
 from frustum.render.options import RENDER_MODES as RENDER_MODES
 from frustum.render.options import SHADING_MODES as SHADING_MODES
 from frustum.render.options import TRANSPARENCY_MODES as TRANSPARENCY_MODES
+from frustum.render.shadows import fractions
 from frustum.render.stages import TILE_SIZE as TILE_SIZE
 from frustum.render.stages import Binned as Binned
 from frustum.render.stages import bin_item as bin_item
@@ -95,10 +96,8 @@ def release_memory() -> int:
     The next ``render`` allocates (and first-touches) them anew. Call it when a program that rendered large
     frames goes on to other work.
     """
-    released = Scratch.release_pool() + FrameBuffers.release()
-    if "frustum.render.shadows.fractions" in sys.modules:  # the shadow maps and per-pixel arrays of the shadow pass
-        released += sys.modules["frustum.render.shadows.fractions"].release_memory()
-    return released
+    # the shadow pass's maps kept for reuse and the per-pixel arrays of every pass (render.buffers.take_array)
+    return Scratch.release_pool() + FrameBuffers.release() + fractions.release_memory()
 
 
 def render(
@@ -255,63 +254,76 @@ def render(
         tone_map=tone_map, exposure=exposure,
     )  # fmt: skip
     if options.factor == 1:
-        return resolve(_draw(scene, camera, options), options)
+        return _draw(scene, camera, options).to_frame(options)
     big = dataclasses.replace(camera, width=camera.width * options.factor, height=camera.height * options.factor)
-    return resolve(_draw(scene, big, options.supersampled()), options)
+    return _draw(scene, big, options.supersampled()).to_frame(options)
 
 
-def _draw(scene: Scene, camera: Camera, options: RenderOptions) -> Buffers:
-    """The passes of one image at the camera's size, in order: the buffers drawn."""
-    buffers = Buffers.for_image(camera, options)
+def _draw(scene: Scene, camera: Camera, options: RenderOptions) -> FrameContext:
+    """The passes of one image at the camera's size, in order, into the frame's context (``render.context``)."""
+    context = FrameContext.for_image(camera, options)
     if options.mode in LINE_MODES:  # lines or points straight into the depth buffer, no surfaces
-        buffers.start(camera, options)
-        lines.draw_edges(scene.items, camera, options, buffers)
-        lines.draw_polylines(scene.polylines, camera, options, buffers)
-        reflection.paint_background(camera, options, buffers)
-        # each ray stopped at the depth the lines wrote
-        volumes.draw_volumes(scene, camera, buffers.depth, buffers.color)
-        particles.draw_particles(scene.particle_layers, camera, buffers.depth, buffers.color)
-        return buffers
-    _draw_surfaces(scene, camera, options, buffers)
-    buffers.scratch.release()
+        context.start(camera, options)
+        lines.draw_edges(scene.items, camera, options, context)
+        lines.draw_polylines(scene.polylines, camera, options, context)
+        reflection.paint_background(camera, options, context)
+        volumes.draw_volumes(scene, camera, context.depth, context.color)  # rays stopped at the lines' depth
+        particles.draw_particles(scene.particle_layers, camera, context.depth, context.color)
+        return context
+    _draw_surfaces(scene, camera, options, context)
+    context.scratch.release()
     if options.mode == "hidden-line":  # the surfaces only fill the depth buffer
-        buffers.color[:, :] = options.background
+        context.color[:, :] = options.background
     volumes_between = bool(scene.volumes) and options.volumes_with_surfaces
-    if not volumes_between:  # else drawn under the volumes, by _draw_surfaces
+    if not volumes_between:  # else drawn under the volumes, by _draw_between
         if options.mode in EDGE_MODES:
-            lines.draw_edges(scene.items, camera, options, buffers)
-        lines.draw_polylines(scene.polylines, camera, options, buffers)
+            lines.draw_edges(scene.items, camera, options, context)
+        lines.draw_polylines(scene.polylines, camera, options, context)
         if not options.volumes_with_surfaces:  # "hidden-line": rays stopped at the (invisible) surfaces
-            volumes.draw_volumes(scene, camera, buffers.depth, buffers.color)
-    particles.draw_particles(scene.particle_layers, camera, buffers.depth, buffers.color)
-    return buffers
+            volumes.draw_volumes(scene, camera, context.depth, context.color)
+    particles.draw_particles(scene.particle_layers, camera, context.depth, context.color)
+    return context
 
 
-def _draw_surfaces(scene: Scene, camera: Camera, options: RenderOptions, buffers: Buffers) -> None:
-    """The surface modes: the opaque surfaces by the method, then (with volumes) the edges, polylines and volumes
-    over them, then the transparent items."""
-
-    def between() -> None:
-        reflection.paint_background(camera, options, buffers)  # the environment where no opaque surface is
-        # every volume ray cast after the opaque surfaces (rays stop at their depth), before the transparent items;
-        # the edges and polylines first, so the part of a cloud in front of a line covers it (polylines write
-        # depth, so they stop the rays too)
-        if scene.volumes and options.volumes_with_surfaces:
-            if options.mode == "surface+edges":
-                lines.draw_edges(scene.items, camera, options, buffers)
-            lines.draw_polylines(scene.polylines, camera, options, buffers)
-            volumes.draw_volumes(scene, camera, buffers.depth, buffers.color)
-
+def _draw_surfaces(scene: Scene, camera: Camera, options: RenderOptions, context: FrameContext) -> None:
+    """The surface modes: the opaque surfaces by the method, then what goes between (``_draw_between``), then
+    the transparent items."""
     if options.method == "ray-tracing":
         from frustum.render import raytrace
 
-        raytrace.draw_surfaces(scene, camera, options, buffers, between)
-    elif options.method == "depth-buffer" and options.transparency == "sort":
-        surfaces.draw_surfaces(scene, scene.items, camera, options, buffers, between)
-        if options.counts is not None:
-            methods.count_depth_tests(scene.items, camera, options)
-    elif options.method == "depth-buffer":  # transparent items through an A-buffer over the depth buffer's
-        surfaces.draw_surfaces(scene, methods.opaque_only(scene.items), camera, options, buffers, between)
-        methods.composite_transparent(scene, camera, options, buffers)
+        raytrace.draw_surfaces(scene, camera, options, context)
+        _draw_between(scene, camera, options, context)
+    elif options.method == "a-buffer":
+        if scene.volumes and options.volumes_with_surfaces:  # opaque fragments, volumes, transparent fragments
+            methods.draw_fragments(scene, camera, options, context, "opaque")
+            _draw_between(scene, camera, options, context)
+            methods.draw_fragments(scene, camera, options, context, "transparent")
+        else:
+            methods.draw_fragments(scene, camera, options, context)
+    elif options.method == "depth-buffer":
+        # transparent items through an A-buffer over the depth buffer's opaque frame, or sorted by the depth buffer
+        items = scene.items if options.transparency == "sort" else methods.opaque_only(scene.items)
+        surfaces.draw_opaque(scene, items, camera, options, context)
+        _draw_between(scene, camera, options, context)
+        surfaces.draw_transparent(scene, items, camera, options, context)
+        if options.transparency == "a-buffer":
+            methods.composite_transparent(scene, camera, options, context)
+        elif options.counted:
+            methods.count_depth_tests(scene.items, camera, options, context)
     else:
-        methods.draw_surfaces_by_method(scene, camera, options, buffers, between)
+        methods.draw_opaque_by_method(scene, camera, options, context)
+        _draw_between(scene, camera, options, context)
+        methods.draw_transparent_by_method(scene, camera, options, context)
+
+
+def _draw_between(scene: Scene, camera: Camera, options: RenderOptions, context: FrameContext) -> None:
+    """What goes over the opaque surfaces and under the transparent ones: the environment where no opaque surface
+    is, and (with volumes) every volume ray cast, rays stopped at the surfaces' depth; the edges and polylines
+    first, so the part of a cloud in front of a line covers it (polylines write depth, so they stop the rays
+    too)."""
+    reflection.paint_background(camera, options, context)
+    if scene.volumes and options.volumes_with_surfaces:
+        if options.mode == "surface+edges":
+            lines.draw_edges(scene.items, camera, options, context)
+        lines.draw_polylines(scene.polylines, camera, options, context)
+        volumes.draw_volumes(scene, camera, context.depth, context.color)

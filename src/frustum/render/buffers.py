@@ -1,20 +1,15 @@
-"""Frame buffers: the arrays a frame is drawn into (``Buffers``), the work arrays recycled between calls
-(``Scratch``) and the color and depth arrays recycled between frames (``FrameBuffers``), the clear, and the
-resolve of a supersampled image into the returned ``Frame`` (box or tent filter, linear or sRGB)."""
+"""Frame buffers: the work arrays recycled between calls (``Scratch``, and ``take_array`` for the passes' per-pixel
+arrays) and the color and depth arrays recycled between frames (``FrameBuffers``), the clear, and the filters that
+resolve a supersampled image (box or tent, nearest depth). What one frame draws into is ``render.context``."""
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import sys
 import threading
 from typing import Any, ClassVar
 
 import numpy as np
-
-from frustum.camera import Camera
-from frustum.frame import Frame
-from frustum.render.options import RenderOptions
 
 _HUGE_PAGE = 1 << 21
 
@@ -119,95 +114,12 @@ class FrameBuffers:
         return released
 
 
-@dataclasses.dataclass
-class Buffers:
-    """The arrays one image is drawn into: ``color`` (H, W, 4) uint8 and ``depth`` (H, W) float32 (set by the
-    first pass that draws: the surface passes take recycled ``FrameBuffers``, the line modes fresh arrays), the
-    asked-for extra outputs ``normals`` (H, W, 3) float32 and ``object_id`` (H, W) int32 (None where not asked
-    for), and the call's work arrays ``scratch``."""
-
-    normals: np.ndarray | None
-    object_id: np.ndarray | None
-    scratch: Scratch
-    color: np.ndarray = dataclasses.field(default_factory=lambda: np.empty((0, 0, 4), dtype=np.uint8))
-    depth: np.ndarray = dataclasses.field(default_factory=lambda: np.empty((0, 0), dtype=np.float32))
-
-    @classmethod
-    def for_image(cls, camera: Camera, options: RenderOptions) -> Buffers:
-        """The extra outputs of `options.buffers` at the camera's size, zero normals and object id −1."""
-        height, width = camera.height, camera.width
-        normals = np.zeros((height, width, 3), dtype=np.float32) if "normals" in options.buffers else None
-        ids = np.full((height, width), -1, dtype=np.int32) if "object_id" in options.buffers else None
-        return cls(normals, ids, Scratch())
-
-    def start(self, camera: Camera, options: RenderOptions) -> None:
-        """New color and depth arrays at the camera's size, cleared to the background and the far plane (the line
-        modes: nothing to recycle them from)."""
-        self.depth = np.ones((camera.height, camera.width), dtype=np.float32)
-        self.color = np.empty((camera.height, camera.width, 4), dtype=np.uint8)
-        self.color[:, :] = options.background
-
-    def extra(self) -> tuple[np.ndarray, np.ndarray]:
-        """The normal and object-id buffers ``shade.shade_pixels`` writes, or 1-pixel dummies where not asked for."""
-        return (
-            np.zeros((1, 1, 3), dtype=np.float32) if self.normals is None else self.normals,
-            np.zeros((1, 1), dtype=np.int32) if self.object_id is None else self.object_id,
-        )
-
-
 def clear_buffers(depth: np.ndarray, color: np.ndarray, background: np.ndarray) -> None:
     """Depth 1.0 (far) and the background color bytes (4,) everywhere (NumPy's fills run at memory bandwidth, as
     a compiled loop did, without its compile time). Face codes need no clearing: a pixel is drawn exactly where
     its depth is below 1, and only there are codes and barycentrics read."""
     depth.fill(1.0)
     color.view(np.uint32).fill(background.view(np.uint32)[0])
-
-
-def resolve(buffers: Buffers, options: RenderOptions) -> Frame:
-    """The Frame of the drawn image: downsampled by ``options.factor`` with ``options.filter`` (depth keeps each
-    block's nearest, normals and object ids the block's middle sample) and encoded in ``options.color_space``."""
-    color, depth, normals, ids = buffers.color, buffers.depth, buffers.normals, buffers.object_id
-    factor = options.factor
-    linear = None
-    if factor != 1:
-        if options.filter == "box" and options.color_space == "linear":
-            color = resolve_color(color, factor)
-        else:
-            linear = downsample(color.astype(np.float64) / 255.0, factor, options.filter)
-        depth = block_min(depth, factor)
-        middle = factor // 2
-        normals = None if normals is None else np.ascontiguousarray(normals[middle::factor, middle::factor])
-        ids = None if ids is None else np.ascontiguousarray(ids[middle::factor, middle::factor])
-        if options.outputs:
-            for key in ("position", "seen"):  # the middle sample of each block, as for normals
-                if key in options.outputs:
-                    options.outputs[key] = np.ascontiguousarray(options.outputs[key][middle::factor, middle::factor])
-    if options.color_space == "srgb":
-        values = color.astype(np.float64) / 255.0 if linear is None else linear
-        values[..., :3] = np.where(
-            values[..., :3] <= 0.0031308, 12.92 * values[..., :3], 1.055 * values[..., :3] ** (1 / 2.4) - 0.055
-        )
-        linear = values
-    if linear is not None:
-        color = np.floor(np.clip(linear, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
-    position, shadow = _shadow_buffers(options)
-    return Frame(color=color, depth=depth, normals=normals, object_id=ids, stats=options.counts, position=position,
-                 shadow=shadow)  # fmt: skip
-
-
-def _shadow_buffers(options: RenderOptions) -> tuple[np.ndarray | None, np.ndarray | None]:
-    """``Frame.position`` and ``Frame.shadow`` where asked for (float32, NaN where nothing is drawn) from what the
-    shadow pass (``render.shadows``) left in ``options.outputs``."""
-    if options.outputs is None or options.outputs.get("position") is None:
-        return None, None
-    points = options.outputs["position"]
-    position = points.astype(np.float32) if "position" in options.buffers else None
-    shadow = None
-    if "shadow" in options.buffers:
-        seen = options.outputs["seen"][..., options.outputs["casting"]]
-        shadow = np.where(np.isnan(points[..., :1]), np.float32(np.nan), seen).astype(np.float32)
-    give_back(points)  # copied out above: the next frame may have it
-    return position, shadow
 
 
 def resolve_color(big: np.ndarray, factor: int) -> np.ndarray:

@@ -12,7 +12,7 @@ from frustum.camera import Camera
 from frustum.clipping import VIEW_VOLUME_PLANES
 from frustum.geometry import Mesh
 from frustum.raster import lines
-from frustum.render.buffers import Buffers
+from frustum.render.context import FrameContext
 from frustum.render.options import EDGE_MODES, RenderOptions
 from frustum.render.stages import cue_color, item_matrices, rows, world_faces
 from frustum.scene import SceneItem
@@ -45,9 +45,9 @@ def _adjacency(mesh: Mesh) -> EdgeAdjacency:
     return cached
 
 
-def draw_edges(items: list[SceneItem], camera: Camera, options: RenderOptions, buffers: Buffers) -> None:
-    """Lines (or points) of every item into the buffers, serially in scene order (``raster.lines``)."""
-    depth, color = buffers.depth, buffers.color
+def draw_edges(items: list[SceneItem], camera: Camera, options: RenderOptions, context: FrameContext) -> None:
+    """Lines (or points) of every item into the frame, serially in scene order (``raster.lines``)."""
+    depth, color = context.depth, context.color
     view = np.array([camera.width / 2.0, camera.height / 2.0])
     eye = np.asarray(camera.frame.eye, dtype=np.float64)
     axis = np.asarray(camera.frame.n, dtype=np.float64)
@@ -91,9 +91,9 @@ def draw_edges(items: list[SceneItem], camera: Camera, options: RenderOptions, b
         lines.draw_lines(clip, view_depth, edges, VIEW_VOLUME_PLANES, view, style, depth, color)
 
 
-def draw_polylines(line_items: list[SceneItem], camera: Camera, options: RenderOptions, buffers: Buffers) -> None:
+def draw_polylines(line_items: list[SceneItem], camera: Camera, options: RenderOptions, context: FrameContext) -> None:
     """Every placed ``Polyline`` as depth-tested lines (or marker squares) in its material color, in order."""
-    depth, color = buffers.depth, buffers.color
+    depth, color = context.depth, context.color
     view = np.array([camera.width / 2.0, camera.height / 2.0])
     cue = line_cue(options)
     for item in line_items:

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import dataclasses
 import importlib
-from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -16,7 +15,8 @@ import numpy as np
 from frustum.camera import Camera
 from frustum.frame import Frame, background_bytes
 from frustum.geometry import Mesh
-from frustum.render.buffers import Buffers, Scratch, clear_buffers
+from frustum.render.buffers import Scratch, clear_buffers
+from frustum.render.context import FrameContext
 from frustum.render.options import METHOD_NAMES, RenderOptions, check_arguments
 from frustum.render.shadows import passes as shadows
 from frustum.render.stages import (
@@ -75,7 +75,7 @@ RENDER_METHODS = {name: render_octrees if name == "octree" else None for name in
 (``VISIBILITY_METHODS``), else the function that draws the frame."""
 
 
-def count_depth_tests(items: list[SceneItem], camera: Camera, options: RenderOptions) -> None:
+def count_depth_tests(items: list[SceneItem], camera: Camera, options: RenderOptions, context: FrameContext) -> None:
     """The depth buffer's counts: depth tests (pixel centres covered, summed over the drawn triangles)."""
     from frustum.raster import window
     from frustum.visibility.window import window_triangles
@@ -83,8 +83,7 @@ def count_depth_tests(items: list[SceneItem], camera: Camera, options: RenderOpt
     tris = window_triangles(items, list(range(len(items))), face_offsets(items), camera, options.cull)
     covered = np.empty(tris.count, dtype=np.int64)
     window.count_covered(tris.xy, tris.box, covered)
-    assert options.counts is not None
-    options.counts.update(depth_tests=int(covered.sum()), triangles=tris.count)
+    context.counter().update(depth_tests=int(covered.sum()), triangles=tris.count)
 
 
 def opaque_only(items: list[SceneItem]) -> list[SceneItem]:
@@ -95,92 +94,119 @@ def opaque_only(items: list[SceneItem]) -> list[SceneItem]:
     ]
 
 
-def draw_surfaces_by_method(
-    scene: Scene, camera: Camera, options: RenderOptions, buffers: Buffers, between: Callable[[], None]
-) -> None:  # fmt: skip
-    """Stages 1–6 by a visible-surface method other than the depth buffer into ``buffers.depth`` and
-    ``buffers.color``: the opaque items, `between` (the volumes), then the transparent items (back to front, or
-    through an A-buffer).
+def draw_fragments(scene: Scene, camera: Camera, options: RenderOptions, context: FrameContext,
+                   which: str = "all") -> None:  # fmt: skip
+    """``method="a-buffer"``: the fragments of the items (`which`: "all", "opaque" into cleared buffers, or
+    "transparent" over the frame drawn so far, behind its depth) shaded once per fragment (a column image through
+    the depth buffer's kernel) and composited per subsample into ``context.color`` and ``context.depth``; their
+    counts into ``context.counts`` (``transparent_*`` for the transparent pass)."""
+    from frustum.visibility.window import window_triangles
 
-    The method writes the depth-buffer's depth, face code and barycentrics of the surface it finds at each pixel
-    (``visibility.window``); ``stages.shade_item`` shades them as for the depth buffer. The A-buffer shades one
-    sample per fragment (a column image through the same kernel) and composites.
+    items = scene.items
+    counts = context.counter()
+    offsets = face_offsets(items)
+    lighting = Lighting.of(scene)
+    if which == "transparent":
+        chosen = [i for i, item in enumerate(items) if item.material.opacity < 1.0]
+        if not chosen:
+            return
+        depth = context.depth
+        tris = window_triangles(items, chosen, offsets, camera, options.cull)
+        found = _composite(tris, items, offsets, camera, options, lighting, context.color, depth.copy(),
+                           context.scratch, under_depth=depth)  # fmt: skip
+        counts.update({f"transparent_{key}": value for key, value in found.items()})
+        counts["triangles"] = counts.get("triangles", 0) + tris.count
+        return
+    _clear(camera, options, context)
+    chosen = [i for i, item in enumerate(items) if which == "all" or item.material.opacity >= 1.0]
+    tris = window_triangles(items, chosen, offsets, camera, options.cull)
+    counts.update(_composite(tris, items, offsets, camera, options, lighting, context.color, context.depth,
+                             context.scratch))  # fmt: skip
+    counts["triangles"] = tris.count
+
+
+def _clear(camera: Camera, options: RenderOptions, context: FrameContext) -> None:
+    """New color and depth arrays at the camera's size, cleared to the background and the far plane."""
+    context.depth = np.empty((camera.height, camera.width), dtype=np.float32)
+    context.color = np.empty((camera.height, camera.width, 4), dtype=np.uint8)
+    clear_buffers(context.depth, context.color, options.background)
+
+
+def draw_opaque_by_method(scene: Scene, camera: Camera, options: RenderOptions, context: FrameContext) -> None:
+    """Stages 1–5 of the opaque items by a visible-surface method other than the depth buffer and the A-buffer,
+    into ``context.depth`` and ``context.color``.
+
+    The method writes the depth buffer's depth, face code and barycentrics of the surface it finds at each pixel
+    (``visibility.window``); the shadow pass and ``stages.shade_item`` then shade them as for the depth buffer.
     """
     from frustum.visibility.window import window_triangles
 
     items = scene.items
     height, width = camera.height, camera.width
-    counts = options.counts if options.counts is not None else {}
+    counts = context.counter()
     offsets = face_offsets(items)
     opaque = [i for i, item in enumerate(items) if item.material.opacity >= 1.0]
-    clear_items = [i for i, item in enumerate(items) if item.material.opacity < 1.0]
-    buffers.depth = depth = np.empty((height, width), dtype=np.float32)
-    buffers.color = color = np.empty((height, width, 4), dtype=np.uint8)
-    clear_buffers(depth, color, options.background)
+    _clear(camera, options, context)
     lighting = Lighting.of(scene)
-    extra = buffers.extra()
-    scratch = buffers.scratch
-    if options.method == "a-buffer":
-        # with volumes: the opaque fragments, the volumes (rays stop at their depth), then the transparent ones
-        volumes_between = bool(scene.volumes) and options.volumes_with_surfaces
-        first = opaque if volumes_between else list(range(len(items)))
-        tris = window_triangles(items, first, offsets, camera, options.cull)
-        counts.update(_composite(tris, items, offsets, camera, options, lighting, color, depth, scratch))
-        counts["triangles"] = tris.count
-        if volumes_between:
-            between()
-            if clear_items:
-                tris = window_triangles(items, clear_items, offsets, camera, options.cull)
-                found = _composite(tris, items, offsets, camera, options, lighting, color, depth.copy(), scratch,
-                                   under_depth=depth)  # fmt: skip
-                counts.update({f"transparent_{key}": value for key, value in found.items()})
-                counts["triangles"] += tris.count
-        return
+    scratch = context.scratch
     codes_dtype = code_type(items)  # the depth buffer's: the shading kernels are compiled for it already
-    pixels = Pixels(depth, np.zeros((height, width), dtype=codes_dtype),
-                    np.zeros((height, width, 2), dtype=np.float32), color, extra)  # fmt: skip
+    pixels = Pixels(context.depth, np.zeros((height, width), dtype=codes_dtype),
+                    np.zeros((height, width, 2), dtype=np.float32), context.color, context.extra())  # fmt: skip
     module, name = VISIBILITY_METHODS[options.method].split(":")  # type: ignore[union-attr]
     draw = getattr(importlib.import_module(module), name)
     if options.method == "ray-casting":  # world-space rays through the scene's index, not window triangles
-        counts.update(draw(scene, camera, options.cull, depth, pixels.codes, pixels.bary))
+        counts.update(draw(scene, camera, options.cull, context.depth, pixels.codes, pixels.bary))
     else:
         tris = window_triangles(items, opaque, offsets, camera, options.cull)
-        counts.update(draw(tris, depth, pixels.codes, pixels.bary))
+        counts.update(draw(tris, context.depth, pixels.codes, pixels.bary))
     attributes = {index: world_attributes(items[index], scratch) for index in opaque}
     shadows.prepare(scene, items, [(i, attributes[i][0], offsets[i]) for i in opaque], camera, options, lighting,
-                    pixels)  # fmt: skip
+                    pixels, context)  # fmt: skip
     for index in opaque:
         shadows.shade_item(items[index], index, offsets[index], camera, options, lighting, attributes[index], pixels,
-                           (0, height), blend=False)  # fmt: skip
-    between()
+                           (0, height), False, context)  # fmt: skip
+
+
+def draw_transparent_by_method(scene: Scene, camera: Camera, options: RenderOptions, context: FrameContext) -> None:
+    """Stage 6 after ``draw_opaque_by_method``: the transparent items through an A-buffer
+    (``transparency="a-buffer"``) or back to front, each blended over the frame as the depth buffer does."""
+    items = scene.items
+    clear_items = [i for i, item in enumerate(items) if item.material.opacity < 1.0]
     if not clear_items:
         return
     if options.transparency == "a-buffer":
-        composite_transparent(scene, camera, options, buffers)
+        composite_transparent(scene, camera, options, context)
         return
+    height, width = camera.height, camera.width
+    codes_dtype = code_type(items)
+    offsets = face_offsets(items)
+    lighting = Lighting.of(scene)
+    bary = np.zeros((height, width, 2), dtype=np.float32)
+    extra = context.extra()
     for index in back_to_front(items, clear_items, camera):  # per-object sort, as the depth buffer does
         item = items[index]
-        layer = Pixels(depth.copy(), np.full((height, width), -1, dtype=codes_dtype), pixels.bary, color, extra)
-        world, normals, band = draw_item(item, camera, options.cull, offsets[index], layer, scratch)
+        layer = Pixels(context.depth.copy(), np.full((height, width), -1, dtype=codes_dtype), bary, context.color,
+                       extra)  # fmt: skip
+        world, normals, band = draw_item(item, camera, options.cull, offsets[index], layer, context.scratch)
         shade_item(item, index, offsets[index], camera, options, lighting, (world, normals), layer, band,
                    blend=True)  # fmt: skip
 
 
-def composite_transparent(scene: Scene, camera: Camera, options: RenderOptions, buffers: Buffers) -> None:
+def composite_transparent(scene: Scene, camera: Camera, options: RenderOptions, context: FrameContext) -> None:
     """``transparency="a-buffer"``: the transparent items' fragments composited per subsample over the finished
-    opaque frame (behind its depth), their counts as ``transparent_*`` in ``options.counts``."""
+    opaque frame (behind its depth), their counts as ``transparent_*`` in ``context.counts``."""
     from frustum.visibility.window import window_triangles
 
     items = scene.items
     clear_items = [i for i, item in enumerate(items) if item.material.opacity < 1.0]
     if not clear_items:
         return
-    counts = options.counts if options.counts is not None else {}
+    counts = context.counter()
     offsets = face_offsets(items)
-    depth = buffers.depth
+    depth = context.depth
     tris = window_triangles(items, clear_items, offsets, camera, options.cull)
-    found = _composite(tris, items, offsets, camera, options, Lighting.of(scene), buffers.color, depth.copy(),
-                       buffers.scratch, under_depth=depth)  # fmt: skip
+    found = _composite(tris, items, offsets, camera, options, Lighting.of(scene), context.color, depth.copy(),
+                       context.scratch, under_depth=depth)  # fmt: skip
     counts.update({f"transparent_{key}": value for key, value in found.items()})
 
 

@@ -98,8 +98,8 @@ DEFAULTS: dict[str, Any] = {
 class RenderOptions:
     """``render``'s options, checked and in the form the passes use (kernel codes, color bytes).
 
-    ``counts`` is the method's counts dict (``Frame.stats``), filled while drawing, or None where nothing is
-    counted; ``factor`` is √samples (the supersampling factor).
+    Configuration only: what the passes produce (counts, buffers, the shadow pass's outputs) goes into the
+    frame's ``render.context.FrameContext``. ``factor`` is √samples (the supersampling factor).
     """
 
     shade_mode: int
@@ -117,12 +117,11 @@ class RenderOptions:
     buffers: tuple[str, ...]
     method: str = "depth-buffer"
     transparency: str = "sort"
-    counts: dict | None = None
+    counted: bool = False  # the method counts its work into Frame.stats (render.context.FrameContext.counts)
     factor: int = 1
     filter: str = "box"
     color_space: str = "linear"
     shadow: Any = None  # ShadowOptions, or None: no shadows
-    outputs: dict | None = None  # "position", "seen", "casting" (render.shadows), filled while drawing
     environment: Any = None  # the scene's EnvironmentMap, for reflections (and the background, below)
     environment_background: bool = False  # no background given: the environment map is the background
     max_depth: int = 5
@@ -167,8 +166,14 @@ class RenderOptions:
                                    max_depth=depth, shadows=shadows)  # fmt: skip
 
     def supersampled(self) -> RenderOptions:
-        """The options for the √samples-times larger image: lines √samples times as wide (the same counts dict)."""
+        """The options for the √samples-times larger image: lines √samples times as wide."""
         return dataclasses.replace(self, line_width=self.line_width * self.factor)
+
+    @property
+    def positions_wanted(self) -> bool:
+        """Whether the shadow pass finds the world points of the drawn pixels (``render.shadows``): shadows on, or
+        the "position" buffer asked for."""
+        return self.shadow is not None or "position" in self.buffers
 
     @property
     def volumes_with_surfaces(self) -> bool:
@@ -178,8 +183,7 @@ class RenderOptions:
 
 
 def shadow_options(options: RenderOptions, shadows: Any, map_size: Any, softness: Any, where: str) -> RenderOptions:
-    """Check the shadow arguments (``check_shadows``); the options with the shadow settings and
-    an outputs dict where the shadow pass runs (shadows on, or the "position" buffer asked for)."""
+    """Check the shadow arguments (``check_shadows``); the options with the shadow settings."""
     shadow = check_shadows(shadows, map_size, softness, options.method, options.mode, where)
     if "shadow" in options.buffers and shadow is None:
         raise FrustumError(
@@ -191,8 +195,7 @@ def shadow_options(options: RenderOptions, shadows: Any, map_size: Any, softness
             f"{where}: buffers = {describe(options.buffers)} asks for 'position' with mode = {options.mode!r}; "
             "positions are those of surfaces: use a surface mode"
         )
-    wanted = shadow is not None or "position" in options.buffers
-    return dataclasses.replace(options, shadow=shadow, outputs={} if wanted else None)
+    return dataclasses.replace(options, shadow=shadow)
 
 
 def physical_options(scene: Scene, options: RenderOptions, tone_map: Any, exposure: Any,
@@ -350,7 +353,7 @@ def check_method(method: Any, where: str) -> None:
 
 def method_options(options: RenderOptions, method: Any, transparency: Any, stats: Any, where: str) -> RenderOptions:
     """Check `transparency` and `stats`; the options with the method (a mesh pipeline one, ``check_method``
-    first), the transparency and a counts dict where counted."""
+    first), the transparency and whether the frame's work is counted (``Frame.stats``)."""
     choice(transparency, TRANSPARENCY_MODES, "transparency", where)
     if not isinstance(stats, bool | np.bool_):
         raise FrustumError(f"{where}: stats = {describe(stats)} is not a bool; give True or False")
@@ -366,8 +369,7 @@ def method_options(options: RenderOptions, method: Any, transparency: Any, stats
             "holds several surfaces); use another method for per-pixel normals or object ids"
         )
     counted = method != "depth-buffer" or transparency != "sort" or bool(stats)
-    counts = {"method": method} if counted else None
-    return dataclasses.replace(options, method=method, transparency=transparency, counts=counts)
+    return dataclasses.replace(options, method=method, transparency=transparency, counted=counted)
 
 
 def ray_options(options: RenderOptions, max_depth: Any, shadows: Any, depth_cue: Any, shading: Any,

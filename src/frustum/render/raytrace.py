@@ -56,7 +56,6 @@ Model for Shaded Display", CACM 23(6), 1980.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -66,7 +65,7 @@ from frustum.budgets import check_operations
 from frustum.camera import Camera
 from frustum.errors import FrustumError
 from frustum.raster.power import textbook_power
-from frustum.render.buffers import Buffers
+from frustum.render.context import FrameContext
 from frustum.render.options import RenderOptions
 from frustum.scene import Scene
 from frustum.shading import AmbientLight, DirectionalLight, SpotLight, pack_lights
@@ -472,17 +471,16 @@ def _check_work(camera: Camera, data: _Scene, max_depth: int, where: str) -> Non
                            f"levels x {1 + data.shadow_lights()} rays per hit")  # fmt: skip
 
 
-def draw_surfaces(scene: Scene, camera: Camera, options: RenderOptions, buffers: Buffers,
-                  between: Callable[[], None]) -> None:  # fmt: skip
-    """``method="ray-tracing"``: color and depth of every pixel into `buffers`, then `between` (the volumes over
-    the primary hits' depth). Counts into ``options.counts``: rays per kind, hits, total internal reflections,
-    the deepest level reached."""
+def draw_surfaces(scene: Scene, camera: Camera, options: RenderOptions, context: FrameContext) -> None:
+    """``method="ray-tracing"``: color and depth of every pixel into `context` (the driver then casts the volumes
+    over the primary hits' depth). Counts into ``context.counts``: rays per kind, hits, total internal
+    reflections, the deepest level reached."""
     height, width = camera.height, camera.width
-    counts = options.counts if options.counts is not None else {}
+    counts = context.counter()
     data = _Scene(scene, _is_phong(options), options.shadows, options)
     _check_work(camera, data, options.max_depth, "render")
-    buffers.depth = depth = np.ones((height, width), dtype=np.float32)
-    buffers.color = color = np.empty((height, width, 4), dtype=np.uint8)
+    context.depth = depth = np.ones((height, width), dtype=np.float32)
+    context.color = color = np.empty((height, width, 4), dtype=np.uint8)
     color[:, :] = options.background
     background = options.background.astype(np.float64) / 255.0
     window_from_world = np.asarray(camera.viewport_matrix @ camera.clip_from_world, dtype=np.float64)
@@ -506,11 +504,10 @@ def draw_surfaces(scene: Scene, camera: Camera, options: RenderOptions, buffers:
         flat_color[target, :3] = np.floor(np.clip(result[rows], 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
         flat_color[target, 3] = 255
         flat_depth[target] = z
-        if buffers.normals is not None:
-            buffers.normals.reshape(-1, 3)[target] = primary.normal.astype(np.float32)
-        if buffers.object_id is not None:
-            buffers.object_id.reshape(-1)[target] = data.numbers[primary.item].astype(np.int32)
-    between()
+        if context.normals is not None:
+            context.normals.reshape(-1, 3)[target] = primary.normal.astype(np.float32)
+        if context.object_id is not None:
+            context.object_id.reshape(-1)[target] = data.numbers[primary.item].astype(np.int32)
 
 
 def _is_phong(options: RenderOptions) -> bool:

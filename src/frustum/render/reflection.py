@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from frustum.camera import Camera
-from frustum.render.buffers import Buffers
+from frustum.render.context import FrameContext
 from frustum.render.options import RenderOptions
 from frustum.shading.environment import reflect_directions
 
@@ -31,14 +31,14 @@ def _pixel_rays(camera: Camera, rows: np.ndarray, cols: np.ndarray) -> np.ndarra
     return camera.ray(window).direction if len(rows) else np.empty((0, 3))
 
 
-def paint_background(camera: Camera, options: RenderOptions, buffers: Buffers) -> None:
+def paint_background(camera: Camera, options: RenderOptions, context: FrameContext) -> None:
     """Where nothing opaque was drawn, the environment map along each pixel's ray (when asked for)."""
     if options.environment is None or not options.environment_background:
         return
-    rows, cols = np.nonzero(buffers.depth >= 1.0)
+    rows, cols = np.nonzero(context.depth >= 1.0)
     colors = options.environment.lookup(_pixel_rays(camera, rows, cols))
-    buffers.color[rows, cols, :3] = _to_bytes(colors)
-    buffers.color[rows, cols, 3] = 255
+    context.color[rows, cols, :3] = _to_bytes(colors)
+    context.color[rows, cols, 3] = 255
 
 
 def reflect(

@@ -1,15 +1,15 @@
-"""The depth buffer's surface pass (stages 1–6 of ``frustum.render``'s docstring): opaque items stage by stage
-(every item binned and filled, then every item shaded) or, for a frame of one opaque mesh on the directional
-path, tile by tile (``raster.tiled``); then transparent items back to front, each blended over the frame."""
+"""The depth buffer's surface passes (stages 1–6 of ``frustum.render``'s docstring): ``draw_opaque``, the opaque
+items stage by stage (every item binned and filled, then every item shaded) or, for a frame of one opaque mesh on
+the directional path, tile by tile (``raster.tiled``); ``draw_transparent``, the transparent items back to front,
+each blended over the frame. The driver draws what goes between them (the volumes)."""
 
 from __future__ import annotations
-
-from collections.abc import Callable
 
 import numpy as np
 
 from frustum.camera import Camera
-from frustum.render.buffers import Buffers, FrameBuffers, clear_buffers
+from frustum.render.buffers import FrameBuffers, clear_buffers
+from frustum.render.context import FrameContext
 from frustum.render.options import RenderOptions
 from frustum.render.shadows import passes as shadows
 from frustum.render.stages import (
@@ -30,66 +30,77 @@ from frustum.render.stages import (
 from frustum.scene import Scene, SceneItem
 
 
-def draw_surfaces(
-    scene: Scene, items: list[SceneItem], camera: Camera, options: RenderOptions, buffers: Buffers,
-    between: Callable[[], None],
-) -> None:  # fmt: skip
-    """Stages 1–6 for every item of `items` into ``buffers.depth`` and ``buffers.color`` (recycled
-    ``FrameBuffers``): the opaque items, then `between` (what is drawn over the opaque surfaces and under the
-    transparent ones: the volumes), then the transparent items back to front."""
+def draw_opaque(scene: Scene, items: list[SceneItem], camera: Camera, options: RenderOptions,
+                context: FrameContext) -> None:  # fmt: skip
+    """Stages 1–5 for the opaque items of `items` into ``context.depth`` and ``context.color`` (recycled
+    ``FrameBuffers``): every item binned and filled, the shadow pass, then every item shaded (or, for a frame of
+    one opaque mesh, tile by tile)."""
     height, width = camera.height, camera.width
     opaque = [i for i, item in enumerate(items) if item.material.opacity >= 1.0]
-    clear_items = [i for i, item in enumerate(items) if item.material.opacity < 1.0]
-    buffers.depth = depth = FrameBuffers.take((height, width), np.float32)
-    buffers.color = color = FrameBuffers.take((height, width, 4), np.uint8)
+    context.depth = depth = FrameBuffers.take((height, width), np.float32)
+    context.color = color = FrameBuffers.take((height, width, 4), np.uint8)
     face_total = sum(item.mesh.face_count for item in items)
-    codes_dtype = code_type(items)
     lighting = Lighting.of(scene)
-    offsets = face_offsets(items)
-    extra = buffers.extra()
-    scratch = buffers.scratch
-    bary = None
+    scratch = context.scratch
     if len(items) == 1 and opaque and face_total and directional(items[0], options, lighting.lights):
-        draw_tiled(items[0], camera, options, lighting, buffers)
+        draw_tiled(items[0], camera, options, lighting, context)
     elif len(items) == 1 and opaque and face_total and shadows.tiled(scene, items[0], options, lighting.lights):
-        shadows.draw_tiled(scene, items[0], camera, options, lighting, buffers)
+        shadows.draw_tiled(scene, items[0], camera, options, lighting, context)
     else:
-        codes = scratch.empty((height, width), codes_dtype)
+        offsets = face_offsets(items)
+        codes = scratch.empty((height, width), code_type(items))
         bary = scratch.empty((height, width, 2), np.float32)  # codes and bary are read only where depth < 1
         clear_buffers(depth, color, options.background)
-        pixels = Pixels(depth, codes, bary, color, extra)
+        pixels = Pixels(depth, codes, bary, color, context.extra())
         drawn = []
         for index in opaque:
             world, normals, band = draw_item(items[index], camera, options.cull, offsets[index], pixels, scratch)
             drawn.append((index, world, normals, band))
-        shadows.prepare(scene, items, [(i, w, offsets[i]) for i, w, _, _ in drawn], camera, options, lighting, pixels)
+        shadows.prepare(scene, items, [(i, w, offsets[i]) for i, w, _, _ in drawn], camera, options, lighting, pixels,
+                        context)  # fmt: skip
         for index, world, normals, band in drawn:
             shadows.shade_item(items[index], index, offsets[index], camera, options, lighting, (world, normals),
-                               pixels, band, blend=False)  # fmt: skip
-    between()
-    if clear_items and bary is None:
-        bary = scratch.empty((height, width, 2), np.float32)
+                               pixels, band, False, context)  # fmt: skip
+        scratch.recycle(bary)  # the transparent items' weights (draw_transparent)
+
+
+def draw_transparent(scene: Scene, items: list[SceneItem], camera: Camera, options: RenderOptions,
+                     context: FrameContext) -> None:  # fmt: skip
+    """Stage 6: the transparent items of `items` back to front by the view distance of their centres, each
+    rasterized alone against a copy of the finished depth buffer and blended over ``context.color``."""
+    clear_items = [i for i, item in enumerate(items) if item.material.opacity < 1.0]
+    if not clear_items:
+        return
+    height, width = camera.height, camera.width
+    codes_dtype = code_type(items)
+    lighting = Lighting.of(scene)
+    offsets = face_offsets(items)
+    extra = context.extra()
+    bary = context.scratch.empty((height, width, 2), np.float32)
     for index in back_to_front(items, clear_items, camera):
         item = items[index]
-        layer = Pixels(depth.copy(), np.full((height, width), -1, dtype=codes_dtype), bary, color, extra)
-        world, normals, band = draw_item(item, camera, options.cull, offsets[index], layer, scratch)
+        layer = Pixels(context.depth.copy(), np.full((height, width), -1, dtype=codes_dtype), bary, context.color,
+                       extra)  # fmt: skip
+        world, normals, band = draw_item(item, camera, options.cull, offsets[index], layer, context.scratch)
         shade_item(item, index, offsets[index], camera, options, lighting, (world, normals), layer, band,
                    blend=True)  # fmt: skip
 
 
-def draw_tiled(item: SceneItem, camera: Camera, options: RenderOptions, lighting: Lighting, buffers: Buffers) -> None:
+def draw_tiled(
+    item: SceneItem, camera: Camera, options: RenderOptions, lighting: Lighting, context: FrameContext
+) -> None:  # fmt: skip
     """Stages 1–5 for a frame of one opaque mesh on the directional fast path: bin, then clear, fill and shade
     tile by tile (``raster.tiled``): the same bytes as the stage-by-stage path, without image-sized codes and
     weights or a second pass over the image."""
     from frustum.raster import tiled
 
-    binned = bin_item(item, camera, options.cull, 0, buffers.scratch, tile_bits=TILED_BITS)
-    world, normals = world_attributes(item, buffers.scratch)
+    binned = bin_item(item, camera, options.cull, 0, context.scratch, tile_bits=TILED_BITS)
+    world, normals = world_attributes(item, context.scratch)
     tiling = np.array([1 << TILED_BITS, binned.tiles_x, 0, camera.width, camera.height], dtype=np.int64)
     params = shading_parameters(item, camera, options, lighting.ambient)
     flags = item_flags(0, 0, options, False, False, False)
     tiled.draw_tiles_directional(
         binned.faces, binned.win_int, binned.win_float, binned.tri_int, binned.tri_float, binned.tri_weights,
-        binned.tile_starts, binned.tile_entries, tiling, buffers.depth, world, normals, params, lighting.lights,
-        flags, options.background, buffers.color,
+        binned.tile_starts, binned.tile_entries, tiling, context.depth, world, normals, params, lighting.lights,
+        flags, options.background, context.color,
     )  # fmt: skip

@@ -15,15 +15,18 @@ from __future__ import annotations
 
 import math
 import weakref
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from frustum.budgets import check_memory, check_operations
 from frustum.camera import Camera
 from frustum.errors import FrustumError
-from frustum.geometry.volume import Volume
 from frustum.scene import Scene, VolumeItem
 from frustum.shading import pack_lights
+
+if TYPE_CHECKING:  # the volume module loads with the first volume (not on the path of a scene without one)
+    from frustum.geometry.volume import Volume
 
 __all__ = ["MODES", "TABLE_SIZE", "TERMINATE", "draw_volumes", "volume_arrays"]
 

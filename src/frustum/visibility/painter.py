@@ -63,7 +63,7 @@ def depth_sort(triangles: WindowTriangles, depth: np.ndarray, codes: np.ndarray,
     """
     from frustum.camera import Camera, ViewFrame
     from frustum.projection import Orthographic
-    from frustum.visibility.bsp import depth_sort as sort
+    from frustum.visibility.depth_sort import depth_sort as sort
 
     if triangles.count == 0:
         return {"fragments": 0, "pixels_painted": 0, "splits": 0, "unresolved": 0, "triangles": 0}

@@ -53,6 +53,7 @@ from frustum.camera import Camera, ViewFrame
 from frustum.projection import Orthographic, Perspective
 from frustum.render.buffers import give_back, release_work_arrays, take_array
 from frustum.render.options import SHADOW_METHODS, ShadowOptions, check_shadows
+from frustum.render.stages import TILED_BITS, bin_item
 from frustum.scene import Scene, SceneItem
 from frustum.shading import AmbientLight, DirectionalLight, PointLight, SpotLight
 
@@ -231,14 +232,28 @@ def _world_faces(item: SceneItem) -> np.ndarray:
     return faces
 
 
+def draw_depth(item: SceneItem, camera: Camera, depth: np.ndarray, fresh: bool) -> None:
+    """Stages 1–4 of one item into `depth` alone (``raster.shadow.fill_depth_tiles``: no face codes or weights,
+    64-pixel tiles): a shadow map, cleared first where `fresh`. Both sides of an open surface; the front faces alone
+    of a closed one (``Mesh.is_watertight``: along any ray from outside the first surface met is a front face, so
+    the map is the same, for half the fill)."""
+    from frustum.raster import shadow
+
+    binned = bin_item(item, camera, bool(item.mesh.is_watertight), tile_bits=TILED_BITS)
+    tiling = np.array([1 << TILED_BITS, binned.tiles_x, 0, depth.shape[1], depth.shape[0]], dtype=np.int64)
+    shadow.fill_depth_tiles(
+        binned.faces, binned.win_int, binned.win_float, binned.tri_int, binned.tri_float, binned.tile_starts,
+        binned.tile_entries, tiling, depth, fresh,
+    )  # fmt: skip
+
+
 def light_fractions(
     scene: Scene, items: list[SceneItem], camera: Camera, options: ShadowOptions, lights: np.ndarray,
-    depth: np.ndarray, points: np.ndarray, facing: np.ndarray,
-    draw_depth: Callable[[SceneItem, Camera, np.ndarray, bool], None], where: str,
+    depth: np.ndarray, points: np.ndarray, facing: np.ndarray, where: str,
 ) -> np.ndarray:  # fmt: skip
     """(H, W, K) float32: the fraction of each packed light (rows of `lights`) reaching each drawn pixel (1 for
-    lights that cast no shadow and on the background). `draw_depth(item, light_camera, depth, fresh)` is
-    the renderer's depth pass of one item into a map (cleared first where `fresh`)."""
+    lights that cast no shadow and on the background). The maps are drawn by ``draw_depth``, the renderer's
+    depth pass of one item."""
     from frustum.raster import shadow
 
     height, width = depth.shape

@@ -1,9 +1,10 @@
 """The shadow pass's place in the surface passes: between filling the depth buffer with the opaque items and shading
 them, ``prepare`` finds each drawn pixel's world point and, with shadows on, the fraction of each light reaching
-it (``render.shadows.fractions``: shadow maps drawn by ``draw_depth``, the renderer's own binning and tile fill from
-the light, or shadow rays); ``shade_item`` then shades with those fractions (``raster.shadow``) or, where there
-are none, exactly as ``stages.shade_item`` does. Off the ordinary path: nothing here runs, and no kernel of
-``raster.shadow`` compiles, unless ``render`` is asked for shadows or the "position" buffer."""
+it (``render.shadows.fractions``: shadow maps drawn by ``fractions.draw_depth``, the renderer's own binning and
+tile fill from the light, or shadow rays), into the frame's context; ``shade_item`` then shades with those
+fractions (``raster.shadow``) or, where there are none, exactly as ``stages.shade_item`` does. Off the ordinary
+path: nothing here runs, and no kernel of ``raster.shadow`` compiles, unless ``render`` is asked for shadows or the
+"position" buffer."""
 
 from __future__ import annotations
 
@@ -16,8 +17,11 @@ from frustum.camera import Camera
 from frustum.geometry import Mesh
 from frustum.raster import shade
 from frustum.render import bumps, pbr, reflection
-from frustum.render.buffers import Buffers
+from frustum.render.buffers import give_back, take_array
+from frustum.render.context import FrameContext
 from frustum.render.options import RenderOptions
+from frustum.render.shadows import fractions
+from frustum.render.shadows.fractions import draw_depth
 from frustum.render.stages import (
     TILED_BITS,
     Lighting,
@@ -36,52 +40,36 @@ SHADOWED_MODES = (shade.SHADE_PHONG, shade.SHADE_GOURAUD, shade.SHADE_FLAT, pbr.
 """Shading modes in which shadows darken the picture (``"none"``, ``"normals"`` and ``"depth"`` ignore them)."""
 
 
-def draw_depth(item: SceneItem, camera: Camera, depth: np.ndarray, fresh: bool) -> None:
-    """Stages 1–4 of one item into `depth` alone (``raster.shadow.fill_depth_tiles``: no face codes or weights,
-    64-pixel tiles): a shadow map, cleared first where `fresh`. Both sides of an open surface; the front faces alone
-    of a closed one (``Mesh.is_watertight``: along any ray from outside the first surface met is a front face, so
-    the map is the same, for half the fill)."""
-    from frustum.raster import shadow
-
-    binned = bin_item(item, camera, bool(item.mesh.is_watertight), tile_bits=TILED_BITS)
-    tiling = np.array([1 << TILED_BITS, binned.tiles_x, 0, depth.shape[1], depth.shape[0]], dtype=np.int64)
-    shadow.fill_depth_tiles(
-        binned.faces, binned.win_int, binned.win_float, binned.tri_int, binned.tri_float, binned.tile_starts,
-        binned.tile_entries, tiling, depth, fresh,
-    )  # fmt: skip
-
-
 def prepare(
     scene: Scene, items: list[SceneItem], drawn: list[tuple[int, np.ndarray, int]], camera: Camera,
-    options: RenderOptions, lighting: Lighting, pixels: Pixels,
+    options: RenderOptions, lighting: Lighting, pixels: Pixels, context: FrameContext,
 ) -> None:  # fmt: skip
     """World points of the drawn opaque pixels (items ``(index, world positions, face offset)``) and, with shadows
-    on, each light's fraction reaching them, into ``options.outputs`` ("position", "seen", "casting"). Nothing
-    without an outputs dict (no shadows, no "position" buffer)."""
-    if options.outputs is None:
+    on, each light's fraction reaching them, into ``context.outputs`` ("position", "seen", "casting"). Nothing
+    where neither shadows nor the "position" buffer are asked for (``options.positions_wanted``)."""
+    if not options.positions_wanted:
         return
-    from frustum.render.shadows import fractions as shadow_pass
-
-    points, facing = shadow_pass.surface_points(items, drawn, pixels.depth, pixels.codes, pixels.bary)
-    options.outputs["position"] = points
+    points, facing = fractions.surface_points(items, drawn, pixels.depth, pixels.codes, pixels.bary)
+    context.outputs["position"] = points
     if options.shadow is not None:
-        options.outputs["seen"] = shadow_pass.light_fractions(
-            scene, items, camera, options.shadow, lighting.lights, pixels.depth, points, facing, draw_depth, "render"
+        context.outputs["seen"] = fractions.light_fractions(
+            scene, items, camera, options.shadow, lighting.lights, pixels.depth, points, facing, "render"
         )
-        options.outputs["casting"] = np.array(shadow_pass.shadow_lights(scene)[0], dtype=np.int64)
-    shadow_pass.give_back(facing)
+        context.outputs["casting"] = np.array(fractions.shadow_lights(scene)[0], dtype=np.int64)
+    give_back(facing)
 
 
 def shade_item(
     item: SceneItem, index: int, face_offset: int, camera: Camera, options: RenderOptions, lighting: Lighting,
     attributes: tuple[np.ndarray, np.ndarray], pixels: Pixels, band: tuple[int, int], blend: bool,
+    context: FrameContext,
 ) -> None:  # fmt: skip
     """``stages.shade_item`` with shadows: an opaque item in a shadowed mode goes through
     ``raster.shadow.shade_pixels_shadowed`` with the fractions ``prepare`` found (an item with a bump or normal
     map in Phong shading: ``bumps.shade_detailed`` with those fractions; an environment to reflect is blended in
     afterwards, as without shadows); anything else is shaded as without shadows (transparent items receive
     none)."""
-    seen = None if options.outputs is None else options.outputs.get("seen")
+    seen = context.outputs.get("seen")
     plain = seen is None or blend or options.shade_mode not in SHADOWED_MODES or seen.shape[:2] != pixels.codes.shape
     if plain:
         shade_item_plainly(item, index, face_offset, camera, options, lighting, attributes, pixels, band, blend)
@@ -162,26 +150,25 @@ def tiled(scene: Scene, item: SceneItem, options: RenderOptions, lights: np.ndar
 
 
 def draw_tiled(
-    scene: Scene, item: SceneItem, camera: Camera, options: RenderOptions, lighting: Lighting, buffers: Buffers
+    scene: Scene, item: SceneItem, camera: Camera, options: RenderOptions, lighting: Lighting, context: FrameContext
 ) -> None:  # fmt: skip
     """Stages 1–5 of a frame of one opaque mesh with shadow maps, tile by tile (``raster.shadow_tiled``): each
     shadow-casting (directional) light's map is fitted to what the camera can see of the mesh before anything is
-    drawn (``shadow_pass.view_map``) and filled, or taken as it is from an earlier frame where nothing it depends
-    on changed (``shadow_pass.kept_maps``: the same vertex and face bytes, modeling transform, light camera and
+    drawn (``fractions.view_map``) and filled, or taken as it is from an earlier frame where nothing it depends
+    on changed (``fractions.kept_maps``: the same vertex and face bytes, modeling transform, light camera and
     size, as in a turntable of a model the camera sees whole under a fixed sun); then each tile is filled and
     shaded, the map lookups made per pixel inside the shading (no image-sized world points, normals or
     fractions)."""
     from frustum.raster import shadow, shadow_tiled
-    from frustum.render.shadows import fractions as shadow_pass
 
-    binned = bin_item(item, camera, options.cull, 0, buffers.scratch, tile_bits=TILED_BITS)
-    world, normals = world_attributes(item, buffers.scratch)
+    binned = bin_item(item, camera, options.cull, 0, context.scratch, tile_bits=TILED_BITS)
+    world, normals = world_attributes(item, context.scratch)
     lights = lighting.lights
     size, softness = options.shadow.map_size, float(options.shadow.softness)
-    rows, casting = shadow_pass.shadow_lights(scene)
+    rows, casting = fractions.shadow_lights(scene)
     cull = bool(item.mesh.is_watertight)
-    casters = shadow_pass.casters_key(item, cull) if casting else None
-    fitted = [shadow_pass.view_map(light, world, camera, size, softness, casters) for light in casting]
+    casters = fractions.casters_key(item, cull) if casting else None
+    fitted = [fractions.view_map(light, world, camera, size, softness, casters) for light in casting]
     records = [(row, found) for row, found in zip(rows, fitted, strict=True) if found is not None]
     check_memory(len(records) * size * size * 4, where="render",
                  cause=f"shadow_map_size = {size} with {len(records)} shadow-casting light(s)")  # fmt: skip
@@ -189,14 +176,14 @@ def draw_tiled(
     views = np.zeros((shape[0], shadow.MAP_FIELDS))
     map_of = np.full(lights.shape[0], -1, dtype=np.int64)
     for m, (row, (light_camera, texel)) in enumerate(records):
-        views[m] = shadow_pass.map_record(light_camera, texel, None)
+        views[m] = fractions.map_record(light_camera, texel, None)
         map_of[row] = m
     key = None
     if records:  # the maps depend on the casters, the light cameras and nothing else: reused while those stay
-        key = shadow_pass.map_key(casters, [found[0] for _, found in records], views)
-    maps = shadow_pass.kept_maps(key, shape)
+        key = fractions.map_key(casters, [found[0] for _, found in records], views)
+    maps = fractions.kept_maps(key, shape)
     if maps is None:
-        maps = shadow_pass.take_array(shape, np.float32)
+        maps = take_array(shape, np.float32)
         for m, (_, (light_camera, _)) in enumerate(records):
             draw_depth(item, light_camera, maps[m], True)
     tiling = np.array([1 << TILED_BITS, binned.tiles_x, 0, camera.width, camera.height], dtype=np.int64)
@@ -204,7 +191,7 @@ def draw_tiled(
     flags = item_flags(0, 0, options, False, False, False)
     shadow_tiled.draw_tiles_shadowed(
         binned.faces, binned.win_int, binned.win_float, binned.tri_int, binned.tri_float, binned.tri_weights,
-        binned.tile_starts, binned.tile_entries, tiling, buffers.depth, world, normals, params, lights,
-        flags, options.background, buffers.color, maps, views, map_of, softness,
+        binned.tile_starts, binned.tile_entries, tiling, context.depth, world, normals, params, lights,
+        flags, options.background, context.color, maps, views, map_of, softness,
     )  # fmt: skip
-    shadow_pass.keep_maps(key, maps)
+    fractions.keep_maps(key, maps)

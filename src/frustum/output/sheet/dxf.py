@@ -36,6 +36,7 @@ from numpy.typing import NDArray
 
 from frustum._files import atomic_path, os_reason
 from frustum.errors import OutputError
+from frustum.output.sheet.model import to_local
 from frustum.output.true_curves import EllipseArc
 
 __all__ = ["DXF_LAYERS", "save_sheet_dxf"]
@@ -59,7 +60,7 @@ def _ezdxf() -> Any:
 
 
 def save_sheet_dxf(drawing: Any, path: str | os.PathLike) -> Path:
-    """Write the sheet `drawing` (``sheet._SheetDrawing``) to `path` as DXF R2010 (see the module); the same
+    """Write the sheet `drawing` (``model.SheetDrawing``) to `path` as DXF R2010 (see the module); the same
     sheet gives the same bytes (ezdxf's fixed meta data: no time stamps or random GUIDs)."""
     ezdxf = _ezdxf()
     previous = ezdxf.options.write_fixed_meta_data_for_testing
@@ -71,8 +72,6 @@ def save_sheet_dxf(drawing: Any, path: str | os.PathLike) -> Path:
 
 
 def _save(ezdxf: Any, drawing: Any, path: str | os.PathLike) -> Path:
-    from frustum.output.sheet import _to_local
-
     where = "drawing_sheet"
     scale, height = drawing.scale, drawing.height
     document = ezdxf.new("R2010")
@@ -102,7 +101,7 @@ def _save(ezdxf: Any, drawing: Any, path: str | os.PathLike) -> Path:
         factor = scale * view.model_per_pixel
 
         def window_to_dxf(points: NDArray, cx: float = cx, cy: float = cy, factor: float = factor) -> NDArray:
-            local = _to_local(np.asarray(points).reshape(-1, 2), factor)
+            local = to_local(np.asarray(points).reshape(-1, 2), factor)
             return to_dxf(np.column_stack([cx + local[:, 0], cy + local[:, 1]]))
 
         # a pictorial view shows visible edges only, as in the SVG; polylines are drawn with the mesh edges

@@ -19,7 +19,7 @@ How it stays private, exact and out of the way:
   ``<temporary folder>/frustum-<uid>``; mode 0700, refused when it belongs to someone else or is open to others),
   and a connection is served only when the process at the other end runs as the same user (``SO_PEERCRED``).
 - **The same work.** The request is the parsed command line with the client's working folder and umask; the
-  resident process runs the function the program runs (``_program.render_files``), one request at a time, and
+  resident process runs the function the program runs (``frustum.app.work.render_files``), one request at a time, and
   sends back every line printed and the exit status. Ctrl-C in the client cancels: partial output files are
   removed and no new one is started (``_files.remove_partial_files``), as in the program itself.
 - **Gone when idle**: after ``IDLE_S`` seconds without a request (``FRUSTUM_RESIDENT_IDLE_S``), or on
@@ -43,6 +43,8 @@ import warnings
 from pathlib import Path
 from typing import Any
 
+from frustum.app.runtime import INTERRUPTED_MESSAGE, INTERRUPTED_STATUS
+
 __all__ = ["IDLE_S", "enabled", "fingerprint", "handed", "start", "status", "stop"]
 
 IDLE_S = 600.0
@@ -51,7 +53,6 @@ IDLE_S = 600.0
 MAX_REQUEST_BYTES = 1 << 16
 """Largest request line a resident process reads (a command line and a folder name)."""
 
-INTERRUPTED_STATUS = 130
 
 _ENV_PREFIXES = ("NUMBA_", "FRUSTUM_")
 _ENV_NAMES = ("PYTHONPATH", "PYTHONHASHSEED")
@@ -65,7 +66,8 @@ def enabled() -> bool:
 
 
 def _package_dir() -> Path:
-    return Path(__file__).resolve().parent
+    """The ``frustum`` package's folder (this module is in its ``app`` package)."""
+    return Path(__file__).resolve().parent.parent
 
 
 class _Digest:
@@ -235,7 +237,7 @@ def _cancel(connection: socket.socket, lines: _Lines) -> int:
         connection.settimeout(2.0)
         while (reply := lines.next()) is not None and "exit" not in reply:
             pass
-    sys.stderr.write("error: interrupted (Ctrl-C); no output file was written or changed\n")
+    sys.stderr.write(f"error: {INTERRUPTED_MESSAGE}\n")
     sys.stderr.flush()
     return INTERRUPTED_STATUS
 
@@ -259,7 +261,7 @@ def start() -> bool:
                                if entry]  # fmt: skip
     environ["PYTHONPATH"] = os.pathsep.join(search)
     code = ("import os, sys; os.chdir(sys.argv[1]); del sys.path[0]; "
-            "from frustum.resident import serve; serve(sys.argv[2], sys.argv[3], sys.argv[4])")  # fmt: skip
+            "from frustum.app.resident import serve; serve(sys.argv[2], sys.argv[3], sys.argv[4])")  # fmt: skip
     arguments = [sys.executable, "-c", code, str(paths[0].parent), str(paths[0]), str(paths[1]),
                  str(_package_dir())]  # fmt: skip
     log = os.fspath(paths[0].with_suffix(".log"))
@@ -404,7 +406,9 @@ class _Server:
                     pass
 
     def render(self, connection: socket.socket, lines: _Lines, message: dict[str, Any]) -> None:
-        from frustum import _files, _program
+        from frustum import _files
+        from frustum.app import runtime
+        from frustum.app.work import render_files
 
         self.requests += 1
         lock = threading.Lock()
@@ -421,9 +425,9 @@ class _Server:
 
             def work() -> None:
                 try:
-                    outcome["written"] = _program.render_files(Path(request["scene"]), request["output"] or None,
-                                                               request["size"], request["up"] or "y",
-                                                               request["shadows"])  # fmt: skip
+                    outcome["written"] = render_files(Path(request["scene"]), request["output"] or None,
+                                                      request["size"], request["up"] or "y",
+                                                      request["shadows"])  # fmt: skip
                 except BaseException as error:  # reported to the client below, as the program reports it
                     outcome["error"] = error
                 finally:
@@ -437,16 +441,14 @@ class _Server:
             if cancelled:
                 return
             error = outcome.get("error")
-            if error is not None and not isinstance(error, _program.REPORTED):  # a traceback, as the program prints
+            if error is not None and not isinstance(error, runtime.REPORTED):  # a traceback, as the program prints
                 import traceback
 
                 sys.stderr.write("".join(traceback.format_exception(error)))
                 code = 1
             elif error is not None:
-                text, code = _program.failure(error)
-                from frustum._arrays import escape_control
-
-                sys.stderr.write(f"error: {escape_control(text, keep_newlines=True)}\n")
+                text, code = runtime.failure(error)
+                runtime.say(runtime.error_line(text), sys.stderr)
             else:
                 code = 0
                 for path in outcome.get("written", []):
@@ -455,7 +457,7 @@ class _Server:
                 _send(connection, {"exit": code})
         except (ValueError, TypeError, OSError) as problem:  # a malformed request or a vanished working folder
             with lock, contextlib.suppress(OSError):
-                _send(connection, {"stream": "err", "text": f"error: {_program.failure(problem)[0]}\n"})
+                _send(connection, {"stream": "err", "text": runtime.error_line(runtime.failure(problem)[0]) + "\n"})
                 _send(connection, {"exit": 1})
         finally:
             sys.stdout, sys.stderr = saved
@@ -573,10 +575,9 @@ def serve(socket_path: str, lock_path: str, package: str) -> None:
         listener.listen(64)
         identity = os.stat(socket_path).st_ino
         _warm_up(Path(socket_path).with_suffix(".plan"))
-        import frustum.raster
-        from frustum import _program
+        from frustum.app.runtime import install_compile_notice
 
-        frustum.raster.compile_notice = _program._compile_notice  # the program's words, should a request compile
+        install_compile_notice()  # the program's words, should a request compile
         gc.collect()
         gc.freeze()
         _Server(listener, package).loop()

@@ -14,10 +14,8 @@ options ``--max-bytes`` and ``--max-operations`` set the work budget (``frustum.
 
 from __future__ import annotations
 
-import gc
 import math
 import sys
-import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Annotated, Any
@@ -26,22 +24,19 @@ import numpy as np
 import typer
 from rich.console import Console
 
-import frustum.raster
 from frustum import __version__
-from frustum._arrays import escape_control
-from frustum._program import (  # noqa: F401 - shared with the program's own plain-render path, kept as names here
+from frustum.app.runtime import (
     _STATE,
-    GC_PAUSE_S,
-    INTERRUPTED_STATUS,
-    MAX_SIZE,
     REPORTED,
     UsageError,
-    _resume_gc_when_due,
-    _run_interruptible,
+    as_program,
+    fail,
     failure,
-    render_files,
+    install_compile_notice,
+    run_interruptible,
 )
-from frustum._program import image_size as _image_size
+from frustum.app.work import image_size as _image_size
+from frustum.app.work import render_files
 from frustum.camera import Camera
 from frustum.errors import FrustumError, GeometryError, OutputError
 from frustum.geometry import Mesh
@@ -71,8 +66,6 @@ app = typer.Typer(
 )
 console = Console()
 error_console = Console(stderr=True, highlight=False, soft_wrap=True)
-
-
 
 
 def _numbers(text: str, counts: tuple[int, ...], step: str) -> list[float]:
@@ -428,7 +421,7 @@ def render_command(
 ) -> None:
     """Render a scene file or a mesh file (framed from a 3/4 view, default lights, the file's materials); without
     -o, the outputs the file names (or out/<name>.png beside it)."""
-    for path in render_files(scene, output or None, size, up, shadows):  # also run without Typer: frustum._program
+    for path in render_files(scene, output or None, size, up, shadows):  # also run without Typer: frustum.app._program
         console.print(f"wrote {path}", markup=False, highlight=False, soft_wrap=True)
 
 
@@ -504,7 +497,7 @@ def warmup_command(
     processes: Annotated[int | None, typer.Option(help="Parallel processes (default: the number of cores).")] = None,
 ) -> None:
     """Compile every kernel ahead of time into Numba's on-disk cache, so no later render waits for it."""
-    from frustum.warmup import warmup
+    from frustum.app.warmup import warmup
 
     error_console.print("compiling every kernel (once per environment) ...", markup=False)
     console.print(str(warmup(processes)), markup=False, highlight=False)
@@ -516,7 +509,7 @@ def resident_command(
 ) -> None:
     """The resident render process that plain `frustum render FILE -o OUT` commands hand their work to, so they
     skip Python's and Numba's start-up (FRUSTUM_RESIDENT=0 turns it off; it exits after 10 idle minutes)."""
-    from frustum import resident
+    from frustum.app import resident
 
     if action == "status":
         running = resident.status()
@@ -728,7 +721,7 @@ def radiosity_command(
             done = min(-math.log10(max(residual, 1e-300)), goal)
             bar.update(task, completed=done, shots=shots, residual=residual)
 
-        result = _run_interruptible(lambda: radiosity(scene_file.scene, progress=progress, **settings))
+        result = run_interruptible(lambda: radiosity(scene_file.scene, progress=progress, **settings))
     keep = {k: v for k, v in scene_file.options.items() if k in ("background", "samples", "color_space", "filter")}
     output.parent.mkdir(parents=True, exist_ok=True)
     render(result.scene, scene_file.cameras[0], shading="none", **keep).save(output)
@@ -745,62 +738,40 @@ _CLICK_USAGE_ERROR = _click_exception("UsageError")
 _CLICK_EXCEPTION = _click_exception("ClickException")
 
 
-def _fail(message: str, status: int) -> None:
-    error_console.print(f"error: {escape_control(message, keep_newlines=True)}", markup=False)
-    raise SystemExit(status)
-
-
-def _compile_notice() -> None:
-    """Told by the kernels once they have been compiling for a second (a first run in a new environment)."""
-    error_console.print("compiling render kernels, first run only (`frustum warmup` does it ahead of time) ...",
-                        markup=False, highlight=False)  # fmt: skip
-
-
 def main(arguments: Sequence[str] | None = None) -> None:
     """Entry point of the ``frustum`` console script: one-line errors, exit 1 (2 for usage), tracebacks on --debug.
 
-    The command runs on a worker thread (``_run_interruptible``): Ctrl-C exits with status 130 within a fraction
-    of a second, leaving no partial output file.
-
-    Run as the program (`arguments` None), the process is short-lived and its objects are nearly all long-lived
-    modules (Numba's ~800): the cyclic garbage collector is paused for the first ``GC_PAUSE_S`` seconds (its
-    passes over the growing module graph cost ~0.1 s of the README render) and every object is frozen
-    (``gc.freeze``) on the way out, so interpreter shutdown does not traverse and tear down that graph object by
-    object (~0.3 s). A command still running after the pause collects garbage as usual. Called from Python
-    (`arguments` given) the collector is left alone.
+    The command runs on a worker thread (``runtime.run_interruptible``): Ctrl-C exits with status 130 within a
+    fraction of a second, leaving no partial output file. Run as the program (`arguments` None), it runs as a
+    short-lived program (``runtime.as_program``); called from Python the garbage collector is left alone.
     """
     if arguments is not None:
         _main(list(arguments))
         return
-    gc.disable()
-    _STATE["resume_gc_at"] = time.monotonic() + GC_PAUSE_S
-    try:
-        _main(sys.argv[1:])
-    finally:
-        gc.freeze()
+    as_program(lambda: _main(sys.argv[1:]))
 
 
 def _main(argv: list[str]) -> None:
     _STATE["debug"] = "--debug" in argv
-    frustum.raster.compile_notice = _compile_notice
+    install_compile_notice()
     try:
-        status = _run_interruptible(lambda: app(args=argv, prog_name="frustum", standalone_mode=False))
+        status = run_interruptible(lambda: app(args=argv, prog_name="frustum", standalone_mode=False))
     except _CLICK_USAGE_ERROR as error:
         message = " ".join(error.format_message().split())
         if not message:  # no command given: the help was printed instead
             raise SystemExit(2) from None
-        _fail(message, 2)
+        fail(message, 2)
     except typer.Abort:
-        _fail("aborted", 1)
+        fail("aborted", 1)
     except RecursionError as error:
         if _STATE["debug"]:
             raise
-        _fail(*failure(error))
+        fail(*failure(error))
     except _CLICK_EXCEPTION as error:
-        _fail(" ".join(error.format_message().split()), error.exit_code)
+        fail(" ".join(error.format_message().split()), error.exit_code)
     except REPORTED as error:
         if _STATE["debug"]:
             raise
-        _fail(*failure(error))
+        fail(*failure(error))
     if isinstance(status, int) and status:
         raise SystemExit(status)

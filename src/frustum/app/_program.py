@@ -1,0 +1,105 @@
+"""The ``frustum`` program's entry point, and what it shares with the Typer command line (``frustum.app.cli``).
+
+``main`` runs the most common command, ``frustum render FILE -o OUT`` (with ``--size``, ``--up``, ``--shadows``),
+straight away: building the Typer application with its fourteen commands and coercing their parameters (Typer
+imports Pydantic for that) took about 0.3 s of a 1.2 s warm one-command render, more than the render itself. The
+same function (``render_files``) does the work, with the same checks, messages, exit statuses, Ctrl-C handling
+and garbage-collector pause. Any other command line (another command, ``--help``, global options, an option this
+module does not know, a value that looks like an option) goes to ``frustum.app.cli.main`` unchanged.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+from frustum.app.runtime import REPORTED, as_program, fail, failure, install_compile_notice, run_interruptible, say
+
+__all__ = ["main", "plain_render"]
+
+
+_RENDER_OPTIONS = {"-o": "output", "--output": "output", "--size": "size", "--up": "up", "--shadows": "shadows"}
+
+
+def plain_render(argv: Sequence[str]) -> dict[str, Any] | None:
+    """The arguments of a ``render`` command line in the plain form ``main`` runs itself, or None.
+
+    Plain: ``render``, one file, and only ``-o/--output`` (repeatable), ``--size``, ``--up`` and ``--shadows``
+    (each at most once), as ``--name value`` or ``--name=value``, no value starting with "-"."""
+    if not argv or argv[0] != "render":
+        return None
+    found: dict[str, Any] = {"output": [], "size": None, "up": None, "shadows": None, "scene": None}
+    words = list(argv[1:])
+    while words:
+        word = words.pop(0)
+        if not word:
+            return None
+        if not word.startswith("-"):
+            if found["scene"] is not None:
+                return None
+            found["scene"] = word
+            continue
+        name, equals, value = word.partition("=")
+        if name not in _RENDER_OPTIONS or (equals and name == "-o"):
+            return None
+        if not equals:
+            if not words:
+                return None
+            value = words.pop(0)
+        if not value or value.startswith("-"):
+            return None
+        key = _RENDER_OPTIONS[name]
+        if key == "output":
+            found["output"].append(Path(value))
+        elif found[key] is not None:
+            return None
+        else:
+            found[key] = value
+    if found["scene"] is None:
+        return None
+    return found
+
+
+def main(arguments: Sequence[str] | None = None) -> None:
+    """Entry point of the ``frustum`` console script and ``python -m frustum``: a plain ``render`` command line
+    (``plain_render``) runs here; every other one runs through ``frustum.app.cli.main`` (Typer).
+
+    As the program (`arguments` None) a plain render goes to the resident render process when one answers
+    (``frustum.app.resident``: the same work without the start-up); otherwise it runs here as a short-lived
+    program (``runtime.as_program``: the garbage collector paused, every object frozen on the way out), and leaves
+    a resident process behind for the next command."""
+    argv = list(sys.argv[1:] if arguments is None else arguments)
+    request = plain_render(argv)
+    if request is None:
+        from frustum.app.cli import main as typer_main
+
+        typer_main(arguments)
+        return
+    if arguments is not None:
+        _render(request)
+        return
+    from frustum.app import resident
+
+    status = resident.handed(request)
+    if status is not None:
+        raise SystemExit(status)
+    try:
+        as_program(lambda: _render(request))
+    finally:
+        resident.start()  # for the next command (``frustum.app.resident``); nothing when one runs or it is off
+
+
+def _render(request: dict[str, Any]) -> None:
+    from frustum.app.work import render_files
+
+    install_compile_notice()
+    try:
+        written = run_interruptible(lambda: render_files(Path(request["scene"]), request["output"] or None,
+                                                         request["size"], request["up"] or "y",
+                                                         request["shadows"]))  # fmt: skip
+    except REPORTED as error:
+        fail(*failure(error))
+    for path in written:
+        say(f"wrote {path}")
