@@ -84,11 +84,12 @@ class MeshPart(NamedTuple):
         def image(array: Any) -> str:
             return "None" if array is None else f"<{'x'.join(map(str, np.shape(array)))} image>"
 
+        physical = (f", metallic={self.metallic!r}, roughness={self.roughness!r}, metallic_roughness_texture="
+                    f"{image(self.metallic_roughness_texture)}, occlusion_texture={image(self.occlusion_texture)}, "
+                    "physical=True") if self.physical else ""  # fmt: skip
         return (f"MeshPart(name={self.name!r}, mesh={self.mesh!r}, texture={image(self.texture)}, "
                 f"color={self.color!r}, normal_map={image(self.normal_map)}, emissive={self.emissive!r}, "
-                f"alpha_mode={self.alpha_mode!r}, metallic={self.metallic!r}, roughness={self.roughness!r}, "
-                f"metallic_roughness_texture={image(self.metallic_roughness_texture)}, "
-                f"occlusion_texture={image(self.occlusion_texture)}, physical={self.physical!r})")  # fmt: skip
+                f"alpha_mode={self.alpha_mode!r}{physical})")  # fmt: skip
 
 
 def load(path: str | Path, texture: str | Path | None = None) -> Mesh:

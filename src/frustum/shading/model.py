@@ -253,10 +253,13 @@ class Material:
         return replace(self, **changes)
 
     def __repr__(self) -> str:
-        """Short: images appear as their shapes (``<1024x1024x3 image>``), not their pixels."""
+        """Short: images appear as their shapes (``<1024x1024x3 image>``), not their pixels; absent glTF maps not
+        at all."""
         shown = []
         for name in self.__dataclass_fields__:
             value = getattr(self, name)
+            if value is None and name.endswith("_texture"):  # the metallic–roughness maps, when there are none
+                continue
             if isinstance(value, np.ndarray) and value.ndim >= 2:
                 shown.append(f"{name}=<{'x'.join(map(str, value.shape))} image>")
             elif isinstance(value, np.ndarray):
