@@ -1,18 +1,24 @@
-"""Your own model in one command (issue 36): `frustum render <mesh file> -o out.png` on six real files, cold (an
-empty Numba cache) and warm, beside F3D's headless render of the same files, in the same run.
+"""Your own model in one command (issues 36, 49): `frustum render <mesh file> -o out.png` on six real files, cold (an
+empty Numba cache) and warm, beside F3D's headless render of the same files, in the same run, three ways:
 
-Each timing is a whole process, as a user runs it: ``frustum render FILE -o out.png`` against a Python one-liner
-that opens F3D offscreen (``f3d.Engine.create(True)``), adds the file, renders 480x360 and saves the PNG. Warm
-timings are medians of `--repeat` runs; cold is one run of the first file with an empty ``NUMBA_CACHE_DIR``.
-F3D is the anchor: the ratio frustum / F3D per file is what this reports (target: warm <= 1), in wall time and in
-CPU time (user + system of the whole process: steadier than wall time on a shared machine). Warm means the kernel
-cache and Python's bytecode cache are filled (``PYTHONDONTWRITEBYTECODE`` is dropped for the runs: a source
-checkout under that setting compiles frustum's ~40 modules from source on every run, ~0.1 s).
+(a) one command per file, each in its own process (the default: no resident process);
+(b) all six files in one command, ``frustum render f1 ... f6 -o {index}-{name}.png`` (per-file time = the
+    command's time / 6; every file with ``--up y``, the teapot lying on its side: the timing is what counts);
+(c) one command per file handed to a resident render process started on purpose (``frustum resident start``).
+
+Each timing is a whole process, as a user runs it, against a Python one-liner that opens F3D offscreen
+(``f3d.Engine.create(True)``), adds the file, renders 480x360 and saves the PNG. Warm timings are medians of
+`--repeat` runs; cold is one run of the first file with an empty ``NUMBA_CACHE_DIR``. F3D is the anchor: the
+ratio frustum / F3D per file is what this reports (targets: (a) <= 1.3, (b) <= 0.5), in wall time and in CPU time
+(user + system of the whole process, and for (c) of the resident's request children too: steadier than wall time
+on a shared machine). Warm means the kernel cache and Python's bytecode cache are filled
+(``PYTHONDONTWRITEBYTECODE`` is dropped for the runs: a source checkout under that setting compiles frustum's
+modules from source on every run, ~0.1 s).
 
     python benchmarks/bench_own_model.py [--repeat 3] [--no-cold]
 
-Needs ``pip install f3d`` (otherwise only frustum's times are printed) and trimesh (for the GLB, STL and OFF
-made from the reference files).
+Needs ``pip install f3d`` (the bench extra; otherwise only frustum's times are printed) and trimesh (for the GLB,
+STL and OFF made from the reference files).
 """
 
 from __future__ import annotations
@@ -87,13 +93,14 @@ def _medians(runs: list[tuple[float, float]]) -> tuple[float, float]:
 
 
 def _resident_cpu(env: dict[str, str]) -> float:
-    """CPU seconds (user + system) the resident render processes of `env`'s runtime folder have used so far."""
+    """CPU seconds (user + system, its own and its reaped request children's) the resident render processes of
+    `env`'s runtime folder have used so far."""
     script = "from frustum.app import resident; print(' '.join(str(e['pid']) for e in resident.status()))"
     pids = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True).stdout.split()
     total = 0.0
     for pid in pids:
         fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
-        total += (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+        total += sum(int(value) for value in fields[11:15]) / os.sysconf("SC_CLK_TCK")
     return total
 
 
@@ -107,8 +114,9 @@ def main() -> None:
         folder = Path(temp)
         (folder / "run").mkdir(mode=0o700)
         env = {**os.environ, "PYTHONPATH": str(ROOT / "src") + os.pathsep + os.environ.get("PYTHONPATH", ""),
-               "XDG_RUNTIME_DIR": str(folder / "run"), "FRUSTUM_RESIDENT": "1"}  # fmt: skip
+               "XDG_RUNTIME_DIR": str(folder / "run")}  # fmt: skip
         env.pop("PYTHONDONTWRITEBYTECODE", None)  # warm = bytecode cached too, as pip install leaves a package
+        env.pop("FRUSTUM_RESIDENT", None)  # the default: (a) and (b) start no resident process
         own_env = {**env, "FRUSTUM_RESIDENT": "0"}
         try:
             import f3d  # noqa: F401
@@ -133,16 +141,19 @@ def _compare(args: argparse.Namespace, frustum_cli: list[str], folder: Path, env
         print(f"cold (empty NUMBA_CACHE_DIR), {first_name}: {cold:.2f} s")
     for path, up in files.values():  # every kernel the six files use is in the cache before timing
         timed([*frustum_cli, "render", str(path), "-o", str(folder / "warm.png"), "--up", up], own_env)
-    # the first plain render leaves the resident process behind; wait until it answers
-    timed([*frustum_cli, "render", str(first), "-o", str(folder / "warm.png"), "--up", up], env)
-    for _ in range(200):
-        if _resident_cpu(env) > 0:
-            break
-        time.sleep(0.05)
-    print("warm: 'resident' = the command handed to the resident render process (CPU: client + resident);"
-          " 'own' = FRUSTUM_RESIDENT=0, the whole render in the command's own process")
-    print(f"{'file':<14} {'resident s':>10} {'own s':>7} {'F3D s':>7} {'ratio':>7} {'own ratio':>9}   "
-          f"{'CPU s: resident':>15} {'own':>6} {'F3D':>6} {'ratio':>6}")  # fmt: skip
+    f3d_runs: dict[str, tuple[float, float]] = {}
+    own_runs: dict[str, tuple[float, float]] = {}
+    for name, (path, up) in files.items():  # (a) and F3D
+        command = [*frustum_cli, "render", str(path), "-o", str(folder / "ours.png"), "--up", up]
+        own_runs[name] = _medians([timed_cpu(command, env) for _ in range(args.repeat)])
+        if have_f3d:
+            f3d_runs[name] = _medians([timed_cpu([sys.executable, "-c", F3D_SCRIPT, str(path), str(folder / "f3d.png")],
+                                                 env) for _ in range(args.repeat)])  # fmt: skip
+    batch = [*frustum_cli, "render", *(str(path) for path, _ in files.values()), "-o",
+             str(folder / "batch" / "{index}-{name}.png"), "--up", "y"]  # fmt: skip
+    batch_wall, batch_cpu = _medians([timed_cpu(batch, env) for _ in range(args.repeat)])  # (b)
+    subprocess.run([*frustum_cli, "resident", "start"], env=env, capture_output=True, check=True)  # (c)
+    resident_runs: dict[str, tuple[float, float]] = {}
     for name, (path, up) in files.items():
         command = [*frustum_cli, "render", str(path), "-o", str(folder / "ours.png"), "--up", up]
         handed = []
@@ -150,17 +161,23 @@ def _compare(args: argparse.Namespace, frustum_cli: list[str], folder: Path, env
             before = _resident_cpu(env)
             wall, cpu = timed_cpu(command, env)
             handed.append((wall, cpu + _resident_cpu(env) - before))
-        ours, ours_cpu = _medians(handed)
-        own, own_cpu = _medians([timed_cpu(command, own_env) for _ in range(args.repeat)])
-        line = f"{name:<14} {ours:>10.2f} {own:>7.2f}"
-        if have_f3d:
-            theirs, theirs_cpu = _medians([
-                timed_cpu([sys.executable, "-c", F3D_SCRIPT, str(path), str(folder / "f3d.png")], env)
-                for _ in range(args.repeat)
-            ])  # fmt: skip
-            line += (f" {theirs:>7.2f} {ours / theirs:>7.2f} {own / theirs:>9.2f}   {ours_cpu:>15.2f} "
-                     f"{own_cpu:>6.2f} {theirs_cpu:>6.2f} {ours_cpu / theirs_cpu:>6.2f}")  # fmt: skip
-        print(line, flush=True)
+        resident_runs[name] = _medians(handed)
+    print("(a) own: one command per file in its own process (no resident); (c) resident: handed to a resident "
+          "started on purpose (CPU: client + the resident's request child)")
+    print(f"{'file':<14} {'own s':>7} {'F3D s':>7} {'own/F3D':>8} {'resident s':>10} {'res/F3D':>8}   "
+          f"{'CPU s: own':>10} {'F3D':>6} {'own/F3D':>8} {'resident':>8}")  # fmt: skip
+    for name in files:
+        own, own_cpu = own_runs[name]
+        handed_wall, handed_cpu = resident_runs[name]
+        theirs, theirs_cpu = f3d_runs.get(name, (float("nan"), float("nan")))
+        print(f"{name:<14} {own:>7.2f} {theirs:>7.2f} {own / theirs:>8.2f} {handed_wall:>10.2f} "
+              f"{handed_wall / theirs:>8.2f}   {own_cpu:>10.2f} {theirs_cpu:>6.2f} {own_cpu / theirs_cpu:>8.2f} "
+              f"{handed_cpu:>8.2f}", flush=True)  # fmt: skip
+    f3d_wall = statistics.median(wall for wall, _ in f3d_runs.values()) if f3d_runs else float("nan")
+    f3d_cpu = statistics.median(cpu for _, cpu in f3d_runs.values()) if f3d_runs else float("nan")
+    print(f"(b) six files in one command: {batch_wall:.2f} s ({batch_cpu:.2f} s CPU), per file {batch_wall / 6:.3f} s "
+          f"= {batch_wall / 6 / f3d_wall:.2f}x F3D's median per file ({f3d_wall:.2f} s); CPU per file "
+          f"{batch_cpu / 6:.3f} s = {batch_cpu / 6 / f3d_cpu:.2f}x F3D's ({f3d_cpu:.2f} s)")  # fmt: skip
 
 
 if __name__ == "__main__":

@@ -12,7 +12,3 @@ settings.register_profile(
 # HYPOTHESIS_PROFILE, when set, wins over CI: .ci/run's random-seed step runs "dev" (--hypothesis-seed is ignored
 # under derandomize=True)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE") or ("ci" if os.environ.get("CI") else "dev"))
-
-# The `frustum` programs the tests start render in their own processes: none leaves a resident render process
-# behind (frustum.resident); tests/test_resident.py turns it on for its own programs, in a folder of its own.
-os.environ["FRUSTUM_RESIDENT"] = "0"

@@ -583,7 +583,8 @@ def test_camera_formats_refuse_projections_they_cannot_describe(tmp_path) -> Non
     ("jobs", "message"),
     [
         (["not a job"], "jobs\\[0\\] = 'not a job' is not a RenderJob"),
-        ([RenderJob("a", "x", None, {"colour": "a.png"})], "outputs has kind 'colour'; expected one of color"),
+        ([RenderJob("a", "x", None, {"colour": "a.png"})],
+         "outputs has kind 'colour'; expected one of annotations, color"),
         ([RenderJob("a", "x", None, {"depth": "a.exr"})], "has suffix '.exr'; expected .npy or .png"),
         ([RenderJob("a", 42, None, {})], "scene = 42 is not a Scene or a scene file path"),
     ],

@@ -4,6 +4,7 @@ exit statuses as the Typer command line, and imports neither Typer, Rich, Pydant
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -40,7 +41,8 @@ def test_plain_render_command_lines_are_taken(argv, expected):
         ["--debug", "render", "a.ply"], ["render", "a.ply", "-o"], ["render", "a.ply", "-o", "-x.png"],
         ["render", "a.ply", "--up", "z", "--up", "y"], ["render", "a.ply", "--quality", "high"],
         ["render", "a.ply", "-o=x.png"], ["render", "", "-o", "x.png"], ["render", "a.ply", "--", "-b.ply"],
-        ["render", "a.ply", "--size="],
+        ["render", "a.ply", "--size="], ["render", "models/*.ply", "-o", "{stem}.png"], ["render", "a.ply", "-o",
+        "out/{stem}.png"], ["render", "a.ply", "b.ply", "-o", "{stem}.png"], ["render", "a.ply", "--jobs", "2"],
     ],
 )  # fmt: skip
 def test_other_command_lines_go_to_typer(argv):
@@ -99,14 +101,34 @@ def test_the_program_fails_as_typer_does(tmp_path, arguments, status, fragment):
     assert program.stderr.count("\n") == 1 and program.stdout == typer.stdout == ""
 
 
-def test_a_plain_render_imports_no_command_line_library_and_no_trimesh(tmp_path):
+def test_a_plain_render_imports_no_command_line_library_nor_what_it_does_not_use(tmp_path):
     code = (
         "import sys\nfrom frustum.app._program import main\n"
         f"sys.argv = ['frustum', 'render', {str(BUNNY)!r}, '-o', 'out.png', '--size', '32x24']\nmain()\n"
-        "print(sorted({m.split('.')[0] for m in sys.modules} & {'typer', 'click', 'rich', 'pydantic', 'trimesh'}))\n"
+        "print(sorted({m.split('.')[0] for m in sys.modules} & {'typer', 'click', 'rich', 'pydantic', 'trimesh',\n"
+        "     'skimage', 'imageio', 'cairosvg', 'manifold3d', 'multiprocessing'}))\n"
     )
     result = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True, timeout=300,
                             check=False)  # fmt: skip
     assert result.returncode == 0, result.stderr
     assert result.stdout.splitlines() == ["wrote out.png", "[]"]
     assert (tmp_path / "out.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_frustum_profile_times_each_stage_and_changes_nothing(tmp_path):
+    plain = subprocess.run([sys.executable, "-m", "frustum", "render", str(BUNNY), "-o", "plain.png", "--size",
+                            "32x24"], cwd=tmp_path, capture_output=True, text=True, timeout=300,
+                           check=False)  # fmt: skip
+    profiled = subprocess.run([sys.executable, "-m", "frustum", "render", str(BUNNY), "-o", "timed.png", "--size",
+                               "32x24"], cwd=tmp_path, capture_output=True, text=True, timeout=300, check=False,
+                              env={**os.environ, "FRUSTUM_PROFILE": "1"})  # fmt: skip
+    assert plain.returncode == profiled.returncode == 0, profiled.stderr
+    assert profiled.stdout == "wrote timed.png\n" and "profile:" not in plain.stderr
+    line = _quiet(profiled.stderr).strip()
+    stages = ["python start-up", "import numpy and numba", "numba target setup", "import frustum", "file reading",
+              "kernel loading", "render", "png write"]  # fmt: skip
+    assert line.startswith("profile: ") and all(f"{stage} " in line for stage in stages), line
+    seconds = [float(part.rsplit(" s", 1)[0].split()[-1]) for part in line.split(";")[0].split(", ")]
+    total = float(line.split("; total ")[1].removesuffix(" s"))
+    assert all(value >= 0 for value in seconds) and sum(seconds) <= total * 1.05 + 0.01
+    assert (tmp_path / "plain.png").read_bytes() == (tmp_path / "timed.png").read_bytes()

@@ -437,8 +437,8 @@ def test_vertex_colors_interpolate_and_multiply_the_material_color():
 
 
 def test_the_directional_fast_path_equals_the_general_shading_kernel_bit_for_bit():
-    """Blinn-Phong with directional lights only runs ``shade_pixels_directional``; asking for an extra buffer
-    forces the general ``shade_pixels``: the colors must be the same bytes."""
+    """Blinn-Phong with directional lights only runs ``shade_pixels_directional``; asking for normals forces the
+    general ``shade_pixels`` (object ids alone do not: they are filled from the face codes): the same bytes."""
     sphere = trimesh.creation.icosphere(subdivisions=3)
     lights = [
         DirectionalLight((-0.3, -0.6, -0.7), color=(1.0, 0.8, 0.6), intensity=0.9),
@@ -449,13 +449,13 @@ def test_the_directional_fast_path_equals_the_general_shading_kernel_bit_for_bit
     scene.add(Mesh(sphere.vertices, sphere.faces), Material(color=(0.7, 0.5, 0.3), emissive=(0.02, 0.0, 0.05)))
     camera = Camera.look_at((0.5, 0.8, 3.0), (0, 0, 0), (0, 1, 0), width=96, height=72)
     fast = render(scene, camera)
-    general = render(scene, camera, buffers=("object_id",))
+    general = render(scene, camera, buffers=("normals",))  # normals: the general kernel writes them
     assert (fast.color == general.color).all() and (fast.depth == general.depth).all()
 
 
 def test_the_phong_kernel_for_any_lights_equals_the_general_shading_kernel_bit_for_bit():
     """Per-pixel Phong with point, spot and directional lights and no extras runs ``shade_pixels_phong``; an extra
-    buffer forces the general ``shade_pixels``: the colors must be the same bytes, both sides lit."""
+    buffer that the kernel writes (normals) forces the general ``shade_pixels``: the same bytes, both sides lit."""
     sphere = trimesh.creation.icosphere(subdivisions=3)
     half = sphere.faces[sphere.triangles_center[:, 2] < 0.3]  # open at the top: back faces seen inside
     lights = [
@@ -469,6 +469,6 @@ def test_the_phong_kernel_for_any_lights_equals_the_general_shading_kernel_bit_f
     camera = Camera.look_at((0.5, 2.5, 2.0), (0, 0, 0), (0, 1, 0), width=96, height=72)
     for specular in ("blinn-phong", "phong"):
         fast = render(scene, camera, cull_back_faces=False, specular=specular)
-        general = render(scene, camera, cull_back_faces=False, specular=specular, buffers=("object_id",))
+        general = render(scene, camera, cull_back_faces=False, specular=specular, buffers=("normals",))
         assert (fast.color == general.color).all() and (fast.depth == general.depth).all()
         assert (fast.depth < 1).sum() > 1000

@@ -24,6 +24,12 @@ from .batch import (
     render_dataset as render_dataset,
     render_many as render_many,
 )
+from .batch.randomize import (
+    cameras_on_shell as cameras_on_shell,
+    drop_on_plane as drop_on_plane,
+    jitter_lights as jitter_lights,
+    jitter_materials as jitter_materials,
+)
 from .visibility.bsp import (
     BSPTree as BSPTree,
 )
@@ -224,6 +230,7 @@ from .output.sheet import (
 from .output.simulate import (
     simulate as simulate,
 )
+from .output.annotations import annotate as annotate
 from .output.stereo import (
     ANAGLYPH_METHODS as ANAGLYPH_METHODS,
     STEREO_LAYOUTS as STEREO_LAYOUTS,

@@ -27,7 +27,12 @@ class Frame:
     scene item seen at each pixel (−1 for background); ``position`` (H, W, 3) float32 world points of the nearest
     opaque surface (NaN where nothing was drawn) and ``shadow`` (H, W, L) float32, the fraction of each of the L
     shadow-casting lights reaching the pixel (1 lit, 0 in shadow, NaN where nothing was drawn; lights in
-    ``Scene.world_lights`` order: the root's first, then those on nodes). All arrays are read-only. ``stats``:
+    ``Scene.world_lights`` order: the root's first, then those on nodes). Ground truth (``render.ground_truth``):
+    ``instance`` (H, W) int32 (``object_id`` by its dataset name), ``semantic`` (H, W) int32 class ids (0 background),
+    ``amodal`` (K, H, W) bool per-item silhouettes ignoring occluders with ``visibility`` (K,) float64 visible /
+    amodal pixels (NaN outside the view), ``object_coords`` and ``nocs`` (H, W, 3) float32 model and normalized
+    object coordinates (NaN on background), ``flow`` (H, W, 2) float32 pixels to the next frame (x right, y down)
+    and ``flow_occluded`` (H, W) bool. All arrays are read-only. ``stats``:
     the visible-surface method's counts (``render(..., method=...)``; spans, areas per level, depth tests,
     fragments per pixel …), with ``stats["method"]`` its name, or None where none were asked for.
     """
@@ -39,6 +44,14 @@ class Frame:
     stats: dict | None = None
     position: NDArray[np.float32] | None = None
     shadow: NDArray[np.float32] | None = None
+    instance: NDArray[np.int32] | None = None
+    semantic: NDArray[np.int32] | None = None
+    amodal: NDArray[np.bool_] | None = None
+    visibility: NDArray[np.float64] | None = None
+    object_coords: NDArray[np.float32] | None = None
+    nocs: NDArray[np.float32] | None = None
+    flow: NDArray[np.float32] | None = None
+    flow_occluded: NDArray[np.bool_] | None = None
 
     def __post_init__(self) -> None:
         color = np.ascontiguousarray(self.color)
@@ -52,10 +65,15 @@ class Frame:
                 f"Frame: depth has dtype {depth.dtype} and shape {depth.shape}; expected {color.shape[:2]} float32"
             )
         lights = None if self.shadow is None else np.shape(self.shadow)[2:3]
+        items = None if self.amodal is None else np.shape(self.amodal)[:1]
         for name, dtype, shape in (
             ("normals", np.float32, (*depth.shape, 3)), ("object_id", np.int32, depth.shape),
             ("position", np.float32, (*depth.shape, 3)),
             ("shadow", np.float32, (*depth.shape, *(lights or (-1,)))),
+            ("instance", np.int32, depth.shape), ("semantic", np.int32, depth.shape),
+            ("amodal", np.bool_, (*(items or (-1,)), *depth.shape)), ("visibility", np.float64, items or (-1,)),
+            ("object_coords", np.float32, (*depth.shape, 3)), ("nocs", np.float32, (*depth.shape, 3)),
+            ("flow", np.float32, (*depth.shape, 2)), ("flow_occluded", np.bool_, depth.shape),
         ):  # fmt: skip
             value = getattr(self, name)
             if value is None:

@@ -15,7 +15,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from frustum.app.runtime import REPORTED, as_program, fail, failure, install_compile_notice, run_interruptible, say
+from frustum.app.runtime import as_program
 
 __all__ = ["main", "plain_render"]
 
@@ -26,8 +26,9 @@ _RENDER_OPTIONS = {"-o": "output", "--output": "output", "--size": "size", "--up
 def plain_render(argv: Sequence[str]) -> dict[str, Any] | None:
     """The arguments of a ``render`` command line in the plain form ``main`` runs itself, or None.
 
-    Plain: ``render``, one file, and only ``-o/--output`` (repeatable), ``--size``, ``--up`` and ``--shadows``
-    (each at most once), as ``--name value`` or ``--name=value``, no value starting with "-"."""
+    Plain: ``render``, one file (not a folder or a glob pattern), and only ``-o/--output`` (repeatable, no
+    ``{field}`` of an output pattern), ``--size``, ``--up`` and ``--shadows`` (each at most once), as ``--name
+    value`` or ``--name=value``, no value starting with "-"."""
     if not argv or argv[0] != "render":
         return None
     found: dict[str, Any] = {"output": [], "size": None, "up": None, "shadows": None, "scene": None}
@@ -57,8 +58,11 @@ def plain_render(argv: Sequence[str]) -> dict[str, Any] | None:
             return None
         else:
             found[key] = value
-    if found["scene"] is None:
-        return None
+    scene = found["scene"]
+    if scene is None or Path(scene).is_dir() or (set(scene) & set("*?[") and not Path(scene).exists()):
+        return None  # a folder or a pattern: several inputs (``frustum.app.many``)
+    if any("{" in str(path) for path in found["output"]):
+        return None  # an output pattern
     return found
 
 
@@ -66,10 +70,13 @@ def main(arguments: Sequence[str] | None = None) -> None:
     """Entry point of the ``frustum`` console script and ``python -m frustum``: a plain ``render`` command line
     (``plain_render``) runs here; every other one runs through ``frustum.app.cli.main`` (Typer).
 
-    As the program (`arguments` None) a plain render goes to the resident render process when one answers
-    (``frustum.app.resident``: the same work without the start-up); otherwise it runs here as a short-lived
-    program (``runtime.as_program``: the garbage collector paused, every object frozen on the way out), and leaves
-    a resident process behind for the next command."""
+    As the program (`arguments` None) a plain render goes to the resident render process when one was started on
+    purpose and takes it (``frustum.app.resident``: the same work without the start-up); otherwise it runs here as
+    a short-lived program (``runtime.as_program``). Only with ``FRUSTUM_RESIDENT=1`` and only after a successful
+    render does it start a resident process for the next command (and says so); by default nothing is left
+    behind."""
+    from frustum.app.work import run_render
+
     argv = list(sys.argv[1:] if arguments is None else arguments)
     request = plain_render(argv)
     if request is None:
@@ -78,28 +85,14 @@ def main(arguments: Sequence[str] | None = None) -> None:
         typer_main(arguments)
         return
     if arguments is not None:
-        _render(request)
-        return
-    from frustum.app import resident
+        status = run_render(request)
+    else:
+        from frustum.app import resident
 
-    status = resident.handed(request)
-    if status is not None:
+        status = resident.handed(request)
+        if status is None:
+            status = as_program(lambda: run_render(request))
+            if status == 0 and resident.wanted():
+                resident.start()
+    if status:
         raise SystemExit(status)
-    try:
-        as_program(lambda: _render(request))
-    finally:
-        resident.start()  # for the next command (``frustum.app.resident``); nothing when one runs or it is off
-
-
-def _render(request: dict[str, Any]) -> None:
-    from frustum.app.work import render_files
-
-    install_compile_notice()
-    try:
-        written = run_interruptible(lambda: render_files(Path(request["scene"]), request["output"] or None,
-                                                         request["size"], request["up"] or "y",
-                                                         request["shadows"]))  # fmt: skip
-    except REPORTED as error:
-        fail(*failure(error))
-    for path in written:
-        say(f"wrote {path}")

@@ -30,13 +30,14 @@ from frustum.app.runtime import (
     REPORTED,
     UsageError,
     as_program,
+    error_line,
     fail,
     failure,
     install_compile_notice,
     run_interruptible,
+    say,
 )
 from frustum.app.work import image_size as _image_size
-from frustum.app.work import render_files
 from frustum.camera import Camera
 from frustum.errors import FrustumError, GeometryError, OutputError
 from frustum.geometry import Mesh
@@ -357,9 +358,7 @@ def _triple_text(values: Sequence[float]) -> str:
     return "(" + ", ".join(f"{float(v):.6g}" for v in values) + ")"
 
 
-@app.command("info")
-def info_command(mesh: Annotated[Path, typer.Argument(help="A mesh file (.ply, .obj, .stl, .off, .glb).")]) -> None:
-    """Print a mesh file's counts, bounds, watertightness and normals."""
+def _info_table(mesh: Path) -> Any:
     from rich.table import Table
 
     loaded = _load_mesh(mesh, "info")
@@ -368,16 +367,62 @@ def info_command(mesh: Annotated[Path, typer.Argument(help="A mesh file (.ply, .
     table.add_column()
     for name, value in _mesh_facts(loaded):
         table.add_row(name, value)
-    console.print(table)
+    return table
+
+
+@app.command("info")
+def info_command(
+    mesh: Annotated[list[Path], typer.Argument(help="Mesh files (.ply, .obj, .stl, .off, .glb), or folders of them.")],
+) -> None:
+    """Print mesh files' counts, bounds, watertightness and normals (one table each; several: one line per
+    unreadable file, exit status 1)."""
+    from frustum.app.many import expand_inputs
+    from frustum.scenefile.loader import MODEL_SUFFIXES
+
+    inputs, several = expand_inputs(mesh, MODEL_SUFFIXES)
+    if not several:
+        console.print(_info_table(inputs[0]))
+        return
+    failed = 0
+    for source in inputs:
+        try:
+            table = _info_table(source)
+        except REPORTED as error:
+            failed += 1
+            say(error_line(f"{source}: {failure(error)[0]}"), sys.stderr)
+            continue
+        console.print(table)
+    if failed:
+        raise typer.Exit(1)
 
 
 # --- turntable --------------------------------------------------------------------------------------------------
 
 
+def _turntable_task(mesh: Path, outputs: list[Path] | None, options: dict[str, Any]) -> list[str]:
+    """One input of ``frustum turntable`` (several: ``frustum.app.many``): its ``wrote`` line."""
+    from frustum.output.animation import framing_camera, turntable
+    from frustum.scenefile.models import model_scene, physical_options
+
+    assert outputs is not None
+    output = outputs[0]
+    width, height = options["size"]
+    _load_mesh(mesh, "turntable")  # the CLI's checks and messages for a bad mesh file
+    scene, _ = model_scene(mesh, up=options["up"], size=(width, height))
+    camera = framing_camera(scene, width, height, elevation=math.radians(options["elevation_deg"]))
+    count = turntable(scene, camera, options["frames"], options["axis"], output, options["fps"],
+                      progress=options.get("progress", False), cull_back_faces=False, mode=options["mode"],
+                      **physical_options(scene))  # fmt: skip
+    return [f"wrote {output} ({count} frames, {width}x{height})"]
+
+
 @app.command("turntable")
 def turntable_command(
-    mesh: Annotated[Path, typer.Argument(help="A mesh file (.ply, .obj, .stl, .off, .glb).")],
-    output: Annotated[Path, typer.Option("--output", "-o", help="The animation file, .gif or .mp4.")],
+    mesh: Annotated[list[Path], typer.Argument(help="Mesh files (.ply, .obj, .stl, .off, .glb), or folders of them.")],
+    output: Annotated[
+        Path, typer.Option("--output", "-o", help="The animation file, .gif or .mp4; for several meshes a pattern "
+                           "with {stem}, {name}, {suffix} or {index}.")
+    ],
     frames: Annotated[int, typer.Option(help="Frames in one full turn.")] = 120,
     size: Annotated[str, typer.Option(help="Image size WIDTHxHEIGHT in pixels.")] = "480x480",
     fps: Annotated[float, typer.Option(help="Frames per second.")] = 30.0,
@@ -385,23 +430,27 @@ def turntable_command(
     elevation_deg: Annotated[float, typer.Option(help="Camera height above the horizon in degrees.")] = 20.0,
     mode: Annotated[str, typer.Option(help="surface, wireframe or points.")] = "surface",
     up: Annotated[str, typer.Option(help="The model's up axis, y or z (glTF is always y).")] = "y",
+    jobs: Annotated[int, typer.Option("--jobs", "-j", help="Worker processes for several meshes.")] = 1,
 ) -> None:
     """Render a mesh from a camera orbiting it once and write the frames as a looping GIF or an MP4 (the file's
     materials and textures, the default lights of frustum.scenefile.models)."""
-    from frustum.output.animation import framing_camera, turntable
-    from frustum.scenefile.models import model_scene, physical_options
+    from frustum.app.many import expand_inputs, output_paths, run_each
+    from frustum.scenefile.loader import MODEL_SUFFIXES
 
     width, height = _image_size(size)
     if not 0 <= abs(elevation_deg) < 90:
         raise UsageError(f"--elevation-deg = {elevation_deg!r} is out of range; give an angle in (-90, 90)")
-    _load_mesh(mesh, "turntable")  # the CLI's checks and messages for a bad mesh file
-    scene, _ = model_scene(mesh, up=up, size=(width, height))
-    camera = framing_camera(scene, width, height, elevation=math.radians(elevation_deg))
-    count = turntable(
-        scene, camera, frames, axis, output, fps, progress=error_console, cull_back_faces=False, mode=mode,
-        **physical_options(scene),
-    )
-    console.print(f"wrote {output} ({count} frames, {width}x{height})", markup=False, highlight=False, soft_wrap=True)
+    inputs, several = expand_inputs(mesh, MODEL_SUFFIXES)
+    outputs = output_paths(inputs, [output], several)
+    options = {"size": (width, height), "up": up, "elevation_deg": elevation_deg, "frames": frames, "axis": axis,
+               "fps": fps, "mode": mode}  # fmt: skip
+    if not several:
+        for line in _turntable_task(inputs[0], outputs[0], {**options, "progress": error_console}):
+            say(line)
+        return
+    status = run_each(_turntable_task, inputs, outputs, options, jobs, "turntable")
+    if status:
+        raise typer.Exit(status)
 
 
 # --- scene files ------------------------------------------------------------------------------------------------
@@ -409,20 +458,29 @@ def turntable_command(
 
 @app.command("render")
 def render_command(
-    scene: Annotated[Path, typer.Argument(help="A TOML scene file or a mesh file.")],
+    scene: Annotated[
+        list[Path], typer.Argument(help="TOML scene files or mesh files, folders of them, or quoted glob patterns.")
+    ],
     output: Annotated[
-        list[Path] | None, typer.Option("--output", "-o", help="Output file(s): .png .svg .pdf .gif .mp4.")
+        list[Path] | None,
+        typer.Option("--output", "-o", help="Output file(s): .png .svg .pdf .gif .mp4; for several inputs a pattern "
+                     "with {stem}, {name}, {suffix} or {index}, e.g. out/{stem}.png."),
     ] = None,
     size: Annotated[str | None, typer.Option(help="Image size WIDTHxHEIGHT, overriding the file's.")] = None,
     up: Annotated[str, typer.Option(help="A mesh file's up axis, y or z (glTF is always y).")] = "y",
     shadows: Annotated[
         str | None, typer.Option(help="Shadows, overriding the file's: on (shadow maps), off, or ray (shadow rays).")
     ] = None,
+    jobs: Annotated[int, typer.Option("--jobs", "-j", help="Worker processes for several inputs.")] = 1,
 ) -> None:
-    """Render a scene file or a mesh file (framed from a 3/4 view, default lights, the file's materials); without
-    -o, the outputs the file names (or out/<name>.png beside it)."""
-    for path in render_files(scene, output or None, size, up, shadows):  # also run without Typer: frustum.app._program
-        console.print(f"wrote {path}", markup=False, highlight=False, soft_wrap=True)
+    """Render scene files or mesh files (framed from a 3/4 view, default lights, the file's materials); without
+    -o, the outputs each file names (or out/<name>.png beside it). Several inputs: one line per failed input, the
+    others still rendered, exit status 1 when any failed."""
+    from frustum.app.many import render_inputs
+
+    status = render_inputs(scene, output or None, size, up, shadows, jobs)  # also run without Typer: _program
+    if status:
+        raise typer.Exit(status)
 
 
 @app.command("explain")
@@ -455,8 +513,11 @@ def explain_command(
 
 @app.command("view")
 def view_command(
-    scene: Annotated[Path, typer.Argument(help="A TOML scene file or a mesh file.")],
-    output: Annotated[Path, typer.Option("--output", "-o", help="The sheet: .svg, .pdf, .png or .dxf (CAD).")],
+    scene: Annotated[list[Path], typer.Argument(help="TOML scene files or mesh files, or folders of them.")],
+    output: Annotated[
+        Path, typer.Option("--output", "-o", help="The sheet: .svg, .pdf, .png or .dxf (CAD); for several scenes a "
+                           "pattern with {stem}, {name}, {suffix} or {index}.")
+    ],
     views: Annotated[
         str | None, typer.Option(help="Comma-separated views: front, top, right, left, rear, bottom, iso.")
     ] = None,
@@ -476,20 +537,38 @@ def view_command(
     tolerance: Annotated[str | None, typer.Option(help="Title block: general tolerances (ISO 2768-m).")] = None,
     units: Annotated[str | None, typer.Option(help="Title block: model units (mm).")] = None,
     up: Annotated[str, typer.Option(help="A mesh file's up axis, y or z (glTF is always y).")] = "y",
+    jobs: Annotated[int, typer.Option("--jobs", "-j", help="Worker processes for several scenes.")] = 1,
 ) -> None:
     """Draw the scene as an engineering sheet: orthographic views at the largest standard scale that fits, with
-    hidden lines, dimensions, title block and scale bar (the scene file's \\[sheet] table sets the defaults)."""
-    from frustum.scenefile import render_view_sheet
+    hidden lines, dimensions, title block and scale bar (the scene file's \\[sheet] table sets the defaults).
+    Several scenes: -o is a pattern with {stem}, {name}, {suffix} or {index}."""
+    from frustum.app.many import expand_inputs, output_paths, run_each
 
     fields = {"title": title, "drawing_number": drawing_number, "sheet": sheet_number, "date": date,
               "author": author, "tolerance": tolerance, "units": units}  # fmt: skip
-    written = render_view_sheet(
-        scene, output, tuple(v.strip() for v in views.split(",") if v.strip()) if views is not None else None,
-        up=up, paper=paper, orientation=orientation, projection_angle=angle,
-        dimensions=False if dimensions == "none" else dimensions,
-        title_block={key: value for key, value in fields.items() if value is not None},
-    )  # fmt: skip
-    console.print(f"wrote {written}", markup=False, highlight=False, soft_wrap=True)
+    options = {"views": tuple(v.strip() for v in views.split(",") if v.strip()) if views is not None else None,
+               "up": up, "paper": paper, "orientation": orientation, "projection_angle": angle,
+               "dimensions": False if dimensions == "none" else dimensions,
+               "title_block": {key: value for key, value in fields.items() if value is not None}}  # fmt: skip
+    inputs, several = expand_inputs(scene)
+    outputs = output_paths(inputs, [output], several)
+    if not several:
+        for line in _view_task(inputs[0], outputs[0], options):
+            say(line)
+        return
+    status = run_each(_view_task, inputs, outputs, options, jobs, "view")
+    if status:
+        raise typer.Exit(status)
+
+
+def _view_task(scene: Path, outputs: list[Path] | None, options: dict[str, Any]) -> list[str]:
+    """One input of ``frustum view`` (several: ``frustum.app.many``): its ``wrote`` line."""
+    from frustum.scenefile import render_view_sheet
+
+    assert outputs is not None
+    options = dict(options)
+    written = render_view_sheet(scene, outputs[0], options.pop("views"), **options)
+    return [f"wrote {written}"]
 
 
 @app.command("warmup")
@@ -505,16 +584,28 @@ def warmup_command(
 
 @app.command("resident")
 def resident_command(
-    action: Annotated[str, typer.Argument(help="status: list the resident render processes; stop: end them.")],
+    action: Annotated[str, typer.Argument(help="start: start one; status: list the running ones; stop: end them.")],
 ) -> None:
-    """The resident render process that plain `frustum render FILE -o OUT` commands hand their work to, so they
-    skip Python's and Numba's start-up (FRUSTUM_RESIDENT=0 turns it off; it exits after 10 idle minutes)."""
+    """The resident render process, started on purpose: plain `frustum render FILE -o OUT` commands hand it their
+    work and skip Python's and Numba's start-up (or FRUSTUM_RESIDENT=1: the first successful render starts it;
+    FRUSTUM_RESIDENT=0: commands ignore it). It exits after 10 idle minutes."""
     from frustum.app import resident
 
-    if action == "status":
+    if action == "start":
+        if not resident.enabled():
+            raise FrustumError("resident: a resident render process needs Linux (SO_PEERCRED and fork)")
+        if resident.start(wait=True) is None:
+            entry = resident.running()
+            if entry is None:
+                raise FrustumError("resident: no resident render process could be started (is the runtime folder "
+                                   "private to you?)")  # fmt: skip
+            console.print(f"a resident render process is already running (pid {entry.get('pid')})", markup=False,
+                          highlight=False, soft_wrap=True)  # fmt: skip
+    elif action == "status":
         running = resident.status()
         for entry in running:
-            console.print(f"pid {entry.get('pid')}: {entry.get('requests')} renders served, idle "
+            busy = ", rendering now" if entry.get("busy") else ""
+            console.print(f"pid {entry.get('pid')}: {entry.get('requests')} renders served{busy}, idle "
                           f"{entry.get('idle_s')} s, frustum at {entry.get('package')}", markup=False,
                           highlight=False, soft_wrap=True)  # fmt: skip
         if not running:
@@ -522,7 +613,7 @@ def resident_command(
     elif action == "stop":
         console.print(f"stopped {resident.stop()} resident render process(es)", markup=False, highlight=False)
     else:
-        raise FrustumError(f"resident: action {action!r} is unknown; expected status or stop")
+        raise FrustumError(f"resident: action {action!r} is unknown; expected start, status or stop")
 
 
 @app.command("examples")
@@ -555,7 +646,9 @@ def dataset_command(
     out: Annotated[str, typer.Option("--out", help="Output folder or URL (s3://bucket/prefix); rerun to resume.")],
     views: Annotated[int | None, typer.Option(help="Number of views (default 100; --layout file: the file's).")] = None,
     layout: Annotated[str, typer.Option(help="orbit, sphere, random or file.")] = "orbit",
-    format_: Annotated[str, typer.Option("--format", help="nerf, nerfstudio, colmap, files or webdataset.")] = "nerf",
+    format_: Annotated[
+        str, typer.Option("--format", help="nerf, nerfstudio, colmap, files, webdataset, coco or bop.")
+    ] = "nerf",
     size: Annotated[str | None, typer.Option(help="Image size WIDTHxHEIGHT, overriding the file's.")] = None,
     seed: Annotated[int, typer.Option(help="Base seed; each view's seed derives from it and the view's key.")] = 0,
     cameras: Annotated[Path | None, typer.Option(help="--layout file: a JSON list of {eye, target, up}.")] = None,

@@ -11,9 +11,7 @@ volume, exact hidden lines, the fractal generators, and the visible-surface meth
 
 from __future__ import annotations
 
-import concurrent.futures
 import importlib
-import multiprocessing
 import os
 import time
 from collections.abc import Callable
@@ -250,6 +248,9 @@ def _run(name: str) -> int:
 
 def warmup(processes: int | None = None) -> WarmupReport:
     """Compile every kernel frustum has into Numba's on-disk cache, `processes` at a time (default: the cores)."""
+    import concurrent.futures  # here, not at the top: a plain render imports this module (compile_in_background)
+    import multiprocessing
+
     processes = max(1, min(processes or os.cpu_count() or 1, len(TASKS)))
     start = time.perf_counter()
     context = multiprocessing.get_context("spawn")  # fresh interpreters: no threads or half-loaded state copied

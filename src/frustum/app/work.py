@@ -4,13 +4,23 @@
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
-from frustum.app.runtime import UsageError
+from frustum.app.runtime import (
+    REPORTED,
+    UsageError,
+    error_line,
+    failure,
+    install_compile_notice,
+    run_interruptible,
+    say,
+)
 from frustum.errors import FrustumError
 
-__all__ = ["MAX_SIZE", "image_size", "render_files"]
+__all__ = ["MAX_SIZE", "image_size", "render_files", "render_task", "run_render", "shadow_choice"]
 
 MAX_SIZE = 8192
 """Largest --size width or height (the scene files' ``[render] size`` limit)."""
@@ -32,6 +42,20 @@ def image_size(text: str) -> tuple[int, int]:
     return size
 
 
+def shadow_choice(shadows: str | None) -> bool | str | None:
+    """``--shadows`` on, off or ray as ``render_scene_file``'s `shadows` (None: the file's)."""
+    choices = {None: None, "on": True, "off": False, "ray": "ray"}
+    if shadows not in choices:
+        raise FrustumError(f"render: --shadows {shadows!r} is unknown; expected on, off or ray")
+    return choices[shadows]
+
+
+def render_task(scene: Path, output: list[Path] | None, options: dict[str, Any]) -> list[str]:
+    """One input of ``frustum render`` with several (``frustum.app.many``): its ``wrote PATH`` lines."""
+    return [f"wrote {path}" for path in render_files(scene, output, options["size"], options["up"],
+                                                     options["shadows"])]  # fmt: skip
+
+
 def render_files(scene: Path, output: Sequence[Path] | None, size: str | None, up: str,
                  shadows: str | None) -> list[Path]:  # fmt: skip
     """``frustum render``: render the scene or mesh file `scene` to `output` (None: the file's outputs) and
@@ -41,9 +65,29 @@ def render_files(scene: Path, output: Sequence[Path] | None, size: str | None, u
 
     compile_in_background()  # a cold cache: a second process compiles part of the kernels meanwhile
 
-    choices = {None: None, "on": True, "off": False, "ray": "ray"}
-    if shadows not in choices:
-        raise FrustumError(f"render: --shadows {shadows!r} is unknown; expected on, off or ray")
     written = render_scene_file(scene, list(output) if output else None, size=image_size(size) if size else None,
-                                shadows=choices[shadows], up=up)  # fmt: skip
+                                shadows=shadow_choice(shadows), up=up)  # fmt: skip
     return written if isinstance(written, list) else [written]
+
+
+def run_render(request: dict[str, Any]) -> int:
+    """Run a plain render `request` (``frustum.app._program.plain_render``) as the program does: ``wrote PATH``
+    lines on stdout, a failure as one ``error:`` line on stderr; the exit status."""
+    from frustum.app import timing
+
+    install_compile_notice()
+
+    def work() -> list[Path]:
+        return render_files(Path(request["scene"]), request["output"] or None, request["size"], request["up"] or "y",
+                            request["shadows"])  # fmt: skip
+
+    profile = timing.Profile() if timing.enabled() else None
+    try:
+        written = run_interruptible(work if profile is None else lambda: timing.profiled(work, profile))
+    except REPORTED as error:
+        text, status = failure(error)
+        say(error_line(text), sys.stderr)
+        return status
+    for path in written:
+        say(f"wrote {path}")
+    return 0

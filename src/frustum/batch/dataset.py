@@ -32,6 +32,7 @@ import json
 import math
 import os
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -39,6 +40,7 @@ from typing import Any
 import numpy as np
 
 from frustum._arrays import describe
+from frustum.batch.bop import BOP_SCENE, bop_models, bop_paths
 from frustum.batch.cameras import camera_record
 from frustum.batch.executors import EXECUTORS, render_many
 from frustum.batch.formats import CAMERA_WRITERS, SHARD_SIZE, check_format_camera
@@ -47,17 +49,21 @@ from frustum.batch.progress import ViewProgress
 from frustum.batch.storage import RemotePath, to_location
 from frustum.camera import Camera
 from frustum.errors import CameraError, FrustumError, OutputError
+from frustum.scene import Scene
 
 __all__ = ["DEPTH_FORMATS", "FORMATS", "LAYOUTS", "DatasetResult", "dataset_cameras", "render_dataset", "view_seed"]
 
 LAYOUTS = ("orbit", "sphere", "random", "file")
 """Camera layouts: a circle at the scene camera's height, a Fibonacci sphere, seeded random directions, a file."""
 FORMATS = tuple(CAMERA_WRITERS)
-"""Dataset formats (camera files): nerf, nerfstudio, colmap, files, webdataset."""
+"""Dataset formats (camera files): nerf, nerfstudio, colmap, files, webdataset; coco and bop (ground truth:
+``frustum.batch.coco``, ``frustum.batch.bop``)."""
+GROUND_TRUTH_FORMATS = ("coco", "bop")
+"""Formats whose views are RGB images with per-object annotations rather than every buffer."""
 DEPTH_FORMATS = ("npy", "png16")
 """Depth files: float32 .npy, or 16-bit PNG in steps of ``depth_scale`` world units."""
 _FOLDERS = {"color": "images", "depth": "depth", "normals": "normals", "object_id": "object_id", "mask": "masks",
-            "position": "position", "shadow": "shadow"}  # fmt: skip
+            "position": "position", "shadow": "shadow", "rgb": "images", "annotations": "annotations"}  # fmt: skip
 _SUFFIXES = {"color": ".png", "depth": ".npy", "normals": ".npy", "object_id": ".png", "mask": ".png"}
 _MANIFEST = "manifest.jsonl"
 _MANIFEST_PARTS = "manifest.parts"
@@ -316,7 +322,8 @@ def _remove_partial_files(out: Any) -> None:
     """Temporary files of a run that was killed: never finished outputs."""
     if isinstance(out, RemotePath) and out.atomic_put:
         return  # an object store has no temporary files: each object is one PUT
-    for sub in (*_FOLDERS.values(), "shards", "sparse/0", "."):
+    bop = [f"{BOP_SCENE}/{sub}" for sub in ("rgb", "depth", "mask", "mask_visib", ".")]
+    for sub in (*_FOLDERS.values(), "shards", "sparse/0", "models", *bop, "."):
         folder = out / sub
         if folder.is_dir():
             for path in folder.iterdir():
@@ -356,6 +363,33 @@ def _paths(out: Any, files: dict[str, str]) -> dict[str, Any]:
     return {kind: out / relative for kind, relative in files.items()}
 
 
+def _ground_truth_readme(config: dict, extra: dict) -> list[str]:
+    """README lines of the COCO and BOP formats."""
+    lines = [
+        "Labels (class ids 1, 2, ... in this order; 0 = background): " + ", ".join(extra["labels"]),
+        "Pixel coordinates (boxes, keypoints, cam_K): u right, v down, the centre of the top-left pixel at (0, 0).",
+        "annotations/<key>.json  per view: every scene item's name, label, class_id, bbox_visible and bbox_amodal",
+        "                        [x, y, w, h], bbox_3d (8 projected box corners) and bbox_3d_visible, pose (4x4",
+        "                        model-to-camera, OpenCV axes, scene units), visibility, pixel counts, keypoints",
+        "                        ([u, v, flag]: 0 outside, 1 hidden, 2 visible) and both masks as COCO RLE.",
+    ]
+    if config["format"] == "coco":
+        lines += [
+            "images/<key>.png        RGB 8 bits per channel",
+            "annotations.json        COCO instances: images, categories, annotations (RLE segmentation of the",
+            "                        visible pixels, area, bbox, iscrowd 0, keypoints when given).",
+        ]
+    else:
+        lines += [
+            f"BOP scenewise (the BOP toolkit's docs/bop_datasets_format.md): models/, {BOP_SCENE}/rgb, depth",
+            f"(uint16; value * depth_scale = mm, depth_scale {extra['bop_depth_scale']!r}), mask (amodal),",
+            "mask_visib, scene_camera.json, scene_gt.json, scene_gt_info.json. Scene units are metres (x 1000 = mm);",
+            "obj_id is the label's class id.",
+        ]
+    lines += ["With samples > 1 every id comes from one sample of the pixel (no blending); depth is the nearest.", ""]
+    return lines
+
+
 def _readme(config: dict, camera: Camera, extra: dict) -> str:
     lines = [
         "frustum multi-view dataset",
@@ -366,6 +400,10 @@ def _readme(config: dict, camera: Camera, extra: dict) -> str:
         f"seed {config['seed']}).",
         "Rerun the same command to resume; manifest.jsonl is the run log (configuration, then finished views).",
         "",
+    ]
+    if config["format"] in GROUND_TRUTH_FORMATS:
+        return "\n".join(lines + _ground_truth_readme(config, extra)) + "\n"
+    lines += [
         "Files per view (key = view_NNNNN, no dots):",
         "  images/<key>.png     color, RGBA 8 bits per channel, linear unless the scene asks for sRGB",
     ]
@@ -416,6 +454,20 @@ def _readme(config: dict, camera: Camera, extra: dict) -> str:
     return "\n".join(lines)
 
 
+def _keypoint_count(scene: Any, keypoints: Any, where: str) -> int:
+    """The number of keypoints per item (COCO's categories list one count); 0 without keypoints."""
+    if keypoints is None:
+        return 0
+    from frustum.output.annotations import _keypoints_per_item
+
+    arrays = _keypoints_per_item(keypoints, scene.item_paths(), scene.item_labels(), where)
+    counts = {a.shape[0] for a in arrays if a is not None}
+    if len(counts) > 1:
+        raise FrustumError(f"{where}: keypoints give {sorted(counts)} points to different items; a COCO dataset "
+                           "has one keypoint count: give every item the same number")  # fmt: skip
+    return counts.pop() if counts else 0
+
+
 def render_dataset(
     scene: Any,
     out: str | os.PathLike,
@@ -434,16 +486,22 @@ def render_dataset(
     retries: int = 1,
     address: str | None = None,
     collect: str | None = None,
+    keypoints: Any = None,
+    cameras: Sequence[Camera] | None = None,
 ) -> DatasetResult:
     """Render a multi-view dataset of a scene file into the folder or URL `out` (see the module docstring).
 
     Parameters
     ----------
-    scene : str, Path or SceneFile
-        A TOML scene file (its camera gives projection, size, distance and the target), or a loaded one.
+    scene : str, Path, SceneFile or Scene
+        A TOML scene file (its camera gives projection, size, distance and the target), or a loaded one; or a
+        ``Scene`` together with `cameras`.
     views, layout, seed, cameras_file
         ``dataset_cameras``.
-    format : {"nerf", "nerfstudio", "colmap", "files", "webdataset"}
+    format : {"nerf", "nerfstudio", "colmap", "files", "webdataset", "coco", "bop"}
+        ``"coco"``: RGB images and COCO instance annotations (``frustum.batch.coco``); ``"bop"``: a BOP
+        scenewise dataset (``frustum.batch.bop``; the scene needs labels). Both write ``annotations/<key>.json``
+        per view (``frustum.annotate``'s records), from which the run's end builds the format's files.
     size : (width, height) or None
         Overrides the scene file's image size.
     depth_format : {"npy", "png16"}
@@ -458,6 +516,10 @@ def render_dataset(
         Start again in a folder that holds a dataset made with another configuration.
     retries : int
         How often failed views are tried again before they are listed.
+    keypoints : None or as ``frustum.annotate``'s
+        Model keypoints per item, written to the annotations (COCO ``keypoints``).
+    cameras : sequence of Camera or None
+        The views themselves (``frustum.batch.randomize.cameras_on_shell``), in place of `layout` and `views`.
 
     Returns
     -------
@@ -492,19 +554,34 @@ def render_dataset(
     elif isinstance(scene, str | os.PathLike):
         scene_path = Path(scene)
         scene_file = load_scene_file(scene_path)  # a scene that does not load fails here, once
+    elif isinstance(scene, Scene) and cameras:
+        first = next(iter(cameras))
+        scene_file = SceneFile(scene, first, {}, (), cameras=(first,))
     else:
-        raise FrustumError(f"{where}: scene = {describe(scene)} is not a scene file path or a SceneFile")
+        raise FrustumError(f"{where}: scene = {describe(scene)} is not a scene file path or a SceneFile (or a Scene "
+                           "with cameras=[...])")  # fmt: skip
     if size is not None:
         scene_file = scene_file.resized(tuple(size))
     base = scene_file.cameras[0]
+    if cameras is not None:
+        cameras = list(cameras)
+        if not cameras or not all(isinstance(c, Camera) for c in cameras):
+            raise CameraError(f"{where}: cameras = {describe(cameras)} is not a non-empty list of Camera")
+        base = cameras[0]
     check_format_camera(format, base, where)
+    if format == "bop":
+        bop_models(scene_file.scene, where)  # labels, one mesh and scale per label: refused before any view
     target = base.frame.target
     if target is None:  # a camera given by its view-plane normal: aim at the middle of the scene
         items = scene_file.scene.items
         corners = [item.world_from_model[:3, :3] @ item.mesh.bounds.T + item.world_from_model[:3, 3:4]
                    for item in items if item.mesh.vertex_count]  # fmt: skip
         target = np.hstack(corners).mean(axis=1) if corners else np.zeros(3)
-    cameras = dataset_cameras(base, views, layout, seed=seed, target=target, cameras_file=cameras_file)
+    given = cameras is not None
+    if given:
+        cameras = list(zip(_view_keys(len(cameras)), cameras, strict=True))
+    else:
+        cameras = dataset_cameras(base, views, layout, seed=seed, target=target, cameras_file=cameras_file)
     _check_budget(scene_file, base, executor, workers, where)
     out = to_location(out)
     remote = isinstance(out, RemotePath)
@@ -515,6 +592,13 @@ def render_dataset(
         far = getattr(base.projection, "far", None)
         depth_scale = float(far) / 65535 if far else 1e-3
         extra["depth_unit_scale_factor"] = depth_scale
+    if format == "bop":  # millimetres per step of depth PNGs (BOP's depth_scale): 0.1 mm while the far plane fits
+        far = float(getattr(base.projection, "far", 0.0) or 0.0)
+        extra["bop_depth_scale"] = max(0.1, far * 1000.0 / 65535.0)
+        depth_scale = extra["bop_depth_scale"] / 1000.0  # world units (metres) per step
+    if format in GROUND_TRUTH_FORMATS:
+        count = _keypoint_count(scene_file.scene, keypoints, where)
+        extra.update(scene=scene_file.scene, labels=scene_file.scene.labels, seed=int(seed), keypoint_count=count)
     config = {
         "frustum": __version__,
         "scene": "<SceneFile>" if scene_path is None else scene_path.name,
@@ -527,6 +611,12 @@ def render_dataset(
         "depth_format": depth_format,
         "cameras_sha256": _sha256(Path(cameras_file)) if layout == "file" and cameras_file else None,
     }
+    if given:  # the views themselves: their records decide whether a resume matches
+        records_text = json.dumps([camera_record(c) for _, c in cameras], sort_keys=True)
+        config["layout"] = "given"
+        config["cameras_sha256"] = hashlib.sha256(records_text.encode("utf-8")).hexdigest()
+    if keypoints is not None:
+        config["keypoints_sha256"] = hashlib.sha256(repr(keypoints).encode("utf-8")).hexdigest()
     if scene_file.up is not None:  # a mesh file: its up axis turns the model, so a resume must match it
         config["up"] = scene_file.up
     manifest = out / _MANIFEST
@@ -552,10 +642,14 @@ def render_dataset(
     kinds = dict(_SUFFIXES)
     if depth_format == "png16":
         kinds["depth"] = ".png"
+    if format in GROUND_TRUTH_FORMATS:
+        kinds = {"rgb": ".png", "annotations": ".json"}
     if scene_file.options.get("shadows") in (True, "ray"):  # a scene with shadows: world points and light fractions
         kinds["position"] = kinds["shadow"] = ".npy"
 
     def files_of(key: str) -> dict[str, str]:
+        if format == "bop":
+            return bop_paths(key)
         return {kind: f"{_FOLDERS[kind]}/{key}{suffix}" for kind, suffix in kinds.items()}
 
     existing = out.files() if remote else None  # one listing of a bucket, not a request per file
@@ -563,7 +657,7 @@ def render_dataset(
             if key in finished and finished[key].get("files") == files_of(key)
             and all(p in existing if remote else (out / p).is_file() for p in files_of(key).values())}  # fmt: skip
     jobs = [
-        RenderJob(key, scene_file.scene, camera, _paths(out, files_of(key)), scene_file.options, depth_scale)
+        RenderJob(key, scene_file.scene, camera, _paths(out, files_of(key)), scene_file.options, depth_scale, keypoints)
         for key, camera in cameras
         if key not in done
     ]

@@ -14,7 +14,9 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
+from frustum.batch.bop import write_bop
 from frustum.batch.cameras import camera_record, colmap_pose, intrinsics
+from frustum.batch.coco import write_coco
 from frustum.batch.jobs import write_atomically
 from frustum.camera import Camera
 from frustum.errors import CameraError
@@ -39,7 +41,7 @@ def _text_writer(text: str) -> Callable:
 
 def check_format_camera(format: str, camera: Camera, where: str) -> None:
     """Raise CameraError if `format` cannot describe `camera` (one check before any view is rendered)."""
-    if format in ("files", "webdataset"):
+    if format in ("files", "webdataset", "coco"):
         return
     pinhole = intrinsics(camera, where=where)
     if format == "nerf":
@@ -188,5 +190,7 @@ CAMERA_WRITERS: dict[str, Callable[[Path, Sequence[View], dict[str, Any]], list[
     "colmap": write_colmap,
     "files": write_files,
     "webdataset": write_webdataset,
+    "coco": write_coco,
+    "bop": write_bop,
 }
 """Dataset format name to its camera-file writer."""

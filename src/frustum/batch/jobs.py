@@ -17,12 +17,15 @@ Output kinds (``RenderJob.outputs`` keys):
 | ``normals`` | ``.npy`` | float32 (H, W, 3) unit world normals, 0 on background |
 | ``object_id`` | ``.png`` | uint16 index of the scene item + 1, 0 on background |
 | ``mask`` | ``.png`` | uint8 255 where a surface was drawn, 0 on background |
+| ``rgb`` | ``.png`` | RGB 8-bit (the color without alpha: COCO and BOP images) |
+| ``annotations`` | ``.json`` | ``frustum.batch.coco.view_annotations``: per-item boxes, pose, masks as RLE |
 """
 
 from __future__ import annotations
 
 import contextlib
 import io
+import json
 import os
 import time
 from collections.abc import Mapping
@@ -46,6 +49,8 @@ OUTPUT_KINDS = {
     "mask": (".png",),
     "position": (".npy",),
     "shadow": (".npy",),
+    "rgb": (".png",),
+    "annotations": (".json",),
 }
 """Output kinds a job may ask for, with the file suffixes each accepts."""
 _MAX_UINT16 = 65535
@@ -74,6 +79,8 @@ class RenderJob:
         the outputs.
     depth_scale : float
         World units per step of a 16-bit depth PNG (only for a ``depth`` output ending in ``.png``).
+    keypoints : None or as ``frustum.annotate``'s
+        Model keypoints for an ``annotations`` output.
     """
 
     key: str
@@ -82,6 +89,7 @@ class RenderJob:
     outputs: Mapping[str, Any] = field(default_factory=dict)
     options: Mapping[str, Any] = field(default_factory=dict)
     depth_scale: float = 1e-3
+    keypoints: Any = None
 
 
 @dataclass(frozen=True)
@@ -169,6 +177,8 @@ def _encoded(kind: str, suffix: str, frame: Any, camera: Any, depth_scale: float
     drawn = frame.depth < 1.0
     if kind == "color":
         return _png_writer(frame.color)
+    if kind == "rgb":
+        return _png_writer(frame.color[..., :3])
     if kind == "depth":
         depth = metric_depth(frame.depth, camera)
         if suffix == ".npy":
@@ -215,6 +225,8 @@ def encode_view(
     render_seconds = 0.0
     try:
         buffers = tuple(b for b in ("normals", "object_id", "position", "shadow") if b in job.outputs)
+        if "annotations" in job.outputs:
+            buffers += ("instance", "amodal")
         merged = {**(options or {}), **job.options, "buffers": buffers}
         frame = render(scene, job.camera, **merged)
         render_seconds = time.perf_counter() - start
@@ -224,12 +236,23 @@ def encode_view(
         for kind, path in job.outputs.items():
             suffix = Path(str(path)).suffix.lower()
             buffer = io.BytesIO()
-            _encoded(kind, suffix, frame, job.camera, job.depth_scale)(buffer)
+            if kind == "annotations":
+                from frustum.batch.coco import view_annotations
+
+                record = view_annotations(frame, _scene_of(scene), job.camera, job.keypoints)
+                buffer.write((json.dumps(record) + "\n").encode("utf-8"))
+            else:
+                _encoded(kind, suffix, frame, job.camera, job.depth_scale)(buffer)
             encoded[kind] = buffer.getvalue()
             files[kind] = _path_text(path)
         return ViewResult(job.key, files, None, render_seconds, time.perf_counter() - encoding, worker), encoded
     except Exception as error:  # every failure of one view is reported with the view, not raised
         return _failed(job, error, render_seconds, worker), {}
+
+
+def _scene_of(scene: Any) -> Any:
+    """The Scene of a worker's scene (a loaded scene file holds one)."""
+    return getattr(scene, "scene", scene)
 
 
 def _failed(job: RenderJob, error: Exception, render_seconds: float, worker: str) -> ViewResult:

@@ -59,7 +59,7 @@ from typing import Any
 
 from frustum.camera import Camera
 from frustum.frame import Frame
-from frustum.render import lines, methods, particles, reflection, surfaces, volumes
+from frustum.render import ground_truth, lines, methods, particles, reflection, surfaces, volumes
 from frustum.render.buffers import FrameBuffers as FrameBuffers
 from frustum.render.buffers import Scratch as Scratch
 from frustum.render.buffers import block_min as block_min
@@ -129,6 +129,7 @@ def render(
     shadow_softness: float = 1.0,
     tone_map: str = "none",
     exposure: float = 1.0,
+    next: tuple[Scene, Camera] | None = None,
 ) -> Frame:
     """Render `scene` seen by `camera` into a ``Frame`` (color (H, W, 4) uint8 and depth (H, W) float32).
 
@@ -185,11 +186,15 @@ def render(
         are drawn √samples times as wide, so they come out anti-aliased. Depth keeps each block's nearest.
     color_space : {"linear", "srgb"}
         Output encoding; "srgb" applies the sRGB transfer curve to the linear result.
-    buffers : tuple of {"normals", "object_id", "position", "shadow"}
+    buffers : tuple of {"normals", "object_id", "position", "shadow", "instance", "semantic", "amodal",
+            "object_coords", "nocs", "flow"}
         Extra per-pixel outputs on the Frame: unit world normals (0 on background), the index of the item
         in ``scene.items`` (−1 on background), the world point of the nearest opaque surface ((H, W, 3) float32,
         NaN on background) and, with `shadows` on, the fraction of each shadow-casting light reaching it ((H, W,
-        L) float32, NaN on background; lights in ``Scene.world_lights`` order, ``frustum.render.shadows.fractions``).
+        L) float32, NaN on background; lights in ``Scene.world_lights`` order, ``frustum.render.shadows.fractions``);
+        the ground truth of ``frustum.render.ground_truth``: instance and semantic ids, amodal masks with
+        ``Frame.visibility``, object coordinates, NOCS and optical flow to `next` with ``Frame.flow_occluded``.
+        Ids and points come from one sample per pixel (never a blend of two objects).
     method : str
         The visible-surface method (``RENDER_METHODS``, docs/visibility.md). For the meshes
         (``VISIBILITY_METHODS``): ``"depth-buffer"`` (the default), ``"scan-line"``, ``"area-subdivision"``
@@ -230,6 +235,9 @@ def render(
         ACES filmic fit, or Khronos PBR Neutral. Classical items are not tone mapped.
     exposure : float
         Linear factor (> 0) on the metallic–roughness model's radiance before the tone map.
+    next : (Scene, Camera) or None
+        With ``"flow"`` in `buffers`: the scene and camera of the next frame (items matched by node path,
+        ``Scene.item_paths``). Backward flow: swap the two frames.
 
     Raises
     ------
@@ -243,6 +251,7 @@ def render(
     [seed] "Back-face detection", "Depth-buffer method", "wire-frame displays".
     """
     check_method(method, "render")
+    following = ground_truth.check_next(tuple(buffers) if isinstance(buffers, tuple | list) else (), next, "render")
     if RENDER_METHODS[method] is not None:
         return RENDER_METHODS[method](scene, camera, background=background)
     options = RenderOptions.from_keywords(
@@ -254,9 +263,11 @@ def render(
         tone_map=tone_map, exposure=exposure,
     )  # fmt: skip
     if options.factor == 1:
-        return _draw(scene, camera, options).to_frame(options)
-    big = dataclasses.replace(camera, width=camera.width * options.factor, height=camera.height * options.factor)
-    return _draw(scene, big, options.supersampled()).to_frame(options)
+        frame = _draw(scene, camera, options).to_frame(options)
+    else:
+        big = dataclasses.replace(camera, width=camera.width * options.factor, height=camera.height * options.factor)
+        frame = _draw(scene, big, options.supersampled()).to_frame(options)
+    return ground_truth.finish(frame, scene, camera, options, tuple(buffers), following)  # the ground-truth pass
 
 
 def _draw(scene: Scene, camera: Camera, options: RenderOptions) -> FrameContext:

@@ -44,7 +44,9 @@ HIDDEN_STYLES = (None, "dimmed", "dashed")
 EDGE_SETS = ("all", "feature")
 FILTERS = ("box", "tent")
 COLOR_SPACES = ("linear", "srgb")
-BUFFERS = ("normals", "object_id", "position", "shadow")
+GROUND_TRUTH_BUFFERS = ("instance", "semantic", "amodal", "object_coords", "nocs", "flow")
+"""Ground-truth buffers (``render.ground_truth``), computed from the ``object_id`` and ``position`` samples."""
+BUFFERS = ("normals", "object_id", "position", "shadow", *GROUND_TRUTH_BUFFERS)
 TRANSPARENCY_MODES = ("sort", "a-buffer")
 METHOD_NAMES = ("depth-buffer", "scan-line", "area-subdivision", "depth-sort", "bsp", "a-buffer", "octree",
                 "ray-casting", "ray-tracing")  # fmt: skip
@@ -90,6 +92,7 @@ DEFAULTS: dict[str, Any] = {
     "shadow_softness": 1.0,
     "tone_map": "none",
     "exposure": 1.0,
+    "next": None,
 }
 """``render``'s keyword arguments and their defaults (a test holds them equal to ``render``'s signature)."""
 
@@ -336,8 +339,23 @@ def check_arguments(
         hidden_color=color_bytes(hidden_color, "hidden_color", where),
         line_width=width,
         depth_cue=depth_cue,
-        buffers=tuple(buffers),
+        buffers=with_implied(tuple(buffers), mode, where),
     )
+
+
+def with_implied(buffers: tuple[str, ...], mode: str, where: str) -> tuple[str, ...]:
+    """`buffers` and those the ground-truth buffers are computed from (``render.ground_truth``): ``object_id``
+    for each, ``position`` for ``object_coords``, ``nocs`` and ``flow``; these need surfaces (a surface mode)."""
+    truth = [name for name in buffers if name in GROUND_TRUTH_BUFFERS]
+    if not truth:
+        return buffers
+    if mode in LINE_MODES:
+        raise FrustumError(
+            f"{where}: buffers = {describe(buffers)} asks for ground truth with mode = {mode!r}; ids and points are "
+            "those of surfaces: use a surface mode"
+        )
+    implied = ["object_id"] + (["position"] if {"object_coords", "nocs", "flow"} & set(truth) else [])
+    return buffers + tuple(name for name in implied if name not in buffers)
 
 
 def check_method(method: Any, where: str) -> None:

@@ -17,7 +17,7 @@ from frustum.raster._jit import threads
 from frustum.raster.vertices import project_vertices, transform_normals, world_points
 from frustum.render import bumps, pbr, reflection
 from frustum.render.buffers import Scratch
-from frustum.render.options import RenderOptions
+from frustum.render.options import GROUND_TRUTH_BUFFERS, RenderOptions
 from frustum.scene import Scene, SceneItem
 from frustum.shading import pack_lights
 
@@ -279,17 +279,23 @@ def cue_color(options: RenderOptions) -> np.ndarray:
     return options.background[:3] / 255.0 if cue is None or cue.color is None else np.asarray(cue.color)
 
 
-def directional(item: SceneItem, options: RenderOptions, lights: np.ndarray) -> bool:
+IDS_APART = frozenset(("object_id", "position", *GROUND_TRUTH_BUFFERS))
+"""Buffers the fast shading kernels allow when the item ids are filled apart, from the face codes
+(``raster.ground_truth.item_ids``): none of them is written by a shading kernel but the ids."""
+
+
+def directional(item: SceneItem, options: RenderOptions, lights: np.ndarray, ids_apart: bool = False) -> bool:
     """Whether the item shades through ``shade.shade_pixels_directional``: per-pixel Blinn-Phong, directional
-    lights only, no vertex colors, texture, depth cue, blending or extra buffers."""
+    lights only, no vertex colors, texture, depth cue, blending or extra buffers (with `ids_apart`, ids and the
+    buffers computed from them allowed: the caller fills the ids)."""
     mesh = item.mesh
     return (
         item.material.opacity >= 1.0
         and options.shade_mode == shade.SHADE_PHONG and options.specular_model == shade.SPECULAR_BLINN
         and bool((lights[:, 0] == 0.0).all()) and getattr(mesh, "vertex_colors", None) is None
         and (item.material.texture is None or getattr(mesh, "uvs", None) is None)
-        and options.depth_cue is None and not options.buffers and options.shadow is None
-        and _plain_surface(item, options)
+        and options.depth_cue is None and options.shadow is None and _plain_surface(item, options)
+        and (not options.buffers or (ids_apart and IDS_APART.issuperset(options.buffers)))
     )  # fmt: skip
 
 
@@ -301,15 +307,16 @@ def _plain_surface(item: SceneItem, options: RenderOptions) -> bool:
     )
 
 
-def _plain_phong(item: SceneItem, options: RenderOptions) -> bool:
+def _plain_phong(item: SceneItem, options: RenderOptions, ids_apart: bool = False) -> bool:
     """Whether the item shades through ``shade.shade_pixels_phong``: per-pixel Phong with any lights and no vertex
-    colors, texture, depth cue, blending or extra buffers."""
+    colors, texture, depth cue, blending or extra buffers (`ids_apart`: as for ``directional``)."""
     mesh = item.mesh
     return (
         item.material.opacity >= 1.0 and options.shade_mode == shade.SHADE_PHONG
         and getattr(mesh, "vertex_colors", None) is None
         and (item.material.texture is None or getattr(mesh, "uvs", None) is None)
-        and options.depth_cue is None and not options.buffers and _plain_surface(item, options)
+        and options.depth_cue is None and _plain_surface(item, options)
+        and (not options.buffers or (ids_apart and IDS_APART.issuperset(options.buffers)))
     )  # fmt: skip
 
 
@@ -368,13 +375,16 @@ def _shade_pixels(
     """The shading kernel for the item's pixels: the directional or plain Phong fast paths where they apply."""
     mesh, material = item.mesh, item.material
     mode = options.shade_mode
-    if not blend and directional(item, options, lights):  # the same bytes without the general branches
+    apart = not write_normals  # item ids, if asked for, filled from the face codes after a fast kernel
+    if not blend and directional(item, options, lights, apart):  # the same bytes without the general branches
         flags = item_flags(index, face_offset, options, blend, False, False)
         shade.shade_pixels_directional(depth, codes, bary, faces, world, normals, params, lights, flags, color)
+        _fill_ids(index, face_offset, mesh.face_count, depth, codes, extra[1], write_ids)
         return
-    if not blend and _plain_phong(item, options):  # the same bytes, without the other models' branches
+    if not blend and _plain_phong(item, options, apart):  # the same bytes, without the other models' branches
         flags = item_flags(index, face_offset, options, blend, False, False)
         shade.shade_pixels_phong(depth, codes, bary, faces, world, normals, params, lights, flags, color)
+        _fill_ids(index, face_offset, mesh.face_count, depth, codes, extra[1], write_ids)
         return
     # The two kernels above interpolate float32 positions and normals with float64 weights (the same numbers as
     # from a float64 copy); the others do arithmetic on them directly, so a float32 Mesh gives them an exact copy.
@@ -398,6 +408,15 @@ def _shade_pixels(
     flags = item_flags(index, face_offset, options, blend, write_normals, write_ids)
     shade.shade_pixels(depth, codes, bary, faces, world, normals, lit, vertex_colors, uvs, texture, params, lights,
                        flags, color, extra[0], extra[1])  # fmt: skip
+
+
+def _fill_ids(index: int, face_offset: int, face_count: int, depth: np.ndarray, codes: np.ndarray, ids: np.ndarray,
+              write_ids: bool) -> None:  # fmt: skip
+    """The item's index into `ids` at its drawn pixels (face codes of its faces), as the general kernel writes it."""
+    if write_ids:
+        from frustum.raster import ground_truth
+
+        ground_truth.item_ids(depth, codes, face_offset, face_count, index, ids)
 
 
 def back_to_front(items: list[SceneItem], indices: list[int], camera: Camera) -> list[int]:

@@ -146,7 +146,7 @@ def _cut_node(
     material = source.material if source.material is not None else inherited
     for child in source.children:
         copy = Node(child.name, None, None, None, lights=[light.transformed(world @ child.transform)
-                                                          for light in child.lights])  # fmt: skip
+                                                          for light in child.lights], label=child.label)  # fmt: skip
         child_world = world @ child.transform
         child_material = child.material if child.material is not None else material
         if isinstance(child.geometry, Polyline):  # kept whole, baked into world coordinates like the meshes

@@ -203,7 +203,9 @@ class Node:
 
     ``transform`` (4x4 affine, default identity) maps this node's coordinates into its parent's;
     ``geometry`` is a ``Mesh`` or a ``Polyline`` (or None for a pure group); ``material`` None inherits the
-    nearest ancestor's (``Material()`` at the top); ``lights`` ride the node (they move with its world transform).
+    nearest ancestor's (``Material()`` at the top); ``lights`` ride the node (they move with its world transform);
+    ``label`` (a non-empty string, or None to inherit the nearest ancestor's) is the semantic class of the meshes
+    at and below the node (``Scene.labels``, ``render(..., buffers=("semantic",))``).
     """
 
     def __init__(
@@ -214,10 +216,17 @@ class Node:
         material: Material | None = None,
         children: Iterable[Node] = (),
         lights: Iterable[Light] = (),
+        *,
+        label: str | None = None,
     ) -> None:
         where = f"Node({name!r})"
         if not isinstance(name, str) or "/" in name:
             raise FrustumError(f"{where}: name = {describe(name)} is not a string without '/'; '/' separates paths")
+        if label is not None and (not isinstance(label, str) or not label):
+            raise FrustumError(
+                f"{where}: label = {describe(label)} is not a class name; give a non-empty string such as 'mug', "
+                "or None to inherit the parent's"
+            )
         if geometry is not None and not (isinstance(geometry, Mesh | Polyline) or is_octree(geometry)):
             raise FrustumError(
                 f"{where}: geometry = {describe(geometry)} is not a Mesh or Polyline; build one with Mesh(vertices, "
@@ -229,6 +238,7 @@ class Node:
         self.transform = modeling_transform(transform, where)
         self.geometry = geometry
         self.material = material
+        self.label = label
         self.children: list[Node] = []
         self.lights: list[Light] = []
         for child in children:
@@ -273,9 +283,8 @@ class Node:
 
     def copy(self) -> Node:
         """A deep copy of the hierarchy (meshes and materials are immutable and shared)."""
-        return Node(
-            self.name, self.transform, self.geometry, self.material, [c.copy() for c in self.children], self.lights
-        )
+        children = [c.copy() for c in self.children]
+        return Node(self.name, self.transform, self.geometry, self.material, children, self.lights, label=self.label)
 
     def __repr__(self) -> str:
         if isinstance(self.geometry, Mesh):
@@ -328,25 +337,27 @@ class Scene:
         *,
         name: str = "",
         parent: Node | str | None = None,
+        label: str | None = None,
     ) -> Node:
         """Place `geometry` (a Mesh, a Polyline, or a whole Node subtree) under `parent` (default the root);
         returns the node.
 
-        For a Mesh or Polyline, a new ``Node(name, transform, geometry, material)`` is made; for a Node,
-        `material` and `transform` must be left out (set them on the node).
+        For a Mesh or Polyline, a new ``Node(name, transform, geometry, material, label=label)`` is made; for a
+        Node, `material`, `transform` and `label` must be left out (set them on the node). `label`: the semantic
+        class (``Node``; ``Scene.labels``).
         """
         where = "Scene.add"
         host = self.root if parent is None else self.find(parent) if isinstance(parent, str) else parent
         if isinstance(geometry, Node):
-            if material is not None or transform is not None:
-                raise FrustumError(f"{where}: give material and transform on the Node itself, not with a Node")
+            if material is not None or transform is not None or label is not None:
+                raise FrustumError(f"{where}: give material, transform and label on the Node itself, not with a Node")
             return host.add(geometry)
         if not (isinstance(geometry, Mesh | Polyline) or is_octree(geometry)):
             raise FrustumError(
                 f"{where}: geometry = {describe(geometry)} is not a Mesh, Polyline or Node; build one with "
                 "Mesh(vertices, faces)"
             )
-        return host.add(Node(name, transform, geometry, material))
+        return host.add(Node(name, transform, geometry, material, label=label))
 
     def add_volume(
         self,
@@ -468,6 +479,41 @@ class Scene:
         """Placed meshes in drawing order, each with its (inherited) material and world transform; a placed
         Octree counts as its cell faces (``Octree.surface``), as the depth buffer draws it."""
         return self._placed(Mesh)
+
+    @property
+    def labels(self) -> list[str]:
+        """The semantic classes of the placed meshes in first-seen order (``items`` order; a node without a label
+        inherits its nearest ancestor's). Class id $c$ of a label is its 1-based position here; 0 is the
+        background (``render(..., buffers=("semantic",))``)."""
+        seen: dict[str, None] = {}
+        for label in self.item_labels():
+            if label is not None:
+                seen.setdefault(label)
+        return list(seen)
+
+    def item_labels(self) -> list[str | None]:
+        """Each item's label (``items`` order), inherited from the nearest labelled ancestor; None where none is."""
+        return [label for _, label in self._item_nodes()]
+
+    def item_paths(self) -> list[str]:
+        """Each item's node path (``items`` order): the names from the root down, '/'-separated, an unnamed node
+        written as ``#i`` (its position among its parent's children), so that ``next`` scenes of
+        ``render(..., buffers=("flow",), next=...)`` and datasets match items across scenes."""
+        return [path for path, _ in self._item_nodes()]
+
+    def _item_nodes(self) -> list[tuple[str, str | None]]:
+        """(path, label) of each placed mesh, in ``_placed(Mesh)``'s order."""
+        result: list[tuple[str, str | None]] = []
+
+        def visit(node: Node, path: str, inherited: str | None) -> None:
+            label = node.label if node.label is not None else inherited
+            if isinstance(node.geometry, Mesh) or is_octree(node.geometry):
+                result.append((path, label))
+            for i, child in enumerate(node.children):
+                visit(child, f"{path}/{child.name or f'#{i}'}".lstrip("/"), label)
+
+        visit(self.root, "", self.root.label)
+        return result
 
     @property
     def polylines(self) -> list[SceneItem]:

@@ -17,7 +17,7 @@ from frustum.scenefile.models import part_material, part_nodes
 from frustum.scenefile.report import _BAD, _bad, _Report
 from frustum.scenefile.transforms import _transform
 
-_NODE_KEYS = ("name", "geometry", "material", "transform", "children", "lights")
+_NODE_KEYS = ("name", "geometry", "material", "transform", "children", "lights", "label")
 
 
 def _node(report: _Report, path: tuple, value: dict, base: Path, materials: dict, names: set) -> Any:
@@ -26,6 +26,10 @@ def _node(report: _Report, path: tuple, value: dict, base: Path, materials: dict
     if not isinstance(name, str) or "/" in name:
         report.add((*path, "name"), name, "is not a name", "give a string without '/' ('/' separates node paths)")
         name = ""
+    label = value.get("label")
+    if label is not None and (not isinstance(label, str) or not label):
+        report.add((*path, "label"), label, "is not a class name", "give a non-empty string such as 'mug'")
+        label = None
     transform = _transform(report, (*path, "transform"), value["transform"]) if "transform" in value else None
     material = None
     if "material" in value:
@@ -50,7 +54,7 @@ def _node(report: _Report, path: tuple, value: dict, base: Path, materials: dict
     if _bad(transform, material, geometry):
         return _BAD
     try:
-        return Node(name, transform, geometry, material, [*extras, *children], lights)
+        return Node(name, transform, geometry, material, [*extras, *children], lights, label=label)
     except FrustumError as error:
         report.refused(path, name, error)
         return _BAD

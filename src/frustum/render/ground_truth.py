@@ -1,0 +1,312 @@
+"""Ground-truth buffers for training vision models: ``instance``, ``semantic``, ``amodal`` (with
+``Frame.visibility``), ``object_coords``, ``nocs`` and ``flow`` (with ``Frame.flow_occluded``).
+
+Every per-pixel id and point comes from **one** sample: the one the depth-buffer pass keeps for ``object_id``
+and ``position`` (with supersampling, the middle sample of each pixel's block, ``render.buffers.resolve``), so a
+pixel never carries a blend of two objects and every id in a mask is an item of the scene.
+
+- ``instance``: ``object_id`` under its dataset name, the index of the item in ``Scene.items`` (−1 background).
+- ``semantic``: the class id of each pixel's item, $c = 1 + $ the position of its label in ``Scene.labels``
+  (0 for the background and for items without a label).
+- ``amodal`` (K, H, W) bool: each item's silhouette alone, occluders ignored, still clipped by the view volume:
+  one depth-only fill of the item (``raster.shadow.fill_depth_tiles``, the same coverage rule as the surface
+  pass) per item. ``visibility`` (K,): $visible / amodal$ pixels, NaN where the amodal mask is empty.
+- ``object_coords`` (H, W, 3) float32: the visible point in its item's model coordinates,
+  $X = (world\\_from\\_model)^{-1} · P_{world}$, NaN on the background.
+- ``nocs``: Normalized Object Coordinate Space (Wang et al. 2019), $(X − c)/‖b_{max} − b_{min}‖ + ½$ with c the
+  centre of the model's bounding box: the box diagonal has length 1 and the box sits centred in [0, 1]³.
+- ``flow`` (H, W, 2) float32: the displacement, in pixels with x right and y down, of each visible point from its
+  projection in this frame to its projection in the next, $p' − p$ with $p = π(camera, M·X)$ and
+  $p' = π(camera', M'·X)$ (items matched by node path, ``Scene.item_paths``); NaN on the background, for items
+  absent from the next scene and for points behind the next camera. ``flow_occluded`` (H, W) bool: the point is
+  outside the next image, behind its camera, or farther than the next frame's depth buffer at the pixel holding
+  it by more than ``DEPTH_TOLERANCE`` of its view distance.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any
+
+import numpy as np
+
+from frustum._arrays import describe
+from frustum.camera import Camera
+from frustum.errors import FrustumError
+from frustum.frame import Frame
+from frustum.render.options import GROUND_TRUTH_BUFFERS
+from frustum.scene import Scene, SceneItem
+
+__all__ = [
+    "DEPTH_TOLERANCE", "amodal_masks", "check_next", "class_ids", "finish", "flow", "nocs",
+    "object_coordinates", "visibility",
+]  # fmt: skip
+
+DEPTH_TOLERANCE = 1e-2
+"""``flow_occluded`` and the visible flags of ``frustum.annotate``: a point counts as hidden when its view distance
+exceeds the depth buffer's (at the pixel that holds it) by more than this fraction (1 cm at 1 m): the buffer holds
+the surface at the pixel's centre, not at the point, so a relative margin keeps sloped surfaces from hiding
+themselves."""
+
+
+def check_next(buffers: tuple[str, ...], next: Any, where: str) -> tuple[Scene, Camera] | None:
+    """`next` as ``(scene, camera)``; None when not given. Required by (and only allowed with) ``"flow"``."""
+    if next is None:
+        if "flow" in buffers:
+            raise FrustumError(
+                f"{where}: buffers = {describe(buffers)} asks for 'flow' without next; give next=(scene_next, "
+                "camera_next), the same scene and camera at the next frame"
+            )
+        return None
+    if (not isinstance(next, tuple | list) or len(next) != 2 or not isinstance(next[0], Scene)
+            or not isinstance(next[1], Camera)):  # fmt: skip
+        raise FrustumError(f"{where}: next = {describe(next)} is not a (Scene, Camera) pair")
+    if "flow" not in buffers:
+        raise FrustumError(f"{where}: next is given but buffers = {describe(buffers)} has no 'flow'; add 'flow'")
+    return next[0], next[1]
+
+
+def class_ids(scene: Scene) -> np.ndarray:
+    """(K,) int32: each item's class id, 1-based in ``Scene.labels`` (0: no label)."""
+    number = {label: i + 1 for i, label in enumerate(scene.labels)}
+    return np.array([0 if label is None else number[label] for label in scene.item_labels()], dtype=np.int32)
+
+
+def amodal_masks(items: list[SceneItem], camera: Camera, cull: bool, factor: int) -> np.ndarray:
+    """(K, H, W) bool: each item drawn alone (depth only) at `factor` times the camera's size, the middle sample
+    of each factor × factor block kept (the sample ``object_id`` keeps)."""
+    from frustum.raster import shadow
+    from frustum.render.stages import TILED_BITS, bin_item
+
+    height, width = camera.height, camera.width
+    big = dataclasses.replace(camera, width=width * factor, height=height * factor) if factor != 1 else camera
+    masks = np.zeros((len(items), height, width), dtype=bool)
+    depth = np.empty((big.height, big.width), dtype=np.float32)
+    middle = factor // 2
+    for k, item in enumerate(items):
+        if item.mesh.face_count == 0:
+            continue
+        binned = bin_item(item, big, cull, tile_bits=TILED_BITS)
+        tiling = np.array([1 << TILED_BITS, binned.tiles_x, 0, big.width, big.height], dtype=np.int64)
+        shadow.fill_depth_tiles(
+            binned.faces, binned.win_int, binned.win_float, binned.tri_int, binned.tri_float, binned.tile_starts,
+            binned.tile_entries, tiling, depth, True,
+        )  # fmt: skip
+        np.less(depth[middle::factor, middle::factor], 1.0, out=masks[k])
+    return masks
+
+
+def visibility(instance: np.ndarray, amodal: np.ndarray) -> np.ndarray:
+    """(K,) float64 $visible / amodal$ pixel counts per item; NaN where the item's amodal mask is empty."""
+    count = amodal.shape[0]
+    visible = np.bincount(instance[instance >= 0].ravel(), minlength=count)[:count].astype(np.float64)
+    total = amodal.reshape(count, -1).sum(axis=1).astype(np.float64)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(total > 0, visible / np.where(total > 0, total, 1.0), np.nan)
+
+
+def object_coordinates(items: list[SceneItem], instance: np.ndarray, position: np.ndarray) -> np.ndarray:
+    """(H, W, 3) float64 model coordinates $(world\\_from\\_model)^{-1}·P$ of each pixel's world point, per item;
+    NaN where nothing is drawn (``raster.ground_truth.model_points``)."""
+    from frustum.raster import ground_truth
+
+    model_from_world = np.zeros((max(1, len(items)), 12))
+    for k, item in enumerate(items):
+        model_from_world[k] = np.linalg.inv(np.asarray(item.world_from_model, dtype=np.float64))[:3].ravel()
+    out = np.empty((*instance.shape, 3))
+    ground_truth.model_points(np.ascontiguousarray(instance, dtype=np.int32),
+                              np.ascontiguousarray(position, dtype=np.float32), model_from_world, out)  # fmt: skip
+    return out
+
+
+def nocs(items: list[SceneItem], instance: np.ndarray, coordinates: np.ndarray) -> np.ndarray:
+    """(H, W, 3) NOCS (module docstring): $(X − c)/‖b_{max} − b_{min}‖ + ½$ per item, NaN where nothing is drawn
+    (``raster.ground_truth.nocs_points``)."""
+    from frustum.raster import ground_truth
+
+    boxes = np.zeros((max(1, len(items)), 4))
+    for k, item in enumerate(items):
+        low, high = np.asarray(item.mesh.bounds, dtype=np.float64)
+        diagonal = float(np.linalg.norm(high - low))
+        boxes[k] = (*(0.5 * (low + high)), 1.0 / diagonal if diagonal > 0 else 1.0)
+    out = np.empty(coordinates.shape)
+    ground_truth.nocs_points(np.ascontiguousarray(instance, dtype=np.int32), coordinates, boxes, out)
+    return out
+
+
+def _window(camera: Camera, points: np.ndarray, world_from_points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(N, 3) window coordinates (x right, y up, depth in [0, 1]) of points placed by `world_from_points`, and
+    their clip w (> 0: in front of a perspective camera)."""
+    clip_from_points = np.asarray(camera.projection_matrix) @ np.asarray(camera.view_matrix) @ world_from_points
+    clip = points @ clip_from_points[:, :3].T + clip_from_points[:, 3]
+    w = clip[:, 3].copy()
+    with np.errstate(invalid="ignore", divide="ignore"):
+        clip[:, :3] /= w[:, None]
+    window = clip[:, :3]
+    window[:, 0] = (window[:, 0] + 1.0) * (0.5 * camera.width)
+    window[:, 1] = (window[:, 1] + 1.0) * (0.5 * camera.height)
+    window[:, 2] = (window[:, 2] + 1.0) * 0.5
+    return window, w
+
+
+def hidden_points(camera: Camera, depth: np.ndarray, points: np.ndarray,
+                  world_from_points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """Window coordinates (N, 3) of points placed by `world_from_points` (NaN rows behind a perspective camera) and
+    whether each is hidden from `camera` whose window depth buffer is `depth`: outside the image or the depth range,
+    behind the camera, or farther than the buffer at the pixel holding it by more than ``DEPTH_TOLERANCE`` of its
+    view distance."""
+    window, w = _window(camera, points, world_from_points)
+    window[w <= 0.0] = np.nan
+    height, width = depth.shape
+    column = np.floor(window[:, 0])
+    row = height - 1 - np.floor(window[:, 1])
+    with np.errstate(invalid="ignore"):
+        inside = (w > 0.0) & (column >= 0) & (column < width) & (row >= 0) & (row < height)
+        inside &= (window[:, 2] >= 0.0) & (window[:, 2] <= 1.0)
+    hidden = ~inside
+    c, r = column[inside].astype(np.int64), row[inside].astype(np.int64)
+    surface = view_distance(camera, depth[r, c])
+    point = view_distance(camera, window[inside, 2])
+    hidden[inside] = point > surface * (1.0 + DEPTH_TOLERANCE)
+    return window, hidden
+
+
+def view_distance(camera: Camera, window_depth: np.ndarray) -> np.ndarray:
+    """The distance along the viewing axis of window depths d, $z_{ndc} = 2d − 1 = (A·z + B)/(C·z + D)$ solved for
+    $−z = −(B − z_{ndc}·D)/(z_{ndc}·C − A)$ with the projection's third and fourth rows (``metric_depth``'s
+    formula)."""
+    p = np.asarray(camera.projection_matrix)
+    z_ndc = 2.0 * np.asarray(window_depth, dtype=np.float64) - 1.0
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return -(p[2, 3] - z_ndc * p[3, 3]) / (z_ndc * p[3, 2] - p[2, 2])
+
+
+def _depth_of(scene: Scene, camera: Camera, cull: bool) -> np.ndarray:
+    """The window depth buffer of `scene`'s meshes seen by `camera` (depth-only fills, 1.0 where none)."""
+    from frustum.raster import shadow
+    from frustum.render.stages import TILED_BITS, bin_item
+
+    depth = np.ones((camera.height, camera.width), dtype=np.float32)
+    for item in scene.items:
+        if item.mesh.face_count == 0:
+            continue
+        binned = bin_item(item, camera, cull, tile_bits=TILED_BITS)
+        tiling = np.array([1 << TILED_BITS, binned.tiles_x, 0, camera.width, camera.height], dtype=np.int64)
+        shadow.fill_depth_tiles(
+            binned.faces, binned.win_int, binned.win_float, binned.tri_int, binned.tri_float, binned.tile_starts,
+            binned.tile_entries, tiling, depth, False,
+        )  # fmt: skip
+    return depth
+
+
+def matched_items(scene: Scene, next_scene: Scene, where: str) -> list[int]:
+    """For each item of `scene`, the index of the item at the same node path in `next_scene` (−1: absent).
+
+    Raises FrustumError naming the node when a path is not unique in either scene (an unmatched item would be
+    ambiguous), or when no item of `scene` is in `next_scene` at all."""
+    paths, next_paths = scene.item_paths(), next_scene.item_paths()
+    for label, listed in (("scene", paths), ("next scene", next_paths)):
+        seen: set[str] = set()
+        for path in listed:
+            if path in seen:
+                raise FrustumError(
+                    f"{where}: the {label} has two meshes at node path {path!r}; flow matches items by path: give "
+                    "sibling nodes distinct names"
+                )
+            seen.add(path)
+    where_next = {path: i for i, path in enumerate(next_paths)}
+    matched = [where_next.get(path, -1) for path in paths]
+    if paths and all(m < 0 for m in matched):
+        raise FrustumError(
+            f"{where}: next scene has no item at the node paths of this scene (first: {paths[0]!r}; next scene: "
+            f"{', '.join(repr(p) for p in next_paths[:5]) or 'no meshes'}); build the next scene with the same "
+            "node names"
+        )
+    return matched
+
+
+def flow(
+    scene: Scene, camera: Camera, instance: np.ndarray, coordinates: np.ndarray, next_scene: Scene,
+    next_camera: Camera, cull: bool, where: str = "render",
+) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """(H, W, 2) forward optical flow in pixels (x right, y down) and (H, W) bool occlusion in the next frame
+    (module docstring)."""
+    from frustum.raster import ground_truth
+
+    matched = matched_items(scene, next_scene, where)
+    items, next_items = scene.items, next_scene.items
+    result = np.empty((*instance.shape, 2))
+    occluded = np.empty(instance.shape, dtype=bool)
+    next_depth = _depth_of(next_scene, next_camera, cull)
+    clip_from_world = np.asarray(camera.projection_matrix) @ np.asarray(camera.view_matrix)
+    next_clip_from_world = np.asarray(next_camera.projection_matrix) @ np.asarray(next_camera.view_matrix)
+    now, later = np.zeros((max(1, len(items)), 16)), np.zeros((max(1, len(items)), 16))
+    for k, item in enumerate(items):
+        now[k] = (clip_from_world @ np.asarray(item.world_from_model, dtype=np.float64)).ravel()
+        if matched[k] >= 0:
+            later[k] = (next_clip_from_world @ np.asarray(next_items[matched[k]].world_from_model, float)).ravel()
+    p = np.asarray(next_camera.projection_matrix)
+    setup = np.array([camera.width, camera.height, next_camera.width, next_camera.height, p[2, 2], p[2, 3], p[3, 2],
+                      p[3, 3]], dtype=np.float64)  # fmt: skip
+    ground_truth.flow_pixels(np.ascontiguousarray(instance, dtype=np.int32), np.ascontiguousarray(coordinates), now,
+                             later, np.array(matched, dtype=np.int64), next_depth, setup, DEPTH_TOLERANCE, result,
+                             occluded)  # fmt: skip
+    return result, occluded
+
+
+def cast_positions(scene: Scene, camera: Camera, instance: np.ndarray, factor: int) -> np.ndarray:
+    """(H, W, 3) float32 world points of the drawn pixels by casting each one's ray through the sample its id came
+    from (``Scene.intersect``; the middle sample of its factor × factor block): for the methods that keep no
+    per-pixel positions (``"ray-tracing"``). NaN elsewhere."""
+    height, width = instance.shape
+    rows, columns = np.nonzero(instance >= 0)
+    offset = (factor // 2 + 0.5) / factor
+    window = np.column_stack([columns + offset, height - rows - offset])
+    result = np.full((height, width, 3), np.nan, dtype=np.float32)
+    if rows.size:
+        ray = camera.ray(window)
+        hits = scene.intersect(ray.origin, ray.direction)
+        result[rows, columns] = hits.point
+    return result
+
+
+def finish(frame: Frame, scene: Scene, camera: Camera, options: Any, asked: tuple[str, ...],
+           next: tuple[Scene, Camera] | None, where: str = "render") -> Frame:  # fmt: skip
+    """`frame` with the asked-for ground-truth buffers (``Frame.instance`` …) added, and the ``object_id`` and
+    ``position`` buffers they were computed from dropped unless asked for too."""
+    wanted = tuple(name for name in asked if name in GROUND_TRUTH_BUFFERS)
+    if not wanted:
+        return frame
+    instance = frame.object_id
+    items = scene.items
+    fields: dict[str, Any] = {
+        "object_id": frame.object_id if "object_id" in asked else None,
+        "position": frame.position if "position" in asked else None,
+    }
+    if "instance" in wanted:
+        fields["instance"] = instance
+    if "semantic" in wanted:
+        table = np.concatenate([[0], class_ids(scene)]).astype(np.int32)
+        fields["semantic"] = table[instance + 1]
+    if "amodal" in wanted:
+        from frustum.budgets import check_memory
+
+        cause = f"amodal masks of {len(items)} items at {camera.width} x {camera.height}"
+        check_memory(len(items) * camera.width * camera.height, where=where, cause=cause)
+        masks = amodal_masks(items, camera, options.cull, options.factor)
+        fields["amodal"] = masks
+        fields["visibility"] = visibility(instance, masks)
+    if any(name in wanted for name in ("object_coords", "nocs", "flow")):
+        position = frame.position if frame.position is not None else cast_positions(scene, camera, instance,
+                                                                                     options.factor)  # fmt: skip
+        coordinates = object_coordinates(items, instance, position)
+        if "object_coords" in wanted:
+            fields["object_coords"] = coordinates.astype(np.float32)
+        if "nocs" in wanted:
+            fields["nocs"] = nocs(items, instance, coordinates).astype(np.float32)
+        if "flow" in wanted:
+            assert next is not None
+            motion, occluded = flow(scene, camera, instance, coordinates, next[0], next[1], options.cull, where)
+            fields["flow"] = motion.astype(np.float32)
+            fields["flow_occluded"] = occluded
+    return dataclasses.replace(frame, **fields)
