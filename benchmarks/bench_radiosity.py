@@ -1,9 +1,10 @@
 """Radiosity of the Cornell box at about 1k, 10k and 50k patches beside Mitsuba 3's path tracer, in one run.
 
-    python benchmarks/bench_radiosity.py [--patches 1000 10000 50000] [--repeat 3] [--json PATH]
+    python benchmarks/bench_radiosity.py [--patches 1000 10000 50000] [--repeat 3] [--form-factors ray] [--json PATH]
 
 For each size: ``frustum.radiosity`` to a residual of 1e-3 (median wall time of ``--repeat`` runs, shots, the
-residual), the mean radiance of each wall, and its relative difference from Mitsuba's (``path`` integrator,
+residual; ``--form-factors ray`` (default) or ``hemicube``), the mean radiance of each wall, and its relative
+difference from Mitsuba's (``path`` integrator,
 ``scalar_rgb``, an orthographic sensor covering each wall face-on, as ``tests/test_radiosity.py`` does). Mitsuba's
 own time is the time to a per-wall standard error of 1 % (samples per pixel doubled until every wall's standard
 error of the mean, from the pixel variance, is at most 1 % of its mean), for scale: the two methods answer
@@ -55,10 +56,11 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--patches", type=int, nargs="+", default=[1000, 10000, 50000])
     parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--form-factors", default="ray", choices=["ray", "hemicube"])
     parser.add_argument("--json", type=Path)
     args = parser.parse_args()
     scene = cornell_box()
-    fr.radiosity(scene, patch_size=0.3, hemicube=32)  # compile (or load) the kernels first
+    fr.radiosity(scene, patch_size=0.3, hemicube=32, form_factors=args.form_factors)  # compile (or load) kernels
     reference, mitsuba_seconds, spp = mitsuba_walls(scene)
     print(f"Mitsuba 3 (path, scalar_rgb): per-wall standard error <= 1 % at {spp} spp on 64² per wall: "
           f"{mitsuba_seconds:.2f} s")  # fmt: skip
@@ -68,7 +70,7 @@ def main() -> None:
         times = []
         for _ in range(args.repeat):
             start = time.perf_counter()
-            result = fr.radiosity(scene, patch_size=size)
+            result = fr.radiosity(scene, patch_size=size, form_factors=args.form_factors)
             times.append(time.perf_counter() - start)
         difference = np.abs(wall_means(result) / reference - 1.0).max(axis=1)
         row = {"patches": result.patches, "patch_size": size, "seconds": statistics.median(times), "runs": times,

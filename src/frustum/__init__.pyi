@@ -6,10 +6,12 @@ __version__: str
 from . import (
     budgets as budgets,
     camera as camera,
+    camera_conventions as camera_conventions,
     clipping as clipping,
     errors as errors,
     frame as frame,
     geometry as geometry,
+    interop as interop,
     projection as projection,
     quaternion as quaternion,
     scene as scene,
@@ -86,6 +88,7 @@ from .errors import (
     CameraError as CameraError,
     ClippingError as ClippingError,
     FrustumError as FrustumError,
+    FrustumWarning as FrustumWarning,
     GeometryError as GeometryError,
     OutputError as OutputError,
     SceneFileError as SceneFileError,
@@ -290,6 +293,9 @@ from .render.radiosity import (
     RadiosityError as RadiosityError,
     RadiosityResult as RadiosityResult,
     radiosity as radiosity,
+)
+from .interop.trimesh import (
+    render_trimesh as render_trimesh,
 )
 from .raster import (
     set_compile_notice as set_compile_notice,

@@ -24,6 +24,7 @@ from typing import Literal, NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from frustum import camera_conventions as conventions
 from frustum._arrays import Matrix4, Points, Vector3, as_points, as_scalar, as_vector3, describe, read_only
 from frustum.errors import CameraError
 from frustum.projection import (
@@ -479,6 +480,109 @@ class Camera:
         else:
             raise CameraError(f"{where}: projection = {describe(projection)} is not 'perspective' or 'orthographic'")
         return cls.look_at(center - distance * line, center, view_up, lens, width, height)
+
+    # --- other programs' conventions (frustum.camera_conventions holds the maths) -------------------------
+
+    @classmethod
+    def from_intrinsics(
+        cls,
+        K: ArrayLike,
+        width: int,
+        height: int,
+        *,
+        world_to_camera: ArrayLike | None = None,
+        camera_to_world: ArrayLike | None = None,
+        convention: Literal["opencv", "opengl"] = "opencv",
+        near: float = 0.05,
+        far: float = 100.0,
+    ) -> Camera:
+        """A pinhole camera from a 3x3 intrinsic matrix K and a pose, as OpenCV, COLMAP or nerfstudio give them.
+
+        Pixel-centre rule: $u = fx·x/z + cx$ with the top-left pixel's centre at (0.5, 0.5) (COLMAP, pyrender;
+        OpenCV counts centres at integers: for its calibrations pass cx + 0.5, cy + 0.5). An off-centre (cx, cy)
+        gives an off-centre ``Frustum`` (``camera_conventions.near_plane_window``).
+
+        Parameters
+        ----------
+        K : (3, 3) array_like
+            [[fx, 0, cx], [0, fy, cy], [0, 0, 1]] in pixels, fx, fy > 0, zero skew; v points down.
+        width, height : int
+            Image size in pixels.
+        world_to_camera, camera_to_world : (4, 4) or (3, 4) array_like, keyword-only
+            The pose as a rigid transform; give exactly one.
+        convention : {"opencv", "opengl"}
+            The pose's camera axes: "opencv" (x right, y down, looking down +z: OpenCV, COLMAP) or "opengl" (y up,
+            looking down −z: nerfstudio, Blender, pyrender).
+        near, far : float
+            Clipping distances along the viewing axis, 0 < near < far (pyrender's defaults).
+
+        Raises
+        ------
+        CameraError
+            K not 3x3, fx or fy <= 0, nonzero skew, a pose that is not a rigid transform (the message names the
+            failed check), both or neither pose given, or an unknown convention.
+        """
+        where = "Camera.from_intrinsics"
+        fx, fy, cx, cy = conventions.pinhole_from_matrix(K, where)
+        for name, value in (("width", width), ("height", height)):
+            if isinstance(value, bool) or not isinstance(value, int | np.integer) or value <= 0:
+                raise CameraError(f"{where}: {name} = {describe(value)} is not a positive integer (pixels)")
+        eye, _u, v, n = conventions.view_from_pose(world_to_camera, camera_to_world, convention, where)
+        near_ = as_scalar(near, "near", where=where, error=CameraError)
+        left, right, bottom, top = conventions.near_plane_window(fx, fy, cx, cy, width, height, near_)
+        frame = ViewFrame(eye, normal=n, up=v)
+        return cls(frame, Frustum(left, right, bottom, top, near_, far), width, height)
+
+    @classmethod
+    def from_colmap(cls, camera: object, image: object, *, near: float = 0.05, far: float = 100.0) -> Camera:
+        """The camera of a COLMAP image: `camera` a ``pycolmap.Camera`` or a cameras.txt row, `image` a
+        ``pycolmap.Image`` or an images.txt row (world-to-camera quaternion and translation, OpenCV axes).
+
+        Pixel-centre rule: COLMAP's, the top-left pixel's centre at (0.5, 0.5), as ``from_intrinsics``.
+        Pinhole models only (SIMPLE_PINHOLE, PINHOLE); other models raise CameraError naming the model.
+        """
+        width, height, k = conventions.colmap_intrinsics(camera)
+        pose = conventions.colmap_world_to_camera(image)
+        return cls.from_intrinsics(k, width, height, world_to_camera=pose, convention="opencv", near=near, far=far)
+
+    @classmethod
+    def from_nerfstudio(
+        cls, frame: dict, transforms: dict | None = None, *, near: float = 0.05, far: float = 100.0
+    ) -> Camera:
+        """The camera of one nerfstudio (or Blender NeRF) frame: its ``transform_matrix`` (camera-to-world,
+        OpenGL axes) and intrinsics ``fl_x, fl_y, cx, cy, w, h`` from the frame or the file's top level
+        (`transforms`, the parsed transforms.json; ``camera_angle_x`` stands in for ``fl_x``).
+
+        Pixel-centre rule: nerfstudio's, the top-left pixel's centre at (0.5, 0.5), as ``from_intrinsics``.
+        """
+        where = "Camera.from_nerfstudio"
+        if not isinstance(frame, dict) or "transform_matrix" not in frame:
+            raise CameraError(f"{where}: frame = {describe(frame)} is not a dict with a 'transform_matrix'")
+        width, height, k = conventions.nerfstudio_intrinsics(frame, transforms, where)
+        return cls.from_intrinsics(k, width, height, camera_to_world=frame["transform_matrix"], convention="opengl",
+                                   near=near, far=far)  # fmt: skip
+
+    def intrinsics(self, width: int | None = None, height: int | None = None) -> NDArray[np.float64]:
+        """The 3x3 K of this pinhole camera for a `width` x `height` image (default: the camera's own size).
+
+        Pixel-centre rule: the top-left pixel's centre at (0.5, 0.5), as ``from_intrinsics``, which it inverts:
+        $fx = W/2·P00$, $cx = W/2·(1 − P02)$, $fy = H/2·P11$, $cy = H/2·(1 + P12)$ for clip_from_view P.
+
+        Raises
+        ------
+        CameraError
+            If the projection is not a pinhole perspective (Perspective or Frustum).
+        """
+        w = self.width if width is None else width
+        h = self.height if height is None else height
+        aspect = w / h if isinstance(w, int) and isinstance(h, int) and h > 0 else 0.0
+        return conventions.intrinsic_matrix(self.projection.matrix(aspect), w, h, "Camera.intrinsics")
+
+    def world_to_camera(self, convention: Literal["opencv", "opengl"] = "opencv") -> Matrix4:
+        """The 4x4 world-to-camera pose in OpenCV axes (x right, y down, looking down +z) or OpenGL ones (y up,
+        looking down −z): ``from_intrinsics(camera.intrinsics(), W, H, world_to_camera=...)`` gives this camera back.
+        """
+        return conventions.world_to_camera(self.frame, convention)
 
     # --- matrices -----------------------------------------------------------------------------------------
 

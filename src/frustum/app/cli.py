@@ -9,7 +9,8 @@ normals, ids and cameras). Errors print as one line, ``error: <message>``,
 without a traceback (the global ``--debug`` option shows it): exit status 1 for a bad value or an unreadable
 file, 2 for a command line that cannot be parsed (unknown option, missing argument, malformed numbers), 130
 after Ctrl-C (honoured at once: the work runs on a worker thread; no partial output file is left). The global
-options ``--max-bytes`` and ``--max-operations`` set the work budget (``frustum.set_budget``).
+options ``--max-bytes`` and ``--max-operations`` set the work budget (``frustum.set_budget``); ``--allow-read PATH``
+(repeatable) lets scene files read meshes and images in a folder outside their own (``FRUSTUM_ALLOW_READ``).
 """
 
 from __future__ import annotations
@@ -157,9 +158,22 @@ def _main(
         typer.Option("--max-operations", help="Work budget of one request in inner iterations, e.g. 1e11 "
                      "(default 5e10; env FRUSTUM_MAX_OPERATIONS).", metavar="COUNT"),
     ] = None,
+    allow_read: Annotated[
+        list[Path] | None,
+        typer.Option("--allow-read", help="A folder outside a scene file's own whose meshes and images it may read "
+                     "(repeatable; env FRUSTUM_ALLOW_READ).", metavar="PATH"),
+    ] = None,
 ) -> None:
     """The classical 3D graphics pipeline, inspectable at every stage."""
     _STATE["debug"] = debug
+    if allow_read:  # through the environment: worker processes and every command's loader see the same rule
+        import os
+
+        from frustum.scenefile import ALLOW_READ_VARIABLE
+
+        folders = [str(path.resolve()) for path in allow_read]
+        previous = os.environ.get(ALLOW_READ_VARIABLE)
+        os.environ[ALLOW_READ_VARIABLE] = os.pathsep.join(folders + ([previous] if previous else []))
     if max_bytes is not None or max_operations is not None:
         from frustum.budgets import set_budget
 
@@ -787,7 +801,7 @@ def radiosity_command(
     size: Annotated[str | None, typer.Option(help="Image size WIDTHxHEIGHT, overriding the file's.")] = None,
     up: Annotated[str, typer.Option(help="A mesh file's up axis, y or z (glTF is always y).")] = "y",
 ) -> None:
-    """Light a scene file by radiosity (diffuse light bouncing between surfaces, hemicube form factors, progressive
+    """Light a scene file by radiosity (diffuse light bouncing between surfaces, ray-cast form factors, progressive
     refinement) and render the lit scene from the file's camera: each pixel the interpolated radiosity."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 

@@ -11,16 +11,9 @@ so the pixel in stored row ``r``, column ``i`` has its centre at window $(i + 0.
 - COLMAP text: OpenCV axes (x right, y down, looking down +z), world-to-camera as a scalar-first quaternion
   ``QW QX QY QZ`` and ``TX TY TZ``; ``PINHOLE fx fy cx cy`` with the top-left pixel's centre at (0.5, 0.5).
 
-With the projection's clip_from_view matrix ``P`` (a perspective one: bottom row (0, 0, −1, 0)) and an image
-of W x H pixels, a view point (x, y, z) lands at window $x_w = W/2·(P00·x/(−z) − P02 + 1)$; in pixel
-coordinates u (right), v (down) with the top-left pixel centre at (0.5, 0.5):
-$fx = W/2·P00$, $cx = W/2·(1 − P02)$, $fy = H/2·P11$, $cy = H/2·(1 + P12)$ — for a symmetric
-``Perspective`` $fx = fy = H / (2·tan(fovy/2))$, $cx = W/2$, $cy = H/2$. OpenCV axes are the OpenGL ones
-turned half a turn about x: $camera_cv = diag(1, −1, −1) · camera_gl$.
-
-Depth: the Frame's window depth d in [0, 1] goes back to view z through the projection's third and fourth rows,
-$z_ndc = 2d − 1 = (A·z + B)/(C·z + D)$, so $z = (B − z_ndc·D)/(z_ndc·C − A)$; the metric z-depth written to
-datasets is $−z$ (distance along the viewing axis), 0 where nothing was drawn.
+The axis conversions, intrinsics (fx, fy, cx, cy from clip_from_view) and metric depth are
+``frustum.camera_conventions``'s (one place for every program's camera convention); this module re-exports them
+for the dataset writers and adds ``camera_record``.
 
 References: [HB 10] "The Viewport Transformation and Three-Dimensional Screen Coordinates"; COLMAP "Output
 format" and "Camera models"; nerfstudio "Data conventions"; the NeRF synthetic data set's transforms.json.
@@ -32,12 +25,17 @@ import math
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
-from frustum._arrays import Matrix4, describe
+from frustum._arrays import Matrix4
 from frustum.camera import Camera
+from frustum.camera_conventions import (
+    OPENCV_FROM_OPENGL,
+    colmap_pose,
+    intrinsics,
+    metric_depth,
+    opengl_camera_to_world,
+)
 from frustum.errors import CameraError
-from frustum.quaternion import Quaternion
 
 __all__ = [
     "OPENCV_FROM_OPENGL",
@@ -48,111 +46,10 @@ __all__ = [
     "opengl_camera_to_world",
 ]
 
-# fmt: off
-OPENCV_FROM_OPENGL = np.array([
-    [1.0,  0.0,  0.0, 0.0],
-    [0.0, -1.0,  0.0, 0.0],
-    [0.0,  0.0, -1.0, 0.0],
-    [0.0,  0.0,  0.0, 1.0],
-])
-# fmt: on
-"""Half a turn about x: OpenGL camera axes (y up, looking down −z) to OpenCV ones (y down, looking down +z)."""
-OPENCV_FROM_OPENGL.flags.writeable = False
-
 
 def _clip_from_view(camera: Camera) -> Matrix4:
     """The right-handed clip_from_view (the frame's handedness only relabels z; the picture is the same)."""
     return camera.projection.matrix(camera.aspect)
-
-
-def intrinsics(camera: Camera, *, where: str = "intrinsics") -> dict[str, float]:
-    """Pinhole intrinsics of a perspective camera in pixels: fx, fy, cx, cy (u right, v down, top-left centre 0.5).
-
-    $fx = W/2·P00$, $fy = H/2·P11$, $cx = W/2·(1 − P02)$, $cy = H/2·(1 + P12)$ from clip_from_view P.
-
-    Raises
-    ------
-    CameraError
-        If the projection is not a pinhole perspective (parallel, oblique or general projections have no
-        pinhole intrinsics).
-    """
-    clip_from_view = _clip_from_view(camera)
-    pinhole = (
-        np.array_equal(clip_from_view[3], (0.0, 0.0, -1.0, 0.0))
-        and clip_from_view[0, 1] == 0.0 and clip_from_view[1, 0] == 0.0
-        and clip_from_view[0, 3] == 0.0 and clip_from_view[1, 3] == 0.0
-    )  # fmt: skip
-    if not pinhole:
-        raise CameraError(
-            f"{where}: projection = {describe(camera.projection)} is not a pinhole perspective; the camera "
-            "formats need Perspective or Frustum (use format 'files' for parallel projections)"
-        )
-    w, h = camera.width, camera.height
-    return {
-        "fx": w / 2 * float(clip_from_view[0, 0]),
-        "fy": h / 2 * float(clip_from_view[1, 1]),
-        "cx": w / 2 * (1.0 - float(clip_from_view[0, 2])),
-        "cy": h / 2 * (1.0 + float(clip_from_view[1, 2])),
-    }
-
-
-def opengl_camera_to_world(camera: Camera) -> Matrix4:
-    """world_from_camera with OpenGL camera axes: columns u, v, n and the eye (NeRF's ``transform_matrix``)."""
-    frame = camera.frame
-    world_from_camera = np.eye(4)
-    world_from_camera[:3, 0], world_from_camera[:3, 1], world_from_camera[:3, 2] = frame.u, frame.v, frame.n
-    world_from_camera[:3, 3] = frame.eye
-    return world_from_camera
-
-
-def colmap_pose(camera: Camera) -> tuple[tuple[float, float, float, float], tuple[float, float, float]]:
-    """COLMAP's world-to-camera pose: scalar-first unit quaternion (QW, QX, QY, QZ) and translation (TX, TY, TZ).
-
-    $camera_cv = R·world + t$ with $[R | t] = OPENCV_FROM_OPENGL · (world_from_camera_gl)⁻¹$.
-    """
-    frame = camera.frame
-    rotation_gl = np.array([frame.u, frame.v, frame.n])  # rows u, v, n: view_from_world's rotation
-    rotation = OPENCV_FROM_OPENGL[:3, :3] @ rotation_gl
-    translation = -(rotation @ np.asarray(frame.eye))
-    q = Quaternion.from_matrix(rotation)
-    # + 0.0 turns −0.0 into 0.0 (the same pose, written the same way)
-    quaternion = (float(q.w) + 0.0, float(q.x) + 0.0, float(q.y) + 0.0, float(q.z) + 0.0)
-    return quaternion, (float(translation[0]) + 0.0, float(translation[1]) + 0.0, float(translation[2]) + 0.0)
-
-
-def metric_depth(window_depth: NDArray[np.float32], camera: Camera) -> NDArray[np.float32]:
-    """Metric z-depth (distance along the viewing axis, world units) of a Frame's window depth; 0 on background.
-
-    $z_ndc = 2d − 1$, $z_view = (B − z_ndc·D)/(z_ndc·C − A)$ with (A, B) and (C, D) the z and w entries of
-    clip_from_view's third and fourth rows; the result is $−z_view$ (positive in front of the camera).
-    Computed in float64, returned as float32.
-
-    Parameters
-    ----------
-    window_depth : (H, W) float32
-        ``Frame.depth``: window depth in [0, 1], 1.0 where nothing was drawn.
-    camera : Camera
-        The camera that rendered the frame.
-
-    Raises
-    ------
-    CameraError
-        If the projection's depth depends on x or y (a general projection onto a tilted plane).
-    """
-    clip_from_view = _clip_from_view(camera)
-    if clip_from_view[2, 0] or clip_from_view[2, 1] or clip_from_view[3, 0] or clip_from_view[3, 1]:
-        raise CameraError(
-            f"metric_depth: projection = {describe(camera.projection)} makes depth depend on x and y; metric "
-            "depth needs a projection whose third and fourth rows involve z only"
-        )
-    a, b = float(clip_from_view[2, 2]), float(clip_from_view[2, 3])
-    c, d = float(clip_from_view[3, 2]), float(clip_from_view[3, 3])
-    depth = np.asarray(window_depth, dtype=np.float64)
-    z_ndc = 2.0 * depth - 1.0
-    with np.errstate(divide="ignore", invalid="ignore"):
-        z_view = (b - z_ndc * d) / (z_ndc * c - a)
-    out = np.where(depth < 1.0, -z_view, 0.0)
-    return out.astype(np.float32)
 
 
 def camera_record(camera: Camera) -> dict[str, Any]:

@@ -203,27 +203,81 @@ def dataset_cameras(
 
 
 def _read_manifest(out: Any) -> tuple[dict | None, dict[str, dict]]:
-    """The configuration line and the finished views of a run log; a torn last line (a killed run) is ignored.
+    """The configuration line and the finished views of a run log, every line checked.
 
-    At a URL, the parts of runs that did not reach their end (``manifest.parts/``) are read after the log.
+    Only a torn last line (a killed run: no newline after it) is ignored; any other line that is not a
+    configuration or a view entry, or a view entry naming a file outside `out`, stops the run with an
+    ``OutputError`` naming the file and the line. At a URL, the parts of runs that did not reach their end
+    (``manifest.parts/``) are read after the log, each checked the same way.
     """
     path = out / _MANIFEST
+    if not isinstance(out, RemotePath) and path.is_symlink():
+        raise OutputError(f"{path}: the run log is a symbolic link; frustum neither reads nor writes a run log "
+                          "through one (remove it, or give another folder)")  # fmt: skip
     if not path.exists():
         return None, {}
-    text = path.read_text(encoding="utf-8", errors="replace")
-    if isinstance(out, RemotePath):
-        text += "\n" + "\n".join(part.read_text(errors="replace") for part in _log_parts(out))
+    logs = [path, *(_log_parts(out) if isinstance(out, RemotePath) else [])]
     config, views = None, {}
-    for line in text.splitlines():
-        try:
-            entry = json.loads(line)
-        except json.JSONDecodeError:
-            continue
-        if "config" in entry and config is None:
-            config = entry["config"]
-        elif "view" in entry:
-            views[entry["view"]] = entry
+    for log in logs:
+        text = log.read_text(encoding="utf-8", errors="replace")
+        lines = text.split("\n")
+        for number, line in enumerate(lines, start=1):
+            if not line.strip():
+                continue
+            torn = number == len(lines)  # the text does not end with a newline: its last line may be torn
+            entry = _manifest_entry(line, out, where=f"{log}, line {number}", torn=torn)
+            if entry is None:
+                continue
+            if "config" in entry:
+                if config is not None or views:
+                    raise OutputError(f"{log}, line {number}: a second configuration line; the run log is "
+                                      "damaged (rerun with --overwrite to start again)")  # fmt: skip
+                config = entry["config"]
+            else:
+                views[entry["view"]] = entry
+    if views and config is None:
+        raise OutputError(f"{path}: view lines but no configuration line; the run log is damaged "
+                          "(rerun with --overwrite to start again)")  # fmt: skip
     return config, views
+
+
+def _manifest_entry(line: str, out: Any, *, where: str, torn: bool) -> dict | None:
+    """One run-log line checked: ``{"config": {...}}`` or ``{"view": key, "files": {kind: relative path}}``
+    with every path inside `out` (after symbolic links); None for a torn last line."""
+    try:
+        entry = json.loads(line)
+    except (json.JSONDecodeError, RecursionError, ValueError):
+        if torn:
+            return None
+        raise OutputError(f"{where}: not a JSON line; the run log is damaged (rerun with --overwrite to start "
+                          "again, or give another folder)") from None  # fmt: skip
+    if isinstance(entry, dict) and set(entry) == {"config"} and isinstance(entry["config"], dict):
+        return entry
+    files = entry.get("files") if isinstance(entry, dict) else None
+    if not (isinstance(entry, dict) and isinstance(entry.get("view"), str) and isinstance(files, dict)
+            and all(isinstance(k, str) and isinstance(v, str) for k, v in files.items())):  # fmt: skip
+        if torn:
+            return None
+        raise OutputError(f"{where}: expected a configuration line or a view line "
+                          '({"view": KEY, "files": {KIND: PATH}}), got ' + describe(entry))  # fmt: skip
+    for relative in files.values():
+        _check_inside(out, relative, where)
+    return entry
+
+
+def _check_inside(out: Any, relative: str, where: str) -> None:
+    """A path a run log names: one of the dataset's folders, inside `out` once symbolic links are followed."""
+    parts = relative.replace("\\", "/").split("/")
+    if (relative.startswith(("/", "\\")) or ".." in parts or ":" in parts[0] or len(parts) < 2
+            or parts[0] not in _FOLDERS.values()):  # fmt: skip
+        folders = ", ".join(sorted(set(_FOLDERS.values())))
+        raise OutputError(f"{where}: the path {relative!r} is not a file of this dataset's folders ({folders}); "
+                          "the run log is damaged or forged")  # fmt: skip
+    if not isinstance(out, RemotePath):
+        root = Path(out).resolve()
+        if not Path(out, relative).resolve().is_relative_to(root):
+            raise OutputError(f"{where}: the path {relative!r} leads outside {str(out)!r} through a symbolic "
+                              "link; frustum reads and removes only files inside the output folder")  # fmt: skip
 
 
 def _log_parts(out: RemotePath) -> list[RemotePath]:
@@ -242,7 +296,8 @@ class _RunLog:
         self.run = f"{time.time_ns():020d}-{os.getpid()}"
         self.parts = 0
         if not self.remote:
-            self.file: Any = open(out / _MANIFEST, "a", encoding="utf-8")  # noqa: SIM115 - closed by close()
+            flags = os.O_WRONLY | os.O_APPEND | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0)  # never through a link
+            self.file: Any = os.fdopen(os.open(out / _MANIFEST, flags, 0o666), "a", encoding="utf-8")
             if config is not None:
                 self.write(json.dumps({"config": config}))
         elif config is not None:

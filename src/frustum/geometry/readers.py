@@ -34,6 +34,8 @@ from typing import Any, NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
+from frustum.errors import FrustumError, GeometryError
+
 __all__ = ["RawPart", "read_parts"]
 
 
@@ -69,7 +71,7 @@ def read_parts(file: Path, data: bytes | None = None) -> list[RawPart] | None:
         return None
     try:
         return reader(file, file.read_bytes() if data is None else data)
-    except MemoryError:
+    except (MemoryError, FrustumError):  # out of memory, or an image over the budget: not trimesh's to retry
         raise
     except Exception:  # anything unusual or malformed: trimesh reads it and reports what is wrong
         return None
@@ -372,8 +374,6 @@ def _hashable_rows(rows: NDArray[np.int64]) -> NDArray[Any]:
 def _read_mtl(file: Path) -> dict[str, tuple[Any, tuple[float, float, float, float]]]:
     """name -> (PIL image or None, base colour) of an MTL file, as trimesh's ``parse_mtl`` and ``SimpleMaterial``
     give them (``Kd`` rounded to bytes; no ``Kd``: trimesh's default gray)."""
-    from PIL import Image
-
     if not _plain_name(file.name):
         raise UnsupportedError("a path in the library name")  # trimesh's resolver tries several readings
     if not file.is_file():
@@ -402,7 +402,7 @@ def _read_mtl(file: Path) -> dict[str, tuple[Any, tuple[float, float, float, flo
             texture = file.parent / line[index:].strip()
             if not _plain_name(line[index:].strip()):
                 raise UnsupportedError("a path or options in map_Kd")  # trimesh's resolver tries several readings
-            image = Image.open(io.BytesIO(texture.read_bytes())) if texture.is_file() else None
+            image = _open_image(io.BytesIO(texture.read_bytes()), file, texture.name) if texture.is_file() else None
         elif key == "kd":
             values = [float(x) for x in words[1:]]
             if len(values) != 3:
@@ -567,15 +567,21 @@ def _gltf_color(factor: Any) -> tuple[float, float, float, float]:
 
 
 def _gltf_image(gltf: dict[str, Any], reference: dict[str, Any], view_bytes: Any) -> Any:
-    from PIL import Image
-
     if set(reference) - {"index", "texCoord", "scale", "strength"} or reference.get("texCoord", 0) != 0:
         raise UnsupportedError("texture reference")
     texture = gltf["textures"][reference["index"]]
     source = gltf["images"][texture["source"]]
     if "bufferView" not in source:
         raise UnsupportedError("image file")
-    return Image.open(io.BytesIO(view_bytes(source["bufferView"])))
+    return _open_image(io.BytesIO(view_bytes(source["bufferView"])), None, f"image {source.get('name', '')!r}")
+
+
+def _open_image(data: Any, file: Path | None, name: str) -> Any:
+    """An embedded or MTL image, its size checked against the memory budget before it is decoded."""
+    from frustum._images import open_image
+
+    where = "load" if file is None else f"load: {file.name}"
+    return open_image(data, where=where, name=name, error=GeometryError)
 
 
 _READERS = {".stl": _read_stl, ".ply": _read_ply, ".off": _read_off, ".obj": _read_obj, ".glb": _read_glb,

@@ -9,11 +9,19 @@ $$B_k = E_k + ρ_k Σ_j B_j F_jk$$
 with the form factor $F_jk$, the fraction of the light leaving patch j that arrives at patch k. Reciprocity
 $A_j F_jk = A_k F_kj$ gives the shooting form $B_k += ρ_k ΔB_j F_jk A_j / A_k$.
 
-* **Form factors by the hemicube** (Cohen & Greenberg 1985): a half cube of side 2 centred on the shooting patch,
-  its top face at height 1 along the patch normal, is rasterized face by face (five faces: the top and the upper
-  halves of the four sides) with frustum's own depth-buffer kernels (``raster.tiles`` / ``raster.triangles``
-  through the render package's item pass), writing the code of the nearest patch into each pixel. Each pixel adds
-  its *delta form factor* to the patch it shows, at (x, y, 1) on the top face and at (x, 1, z) on a side face
+* **Form factors by ray casting** (``form_factors="ray"``, the default; Wallace, Elmquist & Haines 1989): at
+  each receiving patch's centre, the exact point-to-area form factor to the shooting group, by Lambert's contour
+  formula [Baum, Rushmeier & Winget 1989] (``raster.form_factors``; over a flat piece's boundary edges alone, the
+  shared edges cancelling), times whether a shadow ray reaches each quarter of the group; shot as
+  $B_k += ρ_k F_k,group ΔB_group$ with no division by the receiver's area, so a small receiver is as exact as a
+  large one. Receivers nearer a group than its size take each member's factor and own unshot radiosity.
+
+* **Form factors by the hemicube** (``form_factors="hemicube"``; Cohen & Greenberg 1985): a half cube of side 2
+  centred on the shooting patch, its top face at height 1 along the patch normal, is rasterized face by face (five
+  faces: the top and the upper halves of the four sides) with frustum's own depth-buffer kernels
+  (``raster.tiles`` / ``raster.triangles`` through the render package's item pass), writing the code of the
+  nearest patch into each pixel. Each pixel adds its *delta form factor* to the patch it shows, at (x, y, 1) on
+  the top face and at (x, 1, z) on a side face
 
     $$ΔF = ΔA / (π (x² + y² + 1)²)$$
 
@@ -41,7 +49,9 @@ References
 ----------
 [HB] "Radiosity Lighting Model" (the radiosity equation, form factors, the hemicube, progressive refinement).
 Cohen & Greenberg, "The Hemi-Cube", SIGGRAPH 1985; Cohen, Chen, Wallace & Greenberg, "A Progressive Refinement
-Approach to Fast Radiosity Image Generation", SIGGRAPH 1988.
+Approach to Fast Radiosity Image Generation", SIGGRAPH 1988; Wallace, Elmquist & Haines, "A Ray Tracing Algorithm
+for Progressive Radiosity", SIGGRAPH 1989; Baum, Rushmeier & Winget, "Improving Radiosity Solutions Through the
+Use of Analytically Determined Form-Factors", SIGGRAPH 1989.
 """
 
 from __future__ import annotations
@@ -308,6 +318,138 @@ def _delta_cache(resolution: int) -> tuple[np.ndarray, np.ndarray]:
     return _DELTAS[resolution]
 
 
+class _Column(NamedTuple):
+    """One shooting group's form factors: ``far`` (P,) from each patch centre to the group's area, 0 for the
+    ``near`` receivers (R,), which keep ``per_member`` (R, M) factors to each of the group's ``members`` (M,)."""
+
+    far: np.ndarray
+    near: np.ndarray
+    per_member: np.ndarray
+    members: np.ndarray
+
+
+class _RayFactors:
+    """Form factors from every patch centre to a shooting group's area (``form_factors="ray"``), one column per group
+    computed on its first shot and kept: the unoccluded factor to each quarter of the group (exact, per triangle,
+    ``raster.form_factors``) times whether a shadow ray from the receiver reaches that quarter's representative
+    point (the member centroid nearest the quarter's centre) — Wallace, Elmquist & Haines' receiver-side factors
+    with four samples of the source. Receivers nearer the group than its size keep one factor per member, so they
+    receive each member's own unshot radiosity rather than the group's mean (grouping errs only near the group)."""
+
+    def __init__(self, patches: Patches, members: list[np.ndarray]) -> None:
+        from frustum.raster import rays
+
+        self.patches = patches
+        self.members = members
+        self.triangles = patches.vertices[patches.faces]
+        self.index = rays.build(self.triangles)
+        size = float(np.linalg.norm(patches.vertices.max(axis=0) - patches.vertices.min(axis=0)))
+        self.offset = 1e-6 * size
+        self.origins = patches.centre + patches.normal * self.offset
+        self.columns: dict[int, _Column] = {}
+
+    def gain(self, group: int, unshot: np.ndarray) -> np.ndarray:
+        """(P, 3) $Σ_j F_k,j ΔB_j$ over the group's members j: what each patch k receives (before ρ_k) when the
+        group shoots the unshot radiosity `unshot` (P, 3)."""
+        if group not in self.columns:
+            self.columns[group] = self._compute(self.members[group])
+        far, near, per_member, members = self.columns[group]
+        area = self.patches.area[members]
+        mean = (unshot[members] * area[:, None]).sum(axis=0) / area.sum()
+        received = far[:, None] * mean
+        received[near] += per_member @ unshot[members]
+        return received
+
+    def _compute(self, members: np.ndarray) -> _Column:
+        from frustum.raster import rays
+        from frustum.raster.form_factors import point_group_factors, point_triangle_factors
+
+        patches = self.patches
+        quarter, representative = _quarters(patches, members)
+        order = np.argsort(quarter, kind="stable")
+        members, quarter = members[order], quarter[order]
+        pieces = representative.shape[0]
+        first = np.searchsorted(quarter, np.arange(pieces + 1)).astype(np.int64)
+        edges, edge_first = _boundaries(patches.faces[members], quarter, pieces)
+        triangles = np.ascontiguousarray(self.triangles[members])
+        facing = np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0])
+        unoccluded = np.zeros((patches.count, pieces))
+        planes = _planes(patches, members, first)
+        point_group_factors(patches.centre, patches.normal, triangles, facing, first,
+                            np.ascontiguousarray(patches.vertices[edges]), edge_first, planes, unoccluded)  # fmt: skip
+        visible = unoccluded > 0.0
+        receiver, piece = np.nonzero(visible)
+        if receiver.size:
+            target = patches.centre[representative] + patches.normal[representative] * self.offset
+            origins = self.origins[receiver]
+            visible[receiver, piece] = ~rays.any_hits(self.index, origins, target[piece] - origins, 0.0, 1.0)
+        far = (unoccluded * visible).sum(axis=1)
+        corners = triangles.reshape(-1, 3)
+        low, high = corners.min(axis=0), corners.max(axis=0)
+        reach = float(np.linalg.norm(high - low))
+        gap = np.linalg.norm(np.maximum(np.maximum(low - patches.centre, patches.centre - high), 0.0), axis=1)
+        near = np.flatnonzero((gap < reach) & visible.any(axis=1))
+        per_member = np.zeros((near.shape[0], members.shape[0]))
+        if near.size:
+            point_triangle_factors(np.ascontiguousarray(patches.centre[near]),
+                                   np.ascontiguousarray(patches.normal[near]), triangles,
+                                   np.arange(members.shape[0], dtype=np.int64), per_member)  # fmt: skip
+            per_member *= visible[near][:, quarter]
+            far[near] = 0.0
+        return _Column(far, near, per_member, members)
+
+
+def _planes(patches: Patches, members: np.ndarray, first: np.ndarray) -> np.ndarray:
+    """(Q, 4) plane (m, d), m·x = d, of each piece ``members[first[q]:first[q + 1]]`` whose patches all lie on one
+    plane with one normal (to 1e-12 of the scene's size); NaN rows for the others."""
+    planes = np.full((first.shape[0] - 1, 4), np.nan)
+    size = float(np.abs(patches.vertices).max()) or 1.0
+    for q in range(planes.shape[0]):
+        mine = members[first[q] : first[q + 1]]
+        m = patches.normal[mine[0]]
+        d = float(m @ patches.centre[mine[0]])
+        corners = patches.vertices[patches.faces[mine]].reshape(-1, 3)
+        if np.abs(patches.normal[mine] - m).max() <= 1e-12 and np.abs(corners @ m - d).max() <= 1e-12 * size:
+            planes[q, :3], planes[q, 3] = m, d
+    return planes
+
+
+def _boundaries(faces: np.ndarray, piece: np.ndarray, pieces: int) -> tuple[np.ndarray, np.ndarray]:
+    """The boundary edges of each piece of a group: ((E, 2) vertex pairs running as in their triangles, sorted by
+    piece; (pieces + 1,) offsets). An edge is on the boundary when its reverse is not an edge of the same piece."""
+    directed = np.stack([faces, np.roll(faces, -1, axis=1)], axis=2).reshape(-1, 2)  # (3T, 2)
+    owner = np.repeat(piece, 3)
+    keys = np.c_[owner, directed]
+    reverse = np.c_[owner, directed[:, ::-1]]
+    forward = {tuple(k) for k in keys.tolist()}
+    boundary = np.array([tuple(k) not in forward for k in reverse.tolist()], dtype=bool)
+    edges = directed[boundary]
+    first = np.searchsorted(owner[boundary], np.arange(pieces + 1)).astype(np.int64)
+    return edges, first
+
+
+def _quarters(patches: Patches, members: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The members of a group split in (up to) four quarters by the medians of their centroids along the group's two
+    widest principal directions: ((M,) quarter of each member, numbered from 0, (Q,) representative patch of each
+    quarter: the member whose centroid lies nearest the quarter's area-weighted centre)."""
+    centres = patches.centre[members]
+    if members.shape[0] < 4:
+        return np.arange(members.shape[0], dtype=np.int64), members.copy()
+    spread = centres - centres.mean(axis=0)
+    axes = np.linalg.svd(spread, full_matrices=False)[2][:2]
+    along = spread @ axes.T  # (M, 2)
+    key = (along[:, 0] > np.median(along[:, 0])).astype(np.int64) * 2 + (along[:, 1] > np.median(along[:, 1]))
+    labels, subset = np.unique(key, return_inverse=True)
+    subset = subset.reshape(-1).astype(np.int64)
+    representative = np.empty(labels.shape[0], dtype=np.int64)
+    area = patches.area[members]
+    for q in range(labels.shape[0]):
+        mine = subset == q
+        middle = (centres[mine] * area[mine, None]).sum(axis=0) / area[mine].sum()
+        representative[q] = members[mine][np.argmin(np.linalg.norm(centres[mine] - middle, axis=1))]
+    return subset, representative
+
+
 # --- light sources -------------------------------------------------------------------------------------------------
 
 _SAMPLES = np.array([[1 / 3, 1 / 3, 1 / 3], [2 / 3, 1 / 6, 1 / 6], [1 / 6, 2 / 3, 1 / 6], [1 / 6, 1 / 6, 2 / 3]])
@@ -404,6 +546,7 @@ def radiosity(
     max_iterations: int | None = None,
     shooter: float = 4.0,
     progress: Callable[[int, float], None] | None = None,
+    form_factors: str = "ray",
 ) -> RadiosityResult:
     """Solve $B_k = E_k + ρ_k Σ_j B_j F_jk$ for the scene's surfaces by progressive refinement (module docstring).
 
@@ -423,10 +566,18 @@ def radiosity(
         closed scene with ρ ≤ 0.9 or an open one).
     shooter : float
         Patches shoot in groups of about $shooter × patch_size$ (those of one item facing the same way in one
-        grid cell), from the group's area-weighted centre; every patch receives on its own. 1 shoots from every
-        patch alone (the plain method, several times slower); the default 4 keeps wall means within 1 % of it.
+        grid cell); every patch receives on its own. With ray form factors a group shoots from its whole area,
+        and receivers nearer than its size take each member's own unshot radiosity (exact per patch in a closed
+        box at any grouping); with the hemicube it shoots from its area-weighted centre. 1 shoots from every patch
+        alone (several times slower).
     progress : callable(shots, residual), optional
         Called after each shot (the CLI draws a Rich bar with it).
+    form_factors : {"ray", "hemicube"}
+        "ray" (default): each receiving patch's form factor to the shooting group's area, exact at the patch
+        centre (Lambert's contour formula per triangle) times the fraction of shadow rays to four points of the
+        group that nothing blocks (Wallace, Elmquist & Haines 1989); a group's form factor is computed once and
+        reused by its later shots. "hemicube": the hemicube on the group's centre (Cohen & Greenberg 1985), the
+        textbook method, blotchy on small receivers (aliasing) and near the shooter.
 
     Returns
     -------
@@ -454,11 +605,14 @@ def radiosity(
     shooter = as_scalar(shooter, "shooter", where=where, error=RadiosityError)
     if not shooter >= 1.0:
         raise RadiosityError(f"{where}: shooter = {shooter!r} is below 1; give a group size in patch sizes >= 1")
+    if form_factors not in ("ray", "hemicube"):
+        raise RadiosityError(f"{where}: form_factors = {form_factors!r} is not 'ray' or 'hemicube'")
     estimate = _estimated_patches(scene, size)
     pixels = hemicube * hemicube * 3  # the top face and four half sides
     check_memory(estimate * 600.0 + pixels * 16, where=where,
                  cause=f"patch_size = {size:.4g} (about {estimate:.3g} patches)", error=RadiosityError)  # fmt: skip
-    check_operations(estimate / shooter**2 * 10.0 * (pixels + estimate), where=where,
+    work = estimate * estimate * 60.0 if form_factors == "ray" else estimate / shooter**2 * 10.0 * (pixels + estimate)
+    check_operations(work, where=where,
                      cause=f"patch_size = {size:.4g} (about {estimate:.3g} patches, hemicube {hemicube})",
                      error=RadiosityError)  # fmt: skip
     if max_iterations is not None and (isinstance(max_iterations, bool) or not isinstance(max_iterations, int)
@@ -498,14 +652,19 @@ def radiosity(
     power = np.bincount(group, weights=unshot.sum(axis=1) * area, minlength=groups)
     residual = float(power.sum()) / emitted
     taken = 0
+    receiving = _RayFactors(patches, members) if form_factors == "ray" else None
     while residual > tol and taken < limit:
         source = int(np.argmax(power))
         shooting = members[source]
         shot = (unshot[shooting] * area[shooting, None]).sum(axis=0)  # (3,) unshot power of the group
-        factors = hemicube_form_factors(patches, centre[source], normal[source], hemicube, raster)
-        factors[shooting] = 0.0
-        unshot[shooting] = 0.0
-        gain = (factors / area)[:, None] * shot * reflectance
+        if receiving is not None:  # F_k,group at each receiver: B_k += ρ_k F_k,group ΔB_group
+            gain = receiving.gain(source, unshot) * reflectance
+            unshot[shooting] = 0.0
+        else:  # F_group,k by the hemicube and reciprocity: B_k += ρ_k F_group,k ΔB_group A_group / A_k
+            factors = hemicube_form_factors(patches, centre[source], normal[source], hemicube, raster)
+            factors[shooting] = 0.0
+            unshot[shooting] = 0.0
+            gain = (factors / area)[:, None] * shot * reflectance
         radiosity_b += gain
         unshot += gain
         power = np.bincount(group, weights=unshot.sum(axis=1) * area, minlength=groups)

@@ -287,19 +287,27 @@ def light_fractions(
         f"{cube_count} of them point lights (a cube of six maps each, {format_bytes(6 * size * size * 4)})",
     )
     seen_points = points[drawn]
+    # a light's maps depend on every caster's bytes and transform and on the light cameras alone: kept and reused
+    # while those stay (a point or spot light's cameras follow the light and the casters' box, not the view)
+    keys = [casters_key(item, bool(item.mesh.is_watertight)) for item in casters]
+    every = None if any(key is None for key in keys) else tuple(keys)
     for channel, light in zip(rows, casting, strict=True):
         cameras = _light_cameras(light, seen_points, box, size, options.softness)
         if not cameras:
             continue
-        maps = take_array((len(cameras), size, size), np.float32)
         views = np.zeros((len(cameras), shadow.MAP_FIELDS))
         for face, (light_camera, texel) in enumerate(cameras):
-            for number, item in enumerate(casters):
-                draw_depth(item, light_camera, maps[face], number == 0)
             views[face] = map_record(light_camera, texel, light)
+        key = map_key(every, [light_camera for light_camera, _ in cameras], views)
+        maps = kept_maps(key, (len(cameras), size, size))
+        if maps is None:
+            maps = take_array((len(cameras), size, size), np.float32)
+            for face, (light_camera, _) in enumerate(cameras):
+                for number, item in enumerate(casters):
+                    draw_depth(item, light_camera, maps[face], number == 0)
         shadow.map_visibility(depth, points, facing, maps, views, np.ascontiguousarray(lights[channel]),
                               float(options.softness), seen, channel)  # fmt: skip
-        give_back(maps)
+        keep_maps(key, maps)
     return seen
 
 
@@ -370,20 +378,29 @@ def _light_cameras(
     position = np.asarray(light.position, dtype=np.float64)
     distances = np.linalg.norm(corners - position, axis=1)
     far = float(distances.max()) * 1.01 + 1e-9
-    nearest = np.clip(position, box[0], box[1])
-    near = max(0.99 * float(np.linalg.norm(nearest - position)), 1e-3 * far)
+    nearest = float(np.linalg.norm(np.clip(position, box[0], box[1]) - position))
     if isinstance(light, SpotLight):
         axis = np.asarray(light.direction, dtype=np.float64)
         half = min(light.outer_angle, math.radians(85.0))
         fovy = 2.0 * math.atan(math.tan(half) * (1.0 + 2.0 * reach))
         frame = ViewFrame(position, normal=-axis, up=_up_for(axis))
+        near = _near_plane(nearest, fovy, far)
         return [(Camera(frame, Perspective(fovy, near, far), size, size), 2.0 * math.tan(fovy / 2.0) / size)]
     cameras = []
     fovy = 2.0 * math.atan(1.0 + 2.0 * reach)
+    near = _near_plane(nearest, fovy, far)
     for axis in np.array([[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]], dtype=np.float64):
         frame = ViewFrame(position, normal=-axis, up=_up_for(axis))
         cameras.append((Camera(frame, Perspective(fovy, near, far), size, size), 2.0 * math.tan(fovy / 2.0) / size))
     return cameras
+
+
+def _near_plane(nearest: float, fovy: float, far: float) -> float:
+    """The near plane of a square perspective map from a light `nearest` from the casters' box: every caster inside
+    the map's pyramid lies beyond it. A point at distance r from the light and angle θ off the map's axis lies at
+    depth r·cos θ, and θ reaches the pyramid's corner rays, $tan θ_max = √2 · tan(fovy / 2)$: so
+    $near = 0.99 · nearest / √(1 + 2 tan²(fovy / 2))$ (at least $10⁻³ · far$)."""
+    return max(0.99 * nearest / math.sqrt(1.0 + 2.0 * math.tan(fovy / 2.0) ** 2), 1e-3 * far)
 
 
 def _directional_camera(
