@@ -29,10 +29,12 @@ TEAPOT = DATA / "teapot_n10.obj"
 
 
 def _spot_glb(folder: Path) -> Path:
-    """Spot as a GLB with its texture embedded (base colour factor white, so the texture shows as it is)."""
+    """Spot as a GLB with its texture embedded (base colour factor white, so the texture shows as it is; a
+    dielectric: without a metallic factor glTF's default is a metal, dark without an environment)."""
     mesh = trimesh.load(SPOT, process=False)
     image = Image.open(TEXTURE)
-    material = trimesh.visual.material.PBRMaterial(baseColorTexture=image, baseColorFactor=[255, 255, 255, 255])
+    material = trimesh.visual.material.PBRMaterial(baseColorTexture=image, baseColorFactor=[255, 255, 255, 255],
+                                                   metallicFactor=0.0, roughnessFactor=0.6)  # fmt: skip
     mesh.visual = trimesh.visual.TextureVisuals(uv=mesh.visual.uv, material=material)
     path = folder / "spot.glb"
     mesh.export(path)
@@ -84,7 +86,9 @@ def test_gallery_of_real_files_rendered_with_no_options(tmp_path):
         lit = float(luminance[mask].mean())
         assert 0.25 <= lit <= 0.8, (name, lit)
         if name.startswith("spot"):  # the texture shows: its black patches and white hide both appear
-            dark = float((luminance[mask] < 0.12).mean())
+            # a glTF file is written sRGB-encoded (as glTF viewers show it), which lifts dark values: 0.12 → 0.38
+            dark_limit = 0.38 if scene_file.options.get("color_space") == "srgb" else 0.12
+            dark = float((luminance[mask] < dark_limit).mean())
             bright = float((luminance[mask] > 0.55).mean())
             assert dark > 0.03 and bright > 0.1, (name, dark, bright)
 

@@ -416,7 +416,7 @@ def info_command(
 def _turntable_task(mesh: Path, outputs: list[Path] | None, options: dict[str, Any]) -> list[str]:
     """One input of ``frustum turntable`` (several: ``frustum.app.many``): its ``wrote`` line."""
     from frustum.output.animation import framing_camera, turntable
-    from frustum.scenefile.models import model_scene
+    from frustum.scenefile.models import model_scene, physical_options
 
     assert outputs is not None
     output = outputs[0]
@@ -425,7 +425,8 @@ def _turntable_task(mesh: Path, outputs: list[Path] | None, options: dict[str, A
     scene, _ = model_scene(mesh, up=options["up"], size=(width, height))
     camera = framing_camera(scene, width, height, elevation=math.radians(options["elevation_deg"]))
     count = turntable(scene, camera, options["frames"], options["axis"], output, options["fps"],
-                      progress=options.get("progress", False), cull_back_faces=False, mode=options["mode"])  # fmt: skip
+                      progress=options.get("progress", False), cull_back_faces=False, mode=options["mode"],
+                      **physical_options(scene))  # fmt: skip
     return [f"wrote {output} ({count} frames, {width}x{height})"]
 
 

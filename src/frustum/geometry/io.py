@@ -72,14 +72,27 @@ class MeshPart(NamedTuple):
     """A glTF material's ``emissiveFactor`` (linear RGB), when not black: ``Material(emissive=)``."""
     alpha_mode: str | None = None
     """A glTF material's ``alphaMode`` ("OPAQUE", "MASK" or "BLEND"); None for other formats."""
+    metallic: float | None = None
+    """A glTF material's ``metallicFactor`` (None when the file gives none: the specification's default is 1)."""
+    roughness: float | None = None
+    """A glTF material's ``roughnessFactor`` (None when the file gives none: the specification's default is 1)."""
+    metallic_roughness_texture: NDArray[np.uint8] | None = None
+    """A glTF material's ``metallicRoughnessTexture`` as (H, W, 3) bytes: B metallic, G roughness."""
+    occlusion_texture: NDArray[np.uint8] | None = None
+    """A glTF material's ``occlusionTexture`` as (H, W, 3) bytes: R the occlusion."""
+    physical: bool = False
+    """Whether the file describes the material by glTF's metallic–roughness model (a glTF or GLB file)."""
 
     def __repr__(self) -> str:
         def image(array: Any) -> str:
             return "None" if array is None else f"<{'x'.join(map(str, np.shape(array)))} image>"
 
+        physical = (f", metallic={self.metallic!r}, roughness={self.roughness!r}, metallic_roughness_texture="
+                    f"{image(self.metallic_roughness_texture)}, occlusion_texture={image(self.occlusion_texture)}, "
+                    "physical=True") if self.physical else ""  # fmt: skip
         return (f"MeshPart(name={self.name!r}, mesh={self.mesh!r}, texture={image(self.texture)}, "
                 f"color={self.color!r}, normal_map={image(self.normal_map)}, emissive={self.emissive!r}, "
-                f"alpha_mode={self.alpha_mode!r})")  # fmt: skip
+                f"alpha_mode={self.alpha_mode!r}{physical})")  # fmt: skip
 
 
 def load(path: str | Path, texture: str | Path | None = None) -> Mesh:
@@ -158,7 +171,7 @@ def load_parts(path: str | Path, texture: str | Path | None = None) -> list[Mesh
     except Exception as error:  # trimesh raises many types (ValueError, KeyError, struct.error, ...)
         raise _read_error(file, error) from None
     try:
-        parts = scene_parts(scene)
+        parts = scene_parts(scene, file)
     except GeometryError as error:
         raise GeometryError(f"load: path = {str(file)!r} holds invalid geometry ({error}); check the file") from None
     except MemoryError:
@@ -172,10 +185,11 @@ def load_parts(path: str | Path, texture: str | Path | None = None) -> list[Mesh
     return _with_textures(parts, file, explicit)
 
 
-def scene_parts(scene: Any) -> list[MeshPart]:
+def scene_parts(scene: Any, file: Path | None = None) -> list[MeshPart]:
     """Every non-empty triangle mesh of a ``trimesh.Scene`` as a ``MeshPart``, placed by its graph node (world
     transform from one walk of the graph), sorted by node name: what ``load_parts`` returns for a file's scene and
-    ``Scene.from_trimesh`` for a scene in memory. Other geometry (point clouds, paths) is left out."""
+    ``Scene.from_trimesh`` for a scene in memory. Other geometry (point clouds, paths) is left out. The parts of a
+    glTF `file` carry its metallic–roughness materials (``MeshPart.physical``)."""
     import trimesh
 
     parts: list[MeshPart] = []
@@ -189,7 +203,7 @@ def scene_parts(scene: Any) -> list[MeshPart]:
         matrix = np.array(world_from_model, dtype=np.float64)
         emissive, alpha_mode = _emission_and_alpha(geometry)
         parts.append(MeshPart(str(node), mesh, matrix, image, color, _normal_texture(geometry), emissive,
-                              alpha_mode))  # fmt: skip
+                              alpha_mode, *_metallic_roughness(geometry, file)))  # fmt: skip
     return parts
 
 
@@ -221,8 +235,13 @@ def _native_parts(file: Path, text: bytes | None) -> list[MeshPart] | None:
             normal_map = None
             if part.normal_image is not None and part.uvs is not None:
                 normal_map = np.asarray(part.normal_image.convert("RGB"), dtype=np.uint8)
+            physical = [None, None]
+            for k, texture_image in enumerate((part.metallic_roughness_image, part.occlusion_image)):
+                if texture_image is not None and part.uvs is not None:
+                    physical[k] = np.asarray(texture_image.convert("RGB"), dtype=np.uint8)
             parts.append(MeshPart(part.name, mesh, np.asarray(part.world_from_model, dtype=np.float64), image, color,
-                                  normal_map, part.emissive, part.alpha_mode))  # fmt: skip
+                                  normal_map, part.emissive, part.alpha_mode, part.metallic, part.roughness,
+                                  *physical, file.suffix.lower() in (".glb", ".gltf")))  # fmt: skip
     except MemoryError:
         raise
     except Exception:  # invalid geometry or an unreadable image: trimesh's path says what is wrong
@@ -595,6 +614,24 @@ def _normal_texture(geometry: Any) -> NDArray[np.uint8] | None:
     if image is None or getattr(geometry.visual, "uv", None) is None:
         return None
     return np.asarray(image.convert("RGB"), dtype=np.uint8)
+
+
+def _metallic_roughness(geometry: Any, file: Path | None) -> tuple[Any, ...]:
+    """A glTF material's (metallicFactor, roughnessFactor, metallicRoughnessTexture, occlusionTexture, True), the
+    textures as (H, W, 3) bytes (None without UVs); (None, None, None, None, False) for other formats."""
+    if file is None or file.suffix.lower() not in (".glb", ".gltf"):
+        return None, None, None, None, False
+    material = getattr(geometry.visual, "material", None)
+    factors = []
+    for name in ("metallicFactor", "roughnessFactor"):
+        value = getattr(material, name, None)
+        factors.append(None if value is None else float(np.clip(float(value), 0.0, 1.0)))
+    images = []
+    for name in ("metallicRoughnessTexture", "occlusionTexture"):
+        image = getattr(material, name, None)
+        has_uvs = getattr(geometry.visual, "uv", None) is not None
+        images.append(None if image is None or not has_uvs else np.asarray(image.convert("RGB"), dtype=np.uint8))
+    return (*factors, *images, True)
 
 
 def _emission_and_alpha(geometry: Any) -> tuple[tuple[float, float, float] | None, str | None]:

@@ -17,6 +17,7 @@ files and every error message stay trimesh's (and ``load_parts``'s):
 - glTF 2.0 binary (GLB) and JSON (``.gltf``, buffers in files beside it or embedded as base64 data URIs):
   nodes without placements (no matrix or TRS: trimesh repairs those), one indexed triangle primitive per mesh
   with POSITION, NORMAL and TEXCOORD_0, materials' base colour factor and texture (an image in a buffer view),
+  metallic and roughness factors, metallic–roughness and occlusion textures,
   normal texture, emissive factor and alpha mode; no extensions, sparse accessors, vertex colours, skins,
   cameras or morph targets.
 """
@@ -52,6 +53,10 @@ class RawPart(NamedTuple):
     normal_image: Any = None
     emissive: tuple[float, float, float] | None = None
     alpha_mode: str | None = None
+    metallic: float | None = None
+    roughness: float | None = None
+    metallic_roughness_image: Any = None
+    occlusion_image: Any = None
 
 
 class UnsupportedError(Exception):
@@ -412,7 +417,10 @@ def _read_mtl(file: Path) -> dict[str, tuple[Any, tuple[float, float, float, flo
 # --- glTF ---------------------------------------------------------------------------------------------------
 
 _COMPONENTS = {5120: "i1", 5121: "u1", 5122: "i2", 5123: "u2", 5125: "u4", 5126: "f4"}
-_GLTF_MATERIAL_KEYS = {"name", "pbrMetallicRoughness", "normalTexture", "emissiveFactor", "alphaMode", "doubleSided"}
+_GLTF_MATERIAL_KEYS = {"name", "pbrMetallicRoughness", "normalTexture", "occlusionTexture", "emissiveFactor",
+                       "alphaMode", "doubleSided"}  # fmt: skip
+_GLTF_PBR_KEYS = {"baseColorFactor", "baseColorTexture", "metallicFactor", "roughnessFactor",
+                  "metallicRoughnessTexture"}  # fmt: skip
 _WIDTHS = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT4": 16}
 
 
@@ -521,13 +529,20 @@ def _gltf_part(gltf: dict[str, Any], primitive: dict[str, Any], name: str, acces
         uvs[:, 1] = 1.0 - uvs[:, 1]  # glTF's v runs down the image (flipped in float32, as trimesh does)
         uvs = uvs.astype(np.float64)
     image = color = normal_image = emissive = alpha_mode = None
+    metallic = roughness = metallic_roughness_image = occlusion_image = None
     if "material" in primitive:
         material = gltf["materials"][primitive["material"]]
         if material.get("extensions") or not set(material) <= _GLTF_MATERIAL_KEYS:
             raise UnsupportedError("material")
         pbr = material.get("pbrMetallicRoughness", {})
-        if not set(pbr) <= {"baseColorFactor", "baseColorTexture", "metallicFactor", "roughnessFactor"}:
+        if not set(pbr) <= _GLTF_PBR_KEYS:
             raise UnsupportedError("material")
+        metallic, roughness = (None if key not in pbr else float(np.clip(float(pbr[key]), 0.0, 1.0))
+                               for key in ("metallicFactor", "roughnessFactor"))  # fmt: skip
+        if "metallicRoughnessTexture" in pbr:
+            metallic_roughness_image = _gltf_image(gltf, pbr["metallicRoughnessTexture"], view_bytes)
+        if "occlusionTexture" in material:
+            occlusion_image = _gltf_image(gltf, material["occlusionTexture"], view_bytes)
         color = _gltf_color(pbr["baseColorFactor"]) if "baseColorFactor" in pbr else None
         if "baseColorTexture" in pbr:
             image = _gltf_image(gltf, pbr["baseColorTexture"], view_bytes)
@@ -538,7 +553,8 @@ def _gltf_part(gltf: dict[str, Any], primitive: dict[str, Any], name: str, acces
             emissive = tuple(float(c) for c in np.clip(rgb, 0.0, 1.0))
         alpha_mode = str(material["alphaMode"]).upper() if "alphaMode" in material else None
     return RawPart(name, vertices, faces, normals, uvs, _IDENTITY.copy(), image, color, normal_image,
-                   emissive, alpha_mode)  # type: ignore[arg-type]  # fmt: skip
+                   emissive, alpha_mode, metallic, roughness, metallic_roughness_image,
+                   occlusion_image)  # type: ignore[arg-type]  # fmt: skip
 
 
 def _gltf_color(factor: Any) -> tuple[float, float, float, float]:
@@ -551,7 +567,7 @@ def _gltf_color(factor: Any) -> tuple[float, float, float, float]:
 
 
 def _gltf_image(gltf: dict[str, Any], reference: dict[str, Any], view_bytes: Any) -> Any:
-    if set(reference) - {"index", "texCoord", "scale"} or reference.get("texCoord", 0) != 0:
+    if set(reference) - {"index", "texCoord", "scale", "strength"} or reference.get("texCoord", 0) != 0:
         raise UnsupportedError("texture reference")
     texture = gltf["textures"][reference["index"]]
     source = gltf["images"][texture["source"]]

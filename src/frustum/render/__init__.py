@@ -127,6 +127,8 @@ def render(
     shadows: bool | str | None = None,
     shadow_map_size: int = 2048,
     shadow_softness: float = 1.0,
+    tone_map: str = "none",
+    exposure: float = 1.0,
     next: tuple[Scene, Camera] | None = None,
 ) -> Frame:
     """Render `scene` seen by `camera` into a ``Frame`` (color (H, W, 4) uint8 and depth (H, W) float32).
@@ -137,10 +139,14 @@ def render(
         Placed meshes with materials and any number of lights (``frustum.shading``).
     camera : Camera
         Its width and height are the image size.
-    shading : {"phong", "gouraud", "flat", "normals", "depth", "none"} or None
+    shading : {"phong", "gouraud", "flat", "pbr", "normals", "depth", "none"} or None
         Where the illumination model is evaluated: per pixel, per vertex (interpolated), or per face
         (``raster/shade.py``); ``"normals"`` shows $0.5·N + 0.5$ of the world normal, ``"depth"`` the gray
         $(far − d)/(far − near)$ of the view distance; ``"none"`` (or None): the base color, no lighting.
+        ``"pbr"``: every item per pixel by glTF's metallic–roughness model (``frustum.shading.pbr``, lights in
+        glTF units, the scene's environment map as image-based light; a classical material by the mapping
+        there); with ``"phong"`` an item whose ``Material.model`` is ``"pbr"`` is shaded that way too.
+        docs/materials.md.
     specular : {"blinn-phong", "phong"}
         The specular term: (N·H)^n or (R·V)^n.
     background : (4,) array_like
@@ -223,6 +229,12 @@ def render(
     shadow_softness : float
         Percentage-closer filter width in texels, in [0, 16]; 0: hard edges; up to 1 (default): the 2 × 2 texels
         around the point, bilinearly weighted (``frustum.render.shadows.fractions``).
+    tone_map : {"none", "aces", "khronos-neutral"}
+        The metallic–roughness model's output transform after `exposure` and before `color_space`
+        (``frustum.shading.tone``): ``"none"`` (default: the radiance, clamped, as the classical model's), the
+        ACES filmic fit, or Khronos PBR Neutral. Classical items are not tone mapped.
+    exposure : float
+        Linear factor (> 0) on the metallic–roughness model's radiance before the tone map.
     next : (Scene, Camera) or None
         With ``"flow"`` in `buffers`: the scene and camera of the next frame (items matched by node path,
         ``Scene.item_paths``). Backward flow: swap the two frames.
@@ -248,6 +260,7 @@ def render(
         hidden_color=hidden_color, line_width=line_width, depth_cue=depth_cue, samples=samples, filter=filter,
         color_space=color_space, buffers=buffers, method=method, transparency=transparency, stats=stats,
         max_depth=max_depth, shadows=shadows, shadow_map_size=shadow_map_size, shadow_softness=shadow_softness,
+        tone_map=tone_map, exposure=exposure,
     )  # fmt: skip
     if options.factor == 1:
         frame = _draw(scene, camera, options).to_frame(options)

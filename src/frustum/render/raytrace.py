@@ -32,6 +32,13 @@ is black), and rays whose weight is below ``MIN_WEIGHT`` are not traced. The nor
 is the interpolated (shading) normal; rays start $ε$ (1e-9 of the scene's size) off the surface along the
 geometric normal, on the side they leave to, so that they do not meet it again.
 
+An item the metallic–roughness model shades (``render(shading="pbr")``, or a ``Material(model="pbr")``:
+``frustum.render.pbr.applies``) gets that model's local color instead: the same BRDF, light units and
+image-based light as the depth buffer's (``frustum.shading.pbr``, ``frustum.shading.ibl``, NumPy here), each
+positioned light's term multiplied by its shadow ray's visibility, then exposure and the tone map; a rough metal
+thus reflects the environment's prefiltered light and a metal of roughness 0 the map itself (mirror rays of
+other surfaces are traced for ``Material.reflectivity`` only).
+
 The depth buffer receives the window depth of each primary hit, so volumes and particles are composited along
 the primary rays exactly as with ``method="ray-casting"``; ``buffers=("normals", "object_id")`` show the primary
 hit's. Surface textures are not sampled by this method (the base color is the material's and the vertex
@@ -106,8 +113,9 @@ class _Scene:
     """What the tracer reads of a scene, gathered once: the ray index, per-item material arrays, world vertex
     normals and colors with faces in global vertex numbers, and the lights."""
 
-    def __init__(self, scene: Scene, specular_phong: bool, shadows: bool) -> None:
+    def __init__(self, scene: Scene, specular_phong: bool, shadows: bool, options: RenderOptions | None = None) -> None:
         found = scene._triangle_index(where="render")
+        self.options = options
         self.empty = found is None
         self.lights = scene.world_lights()
         self.ambient, _ = pack_lights(self.lights)
@@ -125,6 +133,15 @@ class _Scene:
         self.reflectivity = np.array([m.reflectivity for m in materials], dtype=np.float64)
         self.opacity = np.array([m.opacity for m in materials], dtype=np.float64)
         self.ior = np.array([m.ior for m in materials], dtype=np.float64)
+        self.physical = np.zeros(len(materials), dtype=bool)
+        if options is not None:  # the metallic–roughness model for the items it shades (render.pbr.applies)
+            from frustum.render.pbr import applies
+            from frustum.shading.pbr import phong_roughness
+
+            self.physical = np.array([applies(item, options) for item in items], dtype=bool)
+            self.metallic = np.array([m.metallic for m in materials], dtype=np.float64)
+            self.roughness = np.array([m.roughness if m.model == "pbr" else phong_roughness(m.shininess)
+                                       for m in materials], dtype=np.float64)  # fmt: skip
         normals, faces, colors, offset = [], [], [], 0
         any_colors = any(item.mesh.vertex_colors is not None for item in items)
         for item in items:
@@ -204,6 +221,8 @@ def _local(data: _Scene, hit: _Hits, counts: dict, record: list | None, parents:
     specular_sum = np.zeros_like(diffuse_sum)
     n = hit.normal
     view = -hit.incoming
+    physical = data.physical[k]
+    direct = np.zeros((int(physical.sum()), 3))  # the metallic–roughness model's direct light (shading.pbr)
     for number, light in data.positioned:
         intensity = np.asarray(light.color, dtype=np.float64) * light.intensity
         to_light, falloff = toward_light(light, hit.point)  # the light model's attenuation and spot cone
@@ -230,7 +249,51 @@ def _local(data: _Scene, hit: _Hits, counts: dict, record: list | None, parents:
         shade = np.where(lit, falloff * ndl, 0.0)
         diffuse_sum = diffuse_sum + (kd * shade)[:, None] * intensity
         specular_sum = specular_sum + (ks * falloff * spec)[:, None] * intensity
-    return np.clip(base * diffuse_sum + specular_sum + data.emissive[k], 0.0, 1.0)
+        if direct.shape[0]:
+            direct += _physical_light(data, light, hit, physical, base, to_light, lit) * intensity
+    color = np.clip(base * diffuse_sum + specular_sum + data.emissive[k], 0.0, 1.0)
+    if direct.shape[0]:
+        color[physical] = _physical_color(data, hit, physical, base, direct)
+    return color
+
+
+def _physical_light(data: _Scene, light: Any, hit: _Hits, physical: np.ndarray, base: np.ndarray,
+                    to_light: np.ndarray, lit: np.ndarray) -> np.ndarray:  # fmt: skip
+    """$f(l, v)·E·(n·l)$ per unit light intensity at the physical hits (``shading.pbr``: lux, or candela over d²
+    with the range window and the squared spot cone), 0 where the light is hidden."""
+    from frustum.shading import pbr
+
+    k = hit.item[physical]
+    point, n, l = hit.point[physical], hit.normal[physical], np.asarray(to_light)[physical]  # noqa: E741
+    illuminance = np.ones(point.shape[0])
+    if not isinstance(light, DirectionalLight):
+        offset = np.asarray(light.position, dtype=np.float64) - point
+        d2 = np.einsum("ij,ij->i", offset, offset)
+        illuminance = pbr.range_window(np.sqrt(d2), light.range or 0.0) / np.maximum(d2, 1e-300)
+        if isinstance(light, SpotLight):
+            cos_alpha = -(l @ np.asarray(light.direction, dtype=np.float64))
+            illuminance *= pbr.spot_cone(cos_alpha, math.cos(light.inner_angle), math.cos(light.outer_angle))
+    f = pbr.brdf(n, l, -hit.incoming[physical], base[physical], data.metallic[k], data.roughness[k])
+    cosine = np.maximum(np.einsum("ij,ij->i", n, l), 0.0)
+    return f * np.where(lit[physical], illuminance * cosine, 0.0)[:, None]
+
+
+def _physical_color(data: _Scene, hit: _Hits, physical: np.ndarray, base: np.ndarray,
+                    direct: np.ndarray) -> np.ndarray:  # fmt: skip
+    """The physical hits' display values: direct light, image-based and ambient light (``shading.ibl``) and
+    emission, then exposure and the tone map (``shading.tone``)."""
+    from frustum.render.pbr import image_light
+    from frustum.shading.ibl import ImageLighting, image_radiance
+    from frustum.shading.tone import TONE_MAPS, tone_map
+
+    options = data.options
+    k = hit.item[physical]
+    sh, maps, table, lit = image_light(options)
+    lighting = ImageLighting(sh, maps, table) if lit else None
+    indirect = image_radiance(lighting, options.physical_ambient, hit.normal[physical], -hit.incoming[physical],
+                              base[physical], data.metallic[k], data.roughness[k])  # fmt: skip
+    name = {code: name for name, code in TONE_MAPS.items()}[options.tone_map]
+    return tone_map(direct + indirect + data.emissive[k], name, options.exposure)
 
 
 def _primary(camera: Camera, rows: np.ndarray, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
@@ -368,7 +431,7 @@ def draw_surfaces(scene: Scene, camera: Camera, options: RenderOptions, context:
     reflections, the deepest level reached."""
     height, width = camera.height, camera.width
     counts = context.counter()
-    data = _Scene(scene, _is_phong(options), options.shadows)
+    data = _Scene(scene, _is_phong(options), options.shadows, options)
     _check_work(camera, data, options.max_depth, "render")
     context.depth = depth = np.ones((height, width), dtype=np.float32)
     context.color = color = np.empty((height, width, 4), dtype=np.uint8)

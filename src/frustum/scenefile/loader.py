@@ -386,7 +386,8 @@ def _build(report: _Report, data: dict, base: Path, check_outputs: bool = True) 
     else:
         report.missing(("camera",), "add a [camera] table with eye and target (or [[cameras]])")
     if cameras and _wants_default_lights(data, scene, options):
-        for light in default_lights(cameras[0]):  # no lights named: the default three-point set around the camera
+        physical = any(item.material.model == "pbr" for item in scene.items)  # lights in lux for those materials
+        for light in default_lights(cameras[0], physical):  # no lights named: the three-point set around the camera
             scene.root.add_light(light)
     outputs, animation, svg = _outputs(report, data, base, check_outputs)
     _check_image_memory(report, options, size, max(len(cameras), 1))
@@ -496,7 +497,8 @@ MODEL_SUFFIXES = (".obj", ".stl", ".ply", ".off", ".gltf", ".glb")
 
 
 def _model_scene_file(file: Path, up: str) -> SceneFile:
-    from frustum.scenefile.models import model_scene
+    from frustum.scenefile.models import model_scene, physical_options
 
     scene, camera = model_scene(file, up=up, size=_DEFAULT_SIZE)
-    return SceneFile(scene, camera, {}, (), (camera,), size=_DEFAULT_SIZE, title=file.stem, path=file, up=up)
+    return SceneFile(scene, camera, physical_options(scene), (), (camera,), size=_DEFAULT_SIZE, title=file.stem,
+                     path=file, up=up)  # fmt: skip
