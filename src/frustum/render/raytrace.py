@@ -55,6 +55,7 @@ Model for Shaded Display", CACM 23(6), 1980.
 
 from __future__ import annotations
 
+import math
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -66,7 +67,7 @@ from frustum.errors import FrustumError
 from frustum.render.context import FrameContext
 from frustum.render.options import RenderOptions
 from frustum.scene import Scene
-from frustum.shading import AmbientLight, DirectionalLight, pack_lights
+from frustum.shading import AmbientLight, DirectionalLight, SpotLight, pack_lights
 from frustum.shading.light import specular_terms, toward_light
 
 __all__ = ["MIN_WEIGHT", "RaySegment", "draw_surfaces", "ray_path"]
