@@ -200,8 +200,8 @@ def test_load_scene_takes_a_path_of_either_kind_and_still_takes_toml_text(tmp_pa
     assert load_scene(str(BUNNY)).scene.items[0].mesh.vertex_count == model.scene.items[0].mesh.vertex_count
     toml = f'[camera]\neye = [0, 0, 1]\n[[nodes]]\ngeometry = {{ type = "mesh", path = "{BUNNY.resolve()}" }}\n'
     (tmp_path / "s.toml").write_text(toml)
-    from_text = load_scene(toml)
-    from_file = load_scene(tmp_path / "s.toml")
+    from_text = load_scene(toml, allow_read=[BUNNY.parent])  # an absolute path outside the folder: allowed by name
+    from_file = load_scene(tmp_path / "s.toml", allow_read=[BUNNY.parent])
     assert from_text.scene.items[0].mesh.vertex_count == from_file.scene.items[0].mesh.vertex_count
     with pytest.raises(SceneFileError, match="up"):
         load_scene_file(BUNNY, up="x")
@@ -283,15 +283,17 @@ def test_scene_file_meshes_bring_their_materials_and_textures(tmp_path):
     obj = _spot_with_mtl(tmp_path)
     glb = _spot_glb(tmp_path)
     for path in (obj, glb):
-        scene_file = load_scene(f'[camera]\nfit = true\n[[nodes]]\ngeometry = {{ type = "mesh", path = "{path}" }}\n')
+        scene_file = load_scene(f'[camera]\nfit = true\n[[nodes]]\ngeometry = {{ type = "mesh", path = "{path}" }}\n',
+                                allow_read=[tmp_path])  # fmt: skip
         item = scene_file.scene.items[0]
         assert item.material.texture is not None and item.material.texture.shape[:2] == (1024, 1024)
         mask, luminance = _model_pixels(scene_file.render())
         assert (luminance[mask] < 0.12).mean() > 0.03 and (luminance[mask] > 0.55).mean() > 0.1
     mine = load_scene(f'[camera]\nfit = true\n[[nodes]]\nmaterial = {{ color = [1, 0, 0] }}\n'
-                      f'geometry = {{ type = "mesh", path = "{obj}" }}\n')  # fmt: skip
+                      f'geometry = {{ type = "mesh", path = "{obj}" }}\n', allow_read=[tmp_path])  # fmt: skip
     assert mine.scene.items[0].material.texture is None  # the node's own material wins
-    plain = load_scene(f'[camera]\nfit = true\n[[nodes]]\ngeometry = {{ type = "mesh", path = "{BUNNY}" }}\n')
+    plain = load_scene(f'[camera]\nfit = true\n[[nodes]]\ngeometry = {{ type = "mesh", path = "{BUNNY}" }}\n',
+                       allow_read=[BUNNY.parent])  # fmt: skip
     assert plain.scene.root.children[0].material is None  # nothing in the file: the default Material, as before
 
 
