@@ -1,7 +1,12 @@
 """Benchmark: ``frustum.render`` against Mesa llvmpipe (moderngl, EGL) on the standard scenes, in one run.
 
     python benchmarks/bench_render.py [--scenes NAME ...] [--frames 10] [--warmup 2] [--threads N]
-                                      [--scene-dir DIR] [--skip-llvmpipe] [--save DIR] [--json PATH]
+                                      [--scene-dir DIR] [--skip-llvmpipe] [--save DIR] [--json PATH] [--pbr]
+
+``--pbr`` (issue 46) also renders each scene with ``shading="pbr"`` (the scene's base colour as a metallic 0.6,
+roughness 0.45 material, its light as 3 lux, a sky environment map as image-based light) against llvmpipe running a
+standard glTF PBR fragment shader with the same BRDF, a prefiltered cube map and the split-sum table
+(``anchor_moderngl_pbr.py``), and prints the ratio and the PBR frame over frustum's own Phong frame.
 
 Each scene and each renderer runs in its own child process, so peak RSS (``ru_maxrss`` read in the child) is per
 scene and renderer and includes loading the scene. llvmpipe runs through the shared anchor
@@ -131,6 +136,12 @@ def frustum_child(name: str, args: argparse.Namespace) -> dict:
 
     options = dict(shading="phong", background=background, cull_back_faces=True)
     options.update(_parse_variant(args.child_variant))
+    if options["shading"] == "pbr":  # --pbr: the PBR anchor's material, light (lux) and environment
+        from anchor_moderngl_pbr import LIGHT_LUX, PBR_MATERIAL, bench_environment
+
+        scene = frustum.Scene(lights=[frustum.DirectionalLight(light.direction, intensity=LIGHT_LUX)],
+                              environment=bench_environment())  # fmt: skip
+        scene.add(mesh, material=material.with_(model="pbr", **PBR_MATERIAL))
 
     def frame_once():
         frame = frustum.render(scene, camera, **options)
@@ -273,6 +284,41 @@ def run_llvmpipe(name: str, frames: int, args: argparse.Namespace, env: dict, wo
     return result
 
 
+PBR_ANCHOR = Path(__file__).resolve().parent / "anchor_moderngl_pbr.py"
+PBR_TARGET = 0.7
+"""Issue 46: frustum's shading="pbr" frame (one directional light + IBL) / llvmpipe's glTF PBR shader frame."""
+
+
+def run_pbr(name: str, frames: int, args: argparse.Namespace, env: dict, work: Path, both: bool,
+            phong: dict | None) -> dict:  # fmt: skip
+    """frustum with ``shading="pbr"`` and the PBR anchor on one scene; prints both medians and the ratios."""
+    result: dict = {}
+    try:
+        result["frustum_ms"] = run_frustum(name, frames, args, env, work, "shading=pbr")["frame_ms"]
+        if both:
+            proc = subprocess.run(
+                [sys.executable, str(PBR_ANCHOR), "--scene", str(Path(args.scene_dir) / f"{name}.npz"),
+                 "--frames", str(frames), "--warmup", str(args.warmup)],
+                capture_output=True, text=True, env=env, timeout=args.timeout,
+            )  # fmt: skip
+            if proc.returncode != 0:
+                raise RuntimeError(f"PBR anchor failed: {(proc.stdout + proc.stderr)[-1500:]}")
+            result["llvmpipe_ms"] = json.loads(proc.stdout.strip().splitlines()[-1])["frame_ms"]
+    except (RuntimeError, subprocess.TimeoutExpired) as exc:
+        print(f"{name}: pbr failed: {exc}", flush=True)
+        return result
+    line = f"{name:20s} pbr       frame {result['frustum_ms']:8.1f} ms"
+    if "llvmpipe_ms" in result:
+        result["ratio"] = result["frustum_ms"] / result["llvmpipe_ms"]
+        line += (f"  llvmpipe glTF PBR {result['llvmpipe_ms']:8.1f} ms  ratio {result['ratio']:.2f} "
+                 f"(target <= {PBR_TARGET})")  # fmt: skip
+    if phong:
+        result["over_phong"] = result["frustum_ms"] / phong["frame_ms"]
+        line += f"  {result['over_phong']:.2f}x frustum phong (target <= 1.5)"
+    print(line, flush=True)
+    return result
+
+
 def run_frustum(name: str, frames: int, args: argparse.Namespace, env: dict, work: Path, variant: str = "") -> dict:
     cmd = [
         sys.executable, os.path.abspath(__file__), "--child-frustum", name, "--frames", str(frames),
@@ -391,6 +437,8 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     parser.add_argument("--child-frustum", default=None, help=argparse.SUPPRESS)
     parser.add_argument("--child-out", default=None, help=argparse.SUPPRESS)
     parser.add_argument("--child-variant", default="", help=argparse.SUPPRESS)
+    parser.add_argument("--pbr", action="store_true",
+                        help="also shading=pbr (one light + image-based light) against the PBR anchor (issue 46)")
     parser.add_argument(
         "--variants", nargs="*", default=[],
         help="extra frustum runs per scene, e.g. shading=gouraud mode=hidden-line samples=4 (timed only)",
@@ -482,6 +530,8 @@ def main(argv: list[str] | None = None) -> int:
                 slower = f" ({v['frame_ms'] / f['frame_ms']:.2f}x phong)" if f else ""
                 print(f"{name:20s} {variant:24s} frame {v['frame_ms']:8.1f} ms{ratio}{slower}", flush=True)
                 row.setdefault("variants", {})[variant] = {k: v[k] for k in ("frame_ms", "peak_rss_mb")}
+            if args.pbr:
+                row["pbr"] = run_pbr(name, frames, args, env, work, do_llvmpipe and do_frustum, f)
             if args.save:
                 for label in ("frustum", "llvmpipe"):
                     if row.get(label):

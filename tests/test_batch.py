@@ -391,7 +391,15 @@ def ray_cluster():
     ray = pytest.importorskip("ray")
     for attempt in range(3):  # a loaded machine can miss the 30 s Ray gives its raylet to register
         try:
-            ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False, configure_logging=False)
+            # address="local": a cluster of its own, never one found on the machine (RAY_ADDRESS, a running
+            # `ray start` or a stale ray_current_cluster file), whose num_cpus could not be set
+            saved = os.environ.pop("RAY_ADDRESS", None)  # Ray reads it even for address="local"
+            try:
+                ray.init(address="local", num_cpus=2, include_dashboard=False, log_to_driver=False,
+                         configure_logging=False)  # fmt: skip
+            finally:
+                if saved is not None:
+                    os.environ["RAY_ADDRESS"] = saved
             break
         except Exception:
             ray.shutdown()

@@ -34,7 +34,7 @@ from frustum import (
     torus,
     translate,
 )
-from frustum.geometry.fractals import _menger_cells
+from frustum.geometry.fractals.solids import _menger_cells
 from frustum.geometry.octree import TEXTBOOK_OCTANTS, morton_decode, morton_encode
 from testdata import DATA
 

@@ -404,3 +404,134 @@ def test_bad_ray_input() -> None:
         scene.occluded(np.zeros(3), [0.0, 0.0, 1.0], [1.0, 2.0])
     with pytest.raises(FrustumError, match="t_max = 'far' is not a number"):
         scene.occluded(np.zeros(3), [0.0, 0.0, 1.0], "far")
+    with pytest.raises(FrustumError, match=r"fields has 'normals'; expected names from \('t', 'item'"):
+        scene.intersect(np.zeros(3), [0.0, 0.0, 1.0], fields=("t", "normals"))
+    with pytest.raises(FrustumError, match=r"fields = .* is not a non-empty list"):
+        scene.intersect(np.zeros(3), [0.0, 0.0, 1.0], fields=[])
+
+
+def test_intersect_field_subsets_equal_the_full_columns() -> None:
+    """``fields=`` computes the columns asked for, each equal to the full call's (NaN where it is NaN), the
+    others None; and the shading normals equal the textbook blend $(M₃⁻¹)ᵀ·Σ wᵢ·Nᵢ$, normalized."""
+    scene = two_item_scene()
+    rng = np.random.default_rng(2)
+    origins = rng.uniform(-3.0, 3.0, (3000, 3)) * [1.0, 1.0, 0.2] + [0.0, 0.0, 4.0]
+    origins[::4] = rng.uniform(-1.0, 1.0, (750, 3)) * 0.3 + [-1.5, 0.0, 0.0]  # inside a sphere: its back
+    directions = rng.uniform(-1.0, 1.0, (3000, 3)) * [2.5, 1.2, 1.0] - origins
+    full = scene.intersect(origins, directions)
+    assert 0.1 < (full.item >= 0).mean() < 0.9 and full.back.dtype == bool
+    for fields in (("t", "item", "face"), ("point",), ("shading_normal", "back"), ("barycentrics", "normal"),
+                   ("face", "t"), "item"):  # fmt: skip
+        subset = scene.intersect(origins, directions, fields=fields)
+        names = (fields,) if isinstance(fields, str) else fields
+        for name in RayHits._fields:
+            if name in names:
+                np.testing.assert_array_equal(getattr(subset, name), getattr(full, name))
+            else:
+                assert getattr(subset, name) is None
+    items = scene.items
+    rows = np.flatnonzero(full.item >= 0)
+    for r in rows[:200]:
+        item = items[full.item[r]]
+        corners = item.mesh.faces[full.face[r]]
+        blended = full.barycentrics[r] @ item.mesh.vertex_normals[corners]
+        expected = blended @ np.linalg.inv(np.asarray(item.world_from_model)[:3, :3])
+        np.testing.assert_allclose(full.shading_normal[r], expected / np.linalg.norm(expected), atol=1e-12)
+    empty = Scene().intersect(origins[:3], directions[:3], fields=("t", "back"))
+    assert empty.t.tolist() == [np.inf] * 3 and empty.back.tolist() == [False] * 3 and empty.item is None
+
+
+def binary_hits(index: rays.Index, origins: np.ndarray, directions: np.ndarray, skip: np.ndarray | None = None,
+                cull: bool = False, t_min: float = 0.0, t_max: float = np.inf) -> np.ndarray:  # fmt: skip
+    """(N, 5) t, row, u, v, back of each ray by the binary tree's traversal (``rays._closest``, which
+    ``cast_pixels`` and the step-by-step view use), one ray at a time."""
+    stack, entry = np.empty(index.depth + 2, dtype=np.int64), np.empty(index.depth + 2)
+    mask = np.empty(0, dtype=np.uint8) if skip is None else skip
+    return np.array([rays._closest(index.boxes, index.links, index.triangles, index.order, mask, *o, *d, t_min, t_max,
+                                   int(cull), stack, entry)[:5] for o, d in zip(origins, directions, strict=True)])
+
+
+def assert_wide_equals_binary(index: rays.Index, origins: np.ndarray, directions: np.ndarray, **options) -> None:
+    wide = rays.closest_hits(index, origins, directions, options.get("t_min", 0.0), options.get("t_max", np.inf),
+                             options.get("skip"), options.get("cull", False))  # fmt: skip
+    binary = binary_hits(index, origins, directions, **options)
+    assert np.array_equal(wide.t, binary[:, 0])  # the same bits
+    assert np.array_equal(wide.row, binary[:, 1].astype(np.int64))
+    assert np.array_equal(wide.uv, binary[:, 2:4]) and np.array_equal(wide.back, binary[:, 4].astype(np.uint8))
+
+
+def test_wide_traversal_gives_the_binary_traversals_hits_to_the_byte() -> None:
+    """The four-wide tree's traversal (boxes four at a time, children sorted by entry) and the binary tree's
+    (the nearer child first) find the same hit, bit for bit, with masks, culling and t ranges; the wide tree
+    holds every triangle once and its boxes contain their children's."""
+    rng = np.random.default_rng(9)
+    tri = bunny_triangles()
+    index = rays.build(tri)
+    corners = tri.reshape(-1, 3)
+    centre = 0.5 * (corners.min(axis=0) + corners.max(axis=0))
+    radius = float(np.abs(corners - centre).max())
+    o, d = camera_rays(centre, radius, 40, rng)
+    assert_wide_equals_binary(index, o, d)
+    o, d = inside_rays(centre, radius, 1500, rng)
+    assert_wide_equals_binary(index, o, d)
+    skip = (rng.random(tri.shape[0]) < 0.3).astype(np.uint8)
+    assert_wide_equals_binary(index, o, d, skip=skip, cull=True, t_min=0.01 * radius, t_max=0.5 * radius)
+    faces = rng.integers(0, tri.shape[0], 1500)  # through the corners and edges of faces: ties
+    point = tri[faces, rng.integers(0, 3, 1500)] * 0.5 + tri[faces, rng.integers(0, 3, 1500)] * 0.5
+    d = f32(rng.normal(size=(1500, 3)))
+    assert_wide_equals_binary(index, f32(point - d), d)
+    links = index.wide_links
+    leaves = links[links < 0]
+    codes = ~leaves
+    assert np.sort(np.concatenate([np.arange(c >> 3, (c >> 3) + (c & 7)) for c in codes])).tolist() == list(
+        range(tri.shape[0]))
+    for node in range(links.shape[0]):  # children inside their parent's slot of the node above
+        for c in range(rays.WIDTH):
+            child = links[node, c]
+            if child >= 0:
+                inner = index.wide_boxes[child]
+                assert (inner[:3].min(axis=1) >= index.wide_boxes[node, :3, c]).all()
+                assert (inner[3:].max(axis=1) <= index.wide_boxes[node, 3:, c]).all()
+
+
+@settings(max_examples=20, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), count=st.integers(1, 400), spread=st.floats(0.01, 3.0))
+def test_wide_traversal_equals_binary_on_soups(seed: int, count: int, spread: float) -> None:
+    rng = np.random.default_rng(seed)
+    tri = f32(rng.uniform(-1.0, 1.0, (count, 1, 3)) + rng.normal(size=(count, 3, 3)) * spread * 0.3)
+    if rng.random() < 0.3:  # coincident triangles: every tie
+        tri = np.repeat(tri[:1], count, axis=0)
+    index = rays.build(tri)
+    origins, directions = f32(rng.uniform(-3.0, 3.0, (300, 3))), f32(rng.normal(size=(300, 3)))
+    directions[::7, rng.integers(0, 3)] = 0.0  # axis-parallel rays: infinite inverse directions
+    assert_wide_equals_binary(index, origins, directions)
+    t_max = f32(rng.uniform(0.0, 4.0, 300))
+    assert np.array_equal(rays.any_hits(index, origins, directions, 0.0, t_max),
+                          rays.closest_hits(index, origins, directions).t < t_max)  # fmt: skip
+
+
+def test_vector_slab_test_equals_the_scalar_one() -> None:
+    """``_slab4``'s LLVM vector code gives the bytes of its scalar form (``_slab4_scalar``), empty slots, rays
+    parallel to a slab (an infinite inverse) and origins on a box's plane (0·∞ = NaN) included."""
+    from numba import njit
+
+    @njit
+    def vector(boxes, node, nx, ny, nz, ox, oy, oz, ix, iy, iz, t_min, reach, near):
+        rays._slab4(boxes, node, nx, ny, nz, ox, oy, oz, ix, iy, iz, t_min, reach, near)
+
+    rng = np.random.default_rng(4)
+    low = rng.integers(-4, 4, (50, 3, 4)).astype(np.float32)
+    boxes = np.concatenate([low, low + rng.integers(0, 3, (50, 3, 4))], axis=1)
+    boxes[::5, :3, 1], boxes[::5, 3:, 1] = np.inf, -np.inf  # an empty slot
+    for _ in range(2000):
+        node = int(rng.integers(0, 50))
+        o = rng.integers(-5, 5, 3).astype(np.float64) + rng.choice([0.0, 0.5], 3)
+        inverse = np.where(rng.random(3) < 0.2, np.inf, rng.normal(size=3))
+        inverse = np.where(rng.random(3) < 0.5, inverse, -inverse)
+        rows = [a if inverse[a] >= 0.0 else a + 3 for a in range(3)]
+        reach = float(rng.choice([np.inf, 3.0, 0.5]))
+        ours, theirs = np.empty(4), np.empty(4)
+        vector(boxes, node, *rows, *o, *inverse, 0.0, reach, ours)
+        with np.errstate(invalid="ignore"):  # 0·∞
+            rays._slab4_scalar(boxes, node, *rows, *o, *inverse, 0.0, reach, theirs)
+        assert np.array_equal(ours, theirs, equal_nan=True)

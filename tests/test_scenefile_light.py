@@ -69,7 +69,7 @@ geometry = { type = "plane", size = [2, 2] }
         ('[materials.m]\nreflectivity = 2.0', "reflectivity"),
         ('[materials.m]\nemission = -1.0', "emission"),
         ('[environment]\nkind = "cube"', "image is missing"),
-        ('[environment]\nimage = "nowhere.hdr"', "is not an image file"),
+        ('[environment]\nimage = "nowhere.hdr"', "does not exist"),
         ("[radiosity]\npatches = 3", "patches"),
         ("[radiosity]\npatch_size = -1", "is not a positive number"),
     ],

@@ -54,7 +54,7 @@ def test_cohen_sutherland_steps_end_in_clip_lines_result(p0, p1):
 def test_liang_barsky_twin_equals_the_kernel_bit_for_bit(p0, p1):
     recorded = fs.liang_barsky(p0, p1)
     assert _same_segment(recorded.result, clip_line(p0, p1))  # the compiled kernel
-    from frustum.clipping import _liang_barsky
+    from frustum.clipping.lines import _liang_barsky
     from frustum.raster.clip import clip_segment
 
     start, end = np.array(p0, float), np.array(p1, float)

@@ -88,6 +88,7 @@ from .errors import (
     CameraError as CameraError,
     ClippingError as ClippingError,
     FrustumError as FrustumError,
+    FrustumWarning as FrustumWarning,
     GeometryError as GeometryError,
     OutputError as OutputError,
     SceneFileError as SceneFileError,

@@ -122,6 +122,8 @@ def budget(bytes: Any = None, operations: Any = None) -> Iterator[Budget]:
 def format_bytes(nbytes: float) -> str:
     """Bytes as a short human text: ``'1.5 GiB'``."""
     size = float(nbytes)
+    if size >= 2.0**60:  # an estimate made in log space can be astronomically large
+        return f"{size / 2.0**50:.3g} PiB"
     for unit in ("B", "KiB", "MiB", "GiB", "TiB", "PiB"):
         if size < 1024.0 or unit == "PiB":
             return f"{int(size)} B" if unit == "B" else f"{size:.1f} {unit}"

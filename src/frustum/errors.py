@@ -11,6 +11,7 @@ __all__ = [
     "CameraError",
     "ClippingError",
     "FrustumError",
+    "FrustumWarning",
     "GeometryError",
     "OutputError",
     "SceneFileError",
@@ -54,3 +55,8 @@ class OutputError(FrustumError):
 
 class SimulationError(FrustumError):
     """A bad particle or mass-spring system, or a simulation whose state stopped being finite (a blow-up)."""
+
+
+class FrustumWarning(UserWarning):
+    """Something frustum went on without and says so: a texture a mesh file names that cannot be read, for one
+    (``warnings.filterwarnings("error", category=FrustumWarning)`` turns these into errors)."""

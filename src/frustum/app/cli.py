@@ -9,7 +9,8 @@ normals, ids and cameras). Errors print as one line, ``error: <message>``,
 without a traceback (the global ``--debug`` option shows it): exit status 1 for a bad value or an unreadable
 file, 2 for a command line that cannot be parsed (unknown option, missing argument, malformed numbers), 130
 after Ctrl-C (honoured at once: the work runs on a worker thread; no partial output file is left). The global
-options ``--max-bytes`` and ``--max-operations`` set the work budget (``frustum.set_budget``).
+options ``--max-bytes`` and ``--max-operations`` set the work budget (``frustum.set_budget``); ``--allow-read PATH``
+(repeatable) lets scene files read meshes and images in a folder outside their own (``FRUSTUM_ALLOW_READ``).
 """
 
 from __future__ import annotations
@@ -157,9 +158,22 @@ def _main(
         typer.Option("--max-operations", help="Work budget of one request in inner iterations, e.g. 1e11 "
                      "(default 5e10; env FRUSTUM_MAX_OPERATIONS).", metavar="COUNT"),
     ] = None,
+    allow_read: Annotated[
+        list[Path] | None,
+        typer.Option("--allow-read", help="A folder outside a scene file's own whose meshes and images it may read "
+                     "(repeatable; env FRUSTUM_ALLOW_READ).", metavar="PATH"),
+    ] = None,
 ) -> None:
     """The classical 3D graphics pipeline, inspectable at every stage."""
     _STATE["debug"] = debug
+    if allow_read:  # through the environment: worker processes and every command's loader see the same rule
+        import os
+
+        from frustum.scenefile import ALLOW_READ_VARIABLE
+
+        folders = [str(path.resolve()) for path in allow_read]
+        previous = os.environ.get(ALLOW_READ_VARIABLE)
+        os.environ[ALLOW_READ_VARIABLE] = os.pathsep.join(folders + ([previous] if previous else []))
     if max_bytes is not None or max_operations is not None:
         from frustum.budgets import set_budget
 
@@ -405,7 +419,7 @@ def _turntable_task(mesh: Path, outputs: list[Path] | None, options: dict[str, A
     """One input of ``frustum turntable`` (several: ``frustum.app.many``): its ``wrote`` line."""
     from frustum.geometry.points import point_file_kind
     from frustum.output.animation import framing_camera, turntable
-    from frustum.scenefile.models import model_options, model_scene
+    from frustum.scenefile.models import model_options, model_scene, physical_options
 
     assert outputs is not None
     output = outputs[0]
@@ -416,7 +430,7 @@ def _turntable_task(mesh: Path, outputs: list[Path] | None, options: dict[str, A
     camera = framing_camera(scene, width, height, elevation=math.radians(options["elevation_deg"]))
     count = turntable(scene, camera, options["frames"], options["axis"], output, options["fps"],
                       progress=options.get("progress", False), cull_back_faces=False, mode=options["mode"],
-                      **model_options(scene))  # fmt: skip
+                      **model_options(scene), **physical_options(scene))  # fmt: skip
     return [f"wrote {output} ({count} frames, {width}x{height})"]
 
 
@@ -808,7 +822,9 @@ def radiosity_command(
     for name, value in (("patch_size", patch_size), ("hemicube", hemicube), ("tolerance", tolerance)):
         if value is not None:
             settings[name] = value
-    goal = -math.log10(float(settings.get("tolerance", 1e-3)))
+    tolerance_value = settings.get("tolerance", 1e-3)
+    # the progress bar's goal; a tolerance outside (0, 1) is left for radiosity() to refuse with its message
+    goal = -math.log10(tolerance_value) if isinstance(tolerance_value, float | int) and 0 < tolerance_value < 1 else 3.0
     columns = (TextColumn("radiosity"), BarColumn(), TextColumn("{task.fields[shots]} shots, residual "
                "{task.fields[residual]:.1e}"), TimeElapsedColumn())  # fmt: skip
     with Progress(*columns, console=error_console, transient=True) as bar:

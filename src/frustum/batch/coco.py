@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from frustum.batch.jobs import write_atomically
+from frustum.batch.storage import write_atomically
 
 __all__ = ["rle_decode", "rle_encode", "view_annotations", "write_coco"]
 

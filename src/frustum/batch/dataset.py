@@ -44,9 +44,9 @@ from frustum.batch.bop import BOP_SCENE, bop_models, bop_paths
 from frustum.batch.cameras import camera_record
 from frustum.batch.executors import EXECUTORS, render_many
 from frustum.batch.formats import CAMERA_WRITERS, SHARD_SIZE, check_format_camera
-from frustum.batch.jobs import TEMPORARY_MARK, RenderJob, write_atomically
+from frustum.batch.jobs import RenderJob
 from frustum.batch.progress import ViewProgress
-from frustum.batch.storage import RemotePath, to_location
+from frustum.batch.storage import TEMPORARY_MARK, RemotePath, to_location, write_atomically
 from frustum.camera import Camera
 from frustum.errors import CameraError, FrustumError, OutputError
 from frustum.scene import Scene
@@ -203,27 +203,81 @@ def dataset_cameras(
 
 
 def _read_manifest(out: Any) -> tuple[dict | None, dict[str, dict]]:
-    """The configuration line and the finished views of a run log; a torn last line (a killed run) is ignored.
+    """The configuration line and the finished views of a run log, every line checked.
 
-    At a URL, the parts of runs that did not reach their end (``manifest.parts/``) are read after the log.
+    Only a torn last line (a killed run: no newline after it) is ignored; any other line that is not a
+    configuration or a view entry, or a view entry naming a file outside `out`, stops the run with an
+    ``OutputError`` naming the file and the line. At a URL, the parts of runs that did not reach their end
+    (``manifest.parts/``) are read after the log, each checked the same way.
     """
     path = out / _MANIFEST
+    if not isinstance(out, RemotePath) and path.is_symlink():
+        raise OutputError(f"{path}: the run log is a symbolic link; frustum neither reads nor writes a run log "
+                          "through one (remove it, or give another folder)")  # fmt: skip
     if not path.exists():
         return None, {}
-    text = path.read_text(encoding="utf-8", errors="replace")
-    if isinstance(out, RemotePath):
-        text += "\n" + "\n".join(part.read_text(errors="replace") for part in _log_parts(out))
+    logs = [path, *(_log_parts(out) if isinstance(out, RemotePath) else [])]
     config, views = None, {}
-    for line in text.splitlines():
-        try:
-            entry = json.loads(line)
-        except json.JSONDecodeError:
-            continue
-        if "config" in entry and config is None:
-            config = entry["config"]
-        elif "view" in entry:
-            views[entry["view"]] = entry
+    for log in logs:
+        text = log.read_text(encoding="utf-8", errors="replace")
+        lines = text.split("\n")
+        for number, line in enumerate(lines, start=1):
+            if not line.strip():
+                continue
+            torn = number == len(lines)  # the text does not end with a newline: its last line may be torn
+            entry = _manifest_entry(line, out, where=f"{log}, line {number}", torn=torn)
+            if entry is None:
+                continue
+            if "config" in entry:
+                if config is not None or views:
+                    raise OutputError(f"{log}, line {number}: a second configuration line; the run log is "
+                                      "damaged (rerun with --overwrite to start again)")  # fmt: skip
+                config = entry["config"]
+            else:
+                views[entry["view"]] = entry
+    if views and config is None:
+        raise OutputError(f"{path}: view lines but no configuration line; the run log is damaged "
+                          "(rerun with --overwrite to start again)")  # fmt: skip
     return config, views
+
+
+def _manifest_entry(line: str, out: Any, *, where: str, torn: bool) -> dict | None:
+    """One run-log line checked: ``{"config": {...}}`` or ``{"view": key, "files": {kind: relative path}}``
+    with every path inside `out` (after symbolic links); None for a torn last line."""
+    try:
+        entry = json.loads(line)
+    except (json.JSONDecodeError, RecursionError, ValueError):
+        if torn:
+            return None
+        raise OutputError(f"{where}: not a JSON line; the run log is damaged (rerun with --overwrite to start "
+                          "again, or give another folder)") from None  # fmt: skip
+    if isinstance(entry, dict) and set(entry) == {"config"} and isinstance(entry["config"], dict):
+        return entry
+    files = entry.get("files") if isinstance(entry, dict) else None
+    if not (isinstance(entry, dict) and isinstance(entry.get("view"), str) and isinstance(files, dict)
+            and all(isinstance(k, str) and isinstance(v, str) for k, v in files.items())):  # fmt: skip
+        if torn:
+            return None
+        raise OutputError(f"{where}: expected a configuration line or a view line "
+                          '({"view": KEY, "files": {KIND: PATH}}), got ' + describe(entry))  # fmt: skip
+    for relative in files.values():
+        _check_inside(out, relative, where)
+    return entry
+
+
+def _check_inside(out: Any, relative: str, where: str) -> None:
+    """A path a run log names: one of the dataset's folders, inside `out` once symbolic links are followed."""
+    parts = relative.replace("\\", "/").split("/")
+    if (relative.startswith(("/", "\\")) or ".." in parts or ":" in parts[0] or len(parts) < 2
+            or parts[0] not in _FOLDERS.values()):  # fmt: skip
+        folders = ", ".join(sorted(set(_FOLDERS.values())))
+        raise OutputError(f"{where}: the path {relative!r} is not a file of this dataset's folders ({folders}); "
+                          "the run log is damaged or forged")  # fmt: skip
+    if not isinstance(out, RemotePath):
+        root = Path(out).resolve()
+        if not Path(out, relative).resolve().is_relative_to(root):
+            raise OutputError(f"{where}: the path {relative!r} leads outside {str(out)!r} through a symbolic "
+                              "link; frustum reads and removes only files inside the output folder")  # fmt: skip
 
 
 def _log_parts(out: RemotePath) -> list[RemotePath]:
@@ -242,7 +296,8 @@ class _RunLog:
         self.run = f"{time.time_ns():020d}-{os.getpid()}"
         self.parts = 0
         if not self.remote:
-            self.file: Any = open(out / _MANIFEST, "a", encoding="utf-8")  # noqa: SIM115 - closed by close()
+            flags = os.O_WRONLY | os.O_APPEND | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0)  # never through a link
+            self.file: Any = os.fdopen(os.open(out / _MANIFEST, flags, 0o666), "a", encoding="utf-8")
             if config is not None:
                 self.write(json.dumps({"config": config}))
         elif config is not None:
@@ -533,33 +588,9 @@ def render_dataset(
         describe.
     """
     where = "render_dataset"
-    from frustum import __version__
-    from frustum.scenefile import SceneFile, load_scene_file
 
-    if format not in CAMERA_WRITERS:
-        raise OutputError(f"{where}: format = {format!r} is unknown; expected one of {', '.join(FORMATS)}")
-    if layout not in LAYOUTS:
-        raise CameraError(f"{where}: layout = {layout!r} is unknown; expected one of {', '.join(LAYOUTS)}")
-    if depth_format not in DEPTH_FORMATS:
-        raise OutputError(f"{where}: depth_format = {depth_format!r} is unknown; expected one of "
-                          f"{', '.join(DEPTH_FORMATS)}")  # fmt: skip
-    if executor not in EXECUTORS:
-        raise FrustumError(f"{where}: executor = {executor!r} is unknown; expected one of {', '.join(EXECUTORS)}")
-    if isinstance(retries, bool) or not isinstance(retries, int) or retries < 0:
-        raise FrustumError(f"{where}: retries = {describe(retries)} must be an integer >= 0")
-    scene_path = None
-    if isinstance(scene, SceneFile):
-        scene_file = scene
-        scene_path = scene.path
-    elif isinstance(scene, str | os.PathLike):
-        scene_path = Path(scene)
-        scene_file = load_scene_file(scene_path)  # a scene that does not load fails here, once
-    elif isinstance(scene, Scene) and cameras:
-        first = next(iter(cameras))
-        scene_file = SceneFile(scene, first, {}, (), cameras=(first,))
-    else:
-        raise FrustumError(f"{where}: scene = {describe(scene)} is not a scene file path or a SceneFile (or a Scene "
-                           "with cameras=[...])")  # fmt: skip
+    _check_choices(format, layout, depth_format, executor, retries, where)
+    scene_file, scene_path = _scene_file(scene, cameras, where)
     if size is not None:
         scene_file = scene_file.resized(tuple(size))
     base = scene_file.cameras[0]
@@ -586,40 +617,12 @@ def render_dataset(
     out = to_location(out)
     remote = isinstance(out, RemotePath)
     _check_folder(out, where)
-    extra: dict[str, Any] = {}
-    depth_scale = 1e-3
-    if depth_format == "png16":
-        far = getattr(base.projection, "far", None)
-        depth_scale = float(far) / 65535 if far else 1e-3
-        extra["depth_unit_scale_factor"] = depth_scale
-    if format == "bop":  # millimetres per step of depth PNGs (BOP's depth_scale): 0.1 mm while the far plane fits
-        far = float(getattr(base.projection, "far", 0.0) or 0.0)
-        extra["bop_depth_scale"] = max(0.1, far * 1000.0 / 65535.0)
-        depth_scale = extra["bop_depth_scale"] / 1000.0  # world units (metres) per step
+    extra, depth_scale = _depth_scale(base, format, depth_format)
     if format in GROUND_TRUTH_FORMATS:
         count = _keypoint_count(scene_file.scene, keypoints, where)
         extra.update(scene=scene_file.scene, labels=scene_file.scene.labels, seed=int(seed), keypoint_count=count)
-    config = {
-        "frustum": __version__,
-        "scene": "<SceneFile>" if scene_path is None else scene_path.name,
-        "scene_sha256": _sha256(scene_path),
-        "views": len(cameras),
-        "layout": layout,
-        "format": format,
-        "size": [base.width, base.height],
-        "seed": int(seed),
-        "depth_format": depth_format,
-        "cameras_sha256": _sha256(Path(cameras_file)) if layout == "file" and cameras_file else None,
-    }
-    if given:  # the views themselves: their records decide whether a resume matches
-        records_text = json.dumps([camera_record(c) for _, c in cameras], sort_keys=True)
-        config["layout"] = "given"
-        config["cameras_sha256"] = hashlib.sha256(records_text.encode("utf-8")).hexdigest()
-    if keypoints is not None:
-        config["keypoints_sha256"] = hashlib.sha256(repr(keypoints).encode("utf-8")).hexdigest()
-    if scene_file.up is not None:  # a mesh file: its up axis turns the model, so a resume must match it
-        config["up"] = scene_file.up
-    manifest = out / _MANIFEST
+    config = _config(scene_file, scene_path, cameras, base, layout, format, seed, depth_format, cameras_file, given,
+                     keypoints)  # fmt: skip
     old_config, finished = _read_manifest(out)
     if old_config is not None and old_config != config and not overwrite:
         raise OutputError(
@@ -628,15 +631,7 @@ def render_dataset(
             + "); rerun with overwrite=True (--overwrite) to start again, or give another folder"
         )
     if overwrite and (old_config is not None or finished):
-        for entry in finished.values():
-            for relative in entry.get("files", {}).values():
-                with contextlib.suppress(OSError):
-                    (out / relative).unlink()
-        parts = _log_parts(out) if remote else []
-        for path in [*(out / name for name in _SHARED_FILES), *out.glob("shards/shard-*.tar"), *parts]:
-            with contextlib.suppress(OSError):
-                path.unlink()
-        manifest.unlink()
+        _start_over(out, finished, remote)
         old_config, finished = None, {}
     _remove_partial_files(out)
     kinds = dict(_SUFFIXES)
@@ -689,3 +684,90 @@ def render_dataset(
     written = [str(path) if remote else path for path in (*written, out / "README.txt")]  # URLs as strings
     return DatasetResult(str(out) if remote else out, tuple(sorted(rendered)), tuple(sorted(done)), failed,
                          tuple(written))  # fmt: skip
+
+
+def _check_choices(format: Any, layout: Any, depth_format: Any, executor: Any, retries: Any, where: str) -> None:
+    """``render_dataset``'s named choices and retry count checked (the message lists the valid names)."""
+    if format not in CAMERA_WRITERS:
+        raise OutputError(f"{where}: format = {format!r} is unknown; expected one of {', '.join(FORMATS)}")
+    if layout not in LAYOUTS:
+        raise CameraError(f"{where}: layout = {layout!r} is unknown; expected one of {', '.join(LAYOUTS)}")
+    if depth_format not in DEPTH_FORMATS:
+        raise OutputError(f"{where}: depth_format = {depth_format!r} is unknown; expected one of "
+                          f"{', '.join(DEPTH_FORMATS)}")  # fmt: skip
+    if executor not in EXECUTORS:
+        raise FrustumError(f"{where}: executor = {executor!r} is unknown; expected one of {', '.join(EXECUTORS)}")
+    if isinstance(retries, bool) or not isinstance(retries, int) or retries < 0:
+        raise FrustumError(f"{where}: retries = {describe(retries)} must be an integer >= 0")
+
+
+def _scene_file(scene: Any, cameras: Any, where: str) -> tuple[Any, Path | None]:
+    """(the SceneFile, its path or None): `scene` as given, loaded from its path (a scene that does not load fails
+    here, once), or a Scene with the first of `cameras`."""
+    from frustum.scenefile import SceneFile, load_scene_file
+
+    if isinstance(scene, SceneFile):
+        return scene, scene.path
+    if isinstance(scene, str | os.PathLike):
+        return load_scene_file(Path(scene)), Path(scene)
+    if isinstance(scene, Scene) and cameras:
+        first = next(iter(cameras))
+        return SceneFile(scene, first, {}, (), cameras=(first,)), None
+    raise FrustumError(f"{where}: scene = {describe(scene)} is not a scene file path or a SceneFile (or a Scene "
+                       "with cameras=[...])")  # fmt: skip
+
+
+def _start_over(out: Any, finished: dict, remote: bool) -> None:
+    """``overwrite=True``: remove the files of the finished views, the shared files, the shards and the manifest."""
+    for entry in finished.values():
+        for relative in entry.get("files", {}).values():
+            with contextlib.suppress(OSError):
+                (out / relative).unlink()
+    parts = _log_parts(out) if remote else []
+    for path in [*(out / name for name in _SHARED_FILES), *out.glob("shards/shard-*.tar"), *parts]:
+        with contextlib.suppress(OSError):
+            path.unlink()
+    (out / _MANIFEST).unlink()
+
+
+def _config(scene_file: Any, scene_path: Path | None, cameras: list, base: Any, layout: str, format: str, seed: int,
+            depth_format: str, cameras_file: Any, given: bool, keypoints: Any) -> dict[str, Any]:  # fmt: skip
+    """The dataset's configuration, the first line of its manifest: a resume must match it."""
+    from frustum import __version__
+
+    config = {
+        "frustum": __version__,
+        "scene": "<SceneFile>" if scene_path is None else scene_path.name,
+        "scene_sha256": _sha256(scene_path),
+        "views": len(cameras),
+        "layout": layout,
+        "format": format,
+        "size": [base.width, base.height],
+        "seed": int(seed),
+        "depth_format": depth_format,
+        "cameras_sha256": _sha256(Path(cameras_file)) if layout == "file" and cameras_file else None,
+    }
+    if given:  # the views themselves: their records decide whether a resume matches
+        records_text = json.dumps([camera_record(c) for _, c in cameras], sort_keys=True)
+        config["layout"] = "given"
+        config["cameras_sha256"] = hashlib.sha256(records_text.encode("utf-8")).hexdigest()
+    if keypoints is not None:
+        config["keypoints_sha256"] = hashlib.sha256(repr(keypoints).encode("utf-8")).hexdigest()
+    if scene_file.up is not None:  # a mesh file: its up axis turns the model, so a resume must match it
+        config["up"] = scene_file.up
+    return config
+
+
+def _depth_scale(base: Any, format: str, depth_format: str) -> tuple[dict[str, Any], float]:
+    """(the depth entries of the dataset's shared files, world units per step of a 16-bit depth PNG)."""
+    extra: dict[str, Any] = {}
+    depth_scale = 1e-3
+    if depth_format == "png16":
+        far = getattr(base.projection, "far", None)
+        depth_scale = float(far) / 65535 if far else 1e-3
+        extra["depth_unit_scale_factor"] = depth_scale
+    if format == "bop":  # millimetres per step of depth PNGs (BOP's depth_scale): 0.1 mm while the far plane fits
+        far = float(getattr(base.projection, "far", 0.0) or 0.0)
+        extra["bop_depth_scale"] = max(0.1, far * 1000.0 / 65535.0)
+        depth_scale = extra["bop_depth_scale"] / 1000.0  # world units (metres) per step
+    return extra, depth_scale

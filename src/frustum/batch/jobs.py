@@ -23,7 +23,6 @@ Output kinds (``RenderJob.outputs`` keys):
 
 from __future__ import annotations
 
-import contextlib
 import io
 import json
 import os
@@ -36,7 +35,8 @@ from typing import Any
 import numpy as np
 
 from frustum._arrays import describe
-from frustum.batch.storage import TEMPORARY_MARK, RemotePath, is_url
+from frustum.batch.storage import TEMPORARY_MARK as TEMPORARY_MARK
+from frustum.batch.storage import is_url, write_atomically
 from frustum.errors import FrustumError, OutputError
 
 __all__ = ["OUTPUT_KINDS", "RenderJob", "ViewResult", "encode_view", "render_view", "write_atomically", "write_view"]
@@ -132,31 +132,6 @@ def check_job(job: Any, index: int, where: str) -> None:
             )
     if not (isinstance(job.depth_scale, int | float) and job.depth_scale > 0):
         raise FrustumError(f"{where}: jobs[{index}].depth_scale = {describe(job.depth_scale)} must be a number > 0")
-
-
-def write_atomically(path: str | os.PathLike, write: Any) -> None:
-    """Call ``write(file)`` on a temporary file beside `path`, then rename it to `path`.
-
-    Readers never see a partly written `path`: it appears whole or not at all (``os.replace`` is atomic on
-    one file system). On any exception, Ctrl-C included, the temporary file is removed. A URL (a string with
-    ``scheme://`` or a ``RemotePath``) is written through fsspec, whole or not at all (``RemotePath.write_bytes``).
-    """
-    if is_url(path):
-        buffer = io.BytesIO()
-        write(buffer)
-        (path if isinstance(path, RemotePath) else RemotePath(path)).write_bytes(buffer.getbuffer())
-        return
-    target = Path(path)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    temporary = target.with_name(f".{target.name}{TEMPORARY_MARK}{os.getpid()}")
-    try:
-        with open(temporary, "wb") as file:
-            write(file)
-        os.replace(temporary, target)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.remove(temporary)
-        raise
 
 
 def _png_writer(array: np.ndarray) -> Any:

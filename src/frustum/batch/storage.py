@@ -15,8 +15,10 @@ fsspec's ``FSSPEC_S3_*`` variables), so on a cluster every node needs them.
 from __future__ import annotations
 
 import contextlib
+import io
 import os
 import posixpath
+from pathlib import Path
 from typing import Any
 
 from frustum.errors import OutputError
@@ -220,3 +222,28 @@ def to_location(value: Any) -> Any:
     if is_url(value):
         return RemotePath(value)
     return Path(value)
+
+
+def write_atomically(path: str | os.PathLike, write: Any) -> None:
+    """Call ``write(file)`` on a temporary file beside `path`, then rename it to `path`.
+
+    Readers never see a partly written `path`: it appears whole or not at all (``os.replace`` is atomic on
+    one file system). On any exception, Ctrl-C included, the temporary file is removed. A URL (a string with
+    ``scheme://`` or a ``RemotePath``) is written through fsspec, whole or not at all (``RemotePath.write_bytes``).
+    """
+    if is_url(path):
+        buffer = io.BytesIO()
+        write(buffer)
+        (path if isinstance(path, RemotePath) else RemotePath(path)).write_bytes(buffer.getbuffer())
+        return
+    target = Path(path)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    temporary = target.with_name(f".{target.name}{TEMPORARY_MARK}{os.getpid()}")
+    try:
+        with open(temporary, "wb") as file:
+            write(file)
+        os.replace(temporary, target)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.remove(temporary)
+        raise

@@ -27,7 +27,7 @@ from numpy.typing import ArrayLike, NDArray
 from frustum._arrays import as_scalar, describe
 from frustum.budgets import check_operations
 from frustum.errors import GeometryError
-from frustum.geometry.fractals import _budget, _check_memory
+from frustum.geometry.fractals.checks import byte_budget, check_fractal_memory
 from frustum.geometry.mesh import Mesh
 
 __all__ = ["escape_time_colors", "julia", "mandelbrot", "quaternion_julia", "quaternion_julia_mesh"]
@@ -71,7 +71,7 @@ def _image(where: str, window: Any, width: Any, height: Any, max_iter: Any, esca
     radius = as_scalar(escape_radius, "escape_radius", where=where, error=GeometryError)
     if radius < 2.0:
         raise GeometryError(f"{where}: escape_radius = {radius!r} is below 2; give R >= 2 (orbits past 2 escape)")
-    _check_memory(w * h * 8, _budget(max_bytes, where), where=where, name="width·height", value=w * h)
+    check_fractal_memory(w * h * 8, byte_budget(max_bytes, where), where=where, name="width·height", value=w * h)
     check_operations(w * h * iters, where=where, cause=f"{w} x {h} pixels x max_iter = {iters}", error=GeometryError)
     xs = x0 + (np.arange(w) + 0.5) * ((x1 - x0) / w)
     ys = y1 - (np.arange(h) + 0.5) * ((y1 - y0) / h)
@@ -189,7 +189,7 @@ def quaternion_julia(c: ArrayLike = (-0.2, 0.6, 0.2, 0.0), *, resolution: int = 
     radius = as_scalar(escape_radius, "escape_radius", where=where, error=GeometryError)
     if radius < 2.0:
         raise GeometryError(f"{where}: escape_radius = {radius!r} is below 2; give R >= 2")
-    _check_memory(n**3 * 8 * 4, _budget(max_bytes, where), where=where, name="resolution", value=n)
+    check_fractal_memory(n**3 * 8 * 4, byte_budget(max_bytes, where), where=where, name="resolution", value=n)
     check_operations(n**3 * iters, where=where, cause=f"resolution = {n} (n³ = {n**3} points) x max_iter = {iters}",
                      error=GeometryError)  # fmt: skip
     axis = np.linspace(-b, b, n)

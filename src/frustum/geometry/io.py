@@ -20,7 +20,10 @@ References
 
 from __future__ import annotations
 
+import base64
+import binascii
 import io
+import json
 import re
 from pathlib import Path
 from typing import Any, NamedTuple
@@ -69,14 +72,27 @@ class MeshPart(NamedTuple):
     """A glTF material's ``emissiveFactor`` (linear RGB), when not black: ``Material(emissive=)``."""
     alpha_mode: str | None = None
     """A glTF material's ``alphaMode`` ("OPAQUE", "MASK" or "BLEND"); None for other formats."""
+    metallic: float | None = None
+    """A glTF material's ``metallicFactor`` (None when the file gives none: the specification's default is 1)."""
+    roughness: float | None = None
+    """A glTF material's ``roughnessFactor`` (None when the file gives none: the specification's default is 1)."""
+    metallic_roughness_texture: NDArray[np.uint8] | None = None
+    """A glTF material's ``metallicRoughnessTexture`` as (H, W, 3) bytes: B metallic, G roughness."""
+    occlusion_texture: NDArray[np.uint8] | None = None
+    """A glTF material's ``occlusionTexture`` as (H, W, 3) bytes: R the occlusion."""
+    physical: bool = False
+    """Whether the file describes the material by glTF's metallic–roughness model (a glTF or GLB file)."""
 
     def __repr__(self) -> str:
         def image(array: Any) -> str:
             return "None" if array is None else f"<{'x'.join(map(str, np.shape(array)))} image>"
 
+        physical = (f", metallic={self.metallic!r}, roughness={self.roughness!r}, metallic_roughness_texture="
+                    f"{image(self.metallic_roughness_texture)}, occlusion_texture={image(self.occlusion_texture)}, "
+                    "physical=True") if self.physical else ""  # fmt: skip
         return (f"MeshPart(name={self.name!r}, mesh={self.mesh!r}, texture={image(self.texture)}, "
                 f"color={self.color!r}, normal_map={image(self.normal_map)}, emissive={self.emissive!r}, "
-                f"alpha_mode={self.alpha_mode!r})")  # fmt: skip
+                f"alpha_mode={self.alpha_mode!r}{physical})")  # fmt: skip
 
 
 def load(path: str | Path, texture: str | Path | None = None) -> Mesh:
@@ -130,8 +146,12 @@ def load_parts(path: str | Path, texture: str | Path | None = None) -> list[Mesh
         _check_binary_stl_size(file)
     if file.suffix.lower() == ".glb":
         _check_glb_chunks(file)
+    if file.suffix.lower() in (".gltf", ".glb"):
+        _check_gltf_layout(file)
     _check_file_memory(file)
     text = _text_bytes(file)
+    if file.suffix.lower() == ".obj":
+        _warn_unreadable_textures(file, text)
     try:
         native = _native_parts(file, text)
     except MemoryError:
@@ -151,7 +171,7 @@ def load_parts(path: str | Path, texture: str | Path | None = None) -> list[Mesh
     except Exception as error:  # trimesh raises many types (ValueError, KeyError, struct.error, ...)
         raise _read_error(file, error) from None
     try:
-        parts = scene_parts(scene)
+        parts = scene_parts(scene, file)
     except GeometryError as error:
         raise GeometryError(f"load: path = {str(file)!r} holds invalid geometry ({error}); check the file") from None
     except MemoryError:
@@ -165,10 +185,11 @@ def load_parts(path: str | Path, texture: str | Path | None = None) -> list[Mesh
     return _with_textures(parts, file, explicit)
 
 
-def scene_parts(scene: Any) -> list[MeshPart]:
+def scene_parts(scene: Any, file: Path | None = None) -> list[MeshPart]:
     """Every non-empty triangle mesh of a ``trimesh.Scene`` as a ``MeshPart``, placed by its graph node (world
     transform from one walk of the graph), sorted by node name: what ``load_parts`` returns for a file's scene and
-    ``Scene.from_trimesh`` for a scene in memory. Other geometry (point clouds, paths) is left out."""
+    ``Scene.from_trimesh`` for a scene in memory. Other geometry (point clouds, paths) is left out. The parts of a
+    glTF `file` carry its metallic–roughness materials (``MeshPart.physical``)."""
     import trimesh
 
     parts: list[MeshPart] = []
@@ -182,7 +203,7 @@ def scene_parts(scene: Any) -> list[MeshPart]:
         matrix = np.array(world_from_model, dtype=np.float64)
         emissive, alpha_mode = _emission_and_alpha(geometry)
         parts.append(MeshPart(str(node), mesh, matrix, image, color, _normal_texture(geometry), emissive,
-                              alpha_mode))  # fmt: skip
+                              alpha_mode, *_metallic_roughness(geometry, file)))  # fmt: skip
     return parts
 
 
@@ -214,8 +235,13 @@ def _native_parts(file: Path, text: bytes | None) -> list[MeshPart] | None:
             normal_map = None
             if part.normal_image is not None and part.uvs is not None:
                 normal_map = np.asarray(part.normal_image.convert("RGB"), dtype=np.uint8)
+            physical = [None, None]
+            for k, texture_image in enumerate((part.metallic_roughness_image, part.occlusion_image)):
+                if texture_image is not None and part.uvs is not None:
+                    physical[k] = np.asarray(texture_image.convert("RGB"), dtype=np.uint8)
             parts.append(MeshPart(part.name, mesh, np.asarray(part.world_from_model, dtype=np.float64), image, color,
-                                  normal_map, part.emissive, part.alpha_mode))  # fmt: skip
+                                  normal_map, part.emissive, part.alpha_mode, part.metallic, part.roughness,
+                                  *physical, file.suffix.lower() in (".glb", ".gltf")))  # fmt: skip
     except MemoryError:
         raise
     except Exception:  # invalid geometry or an unreadable image: trimesh's path says what is wrong
@@ -307,6 +333,93 @@ def _check_glb_chunks(file: Path) -> None:
                     f"the file has {size - offset - 8} more; the file is corrupt or truncated"
                 )
             offset, index = offset + 8 + length, index + 1
+
+
+def _check_gltf_layout(file: Path) -> None:
+    """Every buffer view inside its buffer and every accessor inside its view, counts and offsets non-negative
+    integers, buffers read only from the file's own folder: refused here with the byte offset, before frustum's
+    reader or trimesh sees the file (a negative count was drawn; a view past the BIN chunk gave an
+    ``AssertionError``). glTF 2.0 §3.6.2 "Buffers and Buffer Views", §3.6.2.4 "Data Alignment"."""
+    from frustum.geometry.readers import _COMPONENTS, _WIDTHS
+
+    where = f"load: path = {str(file)!r}"
+    data = file.read_bytes()
+    binary: tuple[int, int] | None = None  # (offset in the file, length) of the GLB's BIN chunk
+    try:
+        if data[:4] == b"glTF":
+            length = int.from_bytes(data[12:16], "little")
+            gltf = json.loads(data[20 : 20 + length])
+            if len(data) >= 28 + length and data[24 + length : 28 + length] == b"BIN\x00":
+                binary = (28 + length, int.from_bytes(data[20 + length : 24 + length], "little"))
+        else:
+            gltf = json.loads(data)
+    except (ValueError, RecursionError):
+        return  # not JSON: the readers say what it is not
+    if not isinstance(gltf, dict):
+        return
+
+    def fail(problem: str) -> GeometryError:
+        return GeometryError(f"{where}: {problem}; the file is corrupt")
+
+    def natural(table: dict, key: str, what: str, default: int | None = None, least: int = 0) -> int:
+        value = table.get(key, default)
+        if isinstance(value, bool) or not isinstance(value, int) or value < least:
+            raise fail(f"{what} has {key} = {describe(value)}, not an integer >= {least}")
+        return value
+
+    lengths = []
+    for i, buffer in enumerate(_gltf_list(gltf, "buffers")):
+        uri = buffer.get("uri")
+        if uri is None:
+            lengths.append(binary[1] if binary else 0)
+        elif isinstance(uri, str) and uri.startswith("data:"):
+            try:
+                lengths.append(len(base64.b64decode(uri.split(",", 1)[-1])))
+            except (binascii.Error, ValueError):
+                raise fail(f"buffer {i} has a data: URI that is not base64") from None
+        elif isinstance(uri, str):
+            target = (file.parent / uri).resolve()
+            if not target.is_relative_to(file.parent.resolve()):
+                raise GeometryError(f"{where}: buffer {i} names {uri!r}, outside the glTF file's folder; a glTF "
+                                    "file reads its buffers only beside it (copy the .bin there)")  # fmt: skip
+            lengths.append(target.stat().st_size if target.is_file() else 0)
+        else:
+            raise fail(f"buffer {i} has uri = {describe(uri)}, not a string")
+    views = _gltf_list(gltf, "bufferViews")
+    for i, view in enumerate(views):
+        what = f"bufferView {i}"
+        index = natural(view, "buffer", what)
+        start, length = natural(view, "byteOffset", what, 0), natural(view, "byteLength", what, least=1)
+        if index >= len(lengths) or start + length > lengths[index]:
+            held = f"{lengths[index]} bytes" if index < len(lengths) else "no such buffer"
+            at = f" (the BIN chunk at byte {binary[0]} of the file)" if binary and index == 0 else ""
+            raise fail(f"{what} spans bytes {start}…{start + length} of buffer {index}, which holds {held}{at}")
+    for i, accessor in enumerate(_gltf_list(gltf, "accessors")):
+        what = f"accessor {i}"
+        count = natural(accessor, "count", what, least=1)
+        offset = natural(accessor, "byteOffset", what, 0)
+        if "bufferView" not in accessor:
+            continue  # all zeros (or sparse): nothing read from a view
+        index = natural(accessor, "bufferView", what)
+        if index >= len(views):
+            raise fail(f"{what} names bufferView {index}, but the file has {len(views)}")
+        component = _COMPONENTS.get(accessor.get("componentType"))
+        width = _WIDTHS.get(accessor.get("type"), 0)
+        if component is None or not width:
+            continue  # an unknown type: the readers refuse it by name
+        element = np.dtype(component).itemsize * width
+        stride = views[index].get("byteStride") or element
+        end = offset + (count - 1) * stride + element
+        if end > views[index]["byteLength"]:
+            raise fail(f"{what} reads bytes {offset}…{end} of bufferView {index}, which holds "
+                       f"{views[index]['byteLength']} ({count} elements of {element} bytes)")  # fmt: skip
+
+
+def _gltf_list(gltf: dict, key: str) -> list[dict]:
+    value = gltf.get(key, [])
+    if not isinstance(value, list) or not all(isinstance(entry, dict) for entry in value):
+        raise GeometryError(f"load: {key} = {describe(value)} is not a list of objects; the glTF file is corrupt")
+    return value
 
 
 _LOAD_BYTES_PER_FILE_BYTE = 12
@@ -503,6 +616,24 @@ def _normal_texture(geometry: Any) -> NDArray[np.uint8] | None:
     return np.asarray(image.convert("RGB"), dtype=np.uint8)
 
 
+def _metallic_roughness(geometry: Any, file: Path | None) -> tuple[Any, ...]:
+    """A glTF material's (metallicFactor, roughnessFactor, metallicRoughnessTexture, occlusionTexture, True), the
+    textures as (H, W, 3) bytes (None without UVs); (None, None, None, None, False) for other formats."""
+    if file is None or file.suffix.lower() not in (".glb", ".gltf"):
+        return None, None, None, None, False
+    material = getattr(geometry.visual, "material", None)
+    factors = []
+    for name in ("metallicFactor", "roughnessFactor"):
+        value = getattr(material, name, None)
+        factors.append(None if value is None else float(np.clip(float(value), 0.0, 1.0)))
+    images = []
+    for name in ("metallicRoughnessTexture", "occlusionTexture"):
+        image = getattr(material, name, None)
+        has_uvs = getattr(geometry.visual, "uv", None) is not None
+        images.append(None if image is None or not has_uvs else np.asarray(image.convert("RGB"), dtype=np.uint8))
+    return (*factors, *images, True)
+
+
 def _emission_and_alpha(geometry: Any) -> tuple[tuple[float, float, float] | None, str | None]:
     """A glTF material's ``emissiveFactor`` (None when black or absent) and ``alphaMode`` (None when absent)."""
     material = getattr(geometry.visual, "material", None)
@@ -558,6 +689,39 @@ def _material_color(material: Any) -> tuple[float, float, float, float] | None:
     return tuple(float(c) for c in np.clip(rgba, 0.0, 1.0))  # type: ignore[return-value]
 
 
+_MTL_LIBRARY = re.compile(rb"^[ \t]*mtllib[ \t]+([^\r\n#]+)", re.MULTILINE)
+_MTL_TEXTURE = re.compile(r"^[ \t]*(map_\w+|bump|disp|decal|norm|refl)[ \t]+([^\r\n#]+)", re.MULTILINE | re.IGNORECASE)
+
+
+def _warn_unreadable_textures(file: Path, text: bytes | None) -> None:
+    """A ``FrustumWarning`` for each texture an OBJ's MTL files name that cannot be read: missing, not a regular
+    file, or outside the OBJ's folder (never read from there). The material is drawn without it, as before, but no
+    longer silently."""
+    import warnings
+
+    from frustum.errors import FrustumWarning
+
+    data = text if text is not None else file.read_bytes()
+    folder = file.parent.resolve()
+    for library in _MTL_LIBRARY.findall(data):
+        mtl = file.parent / library.decode("utf-8", "replace").strip()
+        if not mtl.resolve().is_relative_to(folder) or not mtl.is_file():
+            continue  # a missing library: the model loads without materials, as trimesh does
+        for key, value in _MTL_TEXTURE.findall(mtl.read_text("utf-8", "replace")):
+            name = value.split()[-1] if value.split() else value  # options such as -bm 0.5 come before the name
+            texture = (mtl.parent / name).resolve()
+            if not texture.is_relative_to(folder):
+                problem = "lies outside the model's folder (never read from there)"
+            elif not texture.exists():
+                problem = "does not exist"
+            elif not texture.is_file():
+                problem = f"is not a regular file ({file_kind(texture)})"
+            else:
+                continue
+            warnings.warn(f"load: {mtl.name} ({key}) names the texture {name!r}, which {problem}; "
+                          f"{file.name} is drawn without it", FrustumWarning, stacklevel=3)  # fmt: skip
+
+
 def _sibling_texture(file: Path) -> NDArray[np.uint8] | None:
     stem = file.stem
     names = [stem, f"{stem}_texture", f"{stem.split('_')[0]}_texture"]
@@ -570,12 +734,14 @@ def _sibling_texture(file: Path) -> NDArray[np.uint8] | None:
 
 
 def _read_image(file: Path, where: str) -> NDArray[np.uint8]:
-    from PIL import Image, UnidentifiedImageError
+    from PIL import UnidentifiedImageError
 
     if not file.is_file():
         raise GeometryError(f"{where}: texture = {str(file)!r} does not exist; give the path of an image file")
+    from frustum._images import open_image
+
     try:
-        with Image.open(file) as image:
+        with open_image(file, where=where, name=f"texture = {str(file)!r}", error=GeometryError) as image:
             return np.asarray(image.convert("RGBA" if "A" in image.mode else "RGB"), dtype=np.uint8)
     except (OSError, UnidentifiedImageError) as error:
         raise GeometryError(f"{where}: texture = {str(file)!r} is not a readable image ({error})") from None

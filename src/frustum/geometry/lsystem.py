@@ -36,7 +36,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from frustum._arrays import Points, as_scalar, as_vector3, describe
 from frustum.errors import GeometryError
-from frustum.geometry.fractals import _budget, _check_memory, _level
+from frustum.geometry.fractals.checks import byte_budget, check_fractal_memory, check_level
 from frustum.geometry.mesh import Mesh
 
 __all__ = ["CLASSIC_LSYSTEMS", "LSystem", "TurtlePath", "interpret", "parse_rules", "tube_mesh"]
@@ -164,7 +164,7 @@ class LSystem:
 
     def length(self, level: int) -> int:
         """Exact length of the word after `level` rewritings (integer matrix power, nothing expanded)."""
-        n = _level(level, "LSystem.length")
+        n = check_level(level, "LSystem.length")
         symbols = sorted(set(self.axiom).union(*[set(w) for w in self.productions.values()], self.productions))
         index = {s: i for i, s in enumerate(symbols)}
         counts = [0] * len(symbols)
@@ -185,8 +185,8 @@ class LSystem:
         would exceed `max_bytes`.
         """
         where = "LSystem.expand"
-        n = _level(level, where)
-        _check_memory(self.length(n) * 64, _budget(max_bytes, where), where=where, name="level", value=n)
+        n = check_level(level, where)
+        check_fractal_memory(self.length(n) * 64, byte_budget(max_bytes, where), where=where, name="level", value=n)
         table = str.maketrans(self.productions)
         word = self.axiom
         for _ in range(n):
@@ -316,8 +316,8 @@ def tube_mesh(path: TurtlePath, radius: float = 0.1, *, taper: float = 0.7, side
             f"{where}: path.depths has shape {np.shape(path.depths)}; give one depth per segment ({seg.shape[0]},)"
         )
     m = seg.shape[0]
-    _check_memory(m * (2 * sides * 3 * 8 * 3 + (4 * sides - 4) * 3 * 8), _budget(max_bytes, where), where=where,
-                  name="segments", value=m)  # fmt: skip
+    check_fractal_memory(m * (2 * sides * 3 * 8 * 3 + (4 * sides - 4) * 3 * 8), byte_budget(max_bytes, where),
+                         where=where, name="segments", value=m)  # fmt: skip
     if m == 0:
         return Mesh(np.empty((0, 3)), np.empty((0, 3), dtype=np.int64))
     p, q = seg[:, 0], seg[:, 1]

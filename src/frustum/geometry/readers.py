@@ -17,6 +17,7 @@ files and every error message stay trimesh's (and ``load_parts``'s):
 - glTF 2.0 binary (GLB) and JSON (``.gltf``, buffers in files beside it or embedded as base64 data URIs):
   nodes without placements (no matrix or TRS: trimesh repairs those), one indexed triangle primitive per mesh
   with POSITION, NORMAL and TEXCOORD_0, materials' base colour factor and texture (an image in a buffer view),
+  metallic and roughness factors, metallic–roughness and occlusion textures,
   normal texture, emissive factor and alpha mode; no extensions, sparse accessors, vertex colours, skins,
   cameras or morph targets.
 """
@@ -32,6 +33,8 @@ from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
+
+from frustum.errors import FrustumError, GeometryError
 
 __all__ = ["RawPart", "read_parts"]
 
@@ -50,6 +53,10 @@ class RawPart(NamedTuple):
     normal_image: Any = None
     emissive: tuple[float, float, float] | None = None
     alpha_mode: str | None = None
+    metallic: float | None = None
+    roughness: float | None = None
+    metallic_roughness_image: Any = None
+    occlusion_image: Any = None
 
 
 class UnsupportedError(Exception):
@@ -64,7 +71,7 @@ def read_parts(file: Path, data: bytes | None = None) -> list[RawPart] | None:
         return None
     try:
         return reader(file, file.read_bytes() if data is None else data)
-    except MemoryError:
+    except (MemoryError, FrustumError):  # out of memory, or an image over the budget: not trimesh's to retry
         raise
     except Exception:  # anything unusual or malformed: trimesh reads it and reports what is wrong
         return None
@@ -367,8 +374,6 @@ def _hashable_rows(rows: NDArray[np.int64]) -> NDArray[Any]:
 def _read_mtl(file: Path) -> dict[str, tuple[Any, tuple[float, float, float, float]]]:
     """name -> (PIL image or None, base colour) of an MTL file, as trimesh's ``parse_mtl`` and ``SimpleMaterial``
     give them (``Kd`` rounded to bytes; no ``Kd``: trimesh's default gray)."""
-    from PIL import Image
-
     if not _plain_name(file.name):
         raise UnsupportedError("a path in the library name")  # trimesh's resolver tries several readings
     if not file.is_file():
@@ -397,7 +402,7 @@ def _read_mtl(file: Path) -> dict[str, tuple[Any, tuple[float, float, float, flo
             texture = file.parent / line[index:].strip()
             if not _plain_name(line[index:].strip()):
                 raise UnsupportedError("a path or options in map_Kd")  # trimesh's resolver tries several readings
-            image = Image.open(io.BytesIO(texture.read_bytes())) if texture.is_file() else None
+            image = _open_image(io.BytesIO(texture.read_bytes()), file, texture.name) if texture.is_file() else None
         elif key == "kd":
             values = [float(x) for x in words[1:]]
             if len(values) != 3:
@@ -412,7 +417,10 @@ def _read_mtl(file: Path) -> dict[str, tuple[Any, tuple[float, float, float, flo
 # --- glTF ---------------------------------------------------------------------------------------------------
 
 _COMPONENTS = {5120: "i1", 5121: "u1", 5122: "i2", 5123: "u2", 5125: "u4", 5126: "f4"}
-_GLTF_MATERIAL_KEYS = {"name", "pbrMetallicRoughness", "normalTexture", "emissiveFactor", "alphaMode", "doubleSided"}
+_GLTF_MATERIAL_KEYS = {"name", "pbrMetallicRoughness", "normalTexture", "occlusionTexture", "emissiveFactor",
+                       "alphaMode", "doubleSided"}  # fmt: skip
+_GLTF_PBR_KEYS = {"baseColorFactor", "baseColorTexture", "metallicFactor", "roughnessFactor",
+                  "metallicRoughnessTexture"}  # fmt: skip
 _WIDTHS = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT4": 16}
 
 
@@ -521,13 +529,20 @@ def _gltf_part(gltf: dict[str, Any], primitive: dict[str, Any], name: str, acces
         uvs[:, 1] = 1.0 - uvs[:, 1]  # glTF's v runs down the image (flipped in float32, as trimesh does)
         uvs = uvs.astype(np.float64)
     image = color = normal_image = emissive = alpha_mode = None
+    metallic = roughness = metallic_roughness_image = occlusion_image = None
     if "material" in primitive:
         material = gltf["materials"][primitive["material"]]
         if material.get("extensions") or not set(material) <= _GLTF_MATERIAL_KEYS:
             raise UnsupportedError("material")
         pbr = material.get("pbrMetallicRoughness", {})
-        if not set(pbr) <= {"baseColorFactor", "baseColorTexture", "metallicFactor", "roughnessFactor"}:
+        if not set(pbr) <= _GLTF_PBR_KEYS:
             raise UnsupportedError("material")
+        metallic, roughness = (None if key not in pbr else float(np.clip(float(pbr[key]), 0.0, 1.0))
+                               for key in ("metallicFactor", "roughnessFactor"))  # fmt: skip
+        if "metallicRoughnessTexture" in pbr:
+            metallic_roughness_image = _gltf_image(gltf, pbr["metallicRoughnessTexture"], view_bytes)
+        if "occlusionTexture" in material:
+            occlusion_image = _gltf_image(gltf, material["occlusionTexture"], view_bytes)
         color = _gltf_color(pbr["baseColorFactor"]) if "baseColorFactor" in pbr else None
         if "baseColorTexture" in pbr:
             image = _gltf_image(gltf, pbr["baseColorTexture"], view_bytes)
@@ -538,7 +553,8 @@ def _gltf_part(gltf: dict[str, Any], primitive: dict[str, Any], name: str, acces
             emissive = tuple(float(c) for c in np.clip(rgb, 0.0, 1.0))
         alpha_mode = str(material["alphaMode"]).upper() if "alphaMode" in material else None
     return RawPart(name, vertices, faces, normals, uvs, _IDENTITY.copy(), image, color, normal_image,
-                   emissive, alpha_mode)  # type: ignore[arg-type]  # fmt: skip
+                   emissive, alpha_mode, metallic, roughness, metallic_roughness_image,
+                   occlusion_image)  # type: ignore[arg-type]  # fmt: skip
 
 
 def _gltf_color(factor: Any) -> tuple[float, float, float, float]:
@@ -551,15 +567,21 @@ def _gltf_color(factor: Any) -> tuple[float, float, float, float]:
 
 
 def _gltf_image(gltf: dict[str, Any], reference: dict[str, Any], view_bytes: Any) -> Any:
-    from PIL import Image
-
-    if set(reference) - {"index", "texCoord", "scale"} or reference.get("texCoord", 0) != 0:
+    if set(reference) - {"index", "texCoord", "scale", "strength"} or reference.get("texCoord", 0) != 0:
         raise UnsupportedError("texture reference")
     texture = gltf["textures"][reference["index"]]
     source = gltf["images"][texture["source"]]
     if "bufferView" not in source:
         raise UnsupportedError("image file")
-    return Image.open(io.BytesIO(view_bytes(source["bufferView"])))
+    return _open_image(io.BytesIO(view_bytes(source["bufferView"])), None, f"image {source.get('name', '')!r}")
+
+
+def _open_image(data: Any, file: Path | None, name: str) -> Any:
+    """An embedded or MTL image, its size checked against the memory budget before it is decoded."""
+    from frustum._images import open_image
+
+    where = "load" if file is None else f"load: {file.name}"
+    return open_image(data, where=where, name=name, error=GeometryError)
 
 
 _READERS = {".stl": _read_stl, ".ply": _read_ply, ".off": _read_off, ".obj": _read_obj, ".glb": _read_glb,

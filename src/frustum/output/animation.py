@@ -167,6 +167,7 @@ def _write_mp4(frames: Iterator[NDArray[np.uint8]], path: str, fps: float, where
     import subprocess
     from fractions import Fraction
 
+    ffmpeg = _ffmpeg_program(imageio_ffmpeg, path, where)
     count = 0
     with atomic_path(path, where=where) as temporary:
         process: subprocess.Popen | None = None
@@ -177,7 +178,7 @@ def _write_mp4(frames: Iterator[NDArray[np.uint8]], path: str, fps: float, where
                     even = np.pad(rgb, ((0, rgb.shape[0] % 2), (0, rgb.shape[1] % 2), (0, 0)), mode="edge")
                     if process is None:
                         height, width = even.shape[:2]
-                        command = [imageio_ffmpeg.get_ffmpeg_exe(), "-y", "-v", "error", "-f", "rawvideo",
+                        command = [ffmpeg, "-y", "-v", "error", "-f", "rawvideo",
                                    "-vcodec", "rawvideo", "-s", f"{width}x{height}", "-pix_fmt", "rgb24", "-r",
                                    str(Fraction(fps).limit_denominator()), "-i", "-", "-an", "-vcodec", "libx264",
                                    "-pix_fmt", "yuv420p", "-crf", "25", "-f", "mp4", str(temporary)]  # fmt: skip
@@ -219,6 +220,22 @@ def _write_mp4(frames: Iterator[NDArray[np.uint8]], path: str, fps: float, where
                 "existing, writable folder with free space"
             ) from None
     return count
+
+
+def _ffmpeg_program(imageio_ffmpeg: Any, path: Any, where: str) -> str:
+    """The ffmpeg program imageio-ffmpeg names (``IMAGEIO_FFMPEG_EXE``, else its own), checked to be an executable
+    file before any frame is made: a missing one is said to be ffmpeg's fault, not the output folder's."""
+    try:
+        program = imageio_ffmpeg.get_ffmpeg_exe()
+    except RuntimeError as error:
+        raise OutputError(f"{where}: path = {str(path)!r} asks for MP4, but imageio-ffmpeg finds no ffmpeg program "
+                          f"({error}); reinstall imageio-ffmpeg or write a '.gif'") from None  # fmt: skip
+    if not (os.path.isfile(program) and os.access(program, os.X_OK)):
+        named = " (IMAGEIO_FFMPEG_EXE)" if os.environ.get("IMAGEIO_FFMPEG_EXE") else ""
+        raise OutputError(f"{where}: path = {str(path)!r} asks for MP4, but the ffmpeg program {program!r}{named} "
+                          "is not an executable file; point IMAGEIO_FFMPEG_EXE at ffmpeg, unset it, or write a "
+                          "'.gif'")  # fmt: skip
+    return program
 
 
 def _ffmpeg_reason(log: str) -> str:

@@ -5,7 +5,7 @@ run in parallel.
 (``nogil=True``), no ``fastmath`` (results must be the bytes the textbook path gives), no forced inlining (it
 multiplied compile time: the generalized shading kernel took 15 s to compile with every helper inlined).
 
-``parallel_kernel(items)`` makes the three tiers of STYLE habit 6 from one function: the decorated function is a
+``parallel_kernel(items)`` makes the three tiers of a kernel from one function: the decorated function is a
 single-thread kernel over a slice ``[start, stop)`` of independent items (its last two parameters); the name it
 is bound to is a Python driver taking the same arguments without the slice, which splits ``items(*args)`` items
 into pieces and runs them on the calling thread and ``threads() − 1`` pool threads (kernels release the GIL). Each piece

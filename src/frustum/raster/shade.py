@@ -29,7 +29,10 @@ import math
 import numpy as np
 
 from frustum.raster._jit import kernel, parallel_kernel, prefetch
-from frustum.raster.power import SQUARING_MAX, textbook_power
+from frustum.raster.light import SPECULAR_BLINN as SPECULAR_BLINN
+from frustum.raster.light import SPECULAR_PHONG as SPECULAR_PHONG
+from frustum.raster.light import light_terms, power
+from frustum.raster.power import SQUARING_MAX
 
 __all__ = [
     "SHADE_DEPTH",
@@ -47,7 +50,6 @@ __all__ = [
 ]
 
 SHADE_NONE, SHADE_PHONG, SHADE_FLAT, SHADE_GOURAUD, SHADE_NORMALS, SHADE_DEPTH = 0, 1, 2, 3, 4, 5
-SPECULAR_BLINN, SPECULAR_PHONG = 0, 1
 
 # params layout
 P_EYE, P_COLOR, P_AMBIENT, P_DIFFUSE, P_SPECULAR, P_SHININESS = 0, 3, 6, 7, 8, 9
@@ -78,9 +80,6 @@ def _squarable(n: float) -> bool:
     return n == math.floor(n) and 0.0 <= n <= SQUARING_MAX
 
 
-power = kernel(textbook_power)
-"""``textbook_power`` compiled, for the shading kernels (``shading.illuminate`` calls the plain function: the
-same operations, so the same bytes)."""
 
 
 @kernel
@@ -88,7 +87,8 @@ def _illuminate(
     params: np.ndarray, lights: np.ndarray, specular_model: int,
     px: float, py: float, pz: float, nx: float, ny: float, nz: float,
 ) -> tuple[float, float, float, float, float, float]:  # fmt: skip
-    """(D_r, D_g, D_b, S_r, S_g, S_b) at point P with unit normal N: the module docstring's D and S."""
+    """(D_r, D_g, D_b, S_r, S_g, S_b) at point P with unit normal N: the module docstring's D and S, each light's
+    terms by ``raster.light.light_terms`` (unshadowed: visibility 1)."""
     ex, ey, ez = params[P_EYE], params[P_EYE + 1], params[P_EYE + 2]
     shininess = params[P_SHININESS]
     kd, ks = params[P_DIFFUSE], params[P_SPECULAR]
@@ -102,36 +102,11 @@ def _illuminate(
     if length > 0.0:
         vx, vy, vz = vx / length, vy / length, vz / length
     for k in range(lights.shape[0]):
-        kind = lights[k, 0]
-        falloff = 1.0
-        if kind == 0.0:
-            lx, ly, lz = lights[k, 7], lights[k, 8], lights[k, 9]
-        else:
-            lx, ly, lz = lights[k, 4] - px, lights[k, 5] - py, lights[k, 6] - pz
-            distance = math.sqrt((lx * lx + ly * ly) + lz * lz)
-            lx, ly, lz = lx / distance, ly / distance, lz / distance
-            falloff = 1.0 / ((lights[k, 10] + lights[k, 11] * distance) + lights[k, 12] * distance * distance)
-            if kind == 2.0:
-                cos_alpha = -((lx * lights[k, 7] + ly * lights[k, 8]) + lz * lights[k, 9])
-                cos_inner, cos_outer = lights[k, 13], lights[k, 14]
-                if cos_inner > cos_outer:
-                    falloff *= min(max((cos_alpha - cos_outer) / (cos_inner - cos_outer), 0.0), 1.0)
-                elif cos_alpha < cos_outer:
-                    falloff = 0.0
-        ndl = (nx * lx + ny * ly) + nz * lz
-        if ndl <= 0.0 or falloff == 0.0:
+        lit, lambert, spec = light_terms(lights, k, specular_model, shininess, 1.0, px, py, pz, nx, ny, nz, vx, vy, vz)
+        if not lit:
             continue
-        if specular_model == SPECULAR_PHONG:
-            rx, ry, rz = 2.0 * ndl * nx - lx, 2.0 * ndl * ny - ly, 2.0 * ndl * nz - lz
-            spec = power(max((rx * vx + ry * vy) + rz * vz, 0.0), shininess)
-        else:
-            hx, hy, hz = lx + vx, ly + vy, lz + vz
-            length = math.sqrt((hx * hx + hy * hy) + hz * hz)
-            if length > 0.0:
-                hx, hy, hz = hx / length, hy / length, hz / length
-            spec = power(max((nx * hx + ny * hy) + nz * hz, 0.0), shininess)
-        diffuse = kd * (falloff * ndl)
-        specular = ks * (falloff * spec)
+        diffuse = kd * lambert
+        specular = ks * spec
         dr += diffuse * lights[k, 1]
         dg += diffuse * lights[k, 2]
         db += diffuse * lights[k, 3]
@@ -364,6 +339,8 @@ def _shade_row(
             id_out[row, col] = item[I_OBJECT_ID]
 
 
+# Kernel specialization kept on purpose (docs/architecture.md): ``shade_pixels`` for per-pixel Phong alone, half
+# its time; the light itself is the same ``_illuminate`` (``raster.light.light_terms``).
 @parallel_kernel(lambda depth, codes, *_: codes.shape[0], work=lambda depth, *_: depth.size, grain=16384)
 def shade_pixels_phong(
     depth: np.ndarray, codes: np.ndarray, bary: np.ndarray, faces: np.ndarray, world: np.ndarray,
@@ -490,6 +467,8 @@ def _gather_chunk(
         s[_PZ + i] = _interpolate(u0, u1, u2, world[a, 2], world[b, 2], world[c, 2])
 
 
+# Kernel specialization kept on purpose: ``raster.light.light_terms`` for directional lights (falloff 1), as passes
+# over a chunk of pixels that the compiler vectorizes; the same operations in the same order, so the same bytes.
 @kernel
 def _shade_chunk(
     n: int, s: np.ndarray, where: np.ndarray, params: np.ndarray, lights: np.ndarray, words: np.ndarray

@@ -24,6 +24,7 @@ import numpy as np
 
 from frustum.raster._jit import kernel, parallel_kernel
 from frustum.raster.fixed_point import HALF_SUBPIXEL, SUBPIXEL
+from frustum.raster.light import light_terms
 from frustum.raster.shade import (
     I_BLEND,
     I_FACE_OFFSET,
@@ -46,13 +47,11 @@ from frustum.raster.shade import (
     SHADE_FLAT,
     SHADE_NONE,
     SHADE_PHONG,
-    SPECULAR_PHONG,
     _cue,
     _interpolate,
     _sample,
     _surface,
     _to_byte,
-    power,
 )  # fmt: skip
 from frustum.raster.triangles import (
     _ALPHA,
@@ -266,8 +265,8 @@ def _illuminate_visible(
     params: np.ndarray, lights: np.ndarray, specular_model: int, seen: np.ndarray, row: int, col: int,
     px: float, py: float, pz: float, nx: float, ny: float, nz: float,
 ) -> tuple[float, float, float, float, float, float]:  # fmt: skip
-    """``raster.shade._illuminate`` with each light's diffuse and specular terms scaled by the fraction
-    ``seen[row, col, k]`` of it that reaches the point."""
+    """``raster.shade._illuminate`` with each light's visibility the fraction ``seen[row, col, k]`` of it that
+    reaches the point (``raster.light.light_terms`` scales its diffuse and specular terms)."""
     ex, ey, ez = params[P_EYE], params[P_EYE + 1], params[P_EYE + 2]
     shininess = params[P_SHININESS]
     kd, ks = params[P_DIFFUSE], params[P_SPECULAR]
@@ -281,36 +280,13 @@ def _illuminate_visible(
     if length > 0.0:
         vx, vy, vz = vx / length, vy / length, vz / length
     for k in range(lights.shape[0]):
-        kind = lights[k, 0]
-        falloff = float(seen[row, col, k])
-        if kind == 0.0:
-            lx, ly, lz = lights[k, 7], lights[k, 8], lights[k, 9]
-        else:
-            lx, ly, lz = lights[k, 4] - px, lights[k, 5] - py, lights[k, 6] - pz
-            distance = math.sqrt((lx * lx + ly * ly) + lz * lz)
-            lx, ly, lz = lx / distance, ly / distance, lz / distance
-            falloff /= (lights[k, 10] + lights[k, 11] * distance) + lights[k, 12] * distance * distance
-            if kind == 2.0:
-                cos_alpha = -((lx * lights[k, 7] + ly * lights[k, 8]) + lz * lights[k, 9])
-                cos_inner, cos_outer = lights[k, 13], lights[k, 14]
-                if cos_inner > cos_outer:
-                    falloff *= min(max((cos_alpha - cos_outer) / (cos_inner - cos_outer), 0.0), 1.0)
-                elif cos_alpha < cos_outer:
-                    falloff = 0.0
-        ndl = (nx * lx + ny * ly) + nz * lz
-        if ndl <= 0.0 or falloff == 0.0:
+        visible = float(seen[row, col, k])
+        lit, lambert, spec = light_terms(lights, k, specular_model, shininess, visible, px, py, pz, nx, ny, nz,
+                                         vx, vy, vz)  # fmt: skip
+        if not lit:
             continue
-        if specular_model == SPECULAR_PHONG:
-            rx, ry, rz = 2.0 * ndl * nx - lx, 2.0 * ndl * ny - ly, 2.0 * ndl * nz - lz
-            spec = power(max((rx * vx + ry * vy) + rz * vz, 0.0), shininess)
-        else:
-            hx, hy, hz = lx + vx, ly + vy, lz + vz
-            length = math.sqrt((hx * hx + hy * hy) + hz * hz)
-            if length > 0.0:
-                hx, hy, hz = hx / length, hy / length, hz / length
-            spec = power(max((nx * hx + ny * hy) + nz * hz, 0.0), shininess)
-        diffuse = kd * (falloff * ndl)
-        specular = ks * (falloff * spec)
+        diffuse = kd * lambert
+        specular = ks * spec
         dr += diffuse * lights[k, 1]
         dg += diffuse * lights[k, 2]
         db += diffuse * lights[k, 3]
@@ -320,6 +296,8 @@ def _illuminate_visible(
     return dr, dg, db, sr, sg, sb
 
 
+# Kernel specialization kept on purpose: ``raster.shade.shade_pixels`` with each light's fraction (the visibility
+# argument of ``raster.light.light_terms``); apart, so frames without shadows compile no fraction arrays.
 @parallel_kernel(lambda depth, *_: depth.shape[0], work=lambda depth, *_: depth.size, grain=16384)
 def shade_pixels_shadowed(
     depth: np.ndarray, codes: np.ndarray, bary: np.ndarray, faces: np.ndarray, world: np.ndarray, normals: np.ndarray,
@@ -462,6 +440,7 @@ def fill_depth_tiles(
                 depth[np.uint64(top + r), np.uint64(col0 + c)] = near[np.uint64(r), np.uint64(c)]
 
 
+# Kernel specialization kept on purpose: ``raster.triangles._fill_tile`` writing depth alone (a shadow map).
 @kernel
 def _fill_depth_tile(
     tile: int, faces: np.ndarray, win_int: np.ndarray, win_float: np.ndarray, tri_int: np.ndarray,

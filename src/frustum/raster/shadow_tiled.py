@@ -60,6 +60,7 @@ from frustum.raster.triangles import _fill_tile
 __all__ = ["draw_tiles_shadowed"]
 
 
+# Kernel specialization kept on purpose: ``raster.tiled.draw_tiles_directional`` with shadow-map lookups per pixel.
 @parallel_kernel(lambda *args: segments(args[6].shape[0] - 1, args[8][1], args[8][0]), work=lambda *args: args[9].size,
                  grain=65536, pieces_per_thread=8)  # fmt: skip
 def draw_tiles_shadowed(
@@ -383,6 +384,7 @@ def _tap(shadow_map: np.ndarray, row: int, col: int, limit: float, near: float, 
     return 1.0 if stored >= 1.0 or limit <= near + stored * depth_range else 0.0
 
 
+# Kernel specialization kept on purpose: ``raster.shade._shade_chunk`` with each light's fraction as its visibility.
 @kernel
 def _shade_chunk_shadowed(
     n: int, s: np.ndarray, where: np.ndarray, params: np.ndarray, lights: np.ndarray, words: np.ndarray

@@ -35,6 +35,7 @@ import math
 import numpy as np
 
 from frustum.raster._jit import kernel, parallel_kernel
+from frustum.raster.light import SPECULAR_BLINN, SPECULAR_PHONG, light_terms
 
 __all__ = [
     "BLOCK",
@@ -202,39 +203,19 @@ def _shade(data, matrices, params, lights, u, view_dir, r, g, b):  # pragma: no 
     el = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
     if el > 0.0:
         e0, e1, e2 = e0 / el, e1 / el, e2 / el
-    for light in range(lights.shape[0]):
-        row = lights[light]
-        if row[0] == 0.0:
-            l0, l1, l2, falloff = row[7], row[8], row[9], 1.0
-        else:
-            l0, l1, l2 = row[4] - p0, row[5] - p1, row[6] - p2
-            distance = math.sqrt(l0 * l0 + l1 * l1 + l2 * l2)
-            l0, l1, l2 = l0 / distance, l1 / distance, l2 / distance
-            falloff = 1.0 / (row[10] + row[11] * distance + row[12] * distance * distance)
-            if row[0] == 2.0:
-                cos_alpha = -(l0 * row[7] + l1 * row[8] + l2 * row[9])
-                if row[13] > row[14]:
-                    falloff *= min(max((cos_alpha - row[14]) / (row[13] - row[14]), 0.0), 1.0)
-                elif cos_alpha < row[14]:
-                    falloff = 0.0
-        ndl = n0 * l0 + n1 * l1 + n2 * l2
-        if ndl <= 0.0:
+    specular_model = SPECULAR_PHONG if params[P_SPECULAR_PHONG] != 0.0 else SPECULAR_BLINN
+    for k in range(lights.shape[0]):
+        lit, lambert, spec = light_terms(lights, k, specular_model, shininess, 1.0, p0, p1, p2, n0, n1, n2, e0, e1, e2)
+        if not lit:
             continue
-        if params[P_SPECULAR_PHONG] != 0.0:
-            q0, q1, q2 = 2.0 * ndl * n0 - l0, 2.0 * ndl * n1 - l1, 2.0 * ndl * n2 - l2
-            cosine = max(q0 * e0 + q1 * e1 + q2 * e2, 0.0)
-        else:
-            q0, q1, q2 = l0 + e0, l1 + e1, l2 + e2
-            ql = math.sqrt(q0 * q0 + q1 * q1 + q2 * q2)
-            cosine = max((n0 * q0 + n1 * q1 + n2 * q2) / ql, 0.0) if ql > 0.0 else 0.0
-        spec = falloff * cosine**shininess
-        diffuse = falloff * kd * ndl
-        dr += diffuse * row[1]
-        dg += diffuse * row[2]
-        db += diffuse * row[3]
-        sr += ks * spec * row[1]
-        sg += ks * spec * row[2]
-        sb += ks * spec * row[3]
+        diffuse = kd * lambert
+        specular = ks * spec
+        dr += diffuse * lights[k, 1]
+        dg += diffuse * lights[k, 2]
+        db += diffuse * lights[k, 3]
+        sr += specular * lights[k, 1]
+        sg += specular * lights[k, 2]
+        sb += specular * lights[k, 3]
     return (min(max(r * dr + sr, 0.0), 1.0), min(max(g * dg + sg, 0.0), 1.0), min(max(b * db + sb, 0.0), 1.0))
 
 

@@ -140,6 +140,8 @@ def render(
     shadow_softness: float = 1.0,
     eye_dome: bool = False,
     eye_dome_strength: float = 1.0,
+    tone_map: str = "none",
+    exposure: float = 1.0,
     next: tuple[Scene, Camera] | None = None,
 ) -> Frame:
     """Render `scene` seen by `camera` into a ``Frame`` (color (H, W, 4) uint8 and depth (H, W) float32).
@@ -150,10 +152,14 @@ def render(
         Placed meshes with materials and any number of lights (``frustum.shading``).
     camera : Camera
         Its width and height are the image size.
-    shading : {"phong", "gouraud", "flat", "normals", "depth", "none"} or None
+    shading : {"phong", "gouraud", "flat", "pbr", "normals", "depth", "none"} or None
         Where the illumination model is evaluated: per pixel, per vertex (interpolated), or per face
         (``raster/shade.py``); ``"normals"`` shows $0.5·N + 0.5$ of the world normal, ``"depth"`` the gray
         $(far − d)/(far − near)$ of the view distance; ``"none"`` (or None): the base color, no lighting.
+        ``"pbr"``: every item per pixel by glTF's metallic–roughness model (``frustum.shading.pbr``, lights in
+        glTF units, the scene's environment map as image-based light; a classical material by the mapping
+        there); with ``"phong"`` an item whose ``Material.model`` is ``"pbr"`` is shaded that way too.
+        docs/materials.md.
     specular : {"blinn-phong", "phong"}
         The specular term: (N·H)^n or (R·V)^n.
     background : (4,) array_like
@@ -239,6 +245,12 @@ def render(
     eye_dome, eye_dome_strength : bool, float
         Eye-dome lighting, a post-pass that darkens each pixel by how far its neighbours stand in front of it
         (``render.eye_dome``): shape for unlit point clouds (scans); the strength (> 0) scales the darkening.
+    tone_map : {"none", "aces", "khronos-neutral"}
+        The metallic–roughness model's output transform after `exposure` and before `color_space`
+        (``frustum.shading.tone``): ``"none"`` (default: the radiance, clamped, as the classical model's), the
+        ACES filmic fit, or Khronos PBR Neutral. Classical items are not tone mapped.
+    exposure : float
+        Linear factor (> 0) on the metallic–roughness model's radiance before the tone map.
     next : (Scene, Camera) or None
         With ``"flow"`` in `buffers`: the scene and camera of the next frame (items matched by node path,
         ``Scene.item_paths``). Backward flow: swap the two frames.
@@ -265,6 +277,7 @@ def render(
         color_space=color_space, buffers=buffers, method=method, transparency=transparency, stats=stats,
         max_depth=max_depth, shadows=shadows, shadow_map_size=shadow_map_size, shadow_softness=shadow_softness,
         eye_dome=eye_dome, eye_dome_strength=eye_dome_strength,
+        tone_map=tone_map, exposure=exposure,
     )  # fmt: skip
     if options.factor == 1:
         frame = _draw(scene, camera, options).to_frame(options)

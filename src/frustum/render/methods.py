@@ -22,9 +22,8 @@ from frustum.render.shadows import passes as shadows
 from frustum.render.stages import (
     Lighting,
     Pixels,
-    back_to_front,
     code_type,
-    draw_item,
+    draw_transparent,
     face_offsets,
     shade_item,
     world_attributes,
@@ -177,19 +176,7 @@ def draw_transparent_by_method(scene: Scene, camera: Camera, options: RenderOpti
     if options.transparency == "a-buffer":
         composite_transparent(scene, camera, options, context)
         return
-    height, width = camera.height, camera.width
-    codes_dtype = code_type(items)
-    offsets = face_offsets(items)
-    lighting = Lighting.of(scene)
-    bary = np.zeros((height, width, 2), dtype=np.float32)
-    extra = context.extra()
-    for index in back_to_front(items, clear_items, camera):  # per-object sort, as the depth buffer does
-        item = items[index]
-        layer = Pixels(context.depth.copy(), np.full((height, width), -1, dtype=codes_dtype), bary, context.color,
-                       extra)  # fmt: skip
-        world, normals, band = draw_item(item, camera, options.cull, offsets[index], layer, context.scratch)
-        shade_item(item, index, offsets[index], camera, options, lighting, (world, normals), layer, band,
-                   blend=True)  # fmt: skip
+    draw_transparent(scene, items, camera, options, context)  # per-object sort, as the depth buffer does
 
 
 def composite_transparent(scene: Scene, camera: Camera, options: RenderOptions, context: FrameContext) -> None:

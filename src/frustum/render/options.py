@@ -19,6 +19,7 @@ from frustum.camera import Camera
 from frustum.errors import FrustumError
 from frustum.frame import background_bytes
 from frustum.raster import shade
+from frustum.raster.pbr import SHADE_PBR
 from frustum.scene import Scene
 from frustum.shading import SPECULAR_MODELS, DepthCue
 
@@ -29,6 +30,7 @@ SHADING_MODES = {
     "normals": shade.SHADE_NORMALS,
     "depth": shade.SHADE_DEPTH,
     "none": shade.SHADE_NONE,
+    "pbr": SHADE_PBR,
 }
 """Shading names ``render`` accepts (``None`` means ``"none"``)."""
 RENDER_MODES = ("surface", "wireframe", "points", "hidden-line", "surface+edges")
@@ -90,6 +92,8 @@ DEFAULTS: dict[str, Any] = {
     "shadow_softness": 1.0,
     "eye_dome": False,
     "eye_dome_strength": 1.0,
+    "tone_map": "none",
+    "exposure": 1.0,
     "next": None,
 }
 """``render``'s keyword arguments and their defaults (a test holds them equal to ``render``'s signature)."""
@@ -128,6 +132,9 @@ class RenderOptions:
     max_depth: int = 5
     shadows: bool = False  # method="ray-tracing": cast shadow rays (the other methods: ``shadow`` above)
     eye_dome: float = 0.0  # eye-dome lighting strength (``render.eye_dome``); 0: off
+    tone_map: int = 0  # shading.tone.TONE_MAPS code (the metallic–roughness model's output transform)
+    exposure: float = 1.0
+    physical_ambient: Any = None  # (3,) the scene's AmbientLights summed (zero without one): shading.pbr's I_a
 
     @classmethod
     def from_keywords(cls, scene: Any, camera: Any, where: str = "render", **keywords: Any) -> RenderOptions:
@@ -157,8 +164,10 @@ class RenderOptions:
         eye_dome = eye_dome_strength(k["eye_dome"], k["eye_dome_strength"], where)
         check_image_budget(camera, factor, options.buffers, k["filter"], k["color_space"], where)
         environment = getattr(scene, "environment", None)
+        tone_map, exposure, ambient = physical_options(scene, options, k["tone_map"], k["exposure"], where)
         return dataclasses.replace(options, factor=factor, filter=k["filter"], color_space=k["color_space"],
-                                   environment=environment,
+                                   environment=environment, tone_map=tone_map, exposure=exposure,
+                                   physical_ambient=ambient,
                                    environment_background=environment is not None
                                    and k["background"] is DEFAULT_BACKGROUND,
                                    max_depth=depth, shadows=shadows, eye_dome=eye_dome)  # fmt: skip
@@ -204,6 +213,27 @@ def eye_dome_strength(on: Any, strength: Any, where: str) -> float:
     if not value > 0.0:
         raise FrustumError(f"{where}: eye_dome_strength = {value!r} is not positive; give a strength > 0 (1: default)")
     return value if on else 0.0
+def physical_options(scene: Scene, options: RenderOptions, tone_map: Any, exposure: Any,
+                     where: str) -> tuple[int, float, np.ndarray]:  # fmt: skip
+    """The metallic–roughness model's output transform (``shading.tone``: the tone map's code and the exposure, a
+    linear factor > 0) and the scene's ambient radiance; shading "pbr" is not drawn by the A-buffer."""
+    from frustum.shading import AmbientLight
+    from frustum.shading.tone import TONE_MAPS
+
+    choice(tone_map, tuple(TONE_MAPS), "tone_map", where)
+    factor = as_scalar(exposure, "exposure", where=where, error=FrustumError)
+    if not (math.isfinite(factor) and factor > 0.0):
+        raise FrustumError(f"{where}: exposure = {factor!r} is not a factor > 0 (1: the radiance as computed)")
+    if options.shade_mode == SHADE_PBR and "a-buffer" in (options.method, options.transparency):
+        raise FrustumError(
+            f"{where}: shading = 'pbr' is not drawn by the A-buffer (method or transparency 'a-buffer'); use the "
+            "depth buffer or another method with transparency 'sort'"
+        )
+    ambient = np.zeros(3)
+    for light in scene.world_lights():
+        if isinstance(light, AmbientLight):
+            ambient = ambient + light.color * light.intensity
+    return TONE_MAPS[tone_map], factor, ambient
 
 
 def choice(value: Any, valid: tuple, name: str, where: str) -> Any:
@@ -389,9 +419,10 @@ def ray_options(options: RenderOptions, max_depth: Any, shadows: Any, depth_cue:
         raise FrustumError(f"{where}: shadows = {describe(shadows)} is not None, False, True or 'ray'")
     if tracing:
         name = "none" if shading is None else shading
-        if options.mode != "surface" or name != "phong" or depth_cue is not None or options.transparency != "sort":
+        if (options.mode != "surface" or name not in ("phong", "pbr") or depth_cue is not None
+                or options.transparency != "sort"):  # fmt: skip
             raise FrustumError(
-                f"{where}: method 'ray-tracing' draws mode 'surface' with shading 'phong', no depth_cue and "
+                f"{where}: method 'ray-tracing' draws mode 'surface' with shading 'phong' or 'pbr', no depth_cue and "
                 f"transparency 'sort' (transparent surfaces refract); got mode = {options.mode!r}, shading = "
                 f"{shading!r}, depth_cue = {describe(depth_cue)}, transparency = {options.transparency!r}"
             )

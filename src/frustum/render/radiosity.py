@@ -612,9 +612,12 @@ def radiosity(
     check_memory(estimate * 600.0 + pixels * 16, where=where,
                  cause=f"patch_size = {size:.4g} (about {estimate:.3g} patches)", error=RadiosityError)  # fmt: skip
     work = estimate * estimate * 60.0 if form_factors == "ray" else estimate / shooter**2 * 10.0 * (pixels + estimate)
-    check_operations(work, where=where,
-                     cause=f"patch_size = {size:.4g} (about {estimate:.3g} patches, hemicube {hemicube})",
-                     error=RadiosityError)  # fmt: skip
+    # shots grow with the orders of magnitude the unshot power must fall (the estimates above are for 1e-3, three),
+    # up to the limit of 50 shots a group (about ten times the shots 1e-3 takes)
+    decades = min(-math.log10(tol) / 3.0, 10.0) if max_iterations is None else 1.0
+    check_operations(work * max(decades, 1.0), where=where,
+                     cause=f"patch_size = {size:.4g} (about {estimate:.3g} patches, hemicube {hemicube}, tolerance "
+                           f"{tol:.3g})", error=RadiosityError)  # fmt: skip
     if max_iterations is not None and (isinstance(max_iterations, bool) or not isinstance(max_iterations, int)
                                        or max_iterations < 0):  # fmt: skip
         raise RadiosityError(f"{where}: max_iterations = {max_iterations!r} is not a count >= 0 (or None)")

@@ -32,6 +32,13 @@ is black), and rays whose weight is below ``MIN_WEIGHT`` are not traced. The nor
 is the interpolated (shading) normal; rays start $ε$ (1e-9 of the scene's size) off the surface along the
 geometric normal, on the side they leave to, so that they do not meet it again.
 
+An item the metallic–roughness model shades (``render(shading="pbr")``, or a ``Material(model="pbr")``:
+``frustum.render.pbr.applies``) gets that model's local color instead: the same BRDF, light units and
+image-based light as the depth buffer's (``frustum.shading.pbr``, ``frustum.shading.ibl``, NumPy here), each
+positioned light's term multiplied by its shadow ray's visibility, then exposure and the tone map; a rough metal
+thus reflects the environment's prefiltered light and a metal of roughness 0 the map itself (mirror rays of
+other surfaces are traced for ``Material.reflectivity`` only).
+
 The depth buffer receives the window depth of each primary hit, so volumes and particles are composited along
 the primary rays exactly as with ``method="ray-casting"``; ``buffers=("normals", "object_id")`` show the primary
 hit's. Surface textures are not sampled by this method (the base color is the material's and the vertex
@@ -57,11 +64,11 @@ from numpy.typing import NDArray
 from frustum.budgets import check_operations
 from frustum.camera import Camera
 from frustum.errors import FrustumError
-from frustum.raster.power import textbook_power
 from frustum.render.context import FrameContext
 from frustum.render.options import RenderOptions
 from frustum.scene import Scene
 from frustum.shading import AmbientLight, DirectionalLight, SpotLight, pack_lights
+from frustum.shading.light import specular_terms, toward_light
 
 __all__ = ["MIN_WEIGHT", "RaySegment", "draw_surfaces", "ray_path"]
 
@@ -107,8 +114,9 @@ class _Scene:
     """What the tracer reads of a scene, gathered once: the ray index, per-item material arrays, world vertex
     normals and colors with faces in global vertex numbers, and the lights."""
 
-    def __init__(self, scene: Scene, specular_phong: bool, shadows: bool) -> None:
+    def __init__(self, scene: Scene, specular_phong: bool, shadows: bool, options: RenderOptions | None = None) -> None:
         found = scene._triangle_index(where="render")
+        self.options = options
         self.empty = found is None
         self.lights = scene.world_lights()
         self.ambient, _ = pack_lights(self.lights)
@@ -126,6 +134,15 @@ class _Scene:
         self.reflectivity = np.array([m.reflectivity for m in materials], dtype=np.float64)
         self.opacity = np.array([m.opacity for m in materials], dtype=np.float64)
         self.ior = np.array([m.ior for m in materials], dtype=np.float64)
+        self.physical = np.zeros(len(materials), dtype=bool)
+        if options is not None:  # the metallic–roughness model for the items it shades (render.pbr.applies)
+            from frustum.render.pbr import applies
+            from frustum.shading.pbr import phong_roughness
+
+            self.physical = np.array([applies(item, options) for item in items], dtype=bool)
+            self.metallic = np.array([m.metallic for m in materials], dtype=np.float64)
+            self.roughness = np.array([m.roughness if m.model == "pbr" else phong_roughness(m.shininess)
+                                       for m in materials], dtype=np.float64)  # fmt: skip
         normals, faces, colors, offset = [], [], [], 0
         any_colors = any(item.mesh.vertex_colors is not None for item in items)
         for item in items:
@@ -205,24 +222,11 @@ def _local(data: _Scene, hit: _Hits, counts: dict, record: list | None, parents:
     specular_sum = np.zeros_like(diffuse_sum)
     n = hit.normal
     view = -hit.incoming
+    physical = data.physical[k]
+    direct = np.zeros((int(physical.sum()), 3))  # the metallic–roughness model's direct light (shading.pbr)
     for number, light in data.positioned:
         intensity = np.asarray(light.color, dtype=np.float64) * light.intensity
-        if isinstance(light, DirectionalLight):
-            to_light = np.broadcast_to(-np.asarray(light.direction, dtype=np.float64), n.shape)
-            falloff = np.ones(n.shape[0])
-        else:
-            offset = np.asarray(light.position, dtype=np.float64) - hit.point
-            distance = np.sqrt(np.einsum("ij,ij->i", offset, offset))
-            to_light = offset / np.maximum(distance, 1e-300)[:, None]
-            a0, a1, a2 = light.attenuation
-            falloff = 1.0 / (a0 + a1 * distance + a2 * distance * distance)
-            if isinstance(light, SpotLight):
-                cos_inner, cos_outer = math.cos(light.inner_angle), math.cos(light.outer_angle)
-                cos_alpha = -(to_light @ np.asarray(light.direction, dtype=np.float64))
-                if cos_inner > cos_outer:
-                    falloff = falloff * np.clip((cos_alpha - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0)
-                else:
-                    falloff = falloff * (cos_alpha >= cos_outer)
+        to_light, falloff = toward_light(light, hit.point)  # the light model's attenuation and spot cone
         cosine = np.einsum("ij,ij->i", n, to_light)
         ndl = np.maximum(cosine, 0.0)
         lit = ndl > 0.0
@@ -242,41 +246,55 @@ def _local(data: _Scene, hit: _Hits, counts: dict, record: list | None, parents:
                         "shadow", depth, int(parents[row]), origins[j], directions[j], np.inf, -1, -1,
                         np.full(3, np.nan), np.full(3, np.nan), 0.0, number, bool(blocked[j]),
                     ))  # fmt: skip
-        spec = np.zeros(n.shape[0])
-        on = lit
-        if on.any():
-            if data.specular_phong:
-                reflected = 2.0 * cosine[on, None] * n[on] - to_light[on]
-                x = np.maximum(np.einsum("ij,ij->i", reflected, view[on]), 0.0)
-            else:
-                half = to_light[on] + view[on]
-                half = half / np.sqrt(np.einsum("ij,ij->i", half, half))[:, None]
-                x = np.maximum(np.einsum("ij,ij->i", n[on], half), 0.0)
-            spec[on] = [textbook_power(float(a), float(b)) for a, b in zip(x, shininess[on], strict=True)] \
-                if x.shape[0] < 64 else _power(x, shininess[on])  # fmt: skip
+        spec = specular_terms(to_light, cosine, n, view, shininess, data.specular_phong, lit)  # where lit, unshadowed
         shade = np.where(lit, falloff * ndl, 0.0)
         diffuse_sum = diffuse_sum + (kd * shade)[:, None] * intensity
         specular_sum = specular_sum + (ks * falloff * spec)[:, None] * intensity
-    return np.clip(base * diffuse_sum + specular_sum + data.emissive[k], 0.0, 1.0)
+        if direct.shape[0]:
+            direct += _physical_light(data, light, hit, physical, base, to_light, lit) * intensity
+    color = np.clip(base * diffuse_sum + specular_sum + data.emissive[k], 0.0, 1.0)
+    if direct.shape[0]:
+        color[physical] = _physical_color(data, hit, physical, base, direct)
+    return color
 
 
-def _power(x: np.ndarray, n: np.ndarray) -> np.ndarray:
-    """``textbook_power`` over arrays: repeated squaring for integral exponents in its range, else ``x**n``."""
-    from frustum.raster.power import SQUARING_MAX
+def _physical_light(data: _Scene, light: Any, hit: _Hits, physical: np.ndarray, base: np.ndarray,
+                    to_light: np.ndarray, lit: np.ndarray) -> np.ndarray:  # fmt: skip
+    """$f(l, v)·E·(n·l)$ per unit light intensity at the physical hits (``shading.pbr``: lux, or candela over d²
+    with the range window and the squared spot cone), 0 where the light is hidden."""
+    from frustum.shading import pbr
 
-    out = np.empty_like(x)
-    integral = (n == np.floor(n)) & (n >= 0.0) & (n <= SQUARING_MAX)
-    out[~integral] = x[~integral] ** n[~integral]
-    for value in np.unique(n[integral]):
-        chosen = integral & (n == value)
-        base, result, e = x[chosen].copy(), np.ones(int(chosen.sum())), int(value)
-        while e > 0:
-            if e & 1:
-                result = result * base
-            base = base * base
-            e >>= 1
-        out[chosen] = result
-    return out
+    k = hit.item[physical]
+    point, n, l = hit.point[physical], hit.normal[physical], np.asarray(to_light)[physical]  # noqa: E741
+    illuminance = np.ones(point.shape[0])
+    if not isinstance(light, DirectionalLight):
+        offset = np.asarray(light.position, dtype=np.float64) - point
+        d2 = np.einsum("ij,ij->i", offset, offset)
+        illuminance = pbr.range_window(np.sqrt(d2), light.range or 0.0) / np.maximum(d2, 1e-300)
+        if isinstance(light, SpotLight):
+            cos_alpha = -(l @ np.asarray(light.direction, dtype=np.float64))
+            illuminance *= pbr.spot_cone(cos_alpha, math.cos(light.inner_angle), math.cos(light.outer_angle))
+    f = pbr.brdf(n, l, -hit.incoming[physical], base[physical], data.metallic[k], data.roughness[k])
+    cosine = np.maximum(np.einsum("ij,ij->i", n, l), 0.0)
+    return f * np.where(lit[physical], illuminance * cosine, 0.0)[:, None]
+
+
+def _physical_color(data: _Scene, hit: _Hits, physical: np.ndarray, base: np.ndarray,
+                    direct: np.ndarray) -> np.ndarray:  # fmt: skip
+    """The physical hits' display values: direct light, image-based and ambient light (``shading.ibl``) and
+    emission, then exposure and the tone map (``shading.tone``)."""
+    from frustum.render.pbr import image_light
+    from frustum.shading.ibl import ImageLighting, image_radiance
+    from frustum.shading.tone import TONE_MAPS, tone_map
+
+    options = data.options
+    k = hit.item[physical]
+    sh, maps, table, lit = image_light(options)
+    lighting = ImageLighting(sh, maps, table) if lit else None
+    indirect = image_radiance(lighting, options.physical_ambient, hit.normal[physical], -hit.incoming[physical],
+                              base[physical], data.metallic[k], data.roughness[k])  # fmt: skip
+    name = {code: name for name, code in TONE_MAPS.items()}[options.tone_map]
+    return tone_map(direct + indirect + data.emissive[k], name, options.exposure)
 
 
 def _primary(camera: Camera, rows: np.ndarray, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
@@ -414,7 +432,7 @@ def draw_surfaces(scene: Scene, camera: Camera, options: RenderOptions, context:
     reflections, the deepest level reached."""
     height, width = camera.height, camera.width
     counts = context.counter()
-    data = _Scene(scene, _is_phong(options), options.shadows)
+    data = _Scene(scene, _is_phong(options), options.shadows, options)
     _check_work(camera, data, options.max_depth, "render")
     context.depth = depth = np.ones((height, width), dtype=np.float32)
     context.color = color = np.empty((height, width, 4), dtype=np.uint8)

@@ -15,8 +15,9 @@ from frustum.clipping import VIEW_VOLUME_PLANES
 from frustum.raster import shade, tiles, triangles
 from frustum.raster._jit import threads
 from frustum.raster.vertices import project_vertices, transform_normals, world_points
-from frustum.render import bumps, reflection
+from frustum.render import bumps, pbr, reflection
 from frustum.render.buffers import Scratch
+from frustum.render.context import FrameContext
 from frustum.render.options import GROUND_TRUTH_BUFFERS, RenderOptions
 from frustum.scene import Scene, SceneItem
 from frustum.shading import pack_lights
@@ -300,9 +301,9 @@ def directional(item: SceneItem, options: RenderOptions, lights: np.ndarray, ids
 
 
 def _plain_surface(item: SceneItem, options: RenderOptions) -> bool:
-    """No bump or normal map to shade per pixel, and no environment to reflect."""
+    """A classical material with no bump or normal map to shade per pixel, and no environment to reflect."""
     material = item.material
-    return material.bump is None and material.normal_map is None and (
+    return material.model == "phong" and material.bump is None and material.normal_map is None and (
         options.environment is None or material.reflectivity == 0.0
     )
 
@@ -351,6 +352,11 @@ def shade_item(
              pixels.extra[1][rows_] if write_ids else pixels.extra[1])  # fmt: skip
     params = shading_parameters(item, camera, options, ambient)
     faces = world_faces(item) if mesh.face_count else np.empty((0, 3), dtype=np.int64)
+    if pbr.applies(item, options):  # the metallic–roughness model (render.pbr)
+        flags = item_flags(index, face_offset, options, blend, write_normals, write_ids)
+        pbr.shade_item(item, index, face_offset, camera, options, params, lights, attributes, faces,
+                       (depth, codes, bary, color, *extra), blend, flags)  # fmt: skip
+        return
     if options.shade_mode == shade.SHADE_PHONG and bumps.has_detail(item):  # per-pixel normals from the maps
         flags = item_flags(index, face_offset, options, blend, write_normals, write_ids)
         bumps.shade_detailed(item, faces, world, normals, params, lights, flags, depth, codes, bary, color, extra)
@@ -439,3 +445,25 @@ def code_type(items: list[SceneItem]) -> type:
 def face_offsets(items: list[SceneItem]) -> list[int]:
     """Each item's first face code: the face counts of the items before it, summed."""
     return [int(n) for n in np.cumsum([0] + [item.mesh.face_count for item in items])[:-1]]
+
+
+def draw_transparent(scene: Scene, items: list[SceneItem], camera: Camera, options: RenderOptions,
+                     context: FrameContext) -> None:  # fmt: skip
+    """Stage 6: the transparent items of `items` back to front by the view distance of their centres, each
+    rasterized alone against a copy of the finished depth buffer and blended over ``context.color``."""
+    clear_items = [i for i, item in enumerate(items) if item.material.opacity < 1.0]
+    if not clear_items:
+        return
+    height, width = camera.height, camera.width
+    codes_dtype = code_type(items)
+    lighting = Lighting.of(scene)
+    offsets = face_offsets(items)
+    extra = context.extra()
+    bary = context.scratch.empty((height, width, 2), np.float32)
+    for index in back_to_front(items, clear_items, camera):
+        item = items[index]
+        layer = Pixels(context.depth.copy(), np.full((height, width), -1, dtype=codes_dtype), bary, context.color,
+                       extra)  # fmt: skip
+        world, normals, band = draw_item(item, camera, options.cull, offsets[index], layer, context.scratch)
+        shade_item(item, index, offsets[index], camera, options, lighting, (world, normals), layer, band,
+                   blend=True)  # fmt: skip

@@ -16,17 +16,16 @@ from frustum.render.stages import (
     TILED_BITS,
     Lighting,
     Pixels,
-    back_to_front,
     bin_item,
     code_type,
     directional,
     draw_item,
     face_offsets,
     item_flags,
-    shade_item,
     shading_parameters,
     world_attributes,
 )
+from frustum.render.stages import draw_transparent as draw_transparent
 from frustum.scene import Scene, SceneItem
 
 
@@ -62,28 +61,6 @@ def draw_opaque(scene: Scene, items: list[SceneItem], camera: Camera, options: R
             shadows.shade_item(items[index], index, offsets[index], camera, options, lighting, (world, normals),
                                pixels, band, False, context)  # fmt: skip
         scratch.recycle(bary)  # the transparent items' weights (draw_transparent)
-
-
-def draw_transparent(scene: Scene, items: list[SceneItem], camera: Camera, options: RenderOptions,
-                     context: FrameContext) -> None:  # fmt: skip
-    """Stage 6: the transparent items of `items` back to front by the view distance of their centres, each
-    rasterized alone against a copy of the finished depth buffer and blended over ``context.color``."""
-    clear_items = [i for i, item in enumerate(items) if item.material.opacity < 1.0]
-    if not clear_items:
-        return
-    height, width = camera.height, camera.width
-    codes_dtype = code_type(items)
-    lighting = Lighting.of(scene)
-    offsets = face_offsets(items)
-    extra = context.extra()
-    bary = context.scratch.empty((height, width, 2), np.float32)
-    for index in back_to_front(items, clear_items, camera):
-        item = items[index]
-        layer = Pixels(context.depth.copy(), np.full((height, width), -1, dtype=codes_dtype), bary, context.color,
-                       extra)  # fmt: skip
-        world, normals, band = draw_item(item, camera, options.cull, offsets[index], layer, context.scratch)
-        shade_item(item, index, offsets[index], camera, options, lighting, (world, normals), layer, band,
-                   blend=True)  # fmt: skip
 
 
 def draw_tiled(

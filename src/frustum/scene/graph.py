@@ -21,6 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 from frustum._arrays import Matrix4, as_matrix, as_scalar, as_vector3, describe
 from frustum.errors import FrustumError, GeometryError
 from frustum.geometry import Mesh, Polyline
+from frustum.scene_rays import RayHits
 from frustum.shading import LIGHT_TYPES, Light, Material
 from frustum.shading.environment import EnvironmentMap
 
@@ -106,28 +107,6 @@ class Pick(NamedTuple):
     distance: float
 
 
-class RayHits(NamedTuple):
-    """What ``Scene.intersect`` finds for N rays (a miss: t = inf, item = face = −1, the other fields NaN).
-
-    ``t`` (N,) distance along each ray in units of its direction's length ($point = origin + t·direction$);
-    ``item`` (N,) index into ``Scene.items``; ``face`` (N,) the face index in that item's mesh;
-    ``barycentrics`` (N, 3) the weights of the face's corners 0, 1, 2 (in the mesh's corner order) at the hit;
-    ``point`` (N, 3) the world point; ``normal`` (N, 3) the **geometric** unit normal: the face's plane normal in
-    world coordinates, on its front side (counter-clockwise corners, as the renderer draws it), whichever side
-    the ray meets; ``shading_normal`` (N, 3) the **interpolated** unit normal: the mesh's vertex normals in world
-    coordinates (inverse transpose of the modeling matrix) blended by the barycentrics, as Phong shading
-    interpolates them; ``back`` (N,) bool, True where the ray meets the face's back (direction · normal > 0)."""
-
-    t: NDArray[np.float64]
-    item: NDArray[np.int64]
-    face: NDArray[np.int64]
-    barycentrics: NDArray[np.float64]
-    point: NDArray[np.float64]
-    normal: NDArray[np.float64]
-    shading_normal: NDArray[np.float64]
-    back: NDArray[np.bool_]
-
-
 class ParticleLayer(NamedTuple):
     """A particle system drawn over the surfaces (``Scene.add_particles``); particles are in world coordinates."""
 
@@ -163,38 +142,6 @@ class Placed(NamedTuple):
     @property
     def material(self) -> Material | None:
         return self.node.material
-
-
-def _is_numeric(value: Any) -> bool:
-    try:
-        array = np.asarray(value)
-    except (TypeError, ValueError):
-        return False
-    return array.dtype.kind in "biuf"
-
-
-def _rays(origins: Any, directions: Any, where: str) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """(N, 3) float64 origins and directions from (N, 3) or (3,) rows; FrustumError naming the bad one."""
-    result = []
-    for name, value in (("origins", origins), ("directions", directions)):
-        array = np.asarray(value, dtype=np.float64) if _is_numeric(value) else None
-        if array is None or array.ndim not in (1, 2) or array.shape[-1] != 3:
-            raise FrustumError(f"{where}: {name} = {describe(value)} is not (N, 3) or (3,) numbers")
-        if not np.isfinite(array).all():
-            raise FrustumError(f"{where}: {name} has a value that is not finite (NaN or inf)")
-        result.append(np.ascontiguousarray(array.reshape(-1, 3)))
-    o, d = result
-    if o.shape[0] != d.shape[0]:
-        if o.shape[0] == 1:
-            o = np.ascontiguousarray(np.broadcast_to(o, d.shape))
-        elif d.shape[0] == 1:
-            d = np.ascontiguousarray(np.broadcast_to(d, o.shape))
-        else:
-            raise FrustumError(f"{where}: {o.shape[0]} origins and {d.shape[0]} directions; give one of each per ray")
-    zero = np.flatnonzero(~(d != 0.0).any(axis=1))
-    if zero.size:
-        raise FrustumError(f"{where}: directions[{int(zero[0])}] is zero; a ray needs a direction")
-    return o, d
 
 
 def modeling_transform(transform: ArrayLike | None, where: str) -> Matrix4:
@@ -627,7 +574,7 @@ class Scene:
         point = ray.origin + hits.t[0] * ray.direction
         return Pick(items[item_index], int(face[0] - starts[item_index]), point, float(hits.t[0]))
 
-    def intersect(self, origins: Any, directions: Any) -> RayHits:
+    def intersect(self, origins: Any, directions: Any, fields: Iterable[str] | None = None) -> RayHits:
         """The first surface each ray $origin + t·direction$ (t >= 0) meets: a ``RayHits`` of N rows.
 
         `origins`, `directions`: (N, 3) or (3,) world coordinates (directions need not be unit length; t is in
@@ -635,63 +582,21 @@ class Scene:
         scene's ray index (``raster.rays``: a SAH bounding-volume hierarchy of the world triangles, built on first
         use and kept until the meshes or their transforms change; ``pick``, ``occluded`` and
         ``render(..., method="ray-casting"/"ray-tracing")`` share it). Ties (a ray through an edge shared by two
-        faces) go to the lower face number across the items in drawing order.
+        faces) go to the lower face number across the items in drawing order. `fields` names the ``RayHits``
+        columns to compute (``frustum.scene_rays.RAY_FIELDS``; default all), each in the traversal's own pass;
+        the others are None (``fields=("t", "item", "face")`` costs the traversal alone).
 
         Raises
         ------
         FrustumError
-            Origins or directions not finite (N, 3) rows of the same N, or a zero direction.
+            Origins or directions not finite (N, 3) rows of the same N, a zero direction, or `fields` not names
+            of ``RayHits`` columns.
         GeometryError
             The index would exceed the memory budget (``frustum.budgets``).
         """
-        from frustum.raster import rays
+        from frustum import scene_rays
 
-        where = "Scene.intersect"
-        o, d = _rays(origins, directions, where)
-        count = o.shape[0]
-        t = np.full(count, np.inf)
-        item = np.full(count, -1, dtype=np.int64)
-        face = np.full(count, -1, dtype=np.int64)
-        nan3 = np.full((count, 3), np.nan)
-        found = self._triangle_index(where=where)
-        if found is None or count == 0:
-            return RayHits(t, item, face, nan3, nan3.copy(), nan3.copy(), nan3.copy(), np.zeros(count, dtype=bool))
-        items, index, starts = found
-        numbers, swapped = self._pick_index[4], self._pick_index[5]
-        hits = rays.closest_hits(index, o, d)
-        hit = hits.face >= 0
-        rows = np.flatnonzero(hit)
-        global_face = hits.face[rows]
-        k = np.searchsorted(starts, global_face, side="right") - 1
-        t[rows] = hits.t[rows]
-        item[rows] = numbers[k]
-        face[rows] = global_face - starts[k]
-        u, v = hits.uv[rows, 0], hits.uv[rows, 1]
-        flip = swapped[k]
-        bary = np.stack([1.0 - u - v, np.where(flip, v, u), np.where(flip, u, v)], axis=1)
-        corners = index.triangles[hits.row[rows]]
-        point = o[rows] + hits.t[rows, None] * d[rows]
-        geometric = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-        geometric /= np.linalg.norm(geometric, axis=1, keepdims=True)
-        shading = np.empty((rows.shape[0], 3))
-        for j in np.unique(k):
-            chosen = np.flatnonzero(k == j)
-            scene_item = items[j]
-            matrix = np.asarray(scene_item.world_from_model, dtype=np.float64)
-            normal_matrix = np.linalg.inv(matrix[:3, :3]).T
-            vertex_normals = scene_item.mesh.vertex_normals[scene_item.mesh.faces[face[rows[chosen]]]]  # (n, 3, 3)
-            blended = np.einsum("nc,nci->ni", bary[chosen], vertex_normals) @ normal_matrix.T
-            shading[chosen] = blended
-        length = np.linalg.norm(shading, axis=1, keepdims=True)
-        shading = np.where(length > 0.0, shading / np.where(length > 0.0, length, 1.0), geometric)
-        barycentrics, points, normals, shading_normals = nan3, nan3.copy(), nan3.copy(), nan3.copy()
-        barycentrics[rows] = bary
-        points[rows] = point
-        normals[rows] = geometric
-        shading_normals[rows] = shading
-        back = np.zeros(count, dtype=bool)
-        back[rows] = hits.back[rows] != 0
-        return RayHits(t, item, face, barycentrics, points, normals, shading_normals, back)
+        return scene_rays.intersect(self, origins, directions, fields)
 
     def occluded(self, origins: Any, directions: Any, t_max: Any) -> NDArray[np.bool_]:
         """(N,) bool: whether each ray $origin + t·direction$ meets a surface at some 0 <= t < `t_max`.
@@ -706,66 +611,15 @@ class Scene:
         FrustumError
             As ``intersect``, or `t_max` not a number >= 0 (NaN included) or not one per ray.
         """
-        from frustum.raster import rays
+        from frustum import scene_rays
 
-        where = "Scene.occluded"
-        o, d = _rays(origins, directions, where)
-        count = o.shape[0]
-        limit = np.asarray(t_max, dtype=np.float64) if _is_numeric(t_max) else None
-        if limit is None or limit.ndim > 1 or (limit.ndim == 1 and limit.shape[0] != count):
-            raise FrustumError(f"{where}: t_max = {describe(t_max)} is not a number or one number per ray ({count})")
-        if np.isnan(limit).any() or (limit < 0.0).any():
-            raise FrustumError(f"{where}: t_max = {describe(t_max)} has a value below 0 or NaN; expected t_max >= 0")
-        found = self._triangle_index(where=where)
-        if found is None or count == 0:
-            return np.zeros(count, dtype=bool)
-        return rays.any_hits(found[1], o, d, 0.0, np.broadcast_to(limit, (count,)))
+        return scene_rays.occluded(self, origins, directions, t_max)
 
     def _triangle_index(self, where: str = "Scene.pick") -> tuple[list[SceneItem], Any, np.ndarray] | None:
-        """The scene's triangle index: ``(items, index, starts)`` or None when no mesh has a face.
+        """The scene's triangle index, ``(items, index, starts)`` or None (``frustum.scene_rays.triangle_index``)."""
+        from frustum import scene_rays
 
-        `items` are ``self.items`` that have faces, `index` the ``raster.rays.Index`` of all their
-        triangles in world coordinates (item by item, face by face: triangle ``starts[k] + f`` is face f of
-        ``items[k]``, the renderer's face numbering), corners counter-clockwise seen from the front after the
-        modeling transform (corners 1 and 2 swapped where it reverses handedness, as the renderer draws them).
-        Built once and kept until the scene's meshes or transforms change (``pick``, ``intersect``, ``occluded``
-        and ``render(..., method="ray-casting"/"ray-tracing")`` share it); its memory is checked against the work
-        budget first.
-
-        Raises
-        ------
-        GeometryError
-            The index would exceed the memory budget (``frustum.budgets``).
-        """
-        from frustum.budgets import check_memory
-        from frustum.raster import rays
-
-        every = self.items
-        numbers = np.array([i for i, item in enumerate(every) if item.mesh.face_count], dtype=np.int64)
-        items = [every[i] for i in numbers]
-        if not items:
-            return None
-        key = tuple((id(item.mesh), item.world_from_model.tobytes()) for item in items)
-        cached = getattr(self, "_pick_index", None)
-        if cached is None or cached[0] != key:
-            count = sum(item.mesh.face_count for item in items)
-            check_memory(3 * 72 * count + rays.memory_bytes(count), where=where,
-                         cause=f"a triangle index (BVH) over {count} triangles", error=GeometryError)  # fmt: skip
-            corners = []
-            swapped = []
-            for item in items:
-                matrix = np.asarray(item.world_from_model, dtype=np.float64)
-                faces = item.mesh.faces
-                swapped.append(bool(np.linalg.det(matrix[:3, :3]) < 0.0))
-                if swapped[-1]:
-                    faces = faces[:, [0, 2, 1]]
-                corners.append(item.mesh.vertices[faces] @ matrix[:3, :3].T + matrix[:3, 3])
-            starts = np.cumsum([0] + [c.shape[0] for c in corners])
-            cached = (key, rays.build(np.concatenate(corners)), starts, [item.mesh for item in items], numbers,
-                      np.array(swapped, dtype=bool))  # fmt: skip
-            self._pick_index = cached
-        index, starts = cached[1], cached[2]
-        return items, index, starts
+        return scene_rays.triangle_index(self, where)
 
     def _placed(self, kind: type) -> list[SceneItem]:
         result: list[SceneItem] = []

@@ -40,11 +40,19 @@ from frustum.scenefile.commands import (
     render_view_sheet,
 )
 from frustum.scenefile.geometry import GEOMETRY_TYPES
-from frustum.scenefile.loader import MAX_SCENE_FILE_BYTES, SCHEMA_PATH, SceneFile, load_scene, load_scene_file
+from frustum.scenefile.loader import (
+    ALLOW_READ_VARIABLE,
+    MAX_SCENE_FILE_BYTES,
+    SCHEMA_PATH,
+    SceneFile,
+    load_scene,
+    load_scene_file,
+)
 from frustum.scenefile.outputs import OUTPUT_SUFFIXES
 from frustum.scenefile.transforms import TRANSFORM_STEPS
 
 __all__ = [
+    "ALLOW_READ_VARIABLE",
     "EXAMPLES_DIR",
     "GEOMETRY_TYPES",
     "MAX_SCENE_FILE_BYTES",

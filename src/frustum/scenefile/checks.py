@@ -260,3 +260,36 @@ def _resolve(report: _Report, path: tuple, kind: str, module: str, attribute: st
     except (ImportError, AttributeError):
         report.add(path, kind, "is not available in this version", f"{module}.{attribute} is missing")
         return _BAD
+
+
+def _input_file(report: _Report, path: tuple, name: Any, *, what: str) -> Any:
+    """The file a scene file names as input (a mesh, an image), resolved against its folder: a regular file inside
+    that folder, or inside one the user allowed (``load_scene(..., allow_read=[...])``, ``--allow-read PATH``),
+    once symbolic links are followed; else a problem on `report` and ``_BAD``.
+
+    Inputs are confined as outputs are: a scene file that names ``../../etc/passwd`` or ``/home/x/secret.png``
+    cannot make a service that renders users' scene files show the server's files."""
+    from pathlib import Path
+
+    from frustum._files import file_kind
+
+    if not isinstance(name, str) or not name or "\0" in name:
+        report.add(path, name, "is not a file name", f"give the path of {what}, relative to the scene file's folder")
+        return _BAD
+    base = Path(getattr(report, "base", "."))
+    try:
+        file = (base / name).resolve()
+        roots = [base.resolve(), *(Path(root).resolve() for root in getattr(report, "allow_read", ()))]
+    except (OSError, RuntimeError, ValueError):  # a symbolic-link loop
+        report.add(path, name, "cannot be resolved (a symbolic-link loop?)", f"give {what} inside the scene's folder")
+        return _BAD
+    if not any(file.is_relative_to(root) for root in roots):
+        report.add(path, name, f"lies outside the scene file's folder ({file})",
+                   f"give {what} inside {str(roots[0])!r}, or allow its folder: load_scene(..., allow_read=[...]) "
+                   "or --allow-read PATH")  # fmt: skip
+        return _BAD
+    if not file.is_file():
+        problem = f"is not a regular file ({file_kind(file)})" if file.exists() else "does not exist"
+        report.add(path, name, f"{problem} (looked for {file})", f"give {what} relative to the scene file's folder")
+        return _BAD
+    return file

@@ -12,7 +12,6 @@ from typing import Any
 
 import numpy as np
 
-from frustum._files import file_kind
 from frustum.errors import FrustumError
 from frustum.geometry import Mesh
 from frustum.scene import Node
@@ -21,6 +20,7 @@ from frustum.scenefile.checks import (
     _boolean,
     _call,
     _choice,
+    _input_file,
     _number,
     _resolve,
     _table,
@@ -378,14 +378,8 @@ def _mesh_file(report: _Report, path: tuple, params: dict, base: Path, loader: C
         report.missing((*path, "path"), "give the mesh file, relative to the scene file")
         return _BAD
     name = params["path"]
-    if not isinstance(name, str) or not name:
-        report.add((*path, "path"), name, "is not a file name", "give a path string such as 'model.obj'")
-        return _BAD
-    file = (base / name).resolve()
-    if not file.is_file():
-        problem = f"is not a regular file ({file_kind(file)})" if file.exists() else "does not exist"
-        report.add((*path, "path"), name, f"{problem} (looked for {file})",
-                   "give a mesh file relative to the scene file's folder")  # fmt: skip
+    file = _input_file(report, (*path, "path"), name, what="a mesh file")
+    if file is _BAD:
         return _BAD
     if len(params) > 1:
         return _BAD

@@ -2,19 +2,17 @@
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from frustum.budgets import format_bytes, get_budget
-from frustum.errors import FrustumError
-from frustum.scenefile.checks import _call, _choice, _table, _table_list, _unknown_keys
+from frustum.errors import FrustumError, SceneFileError
+from frustum.scenefile.checks import _call, _choice, _input_file, _table, _table_list, _unknown_keys
 from frustum.scenefile.report import _BAD, _Report
 from frustum.shading import AmbientLight, DirectionalLight, Material, PointLight, SpotLight
 from frustum.shading.environment import ENVIRONMENT_KINDS, EnvironmentMap
 
-IMAGE_KEYS = ("texture", "bump", "normal_map")
+IMAGE_KEYS = ("texture", "bump", "normal_map", "base_color_texture", "metallic_roughness_texture", "occlusion_texture")
 """Material keys that name an image file (relative to the scene file's folder): PNG, JPEG, anything Pillow reads."""
 
 _LIGHT_TYPES = {"ambient": AmbientLight, "directional": DirectionalLight, "point": PointLight, "spot": SpotLight}
@@ -35,25 +33,18 @@ def _material(report: _Report, path: tuple, value: Any) -> Any:
 
 def _image(report: _Report, path: tuple, value: Any) -> Any:
     """The image file `value` names (relative to the scene file's folder) as an (H, W, 3|4) uint8 array."""
-    from PIL import Image
 
-    if not isinstance(value, str) or not value:
-        report.add(path, value, "is not a file name", "give the path of a PNG or JPEG image, relative to the file")
+    file = _input_file(report, path, value, what="a PNG or JPEG image")
+    if file is _BAD:
         return _BAD
-    file = Path(getattr(report, "base", ".")) / value
-    if not file.is_file():
-        problem = "does not exist" if not file.exists() else "is not a regular file"
-        report.add(path, value, problem, f"give an image file (looked for {str(file)!r})")
-        return _BAD
+    from frustum._images import decode, open_image
+
     try:
-        with Image.open(file) as image:
-            width, height = image.size
-            budget = get_budget().bytes
-            if width * height * 24 > budget:
-                report.add(path, value, f"is a {width} x {height} image, over the memory budget of "
-                           f"{format_bytes(budget)}", "give a smaller image or raise the budget")  # fmt: skip
-                return _BAD
-            return np.asarray(image.convert("RGBA" if "A" in image.mode else "RGB"), dtype=np.uint8)
+        with open_image(file, where="image", name=repr(value), error=SceneFileError) as image:
+            return np.asarray(decode(image).convert("RGBA" if "A" in image.mode else "RGB"), dtype=np.uint8)
+    except SceneFileError as error:  # over the memory budget, said before decoding
+        report.add(path, value, "is an image over the memory budget", str(error).split("needs ", 1)[-1])
+        return _BAD
     except Exception as error:  # Pillow raises many types for unreadable or hostile files
         report.add(path, value, f"could not be read as an image ({type(error).__name__})",
                    "give a PNG or JPEG image")  # fmt: skip
@@ -72,9 +63,8 @@ def _environment(report: _Report, path: tuple, value: Any) -> Any:
         return _BAD
     kind = _choice(report, (*path, "kind"), params.get("kind", "equirect"), ENVIRONMENT_KINDS)
     image = params["image"]
-    file = Path(getattr(report, "base", ".")) / image if isinstance(image, str) else None
-    if file is None or not file.is_file():
-        report.add((*path, "image"), image, "is not an image file", "give the path of an image, relative to the file")
+    file = _input_file(report, (*path, "image"), image, what="an image of the surroundings")
+    if file is _BAD:
         return _BAD
     if kind is _BAD:
         return _BAD

@@ -4,7 +4,9 @@ built with all problems reported at once (``_build``), and the ``SceneFile`` it 
 from __future__ import annotations
 
 import dataclasses
+import os
 import re
+import sys
 import tomllib
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -153,7 +155,11 @@ def _tile(frames: list[Frame], columns: int, background: Sequence[float]) -> Fra
 
 
 def load_scene(
-    data: Mapping[str, Any] | str | Path, *, source: str = "<scene>", base_dir: str | Path = "."
+    data: Mapping[str, Any] | str | Path,
+    *,
+    source: str = "<scene>",
+    base_dir: str | Path = ".",
+    allow_read: Sequence[str | Path] = (),
 ) -> SceneFile:
     """Validate and build a scene from TOML text or an already parsed dictionary; or load a file: a ``Path``, or a
     one-line string ending in ``.toml`` or a mesh suffix (``MODEL_SUFFIXES``), goes to ``load_scene_file``.
@@ -169,6 +175,10 @@ def load_scene(
         The name errors start with (the file name).
     base_dir : str or Path
         Folder that relative paths (mesh files, outputs) are resolved against.
+    allow_read : sequence of str or Path
+        Folders outside `base_dir` whose files (meshes, images) the scene may read. By default a scene reads
+        only inside its own folder, as it writes only there: a path that leads elsewhere (``..``, absolute, or
+        through a symbolic link) is refused.
 
     Raises
     ------
@@ -178,12 +188,17 @@ def load_scene(
     if isinstance(data, Path) or (
         isinstance(data, str) and "\n" not in data and data.lower().endswith((".toml", *MODEL_SUFFIXES))
     ):
-        return load_scene_file(data)
-    return _load_scene(data, source=source, base_dir=base_dir)
+        return load_scene_file(data, allow_read=allow_read)
+    return _load_scene(data, source=source, base_dir=base_dir, allow_read=allow_read)
 
 
 def _load_scene(
-    data: Mapping[str, Any] | str, *, source: str = "<scene>", base_dir: str | Path = ".", check_outputs: bool = True
+    data: Mapping[str, Any] | str,
+    *,
+    source: str = "<scene>",
+    base_dir: str | Path = ".",
+    check_outputs: bool = True,
+    allow_read: Sequence[str | Path] = (),
 ) -> SceneFile:
     """``load_scene``. ``check_outputs=False`` for a caller that writes elsewhere (``render_scene_file`` with an
     output, ``frustum render FILE -o``): ``[output].files`` outside `base_dir` are not written, so not refused;
@@ -202,22 +217,31 @@ def _load_scene(
         except RecursionError:
             raise SceneFileError(f"{escape_control(source)}: the text nests too deeply to parse; "
                                  f"nest arrays and tables at most {_MAX_NESTING} deep") from None  # fmt: skip
+        except ValueError as error:  # an integer of more digits than Python converts (sys.get_int_max_str_digits)
+            raise SceneFileError(f"{escape_control(source)}: a number in the text is too long to read "
+                                 f"({escape_control(str(error))[:120]}); write numbers of at most "
+                                 f"{sys.get_int_max_str_digits()} digits") from None  # fmt: skip
         lines = data  # the key-line scan (linear, but slow in Python) runs only if a problem is reported
     elif isinstance(data, Mapping):
         parsed = dict(data)
     else:
         raise SceneFileError(f"{source}: data = {describe(data)} is not TOML text or a table; give a str or a dict")
     report = _Report(source, lines)
+    report.allow_read = tuple(_as_folders(allow_read))
     scene_file = _build(report, parsed, Path(base_dir), check_outputs)
     report.raise_if_any()
     assert scene_file is not None
     return dataclasses.replace(scene_file, path=None)
 
 
-_TOKENS = re.compile(r'"""|\'\'\'|"(?:\\.|[^"\\\n])*"|\'[^\'\n]*\'|#[^\n]*|[\[\]{}]|\n')
+_TOKENS = re.compile(r'"""|\'\'\'|"[^"\\\n]*(?:\\.[^"\\\n]*)*"|\'[^\'\n]*\'|#[^\n]*|[\[\]{}]|\n')
+"""Triple quotes, strings (the basic one written as an unrolled loop, so a long string is one linear match),
+comments, brackets and newlines."""
 
 
-_DOTTED = re.compile(r"(?:(?:[A-Za-z0-9_-]+|\"[^\"\n]*\"|'[^'\n]*')[ \t]*\.[ \t]*){" + str(_MAX_NESTING) + "}")
+_KEY_TOKENS = re.compile(r'[A-Za-z0-9_-]+|""|[ \t]+|\.|\n|[^A-Za-z0-9_\-". \t\n]+|"')
+"""The text with its strings blanked, cut into bare keys, empty strings, blanks, dots, newlines and the rest: every
+alternative either matches what it consumes or fails on its first character, so the scan is linear."""
 
 
 def _check_shape(text: str, source: str) -> None:
@@ -259,11 +283,34 @@ def _check_shape(text: str, source: str) -> None:
     if multiline is None:
         code.append(text[last:])
     stripped = "".join(code)
-    dotted = _DOTTED.search(stripped)
-    if dotted:
-        line = stripped.count("\n", 0, dotted.start()) + 1
+    line = _deep_dotted_key_line(stripped)
+    if line is not None:
         raise SceneFileError(f"{where}:{line}: a dotted key has more than {_MAX_NESTING} parts; write at most "
                              f"{_MAX_NESTING} levels of tables")  # fmt: skip
+
+
+def _deep_dotted_key_line(code: str) -> int | None:
+    """The line of the first dotted key of more than `_MAX_NESTING` parts in `code` (strings blanked), or None.
+
+    A state machine over `_KEY_TOKENS` (no backtracking pattern on user text: linear in the text's length)."""
+    line, dots, after_key = 1, 0, False
+    for token in _KEY_TOKENS.finditer(code):
+        value = token.group()
+        if value == ".":
+            dots = dots + 1 if after_key else 0
+            after_key = False
+            if dots >= _MAX_NESTING:
+                return line
+        elif value[0] in " \t":
+            continue
+        elif value == '""' or value[0].isalnum() or value[0] in "_-":
+            if after_key:  # two keys in a row: a new key, not the next part of this one
+                dots = 0
+            after_key = True
+        else:
+            dots, after_key = 0, False
+            line += value == "\n"
+    return None
 
 
 def _radiosity(report: _Report, path: tuple, value: Any) -> dict | None:
@@ -339,7 +386,8 @@ def _build(report: _Report, data: dict, base: Path, check_outputs: bool = True) 
     else:
         report.missing(("camera",), "add a [camera] table with eye and target (or [[cameras]])")
     if cameras and _wants_default_lights(data, scene, options):
-        for light in default_lights(cameras[0]):  # no lights named: the default three-point set around the camera
+        physical = any(item.material.model == "pbr" for item in scene.items)  # lights in lux for those materials
+        for light in default_lights(cameras[0], physical):  # no lights named: the three-point set around the camera
             scene.root.add_light(light)
     outputs, animation, svg = _outputs(report, data, base, check_outputs)
     _check_image_memory(report, options, size, max(len(cameras), 1))
@@ -381,13 +429,15 @@ def _fits(data: dict) -> bool:
     return isinstance(camera, dict) and camera.get("fit") is True
 
 
-def load_scene_file(path: str | Path, *, up: str = "y") -> SceneFile:
+def load_scene_file(path: str | Path, *, up: str = "y", allow_read: Sequence[str | Path] = ()) -> SceneFile:
     """Read, validate and build the TOML scene file at `path` (relative paths inside resolve against its folder),
     or the scene of a mesh file (.obj .stl .ply .off .gltf .glb).
 
     A mesh file gives the scene a file with only ``[[nodes]] geometry = { type = "mesh", path = ... }`` would,
     with the file's materials and textures, a camera framing it from a 3/4 view (``Camera.fit``) and the default
     lights (``frustum.scenefile.models``); `up` = "z" stands a z-up model upright (glTF is y-up and ignores it).
+    A scene file reads meshes and images only inside its own folder and the folders of `allow_read`
+    (``load_scene``).
 
     Raises
     ------
@@ -397,10 +447,31 @@ def load_scene_file(path: str | Path, *, up: str = "y") -> SceneFile:
     GeometryError
         If a mesh file cannot be read.
     """
-    return _load_scene_file(path, up=up)
+    return _load_scene_file(path, up=up, allow_read=allow_read)
 
 
-def _load_scene_file(path: str | Path, check_outputs: bool = True, *, up: str = "y") -> SceneFile:
+ALLOW_READ_VARIABLE = "FRUSTUM_ALLOW_READ"
+"""Folders (``os.pathsep``-separated) every scene file may read besides its own: what ``frustum --allow-read PATH``
+sets, so that worker processes and the viewer's server follow the same rule."""
+
+
+def _as_folders(allow_read: Any) -> list[Path]:
+    """`allow_read` as a list of folders (a single path is one folder), with those of ``FRUSTUM_ALLOW_READ``; names
+    that are not paths are refused."""
+    if isinstance(allow_read, (str, Path)):
+        allow_read = [allow_read]
+    allow_read = [*allow_read, *filter(None, os.environ.get(ALLOW_READ_VARIABLE, "").split(os.pathsep))]
+    folders = []
+    for entry in allow_read:
+        if not isinstance(entry, (str, Path)) or not str(entry) or "\0" in str(entry):
+            raise SceneFileError(f"allow_read = {describe(entry)} is not a folder path; give folder paths")
+        folders.append(Path(entry))
+    return folders
+
+
+def _load_scene_file(
+    path: str | Path, check_outputs: bool = True, *, up: str = "y", allow_read: Sequence[str | Path] = ()
+) -> SceneFile:
     """``load_scene_file``; ``check_outputs`` as for ``_load_scene``."""
     file = Path(path)
     if file.suffix.lower() in MODEL_SUFFIXES:
@@ -416,7 +487,8 @@ def _load_scene_file(path: str | Path, check_outputs: bool = True, *, up: str = 
     except (OSError, UnicodeDecodeError) as error:
         reason = getattr(error, "strerror", None) or str(error)
         raise SceneFileError(f"{shown}: cannot be read ({reason}); give an existing UTF-8 TOML scene file") from None
-    scene_file = _load_scene(text, source=str(file), base_dir=file.parent, check_outputs=check_outputs)
+    scene_file = _load_scene(text, source=str(file), base_dir=file.parent, check_outputs=check_outputs,
+                             allow_read=allow_read)  # fmt: skip
     return dataclasses.replace(scene_file, path=file)
 
 
@@ -425,8 +497,9 @@ MODEL_SUFFIXES = (".obj", ".stl", ".ply", ".off", ".gltf", ".glb", ".xyz", ".pts
 
 
 def _model_scene_file(file: Path, up: str) -> SceneFile:
-    from frustum.scenefile.models import model_options, model_scene
+    from frustum.scenefile.models import model_options, model_scene, physical_options
 
     scene, camera = model_scene(file, up=up, size=_DEFAULT_SIZE)
-    return SceneFile(scene, camera, model_options(scene), (), (camera,), size=_DEFAULT_SIZE, title=file.stem,
-                     path=file, up=up)  # fmt: skip
+    options = {**model_options(scene), **physical_options(scene)}
+    return SceneFile(scene, camera, options, (), (camera,), size=_DEFAULT_SIZE, title=file.stem, path=file,
+                     up=up)  # fmt: skip

@@ -1,6 +1,8 @@
 """A mesh file where a scene file goes: the scene a ``[[nodes]] geometry = { type = "mesh", path = ... }`` file
-gives, with the file's own materials (base colours, textures, normal maps), a camera framing the model from a 3/4
-view (``Camera.fit``) and the default lights (``default_lights``) when nothing else names lights. Scene files
+gives, with the file's own materials (base colours, textures, normal maps; glTF's metallic–roughness materials as
+``model="pbr"``, rendered tone mapped and sRGB-encoded as glTF viewers do: ``physical_options``), a camera framing
+the model from a 3/4 view (``Camera.fit``) and the default lights (``default_lights``) when nothing else names
+lights. Scene files
 that name no lights get the same default lights around their camera when they draw lit surfaces (see
 ``frustum.scenefile.loader._wants_default_lights``; ``lights = []`` keeps a scene unlit on purpose).
 
@@ -14,6 +16,7 @@ Default lights (a three-point setup placed relative to the camera, so every view
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Any
 
@@ -29,27 +32,44 @@ MODEL_UP_AXES = ("y", "z")
 _Z_UP_TO_Y_UP = np.array([[1.0, 0, 0, 0], [0, 0, 1.0, 0], [0, -1.0, 0, 0], [0, 0, 0, 1.0]])  # rotate_x(-90°)
 
 
-def default_lights(camera: Camera) -> list[Any]:
+PHYSICAL_AMBIENT = 0.25
+"""The default ambient radiance of a scene of metallic–roughness materials (its uniform surroundings)."""
+
+
+def default_lights(camera: Camera, physical: bool = False) -> list[Any]:
     """The key, fill and rim directional lights and an ambient light, placed in world space around `camera`'s view
-    (see the module docstring); each ``direction`` is where the light travels."""
+    (see the module docstring); each ``direction`` is where the light travels. `physical`: for metallic–roughness
+    materials, the directional lights in lux, π times the intensities above (a white Lambertian surface facing
+    the key then shows 0.85, as under the classical model), and ambient radiance ``PHYSICAL_AMBIENT``."""
     u, v, n = camera.frame.u, camera.frame.v, camera.frame.n  # right, up, back toward the eye
 
     def towards_model(source: np.ndarray) -> tuple[float, ...]:
         direction = -source / np.linalg.norm(source)
         return tuple(float(x) for x in direction)
 
+    scale = math.pi if physical else 1.0
     return [
-        DirectionalLight(towards_model(-0.6 * u + 0.8 * v + 0.7 * n), intensity=0.85),
-        DirectionalLight(towards_model(0.9 * u + 0.1 * v + 0.5 * n), intensity=0.35),
-        DirectionalLight(towards_model(0.3 * u + 0.6 * v - 1.0 * n), intensity=0.45),
-        AmbientLight(intensity=0.35),
+        DirectionalLight(towards_model(-0.6 * u + 0.8 * v + 0.7 * n), intensity=0.85 * scale),
+        DirectionalLight(towards_model(0.9 * u + 0.1 * v + 0.5 * n), intensity=0.35 * scale),
+        DirectionalLight(towards_model(0.3 * u + 0.6 * v - 1.0 * n), intensity=0.45 * scale),
+        AmbientLight(intensity=PHYSICAL_AMBIENT if physical else 0.35),
     ]
+
+
+def physical_options(scene: Scene) -> dict[str, Any]:
+    """Render options for a model: a scene with a metallic–roughness material is written as a glTF viewer writes
+    it, tone mapped (Khronos PBR Neutral) and sRGB-encoded; others get none (the library's defaults)."""
+    if any(item.material.model == "pbr" for item in scene.items):
+        return {"tone_map": "khronos-neutral", "color_space": "srgb"}
+    return {}
 
 
 def part_material(part: Any) -> Material:
     """The ``Material`` a loaded ``MeshPart`` carries: its base colour (white under a texture, which it multiplies),
     its texture, its normal map, glTF's emissive factor, its alpha as opacity (not for glTF's alphaMode OPAQUE);
-    a part with none of them gets a light neutral gray."""
+    a part with none of them gets a light neutral gray. A glTF part's material is ``model="pbr"`` with the file's
+    metallic and roughness factors (the specification's default 1 where it gives none), its metallic–roughness and
+    occlusion textures, and its base colour texture decoded from sRGB (``Material(base_color_texture=)``)."""
     color = part.color
     texture = part.texture
     normal_map = getattr(part, "normal_map", None)
@@ -60,6 +80,12 @@ def part_material(part: Any) -> Material:
     if getattr(part, "alpha_mode", None) == "OPAQUE":  # glTF: alpha is ignored unless the mode is BLEND (or MASK)
         opacity = 1.0
     emissive = getattr(part, "emissive", None) or (0.0, 0.0, 0.0)
+    if getattr(part, "physical", False):
+        return Material(color=rgb, base_color_texture=texture, normal_map=normal_map, opacity=opacity, specular=0.2,
+                        emissive=emissive, model="pbr", metallic=1.0 if part.metallic is None else part.metallic,
+                        roughness=1.0 if part.roughness is None else part.roughness,
+                        metallic_roughness_texture=part.metallic_roughness_texture,
+                        occlusion_texture=part.occlusion_texture)  # fmt: skip
     return Material(color=rgb, texture=texture, normal_map=normal_map, opacity=opacity, specular=0.2,
                     emissive=emissive)  # fmt: skip
 
@@ -101,7 +127,8 @@ def model_scene(path: str | Path, *, up: str = "y", size: tuple[int, int] = (640
             scene.add(node)
     width, height = size
     camera = Camera.fit(scene, width=width, height=height)
-    for light in default_lights(camera):
+    physical = any(item.material.model == "pbr" for item in scene.items)
+    for light in default_lights(camera, physical):
         scene.root.add_light(light)
     return scene, camera
 

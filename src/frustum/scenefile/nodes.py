@@ -72,7 +72,8 @@ def _mesh_file_parts(report: _Report, path: tuple, table: dict, base: Path) -> t
         return _BAD, [], None
     if len(parts) == 1 and np.allclose(parts[0].world_from_model, np.eye(4)):
         part = parts[0]
-        has_own = any(x is not None for x in (part.texture, part.color, part.normal_map, part.emissive))
+        own = (part.texture, part.color, part.normal_map, part.emissive)
+        has_own = part.physical or any(x is not None for x in own)
         return part.mesh, [], part_material(part) if has_own else None
     return None, part_nodes(parts), None
 

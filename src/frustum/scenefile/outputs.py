@@ -29,6 +29,7 @@ from frustum.scenefile.checks import (
 )
 from frustum.scenefile.report import _BAD, _Report
 from frustum.shading import SPECULAR_MODELS, DepthCue
+from frustum.shading.tone import TONE_MAPS
 
 OUTPUT_SUFFIXES = (".png", ".svg", ".pdf", ".gif", ".mp4")
 """What ``render_scene_file`` writes, chosen by the output's suffix."""
@@ -41,7 +42,8 @@ _MAX_PIXELS = 8192
 _RENDER_KEYS = (
     "size", "shading", "specular", "background", "cull_back_faces", "mode", "edges", "crease_angle_deg", "edge_color",
     "hidden", "hidden_color", "line_width", "depth_cue", "samples", "filter", "color_space", "columns", "method",
-    "transparency", "max_depth", "shadows", "shadow_map_size", "shadow_softness", "eye_dome", "eye_dome_strength",
+    "transparency", "max_depth", "shadows", "shadow_map_size", "shadow_softness", "tone_map", "exposure", "eye_dome",
+    "eye_dome_strength",
 )  # fmt: skip
 
 
@@ -98,6 +100,8 @@ def _render_options(report: _Report, path: tuple, value: Any) -> tuple[dict, tup
         "shadow_softness": lambda p, v: _number(report, p, v, low=0.0, high=16.0),
         "eye_dome": lambda p, v: _boolean(report, p, v),
         "eye_dome_strength": lambda p, v: _number(report, p, v, low=0.0, low_open=True),
+        "tone_map": lambda p, v: _choice(report, p, v, tuple(TONE_MAPS)),
+        "exposure": lambda p, v: _number(report, p, v, low=1e-6, high=1e6),
     }
     for key, check in simple.items():
         if key in params:

@@ -4,6 +4,7 @@
 ``frustum.shading`` re-exports the classical model's names, as the single module of that name did before it became
 a package; the formulas live in the submodules (``docs/architecture.md``)."""
 
+from frustum.shading.light import blinn_phong, illuminate
 from frustum.shading.model import (
     LIGHT_FIELDS,
     LIGHT_TYPES,
@@ -15,8 +16,6 @@ from frustum.shading.model import (
     Material,
     PointLight,
     SpotLight,
-    blinn_phong,
-    illuminate,
     pack_lights,
     sun_45,
 )

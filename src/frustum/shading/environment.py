@@ -135,6 +135,14 @@ class EnvironmentMap:
         else:
             import imageio.v3 as iio
 
+            from frustum._images import open_image
+
+            try:
+                open_image(name, where=where, name=repr(name), error=ShadingError).close()  # the size, first
+            except ShadingError:
+                raise
+            except Exception:  # not an image Pillow knows (EXR): imageio's plugins may
+                pass
             try:
                 image = iio.imread(name)
             except Exception as error:  # imageio raises many types for unreadable files

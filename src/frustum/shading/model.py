@@ -19,7 +19,7 @@ with
 
 Colors are linear RGB in [0, 1]; the result is clamped to [0, 1] and stored as $floor(I·255 + 0.5)$.
 With one white directional light of intensity 1 and no ambient light this is exactly the formula of
-``../shared/bench/README.md``, bit for bit. ``illuminate`` below is the readable one-point version; the
+``../shared/bench/README.md``, bit for bit. ``shading.light.illuminate`` is the readable one-point version; the
 kernels are in ``raster/shade.py``.
 
 Depth cueing [HB 10] "Depth Cueing" blends each color toward a cue color by its distance d from the viewing
@@ -45,7 +45,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from frustum._arrays import Matrix4, Vector3, as_direction, as_scalar, as_vector3, describe, read_only
 from frustum.errors import ShadingError
-from frustum.raster.power import textbook_power as power
+from frustum.shading.tone import srgb_to_linear
 from frustum.transforms import apply, apply_to_directions
 
 __all__ = [
@@ -57,17 +57,18 @@ __all__ = [
     "Material",
     "PointLight",
     "SpotLight",
-    "blinn_phong",
-    "illuminate",
     "pack_lights",
 ]
 
 SPECULAR_MODELS = ("blinn-phong", "phong")
 """Specular terms ``illuminate`` and ``render`` accept: Blinn-Phong (N·H)^n (default) or Phong (R·V)^n."""
 
+MATERIAL_MODELS = ("phong", "pbr")
+"""``Material(model=)``: the classical illumination model or glTF's metallic–roughness model."""
+
 LIGHT_FIELDS = 16
 """Row length of ``pack_lights``: kind, I_l (3), position (3), to-light or axis direction (3), attenuation (3),
-cos θ_inner, cos θ_outer, spare."""
+cos θ_inner, cos θ_outer, range."""
 LIGHT_DIRECTIONAL, LIGHT_POINT, LIGHT_SPOT = 0, 1, 2
 
 
@@ -99,6 +100,16 @@ def _check_cast_shadows(value: Any, where: str) -> None:
     """``cast_shadows`` (whether surfaces shadow this light where a method draws shadows) must be a bool."""
     if not isinstance(value, bool | np.bool_):
         raise ShadingError(f"{where}: cast_shadows = {describe(value)} is not a bool; give True or False")
+
+
+def _check_range(light: Any, where: str) -> None:
+    """A point or spot light's ``range``: None or a finite distance > 0."""
+    if light.range is None:
+        return
+    reach = as_scalar(light.range, "range", where=where, error=ShadingError)
+    if not reach > 0.0:
+        raise ShadingError(f"{where}: range = {reach!r} is not a distance > 0; give one, or None for no limit")
+    object.__setattr__(light, "range", reach)
 
 
 def _texture(value: Any, where: str) -> NDArray[np.float32] | None:
@@ -139,6 +150,14 @@ class Material:
     ``bump`` an (H, W[, 3|4]) height image (gray, in [0, 1], times ``bump_scale`` world units) and ``normal_map``
     an (H, W, 3|4) tangent-space normal image (OpenGL convention, +y up): both perturb the shading normal per pixel
     in Phong shading, from the mesh's UVs (``frustum.shading.surface_detail``; flat and Gouraud shading ignore them).
+    ``model`` the illumination model the material is written for: ``"phong"`` (the classical coefficients above)
+    or ``"pbr"``, glTF's metallic–roughness model (``frustum.shading.pbr``): ``color`` is the base colour,
+    ``metallic`` and ``roughness`` in [0, 1] its factors, ``metallic_roughness_texture`` an image whose B channel
+    scales metallic and G roughness, ``occlusion_texture`` one whose R channel r darkens image-based and ambient
+    light by $1 + occlusion_strength·(r − 1)$; ``base_color_texture`` an sRGB-encoded image (as glTF stores it),
+    decoded to linear values into ``texture`` (give one of the two). ``render(shading="phong")`` shades a
+    ``"pbr"`` material per pixel by that model, ``shading="pbr"`` every material (a ``"phong"`` one with
+    ``shading.pbr.phong_roughness(shininess)``); docs/materials.md.
     ``hatch`` (vector output only): the spacing of 45° section lines drawn over the faces in filled SVG/PDF,
     in drawing units, as engineering drawings mark cut surfaces (``cutaway`` sets it on section caps).
     With ``render(..., method="ray-tracing")`` ``reflectivity`` is the weight of the traced mirror-reflected ray
@@ -163,6 +182,13 @@ class Material:
     bump_scale: float = 1.0
     normal_map: NDArray[np.float32] | None = None
     ior: float = 1.0
+    metallic: float = 0.0
+    roughness: float = 0.5
+    model: str = "phong"
+    base_color_texture: NDArray[np.float32] | None = None
+    metallic_roughness_texture: NDArray[np.float32] | None = None
+    occlusion_texture: NDArray[np.float32] | None = None
+    occlusion_strength: float = 1.0
 
     def __post_init__(self) -> None:
         where = "Material"
@@ -193,16 +219,44 @@ class Material:
         bump_scale = as_scalar(self.bump_scale, "bump_scale", where=where, error=ShadingError)
         object.__setattr__(self, "bump_scale", bump_scale)
         object.__setattr__(self, "normal_map", _texture(self.normal_map, f"{where} normal_map"))
+        self._check_physical(where)
+
+    def _check_physical(self, where: str) -> None:
+        """The metallic–roughness fields: factors in [0, 1], a known model, the glTF textures (the base colour
+        one decoded from sRGB into ``texture``)."""
+        if self.model not in MATERIAL_MODELS:
+            raise ShadingError(f"{where}: model = {describe(self.model)} is unknown; expected one of {MATERIAL_MODELS}")
+        for name in ("metallic", "roughness", "occlusion_strength"):
+            value = _nonnegative(getattr(self, name), name, where)
+            if value > 1.0:
+                raise ShadingError(f"{where}: {name} = {value!r} is above 1; expected a number in [0, 1]")
+            object.__setattr__(self, name, value)
+        if self.base_color_texture is not None:
+            if self.texture is not None:
+                raise ShadingError(
+                    f"{where}: both texture and base_color_texture are given; give one (texture: linear values, "
+                    "base_color_texture: an sRGB-encoded image as glTF stores it)"
+                )
+            texels = _texture(self.base_color_texture, f"{where} base_color_texture")
+            linear = np.array(texels)
+            linear[..., :3] = srgb_to_linear(linear[..., :3])
+            object.__setattr__(self, "texture", read_only(linear))
+            object.__setattr__(self, "base_color_texture", None)
+        for name in ("metallic_roughness_texture", "occlusion_texture"):
+            object.__setattr__(self, name, _texture(getattr(self, name), f"{where} {name}"))
 
     def with_(self, **changes: Any) -> Material:
         """A copy with some fields changed, e.g. ``material.with_(opacity=0.3)``."""
         return replace(self, **changes)
 
     def __repr__(self) -> str:
-        """Short: images appear as their shapes (``<1024x1024x3 image>``), not their pixels."""
+        """Short: images appear as their shapes (``<1024x1024x3 image>``), not their pixels; absent glTF maps not
+        at all."""
         shown = []
         for name in self.__dataclass_fields__:
             value = getattr(self, name)
+            if value is None and name.endswith("_texture"):  # the metallic–roughness maps, when there are none
+                continue
             if isinstance(value, np.ndarray) and value.ndim >= 2:
                 shown.append(f"{name}=<{'x'.join(map(str, value.shape))} image>")
             elif isinstance(value, np.ndarray):
@@ -259,13 +313,18 @@ class DirectionalLight:
 
 @dataclass(frozen=True, eq=False)
 class PointLight:
-    """A light at ``position`` shining equally in all directions, dimmed by $1/(a0 + a1·d + a2·d²)$."""
+    """A light at ``position`` shining equally in all directions, dimmed by $1/(a0 + a1·d + a2·d²)$.
+
+    With the metallic–roughness model (``frustum.shading.pbr``) ``intensity`` is in candela, the falloff is the
+    inverse square $1/d²$ and ``range`` (None: unlimited; else > 0) fades it to zero as KHR_lights_punctual does.
+    """
 
     position: Vector3
     color: Vector3 = (1.0, 1.0, 1.0)  # type: ignore[assignment]
     intensity: float = 1.0
     attenuation: Vector3 = (1.0, 0.0, 0.0)  # type: ignore[assignment]
     cast_shadows: bool = True
+    range: float | None = None
 
     def __post_init__(self) -> None:
         where = type(self).__name__
@@ -276,6 +335,7 @@ class PointLight:
         object.__setattr__(self, "color", _unit_color(self.color, "color", where))
         object.__setattr__(self, "intensity", _nonnegative(self.intensity, "intensity", where))
         object.__setattr__(self, "attenuation", _attenuation(self.attenuation, where))
+        _check_range(self, where)
 
     def transformed(self, world_from_model: Matrix4) -> PointLight:
         """The light riding a node: its position mapped by the node's world transform."""
@@ -286,6 +346,9 @@ class PointLight:
 class SpotLight:
     """A point light limited to a cone around ``direction`` (where it shines), full inside ``inner_angle``
     and fading linearly in cos α to zero at ``outer_angle`` (half-angles in radians, 0 <= inner <= outer < π/2).
+
+    With the metallic–roughness model: candela, $1/d²$, ``range`` as ``PointLight``'s, and the cone factor
+    squared (KHR_lights_punctual's smooth cone).
     """
 
     position: Vector3
@@ -296,6 +359,7 @@ class SpotLight:
     outer_angle: float = math.radians(30.0)
     attenuation: Vector3 = (1.0, 0.0, 0.0)  # type: ignore[assignment]
     cast_shadows: bool = True
+    range: float | None = None
 
     def __post_init__(self) -> None:
         where = "SpotLight"
@@ -318,6 +382,7 @@ class SpotLight:
             )
         object.__setattr__(self, "inner_angle", inner)
         object.__setattr__(self, "outer_angle", outer)
+        _check_range(self, where)
 
     def transformed(self, world_from_model: Matrix4) -> SpotLight:
         """The light riding a node: position and direction mapped by the node's world transform."""
@@ -383,7 +448,7 @@ def pack_lights(lights: list[Light]) -> tuple[NDArray[np.float64], NDArray[np.fl
 
     Row: kind (0 directional, 1 point, 2 spot), I_l = color·intensity (3), position (3), direction (3:
     toward the light for a directional light, the cone axis (where it shines) for a spot), attenuation
-    (a0, a1, a2), cos θ_inner, cos θ_outer, 0.
+    (a0, a1, a2), cos θ_inner, cos θ_outer, range (0: none; read by the metallic–roughness model only).
     """
     ambient_lights = [light for light in lights if isinstance(light, AmbientLight)]
     if ambient_lights:
@@ -406,6 +471,7 @@ def pack_lights(lights: list[Light]) -> tuple[NDArray[np.float64], NDArray[np.fl
             row[0] = LIGHT_POINT if isinstance(light, PointLight) else LIGHT_SPOT
             row[4:7] = light.position
             row[10:13] = light.attenuation
+            row[15] = 0.0 if light.range is None else light.range
             if isinstance(light, SpotLight):
                 row[7:10] = light.direction
                 row[13] = math.cos(light.inner_angle)
@@ -414,76 +480,3 @@ def pack_lights(lights: list[Light]) -> tuple[NDArray[np.float64], NDArray[np.fl
     return ambient, np.array(rows, dtype=np.float64).reshape(-1, LIGHT_FIELDS)
 
 
-def _light_terms(light: Light, point: NDArray, normal: NDArray, view: NDArray, shininess: float, specular: str):
-    """(f·ndl, f·spec): the attenuated diffuse and specular factors of one light at one point."""
-    if isinstance(light, DirectionalLight):
-        to_light, falloff = light.to_light, 1.0
-    else:
-        offset = light.position - point
-        distance = math.sqrt(float(offset @ offset))
-        to_light = offset / distance
-        a0, a1, a2 = light.attenuation
-        falloff = 1.0 / (a0 + a1 * distance + a2 * distance * distance)
-        if isinstance(light, SpotLight):
-            cos_inner, cos_outer = math.cos(light.inner_angle), math.cos(light.outer_angle)
-            cos_alpha = float(-to_light @ light.direction)
-            if cos_inner > cos_outer:
-                falloff *= min(max((cos_alpha - cos_outer) / (cos_inner - cos_outer), 0.0), 1.0)
-            else:
-                falloff *= 1.0 if cos_alpha >= cos_outer else 0.0
-    ndl = max(float(normal @ to_light), 0.0)
-    spec = 0.0
-    if ndl > 0.0:
-        if specular == "phong":
-            reflected = 2.0 * float(normal @ to_light) * normal - to_light
-            spec = power(max(float(reflected @ view), 0.0), shininess)
-        else:
-            half = to_light + view
-            half = half / math.sqrt(float(half @ half))
-            spec = power(max(float(normal @ half), 0.0), shininess)
-    return falloff * ndl, falloff * spec
-
-
-def illuminate(
-    material: Material,
-    lights: list[Light],
-    point: ArrayLike,
-    normal: ArrayLike,
-    eye: ArrayLike,
-    *,
-    base_color: ArrayLike | None = None,
-    specular: str = "blinn-phong",
-) -> NDArray[np.float64]:
-    """Linear RGB (3,) in [0, 1] of one surface point by the formula of this module's docstring (slow, readable).
-
-    `normal` need not be unit length. `base_color` replaces the material color (for vertex colors or a
-    texture sample already multiplied in).
-    """
-    if specular not in SPECULAR_MODELS:
-        raise ShadingError(f"illuminate: specular = {specular!r} is unknown; expected one of {SPECULAR_MODELS}")
-    n = np.asarray(normal, dtype=np.float64)
-    n = n / math.sqrt(float(n @ n))
-    p = np.asarray(point, dtype=np.float64)
-    view = np.asarray(eye, dtype=np.float64) - p
-    view = view / math.sqrt(float(view @ view))
-    color = material.color if base_color is None else np.asarray(base_color, dtype=np.float64)
-    ambient, _ = pack_lights(lights)
-    diffuse_sum = material.ambient * ambient
-    specular_sum = np.zeros(3)
-    for light in lights:
-        if isinstance(light, AmbientLight):
-            continue
-        ndl, spec = _light_terms(light, p, n, view, material.shininess, specular)
-        intensity = light.color * light.intensity
-        diffuse_sum = diffuse_sum + material.diffuse * ndl * intensity
-        specular_sum = specular_sum + material.specular * spec * intensity
-    return np.clip(color * diffuse_sum + specular_sum + material.emissive, 0.0, 1.0)
-
-
-def blinn_phong(
-    material: Material, light: DirectionalLight, normal: ArrayLike, point: ArrayLike, eye: ArrayLike
-) -> tuple[int, int, int]:
-    """8-bit RGB of one point lit by one directional light: $floor(illuminate(...)·255 + 0.5)$ (the bench formula)."""
-    rgb = illuminate(material, [light], point, normal, eye)
-    r, g, b = np.floor(rgb * 255.0 + 0.5).astype(int).tolist()
-    return r, g, b

@@ -1,6 +1,6 @@
 """Things that move: Reeves particle systems and mass–spring systems, stepped in time, handed to the scene.
 
-The simulation layer sits between modeling and the world (DESIGN.md): it imports geometry, transforms and the
+The simulation layer sits between modeling and the world (docs/architecture.md): it imports geometry, transforms and the
 checkers, never the scene, the renderer or the kernels. State lives in numpy arrays and every step is
 whole-array numpy work (a million particles per step without a Python loop per particle).
 """

@@ -24,6 +24,7 @@ from typing import Any, overload
 import numpy as np
 
 from frustum._files import atomic_path
+from frustum.budgets import check_memory
 from frustum.errors import OutputError
 
 __all__ = ["FIGURE_HEIGHT", "FIGURE_WIDTH", "SAVE_FORMATS", "Step", "Steps"]
@@ -319,6 +320,26 @@ class Steps(Sequence[Step]):
         text = {".svg": self.sheet, ".html": self.to_html, ".md": self.to_markdown}[suffix]()
         _write_text(target, text)
         return [target]
+
+
+RECORDING_BASE_BYTES = 2**18
+"""What any recording costs besides its drawn elements (steps, captions, the page): about 256 KiB."""
+
+
+def log_geometric_sum(ratio: float, terms: int) -> float:
+    """ln(Σ_{k=0}^{terms−1} ratio^k) = ln((ratio^terms − 1)/(ratio − 1)) for ratio > 1, computed in log space so that
+    any number of terms gives a finite float (no OverflowError)."""
+    exponent = terms * math.log(ratio)
+    return exponent + math.log1p(-math.exp(-exponent)) - math.log(ratio - 1.0)
+
+
+def check_recording(log_elements: float, bytes_per_element: float, where: str, cause: str) -> None:
+    """Refuse, before any work, a recording of about e^log_elements drawn elements of `bytes_per_element` each
+    (measured: the peak memory of building the steps and writing their sheet, per element) over the memory
+    budget. The estimate is made in log space: ``level = 100000`` gives the budget's error, not an overflow."""
+    log_bytes = math.log(bytes_per_element) + log_elements
+    nbytes = RECORDING_BASE_BYTES + math.exp(min(log_bytes, 700.0))  # e^700 ≈ 1e304: still a float
+    check_memory(nbytes, where=where, cause=cause, error=OutputError)
 
 
 _ids = itertools.count(1)

@@ -1,4 +1,4 @@
-"""Interactive viewing: the ``Viewer`` Jupyter widget and ``frustum serve`` (DESIGN.md's "at scale" layer).
+"""Interactive viewing: the ``Viewer`` Jupyter widget and ``frustum serve`` ("at scale", docs/architecture.md).
 
 ``interaction`` (the camera-interaction model) and ``session`` (one view's state and message protocol) are plain
 Python; ``widget`` needs the ``viewer`` extra's anywidget and ``server`` its Starlette and uvicorn, imported only

@@ -19,13 +19,15 @@ References
 
 from frustum.geometry.curves.bezier import M_B, BezierCurve, bernstein, bezier_matrix_form
 from frustum.geometry.curves.bspline import BSpline, NURBSCurve, cox_de_boor, open_uniform_knots
-from frustum.geometry.curves.piecewise import Continuity, PiecewiseBezier, continuity
-from frustum.geometry.curves.splines import (
+from frustum.geometry.curves.piecewise import (
     M_H,
+    Continuity,
     CubicSpline,
     HermiteCurve,
+    PiecewiseBezier,
     cardinal_spline,
     catmull_rom,
+    continuity,
     hermite_blending,
 )
 

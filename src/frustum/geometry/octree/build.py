@@ -213,7 +213,7 @@ def from_mesh(
 
 def menger_sponge(cls: type[Octree], level: int, size: float = 1.0) -> Octree:
     """``Octree.menger_sponge`` (the method's docstring says what it does)."""
-    from frustum.geometry.fractals import _menger_cells
+    from frustum.geometry.fractals.solids import _menger_cells
 
     where = "Octree.menger_sponge"
     n = as_count(level, "level", 0, where=where)

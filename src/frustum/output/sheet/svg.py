@@ -192,29 +192,9 @@ def drawing_sheet(
     where = "drawing_sheet"
     width_line = _check_common(scene, stroke_width, hidden, where)
     names = view_names(views, where)
-    if projection_angle not in ("third", "first"):
-        raise OutputError(
-            f"{where}: projection_angle = {describe(projection_angle)} is unknown; expected 'third' or 'first'"
-        )
-    if orientation not in ORIENTATIONS:
-        raise OutputError(
-            f"{where}: orientation = {describe(orientation)} is unknown; expected 'landscape' or 'portrait'"
-        )
-    if dimensions is True or dimensions is False or isinstance(dimensions, np.bool_):
-        mode = "overall" if dimensions else None
-    elif isinstance(dimensions, str) and dimensions in DIMENSION_MODES:
-        mode = dimensions
-    else:
-        raise OutputError(
-            f"{where}: dimensions = {describe(dimensions)} is unknown; expected 'overall', 'parts' or False"
-        )
+    mode, given_scale = _checked_options(projection_angle, orientation, dimensions, scale, where)
     paper_width, paper_height = paper_size(paper, orientation, where)
     fields = title_fields(title_block, title, where)
-    given_scale = None
-    if scale is not None:
-        given_scale = as_scalar(scale, "scale", where=where, error=OutputError)
-        if not given_scale > 0.0:
-            raise OutputError(f"{where}: scale = {given_scale!r} must be > 0; paper length / model length")
     if scene.volumes:  # a dimensioned line drawing has no form for a scalar field: say so rather than drop it
         count = len(scene.volumes)
         raise OutputError(
@@ -238,6 +218,84 @@ def drawing_sheet(
     # the drawing area: inside the border, above the title strip
     area = (MARGIN, MARGIN, paper_width - 2 * MARGIN, paper_height - 2 * MARGIN - TITLE_HEIGHT)
 
+    drawing_scale, used, marks, places = _fit(sheet_views, cells, area, plan, mode, given_scale, len(names), paper,
+                                              where)  # fmt: skip
+    body = [
+        f'<rect id="border" x="{_number(MARGIN)}" y="{_number(MARGIN)}" '
+        f'width="{_number(paper_width - 2 * MARGIN)}" height="{_number(paper_height - 2 * MARGIN)}" '
+        'fill="none" stroke="#000000" stroke-width="0.7"/>'
+    ]
+    for view in sheet_views:
+        centre_x, centre_y = places[view.name]
+        # a pictorial view shows visible edges only (hidden lines are for the orthographic views)
+        view_hidden = None if view.name == "isometric" else hidden
+        body.append(_view_group(view, placed, centre_x, centre_y, drawing_scale, view_hidden, width_line))
+        if shadows:  # sciagraphy: the exact shadow polygons of the scene's lights in each view, hatched
+            body.append(_view_shadows(scene, view, centre_x, centre_y, drawing_scale))
+        body += [_mark_svg(mark, f"{view.name}-", centre_x, centre_y) for mark in marks[view.name]]
+    paper_name = (
+        paper.upper()
+        if isinstance(paper, str) and paper.lower() != "letter" and paper.lower() != "tabloid"
+        else (paper.capitalize() if isinstance(paper, str) else f"{_number(paper_width)} x {_number(paper_height)}")
+    )
+    title_marks = draw_title_block(paper_width, paper_height, fields, drawing_scale, projection_angle, paper_name)
+    data = {**fields, "scale": scale_label(drawing_scale), "projection": projection_angle, "size": paper_name,
+            "dimensions": str(used).lower()}  # fmt: skip
+    attributes = "".join(f' data-{key.replace("_", "-")}="{_html_escape(value)}"' for key, value in data.items())
+    body.append(f'<g id="title-block"{attributes}>{"".join(_mark_svg(mark, "", 0.0, 0.0) for mark in title_marks)}</g>')
+    length, bar = scale_bar(drawing_scale, paper_height)
+    body.append(f'<g id="scale-bar" data-length="{_number(length)}">{_mark_svg(bar, "", 0.0, 0.0)}</g>')
+    title_marks.append(bar)
+    text = svg_document(paper_width, paper_height, body, units="mm")
+    if path is not None:
+        if str(path).lower().endswith(".dxf"):
+            from frustum.output.sheet.dxf import save_sheet_dxf
+
+            save_sheet_dxf(
+                SheetDrawing(paper_width, paper_height, drawing_scale, sheet_views, places, marks, title_marks,
+                              hidden, fields["units"], placed),
+                path,
+            )  # fmt: skip
+        else:
+            save_svg(text, path)
+    return text
+
+
+def _checked_options(projection_angle: Any, orientation: Any, dimensions: Any, scale: Any,
+                     where: str) -> tuple[str | None, float | None]:  # fmt: skip
+    """``drawing_sheet``'s projection angle, orientation, dimensions and scale checked: (dimension mode or None, the
+    given scale or None)."""
+    if projection_angle not in ("third", "first"):
+        raise OutputError(
+            f"{where}: projection_angle = {describe(projection_angle)} is unknown; expected 'third' or 'first'"
+        )
+    if orientation not in ORIENTATIONS:
+        raise OutputError(
+            f"{where}: orientation = {describe(orientation)} is unknown; expected 'landscape' or 'portrait'"
+        )
+    if dimensions is True or dimensions is False or isinstance(dimensions, np.bool_):
+        mode = "overall" if dimensions else None
+    elif isinstance(dimensions, str) and dimensions in DIMENSION_MODES:
+        mode = dimensions
+    else:
+        raise OutputError(
+            f"{where}: dimensions = {describe(dimensions)} is unknown; expected 'overall', 'parts' or False"
+        )
+    given_scale = None
+    if scale is not None:
+        given_scale = as_scalar(scale, "scale", where=where, error=OutputError)
+        if not given_scale > 0.0:
+            raise OutputError(f"{where}: scale = {given_scale!r} must be > 0; paper length / model length")
+    return mode, given_scale
+
+
+def _fit(
+    sheet_views: list[SheetView], cells: dict, area: tuple, plan: Any, mode: str | None, given_scale: float | None,
+    view_count: int, paper: Any, where: str,
+) -> tuple[float, str | None, dict, dict]:  # fmt: skip
+    """(scale, dimension mode used, marks, places): the views and their dimensions laid out at the given scale, or
+    at the largest standard scale at which they fit (``mode="parts"`` falls back to "overall" where each part's
+    dimensions crowd the paper)."""
     empty: dict[str, list[Mark]] = {view.name: [] for view in sheet_views}
 
     def attempt(candidate: float, use: str | None) -> tuple[dict, dict] | None:
@@ -284,49 +342,11 @@ def drawing_sheet(
             largest = search(used, None)
             hint = f"the largest standard scale that fits is {scale_label(largest[0])}" if largest else "none fits"
             raise OutputError(
-                f"{where}: scale = {drawing_scale!r} does not fit {len(names)} views on {paper_text(paper)} "
+                f"{where}: scale = {drawing_scale!r} does not fit {view_count} views on {paper_text(paper)} "
                 f"({hint}); give a smaller scale, fewer views or larger paper"
             )
         marks, places = fitted
-    body = [
-        f'<rect id="border" x="{_number(MARGIN)}" y="{_number(MARGIN)}" '
-        f'width="{_number(paper_width - 2 * MARGIN)}" height="{_number(paper_height - 2 * MARGIN)}" '
-        'fill="none" stroke="#000000" stroke-width="0.7"/>'
-    ]
-    for view in sheet_views:
-        centre_x, centre_y = places[view.name]
-        # a pictorial view shows visible edges only (hidden lines are for the orthographic views)
-        view_hidden = None if view.name == "isometric" else hidden
-        body.append(_view_group(view, placed, centre_x, centre_y, drawing_scale, view_hidden, width_line))
-        if shadows:  # sciagraphy: the exact shadow polygons of the scene's lights in each view, hatched
-            body.append(_view_shadows(scene, view, centre_x, centre_y, drawing_scale))
-        body += [_mark_svg(mark, f"{view.name}-", centre_x, centre_y) for mark in marks[view.name]]
-    paper_name = (
-        paper.upper()
-        if isinstance(paper, str) and paper.lower() != "letter" and paper.lower() != "tabloid"
-        else (paper.capitalize() if isinstance(paper, str) else f"{_number(paper_width)} x {_number(paper_height)}")
-    )
-    title_marks = draw_title_block(paper_width, paper_height, fields, drawing_scale, projection_angle, paper_name)
-    data = {**fields, "scale": scale_label(drawing_scale), "projection": projection_angle, "size": paper_name,
-            "dimensions": str(used).lower()}  # fmt: skip
-    attributes = "".join(f' data-{key.replace("_", "-")}="{_html_escape(value)}"' for key, value in data.items())
-    body.append(f'<g id="title-block"{attributes}>{"".join(_mark_svg(mark, "", 0.0, 0.0) for mark in title_marks)}</g>')
-    length, bar = scale_bar(drawing_scale, paper_height)
-    body.append(f'<g id="scale-bar" data-length="{_number(length)}">{_mark_svg(bar, "", 0.0, 0.0)}</g>')
-    title_marks.append(bar)
-    text = svg_document(paper_width, paper_height, body, units="mm")
-    if path is not None:
-        if str(path).lower().endswith(".dxf"):
-            from frustum.output.sheet.dxf import save_sheet_dxf
-
-            save_sheet_dxf(
-                SheetDrawing(paper_width, paper_height, drawing_scale, sheet_views, places, marks, title_marks,
-                              hidden, fields["units"], placed),
-                path,
-            )  # fmt: skip
-        else:
-            save_svg(text, path)
-    return text
+    return drawing_scale, used, marks, places
 
 
 def _view_group(

@@ -16,7 +16,7 @@ from frustum.budgets import check_memory
 from frustum.camera import Camera
 from frustum.geometry import Mesh
 from frustum.raster import shade
-from frustum.render import bumps, reflection
+from frustum.render import bumps, pbr, reflection
 from frustum.render.buffers import give_back, take_array
 from frustum.render.context import FrameContext
 from frustum.render.options import RenderOptions
@@ -36,7 +36,7 @@ from frustum.render.stages import (
 from frustum.render.stages import shade_item as shade_item_plainly
 from frustum.scene import Scene, SceneItem
 
-SHADOWED_MODES = (shade.SHADE_PHONG, shade.SHADE_GOURAUD, shade.SHADE_FLAT)
+SHADOWED_MODES = (shade.SHADE_PHONG, shade.SHADE_GOURAUD, shade.SHADE_FLAT, pbr.SHADE_PBR)
 """Shading modes in which shadows darken the picture (``"none"``, ``"normals"`` and ``"depth"`` ignore them)."""
 
 
@@ -88,6 +88,11 @@ def shade_item(
     faces = world_faces(item) if mesh.face_count else np.empty((0, 3), dtype=np.int64)
     world, normals = (np.asarray(a, dtype=np.float64) for a in attributes)
     flags = item_flags(index, face_offset, options, blend, write_normals, write_ids)
+    if pbr.applies(item, options):  # the metallic–roughness model with each light's fraction (render.pbr)
+        pbr.shade_item(item, index, face_offset, camera, options, params, lights, (world, normals), faces,
+                       (pixels.depth[rows], codes, pixels.bary[rows], pixels.color[rows], *extra), blend, flags,
+                       seen=seen[rows])  # fmt: skip
+        return
     if options.shade_mode == shade.SHADE_PHONG and bumps.has_detail(item):  # per-pixel normals from the maps
         bumps.shade_detailed(item, faces, world, normals, params, lights, flags, pixels.depth[rows], codes,
                              pixels.bary[rows], pixels.color[rows], extra, seen=seen[rows])  # fmt: skip

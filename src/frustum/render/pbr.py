@@ -1,0 +1,113 @@
+"""The metallic–roughness model's place in the surface passes: which items it shades (every item with
+``shading="pbr"``; items whose ``Material.model`` is ``"pbr"`` with per-pixel ``shading="phong"``), the kernel's
+parameters (``raster.pbr``), and the shading of one item's pixels, with the scene's environment map as image-based
+light (``shading.ibl``, precomputed once per map) and, with shadows on, each light's fraction reaching a pixel.
+
+Not drawn by this model (documented, docs/materials.md): bump and normal maps (the interpolated normal is used),
+``Material.reflectivity`` (the environment reflects through the BRDF instead), and the other shading modes
+(``"gouraud"`` and ``"flat"`` shade a ``"pbr"`` material with its classical coefficients)."""
+
+from __future__ import annotations
+
+import weakref
+
+import numpy as np
+
+from frustum.camera import Camera
+from frustum.raster import pbr as kernel
+from frustum.raster import shade
+from frustum.render.options import RenderOptions
+from frustum.scene import SceneItem
+from frustum.shading import Material
+from frustum.shading.pbr import phong_roughness
+
+SHADE_PBR = kernel.SHADE_PBR
+
+_NO_MAPS = np.zeros((2, 1, 2, 3), dtype=np.float32)
+_NO_SH = np.zeros((9, 3))
+_SURFACE_MAPS: weakref.WeakKeyDictionary[Material, np.ndarray] = weakref.WeakKeyDictionary()
+
+
+def applies(item: SceneItem, options: RenderOptions) -> bool:
+    """Whether the item's pixels are shaded by the metallic–roughness model."""
+    return options.shade_mode == SHADE_PBR or (
+        options.shade_mode == shade.SHADE_PHONG and item.material.model == "pbr"
+    )
+
+
+def physical_parameters(material: Material, options: RenderOptions, lit_by_environment: bool) -> np.ndarray:
+    """(raster.pbr.PBR,) float64: metallic, roughness (a ``"phong"`` material's from its shininess), occlusion
+    strength, exposure, tone map code, whether an environment lights the item, the ambient radiance (3)."""
+    values = np.zeros(kernel.PBR)
+    values[kernel.Q_METALLIC] = material.metallic
+    values[kernel.Q_ROUGHNESS] = (
+        material.roughness if material.model == "pbr" else phong_roughness(material.shininess)
+    )
+    values[kernel.Q_OCCLUSION_STRENGTH] = material.occlusion_strength
+    values[kernel.Q_EXPOSURE] = options.exposure
+    values[kernel.Q_TONE_MAP] = options.tone_map
+    values[kernel.Q_ENVIRONMENT] = float(lit_by_environment)
+    values[kernel.Q_AMBIENT : kernel.Q_AMBIENT + 3] = options.physical_ambient
+    return values
+
+
+def surface_maps(material: Material) -> np.ndarray:
+    """(H, W, 4) float32: the occlusion texture's R in channel 0, the metallic–roughness texture's G (roughness)
+    and B (metallic) in channels 1 and 2 (1 where a texture is missing; the occlusion texture resampled to the
+    other's size, nearest texel, when they differ); (0, 0, 4) without either. Cached per material."""
+    metal_rough, occlusion = material.metallic_roughness_texture, material.occlusion_texture
+    if metal_rough is None and occlusion is None:
+        return np.empty((0, 0, 4), dtype=np.float32)
+    cached = _SURFACE_MAPS.get(material)
+    if cached is not None:
+        return cached
+    shape = (metal_rough if metal_rough is not None else occlusion).shape[:2]
+    maps = np.ones((*shape, 4), dtype=np.float32)
+    if metal_rough is not None:
+        maps[..., 1:3] = metal_rough[..., 1:3]
+    if occlusion is not None:
+        rows = (np.arange(shape[0]) * occlusion.shape[0]) // shape[0]
+        columns = (np.arange(shape[1]) * occlusion.shape[1]) // shape[1]
+        maps[..., 0] = occlusion[rows[:, None], columns[None, :], 0]
+    maps.setflags(write=False)
+    _SURFACE_MAPS[material] = maps
+    return maps
+
+
+def image_light(options: RenderOptions) -> tuple[np.ndarray, np.ndarray, np.ndarray, bool]:
+    """(sh, prefiltered maps, split-sum table, whether there is an environment) for the kernel."""
+    from frustum.shading.ibl import brdf_table, image_lighting
+
+    if options.environment is None:
+        return _NO_SH, _NO_MAPS, brdf_table(), False
+    lighting = image_lighting(options.environment)
+    return lighting.sh, lighting.prefiltered, lighting.table, True
+
+
+def shade_item(
+    item: SceneItem, index: int, face_offset: int, camera: Camera, options: RenderOptions, params: np.ndarray,
+    lights: np.ndarray, attributes: tuple[np.ndarray, np.ndarray], faces: np.ndarray, rows: tuple,
+    blend: bool, flags: np.ndarray, seen: np.ndarray | None = None,
+) -> None:  # fmt: skip
+    """Shade the item's pixels in `rows` ((depth, codes, bary, color, normal_out, id_out) of its band) with the
+    metallic–roughness model (``raster.pbr.shade_pixels_pbr``); `seen` the (band, W, K) light fractions of the
+    shadow pass, or None."""
+    mesh, material = item.mesh, item.material
+    world, normals = (np.asarray(a, dtype=np.float64) for a in attributes)
+    vertex_colors = getattr(mesh, "vertex_colors", None)
+    vertex_colors = np.empty((0, 3)) if vertex_colors is None else np.ascontiguousarray(vertex_colors[:, :3], float)
+    uvs = getattr(mesh, "uvs", None)
+    texture, maps_of_surface = material.texture, surface_maps(material)
+    if uvs is None:
+        texture, maps_of_surface, uvs = None, np.empty((0, 0, 4), dtype=np.float32), np.empty((0, 2))
+    else:
+        uvs = np.ascontiguousarray(uvs, dtype=np.float64)
+    if texture is None:
+        texture = np.empty((0, 0, 4), dtype=np.float32)
+    sh, maps, table, lit = image_light(options)
+    values = physical_parameters(material, options, lit)
+    depth, codes, bary, color, normal_out, id_out = rows
+    fractions = np.empty((0, 0, 0), dtype=np.float32) if seen is None else np.ascontiguousarray(seen, np.float32)
+    kernel.shade_pixels_pbr(depth, codes, bary, faces, world, normals, vertex_colors, uvs, texture, maps_of_surface,
+                            params, values, lights, sh, maps, table, fractions, flags, color, normal_out,
+                            id_out)  # fmt: skip
