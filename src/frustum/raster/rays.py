@@ -1,5 +1,8 @@
 """The ray-query index: a surface-area-heuristic BVH over world triangles and its traversal kernels (Numba).
 
+kernel module: the BVH's build and its traversals (binary for pictures and lessons, four-wide for queries) are one
+algorithm's flat loops, kept in one module so the kernels inline one another; hence its length.
+
 Build (``build``): a binary bounding-volume hierarchy by the binned surface area heuristic [Wald 2007]: each
 triangle's box is rounded outward to float32 once (``_prepare``; outward rounding is monotone, so every union of
 them is the float64 union rounded outward: a box never shrinks below its triangles) and these rows are partitioned
