@@ -37,7 +37,7 @@ from frustum.projection import (
     multiview,
     viewport,
 )
-from frustum.transforms import Step, compose, invert, translate
+from frustum.transforms import Step, apply, compose, invert, translate
 
 __all__ = [
     "Camera",
@@ -775,14 +775,11 @@ class Camera:
 
 def _fit_points(value: object, where: str) -> NDArray[np.float64]:
     """World points whose bounds `Camera.fit` frames: a scene's placed vertices, a mesh's, or given points."""
-    from frustum.transforms import apply
-
     scene = getattr(value, "scene", value)  # a SceneFile holds its scene
     if hasattr(scene, "items") and not isinstance(scene, np.ndarray):
         chunks = [apply(item.world_from_model, item.mesh.vertices) for item in scene.items if item.mesh.vertex_count]
         for placed in getattr(scene, "point_clouds", ()):  # point clouds and splats: the corners of their boxes
-            low, high = placed.geometry.bounds
-            corners = np.array([[(low, high)[i >> k & 1][k] for k in range(3)] for i in range(8)])
+            corners = np.array(np.meshgrid(*zip(*placed.geometry.bounds, strict=True))).reshape(3, -1).T
             chunks.append(apply(placed.world_from_model, corners))
         if not chunks:
             raise CameraError(f"{where}: the scene has no vertices; add a mesh before framing it")
