@@ -93,8 +93,6 @@ def _triple_text(values: Sequence[float]) -> str:
 def info_table(mesh: Path) -> Any:
     from rich.table import Table
 
-    from frustum.geometry.points import point_file_facts
-
     facts = point_file_facts(mesh)  # a point cloud's or splat file's counts
     table = Table(title=str(mesh), show_header=False, title_justify="left")
     table.add_column(style="bold")
@@ -102,3 +100,27 @@ def info_table(mesh: Path) -> Any:
     for name, value in facts if facts is not None else _mesh_facts(load_mesh(mesh, "info")):
         table.add_row(name, value)
     return table
+
+
+def point_file_facts(path: str | Path) -> list[tuple[str, str]] | None:
+    """(name, value) rows for ``frustum info`` of a point or splat file (None for a mesh file)."""
+    from frustum.geometry.points import load_points, point_file_kind
+    from frustum.geometry.splats import GaussianSplats
+
+    kind = point_file_kind(path)
+    if kind is None:
+        return None
+    if kind == "splats":
+        splats = GaussianSplats.load(path)
+        low, high = splats.bounds
+        return [("kind", "3D Gaussian splats (3DGS PLY)"), ("splats", f"{splats.count}"),
+                ("spherical-harmonic degree", f"{splats.degree}"), ("bounds min", _triple_text(low)),
+                ("bounds max", _triple_text(high)),
+                ("opacity", f"mean {float(splats.opacities.mean()):.3g}" if splats.count else "none")]  # fmt: skip
+    cloud = load_points(path)
+    low, high = cloud.bounds
+    return [("kind", "point cloud"), ("points", f"{cloud.point_count}"), ("bounds min", _triple_text(low)),
+            ("bounds max", _triple_text(high)), ("size", _triple_text(high - low)),
+            ("colors", "yes" if cloud.colors is not None else "no"),
+            ("normals", "yes" if cloud.normals is not None else "no"),
+            ("radii", "yes" if cloud.radii is not None else "no")]  # fmt: skip

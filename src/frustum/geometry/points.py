@@ -37,7 +37,7 @@ from frustum.transforms import apply, apply_to_normals
 
 __all__ = [
     "DEFAULT_POINT_SIZE", "POINT_STYLES", "POINT_SUFFIXES", "PointCloud", "PointStyle", "load_points",
-    "point_file_facts", "point_file_kind", "point_style", "read_ply_header", "read_ply_vertices",
+    "point_file_kind", "point_style", "read_ply_header", "read_ply_vertices",
 ]  # fmt: skip
 
 POINT_SUFFIXES = (".ply", ".xyz", ".txt", ".csv", ".pts")
@@ -266,33 +266,6 @@ def point_file_kind(path: str | Path) -> str | None:
         return "splats"
     face = header.element("face")
     return "points" if face is None or face[1] == 0 else None
-
-
-def point_file_facts(path: str | Path) -> list[tuple[str, str]] | None:
-    """(name, value) rows for ``frustum info`` of a point or splat file (None for a mesh file)."""
-    kind = point_file_kind(path)
-    if kind is None:
-        return None
-    if kind == "splats":
-        from frustum.geometry.splats import GaussianSplats
-
-        splats = GaussianSplats.load(path)
-        low, high = splats.bounds
-        return [("kind", "3D Gaussian splats (3DGS PLY)"), ("splats", f"{splats.count}"),
-                ("spherical-harmonic degree", f"{splats.degree}"), ("bounds min", _triple(low)),
-                ("bounds max", _triple(high)),
-                ("opacity", f"mean {float(splats.opacities.mean()):.3g}" if splats.count else "none")]  # fmt: skip
-    cloud = load_points(path)
-    low, high = cloud.bounds
-    return [("kind", "point cloud"), ("points", f"{cloud.point_count}"), ("bounds min", _triple(low)),
-            ("bounds max", _triple(high)), ("size", _triple(high - low)),
-            ("colors", "yes" if cloud.colors is not None else "no"),
-            ("normals", "yes" if cloud.normals is not None else "no"),
-            ("radii", "yes" if cloud.radii is not None else "no")]  # fmt: skip
-
-
-def _triple(values: Any) -> str:
-    return "(" + ", ".join(f"{float(v):.6g}" for v in values) + ")"
 
 
 # --- files ----------------------------------------------------------------------------------------------------
