@@ -75,6 +75,7 @@ from frustum.render.buffers import FrameBuffers as FrameBuffers
 from frustum.render.buffers import Scratch as Scratch
 from frustum.render.buffers import block_min as block_min
 from frustum.render.buffers import clear_buffers as clear_buffers
+from frustum.render.buffers import release_kept
 from frustum.render.buffers import resolve_color as resolve_color
 from frustum.render.context import FrameContext
 from frustum.render.lines import mesh_edges as mesh_edges
@@ -85,7 +86,6 @@ from frustum.render.options import HIDDEN_STYLES as HIDDEN_STYLES
 from frustum.render.options import RENDER_MODES as RENDER_MODES
 from frustum.render.options import SHADING_MODES as SHADING_MODES
 from frustum.render.options import TRANSPARENCY_MODES as TRANSPARENCY_MODES
-from frustum.render.shadows import fractions
 from frustum.render.stages import TILE_SIZE as TILE_SIZE
 from frustum.render.stages import Binned as Binned
 from frustum.render.stages import bin_item as bin_item
@@ -108,7 +108,7 @@ def release_memory() -> int:
     frames goes on to other work.
     """
     # the shadow pass's maps kept for reuse and the per-pixel arrays of every pass (render.buffers.take_array)
-    return Scratch.release_pool() + FrameBuffers.release() + fractions.release_memory()
+    return Scratch.release_pool() + FrameBuffers.release() + release_kept()
 
 
 def render(

@@ -212,3 +212,20 @@ def release_work_arrays() -> int:
         released = sum(a.nbytes for arrays in _POOL.values() for a in arrays)
         _POOL.clear()
     return released
+
+
+_KEEPERS: list[Any] = []
+"""``release`` functions of the passes that keep memory between frames (the shadow pass's maps), added by each
+pass's module when it is first imported: ``render.release_memory`` frees what they hold without importing a pass
+that never ran."""
+
+
+def keeps_memory(release: Any) -> Any:
+    """Register `release` (() -> bytes freed) with ``release_kept``; returns it (usable as a decorator)."""
+    _KEEPERS.append(release)
+    return release
+
+
+def release_kept() -> int:
+    """Call every registered pass's release function; return the bytes they freed."""
+    return sum(release() for release in _KEEPERS)

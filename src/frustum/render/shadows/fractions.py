@@ -51,7 +51,7 @@ import numpy as np
 from frustum.budgets import check_memory, format_bytes
 from frustum.camera import Camera, ViewFrame
 from frustum.projection import Orthographic, Perspective
-from frustum.render.buffers import give_back, release_work_arrays, take_array
+from frustum.render.buffers import give_back, keeps_memory, release_work_arrays, take_array
 from frustum.render.options import SHADOW_METHODS, ShadowOptions, check_shadows
 from frustum.render.stages import TILED_BITS, bin_item
 from frustum.scene import Scene, SceneItem
@@ -70,6 +70,7 @@ _MARGIN_TEXELS = 3.0
 _LOCK = threading.Lock()
 
 
+@keeps_memory
 def release_memory() -> int:
     """Free the work arrays the shadow pass keeps between frames and the shadow maps kept for reuse; return their
     bytes."""

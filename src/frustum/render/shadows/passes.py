@@ -20,8 +20,6 @@ from frustum.render import bumps, pbr, reflection
 from frustum.render.buffers import give_back, take_array
 from frustum.render.context import FrameContext
 from frustum.render.options import RenderOptions
-from frustum.render.shadows import fractions
-from frustum.render.shadows.fractions import draw_depth
 from frustum.render.stages import (
     TILED_BITS,
     Lighting,
@@ -49,6 +47,8 @@ def prepare(
     where neither shadows nor the "position" buffer are asked for (``options.positions_wanted``)."""
     if not options.positions_wanted:
         return
+    from frustum.render.shadows import fractions  # the shadow maps' module: loaded by the first frame that needs it
+
     points, facing = fractions.surface_points(items, drawn, pixels.depth, pixels.codes, pixels.bary)
     context.outputs["position"] = points
     if options.shadow is not None:
@@ -160,6 +160,7 @@ def draw_tiled(
     shaded, the map lookups made per pixel inside the shading (no image-sized world points, normals or
     fractions)."""
     from frustum.raster import shadow, shadow_tiled
+    from frustum.render.shadows import fractions
 
     binned = bin_item(item, camera, options.cull, 0, context.scratch, tile_bits=TILED_BITS)
     world, normals = world_attributes(item, context.scratch)
@@ -185,7 +186,7 @@ def draw_tiled(
     if maps is None:
         maps = take_array(shape, np.float32)
         for m, (_, (light_camera, _)) in enumerate(records):
-            draw_depth(item, light_camera, maps[m], True)
+            fractions.draw_depth(item, light_camera, maps[m], True)
     tiling = np.array([1 << TILED_BITS, binned.tiles_x, 0, camera.width, camera.height], dtype=np.int64)
     params = shading_parameters(item, camera, options, lighting.ambient)
     flags = item_flags(0, 0, options, False, False, False)
