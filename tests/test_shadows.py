@@ -787,7 +787,7 @@ def test_depth_only_map_fill_equals_the_tile_rasterizer(closed):
     """``raster.shadow.fill_depth_tiles`` (depth alone, 64-pixel tiles, branch-free rows) writes the same map as
     ``raster.triangles.rasterize_tiles`` for the same items (a second item drawn over the first: fresh=False)."""
     from frustum.raster import shadow, triangles
-    from frustum.render.shadows import passes as render_shadows
+    from frustum.render.shadows import fractions as render_shadows
     from frustum.render.stages import TILE_SIZE, bin_item
 
     scene = _sphere_and_box(LIGHTS["directional"])

@@ -1028,7 +1028,7 @@ def _intersect_rays(wide_boxes, wide_links, triangles, order, depth, origins, di
                     shading_out, back_out, start, stop):  # fmt: skip
     """The first hit of rays [start, stop) (t >= 0, both sides) and, in the same pass, the ``FIELDS`` that
     `wanted` asks for (the others' outputs are not touched: pass empty arrays). Triangle g of the index is face
-    ``g − starts[k]`` of item ``numbers[k]`` (``starts[k] <= g < starts[k + 1]``), its corners 1 and 2 swapped
+    $g − starts[k]$ of item ``numbers[k]`` (``starts[k] <= g < starts[k + 1]``), its corners 1 and 2 swapped
     in the index where ``swapped[k]``; barycentrics (w0, w1, w2) are the weights of the face's own corners
     ($w0 = 1 − u − v$); point $o + t·d$; normal the unit $e1 × e2$ of the indexed corners; shading normal the
     unit $Σ wᵢ·N_{vᵢ}$ of ``vertex_normals`` (world, one per row of ``face_vertices[g]``), the normal where that
