@@ -189,7 +189,7 @@ def test_bad_input_names_the_value(scene, tmp_path):
         orbit_cameras(camera, 2, axis=(0, 0, 0))
     with pytest.raises(OutputError, match=r"turntable: size = \(0.0, 10.0\) is not \(width, height\)"):
         turntable(scene, None, frames=2, size=(0, 10))
-    with pytest.raises(CameraError, match=r"framing_camera: scene has no vertices"):
+    with pytest.raises(CameraError, match=r"framing_camera: the scene has no vertices"):
         turntable(Scene(), None, frames=2)
     with pytest.raises(OutputError, match=r"write_animation: frames is empty"):
         write_animation([], tmp_path / "empty.gif")
