@@ -329,6 +329,8 @@ def _shade_row_pbr(
                            pbr, lights, sh, maps, table, seen, row, col)  # fmt: skip
         r, g, b = tone(tone_code, pbr[Q_EXPOSURE], r + params[P_EMISSIVE], g + params[P_EMISSIVE + 1],
                        b + params[P_EMISSIVE + 2])  # fmt: skip
+        # depth cue and store: the same lines as raster/shade.py's and raster/shadow.py's pixel loops, a kernel
+        # specialised per mode on purpose (the Phong kernels stay byte-equal and never compile the PBR terms)
         if params[P_CUE_ON] != 0.0:
             d = 0.0
             for k in range(3):
