@@ -15,10 +15,13 @@ Rules, written out once more (the arithmetic order matters for byte equality):
   with corners 1 and 2 swapped and the back flag set.
 - pixel centre (256i + 128, 256j + 128); E_ab = (Xb − Xa)(Yp − Ya) − (Yb − Ya)(Xp − Xa); inside when E >= 0 on
   top/left edges (dy < 0, or dy = 0 and dx < 0) and E > 0 on the others.
-- depth on the plane through the drawn corners, from corner 0: float32((z0 + β·(Yp − Y0)) + α·(Xp − X0)) with
-  α = −((dy12·z0 + dy20·z1) + dy01·z2)·r and β = ((dx12·z0 + dx20·z1) + dx01·z2)·r, r = 1 / area2 (d_ab = b − a),
-  test "less"; weights g_k = E_k / w_k, r = 1 / Σ g_k, b_k = g_k·r, mapped onto the source face through the clip
-  weights, stored as float32.
+- depth on the plane through the drawn corners before the snap, (X_k + r_k, Y_k + s_k, z_k) with the residuals
+  r = x·256 − X, s = y·256 − Y, written from the snapped corner 0: float32((z0' + β·(Yp − Y0)) + α·(Xp − X0)) with
+  α = −((dy12·z0 + dy20·z1) + dy01·z2)·r and β = ((dx12·z0 + dx20·z1) + dx01·z2)·r, r = 1 / area2,
+  z0' = (z0 − α·r0) − β·s0, where d_ab = float(B − A) + (residual_b − residual_a) and area2 = dx01·(float(Y2 − Y0) +
+  (s2 − s0)) − dy01·(float(X2 − X0) + (r2 − r0)); a sliver (area2·A < A²/2, A the snapped corners' integer area2)
+  takes the snapped corners (residuals 0) instead; test "less"; weights g_k = E_k / w_k, r = 1 / Σ g_k,
+  b_k = g_k·r, mapped onto the source face through the clip weights, stored as float32.
 """
 
 from __future__ import annotations
@@ -91,9 +94,10 @@ def reference_render(scene, camera, shading="phong", background=(0, 0, 0, 1), cu
                 else:
                     weight = clipped.new_vertex_weights[index - n_input]
                 w = position[3]
-                x = _snap((position[0] / w) * (width / 2.0) + width / 2.0)
-                y = _snap((position[1] / w) * (height / 2.0) + height / 2.0)
-                corners.append((x, y, (position[2] / w) * 0.5 + 0.5, 1.0 / w, weight))
+                x_w = (position[0] / w) * (width / 2.0) + width / 2.0
+                y_w = (position[1] / w) * (height / 2.0) + height / 2.0
+                x, y = _snap(x_w), _snap(y_w)
+                corners.append((x, y, (position[2] / w) * 0.5 + 0.5, 1.0 / w, weight, x_w * 256.0 - x, y_w * 256.0 - y))
             (x0, y0, *_), (x1, y1, *_), (x2, y2, *_) = corners
             area = (x1 - x0) * (y2 - y0) - (x2 - x0) * (y1 - y0)
             if area == 0:
@@ -119,7 +123,7 @@ def reference_render(scene, camera, shading="phong", background=(0, 0, 0, 1), cu
 
 
 def _fill(corners, area, index, px, py, depth, owner, bary):
-    (x0, y0, z0, q0, w0), (x1, y1, z1, q1, w1), (x2, y2, z2, q2, w2) = corners
+    (x0, y0, z0, q0, w0, r0, s0), (x1, y1, z1, q1, w1, r1, s1), (x2, y2, z2, q2, w2, r2, s2) = corners
     e = []
     inside = np.ones(depth.shape, dtype=bool)
     for (ax, ay), (bx, by) in (((x1, y1), (x2, y2)), ((x2, y2), (x0, y0)), ((x0, y0), (x1, y1))):
@@ -127,9 +131,17 @@ def _fill(corners, area, index, px, py, depth, owner, bary):
         edge = dx * (py - ay) - dy * (px - ax)  # (H, W) int64, exact
         inside &= edge >= 0 if _top_left(dx, dy) else edge > 0
         e.append(edge.astype(np.float64))
-    reciprocal = 1.0 / float(area)
-    alpha = -((float(y2 - y1) * z0 + float(y0 - y2) * z1) + float(y1 - y0) * z2) * reciprocal
-    beta = ((float(x2 - x1) * z0 + float(x0 - x2) * z1) + float(x1 - x0) * z2) * reciprocal
+    dx = (float(x2 - x1) + (r2 - r1), float(x0 - x2) + (r0 - r2), float(x1 - x0) + (r1 - r0))
+    dy = (float(y2 - y1) + (s2 - s1), float(y0 - y2) + (s0 - s2), float(y1 - y0) + (s1 - s0))
+    unsnapped = dx[2] * (float(y2 - y0) + (s2 - s0)) - dy[2] * (float(x2 - x0) + (r2 - r0))
+    if unsnapped * area < 0.5 * float(area) * float(area):  # a sliver: the snapped corners' plane
+        dx = (float(x2 - x1), float(x0 - x2), float(x1 - x0))
+        dy = (float(y2 - y1), float(y0 - y2), float(y1 - y0))
+        unsnapped, r0, s0 = float(area), 0.0, 0.0
+    reciprocal = 1.0 / unsnapped
+    alpha = -((dy[0] * z0 + dy[1] * z1) + dy[2] * z2) * reciprocal
+    beta = ((dx[0] * z0 + dx[1] * z1) + dx[2] * z2) * reciprocal
+    z0 = (z0 - alpha * r0) - beta * s0
     z = ((z0 + beta * (py - y0).astype(np.float64)) + alpha * (px - x0).astype(np.float64)).astype(np.float32)
     visible = inside & (z < depth)
     g0, g1, g2 = e[0] * q0, e[1] * q1, e[2] * q2

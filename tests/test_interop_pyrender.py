@@ -138,18 +138,19 @@ def _intrinsics(shift=(0.0, 0.0)):
 
 
 def _coverage_and_depth(reference, ours, *, coverage=0.999):
-    """Depth coverage equal on >= `coverage` of the pixels; depth within 1e-4 relative where both drew.
+    """Depth coverage equal on >= `coverage` of the pixels; depth within 1e-4 relative on every pixel both drew.
 
-    A few pixels on silhouettes seen at a grazing angle (depth changing fast across the pixel) may differ by up
-    to 1e-3: frustum snaps window positions to 1/256 pixel; at most 1 in 2,000 of the pixels both cover.
+    Grazing pixels included: frustum's depth is the plane through the triangle's corners before their window
+    positions snap to 1/256 pixel (``raster.triangles.depth_plane``); the plane through the snapped corners was
+    off by up to 2.7e-4 on 5 of the 44,096 pixels of the intrinsics scene, where pyrender's depth and a float64
+    ray cast agree within 2e-6.
     """
     agree = (reference > 0) == (ours > 0)
     assert agree.mean() >= coverage, f"coverage equal on {agree.mean():.5f} of the pixels"
     both = (reference > 0) & (ours > 0)
     assert both.sum() > 5000
     relative = np.abs(ours[both].astype(np.float64) / reference[both] - 1.0)
-    assert (relative <= 1e-4).mean() >= 0.9995, f"{(relative > 1e-4).sum()} of {both.sum()} pixels beyond 1e-4"
-    assert relative.max() <= 1e-3, f"depth differs by {relative.max():.3g} relative"
+    assert relative.max() <= 1e-4, f"{(relative > 1e-4).sum()} of {both.sum()} pixels beyond 1e-4 relative"
 
 
 def _colors_close(reference, ours, covered, *, share=0.99, tolerance=3):

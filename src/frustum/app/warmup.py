@@ -40,8 +40,8 @@ class WarmupReport:
 def _api() -> SimpleNamespace:
     """The public names the tasks use, from their own modules (the interface layer imports downward only)."""
     names = {}
-    for module in ("camera", "clipping", "geometry", "projection", "render", "scene", "shading", "transforms",
-                   "output.svg"):  # fmt: skip
+    for module in ("camera", "clipping", "geometry", "projection", "render", "render.radiosity", "scene", "shading",
+                   "shading.environment", "transforms", "output.svg"):  # fmt: skip
         loaded = importlib.import_module(f"frustum.{module}")  # (``from frustum import render`` is the function)
         names.update({name: getattr(loaded, name) for name in loaded.__all__})
     return SimpleNamespace(**names)
@@ -192,6 +192,65 @@ def _points_and_splats() -> None:
     fr.render(scene, camera)
 
 
+def _shadows() -> None:
+    fr = _api()
+
+    camera = _camera()
+    for light in (fr.DirectionalLight(direction=(-0.3, -1, -0.5)), fr.PointLight((1, 3, 2)),
+                  fr.SpotLight((0, 3, 2), (0, -1, -0.6))):  # fmt: skip
+        scene = fr.Scene(lights=[light])
+        scene.add(fr.uv_sphere(0.6, 16, 8), fr.Material(color=(0.8, 0.5, 0.2)), fr.translate(0, 0.3, 0))
+        scene.add(fr.box((4.0, 0.1, 4.0)), fr.Material(), fr.translate(0, -0.5, 0))
+        for shadows in (True, "ray"):
+            fr.render(scene, camera, shadows=shadows, buffers=("shadow",))
+    one = fr.Scene(lights=[fr.DirectionalLight(direction=(-0.3, -1, -0.5))])
+    one.add(fr.uv_sphere(0.6, 16, 8), fr.Material(color=(0.8, 0.5, 0.2)))
+    fr.render(one, camera, shadows=True)  # one mesh: the fused tile path
+
+
+def _physically_based_and_ground_truth() -> None:
+    fr = _api()
+
+    sky = np.linspace(0.0, 1.0, 16 * 32 * 3, dtype=np.float32).reshape(16, 32, 3)
+    scene = fr.Scene(lights=[fr.DirectionalLight(direction=(0, -1, -1))], environment=fr.EnvironmentMap(sky))
+    scene.add(fr.uv_sphere(1.0, 16, 8), fr.Material(color=(0.8, 0.5, 0.2), model="pbr", metallic=1.0,
+                                                     roughness=0.3), label="ball")  # fmt: skip
+    scene.add(fr.uv_sphere(0.5, 8, 4), fr.Material(model="pbr"), fr.translate(1.2, 0, 0), label="small")
+    camera = _camera()
+    fr.render(scene, camera, shading="pbr", tone_map="aces")
+    fr.render(scene, camera, buffers=("instance", "semantic", "amodal", "object_coords", "nocs", "flow"),
+              next=(scene, _camera((0.1, 1.0, 4.0))), samples=4)  # fmt: skip
+
+
+def _rays_and_radiosity() -> None:
+    fr = _api()
+
+    scene = _scene("all")
+    origins = np.tile((0.0, 0.0, 4.0), (8, 1))
+    directions = np.tile((0.0, 0.0, -1.0), (8, 1))
+    scene.intersect(origins, directions)
+    scene.intersect(origins, directions, fields=("t", "item", "face"))
+    scene.occluded(origins, directions, np.full(8, 10.0))
+    fr.render(scene, _camera(), method="ray-tracing")
+    room = fr.Scene()
+    room.add(fr.box((2.0, 2.0, 2.0)).flipped(), fr.Material(color=(0.7, 0.7, 0.7)))
+    room.add(fr.box((0.4, 0.05, 0.4)), fr.Material(emissive=(1, 1, 1)), fr.translate(0, 0.9, 0))
+    fr.radiosity(room, patch_size=0.5)
+    fr.radiosity(room, patch_size=0.5, form_factors="hemicube", hemicube=16)
+
+
+def _pyrender_scenes() -> None:
+    from frustum.interop import pyrender_shading
+
+    fr = _api()
+
+    scene, camera = _scene(), _camera()
+    frame = fr.render(scene, camera, shading="none", buffers=("normals", "object_id"))
+    items = np.array([[0.8, 0.5, 0.2, 0.0, 0.5, 0.0, 0.0, 0.0, pyrender_shading.MODE_CONSTANT, 1.0]])
+    light = (pyrender_shading.LIGHT_DIRECTIONAL, np.ones(3), np.zeros(3), np.array([0.0, -1.0, -1.0]), 0.0, 0.0, -1)
+    pyrender_shading.shade(frame, camera, items, [light], (0.1, 0.1, 0.1), True)
+
+
 TASKS: dict[str, Callable[[], None]] = {
     "surfaces (general shader)": _surfaces_general,
     "surfaces (fast path, supersampling, clipping)": _surfaces_fast,
@@ -202,6 +261,10 @@ TASKS: dict[str, Callable[[], None]] = {
     "visible-surface methods (scan-line, area subdivision, painter, ray casting, A-buffer)": _visibility_methods,
     "volume ray casting (composite, merged, MIP, isosurface)": _volumes,
     "point clouds and Gaussian splats": _points_and_splats,
+    "shadows (maps of every light, the fused tile path, shadow rays)": _shadows,
+    "physically based shading and ground-truth buffers": _physically_based_and_ground_truth,
+    "ray queries, ray tracing and radiosity": _rays_and_radiosity,
+    "pyrender scenes (pyrender's light model)": _pyrender_scenes,
 }
 """The families of kernels ``warmup`` compiles, each by running small examples of what uses them."""
 

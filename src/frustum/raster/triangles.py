@@ -18,7 +18,7 @@ triangle is stored, the tile lists hold its face index. A face crossing the view
 (Sutherland–Hodgman) into a fan whose triangles get records (tile list entry $−1 − r$ for record r):
 ``tri_int`` (R, 11) int64: ``X0, Y0, X1, Y1, X2, Y2`` snapped corners, $code = 2·face + back$, the pixel
 bounding box ``i_min, i_max, j_min, j_max`` (inclusive, inside the image);
-``tri_float`` (R, 3, 2) float64 per corner: window depth ``z_w`` and ``1/w_clip``;
+``tri_float`` (R, 3, 2 or 4) float64 per corner: window depth ``z_w`` and ``1/w_clip`` (and the snap residuals);
 ``tri_weights`` (R, 3, 2) float64 per corner: its barycentric weights ``(u1, u2)`` with respect to the source
 face's corners 1 and 2 ($u0 = 1 − u1 − u2$ is never read). A trivially accepted face's corners are its own
 corners 0, 1, 2 in drawing order (1 and 2 swapped when back = 1), so its weights are one-hot and the fill takes
@@ -26,7 +26,8 @@ the pixel's own barycentrics instead, which is bit-identical to weighting by one
 ($(b0·0 + b1·1) + b2·0 = b1$ exactly for b_k >= 0).
 
 Depth and weights at a covered pixel centre P. Window depth is affine in screen space, so it is the plane through
-the snapped corners ``(X_k, Y_k, z_k)`` written from corner 0 with its gradients (``depth_gradients``):
+the corners ``(X_k, Y_k, z_k)`` written from corner 0 with its gradients (``depth_plane``: the corners before the
+snap where the vertex records carry their residuals, which the frame's own pass asks for):
 $z(P) = (z_0 + β·(Y_P − Y_0)) + α·(X_P − X_0)$, $α = −Σ dy_k z_k · r$, $β = Σ dx_k z_k · r$, $r = 1/(2·area)$
 (edge k opposite corner k) — the depth-buffer method's incremental form $z' = z − A/C$ per step along a scan
 line [HB 9 "Depth-Buffer Method"], evaluated from the corner instead of accumulated, so every pixel's value is
@@ -58,7 +59,7 @@ __all__ = [
     "SUBPIXEL",
     "clip_faces",
     "covers_centre",
-    "depth_gradients",
+    "depth_plane",
     "face_box",
     "list_crossing",
     "rasterize_tiles",
@@ -113,19 +114,29 @@ def _span(e: int, step: int, bias: int, inverse: float, first: int, last: int) -
 
 
 @kernel
-def depth_gradients(
-    x0: int, y0: int, x1: int, y1: int, x2: int, y2: int, z0: float, z1: float, z2: float
-) -> tuple[float, float]:  # fmt: skip
-    """$(α, β)$: change of window depth per 1/256 pixel in x and y on the plane through the snapped corners,
-    $α = −((dy_0 z_0 + dy_1 z_1) + dy_2 z_2)·r$, $β = ((dx_0 z_0 + dx_1 z_1) + dx_2 z_2)·r$ with
-    $r = 1/(2·area)$ (module docstring; 2·area ≠ 0)."""
-    dx0, dy0 = x2 - x1, y2 - y1
-    dx1, dy1 = x0 - x2, y0 - y2
-    dx2, dy2 = x1 - x0, y1 - y0
-    reciprocal = 1.0 / float(dx2 * (y2 - y0) - dy2 * (x2 - x0))
-    alpha = -((float(dy0) * z0 + float(dy1) * z1) + float(dy2) * z2) * reciprocal
-    beta = ((float(dx0) * z0 + float(dx1) * z1) + float(dx2) * z2) * reciprocal
-    return alpha, beta
+def depth_plane(
+    x0: int, y0: int, x1: int, y1: int, x2: int, y2: int, r0: float, s0: float, r1: float, s1: float, r2: float,
+    s2: float, z0: float, z1: float, z2: float,
+) -> tuple[float, float, float]:  # fmt: skip
+    """$(z_0', α, β)$: window depth's plane through the unsnapped corners $(X_k + r_k, Y_k + s_k, z_k)$ (r, s the
+    snap residuals, 1/256 pixel), $z(P) = (z_0' + β·(Y_P − Y_0)) + α·(X_P − X_0)$ from the snapped corner 0:
+    $α = −Σ dy_k z_k / (2·area)$, $β = Σ dx_k z_k / (2·area)$, $z_0' = z_0 − α·r_0 − β·s_0$ (module docstring).
+
+    The snapped corners' plane instead where the unsnapped triangle's area is under half the snapped one's or of
+    the other sign (a sliver whose shape the snap decides). Residuals 0 give the snapped corners' plane, bit for
+    bit: every coordinate is an integer below 2^26, so the differences and products are exact.
+    """
+    fx0, fy0, fx1, fy1, fx2, fy2 = x0 + r0, y0 + s0, x1 + r1, y1 + s1, x2 + r2, y2 + s2
+    snapped = float((x1 - x0) * (y2 - y0) - (y1 - y0) * (x2 - x0))
+    area = (fx1 - fx0) * (fy2 - fy0) - (fy1 - fy0) * (fx2 - fx0)
+    if area * snapped < 0.5 * snapped * snapped:  # np.divide below: no ZeroDivisionError branch
+        fx0, fy0, fx1, fy1, fx2, fy2 = float(x0), float(y0), float(x1), float(y1), float(x2), float(y2)
+        area = snapped
+        r0, s0 = 0.0, 0.0
+    reciprocal = np.divide(1.0, area)
+    alpha = -(((fy2 - fy1) * z0 + (fy0 - fy2) * z1) + (fy1 - fy0) * z2) * reciprocal
+    beta = (((fx2 - fx1) * z0 + (fx0 - fx2) * z1) + (fx1 - fx0) * z2) * reciprocal
+    return (z0 - alpha * r0) - beta * s0, alpha, beta
 
 
 @kernel
@@ -231,6 +242,10 @@ def _setup_triangle(
         w = corners[p, 3]
         tri_float[slot, v, 0] = (corners[p, 2] / w) * 0.5 + 0.5
         tri_float[slot, v, 1] = 1.0 / w
+        if tri_float.shape[2] >= 4:  # the snap residuals (``depth_plane``)
+            x_w, y_w = (corners[p, 0] / w) * view[0] + view[0], (corners[p, 1] / w) * view[1] + view[1]
+            tri_float[slot, v, 2] = x_w * SUBPIXEL - (xa if v == 0 else (xb if v == 1 else xc))
+            tri_float[slot, v, 3] = y_w * SUBPIXEL - (ya if v == 0 else (yb if v == 1 else yc))
         tri_weights[slot, v, 0], tri_weights[slot, v, 1] = weights[p, 1], weights[p, 2]
     tri_int[slot, 6] = 2 * code + back
     tri_int[slot, 7], tri_int[slot, 8], tri_int[slot, 9], tri_int[slot, 10] = i_min, i_max, j_min, j_max
@@ -278,19 +293,21 @@ def clip_faces(
 
 
 FILL_BLOCK = 128
-"""Tile entries per block of ``_fill_tile`` (its work blocks, 13 + 8 rows of FILL_BLOCK int64 and float64, 21 KiB,
-stay in the L1 cache)."""
+"""Tile entries per block of ``_fill_tile`` (its work blocks, 13 + 14 rows of FILL_BLOCK int64 and float64,
+27 KiB, stay in the L1 cache)."""
 _GENERAL = 16
 """``_setup_entries`` kind of an entry filled by the row loop (a larger box, or a clipped record); 0: nothing to
 draw, 1–15: the covered centres of a box of at most 2 × 2 (bit ci + 2·cj)."""
-_INT_ROWS, _FLOAT_ROWS = 13, 8
+_INT_ROWS, _FLOAT_ROWS = 13, 14
 (_X0, _Y0, _X1, _Y1, _X2, _Y2, _CODE, _ENTRY, _KIND, _IMIN, _IMAX, _JMIN, _JMAX) = (
     np.uint64(k * FILL_BLOCK) for k in range(_INT_ROWS)
 )
 """Rows of the int64 work block (unsigned offsets): corners (counter-clockwise once set up), code, tile entry, kind,
 box."""
-(_Z0, _Z1, _Z2, _Q0, _Q1, _Q2, _ALPHA, _BETA) = (np.uint64(k * FILL_BLOCK) for k in range(_FLOAT_ROWS))
-"""Rows of the float64 work block: corners' ``z_w`` and ``1/w``, depth gradients."""
+(_Z0, _Z1, _Z2, _Q0, _Q1, _Q2, _ALPHA, _BETA, _R0, _S0, _R1, _S1, _R2, _S2) = (
+    np.uint64(k * FILL_BLOCK) for k in range(_FLOAT_ROWS)
+)
+"""Rows of the float64 work block: corners' ``z_w`` and ``1/w``, depth gradients, corners' snap residuals."""
 
 
 @kernel
@@ -306,10 +323,14 @@ def _setup_entries(
     ``tri_int``/``tri_float``), code without the back bit ($2·face$; a record's whole code), the entry. The set
     up (vectorized by LLVM, 8 entries an AVX-512 instruction): a clockwise face's corners 1 and 2 swapped and its
     back bit added to the code, the pixel box clamped to the tile [col0, col1) × [row0, row1), the kind
-    (``_GENERAL``; the 2 × 2 coverage mask) and the depth gradients (``depth_gradients``' formulas). The depths of
+    (``_GENERAL``; the 2 × 2 coverage mask) and the depth plane (``depth_plane``'s formulas). The depths of
     the 2 × 2 centres computed here as well were 2 % faster but cost 0.25 s more compile time; the two passes in
     two kernels, 0.1 s more.
     """
+    residuals, record_residuals = win_float.shape[1] >= 4, tri_float.shape[2] >= 4
+    if not (residuals and record_residuals):  # the snapped corners' plane (the rows stay 0 where not read)
+        for k in range(6 * FILL_BLOCK):
+            values[_R0 + np.uint64(k)] = 0.0
     for n in range(stop - first):
         u = np.uint64(n)
         slot = first + n
@@ -332,6 +353,10 @@ def _setup_entries(
             values[u + _Z0], values[u + _Q0] = win_float[v0, 0], win_float[v0, 1]
             values[u + _Z1], values[u + _Q1] = win_float[v1, 0], win_float[v1, 1]
             values[u + _Z2], values[u + _Q2] = win_float[v2, 0], win_float[v2, 1]
+            if residuals:
+                values[u + _R0], values[u + _S0] = win_float[v0, 2], win_float[v0, 3]
+                values[u + _R1], values[u + _S1] = win_float[v1, 2], win_float[v1, 3]
+                values[u + _R2], values[u + _S2] = win_float[v2, 2], win_float[v2, 3]
             block[u + _CODE] = 2 * (face_offset + entry)
         else:
             r = -1 - entry
@@ -340,6 +365,10 @@ def _setup_entries(
             values[u + _Z0], values[u + _Q0] = tri_float[r, 0, 0], tri_float[r, 0, 1]
             values[u + _Z1], values[u + _Q1] = tri_float[r, 1, 0], tri_float[r, 1, 1]
             values[u + _Z2], values[u + _Q2] = tri_float[r, 2, 0], tri_float[r, 2, 1]
+            if record_residuals:
+                values[u + _R0], values[u + _S0] = tri_float[r, 0, 2], tri_float[r, 0, 3]
+                values[u + _R1], values[u + _S1] = tri_float[r, 1, 2], tri_float[r, 1, 3]
+                values[u + _R2], values[u + _S2] = tri_float[r, 2, 2], tri_float[r, 2, 3]
             block[u + _CODE] = tri_int[r, 6]
         block[u + _ENTRY] = entry
     m = stop - first
@@ -348,11 +377,15 @@ def _setup_entries(
         x0, y0, x1, y1 = block[u + _X0], block[u + _Y0], block[u + _X1], block[u + _Y1]
         x2, y2 = block[u + _X2], block[u + _Y2]
         z0, z1, z2, q1, q2 = values[u + _Z0], values[u + _Z1], values[u + _Z2], values[u + _Q1], values[u + _Q2]
+        rx0, ry0, rx1, ry1 = values[u + _R0], values[u + _S0], values[u + _R1], values[u + _S1]
+        rx2, ry2 = values[u + _R2], values[u + _S2]
         back = (x1 - x0) * (y2 - y0) - (x2 - x0) * (y1 - y0) < 0  # never for a record (set up counter-clockwise)
         x1, x2 = (x2, x1) if back else (x1, x2)
         y1, y2 = (y2, y1) if back else (y1, y2)
         z1, z2 = (z2, z1) if back else (z1, z2)
         q1, q2 = (q2, q1) if back else (q1, q2)
+        rx1, rx2 = (rx2, rx1) if back else (rx1, rx2)
+        ry1, ry2 = (ry2, ry1) if back else (ry1, ry2)
         i_min = max((min(x0, min(x1, x2)) + (HALF_SUBPIXEL - 1)) >> SUBPIXEL_BITS, col0)  # _first_centre
         i_max = min((max(x0, max(x1, x2)) - HALF_SUBPIXEL) >> SUBPIXEL_BITS, col1 - 1)
         j_min = max((min(y0, min(y1, y2)) + (HALF_SUBPIXEL - 1)) >> SUBPIXEL_BITS, row0)
@@ -380,10 +413,21 @@ def _setup_entries(
         empty = (i_min > i_max) | (j_min > j_max)
         small = (i_max - i_min <= 1) & (j_max - j_min <= 1) & (block[u + _ENTRY] >= 0)
         kind = 0 if empty else (mask if small else _GENERAL)
-        # depth_gradients (np.divide: no ZeroDivisionError branch, so the loop vectorizes; 2·area ≠ 0 here)
-        reciprocal = np.divide(1.0, float(dx2 * (y2 - y0) - dy2 * (x2 - x0)))
-        alpha = -((float(dy0) * z0 + float(dy1) * z1) + float(dy2) * z2) * reciprocal
-        beta = ((float(dx0) * z0 + float(dx1) * z1) + float(dx2) * z2) * reciprocal
+        # depth_plane, without a branch (selects), so the loop vectorizes; 2·area ≠ 0 here
+        snapped = float(dx2 * (y2 - y0) - dy2 * (x2 - x0))
+        fdx0, fdy0 = float(dx0) + (rx2 - rx1), float(dy0) + (ry2 - ry1)
+        fdx1, fdy1 = float(dx1) + (rx0 - rx2), float(dy1) + (ry0 - ry2)
+        fdx2, fdy2 = float(dx2) + (rx1 - rx0), float(dy2) + (ry1 - ry0)
+        area = fdx2 * (float(y2 - y0) + (ry2 - ry0)) - fdy2 * (float(x2 - x0) + (rx2 - rx0))
+        sliver = area * snapped < 0.5 * snapped * snapped
+        fdx0, fdy0 = (float(dx0), float(dy0)) if sliver else (fdx0, fdy0)
+        fdx1, fdy1 = (float(dx1), float(dy1)) if sliver else (fdx1, fdy1)
+        fdx2, fdy2 = (float(dx2), float(dy2)) if sliver else (fdx2, fdy2)
+        rx0, ry0, area = (0.0, 0.0, snapped) if sliver else (rx0, ry0, area)
+        reciprocal = np.divide(1.0, area)
+        alpha = -((fdy0 * z0 + fdy1 * z1) + fdy2 * z2) * reciprocal
+        beta = ((fdx0 * z0 + fdx1 * z1) + fdx2 * z2) * reciprocal
+        values[u + _Z0] = (z0 - alpha * rx0) - beta * ry0
         values[u + _Z1], values[u + _Z2], values[u + _Q1], values[u + _Q2] = z1, z2, q1, q2
         values[u + _ALPHA], values[u + _BETA] = alpha, beta
         block[u + _X1], block[u + _X2], block[u + _Y1], block[u + _Y2] = x1, x2, y1, y2

@@ -21,7 +21,7 @@ import math
 import numpy as np
 
 from frustum.raster._jit import kernel, parallel_kernel
-from frustum.raster.fixed_point import snap
+from frustum.raster.fixed_point import SUBPIXEL, snap
 
 __all__ = [
     "clip_vertex",
@@ -88,10 +88,12 @@ def project_vertices(
 
     view = (width/2, height/2). codes (N,) any integer type of 6 bits or more; win_int (N, 2) int32 or
     int64 receives the snapped $X = floor((x_c/w·W/2 + W/2)·256 + 0.5)$, Y alike; win_float (N, 2) float64 the
-    window depth $z_w = (z_c/w)·0.5 + 0.5$ and ``1/w``. Rows of vertices outside (code != 0) are left
+    window depth $z_w = (z_c/w)·0.5 + 0.5$ and ``1/w``, and where it has four columns the snap residuals
+    $x_w·256 − X$, $y_w·256 − Y$ (``triangles.depth_plane``). Rows of vertices outside (code != 0) are left
     unwritten: their faces are clipped (from ``clip_vertex``) or rejected.
     """
     m = clip_from_model
+    residuals = win_float.shape[1] >= 4
     for i in range(start, stop):
         x, y, z = vertices[i, 0], vertices[i, 1], vertices[i, 2]
         cx, cy = _affine_row(m, 0, x, y, z), _affine_row(m, 1, x, y, z)
@@ -100,10 +102,12 @@ def project_vertices(
         codes[i] = code
         if code != 0:
             continue
-        win_int[i, 0] = snap((cx / cw) * view[0] + view[0])
-        win_int[i, 1] = snap((cy / cw) * view[1] + view[1])
+        x_w, y_w = (cx / cw) * view[0] + view[0], (cy / cw) * view[1] + view[1]
+        win_int[i, 0], win_int[i, 1] = snap(x_w), snap(y_w)
         win_float[i, 0] = (cz / cw) * 0.5 + 0.5
         win_float[i, 1] = 1.0 / cw
+        if residuals:
+            win_float[i, 2], win_float[i, 3] = x_w * SUBPIXEL - win_int[i, 0], y_w * SUBPIXEL - win_int[i, 1]
 
 
 @parallel_kernel(lambda vertices, *_: vertices.shape[0], grain=4096)

@@ -23,7 +23,7 @@ import numpy as np
 
 from frustum.raster._jit import kernel, parallel_kernel
 from frustum.raster.fixed_point import HALF_SUBPIXEL, SUBPIXEL
-from frustum.raster.triangles import FACE_DRAWN, depth_gradients, face_box
+from frustum.raster.triangles import FACE_DRAWN, depth_plane, face_box
 
 __all__ = [
     "count_covered",
@@ -66,6 +66,8 @@ def gather_faces(
             v = v0 if k == 0 else (v1 if k == 1 else v2)
             xy[t, 2 * k], xy[t, 2 * k + 1] = win_int[v, 0], win_int[v, 1]
             zq[t, k, 0], zq[t, k, 1] = win_float[v, 0], win_float[v, 1]
+            if zq.shape[2] >= 4:
+                zq[t, k, 2], zq[t, k, 3] = win_float[v, 2], win_float[v, 3]
         weights[t, 0, 0], weights[t, 0, 1] = 0.0, 0.0
         weights[t, 1, 0], weights[t, 1, 1] = w1, w2
         weights[t, 2, 0], weights[t, 2, 1] = w2, w1
@@ -108,10 +110,13 @@ def covers(xy: np.ndarray, t: int, px: int, py: int) -> bool:
 @kernel
 def plane_depth(xy: np.ndarray, zq: np.ndarray, t: int, px: int, py: int) -> float:
     """Window depth (float64) of triangle t's plane at the fixed-point point (px, py):
-    $(z_0 + β·(py − Y_0)) + α·(px − X_0)$ with ``(α, β) = triangles.depth_gradients`` (the depth buffer's bits)."""
+    $(z_0' + β·(py − Y_0)) + α·(px − X_0)$ with ``(z_0', α, β) = triangles.depth_plane`` (the depth buffer's bits)."""
     x0, y0 = xy[t, 0], xy[t, 1]
-    z0 = zq[t, 0, 0]
-    alpha, beta = depth_gradients(x0, y0, xy[t, 2], xy[t, 3], xy[t, 4], xy[t, 5], z0, zq[t, 1, 0], zq[t, 2, 0])
+    r0 = s0 = r1 = s1 = r2 = s2 = 0.0
+    if zq.shape[2] >= 4:
+        r0, s0, r1, s1, r2, s2 = zq[t, 0, 2], zq[t, 0, 3], zq[t, 1, 2], zq[t, 1, 3], zq[t, 2, 2], zq[t, 2, 3]
+    z0, alpha, beta = depth_plane(x0, y0, xy[t, 2], xy[t, 3], xy[t, 4], xy[t, 5], r0, s0, r1, s1, r2, s2,
+                                  zq[t, 0, 0], zq[t, 1, 0], zq[t, 2, 0])  # fmt: skip
     return (z0 + beta * float(py - y0)) + alpha * float(px - x0)
 
 

@@ -123,11 +123,11 @@ def world_attributes(item: SceneItem, scratch: Scratch) -> tuple[np.ndarray, np.
 class Binned:
     """One item after the vertex stage, triangle setup and binning: everything the tile fill reads.
 
-    ``win_int`` (N, 2) snapped window ``X, Y`` and ``win_float`` (N, 2) ``z_w, 1/w`` of the vertices inside the
-    view volume (``vertex_codes == 0``; other rows are undefined); the clipped triangles' records ``tri_int``,
-    ``tri_float``, ``tri_weights`` (``raster.triangles``) of the ``crossing`` faces; tile t's entries, in
-    drawing order, ``tile_entries[tile_starts[t]:tile_starts[t + 1]]``: a face index f >= 0 or $−1 − r$ for
-    record r; ``tiles_x`` tiles of ``TILE_SIZE`` pixels per row.
+    ``win_int`` (N, 2) snapped window ``X, Y`` and ``win_float`` (N, 4) ``z_w, 1/w`` and the snap residuals of the
+    vertices inside the view volume (``vertex_codes == 0``; other rows are undefined); the clipped triangles'
+    records ``tri_int``, ``tri_float``, ``tri_weights`` (``raster.triangles``) of the ``crossing`` faces; tile t's
+    entries, in drawing order, ``tile_entries[tile_starts[t]:tile_starts[t + 1]]``: a face index f >= 0 or
+    $−1 − r$ for record r; ``tiles_x`` tiles of ``TILE_SIZE`` pixels per row.
     """
 
     faces: np.ndarray
@@ -157,7 +157,7 @@ def bin_item(
     clip_from_model = item_matrices(item, camera)[0]
     small = triangles.SUBPIXEL * (max(width, height) + 2) < 2**31
     win_int = empty((mesh.vertex_count, 2), np.int32 if small else np.int64)
-    win_float = empty((mesh.vertex_count, 2), np.float64)
+    win_float = empty((mesh.vertex_count, 4), np.float64)  # z_w, 1/w and the snap residuals (depth_plane)
     vertex_codes = empty((mesh.vertex_count,), np.uint8)  # 6 view-volume planes: one bit each
     project_vertices(mesh.vertices, clip_from_model, view, win_int, win_float, vertex_codes)
     # per face: reject / accept / crossing, cull, box, count its tiles (parallel over chunks of faces)
@@ -178,7 +178,7 @@ def bin_item(
     crossing_starts = np.concatenate([[0], np.cumsum(crossing_counts)])
     crossing = np.empty(int(crossing_starts[-1]), dtype=np.int64)
     tri_int = np.empty((0, triangles.RECORD_FIELDS), dtype=np.int64)
-    tri_float, tri_weights = np.empty((0, 3, 2)), np.empty((0, 3, 2))
+    tri_float, tri_weights = np.empty((0, 3, 4)), np.empty((0, 3, 2))
     record_starts = np.zeros(crossing.shape[0] + 1, dtype=np.int64)
     if crossing.shape[0]:
         triangles.list_crossing(listed, listed_tiles, chunk, listed_counts, crossing_starts[:-1], crossing)
@@ -187,7 +187,7 @@ def bin_item(
         if crossing.shape[0] <= ONE_PASS_CLIPPING:  # clip once into FAN_MAX slots per face, then close the gaps
             slots = crossing.shape[0] * triangles.FAN_MAX
             tri_int = np.empty((slots, triangles.RECORD_FIELDS), dtype=np.int64)
-            tri_float, tri_weights = np.empty((slots, 3, 2)), np.empty((slots, 3, 2))
+            tri_float, tri_weights = np.empty((slots, 3, 4)), np.empty((slots, 3, 2))
             made = np.arange(0, slots, triangles.FAN_MAX, dtype=np.int64)  # first slots in, record counts out
             clip_options[4] = 2
             triangles.clip_faces(*arguments, made, tri_int, tri_float, tri_weights)
@@ -199,7 +199,7 @@ def bin_item(
             record_starts = np.cumsum(record_starts)
             total = int(record_starts[-1])
             tri_int = np.empty((total, triangles.RECORD_FIELDS), dtype=np.int64)
-            tri_float, tri_weights = np.empty((total, 3, 2)), np.empty((total, 3, 2))
+            tri_float, tri_weights = np.empty((total, 3, 4)), np.empty((total, 3, 2))
             clip_options[4] = 1
             triangles.clip_faces(*arguments, record_starts[:-1], tri_int, tri_float, tri_weights)
         tiles.add_record_tiles(tri_int, options, counts)

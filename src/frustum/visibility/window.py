@@ -30,9 +30,9 @@ __all__ = ["WindowTriangles", "window_triangles"]
 @dataclasses.dataclass(frozen=True)
 class WindowTriangles:
     """T drawn triangles in window coordinates (layout of ``raster.window``): ``xy`` (T, 6) int64 snapped
-    counter-clockwise corners, ``zq`` (T, 3, 2) float64 ``z_w, 1/w``, ``weights`` (T, 3, 2) float64 barycentric
-    weights onto the source face, ``code`` (T,) int64 $2·face + back$, ``box`` (T, 4) int64 pixel box, ``item``
-    (T,) int64 index of the scene item; ``width``, ``height`` of the image."""
+    counter-clockwise corners, ``zq`` (T, 3, 4) float64 ``z_w, 1/w`` and the snap residuals, ``weights`` (T, 3, 2)
+    float64 barycentric weights onto the source face, ``code`` (T,) int64 $2·face + back$, ``box`` (T, 4) int64
+    pixel box, ``item`` (T,) int64 index of the scene item; ``width``, ``height`` of the image."""
 
     xy: np.ndarray
     zq: np.ndarray
@@ -102,7 +102,7 @@ def window_triangles(
         clip_from_model = camera.clip_from_world @ np.asarray(item.world_from_model, dtype=np.float64)
         small = triangles.SUBPIXEL * (max(width, height) + 2) < 2**31  # as render.bin_item: one compiled version
         win_int = np.empty((mesh.vertex_count, 2), dtype=np.int32 if small else np.int64)
-        win_float = np.empty((mesh.vertex_count, 2))
+        win_float = np.empty((mesh.vertex_count, 4))  # z_w, 1/w and the snap residuals
         vertex_codes = np.zeros(mesh.vertex_count, dtype=np.uint8)
         project_vertices(mesh.vertices, clip_from_model, view, win_int, win_float, vertex_codes)
         options = np.array([width, height, int(cull), face_offsets[k], 0], dtype=np.int64)
@@ -122,14 +122,14 @@ def window_triangles(
             clip_options = np.array([width, height, int(cull), face_offsets[k], 0], dtype=np.int64)
             record_starts = np.zeros(crossing.shape[0] + 1, dtype=np.int64)
             tri_int = np.empty((0, triangles.RECORD_FIELDS), dtype=np.int64)
-            tri_float, tri_weights = np.empty((0, 3, 2)), np.empty((0, 3, 2))
+            tri_float, tri_weights = np.empty((0, 3, 4)), np.empty((0, 3, 2))
             arguments = (crossing, faces, mesh.vertices, clip_from_model, VIEW_VOLUME_PLANES, view, clip_options)
             triangles.clip_faces(*arguments, record_starts[1:], tri_int, tri_float, tri_weights)
             counts = record_starts[1:].copy()
             record_starts = np.cumsum(record_starts)
             total = int(record_starts[-1])
             tri_int = np.empty((total, triangles.RECORD_FIELDS), dtype=np.int64)
-            tri_float, tri_weights = np.empty((total, 3, 2)), np.empty((total, 3, 2))
+            tri_float, tri_weights = np.empty((total, 3, 4)), np.empty((total, 3, 2))
             clip_options[4] = 1
             triangles.clip_faces(*arguments, record_starts[:-1], tri_int, tri_float, tri_weights)
             records = (
@@ -147,6 +147,6 @@ def window_triangles(
 
 def _allocate(count: int) -> tuple[np.ndarray, ...]:
     return (
-        np.empty((count, 6), dtype=np.int64), np.empty((count, 3, 2)), np.empty((count, 3, 2)),
+        np.empty((count, 6), dtype=np.int64), np.empty((count, 3, 4)), np.empty((count, 3, 2)),
         np.empty(count, dtype=np.int64), np.empty((count, 4), dtype=np.int64),
     )  # fmt: skip
