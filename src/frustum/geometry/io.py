@@ -239,9 +239,10 @@ def _native_parts(file: Path, text: bytes | None) -> list[MeshPart] | None:
             for k, texture_image in enumerate((part.metallic_roughness_image, part.occlusion_image)):
                 if texture_image is not None and part.uvs is not None:
                     physical[k] = np.asarray(texture_image.convert("RGB"), dtype=np.uint8)
+            pbr = file.suffix.lower() in (".glb", ".gltf") or part.metallic is not None  # glTF, or an MTL's Pr/Pm
             parts.append(MeshPart(part.name, mesh, np.asarray(part.world_from_model, dtype=np.float64), image, color,
                                   normal_map, part.emissive, part.alpha_mode, part.metallic, part.roughness,
-                                  *physical, file.suffix.lower() in (".glb", ".gltf") or part.metallic is not None))  # fmt: skip
+                                  *physical, pbr))  # fmt: skip
     except MemoryError:
         raise
     except Exception:  # invalid geometry or an unreadable image: trimesh's path says what is wrong
