@@ -7,6 +7,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pytest
 from PIL import Image
 
 from frustum.geometry.io import load_parts
@@ -61,3 +62,125 @@ def test_an_mtl_without_pbr_statements_stays_phong(tmp_path):
         assert part.metallic_roughness_texture is None
         material = part_material(part)
         assert material.model == "phong" and material.metallic == 0.0
+
+
+# --- KHR_lights_punctual ------------------------------------------------------------------------------------
+
+
+def _glb_with_lights(path: Path) -> Path:
+    """A metal-and-plastic sphere GLB (trimesh's export) with three lights patched into its JSON chunk: a
+    directional light turned by a node rotation, a point light under a translated parent, a spot light."""
+    import json
+    import math
+    import struct
+
+    import trimesh
+
+    sphere = trimesh.creation.icosphere(subdivisions=3)
+    sphere.visual = trimesh.visual.TextureVisuals(material=trimesh.visual.material.PBRMaterial(
+        baseColorFactor=[200, 120, 60, 255], metallicFactor=0.3, roughnessFactor=0.4))  # fmt: skip
+    data = trimesh.Scene(sphere).export(file_type="glb")
+    (length,) = struct.unpack_from("<I", data, 12)
+    gltf = json.loads(data[20 : 20 + length])
+    rest = data[20 + length :]
+    half = math.sqrt(0.5)
+    gltf["extensionsUsed"] = ["KHR_lights_punctual"]
+    gltf["extensions"] = {"KHR_lights_punctual": {"lights": [
+        {"type": "directional", "intensity": 3.0, "color": [1.0, 0.9, 0.8]},
+        {"type": "point", "intensity": 40.0, "range": 9.0},
+        {"type": "spot", "intensity": 25.0, "color": [0.5, 0.5, 1.0],
+         "spot": {"innerConeAngle": 0.2, "outerConeAngle": 0.5}},
+    ]}}  # fmt: skip
+    first = len(gltf["nodes"])
+    gltf["nodes"] += [
+        {"rotation": [-half, 0.0, 0.0, half], "extensions": {"KHR_lights_punctual": {"light": 0}}},  # −Z → −Y
+        {"translation": [0.0, 1.0, 0.0], "children": [first + 2]},
+        {"translation": [2.0, 0.0, 3.0], "extensions": {"KHR_lights_punctual": {"light": 1}}},
+        {"translation": [0.0, 0.0, 4.0], "extensions": {"KHR_lights_punctual": {"light": 2}}},
+    ]
+    gltf["scenes"][gltf.get("scene", 0)]["nodes"] += [first, first + 1, first + 3]
+    text = json.dumps(gltf).encode()
+    text += b" " * (-len(text) % 4)
+    body = struct.pack("<I4s", len(text), b"JSON") + text + rest
+    path.write_bytes(struct.pack("<4sII", b"glTF", 2, 12 + len(body)) + body)
+    return path
+
+
+def _expected_lights() -> list:
+    from frustum.shading import DirectionalLight, PointLight, SpotLight
+
+    return [
+        DirectionalLight((0.0, -1.0, 0.0), color=(1.0, 0.9, 0.8), intensity=3.0),
+        PointLight((2.0, 1.0, 3.0), intensity=40.0, range=9.0),
+        SpotLight((0.0, 0.0, 4.0), (0.0, 0.0, -1.0), color=(0.5, 0.5, 1.0), intensity=25.0, inner_angle=0.2,
+                  outer_angle=0.5),
+    ]
+
+
+def _same_light(a, b) -> bool:
+    fields = ("direction", "position", "color", "intensity", "range", "inner_angle", "outer_angle")
+    return type(a) is type(b) and all(
+        np.allclose(getattr(a, name), getattr(b, name), atol=1e-12) if getattr(a, name, None) is not None
+        else getattr(b, name, None) is None for name in fields)  # fmt: skip
+
+
+def test_khr_lights_punctual_are_read_with_their_nodes_placements(tmp_path):
+    from frustum.scenefile.gltf_lights import gltf_lights
+
+    lights = gltf_lights(_glb_with_lights(tmp_path / "lit.glb"))
+    assert len(lights) == 3
+    for found, expected in zip(lights, _expected_lights(), strict=True):
+        assert _same_light(found, expected), (found, expected)
+
+
+def test_a_glb_with_lights_renders_as_the_same_scene_lit_by_hand(tmp_path):
+    import frustum as fr
+    from frustum.scenefile import load_scene_file
+    from frustum.scenefile.models import PHYSICAL_AMBIENT, model_scene, part_nodes, physical_options
+
+    path = _glb_with_lights(tmp_path / "lit.glb")
+    scene, camera = model_scene(path, size=(96, 72))
+    by_hand = fr.Scene()
+    for node in part_nodes(load_parts(path)):
+        by_hand.add(node)
+    for light in [*_expected_lights(), fr.AmbientLight(intensity=PHYSICAL_AMBIENT)]:
+        by_hand.root.add_light(light)
+    options = physical_options(scene)
+    assert options["tone_map"] == "khronos-neutral"
+    picture = fr.render(scene, camera, **options).color
+    assert np.array_equal(picture, fr.render(by_hand, camera, **options).color)
+    assert picture[..., :3].max() > 60  # lit, not black
+    loaded = load_scene_file(path)  # what `frustum render lit.glb` draws
+    assert [type(light).__name__ for light in loaded.scene.world_lights()] == [
+        "DirectionalLight", "PointLight", "SpotLight", "AmbientLight"]  # fmt: skip
+
+
+def test_a_glb_without_lights_keeps_the_default_lights(tmp_path):
+    import trimesh
+
+    from frustum.scenefile.gltf_lights import gltf_lights
+    from frustum.scenefile.models import model_scene
+
+    path = tmp_path / "plain.glb"
+    trimesh.creation.box().export(path)
+    assert gltf_lights(path) == []
+    scene, _ = model_scene(path)
+    assert len(scene.world_lights()) == 4  # key, fill, rim, ambient
+
+
+def test_malformed_lights_are_refused_with_the_light(tmp_path):
+    import json
+    import struct
+
+    from frustum.errors import GeometryError
+    from frustum.scenefile.gltf_lights import gltf_lights
+
+    path = _glb_with_lights(tmp_path / "lit.glb")
+    data = path.read_bytes()
+    (length,) = struct.unpack_from("<I", data, 12)
+    gltf = json.loads(data[20 : 20 + length])
+    for light, message in (({"type": "area"}, "type = 'area'"), ({"type": "point", "intensity": -1}, "light 0")):
+        gltf["extensions"]["KHR_lights_punctual"]["lights"][0] = light
+        (tmp_path / "bad.gltf").write_text(json.dumps(gltf))
+        with pytest.raises(GeometryError, match=message):
+            gltf_lights(tmp_path / "bad.gltf")

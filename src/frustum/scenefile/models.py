@@ -2,7 +2,7 @@
 gives, with the file's own materials (base colours, textures, normal maps; glTF's metallic–roughness materials as
 ``model="pbr"``, rendered tone mapped and sRGB-encoded as glTF viewers do: ``physical_options``), a camera framing
 the model from a 3/4 view (``Camera.fit``) and the default lights (``default_lights``) when nothing else names
-lights. Scene files
+lights (a glTF file's own ``KHR_lights_punctual`` lights replace them: ``frustum.scenefile.gltf_lights``). Scene files
 that name no lights get the same default lights around their camera when they draw lit surfaces (see
 ``frustum.scenefile.loader._wants_default_lights``; ``lights = []`` keeps a scene unlit on purpose).
 
@@ -128,9 +128,20 @@ def model_scene(path: str | Path, *, up: str = "y", size: tuple[int, int] = (640
     width, height = size
     camera = Camera.fit(scene, width=width, height=height)
     physical = any(item.material.model == "pbr" for item in scene.items)
-    for light in default_lights(camera, physical):
+    for light in _file_lights(file) or default_lights(camera, physical):
         scene.root.add_light(light)
     return scene, camera
+
+
+def _file_lights(file: Path) -> list[Any]:
+    """A glTF file's own punctual lights (``frustum.scenefile.gltf_lights``, glTF units) with the ambient light of
+    ``default_lights`` (the uniform surroundings a viewer's environment gives), or [] when it carries none."""
+    if file.suffix.lower() not in (".glb", ".gltf"):
+        return []
+    from frustum.scenefile.gltf_lights import gltf_lights
+
+    lights = gltf_lights(file)
+    return [*lights, AmbientLight(intensity=PHYSICAL_AMBIENT)] if lights else []
 
 
 def _add_points(scene: Scene, file: Path, turn: np.ndarray | None) -> bool:
