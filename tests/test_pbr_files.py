@@ -184,3 +184,48 @@ def test_malformed_lights_are_refused_with_the_light(tmp_path):
         (tmp_path / "bad.gltf").write_text(json.dumps(gltf))
         with pytest.raises(GeometryError, match=message):
             gltf_lights(tmp_path / "bad.gltf")
+
+
+# --- ray tracing: the mirror of smooth metals ---------------------------------------------------------------
+
+
+def test_a_smooth_metal_sphere_reflects_a_coloured_wall_by_its_fresnel_colour():
+    """A metal sphere of roughness 0 in front of a glowing wall (behind the camera, black and lit by nothing but its
+    emission E): each sphere pixel is $F·E$ where its mirror ray meets the wall (computed here: the primary ray,
+    the buffer's normal, R = d − 2(d·n)n, the plane z = 6), $F = F_0 + (1 − F_0)(1 − n·v)⁵$ with $F_0$ = the base
+    colour; black where the mirror ray leaves the scene (no ambient light, no environment)."""
+    import frustum as fr
+
+    base = np.array([0.95, 0.7, 0.35])
+    glow = np.array([0.2, 0.55, 0.9])
+    scene = fr.Scene([])
+    scene.add(fr.icosphere(1.0, 5), fr.Material(color=base, metallic=1.0, roughness=0.0, model="pbr"))
+    wall = fr.Mesh(np.array([[-20.0, -20.0, 6.0], [20.0, -20.0, 6.0], [20.0, 20.0, 6.0], [-20.0, 20.0, 6.0]]),
+                   np.array([[0, 2, 1], [0, 3, 2]]))  # fmt: skip
+    scene.add(wall, fr.Material(color=(0.0, 0.0, 0.0), emissive=glow, metallic=0.0, roughness=0.6, model="pbr"))
+    camera = fr.Camera.look_at((0.3, 0.4, 3.2), (0, 0, 0), (0, 1, 0), fr.Perspective(0.75, 0.1, 10.0), 80, 80)
+    frame = fr.render(scene, camera, method="ray-tracing", background=(0, 0, 0, 1), buffers=("normals",))
+    sphere = frame.depth < 1.0
+    rows, columns = np.nonzero(sphere)
+    x, y = columns + 0.5, (camera.height - 1 - rows) + 0.5  # window coordinates, y up
+    m = np.asarray(camera.world_from_window, dtype=np.float64)
+
+    def unproject(z):
+        w = m[3, 0] * x + m[3, 1] * y + m[3, 2] * z + m[3, 3]
+        return np.stack([(m[a, 0] * x + m[a, 1] * y + m[a, 2] * z + m[a, 3]) / w for a in range(3)], axis=1)
+
+    near, point = unproject(0.0), unproject(frame.depth[sphere].astype(np.float64))
+    d = point - near
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    n = frame.normals[sphere].astype(np.float64)
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    cos = np.clip(-(d * n).sum(axis=1), 0.0, 1.0)
+    reflected = d + 2.0 * cos[:, None] * n
+    t = (6.0 - point[:, 2]) / np.where(reflected[:, 2] > 1e-9, reflected[:, 2], np.nan)
+    on_wall = np.abs(point[:, :2] + t[:, None] * reflected[:, :2]).max(axis=1) < 20.0
+    fresnel = base + (1.0 - base) * (1.0 - cos[:, None]) ** 5
+    expected = np.where(on_wall[:, None], fresnel * glow, 0.0)
+    got = frame.color[sphere][:, :3].astype(np.float64) / 255.0
+    assert on_wall.mean() > 0.4 and (~on_wall).sum() > 50  # both cases are present
+    assert np.abs(got - expected).max() < 1.5 / 255.0
+    assert np.abs(got - expected).mean() < 0.3 / 255.0
