@@ -229,3 +229,97 @@ def test_a_smooth_metal_sphere_reflects_a_coloured_wall_by_its_fresnel_colour():
     assert on_wall.mean() > 0.4 and (~on_wall).sum() > 50  # both cases are present
     assert np.abs(got - expected).max() < 1.5 / 255.0
     assert np.abs(got - expected).mean() < 0.3 / 255.0
+
+
+# --- the output transform where the viewer, datasets and turntables render -----------------------------------
+
+_TONED_SCENE = """
+[render]
+size = [64, 48]
+shading = "pbr"
+tone_map = "aces"
+exposure = 2.5
+
+[camera]
+eye = [0.0, 0.5, 3.5]
+
+[[lights]]
+type = "directional"
+direction = [-0.3, -0.5, -1.0]
+intensity = 4.0
+
+[materials.metal]
+color = [0.9, 0.6, 0.3]
+model = "pbr"
+metallic = 1.0
+roughness = 0.35
+
+[[nodes]]
+material = "metal"
+geometry = { type = "icosphere", radius = 1.0, subdivisions = 3 }
+"""
+
+
+def _toned(tmp_path):
+    from frustum.scenefile import load_scene_file
+
+    path = tmp_path / "toned.toml"
+    path.write_text(_TONED_SCENE)
+    scene_file = load_scene_file(path)
+    assert scene_file.options["tone_map"] == "aces" and scene_file.options["exposure"] == 2.5
+    return path, scene_file
+
+
+def _plain_render(scene_file, camera, **changes):
+    import frustum as fr
+
+    return fr.render(scene_file.scene, camera, **{**scene_file.options, **changes}).color
+
+
+def test_the_viewer_renders_with_the_files_tone_map_and_exposure(tmp_path):
+    from frustum.viewer import SHADINGS, ViewerSession
+
+    _, scene_file = _toned(tmp_path)
+    session = ViewerSession(scene_file.scene, scene_file.camera, scene_file.options, rest_samples=1)
+    assert "pbr" in SHADINGS and session.controls["shading"] == "pbr"
+    options = session.render_options("rest")
+    assert (options["tone_map"], options["exposure"]) == ("aces", 2.5)
+    picture = session.render("rest").color
+    camera = session.camera("rest")
+    assert np.array_equal(picture, _plain_render(scene_file, camera, samples=1, shadows=options["shadows"]))
+    assert not np.array_equal(picture, _plain_render(scene_file, camera, samples=1, shadows=options["shadows"],
+                                                     tone_map="none", exposure=1.0))  # fmt: skip
+
+
+def test_a_dataset_renders_with_the_files_tone_map_and_exposure(tmp_path):
+    from frustum.batch.dataset import render_dataset
+
+    path, scene_file = _toned(tmp_path)
+    render_dataset(path, tmp_path / "out", views=1, layout="orbit", format="files", executor="serial",
+                   progress=False, cameras=[scene_file.camera])  # fmt: skip
+    image = np.asarray(Image.open(tmp_path / "out" / "images" / "view_00000.png"))
+    assert np.array_equal(image[..., :3], _plain_render(scene_file, scene_file.camera)[..., :3])
+
+
+def test_turntables_render_with_the_tone_map_and_exposure(tmp_path, monkeypatch):
+    from frustum.output import animation
+
+    _, scene_file = _toned(tmp_path)
+    frames = animation.turntable(scene_file.scene, scene_file.camera, 2, progress=False, shading="pbr",
+                                 tone_map="aces", exposure=2.5)  # fmt: skip
+    assert np.array_equal(frames[0].color, _plain_render(scene_file, scene_file.camera))
+    # the command: a glTF model's default output transform, and --tone-map / --exposure over it
+    from typer.testing import CliRunner
+
+    from frustum.app.cli import app
+
+    seen = []
+    monkeypatch.setattr(animation, "turntable", lambda *args, **options: seen.append(options) or 1)
+    model = _glb_with_lights(tmp_path / "lit.glb")
+    runner = CliRunner()
+    for extra, expected in (([], ("khronos-neutral", 1.0)), (["--tone-map", "aces", "--exposure", "2"], ("aces", 2.0))):
+        result = runner.invoke(app, ["turntable", str(model), "-o", str(tmp_path / "t.gif"), "--frames", "2", *extra])
+        assert result.exit_code == 0, result.output
+        assert (seen[-1]["tone_map"], seen[-1]["exposure"], seen[-1]["color_space"]) == (*expected, "srgb")
+    result = runner.invoke(app, ["turntable", str(model), "-o", str(tmp_path / "t.gif"), "--tone-map", "filmic"])
+    assert result.exit_code != 0 and "filmic" in f"{result.output}{result.exception}"
