@@ -73,15 +73,18 @@ class MeshPart(NamedTuple):
     alpha_mode: str | None = None
     """A glTF material's ``alphaMode`` ("OPAQUE", "MASK" or "BLEND"); None for other formats."""
     metallic: float | None = None
-    """A glTF material's ``metallicFactor`` (None when the file gives none: the specification's default is 1)."""
+    """A glTF material's ``metallicFactor`` (None when the file gives none: the specification's default is 1), or
+    an MTL material's ``Pm`` (``frustum.geometry.mtl_pbr``)."""
     roughness: float | None = None
-    """A glTF material's ``roughnessFactor`` (None when the file gives none: the specification's default is 1)."""
+    """A glTF material's ``roughnessFactor`` (None when the file gives none: the specification's default is 1), or
+    an MTL material's ``Pr``."""
     metallic_roughness_texture: NDArray[np.uint8] | None = None
     """A glTF material's ``metallicRoughnessTexture`` as (H, W, 3) bytes: B metallic, G roughness."""
     occlusion_texture: NDArray[np.uint8] | None = None
     """A glTF material's ``occlusionTexture`` as (H, W, 3) bytes: R the occlusion."""
     physical: bool = False
-    """Whether the file describes the material by glTF's metallic–roughness model (a glTF or GLB file)."""
+    """Whether the file describes the material by glTF's metallic–roughness model (a glTF or GLB file, or an OBJ
+    whose MTL material has PBR statements: ``frustum.geometry.mtl_pbr``)."""
 
     def __repr__(self) -> str:
         def image(array: Any) -> str:

@@ -69,7 +69,8 @@ def part_material(part: Any) -> Material:
     its texture, its normal map, glTF's emissive factor, its alpha as opacity (not for glTF's alphaMode OPAQUE);
     a part with none of them gets a light neutral gray. A glTF part's material is ``model="pbr"`` with the file's
     metallic and roughness factors (the specification's default 1 where it gives none), its metallic–roughness and
-    occlusion textures, and its base colour texture decoded from sRGB (``Material(base_color_texture=)``)."""
+    occlusion textures, and its base colour texture decoded from sRGB (``Material(base_color_texture=)``); so is an
+    OBJ part whose MTL material has PBR statements (``Pr``, ``Pm``: ``frustum.geometry.mtl_pbr``)."""
     color = part.color
     texture = part.texture
     normal_map = getattr(part, "normal_map", None)
