@@ -231,6 +231,25 @@ def test_a_smooth_metal_sphere_reflects_a_coloured_wall_by_its_fresnel_colour():
     assert np.abs(got - expected).mean() < 0.3 / 255.0
 
 
+def test_a_smooth_metals_mirror_rays_that_leave_see_the_environment_and_the_ambient_light():
+    import frustum as fr
+
+    base = np.array([0.9, 0.5, 0.2])
+    sky = fr.EnvironmentMap(np.full((8, 16, 3), 0.3, dtype=np.float32))
+    scene = fr.Scene([fr.AmbientLight(intensity=0.4)], environment=sky)
+    scene.add(fr.icosphere(1.0, 4), fr.Material(color=base, metallic=1.0, roughness=0.0, model="pbr"))
+    camera = fr.Camera.look_at((0.0, 0.0, 3.5), (0, 0, 0), (0, 1, 0), fr.Perspective(0.75, 0.1, 10.0), 48, 48)
+    frame = fr.render(scene, camera, method="ray-tracing", background=(0, 0, 0, 1), buffers=("normals",))
+    sphere = frame.depth < 1.0
+    n = frame.normals[sphere].astype(np.float64)
+    eye_side = np.array([0.0, 0.0, 1.0])  # the view direction, nearly: the camera is 3.5 radii away
+    cos = np.clip(n @ eye_side / np.linalg.norm(n, axis=1), 0.0, 1.0)
+    expected = (base + (1.0 - base) * (1.0 - cos[:, None]) ** 5) * 0.7
+    centre = cos > 0.9  # where the view direction's error does not matter
+    got = frame.color[sphere][:, :3] / 255.0
+    assert np.abs(got[centre] - expected[centre]).max() < 1.5 / 255.0
+
+
 # --- the output transform where the viewer, datasets and turntables render -----------------------------------
 
 _TONED_SCENE = """
