@@ -337,22 +337,17 @@ def _turntable_task(mesh: Path, outputs: list[Path] | None, options: dict[str, A
         load_mesh(mesh, "turntable")  # the CLI's checks and messages for a bad mesh file
     scene, _ = model_scene(mesh, up=options["up"], size=(width, height))
     camera = framing_camera(scene, width, height, elevation=math.radians(options["elevation_deg"]))
-    output_transform = {**physical_options(scene), "exposure": options.get("exposure", 1.0)}
-    if options.get("tone_map") is not None:
-        output_transform["tone_map"] = options["tone_map"]
     count = turntable(scene, camera, options["frames"], options["axis"], output, options["fps"],
                       progress=options.get("progress", False), cull_back_faces=False, mode=options["mode"],
-                      **model_options(scene), **output_transform)  # fmt: skip
+                      **model_options(scene), **physical_options(scene, options["tone_map"], options["exposure"]))
     return [f"wrote {output} ({count} frames, {width}x{height})"]
 
 
 @app.command("turntable")
 def turntable_command(
     mesh: Annotated[list[Path], typer.Argument(help="Mesh files (.ply, .obj, .stl, .off, .glb), or folders of them.")],
-    output: Annotated[
-        Path, typer.Option("--output", "-o", help="The animation file, .gif or .mp4; for several meshes a pattern "
-                           "with {stem}, {name}, {suffix} or {index}.")
-    ],
+    output: Annotated[Path, typer.Option("--output", "-o", help="The animation file, .gif or .mp4; for several "
+                                         "meshes a pattern with {stem}, {name}, {suffix} or {index}.")],
     frames: Annotated[int, typer.Option(help="Frames in one full turn.")] = 120,
     size: Annotated[str, typer.Option(help="Image size WIDTHxHEIGHT in pixels.")] = "480x480",
     fps: Annotated[float, typer.Option(help="Frames per second.")] = 30.0,
@@ -363,23 +358,18 @@ def turntable_command(
     jobs: Annotated[int, typer.Option("--jobs", "-j", help="Worker processes for several meshes.")] = 1,
     tone_map: Annotated[str | None, typer.Option(help="none, aces or khronos-neutral (default: khronos-neutral "
                                                  "for a glTF or PBR model, else none).")] = None,
-    exposure: Annotated[float, typer.Option(help="Exposure of the physically based shading (a factor).")] = 1.0,
+    exposure: Annotated[float, typer.Option(help="Exposure of the physically based shading (a factor > 0).")] = 1.0,
 ) -> None:
     """Render a mesh from a camera orbiting it once and write the frames as a looping GIF or an MP4 (the file's
     materials and textures, the default lights of frustum.scenefile.models, or a glTF file's own lights)."""
     from frustum.app.many import expand_inputs, output_paths, run_each
     from frustum.scenefile.loader import MODEL_SUFFIXES
-    from frustum.shading.tone import TONE_MAPS
 
     width, height = _image_size(size)
     if not 0 <= abs(elevation_deg) < 90:
         raise UsageError(f"--elevation-deg = {elevation_deg!r} is out of range; give an angle in (-90, 90)")
     inputs, several = expand_inputs(mesh, MODEL_SUFFIXES)
     outputs = output_paths(inputs, [output], several)
-    if tone_map is not None and tone_map not in TONE_MAPS:
-        raise UsageError(f"--tone-map = {tone_map!r} is unknown; give one of {', '.join(TONE_MAPS)}")
-    if not (math.isfinite(exposure) and exposure > 0.0):
-        raise UsageError(f"--exposure = {exposure!r} is not a positive factor; give e.g. 1.0 or 2.0")
     options = {"size": (width, height), "up": up, "elevation_deg": elevation_deg, "frames": frames, "axis": axis,
                "fps": fps, "mode": mode, "tone_map": tone_map, "exposure": exposure}  # fmt: skip
     if not several:

@@ -56,12 +56,15 @@ def default_lights(camera: Camera, physical: bool = False) -> list[Any]:
     ]
 
 
-def physical_options(scene: Scene) -> dict[str, Any]:
+def physical_options(scene: Scene, tone_map: str | None = None, exposure: float | None = None) -> dict[str, Any]:
     """Render options for a model: a scene with a metallic–roughness material is written as a glTF viewer writes
-    it, tone mapped (Khronos PBR Neutral) and sRGB-encoded; others get none (the library's defaults)."""
+    it, tone mapped (Khronos PBR Neutral) and sRGB-encoded; others get none (the library's defaults). A command's
+    `tone_map` and `exposure` (None: these defaults) go over them (``render`` checks them)."""
+    options: dict[str, Any] = {}
     if any(item.material.model == "pbr" for item in scene.items):
-        return {"tone_map": "khronos-neutral", "color_space": "srgb"}
-    return {}
+        options = {"tone_map": "khronos-neutral", "color_space": "srgb"}
+    chosen = {"tone_map": tone_map, "exposure": exposure}
+    return {**options, **{key: value for key, value in chosen.items() if value is not None}}
 
 
 def part_material(part: Any) -> Material:
