@@ -339,17 +339,15 @@ def _turntable_task(mesh: Path, outputs: list[Path] | None, options: dict[str, A
     camera = framing_camera(scene, width, height, elevation=math.radians(options["elevation_deg"]))
     count = turntable(scene, camera, options["frames"], options["axis"], output, options["fps"],
                       progress=options.get("progress", False), cull_back_faces=False, mode=options["mode"],
-                      **model_options(scene), **physical_options(scene))  # fmt: skip
+                      **model_options(scene), **physical_options(scene, options["tone_map"], options["exposure"]))
     return [f"wrote {output} ({count} frames, {width}x{height})"]
 
 
 @app.command("turntable")
 def turntable_command(
     mesh: Annotated[list[Path], typer.Argument(help="Mesh files (.ply, .obj, .stl, .off, .glb), or folders of them.")],
-    output: Annotated[
-        Path, typer.Option("--output", "-o", help="The animation file, .gif or .mp4; for several meshes a pattern "
-                           "with {stem}, {name}, {suffix} or {index}.")
-    ],
+    output: Annotated[Path, typer.Option("--output", "-o", help="The animation file, .gif or .mp4; for several "
+                                         "meshes a pattern with {stem}, {name}, {suffix} or {index}.")],
     frames: Annotated[int, typer.Option(help="Frames in one full turn.")] = 120,
     size: Annotated[str, typer.Option(help="Image size WIDTHxHEIGHT in pixels.")] = "480x480",
     fps: Annotated[float, typer.Option(help="Frames per second.")] = 30.0,
@@ -358,9 +356,12 @@ def turntable_command(
     mode: Annotated[str, typer.Option(help="surface, wireframe or points.")] = "surface",
     up: Annotated[str, typer.Option(help="The model's up axis, y or z (glTF is always y).")] = "y",
     jobs: Annotated[int, typer.Option("--jobs", "-j", help="Worker processes for several meshes.")] = 1,
+    tone_map: Annotated[str | None, typer.Option(help="none, aces or khronos-neutral (default: khronos-neutral "
+                                                 "for a glTF or PBR model, else none).")] = None,
+    exposure: Annotated[float, typer.Option(help="Exposure of the physically based shading (a factor > 0).")] = 1.0,
 ) -> None:
     """Render a mesh from a camera orbiting it once and write the frames as a looping GIF or an MP4 (the file's
-    materials and textures, the default lights of frustum.scenefile.models)."""
+    materials and textures, the default lights of frustum.scenefile.models, or a glTF file's own lights)."""
     from frustum.app.many import expand_inputs, output_paths, run_each
     from frustum.scenefile.loader import MODEL_SUFFIXES
 
@@ -370,7 +371,7 @@ def turntable_command(
     inputs, several = expand_inputs(mesh, MODEL_SUFFIXES)
     outputs = output_paths(inputs, [output], several)
     options = {"size": (width, height), "up": up, "elevation_deg": elevation_deg, "frames": frames, "axis": axis,
-               "fps": fps, "mode": mode}  # fmt: skip
+               "fps": fps, "mode": mode, "tone_map": tone_map, "exposure": exposure}  # fmt: skip
     if not several:
         for line in _turntable_task(inputs[0], outputs[0], {**options, "progress": error_console}):
             say(line)

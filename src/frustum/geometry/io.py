@@ -73,15 +73,18 @@ class MeshPart(NamedTuple):
     alpha_mode: str | None = None
     """A glTF material's ``alphaMode`` ("OPAQUE", "MASK" or "BLEND"); None for other formats."""
     metallic: float | None = None
-    """A glTF material's ``metallicFactor`` (None when the file gives none: the specification's default is 1)."""
+    """A glTF material's ``metallicFactor`` (None when the file gives none: the specification's default is 1), or
+    an MTL material's ``Pm`` (``frustum.geometry.mtl_pbr``)."""
     roughness: float | None = None
-    """A glTF material's ``roughnessFactor`` (None when the file gives none: the specification's default is 1)."""
+    """A glTF material's ``roughnessFactor`` (None when the file gives none: the specification's default is 1), or
+    an MTL material's ``Pr``."""
     metallic_roughness_texture: NDArray[np.uint8] | None = None
     """A glTF material's ``metallicRoughnessTexture`` as (H, W, 3) bytes: B metallic, G roughness."""
     occlusion_texture: NDArray[np.uint8] | None = None
     """A glTF material's ``occlusionTexture`` as (H, W, 3) bytes: R the occlusion."""
     physical: bool = False
-    """Whether the file describes the material by glTF's metallic–roughness model (a glTF or GLB file)."""
+    """Whether the file describes the material by glTF's metallic–roughness model (a glTF or GLB file, or an OBJ
+    whose MTL material has PBR statements: ``frustum.geometry.mtl_pbr``)."""
 
     def __repr__(self) -> str:
         def image(array: Any) -> str:
@@ -239,9 +242,10 @@ def _native_parts(file: Path, text: bytes | None) -> list[MeshPart] | None:
             for k, texture_image in enumerate((part.metallic_roughness_image, part.occlusion_image)):
                 if texture_image is not None and part.uvs is not None:
                     physical[k] = np.asarray(texture_image.convert("RGB"), dtype=np.uint8)
+            pbr = file.suffix.lower() in (".glb", ".gltf") or part.metallic is not None  # glTF, or an MTL's Pr/Pm
             parts.append(MeshPart(part.name, mesh, np.asarray(part.world_from_model, dtype=np.float64), image, color,
                                   normal_map, part.emissive, part.alpha_mode, part.metallic, part.roughness,
-                                  *physical, file.suffix.lower() in (".glb", ".gltf")))  # fmt: skip
+                                  *physical, pbr))  # fmt: skip
     except MemoryError:
         raise
     except Exception:  # invalid geometry or an unreadable image: trimesh's path says what is wrong
@@ -618,10 +622,13 @@ def _normal_texture(geometry: Any) -> NDArray[np.uint8] | None:
 
 def _metallic_roughness(geometry: Any, file: Path | None) -> tuple[Any, ...]:
     """A glTF material's (metallicFactor, roughnessFactor, metallicRoughnessTexture, occlusionTexture, True), the
-    textures as (H, W, 3) bytes (None without UVs); (None, None, None, None, False) for other formats."""
+    textures as (H, W, 3) bytes (None without UVs); an OBJ material's from its MTL's PBR statements
+    (``frustum.geometry.mtl_pbr``); (None, None, None, None, False) for other formats and other OBJ materials."""
+    material = getattr(geometry.visual, "material", None)
+    if file is not None and file.suffix.lower() == ".obj":
+        return _mtl_physical(file, getattr(material, "name", None), getattr(geometry.visual, "uv", None) is not None)
     if file is None or file.suffix.lower() not in (".glb", ".gltf"):
         return None, None, None, None, False
-    material = getattr(geometry.visual, "material", None)
     factors = []
     for name in ("metallicFactor", "roughnessFactor"):
         value = getattr(material, name, None)
@@ -632,6 +639,20 @@ def _metallic_roughness(geometry: Any, file: Path | None) -> tuple[Any, ...]:
         has_uvs = getattr(geometry.visual, "uv", None) is not None
         images.append(None if image is None or not has_uvs else np.asarray(image.convert("RGB"), dtype=np.uint8))
     return (*factors, *images, True)
+
+
+def _mtl_physical(file: Path, name: str | None, has_uvs: bool) -> tuple[Any, ...]:
+    """``_metallic_roughness`` of the OBJ material `name` (trimesh's reading), from the MTL libraries `file` names."""
+    from frustum.geometry.mtl_pbr import physical_materials
+
+    folder = file.parent.resolve()
+    for library in _MTL_LIBRARY.findall(file.read_bytes()) if name is not None else []:
+        mtl = file.parent / library.decode("utf-8", "replace").strip()
+        found = physical_materials(mtl).get(name) if mtl.resolve().is_relative_to(folder) else None
+        if found is not None:
+            texture = None if found.texture is None or not has_uvs else np.asarray(found.texture, dtype=np.uint8)
+            return found.metallic, found.roughness, texture, None, True
+    return None, None, None, None, False
 
 
 def _emission_and_alpha(geometry: Any) -> tuple[tuple[float, float, float] | None, str | None]:

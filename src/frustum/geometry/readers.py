@@ -13,7 +13,8 @@ files and every error message stay trimesh's (and ``load_parts``'s):
   no colours, texture coordinates or texture-file comments;
 - OFF: triangles, no comments or colours;
 - OBJ: ``v`` (x y z), ``vt``, ``vn``, triangle ``f`` lines of one form with positive indices, at most one
-  ``mtllib`` and one ``usemtl`` before the faces (the MTL's ``Kd`` and ``map_Kd``), no ``o``/``g`` lines;
+  ``mtllib`` and one ``usemtl`` before the faces (the MTL's ``Kd`` and ``map_Kd``, and its PBR statements:
+  ``frustum.geometry.mtl_pbr``), no ``o``/``g`` lines;
 - glTF 2.0 binary (GLB) and JSON (``.gltf``, buffers in files beside it or embedded as base64 data URIs):
   nodes without placements (no matrix or TRS: trimesh repairs those), one indexed triangle primitive per mesh
   with POSITION, NORMAL and TEXCOORD_0, materials' base colour factor and texture (an image in a buffer view),
@@ -297,7 +298,16 @@ def _read_obj(file: Path, data: bytes) -> list[RawPart]:
         image, color = materials[material]
     if normals is not None:
         normals = _file_normals(normals, vertices)
-    return [RawPart(name, vertices, new_faces, normals, uv, _IDENTITY.copy(), image, color)]
+    physical = None  # the MTL's PBR statements (frustum.geometry.mtl_pbr), when the material has any
+    if material in materials:
+        from frustum.geometry.mtl_pbr import physical_materials
+
+        physical = physical_materials(file.parent / library).get(material)  # type: ignore[operator]
+    if physical is None:
+        return [RawPart(name, vertices, new_faces, normals, uv, _IDENTITY.copy(), image, color)]
+    texture = physical.texture if uv is not None else None
+    return [RawPart(name, vertices, new_faces, normals, uv, _IDENTITY.copy(), image, color, metallic=physical.metallic,
+                    roughness=physical.roughness, metallic_roughness_image=texture)]  # fmt: skip
 
 
 def _plain_name(name: str) -> bool:

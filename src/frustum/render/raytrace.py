@@ -35,9 +35,13 @@ geometric normal, on the side they leave to, so that they do not meet it again.
 An item the metallic–roughness model shades (``render(shading="pbr")``, or a ``Material(model="pbr")``:
 ``frustum.render.pbr.applies``) gets that model's local color instead: the same BRDF, light units and
 image-based light as the depth buffer's (``frustum.shading.pbr``, ``frustum.shading.ibl``, NumPy here), each
-positioned light's term multiplied by its shadow ray's visibility, then exposure and the tone map; a rough metal
-thus reflects the environment's prefiltered light and a metal of roughness 0 the map itself (mirror rays of
-other surfaces are traced for ``Material.reflectivity`` only).
+positioned light's term multiplied by its shadow ray's visibility; a rough metal thus reflects the environment's
+prefiltered light. A smooth one (roughness 0, metal or not) reflects the scene itself: its image-based specular
+term is replaced by a traced **mirror ray** along R, weighted by Schlick's Fresnel colour
+$F = F_0 + (1 − F_0)(1 − n·v)⁵$, $F_0 = mix(0.04, base, metallic)$ (a metal's base colour), traced recursively
+like the Whitted mirrors of ``Material.reflectivity``; where it leaves the scene it sees the surroundings that
+image-based lighting uses (the ambient radiance plus the environment map along R). The light of these items is
+summed as linear radiance over the pixel's rays and goes through exposure and the tone map once, at the end.
 
 The depth buffer receives the window depth of each primary hit, so volumes and particles are composited along
 the primary rays exactly as with ``method="ray-casting"``; ``buffers=("normals", "object_id")`` show the primary
@@ -135,6 +139,7 @@ class _Scene:
         self.opacity = np.array([m.opacity for m in materials], dtype=np.float64)
         self.ior = np.array([m.ior for m in materials], dtype=np.float64)
         self.physical = np.zeros(len(materials), dtype=bool)
+        self.mirror = self.physical
         if options is not None:  # the metallic–roughness model for the items it shades (render.pbr.applies)
             from frustum.render.pbr import applies
             from frustum.shading.pbr import phong_roughness
@@ -143,6 +148,7 @@ class _Scene:
             self.metallic = np.array([m.metallic for m in materials], dtype=np.float64)
             self.roughness = np.array([m.roughness if m.model == "pbr" else phong_roughness(m.shininess)
                                        for m in materials], dtype=np.float64)  # fmt: skip
+            self.mirror = self.physical & (self.roughness == 0.0)  # smooth: a traced mirror ray (_mirror_rays)
         normals, faces, colors, offset = [], [], [], 0
         any_colors = any(item.mesh.vertex_colors is not None for item in items)
         for item in items:
@@ -212,7 +218,8 @@ def _hits(data: _Scene, origins: np.ndarray, directions: np.ndarray, t_max: floa
 
 def _local(data: _Scene, hit: _Hits, counts: dict, record: list | None, parents: np.ndarray | None,
            depth: int) -> np.ndarray:  # fmt: skip
-    """I_local (n, 3) at the hits, with shadow rays (module docstring)."""
+    """I_local (n, 3) at the hits, with shadow rays (module docstring): display values, except at the hits the
+    metallic–roughness model shades (``data.physical``), where it is linear radiance (``_physical_radiance``)."""
     from frustum.raster import rays
 
     k = hit.item
@@ -254,7 +261,7 @@ def _local(data: _Scene, hit: _Hits, counts: dict, record: list | None, parents:
             direct += _physical_light(data, light, hit, physical, base, to_light, lit) * intensity
     color = np.clip(base * diffuse_sum + specular_sum + data.emissive[k], 0.0, 1.0)
     if direct.shape[0]:
-        color[physical] = _physical_color(data, hit, physical, base, direct)
+        color[physical] = _physical_radiance(data, hit, physical, base, direct)
     return color
 
 
@@ -279,22 +286,48 @@ def _physical_light(data: _Scene, light: Any, hit: _Hits, physical: np.ndarray, 
     return f * np.where(lit[physical], illuminance * cosine, 0.0)[:, None]
 
 
-def _physical_color(data: _Scene, hit: _Hits, physical: np.ndarray, base: np.ndarray,
-                    direct: np.ndarray) -> np.ndarray:  # fmt: skip
-    """The physical hits' display values: direct light, image-based and ambient light (``shading.ibl``) and
-    emission, then exposure and the tone map (``shading.tone``)."""
+def _physical_radiance(data: _Scene, hit: _Hits, physical: np.ndarray, base: np.ndarray,
+                       direct: np.ndarray) -> np.ndarray:  # fmt: skip
+    """The physical hits' linear radiance: direct light, image-based and ambient light (``shading.ibl``; at a
+    smooth hit without its specular term, which the mirror ray brings: ``_mirror_rays``) and emission."""
     from frustum.render.pbr import image_light
     from frustum.shading.ibl import ImageLighting, image_radiance
-    from frustum.shading.tone import TONE_MAPS, tone_map
 
     options = data.options
     k = hit.item[physical]
     sh, maps, table, lit = image_light(options)
     lighting = ImageLighting(sh, maps, table) if lit else None
-    indirect = image_radiance(lighting, options.physical_ambient, hit.normal[physical], -hit.incoming[physical],
-                              base[physical], data.metallic[k], data.roughness[k])  # fmt: skip
+    indirect = np.empty_like(direct)
+    for smooth in (False, True):
+        rows = data.mirror[k] == smooth
+        indirect[rows] = image_radiance(lighting, options.physical_ambient, hit.normal[physical][rows],
+                                        -hit.incoming[physical][rows], base[physical][rows], data.metallic[k][rows],
+                                        data.roughness[k][rows], specular=not smooth)  # fmt: skip
+    return direct + indirect + data.emissive[k]
+
+
+def _display(data: _Scene, radiance: np.ndarray) -> np.ndarray:
+    """Display values of linear radiance: the render's exposure and tone map (``shading.tone``)."""
+    from frustum.shading.tone import TONE_MAPS, tone_map
+
+    options = data.options
     name = {code: name for name, code in TONE_MAPS.items()}[options.tone_map]
-    return tone_map(direct + indirect + data.emissive[k], name, options.exposure)
+    return tone_map(radiance, name, options.exposure)
+
+
+def _mirror_rays(data: _Scene, hit: _Hits, local_weight: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(rows, weights (m, 3)) of the mirror rays of the smooth physical hits: $F = F_0 + (1 − F_0)(1 − n·v)^5$
+    (Schlick, ``shading.pbr.fresnel_schlick``), $F_0 = mix(0.04, base, metallic)$, times the hit's own weight."""
+    from frustum.shading.pbr import DIELECTRIC_F0, fresnel_schlick
+
+    if not data.mirror.any():
+        return np.empty(0, dtype=np.int64), np.empty((0, 3))
+    rows = np.flatnonzero(data.mirror[hit.item] & (local_weight.max(axis=1) > 0.0))
+    k = hit.item[rows]
+    metallic = data.metallic[k][:, None]
+    f0 = (1.0 - metallic) * DIELECTRIC_F0 + metallic * data.color[k] * hit.base[rows]
+    n_dot_v = np.clip(-np.einsum("ij,ij->i", hit.normal[rows], hit.incoming[rows]), 0.0, 1.0)
+    return rows, local_weight[rows] * fresnel_schlick(f0, n_dot_v[:, None])
 
 
 def _primary(camera: Camera, rows: np.ndarray, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
@@ -315,106 +348,142 @@ def _trace(data: _Scene, origins: np.ndarray, directions: np.ndarray, pixel: np.
            record: list | None = None, environment: Any = None,
            ) -> tuple[np.ndarray, _Hits | None, np.ndarray]:  # fmt: skip
     """The color (count, 3) of rays `origins`, `directions` (primary rays over t in [0, 1)) belonging to pixels
-    `pixel` (0 … count − 1); the primary hits and their window depths (None: not computed)."""
+    `pixel` (0 … count − 1); the primary hits and their window depths (None: not computed). Each ray carries an
+    RGB weight (a smooth physical surface's mirror ray: its Fresnel colour); the light of physically shaded hits
+    is summed as radiance and goes through the exposure and tone map once per pixel, at the end."""
     color = np.zeros((count, 3))
-    weight = np.ones(origins.shape[0])
+    radiance = np.zeros((count, 3))
+    weight = np.ones((origins.shape[0], 3))
     kinds = np.zeros(origins.shape[0], dtype=np.int8)  # 0 primary, 1 reflected, 2 refracted
     tir = np.zeros(origins.shape[0], dtype=bool)
+    physical_ray = np.zeros(origins.shape[0], dtype=bool)  # a mirror ray of a smooth physical surface
     parents = np.full(origins.shape[0], -1, dtype=np.int64)
     primary: _Hits | None = None
     z = np.empty(0, dtype=np.float32)
-    names = ("primary", "reflected", "refracted")
     for depth in range(max_depth + 1):
         if origins.shape[0] == 0:
             break
         counts["depth_reached"] = max(counts.get("depth_reached", 0), depth)
-        for kind in (0, 1, 2):
-            key = f"{names[kind]}_rays"
-            counts[key] = counts.get(key, 0) + int((kinds == kind).sum())
+        for kind, name in enumerate(("primary", "reflected", "refracted")):
+            counts[f"{name}_rays"] = counts.get(f"{name}_rays", 0) + int((kinds == kind).sum())
         if data.empty:
             hit = _Hits(*(np.empty(0, dtype=np.int64),) * 10)  # type: ignore[arg-type]
-            rows = np.empty(0, dtype=np.int64)
         else:
             hit = _hits(data, origins, directions, 1.0 if depth == 0 else np.inf, cull and depth == 0)
-            rows = hit.rows
-        if depth == 0 and window_from_world is not None and rows.shape[0]:
+        if depth == 0 and window_from_world is not None and hit.rows.shape[0]:
             w = window_from_world
             p = hit.point
             zz = ((p @ w[2, :3] + w[2, 3]) / (p @ w[3, :3] + w[3, 3])).astype(np.float32)
             near = zz < 1.0  # as the depth buffer: a depth that rounds to 1 is not drawn
             if not near.all():
-                keep = np.flatnonzero(near)
-                hit = _Hits(*(field[keep] for field in hit))
-                rows = hit.rows
-                zz = zz[keep]
+                hit = _Hits(*(field[np.flatnonzero(near)] for field in hit))
+                zz = zz[near]
             z = zz
         if depth == 0:
             primary = hit
+        rows = hit.rows
         counts["hits"] = counts.get("hits", 0) + int(rows.shape[0])
         missed = np.ones(origins.shape[0], dtype=bool)
         missed[rows] = False
-        if environment is not None and depth > 0:  # reflected and refracted rays that leave see the surroundings
-            seen = environment.lookup(directions[missed])
-            np.add.at(color, pixel[missed], weight[missed, None] * seen)
-        else:
-            np.add.at(color, pixel[missed], weight[missed, None] * background[None, :3])
+        for physical in (False, True):
+            _add_missed(data, color if not physical else radiance, pixel, weight, directions,
+                        missed & (physical_ray == physical), environment, background, depth, physical)  # fmt: skip
         segment_index = None
         if record is not None:
-            segment_index = np.empty(origins.shape[0], dtype=np.int64)
-            for r in range(origins.shape[0]):
-                segment_index[r] = len(record)
-                found = np.flatnonzero(rows == r)
-                j = int(found[0]) if found.size else -1
-                record.append(RaySegment(
-                    names[kinds[r]], depth, int(parents[r]), origins[r], directions[r],
-                    float(hit.t[j]) if j >= 0 else np.inf, int(data.numbers[hit.item[j]]) if j >= 0 else -1,
-                    int(hit.face[j]) if j >= 0 else -1, hit.point[j] if j >= 0 else np.full(3, np.nan),
-                    hit.normal[j] if j >= 0 else np.full(3, np.nan), float(weight[r]),
-                    total_internal_reflection=bool(tir[r]),
-                ))  # fmt: skip
+            segment_index = _record_rays(record, data, hit, origins, directions, kinds, depth, parents, weight, tir)
         if rows.shape[0] == 0:
             break
         k = hit.item
         w = weight[rows]
         kr = data.reflectivity[k]
         alpha = data.opacity[k]
-        local_weight = w * (1.0 - kr) * alpha
-        shaded = local_weight > 0.0
+        local_weight = w * ((1.0 - kr) * alpha)[:, None]
+        shaded = local_weight.max(axis=1) > 0.0
         if shaded.any():
             sub = _Hits(*(field[shaded] for field in hit))
             hit_parents = None if segment_index is None else segment_index[sub.rows]
-            local = _local(data, sub, counts, record, hit_parents, depth)
-            np.add.at(color, pixel[sub.rows], local_weight[shaded, None] * local)
+            local = local_weight[shaded] * _local(data, sub, counts, record, hit_parents, depth)
+            linear = data.physical[sub.item]
+            np.add.at(color, pixel[sub.rows[~linear]], local[~linear])
+            np.add.at(radiance, pixel[sub.rows[linear]], local[linear])
         if depth == max_depth:
             break
-        reflect_weight = w * kr
-        refract_weight = w * (1.0 - kr) * (1.0 - alpha)
+        reflect_weight = w * kr[:, None]
+        refract_weight = w * ((1.0 - kr) * (1.0 - alpha))[:, None]
         n = hit.normal
         incoming = hit.incoming
         cos_i = np.clip(-np.einsum("ij,ij->i", n, incoming), 0.0, 1.0)
         eta = np.where(hit.back, data.ior[k], 1.0 / data.ior[k])
         sin2 = eta * eta * (1.0 - cos_i * cos_i)
-        total = (refract_weight > 0.0) & (sin2 > 1.0)
+        total = (refract_weight.max(axis=1) > 0.0) & (sin2 > 1.0)
         counts["total_internal_reflections"] = counts.get("total_internal_reflections", 0) + int(total.sum())
-        reflect_weight = reflect_weight + np.where(total, refract_weight, 0.0)
-        refract_weight = np.where(total, 0.0, refract_weight)
+        reflect_weight = reflect_weight + np.where(total[:, None], refract_weight, 0.0)
+        refract_weight = np.where(total[:, None], 0.0, refract_weight)
         reflected = incoming + 2.0 * cos_i[:, None] * n
         cos_t = np.sqrt(np.maximum(1.0 - sin2, 0.0))
         refracted = eta[:, None] * incoming + (eta * cos_i - cos_t)[:, None] * n
-        go_r = np.flatnonzero(reflect_weight >= MIN_WEIGHT)
-        go_t = np.flatnonzero(refract_weight >= MIN_WEIGHT)
+        go_r = np.flatnonzero(reflect_weight.max(axis=1) >= MIN_WEIGHT)
+        go_t = np.flatnonzero(refract_weight.max(axis=1) >= MIN_WEIGHT)
+        go_m, mirror_weight = _mirror_rays(data, hit, local_weight)
+        strong = mirror_weight.max(axis=1) >= MIN_WEIGHT
+        go_m, mirror_weight = go_m[strong], mirror_weight[strong]
         offset = data.epsilon * hit.geometric
-        origins = np.concatenate([hit.point[go_r] + offset[go_r], hit.point[go_t] - offset[go_t]])
-        directions = np.concatenate([reflected[go_r], refracted[go_t]])
-        pixel = np.concatenate([pixel[rows[go_r]], pixel[rows[go_t]]])
-        weight = np.concatenate([reflect_weight[go_r], refract_weight[go_t]])
-        kinds = np.concatenate([np.ones(go_r.shape[0], np.int8), np.full(go_t.shape[0], 2, np.int8)])
-        tir = np.concatenate([total[go_r], np.zeros(go_t.shape[0], dtype=bool)])
+        origins = np.concatenate([hit.point[go_r] + offset[go_r], hit.point[go_t] - offset[go_t],
+                                  hit.point[go_m] + offset[go_m]])  # fmt: skip
+        directions = np.concatenate([reflected[go_r], refracted[go_t], reflected[go_m]])
+        pixel = np.concatenate([pixel[rows[go_r]], pixel[rows[go_t]], pixel[rows[go_m]]])
+        weight = np.concatenate([reflect_weight[go_r], refract_weight[go_t], mirror_weight])
+        kinds = np.concatenate([np.ones(go_r.shape[0], np.int8), np.full(go_t.shape[0], 2, np.int8),
+                                np.ones(go_m.shape[0], np.int8)])  # fmt: skip
+        tir = np.concatenate([total[go_r], np.zeros(go_t.shape[0] + go_m.shape[0], dtype=bool)])
+        physical_ray = np.arange(origins.shape[0]) >= go_r.shape[0] + go_t.shape[0]
         parents = np.empty(0, dtype=np.int64) if segment_index is None else np.concatenate(
-            [segment_index[rows[go_r]], segment_index[rows[go_t]]])  # fmt: skip
+            [segment_index[rows[go_r]], segment_index[rows[go_t]], segment_index[rows[go_m]]])  # fmt: skip
         if parents.shape[0] != origins.shape[0]:
             parents = np.full(origins.shape[0], -1, dtype=np.int64)
+    if radiance.any():
+        color += _display(data, radiance)
     return color, primary, z
+
+
+def _record_rays(record: list, data: _Scene, hit: _Hits, origins: np.ndarray, directions: np.ndarray,
+                 kinds: np.ndarray, depth: int, parents: np.ndarray, weight: np.ndarray, tir: np.ndarray,
+                 ) -> np.ndarray:  # fmt: skip
+    """A ``RaySegment`` per ray of one level appended to `record` (``ray_path``); their indices in it."""
+    names = ("primary", "reflected", "refracted")
+    segment_index = np.empty(origins.shape[0], dtype=np.int64)
+    for r in range(origins.shape[0]):
+        segment_index[r] = len(record)
+        found = np.flatnonzero(hit.rows == r)
+        j = int(found[0]) if found.size else -1
+        record.append(RaySegment(
+            names[kinds[r]], depth, int(parents[r]), origins[r], directions[r],
+            float(hit.t[j]) if j >= 0 else np.inf, int(data.numbers[hit.item[j]]) if j >= 0 else -1,
+            int(hit.face[j]) if j >= 0 else -1, hit.point[j] if j >= 0 else np.full(3, np.nan),
+            hit.normal[j] if j >= 0 else np.full(3, np.nan), float(weight[r].max()),
+            total_internal_reflection=bool(tir[r]),
+        ))  # fmt: skip
+    return segment_index
+
+
+def _add_missed(data: _Scene, out: np.ndarray, pixel: np.ndarray, weight: np.ndarray, directions: np.ndarray,
+                missed: np.ndarray, environment: Any, background: np.ndarray, depth: int, physical: bool,
+                ) -> None:  # fmt: skip
+    """What the rays `missed` see, times their weights, into their pixels of `out`: the background, or the
+    environment map for reflected and refracted rays; for `physical` rays (a smooth physical surface's mirror
+    rays) the radiance of the surroundings that image-based lighting uses (``shading.ibl``: the uniform ambient
+    plus the map), into the radiance sum."""
+    if not missed.any():
+        return
+    if physical:
+        seen = np.broadcast_to(np.asarray(data.options.physical_ambient, dtype=np.float64), (int(missed.sum()), 3))
+        if environment is not None:
+            seen = seen + environment.lookup(directions[missed])
+        np.add.at(out, pixel[missed], weight[missed] * seen)
+    elif environment is not None and depth > 0:
+        np.add.at(out, pixel[missed], weight[missed] * environment.lookup(directions[missed]))
+    else:
+        np.add.at(out, pixel[missed], weight[missed] * background[None, :3])
 
 
 def _check_work(camera: Camera, data: _Scene, max_depth: int, where: str) -> None:

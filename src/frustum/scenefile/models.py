@@ -2,7 +2,7 @@
 gives, with the file's own materials (base colours, textures, normal maps; glTF's metallic–roughness materials as
 ``model="pbr"``, rendered tone mapped and sRGB-encoded as glTF viewers do: ``physical_options``), a camera framing
 the model from a 3/4 view (``Camera.fit``) and the default lights (``default_lights``) when nothing else names
-lights. Scene files
+lights (a glTF file's own ``KHR_lights_punctual`` lights replace them: ``frustum.scenefile.gltf_lights``). Scene files
 that name no lights get the same default lights around their camera when they draw lit surfaces (see
 ``frustum.scenefile.loader._wants_default_lights``; ``lights = []`` keeps a scene unlit on purpose).
 
@@ -56,12 +56,15 @@ def default_lights(camera: Camera, physical: bool = False) -> list[Any]:
     ]
 
 
-def physical_options(scene: Scene) -> dict[str, Any]:
+def physical_options(scene: Scene, tone_map: str | None = None, exposure: float | None = None) -> dict[str, Any]:
     """Render options for a model: a scene with a metallic–roughness material is written as a glTF viewer writes
-    it, tone mapped (Khronos PBR Neutral) and sRGB-encoded; others get none (the library's defaults)."""
+    it, tone mapped (Khronos PBR Neutral) and sRGB-encoded; others get none (the library's defaults). A command's
+    `tone_map` and `exposure` (None: these defaults) go over them (``render`` checks them)."""
+    options: dict[str, Any] = {}
     if any(item.material.model == "pbr" for item in scene.items):
-        return {"tone_map": "khronos-neutral", "color_space": "srgb"}
-    return {}
+        options = {"tone_map": "khronos-neutral", "color_space": "srgb"}
+    chosen = {"tone_map": tone_map, "exposure": exposure}
+    return {**options, **{key: value for key, value in chosen.items() if value is not None}}
 
 
 def part_material(part: Any) -> Material:
@@ -69,7 +72,8 @@ def part_material(part: Any) -> Material:
     its texture, its normal map, glTF's emissive factor, its alpha as opacity (not for glTF's alphaMode OPAQUE);
     a part with none of them gets a light neutral gray. A glTF part's material is ``model="pbr"`` with the file's
     metallic and roughness factors (the specification's default 1 where it gives none), its metallic–roughness and
-    occlusion textures, and its base colour texture decoded from sRGB (``Material(base_color_texture=)``)."""
+    occlusion textures, and its base colour texture decoded from sRGB (``Material(base_color_texture=)``); so is an
+    OBJ part whose MTL material has PBR statements (``Pr``, ``Pm``: ``frustum.geometry.mtl_pbr``)."""
     color = part.color
     texture = part.texture
     normal_map = getattr(part, "normal_map", None)
@@ -128,9 +132,20 @@ def model_scene(path: str | Path, *, up: str = "y", size: tuple[int, int] = (640
     width, height = size
     camera = Camera.fit(scene, width=width, height=height)
     physical = any(item.material.model == "pbr" for item in scene.items)
-    for light in default_lights(camera, physical):
+    for light in _file_lights(file) or default_lights(camera, physical):
         scene.root.add_light(light)
     return scene, camera
+
+
+def _file_lights(file: Path) -> list[Any]:
+    """A glTF file's own punctual lights (``frustum.scenefile.gltf_lights``, glTF units) with the ambient light of
+    ``default_lights`` (the uniform surroundings a viewer's environment gives), or [] when it carries none."""
+    if file.suffix.lower() not in (".glb", ".gltf"):
+        return []
+    from frustum.scenefile.gltf_lights import gltf_lights
+
+    lights = gltf_lights(file)
+    return [*lights, AmbientLight(intensity=PHYSICAL_AMBIENT)] if lights else []
 
 
 def _add_points(scene: Scene, file: Path, turn: np.ndarray | None) -> bool:

@@ -230,10 +230,11 @@ def prefiltered_lookup(maps: NDArray, directions: ArrayLike, roughness: ArrayLik
 
 def image_radiance(
     lighting: ImageLighting | None, ambient: ArrayLike, normal: ArrayLike, to_viewer: ArrayLike, base: ArrayLike,
-    metallic: ArrayLike, roughness: ArrayLike, occlusion: ArrayLike = 1.0,
+    metallic: ArrayLike, roughness: ArrayLike, occlusion: ArrayLike = 1.0, specular: bool = True,
 ) -> NDArray[np.float64]:  # fmt: skip
     """(N, 3) radiance the environment (``lighting``, or None) and a uniform ambient radiance (3,) reflect toward
-    the viewer: $ao·(S·(P(R) + I_a) + (1 − metallic)·(1 − S_0)·base·(E(n)/π + I_a))$ (module docstring)."""
+    the viewer: $ao·(S·(P(R) + I_a) + (1 − metallic)·(1 − S_0)·base·(E(n)/π + I_a))$ (module docstring); without
+    the specular term $S·(P(R) + I_a)$ when not `specular` (a ray tracer's mirror ray brings that light instead)."""
     n = np.atleast_2d(np.asarray(normal, dtype=np.float64))
     v = np.atleast_2d(np.asarray(to_viewer, dtype=np.float64))
     base = np.broadcast_to(np.asarray(base, dtype=np.float64), n.shape)
@@ -245,6 +246,8 @@ def image_radiance(
     f0 = (1.0 - metallic) * DIELECTRIC_F0 + metallic * base
     specular_weight = f0 * a[:, None] + b[:, None]
     diffuse_weight = (1.0 - metallic) * (1.0 - (DIELECTRIC_F0 * a + b))[:, None] * base
+    if not specular:
+        specular_weight = np.zeros_like(specular_weight)
     specular_light = np.broadcast_to(ambient, n.shape).copy()
     diffuse_light = specular_light.copy()
     if lighting is not None:

@@ -68,7 +68,7 @@ __all__ = [
 
 _log = logging.getLogger("frustum.viewer")
 
-SHADINGS = ("phong", "gouraud", "flat", "normals", "depth", "none")
+SHADINGS = ("phong", "pbr", "gouraud", "flat", "normals", "depth", "none")
 """Shading models the viewer offers (``render``'s ``shading``)."""
 MODES = ("surface", "wireframe", "hidden-line", "surface+edges")
 """Render modes the viewer offers (``render``'s ``mode``)."""
