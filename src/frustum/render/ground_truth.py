@@ -26,19 +26,17 @@ pixel never carries a blend of two objects and every id in a mask is an item of 
 from __future__ import annotations
 
 import dataclasses
-from typing import Any
 
 import numpy as np
 
-from frustum._arrays import describe
 from frustum.camera import Camera
 from frustum.errors import FrustumError
-from frustum.frame import Frame
-from frustum.render.options import GROUND_TRUTH_BUFFERS
+from frustum.render.context import FrameContext, middle_samples
+from frustum.render.options import GROUND_TRUTH_BUFFERS, RenderOptions
 from frustum.scene import Scene, SceneItem
 
 __all__ = [
-    "DEPTH_TOLERANCE", "amodal_masks", "check_next", "class_ids", "finish", "flow", "nocs",
+    "DEPTH_TOLERANCE", "amodal_masks", "class_ids", "draw", "flow", "nocs",
     "object_coordinates", "visibility",
 ]  # fmt: skip
 
@@ -47,23 +45,6 @@ DEPTH_TOLERANCE = 1e-2
 exceeds the depth buffer's (at the pixel that holds it) by more than this fraction (1 cm at 1 m): the buffer holds
 the surface at the pixel's centre, not at the point, so a relative margin keeps sloped surfaces from hiding
 themselves."""
-
-
-def check_next(buffers: tuple[str, ...], next: Any, where: str) -> tuple[Scene, Camera] | None:
-    """`next` as ``(scene, camera)``; None when not given. Required by (and only allowed with) ``"flow"``."""
-    if next is None:
-        if "flow" in buffers:
-            raise FrustumError(
-                f"{where}: buffers = {describe(buffers)} asks for 'flow' without next; give next=(scene_next, "
-                "camera_next), the same scene and camera at the next frame"
-            )
-        return None
-    if (not isinstance(next, tuple | list) or len(next) != 2 or not isinstance(next[0], Scene)
-            or not isinstance(next[1], Camera)):  # fmt: skip
-        raise FrustumError(f"{where}: next = {describe(next)} is not a (Scene, Camera) pair")
-    if "flow" not in buffers:
-        raise FrustumError(f"{where}: next is given but buffers = {describe(buffers)} has no 'flow'; add 'flow'")
-    return next[0], next[1]
 
 
 def class_ids(scene: Scene) -> np.ndarray:
@@ -270,19 +251,20 @@ def cast_positions(scene: Scene, camera: Camera, instance: np.ndarray, factor: i
     return result
 
 
-def finish(frame: Frame, scene: Scene, camera: Camera, options: Any, asked: tuple[str, ...],
-           next: tuple[Scene, Camera] | None, where: str = "render") -> Frame:  # fmt: skip
-    """`frame` with the asked-for ground-truth buffers (``Frame.instance`` …) added, and the ``object_id`` and
-    ``position`` buffers they were computed from dropped unless asked for too."""
-    wanted = tuple(name for name in asked if name in GROUND_TRUTH_BUFFERS)
+def draw(scene: Scene, camera: Camera, options: RenderOptions, context: FrameContext, where: str = "render") -> None:
+    """The ground-truth pass: the asked-for buffers (``Frame.instance`` …) into ``context.fields`` at the output size,
+    from the middle sample of each pixel's block of the ids and points the surface passes left in the context
+    (``object_id``, ``outputs["position"]``). Nothing where no ground truth is asked for."""
+    wanted = tuple(name for name in options.buffers if name in GROUND_TRUTH_BUFFERS)
     if not wanted:
-        return frame
-    instance = frame.object_id
+        return
+    factor = options.factor
+    if factor != 1:  # the drawn image is the output's √samples times
+        camera = dataclasses.replace(camera, width=camera.width // factor, height=camera.height // factor)
+    assert context.object_id is not None  # implied by every ground-truth buffer (render.options.with_implied)
+    instance = middle_samples(context.object_id, factor)
     items = scene.items
-    fields: dict[str, Any] = {
-        "object_id": frame.object_id if "object_id" in asked else None,
-        "position": frame.position if "position" in asked else None,
-    }
+    fields = context.fields
     if "instance" in wanted:
         fields["instance"] = instance
     if "semantic" in wanted:
@@ -293,20 +275,21 @@ def finish(frame: Frame, scene: Scene, camera: Camera, options: Any, asked: tupl
 
         cause = f"amodal masks of {len(items)} items at {camera.width} x {camera.height}"
         check_memory(len(items) * camera.width * camera.height, where=where, cause=cause)
-        masks = amodal_masks(items, camera, options.cull, options.factor)
+        masks = amodal_masks(items, camera, options.cull, factor)
         fields["amodal"] = masks
         fields["visibility"] = visibility(instance, masks)
     if any(name in wanted for name in ("object_coords", "nocs", "flow")):
-        position = frame.position if frame.position is not None else cast_positions(scene, camera, instance,
-                                                                                     options.factor)  # fmt: skip
+        drawn = context.outputs.get("position")
+        position = (cast_positions(scene, camera, instance, factor) if drawn is None
+                    else middle_samples(drawn, factor))  # fmt: skip
         coordinates = object_coordinates(items, instance, position)
         if "object_coords" in wanted:
             fields["object_coords"] = coordinates.astype(np.float32)
         if "nocs" in wanted:
             fields["nocs"] = nocs(items, instance, coordinates).astype(np.float32)
         if "flow" in wanted:
-            assert next is not None
-            motion, occluded = flow(scene, camera, instance, coordinates, next[0], next[1], options.cull, where)
+            assert options.next is not None  # required with "flow" (render.options.check_next)
+            next_scene, next_camera = options.next
+            motion, occluded = flow(scene, camera, instance, coordinates, next_scene, next_camera, options.cull, where)
             fields["flow"] = motion.astype(np.float32)
             fields["flow_occluded"] = occluded
-    return dataclasses.replace(frame, **fields)
