@@ -203,7 +203,8 @@ def render(
     samples : int
         Supersampling: 1, 4, 9, 16 (any square): render at √samples times the size and downsample with
         `filter` ("box": the mean of each block; "tent": a separable triangle filter twice as wide). Lines
-        are drawn √samples times as wide, so they come out anti-aliased. Depth keeps each block's nearest.
+        are drawn √samples times as wide, so they come out anti-aliased. Depth keeps each block's nearest
+        (with a ground-truth buffer asked for, the block's middle sample: the one its ids and points come from).
     color_space : {"linear", "srgb"}
         Output encoding; "srgb" applies the sRGB transfer curve to the linear result.
     buffers : tuple of {"normals", "object_id", "position", "shadow", "instance", "semantic", "amodal",
