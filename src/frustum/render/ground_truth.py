@@ -36,8 +36,8 @@ from frustum.render.options import GROUND_TRUTH_BUFFERS, RenderOptions
 from frustum.scene import Scene, SceneItem
 
 __all__ = [
-    "DEPTH_TOLERANCE", "amodal_masks", "class_ids", "draw", "flow", "nocs",
-    "object_coordinates", "visibility",
+    "DEPTH_TOLERANCE", "amodal_masks", "class_ids", "draw", "flow_setup", "model_from_world", "nocs_boxes",
+    "point_buffers", "visibility",
 ]  # fmt: skip
 
 DEPTH_TOLERANCE = 1e-2
@@ -80,39 +80,30 @@ def amodal_masks(items: list[SceneItem], camera: Camera, cull: bool, factor: int
 def visibility(instance: np.ndarray, amodal: np.ndarray) -> np.ndarray:
     """(K,) float64 $visible / amodal$ pixel counts per item; NaN where the item's amodal mask is empty."""
     count = amodal.shape[0]
-    visible = np.bincount(instance[instance >= 0].ravel(), minlength=count)[:count].astype(np.float64)
-    total = amodal.reshape(count, -1).sum(axis=1).astype(np.float64)
+    visible = np.bincount(instance.ravel() + 1, minlength=count + 1)[1 : count + 1].astype(np.float64)
+    total = np.count_nonzero(amodal.reshape(count, -1), axis=1).astype(np.float64)
     with np.errstate(invalid="ignore", divide="ignore"):
         return np.where(total > 0, visible / np.where(total > 0, total, 1.0), np.nan)
 
 
-def object_coordinates(items: list[SceneItem], instance: np.ndarray, position: np.ndarray) -> np.ndarray:
-    """(H, W, 3) float64 model coordinates $(world\\_from\\_model)^{-1}·P$ of each pixel's world point, per item;
-    NaN where nothing is drawn (``raster.ground_truth.model_points``)."""
-    from frustum.raster import ground_truth
-
-    model_from_world = np.zeros((max(1, len(items)), 12))
+def model_from_world(items: list[SceneItem]) -> np.ndarray:
+    """(K, 12) float64: each item's $(world\\_from\\_model)^{-1}$, the top three rows row-major (one row for no
+    items: the kernels index it only at drawn pixels)."""
+    rows = np.zeros((max(1, len(items)), 12))
     for k, item in enumerate(items):
-        model_from_world[k] = np.linalg.inv(np.asarray(item.world_from_model, dtype=np.float64))[:3].ravel()
-    out = np.empty((*instance.shape, 3))
-    ground_truth.model_points(np.ascontiguousarray(instance, dtype=np.int32),
-                              np.ascontiguousarray(position, dtype=np.float32), model_from_world, out)  # fmt: skip
-    return out
+        rows[k] = np.linalg.inv(np.asarray(item.world_from_model, dtype=np.float64))[:3].ravel()
+    return rows
 
 
-def nocs(items: list[SceneItem], instance: np.ndarray, coordinates: np.ndarray) -> np.ndarray:
-    """(H, W, 3) NOCS (module docstring): $(X − c)/‖b_{max} − b_{min}‖ + ½$ per item, NaN where nothing is drawn
-    (``raster.ground_truth.nocs_points``)."""
-    from frustum.raster import ground_truth
-
+def nocs_boxes(items: list[SceneItem]) -> np.ndarray:
+    """(K, 4) float64: the centre c of each model's bounding box and $1/‖b_{max} − b_{min}‖$ (1 for a point), the
+    terms of NOCS's $(X − c)/‖b_{max} − b_{min}‖ + ½$ (module docstring)."""
     boxes = np.zeros((max(1, len(items)), 4))
     for k, item in enumerate(items):
         low, high = np.asarray(item.mesh.bounds, dtype=np.float64)
         diagonal = float(np.linalg.norm(high - low))
         boxes[k] = (*(0.5 * (low + high)), 1.0 / diagonal if diagonal > 0 else 1.0)
-    out = np.empty(coordinates.shape)
-    ground_truth.nocs_points(np.ascontiguousarray(instance, dtype=np.int32), coordinates, boxes, out)
-    return out
+    return boxes
 
 
 def _window(camera: Camera, points: np.ndarray, world_from_points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -206,19 +197,13 @@ def matched_items(scene: Scene, next_scene: Scene, where: str) -> list[int]:
     return matched
 
 
-def flow(
-    scene: Scene, camera: Camera, instance: np.ndarray, coordinates: np.ndarray, next_scene: Scene,
-    next_camera: Camera, cull: bool, where: str = "render",
-) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
-    """(H, W, 2) forward optical flow in pixels (x right, y down) and (H, W) bool occlusion in the next frame
-    (module docstring)."""
-    from frustum.raster import ground_truth
-
+def flow_setup(scene: Scene, camera: Camera, next_scene: Scene, next_camera: Camera, cull: bool,
+               where: str = "render") -> tuple[np.ndarray, ...]:  # fmt: skip
+    """The terms of ``raster.ground_truth.point_truth``'s flow (its array contracts): clip_from_model of each item
+    now and in the next frame, the matched items (``matched_items``), the next frame's depth buffer and the image
+    sizes and next projection."""
     matched = matched_items(scene, next_scene, where)
     items, next_items = scene.items, next_scene.items
-    result = np.empty((*instance.shape, 2))
-    occluded = np.empty(instance.shape, dtype=bool)
-    next_depth = _depth_of(next_scene, next_camera, cull)
     clip_from_world = np.asarray(camera.projection_matrix) @ np.asarray(camera.view_matrix)
     next_clip_from_world = np.asarray(next_camera.projection_matrix) @ np.asarray(next_camera.view_matrix)
     now, later = np.zeros((max(1, len(items)), 16)), np.zeros((max(1, len(items)), 16))
@@ -229,10 +214,37 @@ def flow(
     p = np.asarray(next_camera.projection_matrix)
     setup = np.array([camera.width, camera.height, next_camera.width, next_camera.height, p[2, 2], p[2, 3], p[3, 2],
                       p[3, 3]], dtype=np.float64)  # fmt: skip
-    ground_truth.flow_pixels(np.ascontiguousarray(instance, dtype=np.int32), np.ascontiguousarray(coordinates), now,
-                             later, np.array(matched, dtype=np.int64), next_depth, setup, DEPTH_TOLERANCE, result,
-                             occluded)  # fmt: skip
-    return result, occluded
+    return now, later, np.array(matched, dtype=np.int64), _depth_of(next_scene, next_camera, cull), setup
+
+
+def point_buffers(scene: Scene, camera: Camera, instance: np.ndarray, position: np.ndarray, wanted: tuple[str, ...],
+                  options: RenderOptions, where: str = "render") -> dict[str, np.ndarray]:  # fmt: skip
+    """The Frame fields of the model points of the drawn pixels, those of `wanted` (``object_coords``, ``nocs``,
+    ``flow`` with ``flow_occluded``), float32 (bool), NaN where nothing is drawn, in one pass over the pixels
+    (``raster.ground_truth.point_truth``)."""
+    from frustum.raster import ground_truth
+
+    shape = instance.shape
+    names = [name for name in ("object_coords", "nocs", "flow") if name in wanted]
+    layers = {"object_coords": 3, "nocs": 3, "flow": 2, "flow_occluded": 0}
+    if "flow" in wanted:
+        assert options.next is not None  # required with "flow" (render.options.check_next)
+        terms = flow_setup(scene, camera, *options.next, options.cull, where)
+        names.append("flow_occluded")
+    else:  # 1-row stand-ins, never read
+        terms = (np.zeros((1, 16)), np.zeros((1, 16)), np.zeros(1, dtype=np.int64), np.ones((1, 1), np.float32),
+                 np.ones(8))  # fmt: skip
+    outputs = {  # the image-sized arrays asked for, 1-pixel dummies for the others
+        name: np.empty((*(shape if name in names else (1, 1)), *((depth,) if depth else ())),
+                       dtype=bool if name == "flow_occluded" else np.float32)
+        for name, depth in layers.items()
+    }  # fmt: skip
+    flags = 1 * ("object_coords" in names) + 2 * ("nocs" in names) + 4 * ("flow" in names)
+    ground_truth.point_truth(
+        np.ascontiguousarray(instance, dtype=np.int32), np.ascontiguousarray(position, dtype=np.float64),
+        model_from_world(scene.items), nocs_boxes(scene.items), *terms, DEPTH_TOLERANCE, flags, *outputs.values(),
+    )  # fmt: skip
+    return {name: outputs[name] for name in names}
 
 
 def cast_positions(scene: Scene, camera: Camera, instance: np.ndarray, factor: int) -> np.ndarray:
@@ -282,14 +294,4 @@ def draw(scene: Scene, camera: Camera, options: RenderOptions, context: FrameCon
         drawn = context.outputs.get("position")
         position = (cast_positions(scene, camera, instance, factor) if drawn is None
                     else middle_samples(drawn, factor))  # fmt: skip
-        coordinates = object_coordinates(items, instance, position)
-        if "object_coords" in wanted:
-            fields["object_coords"] = coordinates.astype(np.float32)
-        if "nocs" in wanted:
-            fields["nocs"] = nocs(items, instance, coordinates).astype(np.float32)
-        if "flow" in wanted:
-            assert options.next is not None  # required with "flow" (render.options.check_next)
-            next_scene, next_camera = options.next
-            motion, occluded = flow(scene, camera, instance, coordinates, next_scene, next_camera, options.cull, where)
-            fields["flow"] = motion.astype(np.float32)
-            fields["flow_occluded"] = occluded
+        fields.update(point_buffers(scene, camera, instance, position, wanted, options, where))
