@@ -1,9 +1,11 @@
 """Ground-truth buffers for training vision models: ``instance``, ``semantic``, ``amodal`` (with
 ``Frame.visibility``), ``object_coords``, ``nocs`` and ``flow`` (with ``Frame.flow_occluded``).
 
-Every per-pixel id and point comes from **one** sample: the one the depth-buffer pass keeps for ``object_id``
-and ``position`` (with supersampling, the middle sample of each pixel's block, ``render.buffers.resolve``), so a
-pixel never carries a blend of two objects and every id in a mask is an item of the scene.
+A pass (``draw``), the last of the surface modes' passes (``render._draw``): every per-pixel id and point comes
+from **one** sample of the ``object_id`` and ``position`` the surface passes leave in the frame's context (with
+supersampling, the middle sample of each pixel's block, ``render.context.middle_samples``, which is then also the
+sample ``Frame.depth`` reports), so a pixel never carries a blend of two objects and every id in a mask is an item
+of the scene. The pass writes the Frame's fields at the output size into ``context.fields``.
 
 - ``instance``: ``object_id`` under its dataset name, the index of the item in ``Scene.items`` (−1 background).
 - ``semantic``: the class id of each pixel's item, $c = 1 + $ the position of its label in ``Scene.labels``
