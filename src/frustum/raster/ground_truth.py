@@ -18,8 +18,6 @@ Array contracts (kernels never validate):
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from frustum.raster._jit import parallel_kernel
@@ -41,7 +39,7 @@ def point_truth(instance: np.ndarray, position: np.ndarray, model_from_world: np
     write_coordinates, write_nocs, write_flow = flags & 1 != 0, flags & 2 != 0, flags & 4 != 0
     w0, h0, w1, h1 = setup[0], setup[1], setup[2], setup[3]
     a_, b_, c_, d_ = setup[4], setup[5], setup[6], setup[7]
-    columns, rows = next_depth.shape[1], next_depth.shape[0]
+    rows = next_depth.shape[0]  # H'
     for r in range(start, stop):
         for c in range(width):
             k = instance[r, c]
@@ -87,11 +85,9 @@ def point_truth(instance: np.ndarray, position: np.ndarray, model_from_world: np
             d1 = ((n[8] * x + n[9] * y + n[10] * z + n[11]) / nw + 1.0) * 0.5
             flow[r, c, 0] = x1 - x0
             flow[r, c, 1] = y0 - y1
-            column = math.floor(x1)
-            row = h1 - 1.0 - math.floor(y1)
-            if not (0.0 <= column < w1 and 0.0 <= row < h1 and 0.0 <= d1 <= 1.0):
+            if not (0.0 <= x1 < w1 and 0.0 <= y1 < h1 and 0.0 <= d1 <= 1.0):  # the pixel holding it: in the image
                 continue
-            surface_ndc = 2.0 * float(next_depth[min(int(row), rows - 1), min(int(column), columns - 1)]) - 1.0
+            surface_ndc = 2.0 * float(next_depth[rows - 1 - int(y1), int(x1)]) - 1.0  # int() floors x, y >= 0
             point_ndc = 2.0 * d1 - 1.0
             surface = -(b_ - surface_ndc * d_) / (surface_ndc * c_ - a_)
             point = -(b_ - point_ndc * d_) / (point_ndc * c_ - a_)
