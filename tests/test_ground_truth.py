@@ -129,6 +129,19 @@ def test_supersampled_ids_are_never_blended():
     assert agree.mean() > 0.8
 
 
+def test_supersampled_depth_reports_the_sample_the_ids_come_from():
+    scene = _scene()
+    camera = _camera()
+    frame = render(scene, camera, buffers=("instance", "object_coords"), samples=16)
+    big = render(scene, Camera(camera.frame, camera.projection, WIDTH * 4, HEIGHT * 4),
+                 buffers=("object_id", "position"))  # fmt: skip
+    np.testing.assert_array_equal(frame.instance, big.object_id[2::4, 2::4])
+    np.testing.assert_array_equal(frame.depth, big.depth[2::4, 2::4])  # the same sample, not the block's nearest
+    plain = render(scene, camera, samples=16)
+    assert (plain.depth <= frame.depth).all() and (plain.depth < frame.depth).any()  # without ground truth: nearest
+    assert frame.object_id is None and frame.position is None  # implied by the ground truth, not asked for
+
+
 # --- amodal masks and visibility ------------------------------------------------------------------------------------
 
 

@@ -81,7 +81,14 @@ from frustum.render.context import FrameContext
 from frustum.render.lines import mesh_edges as mesh_edges
 from frustum.render.methods import RENDER_METHODS as RENDER_METHODS
 from frustum.render.methods import VISIBILITY_METHODS as VISIBILITY_METHODS
-from frustum.render.options import DEFAULT_BACKGROUND, EDGE_MODES, LINE_MODES, RenderOptions, check_method
+from frustum.render.options import (
+    DEFAULT_BACKGROUND,
+    EDGE_MODES,
+    LINE_MODES,
+    RenderOptions,
+    check_method,
+    check_next,
+)
 from frustum.render.options import HIDDEN_STYLES as HIDDEN_STYLES
 from frustum.render.options import RENDER_MODES as RENDER_MODES
 from frustum.render.options import SHADING_MODES as SHADING_MODES
@@ -196,7 +203,8 @@ def render(
     samples : int
         Supersampling: 1, 4, 9, 16 (any square): render at √samples times the size and downsample with
         `filter` ("box": the mean of each block; "tent": a separable triangle filter twice as wide). Lines
-        are drawn √samples times as wide, so they come out anti-aliased. Depth keeps each block's nearest.
+        are drawn √samples times as wide, so they come out anti-aliased. Depth keeps each block's nearest
+        (with a ground-truth buffer asked for, the block's middle sample: the one its ids and points come from).
     color_space : {"linear", "srgb"}
         Output encoding; "srgb" applies the sRGB transfer curve to the linear result.
     buffers : tuple of {"normals", "object_id", "position", "shadow", "instance", "semantic", "amodal",
@@ -267,7 +275,7 @@ def render(
     [seed] "Back-face detection", "Depth-buffer method", "wire-frame displays".
     """
     check_method(method, "render")
-    following = ground_truth.check_next(tuple(buffers) if isinstance(buffers, tuple | list) else (), next, "render")
+    check_next(buffers, next, "render")  # the methods of RENDER_METHODS too
     if RENDER_METHODS[method] is not None:
         return RENDER_METHODS[method](scene, camera, background=background)
     options = RenderOptions.from_keywords(
@@ -277,14 +285,12 @@ def render(
         color_space=color_space, buffers=buffers, method=method, transparency=transparency, stats=stats,
         max_depth=max_depth, shadows=shadows, shadow_map_size=shadow_map_size, shadow_softness=shadow_softness,
         eye_dome=eye_dome, eye_dome_strength=eye_dome_strength,
-        tone_map=tone_map, exposure=exposure,
+        tone_map=tone_map, exposure=exposure, next=next,
     )  # fmt: skip
     if options.factor == 1:
-        frame = _draw(scene, camera, options).to_frame(options)
-    else:
-        big = dataclasses.replace(camera, width=camera.width * options.factor, height=camera.height * options.factor)
-        frame = _draw(scene, big, options.supersampled()).to_frame(options)
-    return ground_truth.finish(frame, scene, camera, options, tuple(buffers), following)  # the ground-truth pass
+        return _draw(scene, camera, options).to_frame(options)
+    big = dataclasses.replace(camera, width=camera.width * options.factor, height=camera.height * options.factor)
+    return _draw(scene, big, options.supersampled()).to_frame(options)
 
 
 def _draw(scene: Scene, camera: Camera, options: RenderOptions) -> FrameContext:
@@ -314,6 +320,7 @@ def _draw(scene: Scene, camera: Camera, options: RenderOptions) -> FrameContext:
             volumes.draw_volumes(scene, camera, context.depth, context.color)
     particles.draw_particles(scene.particle_layers, camera, context.depth, context.color)
     eye_dome.shade(camera, options, context)
+    ground_truth.draw(scene, camera, options, context)  # ids, masks, model points, flow of the opaque surfaces
     return context
 
 

@@ -13,6 +13,8 @@ hands it to every pass with the options, and turns it into the returned ``Frame`
 - ``outputs``: per-pixel arrays passes hand to later passes and to the Frame, by name: ``"position"`` (world
   points of the drawn pixels), ``"seen"`` (the fraction of each light reaching them) and ``"casting"`` (which
   lights cast shadows), written by the shadow pass (``render.shadows``);
+- ``fields``: ``Frame`` fields a pass makes at the output size from the middle samples itself
+  (``middle_samples``), set on the Frame as they are: the ground-truth pass's (``render.ground_truth``);
 - ``scratch``: the call's work arrays (``render.buffers.Scratch``).
 
 **Adding a buffer pass** (a per-pixel output such as instance ids or object coordinates):
@@ -39,9 +41,9 @@ import numpy as np
 from frustum.camera import Camera
 from frustum.frame import Frame
 from frustum.render.buffers import Scratch, block_min, downsample, give_back, resolve_color
-from frustum.render.options import RenderOptions
+from frustum.render.options import GROUND_TRUTH_BUFFERS, RenderOptions
 
-__all__ = ["FrameContext"]
+__all__ = ["FrameContext", "middle_samples"]
 
 
 @dataclasses.dataclass
@@ -53,6 +55,7 @@ class FrameContext:
     scratch: Scratch
     counts: dict[str, Any] | None = None
     outputs: dict[str, np.ndarray] = dataclasses.field(default_factory=dict)
+    fields: dict[str, Any] = dataclasses.field(default_factory=dict)
     color: np.ndarray = dataclasses.field(default_factory=lambda: np.empty((0, 0, 4), dtype=np.uint8))
     depth: np.ndarray = dataclasses.field(default_factory=lambda: np.empty((0, 0), dtype=np.float32))
 
@@ -86,8 +89,9 @@ class FrameContext:
 
     def to_frame(self, options: RenderOptions) -> Frame:
         """The Frame of the drawn image: downsampled by ``options.factor`` with ``options.filter`` (depth keeps each
-        block's nearest; normals, object ids and every image-sized output the block's middle sample) and encoded in
-        ``options.color_space``."""
+        block's nearest, or with ground truth asked for the middle sample its ids and points come from; normals,
+        object ids and every image-sized output the block's middle sample), encoded in ``options.color_space``,
+        with the ``fields`` passes made; the buffers only implied by the ground truth left off."""
         color, depth, normals, ids = self.color, self.depth, self.normals, self.object_id
         factor = options.factor
         linear = None
@@ -96,12 +100,13 @@ class FrameContext:
                 color = resolve_color(color, factor)
             else:
                 linear = downsample(color.astype(np.float64) / 255.0, factor, options.filter)
-            depth = block_min(depth, factor)
-            normals = None if normals is None else _middle(normals, factor)
-            ids = None if ids is None else _middle(ids, factor)
+            truth = any(name in GROUND_TRUTH_BUFFERS for name in options.buffers)
+            depth = middle_samples(depth, factor) if truth else block_min(depth, factor)
+            normals = None if normals is None else middle_samples(normals, factor)
+            ids = None if ids is None else middle_samples(ids, factor)
             for key, array in self.outputs.items():  # the middle sample of each block, as for normals
                 if array.shape[:2] == self.depth.shape:
-                    self.outputs[key] = _middle(array, factor)
+                    self.outputs[key] = middle_samples(array, factor)
         if options.color_space == "srgb":
             values = color.astype(np.float64) / 255.0 if linear is None else linear
             values[..., :3] = np.where(
@@ -110,8 +115,9 @@ class FrameContext:
             linear = values
         if linear is not None:
             color = np.floor(np.clip(linear, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
+        ids = None if "object_id" in options.implied else ids
         return Frame(color=color, depth=depth, normals=normals, object_id=ids, stats=self.counts,
-                     **self.frame_outputs(options))  # fmt: skip
+                     **self.frame_outputs(options), **self.fields)  # fmt: skip
 
     def frame_outputs(self, options: RenderOptions) -> dict[str, np.ndarray | None]:
         """The Frame fields made of ``outputs``: ``position`` and ``shadow`` where asked for (float32, NaN where
@@ -119,7 +125,8 @@ class FrameContext:
         points = self.outputs.get("position")
         if points is None:
             return {"position": None, "shadow": None}
-        position = points.astype(np.float32) if "position" in options.buffers else None
+        asked = "position" in options.buffers and "position" not in options.implied
+        position = points.astype(np.float32) if asked else None
         shadow = None
         if "shadow" in options.buffers:
             seen = self.outputs["seen"][..., self.outputs["casting"]]
@@ -128,7 +135,9 @@ class FrameContext:
         return {"position": position, "shadow": shadow}
 
 
-def _middle(array: np.ndarray, factor: int) -> np.ndarray:
-    """The middle sample of each factor × factor block of an image-sized array."""
+def middle_samples(array: np.ndarray, factor: int) -> np.ndarray:
+    """The middle sample of each factor × factor block of an image-sized array (the array itself at factor 1)."""
+    if factor == 1:
+        return array
     middle = factor // 2
     return np.ascontiguousarray(array[middle::factor, middle::factor])

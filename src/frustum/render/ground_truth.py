@@ -1,9 +1,11 @@
 """Ground-truth buffers for training vision models: ``instance``, ``semantic``, ``amodal`` (with
 ``Frame.visibility``), ``object_coords``, ``nocs`` and ``flow`` (with ``Frame.flow_occluded``).
 
-Every per-pixel id and point comes from **one** sample: the one the depth-buffer pass keeps for ``object_id``
-and ``position`` (with supersampling, the middle sample of each pixel's block, ``render.buffers.resolve``), so a
-pixel never carries a blend of two objects and every id in a mask is an item of the scene.
+A pass (``draw``), the last of the surface modes' passes (``render._draw``): every per-pixel id and point comes
+from **one** sample of the ``object_id`` and ``position`` the surface passes leave in the frame's context (with
+supersampling, the middle sample of each pixel's block, ``render.context.middle_samples``, which is then also the
+sample ``Frame.depth`` reports), so a pixel never carries a blend of two objects and every id in a mask is an item
+of the scene. The pass writes the Frame's fields at the output size into ``context.fields``.
 
 - ``instance``: ``object_id`` under its dataset name, the index of the item in ``Scene.items`` (−1 background).
 - ``semantic``: the class id of each pixel's item, $c = 1 + $ the position of its label in ``Scene.labels``
@@ -26,20 +28,18 @@ pixel never carries a blend of two objects and every id in a mask is an item of 
 from __future__ import annotations
 
 import dataclasses
-from typing import Any
 
 import numpy as np
 
-from frustum._arrays import describe
 from frustum.camera import Camera
 from frustum.errors import FrustumError
-from frustum.frame import Frame
-from frustum.render.options import GROUND_TRUTH_BUFFERS
+from frustum.render.context import FrameContext, middle_samples
+from frustum.render.options import GROUND_TRUTH_BUFFERS, RenderOptions
 from frustum.scene import Scene, SceneItem
 
 __all__ = [
-    "DEPTH_TOLERANCE", "amodal_masks", "check_next", "class_ids", "finish", "flow", "nocs",
-    "object_coordinates", "visibility",
+    "DEPTH_TOLERANCE", "amodal_masks", "class_ids", "draw", "flow_setup", "model_from_world", "nocs_boxes",
+    "point_buffers", "visibility",
 ]  # fmt: skip
 
 DEPTH_TOLERANCE = 1e-2
@@ -47,23 +47,6 @@ DEPTH_TOLERANCE = 1e-2
 exceeds the depth buffer's (at the pixel that holds it) by more than this fraction (1 cm at 1 m): the buffer holds
 the surface at the pixel's centre, not at the point, so a relative margin keeps sloped surfaces from hiding
 themselves."""
-
-
-def check_next(buffers: tuple[str, ...], next: Any, where: str) -> tuple[Scene, Camera] | None:
-    """`next` as ``(scene, camera)``; None when not given. Required by (and only allowed with) ``"flow"``."""
-    if next is None:
-        if "flow" in buffers:
-            raise FrustumError(
-                f"{where}: buffers = {describe(buffers)} asks for 'flow' without next; give next=(scene_next, "
-                "camera_next), the same scene and camera at the next frame"
-            )
-        return None
-    if (not isinstance(next, tuple | list) or len(next) != 2 or not isinstance(next[0], Scene)
-            or not isinstance(next[1], Camera)):  # fmt: skip
-        raise FrustumError(f"{where}: next = {describe(next)} is not a (Scene, Camera) pair")
-    if "flow" not in buffers:
-        raise FrustumError(f"{where}: next is given but buffers = {describe(buffers)} has no 'flow'; add 'flow'")
-    return next[0], next[1]
 
 
 def class_ids(scene: Scene) -> np.ndarray:
@@ -99,39 +82,30 @@ def amodal_masks(items: list[SceneItem], camera: Camera, cull: bool, factor: int
 def visibility(instance: np.ndarray, amodal: np.ndarray) -> np.ndarray:
     """(K,) float64 $visible / amodal$ pixel counts per item; NaN where the item's amodal mask is empty."""
     count = amodal.shape[0]
-    visible = np.bincount(instance[instance >= 0].ravel(), minlength=count)[:count].astype(np.float64)
-    total = amodal.reshape(count, -1).sum(axis=1).astype(np.float64)
+    visible = np.bincount(instance.ravel() + 1, minlength=count + 1)[1 : count + 1].astype(np.float64)
+    total = np.count_nonzero(amodal.reshape(count, -1), axis=1).astype(np.float64)
     with np.errstate(invalid="ignore", divide="ignore"):
         return np.where(total > 0, visible / np.where(total > 0, total, 1.0), np.nan)
 
 
-def object_coordinates(items: list[SceneItem], instance: np.ndarray, position: np.ndarray) -> np.ndarray:
-    """(H, W, 3) float64 model coordinates $(world\\_from\\_model)^{-1}·P$ of each pixel's world point, per item;
-    NaN where nothing is drawn (``raster.ground_truth.model_points``)."""
-    from frustum.raster import ground_truth
-
-    model_from_world = np.zeros((max(1, len(items)), 12))
+def model_from_world(items: list[SceneItem]) -> np.ndarray:
+    """(K, 12) float64: each item's $(world\\_from\\_model)^{-1}$, the top three rows row-major (one row for no
+    items: the kernels index it only at drawn pixels)."""
+    rows = np.zeros((max(1, len(items)), 12))
     for k, item in enumerate(items):
-        model_from_world[k] = np.linalg.inv(np.asarray(item.world_from_model, dtype=np.float64))[:3].ravel()
-    out = np.empty((*instance.shape, 3))
-    ground_truth.model_points(np.ascontiguousarray(instance, dtype=np.int32),
-                              np.ascontiguousarray(position, dtype=np.float32), model_from_world, out)  # fmt: skip
-    return out
+        rows[k] = np.linalg.inv(np.asarray(item.world_from_model, dtype=np.float64))[:3].ravel()
+    return rows
 
 
-def nocs(items: list[SceneItem], instance: np.ndarray, coordinates: np.ndarray) -> np.ndarray:
-    """(H, W, 3) NOCS (module docstring): $(X − c)/‖b_{max} − b_{min}‖ + ½$ per item, NaN where nothing is drawn
-    (``raster.ground_truth.nocs_points``)."""
-    from frustum.raster import ground_truth
-
+def nocs_boxes(items: list[SceneItem]) -> np.ndarray:
+    """(K, 4) float64: the centre c of each model's bounding box and $1/‖b_{max} − b_{min}‖$ (1 for a point), the
+    terms of NOCS's $(X − c)/‖b_{max} − b_{min}‖ + ½$ (module docstring)."""
     boxes = np.zeros((max(1, len(items)), 4))
     for k, item in enumerate(items):
         low, high = np.asarray(item.mesh.bounds, dtype=np.float64)
         diagonal = float(np.linalg.norm(high - low))
         boxes[k] = (*(0.5 * (low + high)), 1.0 / diagonal if diagonal > 0 else 1.0)
-    out = np.empty(coordinates.shape)
-    ground_truth.nocs_points(np.ascontiguousarray(instance, dtype=np.int32), coordinates, boxes, out)
-    return out
+    return boxes
 
 
 def _window(camera: Camera, points: np.ndarray, world_from_points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -225,19 +199,13 @@ def matched_items(scene: Scene, next_scene: Scene, where: str) -> list[int]:
     return matched
 
 
-def flow(
-    scene: Scene, camera: Camera, instance: np.ndarray, coordinates: np.ndarray, next_scene: Scene,
-    next_camera: Camera, cull: bool, where: str = "render",
-) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
-    """(H, W, 2) forward optical flow in pixels (x right, y down) and (H, W) bool occlusion in the next frame
-    (module docstring)."""
-    from frustum.raster import ground_truth
-
+def flow_setup(scene: Scene, camera: Camera, next_scene: Scene, next_camera: Camera, cull: bool,
+               where: str = "render") -> tuple[np.ndarray, ...]:  # fmt: skip
+    """The terms of ``raster.ground_truth.point_truth``'s flow (its array contracts): clip_from_model of each item
+    now and in the next frame, the matched items (``matched_items``), the next frame's depth buffer and the image
+    sizes and next projection."""
     matched = matched_items(scene, next_scene, where)
     items, next_items = scene.items, next_scene.items
-    result = np.empty((*instance.shape, 2))
-    occluded = np.empty(instance.shape, dtype=bool)
-    next_depth = _depth_of(next_scene, next_camera, cull)
     clip_from_world = np.asarray(camera.projection_matrix) @ np.asarray(camera.view_matrix)
     next_clip_from_world = np.asarray(next_camera.projection_matrix) @ np.asarray(next_camera.view_matrix)
     now, later = np.zeros((max(1, len(items)), 16)), np.zeros((max(1, len(items)), 16))
@@ -248,10 +216,37 @@ def flow(
     p = np.asarray(next_camera.projection_matrix)
     setup = np.array([camera.width, camera.height, next_camera.width, next_camera.height, p[2, 2], p[2, 3], p[3, 2],
                       p[3, 3]], dtype=np.float64)  # fmt: skip
-    ground_truth.flow_pixels(np.ascontiguousarray(instance, dtype=np.int32), np.ascontiguousarray(coordinates), now,
-                             later, np.array(matched, dtype=np.int64), next_depth, setup, DEPTH_TOLERANCE, result,
-                             occluded)  # fmt: skip
-    return result, occluded
+    return now, later, np.array(matched, dtype=np.int64), _depth_of(next_scene, next_camera, cull), setup
+
+
+def point_buffers(scene: Scene, camera: Camera, instance: np.ndarray, position: np.ndarray, wanted: tuple[str, ...],
+                  options: RenderOptions, where: str = "render") -> dict[str, np.ndarray]:  # fmt: skip
+    """The Frame fields of the model points of the drawn pixels, those of `wanted` (``object_coords``, ``nocs``,
+    ``flow`` with ``flow_occluded``), float32 (bool), NaN where nothing is drawn, in one pass over the pixels
+    (``raster.ground_truth.point_truth``)."""
+    from frustum.raster import ground_truth
+
+    shape = instance.shape
+    names = [name for name in ("object_coords", "nocs", "flow") if name in wanted]
+    layers = {"object_coords": 3, "nocs": 3, "flow": 2, "flow_occluded": 0}
+    if "flow" in wanted:
+        assert options.next is not None  # required with "flow" (render.options.check_next)
+        terms = flow_setup(scene, camera, *options.next, options.cull, where)
+        names.append("flow_occluded")
+    else:  # 1-row stand-ins, never read
+        terms = (np.zeros((1, 16)), np.zeros((1, 16)), np.zeros(1, dtype=np.int64), np.ones((1, 1), np.float32),
+                 np.ones(8))  # fmt: skip
+    outputs = {  # the image-sized arrays asked for, 1-pixel dummies for the others
+        name: np.empty((*(shape if name in names else (1, 1)), *((depth,) if depth else ())),
+                       dtype=bool if name == "flow_occluded" else np.float32)
+        for name, depth in layers.items()
+    }  # fmt: skip
+    flags = 1 * ("object_coords" in names) + 2 * ("nocs" in names) + 4 * ("flow" in names)
+    ground_truth.point_truth(
+        np.ascontiguousarray(instance, dtype=np.int32), np.ascontiguousarray(position, dtype=np.float64),
+        model_from_world(scene.items), nocs_boxes(scene.items), *terms, DEPTH_TOLERANCE, flags, *outputs.values(),
+    )  # fmt: skip
+    return {name: outputs[name] for name in names}
 
 
 def cast_positions(scene: Scene, camera: Camera, instance: np.ndarray, factor: int) -> np.ndarray:
@@ -270,19 +265,20 @@ def cast_positions(scene: Scene, camera: Camera, instance: np.ndarray, factor: i
     return result
 
 
-def finish(frame: Frame, scene: Scene, camera: Camera, options: Any, asked: tuple[str, ...],
-           next: tuple[Scene, Camera] | None, where: str = "render") -> Frame:  # fmt: skip
-    """`frame` with the asked-for ground-truth buffers (``Frame.instance`` …) added, and the ``object_id`` and
-    ``position`` buffers they were computed from dropped unless asked for too."""
-    wanted = tuple(name for name in asked if name in GROUND_TRUTH_BUFFERS)
+def draw(scene: Scene, camera: Camera, options: RenderOptions, context: FrameContext, where: str = "render") -> None:
+    """The ground-truth pass: the asked-for buffers (``Frame.instance`` …) into ``context.fields`` at the output size,
+    from the middle sample of each pixel's block of the ids and points the surface passes left in the context
+    (``object_id``, ``outputs["position"]``). Nothing where no ground truth is asked for."""
+    wanted = tuple(name for name in options.buffers if name in GROUND_TRUTH_BUFFERS)
     if not wanted:
-        return frame
-    instance = frame.object_id
+        return
+    factor = options.factor
+    if factor != 1:  # the drawn image is the output's √samples times
+        camera = dataclasses.replace(camera, width=camera.width // factor, height=camera.height // factor)
+    assert context.object_id is not None  # implied by every ground-truth buffer (render.options.with_implied)
+    instance = middle_samples(context.object_id, factor)
     items = scene.items
-    fields: dict[str, Any] = {
-        "object_id": frame.object_id if "object_id" in asked else None,
-        "position": frame.position if "position" in asked else None,
-    }
+    fields = context.fields
     if "instance" in wanted:
         fields["instance"] = instance
     if "semantic" in wanted:
@@ -293,20 +289,11 @@ def finish(frame: Frame, scene: Scene, camera: Camera, options: Any, asked: tupl
 
         cause = f"amodal masks of {len(items)} items at {camera.width} x {camera.height}"
         check_memory(len(items) * camera.width * camera.height, where=where, cause=cause)
-        masks = amodal_masks(items, camera, options.cull, options.factor)
+        masks = amodal_masks(items, camera, options.cull, factor)
         fields["amodal"] = masks
         fields["visibility"] = visibility(instance, masks)
     if any(name in wanted for name in ("object_coords", "nocs", "flow")):
-        position = frame.position if frame.position is not None else cast_positions(scene, camera, instance,
-                                                                                     options.factor)  # fmt: skip
-        coordinates = object_coordinates(items, instance, position)
-        if "object_coords" in wanted:
-            fields["object_coords"] = coordinates.astype(np.float32)
-        if "nocs" in wanted:
-            fields["nocs"] = nocs(items, instance, coordinates).astype(np.float32)
-        if "flow" in wanted:
-            assert next is not None
-            motion, occluded = flow(scene, camera, instance, coordinates, next[0], next[1], options.cull, where)
-            fields["flow"] = motion.astype(np.float32)
-            fields["flow_occluded"] = occluded
-    return dataclasses.replace(frame, **fields)
+        drawn = context.outputs.get("position")
+        position = (cast_positions(scene, camera, instance, factor) if drawn is None
+                    else middle_samples(drawn, factor))  # fmt: skip
+        fields.update(point_buffers(scene, camera, instance, position, wanted, options, where))

@@ -135,6 +135,8 @@ class RenderOptions:
     tone_map: int = 0  # shading.tone.TONE_MAPS code (the metallic–roughness model's output transform)
     exposure: float = 1.0
     physical_ambient: Any = None  # (3,) the scene's AmbientLights summed (zero without one): shading.pbr's I_a
+    implied: tuple[str, ...] = ()  # buffers the ground truth is computed from, not asked for: left off the Frame
+    next: Any = None  # (Scene, Camera) of the next frame, for the "flow" buffer (``check_next``)
 
     @classmethod
     def from_keywords(cls, scene: Any, camera: Any, where: str = "render", **keywords: Any) -> RenderOptions:
@@ -163,6 +165,7 @@ class RenderOptions:
         depth, shadows = ray_options(options, k["max_depth"], k["shadows"], k["depth_cue"], k["shading"], where)
         eye_dome = eye_dome_strength(k["eye_dome"], k["eye_dome_strength"], where)
         check_image_budget(camera, factor, options.buffers, k["filter"], k["color_space"], where)
+        following = check_next(options.buffers, k["next"], where)
         environment = getattr(scene, "environment", None)
         tone_map, exposure, ambient = physical_options(scene, options, k["tone_map"], k["exposure"], where)
         return dataclasses.replace(options, factor=factor, filter=k["filter"], color_space=k["color_space"],
@@ -170,7 +173,7 @@ class RenderOptions:
                                    physical_ambient=ambient,
                                    environment_background=environment is not None
                                    and k["background"] is DEFAULT_BACKGROUND,
-                                   max_depth=depth, shadows=shadows, eye_dome=eye_dome)  # fmt: skip
+                                   max_depth=depth, shadows=shadows, eye_dome=eye_dome, next=following)  # fmt: skip
 
     def supersampled(self) -> RenderOptions:
         """The options for the √samples-times larger image: lines √samples times as wide."""
@@ -333,6 +336,7 @@ def check_arguments(
             + ", ".join(repr(b) for b in BUFFERS)
         )
     background_rgba = background_bytes(background, where)
+    full = with_implied(tuple(buffers), mode, where)
     if edge_color is None:  # material colors for wireframes; black on light backgrounds, white on dark ones
         light = background_rgba[:3].astype(float) @ (0.2126, 0.7152, 0.0722) > 127.5
         edge = None if mode in LINE_MODES else np.array([0.0, 0.0, 0.0, 255.0]) * light + 255.0 * (not light)
@@ -351,7 +355,8 @@ def check_arguments(
         hidden_color=color_bytes(hidden_color, "hidden_color", where),
         line_width=width,
         depth_cue=depth_cue,
-        buffers=with_implied(tuple(buffers), mode, where),
+        buffers=full,
+        implied=tuple(name for name in full if name not in buffers),
     )
 
 
@@ -368,6 +373,24 @@ def with_implied(buffers: tuple[str, ...], mode: str, where: str) -> tuple[str, 
         )
     implied = ["object_id"] + (["position"] if {"object_coords", "nocs", "flow"} & set(truth) else [])
     return buffers + tuple(name for name in implied if name not in buffers)
+
+
+def check_next(buffers: Any, next: Any, where: str) -> tuple[Scene, Camera] | None:
+    """`next` as ``(scene, camera)``; None when not given. Required by (and only allowed with) ``"flow"``."""
+    buffers = tuple(buffers) if isinstance(buffers, tuple | list) else ()
+    if next is None:
+        if "flow" in buffers:
+            raise FrustumError(
+                f"{where}: buffers = {describe(buffers)} asks for 'flow' without next; give next=(scene_next, "
+                "camera_next), the same scene and camera at the next frame"
+            )
+        return None
+    if (not isinstance(next, tuple | list) or len(next) != 2 or not isinstance(next[0], Scene)
+            or not isinstance(next[1], Camera)):  # fmt: skip
+        raise FrustumError(f"{where}: next = {describe(next)} is not a (Scene, Camera) pair")
+    if "flow" not in buffers:
+        raise FrustumError(f"{where}: next is given but buffers = {describe(buffers)} has no 'flow'; add 'flow'")
+    return next[0], next[1]
 
 
 def check_method(method: Any, where: str) -> None:
