@@ -5,12 +5,19 @@ Every per-pixel id and point comes from **one** sample: the one the depth-buffer
 and ``position`` (with supersampling, the middle sample of each pixel's block, ``render.buffers.resolve``), so a
 pixel never carries a blend of two objects and every id in a mask is an item of the scene.
 
-- ``instance``: ``object_id`` under its dataset name, the index of the item in ``Scene.items`` (−1 background).
-- ``semantic``: the class id of each pixel's item, $c = 1 + $ the position of its label in ``Scene.labels``
-  (0 for the background and for items without a label).
-- ``amodal`` (K, H, W) bool: each item's silhouette alone, occluders ignored, still clipped by the view volume:
-  one depth-only fill of the item (``raster.shadow.fill_depth_tiles``, the same coverage rule as the surface
-  pass) per item. ``visibility`` (K,): $visible / amodal$ pixels, NaN where the amodal mask is empty.
+- The objects (``objects``): the meshes of ``Scene.items`` (ids 0 … K − 1), then the point clouds and splat sets
+  of ``Scene.point_clouds`` (ids K … K + P − 1, as the point and splat passes write them: ``render.points``,
+  ``render.splats``; a splat pixel is its set's where the accumulated alpha reaches ½).
+- ``instance``: ``object_id`` under its dataset name, the object's index (−1 background).
+- ``semantic``: the class id of each pixel's object, $c = 1 + $ the position of its label in ``Scene.labels``
+  (0 for the background and for objects without a label).
+- ``amodal`` (K + P, H, W) bool: each object's silhouette alone, occluders ignored, still clipped by the view
+  volume: one depth-only fill of each mesh (``raster.shadow.fill_depth_tiles``, the same coverage rule as the
+  surface pass), each cloud or splat set drawn alone (``render.points.silhouettes``). ``visibility`` (K + P,):
+  $visible / amodal$ pixels, NaN where the amodal mask is empty.
+- Point objects have no surface between their points: their pixels' world points (for ``object_coords``, ``nocs``
+  and ``flow``) are the window depth unprojected (``Camera.unproject``; a splat pixel's is its expected depth),
+  their NOCS box the box of their points; the next frame's depth buffer of ``flow_occluded`` holds the meshes.
 - ``object_coords`` (H, W, 3) float32: the visible point in its item's model coordinates,
   $X = (world\\_from\\_model)^{-1} · P_{world}$, NaN on the background.
 - ``nocs``: Normalized Object Coordinate Space (Wang et al. 2019), $(X − c)/‖b_{max} − b_{min}‖ + ½$ with c the
@@ -39,7 +46,7 @@ from frustum.scene import Scene, SceneItem
 
 __all__ = [
     "DEPTH_TOLERANCE", "amodal_masks", "check_next", "class_ids", "finish", "flow", "nocs",
-    "object_coordinates", "visibility",
+    "object_coordinates", "object_labels", "object_paths", "objects", "point_positions", "visibility",
 ]  # fmt: skip
 
 DEPTH_TOLERANCE = 1e-2
@@ -66,10 +73,40 @@ def check_next(buffers: tuple[str, ...], next: Any, where: str) -> tuple[Scene, 
     return next[0], next[1]
 
 
+def objects(scene: Scene) -> list[SceneItem]:
+    """The objects the ids count (module docstring): ``Scene.items``, then each entry of ``Scene.point_clouds`` as a
+    ``SceneItem`` whose ``mesh`` holds the PointCloud or GaussianSplats."""
+    return [*scene.items, *(SceneItem(p.geometry, p.material, p.world_from_model) for p in scene.point_clouds)]
+
+
+def object_labels(scene: Scene) -> list[str | None]:
+    """Each object's label (``objects`` order)."""
+    return [*scene.item_labels(), *scene.point_labels()]
+
+
+def object_paths(scene: Scene) -> list[str]:
+    """Each object's node path (``objects`` order)."""
+    return [*scene.item_paths(), *scene.point_paths()]
+
+
 def class_ids(scene: Scene) -> np.ndarray:
-    """(K,) int32: each item's class id, 1-based in ``Scene.labels`` (0: no label)."""
+    """(K + P,) int32: each object's class id, 1-based in ``Scene.labels`` (0: no label)."""
     number = {label: i + 1 for i, label in enumerate(scene.labels)}
-    return np.array([0 if label is None else number[label] for label in scene.item_labels()], dtype=np.int32)
+    return np.array([0 if label is None else number[label] for label in object_labels(scene)], dtype=np.int32)
+
+
+def point_positions(camera: Camera, depth: np.ndarray, instance: np.ndarray, first: int,
+                    position: np.ndarray) -> np.ndarray:  # fmt: skip
+    """`position` with the world points of the point objects' pixels (ids >= `first`) replaced by their window
+    depth unprojected (``Camera.unproject`` at the pixel centre)."""
+    rows, columns = np.nonzero(instance >= first)
+    if rows.size == 0:
+        return position
+    height = instance.shape[0]
+    window = np.column_stack([columns + 0.5, height - rows - 0.5, depth[rows, columns]])
+    result = np.array(position, dtype=np.float32)
+    result[rows, columns] = camera.unproject(window)
+    return result
 
 
 def amodal_masks(items: list[SceneItem], camera: Camera, cull: bool, factor: int) -> np.ndarray:
@@ -204,7 +241,7 @@ def matched_items(scene: Scene, next_scene: Scene, where: str) -> list[int]:
 
     Raises FrustumError naming the node when a path is not unique in either scene (an unmatched item would be
     ambiguous), or when no item of `scene` is in `next_scene` at all."""
-    paths, next_paths = scene.item_paths(), next_scene.item_paths()
+    paths, next_paths = object_paths(scene), object_paths(next_scene)
     for label, listed in (("scene", paths), ("next scene", next_paths)):
         seen: set[str] = set()
         for path in listed:
@@ -234,7 +271,7 @@ def flow(
     from frustum.raster import ground_truth
 
     matched = matched_items(scene, next_scene, where)
-    items, next_items = scene.items, next_scene.items
+    items, next_items = objects(scene), objects(next_scene)
     result = np.empty((*instance.shape, 2))
     occluded = np.empty(instance.shape, dtype=bool)
     next_depth = _depth_of(next_scene, next_camera, cull)
@@ -278,7 +315,7 @@ def finish(frame: Frame, scene: Scene, camera: Camera, options: Any, asked: tupl
     if not wanted:
         return frame
     instance = frame.object_id
-    items = scene.items
+    items = objects(scene)
     fields: dict[str, Any] = {
         "object_id": frame.object_id if "object_id" in asked else None,
         "position": frame.position if "position" in asked else None,
@@ -293,12 +330,17 @@ def finish(frame: Frame, scene: Scene, camera: Camera, options: Any, asked: tupl
 
         cause = f"amodal masks of {len(items)} items at {camera.width} x {camera.height}"
         check_memory(len(items) * camera.width * camera.height, where=where, cause=cause)
-        masks = amodal_masks(items, camera, options.cull, options.factor)
+        masks = amodal_masks(scene.items, camera, options.cull, options.factor)
+        if scene.point_clouds:
+            from frustum.render import points
+
+            masks = np.concatenate([masks, points.silhouettes(scene, camera, options)])
         fields["amodal"] = masks
         fields["visibility"] = visibility(instance, masks)
     if any(name in wanted for name in ("object_coords", "nocs", "flow")):
         position = frame.position if frame.position is not None else cast_positions(scene, camera, instance,
                                                                                      options.factor)  # fmt: skip
+        position = point_positions(camera, frame.depth, instance, len(scene.items), position)
         coordinates = object_coordinates(items, instance, position)
         if "object_coords" in wanted:
             fields["object_coords"] = coordinates.astype(np.float32)
