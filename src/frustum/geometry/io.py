@@ -110,7 +110,9 @@ def load(path: str | Path, texture: str | Path | None = None) -> Mesh:
     ------
     GeometryError
         Unknown suffix (the message lists the supported ones), missing file, unreadable or corrupt data, or a
-        file without triangles.
+        file without triangles. A PLY without faces (a point cloud, or 3DGS splats) is refused with the reader
+        that takes it: ``frustum.load_points`` (a ``PointCloud``) or ``GaussianSplats.load``; ``load`` always
+        returns a ``Mesh``.
     """
     parts = load_parts(path, texture=texture)
     placed = [
@@ -141,6 +143,7 @@ def load_parts(path: str | Path, texture: str | Path | None = None) -> list[Mesh
         As for ``load``.
     """
     file = _checked_path(path, "load")
+    _refuse_points(file)
     explicit = None if texture is None else _read_image(Path(texture), "load")
     if file.suffix.lower() == ".stl":
         _check_binary_stl_size(file)
@@ -275,6 +278,26 @@ def save(mesh: Mesh, path: str | Path, binary: bool = True, texture: Any = None)
 
 
 # --- helpers ------------------------------------------------------------------------------------------------
+
+
+def _refuse_points(file: Path) -> None:
+    """A PLY without faces refused with the loader that reads it (its header alone is read)."""
+    if file.suffix.lower() != ".ply":
+        return
+    from frustum.geometry.points import point_file_kind
+
+    kind = point_file_kind(file)
+    if kind == "points":
+        raise GeometryError(
+            f"load: path = {str(file)!r} is a PLY without faces: a point cloud, not a triangle mesh; read it with "
+            "frustum.load_points(path), a PointCloud that Scene.add draws (style='square', 'disk', 'sphere', "
+            "'surfel')"
+        )
+    if kind == "splats":
+        raise GeometryError(
+            f"load: path = {str(file)!r} holds 3D Gaussian splats (the 3DGS PLY layout), not a triangle mesh; read "
+            "it with frustum.GaussianSplats.load(path), which Scene.add draws"
+        )
 
 
 def _checked_path(path: Any, where: str) -> Path:
