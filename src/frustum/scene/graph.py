@@ -171,8 +171,8 @@ class Node:
     ``transform`` (4x4 affine, default identity) maps this node's coordinates into its parent's;
     ``geometry`` is a ``Mesh`` or a ``Polyline`` (or None for a pure group); ``material`` None inherits the
     nearest ancestor's (``Material()`` at the top); ``lights`` ride the node (they move with its world transform);
-    ``label`` (a non-empty string, or None to inherit the nearest ancestor's) is the semantic class of the meshes
-    at and below the node (``Scene.labels``, ``render(..., buffers=("semantic",))``).
+    ``label`` (a non-empty string, or None to inherit the nearest ancestor's) is the semantic class of the meshes,
+    point clouds and splat sets at and below the node (``Scene.labels``, ``render(..., buffers=("semantic",))``).
     """
 
     def __init__(
