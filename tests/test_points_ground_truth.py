@@ -171,13 +171,14 @@ def _point_ply(path, count=30, extra=""):
         file.write(f"ply\nformat ascii 1.0\nelement vertex {count}\nproperty float x\nproperty float y\n"
                    f"property float z\n{extra}end_header\n")  # fmt: skip
         for point in rng.uniform(-1, 1, size=(count, 3)):
-            file.write("%f %f %f\n" % tuple(point))
+            file.write(" ".join(f"{v:f}" for v in point) + "\n")
     return path
 
 
 def test_load_refuses_point_and_splat_files_naming_their_loaders(tmp_path):
-    from frustum import load_points
     from tests.testdata import DATA
+
+    from frustum import load_points
 
     cloud = _point_ply(tmp_path / "cloud.ply")
     for function in (load, load_parts):

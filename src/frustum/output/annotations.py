@@ -103,8 +103,9 @@ def annotate(frame: Frame, scene: Scene, camera: Camera, keypoints: Any = None) 
     """One record per object of `scene` (``Scene.items`` order, then ``Scene.point_clouds``) of a frame rendered with
     ``buffers=("instance", "amodal")`` (conventions: the module docstring).
 
-    Each record: ``name`` (the node path), ``kind`` (``"mesh"``, ``"points"`` or ``"splats"``), ``label`` (or None), ``class_id`` (1-based in ``Scene.labels``, 0 without
-    a label), ``bbox_visible`` and ``bbox_amodal`` (COCO ``[x, y, w, h]`` of the instance and amodal masks),
+    Each record: ``name`` (the node path), ``kind`` (``"mesh"``, ``"points"`` or ``"splats"``), ``label`` (or
+    None), ``class_id`` (1-based in ``Scene.labels``, 0 without a label), ``bbox_visible`` and ``bbox_amodal``
+    (COCO ``[x, y, w, h]`` of the instance and amodal masks),
     ``bbox_3d`` ((8, 2) pixel coordinates of the model's bounding-box corners, x fastest, NaN behind the camera) with
     ``bbox_3d_visible`` (8,) bool, ``pose`` (4×4 model-to-camera in OpenCV axes), ``visibility`` (visible / amodal
     pixels, NaN outside the view), ``px_count_visible`` and ``px_count_all`` (pixels of the two masks) and, where

@@ -13,7 +13,7 @@ pixel never carries a blend of two objects and every id in a mask is an item of 
   (0 for the background and for objects without a label).
 - ``amodal`` (K + P, H, W) bool: each object's silhouette alone, occluders ignored, still clipped by the view
   volume: one depth-only fill of each mesh (``raster.shadow.fill_depth_tiles``, the same coverage rule as the
-  surface pass), each cloud or splat set drawn alone (``render.points.silhouettes``). ``visibility`` (K + P,):
+  surface pass), each cloud or splat set drawn alone (``point_masks``). ``visibility`` (K + P,):
   $visible / amodal$ pixels, NaN where the amodal mask is empty.
 - Point objects have no surface between their points: their pixels' world points (for ``object_coords``, ``nocs``
   and ``flow``) are the window depth unprojected (``Camera.unproject``; a splat pixel's is its expected depth),
@@ -46,7 +46,8 @@ from frustum.scene import Scene, SceneItem
 
 __all__ = [
     "DEPTH_TOLERANCE", "amodal_masks", "check_next", "class_ids", "finish", "flow", "nocs",
-    "object_coordinates", "object_labels", "object_paths", "objects", "point_positions", "visibility",
+    "object_coordinates", "object_labels", "object_paths", "objects", "point_masks", "point_positions",
+    "visibility",
 ]  # fmt: skip
 
 DEPTH_TOLERANCE = 1e-2
@@ -130,6 +131,22 @@ def amodal_masks(items: list[SceneItem], camera: Camera, cull: bool, factor: int
             binned.tile_entries, tiling, depth, True,
         )  # fmt: skip
         np.less(depth[middle::factor, middle::factor], 1.0, out=masks[k])
+    return masks
+
+
+def point_masks(scene: Scene, camera: Camera, options: Any) -> np.ndarray:
+    """(P, H, W) bool: each entry of ``Scene.point_clouds`` drawn alone at ``options.factor`` times the camera's size,
+    the middle sample of each block kept (the sample ``object_id`` keeps): a cloud where it writes depth
+    (``render.points.silhouette``), a splat set where its accumulated alpha reaches ½ (``render.splats.silhouette``)."""
+    from frustum.render import points, splats
+
+    placed = scene.point_clouds
+    factor, middle = options.factor, options.factor // 2
+    big = dataclasses.replace(camera, width=camera.width * factor, height=camera.height * factor)
+    masks = np.zeros((len(placed), camera.height, camera.width), dtype=bool)
+    for k, item in enumerate(placed):
+        drawn = splats.silhouette(item, big) if item.style.style == "splats" else points.silhouette(item, big, options)
+        masks[k] = drawn[middle::factor, middle::factor]
     return masks
 
 
@@ -332,9 +349,7 @@ def finish(frame: Frame, scene: Scene, camera: Camera, options: Any, asked: tupl
         check_memory(len(items) * camera.width * camera.height, where=where, cause=cause)
         masks = amodal_masks(scene.items, camera, options.cull, options.factor)
         if scene.point_clouds:
-            from frustum.render import points
-
-            masks = np.concatenate([masks, points.silhouettes(scene, camera, options)])
+            masks = np.concatenate([masks, point_masks(scene, camera, options)])
         fields["amodal"] = masks
         fields["visibility"] = visibility(instance, masks)
     if any(name in wanted for name in ("object_coords", "nocs", "flow")):

@@ -17,7 +17,7 @@ their disk normal turned toward the viewer (``shading="none"``: colors only). Si
 √samples when supersampling. Object ids (``buffers=("object_id",)``) of clouds follow the meshes':
 $len(scene.items) + i$ for the i-th placed cloud or splat set (``Scene.point_clouds``), so ``instance``,
 ``semantic`` and the datasets hold them (``render.ground_truth``); a cloud's amodal mask is the cloud drawn alone
-(``silhouettes``).
+(``silhouette``).
 
 References
 ----------
@@ -32,14 +32,15 @@ import dataclasses
 import numpy as np
 
 from frustum.camera import Camera
+from frustum.render.buffers import Scratch
 from frustum.render.context import FrameContext
 from frustum.render.options import RenderOptions
-from frustum.render.buffers import Scratch
 from frustum.render.stages import Lighting, shading_parameters
 from frustum.scene import PointItem, Scene, SceneItem
+from frustum.shading import pack_lights
 from frustum.transforms import apply, apply_to_normals
 
-__all__ = ["draw_point_clouds", "draw_points", "silhouettes"]
+__all__ = ["draw_point_clouds", "draw_points", "silhouette"]
 
 
 def draw_point_clouds(scene: Scene, camera: Camera, options: RenderOptions, buffers: FrameContext) -> None:
@@ -54,31 +55,18 @@ def draw_point_clouds(scene: Scene, camera: Camera, options: RenderOptions, buff
         draw_points(item, first_id + index, camera, options, lighting, buffers)
 
 
-def silhouettes(scene: Scene, camera: Camera, options: RenderOptions) -> np.ndarray:
-    """(P, H, W) bool: each entry of ``Scene.point_clouds`` drawn alone at ``options.factor`` times the camera's size,
-    the middle sample of each block kept (the sample ``object_id`` keeps): a cloud where it writes depth, a splat
-    set where its accumulated alpha reaches ½ (``render.splats.silhouette``). The amodal masks of point objects."""
+def silhouette(item: PointItem, camera: Camera, options: RenderOptions) -> np.ndarray:
+    """(H, W) bool at the camera's size: where the cloud `item` drawn alone writes depth (its amodal mask; sizes in
+    pixels times ``options.factor``, as when drawn with the scene)."""
     from frustum.raster import shade
 
-    placed = scene.point_clouds
-    factor, middle = options.factor, options.factor // 2
-    big = dataclasses.replace(camera, width=camera.width * factor, height=camera.height * factor)
     unlit = dataclasses.replace(options, shade_mode=shade.SHADE_NONE)  # coverage only: no lighting needed
-    lighting = Lighting.of(scene)
-    masks = np.zeros((len(placed), camera.height, camera.width), dtype=bool)
-    for k, item in enumerate(placed):
-        if item.style.style == "splats":
-            from frustum.render import splats
-
-            drawn = splats.silhouette(item, big)
-        else:
-            context = FrameContext(None, None, Scratch())
-            context.depth = np.ones((big.height, big.width), dtype=np.float32)
-            context.color = np.zeros((big.height, big.width, 4), dtype=np.uint8)
-            draw_points(item, k, big, unlit, lighting, context)
-            drawn = context.depth < 1.0
-        masks[k] = drawn[middle::factor, middle::factor]
-    return masks
+    lighting = Lighting(*pack_lights([]))
+    context = FrameContext(None, None, Scratch())
+    context.depth = np.ones((camera.height, camera.width), dtype=np.float32)
+    context.color = np.zeros((camera.height, camera.width, 4), dtype=np.uint8)
+    draw_points(item, 0, camera, unlit, lighting, context)
+    return context.depth < 1.0
 
 
 def _bands(rows: np.ndarray, height: int) -> tuple[np.ndarray, np.ndarray, int]:
