@@ -143,7 +143,6 @@ def load_parts(path: str | Path, texture: str | Path | None = None) -> list[Mesh
         As for ``load``.
     """
     file = _checked_path(path, "load")
-    _refuse_points(file)
     explicit = None if texture is None else _read_image(Path(texture), "load")
     if file.suffix.lower() == ".stl":
         _check_binary_stl_size(file)
@@ -182,6 +181,7 @@ def load_parts(path: str | Path, texture: str | Path | None = None) -> list[Mesh
     except Exception as error:
         raise _read_error(file, error) from None
     if not parts:
+        _refuse_points(file)
         raise GeometryError(
             f"load: path = {str(file)!r} contains no triangles; give a file with at least one triangle mesh"
         )
@@ -281,7 +281,8 @@ def save(mesh: Mesh, path: str | Path, binary: bool = True, texture: Any = None)
 
 
 def _refuse_points(file: Path) -> None:
-    """A PLY without faces refused with the loader that reads it (its header alone is read)."""
+    """A PLY that holds no triangles refused with the loader that reads it, where its header says it is a point
+    cloud or 3DGS splats (``frustum.geometry.points.point_file_kind``)."""
     if file.suffix.lower() != ".ply":
         return
     from frustum.geometry.points import point_file_kind
