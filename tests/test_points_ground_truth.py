@@ -45,7 +45,8 @@ def spheres_scene() -> tuple[Scene, np.ndarray, np.ndarray]:
 def test_point_clouds_are_objects_of_instance_semantic_and_amodal():
     scene, centers, radii = spheres_scene()
     cam = camera()
-    frame = render(scene, cam, buffers=("object_id", "instance", "semantic", "amodal", "object_coords", "nocs"))
+    frame = render(scene, cam, buffers=("object_id", "instance", "semantic", "amodal", "object_coords", "nocs",
+                                        "position"))  # fmt: skip
     assert scene.labels == ["floor", "scan"] and scene.point_labels() == ["scan"] and scene.point_paths() == ["scan"]
     drawn = frame.depth < 1
     alone = Scene()
@@ -62,6 +63,10 @@ def test_point_clouds_are_objects_of_instance_semantic_and_amodal():
     points = frame.object_coords[frame.instance == 1].astype(np.float64)
     distance = np.abs(np.linalg.norm(points[:, None] - centers[None], axis=2) - radii[None]).min(axis=1)
     assert np.median(distance) < 1e-3 and distance.max() < 2e-2  # float32 depth at grazing pixels
+    # the "position" buffer holds the spheres' world points there (the points pass writes them), the floor's elsewhere
+    world = frame.position[frame.instance == 1].astype(np.float64) - (0.1, -0.1, 0.2)
+    np.testing.assert_allclose(world, points, atol=1e-5)
+    assert np.abs(frame.position[frame.instance == 0][:, 2] + 1.0).max() < 1e-5
     low, high = np.asarray(PointCloud(centers).bounds)
     nocs = (points - 0.5 * (low + high)) / np.linalg.norm(high - low) + 0.5
     np.testing.assert_allclose(frame.nocs[frame.instance == 1], nocs, atol=1e-5)
@@ -123,7 +128,7 @@ def test_splats_over_a_mesh_keep_the_mesh_id_where_their_alpha_stays_below_one_h
     scene.add(PLANE, name="floor")
     scene.add(splats, name="fog")
     cam = camera()
-    frame = render(scene, cam, buffers=("instance", "amodal"))
+    frame = render(scene, cam, buffers=("instance", "amodal", "position"))
     alone = Scene()
     alone.add(splats)
     alpha = render(alone, cam, background=(0, 0, 0, 0)).color[..., 3] / 255.0
@@ -135,6 +140,10 @@ def test_splats_over_a_mesh_keep_the_mesh_id_where_their_alpha_stays_below_one_h
     under = render(floor, cam, buffers=("object_id",)).object_id  # 0 on the floor, −1 beside it
     np.testing.assert_array_equal(frame.instance[sure & (alpha < 0.5)], under[sure & (alpha < 0.5)])
     assert (under[sure & (alpha < 0.5)] == 0).sum() > 100
+    # world points: the floor's (z = −1) under faint splats, the expected depth's among the splats where they own it
+    assert np.abs(frame.position[frame.instance == 0][:, 2] + 1.0).max() < 1e-5
+    owned = frame.position[frame.instance == 1]
+    assert np.isfinite(owned).all() and np.abs(owned).max() < 0.6 + 3 * 0.08 + 1e-3
     np.testing.assert_array_equal(frame.amodal[1][sure], (alpha >= 0.5)[sure])
 
 

@@ -16,7 +16,8 @@ pixel never carries a blend of two objects and every id in a mask is an item of 
   surface pass), each cloud or splat set drawn alone (``point_masks``). ``visibility`` (K + P,):
   $visible / amodal$ pixels, NaN where the amodal mask is empty.
 - Point objects have no surface between their points: their pixels' world points (for ``object_coords``, ``nocs``
-  and ``flow``) are the window depth unprojected (``Camera.unproject``; a splat pixel's is its expected depth),
+  and ``flow``; the passes write them, ``FrameContext.place_drawn``, or ``point_positions`` where the frame has
+  none) are the window depth unprojected (``Camera.unproject``; a splat pixel's is its expected depth),
   their NOCS box the box of their points; the next frame's depth buffer of ``flow_occluded`` holds the meshes.
 - ``object_coords`` (H, W, 3) float32: the visible point in its item's model coordinates,
   $X = (world\\_from\\_model)^{-1} · P_{world}$, NaN on the background.
@@ -41,6 +42,7 @@ from frustum._arrays import describe
 from frustum.camera import Camera
 from frustum.errors import FrustumError
 from frustum.frame import Frame
+from frustum.render.context import pixel_points
 from frustum.render.options import GROUND_TRUTH_BUFFERS
 from frustum.scene import Scene, SceneItem
 
@@ -100,13 +102,11 @@ def point_positions(camera: Camera, depth: np.ndarray, instance: np.ndarray, fir
                     position: np.ndarray) -> np.ndarray:  # fmt: skip
     """`position` with the world points of the point objects' pixels (ids >= `first`) replaced by their window
     depth unprojected (``Camera.unproject`` at the pixel centre)."""
-    rows, columns = np.nonzero(instance >= first)
-    if rows.size == 0:
+    mask = instance >= first
+    if not mask.any():
         return position
-    height = instance.shape[0]
-    window = np.column_stack([columns + 0.5, height - rows - 0.5, depth[rows, columns]])
     result = np.array(position, dtype=np.float32)
-    result[rows, columns] = camera.unproject(window)
+    result[mask] = pixel_points(camera, depth, mask)
     return result
 
 
@@ -353,9 +353,10 @@ def finish(frame: Frame, scene: Scene, camera: Camera, options: Any, asked: tupl
         fields["amodal"] = masks
         fields["visibility"] = visibility(instance, masks)
     if any(name in wanted for name in ("object_coords", "nocs", "flow")):
-        position = frame.position if frame.position is not None else cast_positions(scene, camera, instance,
-                                                                                     options.factor)  # fmt: skip
-        position = point_positions(camera, frame.depth, instance, len(scene.items), position)
+        position = frame.position  # the passes' world points (points and splats: their depth unprojected)
+        if position is None:
+            position = point_positions(camera, frame.depth, instance, len(scene.items),
+                                       cast_positions(scene, camera, instance, options.factor))  # fmt: skip
         coordinates = object_coordinates(items, instance, position)
         if "object_coords" in wanted:
             fields["object_coords"] = coordinates.astype(np.float32)

@@ -51,8 +51,11 @@ def draw_point_clouds(scene: Scene, camera: Camera, options: RenderOptions, buff
         return
     lighting = Lighting.of(scene)
     first_id = len(scene.items)
+    before = buffers.depth.copy() if "position" in buffers.outputs else None
     for index, item in clouds:
         draw_points(item, first_id + index, camera, options, lighting, buffers)
+    if before is not None:  # the "position" buffer: the points' pixels hold their own world points
+        buffers.place_drawn(camera, buffers.depth != before)
 
 
 def silhouette(item: PointItem, camera: Camera, options: RenderOptions) -> np.ndarray:

@@ -17,7 +17,8 @@ Object ids (``buffers=("object_id",)``, and so ``instance``, ``semantic`` and th
 accumulated splat alpha $1 − T$ reaches ½ gets the id of the splat set of its median splat (the one whose
 compositing brings $1 − T$ to ½ or more, ``raster.splats``), $len(scene.items) + i$ for the i-th entry of
 ``Scene.point_clouds`` as points have; its normal becomes (0, 0, 0) (splats have no surface). Below ½ the pixel
-keeps the id and normal of what is under the splats (a surface, or −1 on the background). A splat set's amodal mask
+keeps the id, normal and world point (``buffers=("position",)``) of what is under the splats (a surface, or −1 on
+the background); a pixel the splats own has the world point of its expected depth. A splat set's amodal mask
 (``silhouette``) is the same rule applied to the set drawn alone.
 
 References
@@ -118,6 +119,9 @@ def draw_splats(scene: Scene, camera: Camera, options: RenderOptions, buffers: F
         buffers.object_id[covered] = ids[layer.item[covered]]
     if buffers.normals is not None:
         buffers.normals[covered] = 0.0
+    seen = ~np.isnan(layer.depth)
+    buffers.depth[seen] = layer.depth[seen]
+    buffers.place_drawn(camera, covered)
     color = buffers.color
     under = color.astype(np.float32) / 255.0
     t = layer.transmittance[..., None]
@@ -125,8 +129,6 @@ def draw_splats(scene: Scene, camera: Camera, options: RenderOptions, buffers: F
     alpha = (1.0 - layer.transmittance) + layer.transmittance * under[..., 3]
     color[..., :3] = np.floor(np.clip(rgb, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
     color[..., 3] = np.floor(np.clip(alpha, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
-    seen = ~np.isnan(layer.depth)
-    buffers.depth[seen] = layer.depth[seen]
 
 
 def silhouette(item: PointItem, camera: Camera) -> np.ndarray:
