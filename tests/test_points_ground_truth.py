@@ -15,7 +15,7 @@ import pytest
 from tests.test_splats import HEIGHT, WIDTH, random_camera, random_splats, screen_gaussians
 
 from frustum import Camera, GaussianSplats, Perspective, PointCloud, annotate, load, load_parts, render
-from frustum.errors import GeometryError
+from frustum.errors import GeometryError, OutputError
 from frustum.geometry import Mesh
 from frustum.output.annotations import mask_box
 from frustum.scene import Scene
@@ -172,6 +172,11 @@ def test_annotate_and_coco_and_bop_take_point_objects(tmp_path):
     truth = json.loads((tmp_path / "bop" / "train" / "000000" / "scene_gt.json").read_text())
     assert [entry["obj_id"] for entry in truth["0"]] == [1]
     assert sorted(p.name for p in (tmp_path / "bop" / "models").glob("*.ply")) == ["obj_000001.ply"]
+    only_points = Scene()
+    only_points.add(PLANE, name="floor")
+    only_points.add(PointCloud([[0.0, 0.0, 0.0]]), name="scan", label="scan")
+    with pytest.raises(OutputError, match=r"needs labels.*a BOP object is a mesh model.*none on its meshes"):
+        render_dataset(only_points, tmp_path / "bop2", cameras=[cam], format="bop", executor="serial", progress=False)
 
 
 def _point_ply(path, count=30, extra=""):

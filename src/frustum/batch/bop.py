@@ -72,14 +72,15 @@ def bop_models(scene: Any, where: str = "render_dataset") -> dict[int, tuple[np.
     Raises
     ------
     OutputError
-        A scene without labels, a labelled item mirrored by its transform, or two items of one label with
+        A scene without labelled meshes, a labelled item mirrored by its transform, or two items of one label with
         different meshes or scales.
     """
     labels = scene.labels
-    if not labels:
+    if all(label is None for label in scene.item_labels()):
         raise OutputError(
-            f"{where}: format = 'bop' needs labels on the scene's objects (obj_id is the label's class id) and the "
-            'scene has none; give label= to Scene.add or Node, or label = "..." on a scene file\'s node'
+            f"{where}: format = 'bop' needs labels on the scene's objects (obj_id is the label's class id; a BOP "
+            "object is a mesh model) and the scene has none on its meshes; give label= to Scene.add or Node, or "
+            'label = "..." on a scene file\'s node'
         )
     models: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
     owners: dict[int, tuple[str, Any, np.ndarray]] = {}
