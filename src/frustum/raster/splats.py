@@ -18,15 +18,14 @@
    pixel centre (d from the projected centre), skipped below 1/255; $C += c·α·T$, $T ← T·(1 − α)$, stopping
    before T would fall below 1e-4 (that splat not drawn); a splat at or behind the depth already in the depth
    buffer (an opaque surface) ends the pixel. The expected depth $Σ wᵢ zᵢ / Σ wᵢ$ ($wᵢ = αᵢ·Tᵢ$, z window depth
-   of the centre) is written where $Σ wᵢ > 0$, and the item (``F_ITEM``) of the median splat: the one whose
-   compositing brings the accumulated alpha $1 − T$ to ½ or more (T from above ½ to at most ½; −1 where it stays
-   below ½), as 3DGS's median depth picks its splat.
+   of the centre) is written where $Σ wᵢ > 0$, and the item of the median splat: the one whose compositing brings
+   the accumulated alpha $1 − T$ to ½ or more (T from above ½ to at most ½; −1 where it stays below ½), as 3DGS's
+   median depth picks its splat; item i holds records ``item_starts[i]`` to ``item_starts[i + 1] − 1``.
 
 Records (``SPLAT_FIELDS`` float64): window x, y (y up), window depth z of the centre, bound half side r (pixels,
 0: culled), conic (A, B, C) of $Σ'⁻¹$ in window axes, opacity o, colour (3), Σ' in image axes (x right,
 y down, 3DGS's convention; a, b, c) for testing, and the half sides $k·√Σ'_{xx}$, $k·√Σ'_{yy}$ of the box around the
-ellipse $dᵀΣ'⁻¹d <= k²$ (inside the square bound: the pixels and tiles actually visited), and the index of the
-splat's set among the drawn ones (``F_ITEM``, written by the caller). Kernels never validate
+ellipse $dᵀΣ'⁻¹d <= k²$ (inside the square bound: the pixels and tiles actually visited). Kernels never validate
 (arrays contiguous, shapes as stated).
 
 References
@@ -48,10 +47,10 @@ __all__ = [
     "LAYER_CHANNELS", "SPLAT_FIELDS", "TILE", "blend_tiles", "count_tiles", "fill_tiles", "project_splats", "sh_color",
 ]  # fmt: skip
 
-SPLAT_FIELDS = 17
+SPLAT_FIELDS = 16
 TILE = 16
 """Tile side in pixels."""
-F_X, F_Y, F_Z, F_RADIUS, F_CONIC, F_OPACITY, F_COLOR, F_COV, F_EXTENT, F_ITEM = 0, 1, 2, 3, 4, 7, 8, 11, 14, 16
+F_X, F_Y, F_Z, F_RADIUS, F_CONIC, F_OPACITY, F_COLOR, F_COV, F_EXTENT = 0, 1, 2, 3, 4, 7, 8, 11, 14
 LAYER_CHANNELS = 7
 """``blend_tiles``' per-pixel outputs: colour (3), transmittance, $Σ wᵢ$, $Σ wᵢ zᵢ$, the median splat's item."""
 PREFETCH_AHEAD = 8
@@ -223,7 +222,7 @@ def fill_tiles(records: np.ndarray, order: np.ndarray, height: int, tiles_x: int
 # many small pieces: tiles differ in cost by orders of magnitude (empty sky, dense surfaces), so threads balance
 @parallel_kernel(lambda records, starts, *_: starts.size - 1, pieces_per_thread=32)
 def blend_tiles(records: np.ndarray, starts: np.ndarray, entries: np.ndarray, tiles_x: int, depth: np.ndarray,
-                layer: np.ndarray, start: int, stop: int) -> None:  # fmt: skip
+                item_starts: np.ndarray, layer: np.ndarray, start: int, stop: int) -> None:  # fmt: skip
     """Tiles [start, stop): ``layer`` (H, W, ``LAYER_CHANNELS``) float32 ← premultiplied colour $Σ cᵢ·αᵢ·Tᵢ$ (3),
     the final transmittance T, $Σ wᵢ$, $Σ wᵢ·zᵢ$ and the median splat's item (−1: none) per pixel (module
     docstring, step 3); `depth` (H, W) is only read."""
@@ -292,8 +291,11 @@ def blend_tiles(records: np.ndarray, starts: np.ndarray, entries: np.ndarray, ti
                     color[i, j, 2] += records[k, F_COLOR + 2] * w
                     weight[i, j] += w
                     weighted_z[i, j] += w * z
-                    if t > 0.5 >= after:
-                        median[i, j] = records[k, F_ITEM]
+                    if t > 0.5 >= after:  # the median splat: its item (once per pixel)
+                        item = 0
+                        while k >= item_starts[item + 1]:
+                            item += 1
+                        median[i, j] = item
                     transmittance[i, j] = after
         for i in range(rows):
             for j in range(cols):

@@ -63,7 +63,7 @@ def project(items: list[PointItem], camera: Camera, scratch: Scratch | None = No
     first = 0
     frame = np.array([camera.width, camera.height, *camera.frame.eye], dtype=np.float64)
     clip_from_view = np.asarray(camera.projection_matrix, dtype=np.float64)
-    for index, item in enumerate(items):
+    for item in items:
         splats = item.geometry
         world_from_model = np.asarray(item.world_from_model, dtype=np.float64)
         matrices = np.ascontiguousarray(np.stack([
@@ -73,7 +73,6 @@ def project(items: list[PointItem], camera: Camera, scratch: Scratch | None = No
         kernels.project_splats(np.ascontiguousarray(splats.positions), np.ascontiguousarray(splats.scales),
                                np.ascontiguousarray(splats.rotations), np.ascontiguousarray(splats.opacities),
                                np.ascontiguousarray(splats.sh), matrices, frame, part)  # fmt: skip
-        part[:, kernels.F_ITEM] = index
         first += splats.count
     return records
 
@@ -99,7 +98,9 @@ def splat_layer(items: list[PointItem], camera: Camera, depth: np.ndarray | None
     entries = np.empty(int(starts[-1]), dtype=np.int64)
     kernels.fill_tiles(records, order, height, tiles_x, tiles_y, starts, entries)
     layer = empty((height, width, kernels.LAYER_CHANNELS), np.float32)
-    kernels.blend_tiles(records, starts, entries, tiles_x, np.ascontiguousarray(depth, dtype=np.float32), layer)
+    item_starts = np.cumsum([0] + [item.geometry.count for item in items], dtype=np.int64)  # items' records
+    kernels.blend_tiles(records, starts, entries, tiles_x, np.ascontiguousarray(depth, dtype=np.float32), item_starts,
+                        layer)  # fmt: skip
     with np.errstate(invalid="ignore", divide="ignore"):
         expected = np.where(layer[..., 4] > 0.0, layer[..., 5] / layer[..., 4], np.nan).astype(np.float32)
     return SplatLayer(layer[..., :3], layer[..., 3], expected, layer[..., 6].astype(np.int32))
