@@ -17,7 +17,9 @@ describes them: one scene ``train/000000/`` of every view, and the object models
 
 The annotations of an image are the scene's labelled items in ``Scene.items`` order (unlabelled ones, such as a
 support plane, occlude but are not annotated); ``obj_id`` is the label's class id (1-based in ``Scene.labels``),
-so items of one label must share one mesh and one scale. Scene units are taken as metres (× 1000 = mm). A
+so items of one label must share one mesh and one scale. A BOP object is a mesh model: point clouds and splat sets
+(``Scene.point_clouds``) are never annotated, labelled or not; they occlude the meshes (``mask_visib``) and are in
+the depth images. Scene units are taken as metres (× 1000 = mm). A
 modeling transform $A = R·S$ (polar decomposition: R a rotation, S symmetric positive definite) gives the pose R
 and the model $1000·S·V$; BOP poses are rigid.
 """
@@ -70,14 +72,15 @@ def bop_models(scene: Any, where: str = "render_dataset") -> dict[int, tuple[np.
     Raises
     ------
     OutputError
-        A scene without labels, a labelled item mirrored by its transform, or two items of one label with
+        A scene without labelled meshes, a labelled item mirrored by its transform, or two items of one label with
         different meshes or scales.
     """
     labels = scene.labels
-    if not labels:
+    if all(label is None for label in scene.item_labels()):
         raise OutputError(
-            f"{where}: format = 'bop' needs labels on the scene's objects (obj_id is the label's class id) and the "
-            'scene has none; give label= to Scene.add or Node, or label = "..." on a scene file\'s node'
+            f"{where}: format = 'bop' needs labels on the scene's objects (obj_id is the label's class id; a BOP "
+            "object is a mesh model) and the scene has none on its meshes; give label= to Scene.add or Node, or "
+            'label = "..." on a scene file\'s node'
         )
     models: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
     owners: dict[int, tuple[str, Any, np.ndarray]] = {}
@@ -166,7 +169,7 @@ def write_bop(folder: Path, views: Sequence[View], extra: dict[str, Any]) -> lis
                                 "cam_t_w2c": (MILLIMETRES * camera_from_world[:3, 3]).tolist(),
                                 "depth_scale": depth_scale}  # fmt: skip
         gts, infos = [], []
-        for item in (entry for entry in view["objects"] if entry["class_id"] > 0):
+        for item in (entry for entry in view["objects"] if entry["class_id"] > 0 and entry["kind"] == "mesh"):
             pose = np.asarray(item["pose"], dtype=np.float64)
             rotation, _ = _polar(pose[:3, :3])
             gts.append({"cam_R_m2c": rotation.ravel().tolist(), "cam_t_m2c": (MILLIMETRES * pose[:3, 3]).tolist(),

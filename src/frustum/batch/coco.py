@@ -96,7 +96,7 @@ def view_annotations(frame: Any, scene: Any, camera: Any, keypoints: Any = None)
     for k, record in enumerate(records):
         amodal = frame.amodal[k]
         entry = {
-            "name": record["name"], "label": record["label"], "class_id": record["class_id"],
+            "name": record["name"], "kind": record["kind"], "label": record["label"], "class_id": record["class_id"],
             "bbox_visible": record["bbox_visible"], "bbox_amodal": record["bbox_amodal"],
             "bbox_3d": [[_finite(v) for v in row] for row in record["bbox_3d"].tolist()],
             "bbox_3d_visible": [bool(v) for v in record["bbox_3d_visible"]],

@@ -113,7 +113,9 @@ def load(path: str | Path, texture: str | Path | None = None) -> Mesh:
     ------
     GeometryError
         Unknown suffix (the message lists the supported ones), missing file, unreadable or corrupt data, or a
-        file without triangles.
+        file without triangles. A PLY without faces (a point cloud, or 3DGS splats) is refused with the reader
+        that takes it: ``frustum.load_points`` (a ``PointCloud``) or ``GaussianSplats.load``; ``load`` always
+        returns a ``Mesh``.
     """
     parts = load_parts(path, texture=texture)
     placed = [
@@ -182,6 +184,7 @@ def load_parts(path: str | Path, texture: str | Path | None = None) -> list[Mesh
     except Exception as error:
         raise _read_error(file, error) from None
     if not parts:
+        _refuse_points(file)
         raise GeometryError(
             f"load: path = {str(file)!r} contains no triangles; give a file with at least one triangle mesh"
         )
@@ -279,6 +282,27 @@ def save(mesh: Mesh, path: str | Path, binary: bool = True, texture: Any = None)
 
 
 # --- helpers ------------------------------------------------------------------------------------------------
+
+
+def _refuse_points(file: Path) -> None:
+    """A PLY that holds no triangles refused with the loader that reads it, where its header says it is a point
+    cloud or 3DGS splats (``frustum.geometry.points.point_file_kind``)."""
+    if file.suffix.lower() != ".ply":
+        return
+    from frustum.geometry.points import point_file_kind
+
+    kind = point_file_kind(file)
+    if kind == "points":
+        raise GeometryError(
+            f"load: path = {str(file)!r} is a PLY without faces: a point cloud, not a triangle mesh; read it with "
+            "frustum.load_points(path), a PointCloud that Scene.add draws (style='square', 'disk', 'sphere', "
+            "'surfel')"
+        )
+    if kind == "splats":
+        raise GeometryError(
+            f"load: path = {str(file)!r} holds 3D Gaussian splats (the 3DGS PLY layout), not a triangle mesh; read "
+            "it with frustum.GaussianSplats.load(path), which Scene.add draws"
+        )
 
 
 def _checked_path(path: Any, where: str) -> Path:

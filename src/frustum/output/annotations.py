@@ -1,7 +1,9 @@
 """Per-object annotations of a rendered frame: ``annotate(frame, scene, camera, keypoints=None)``.
 
-One record per scene item (``Scene.items`` order) with what detectors, segmenters and 6-DoF pose estimators train
-on: 2D boxes from the masks, the projected 3D box, the model-to-camera pose, visibility and keypoints.
+One record per scene object (``render.ground_truth.objects``: ``Scene.items``, then ``Scene.point_clouds``) with
+what detectors, segmenters and 6-DoF pose estimators train on: 2D boxes from the masks, the projected 3D box, the
+model-to-camera pose, visibility and keypoints (meshes only). A point cloud's or splat set's 3D box is the box of
+its points (splat centres).
 
 Pixel coordinates are OpenCV's (and COCO's, BOP's): u right, v down, the centre of the top-left pixel at (0, 0),
 so a window point $(x_w, y_w)$ (y up, centres at half-integers, ``Camera.project``) is at
@@ -24,7 +26,8 @@ from frustum._arrays import describe
 from frustum.camera import Camera
 from frustum.errors import FrustumError
 from frustum.frame import Frame
-from frustum.render.ground_truth import class_ids, hidden_points
+from frustum.geometry import Mesh
+from frustum.render.ground_truth import class_ids, hidden_points, object_labels, object_paths, objects
 from frustum.scene import Scene
 
 __all__ = ["OPENCV_FROM_VIEW", "annotate", "mask_box"]
@@ -97,11 +100,12 @@ def _keypoints_per_item(keypoints: Any, paths: list[str], labels: list[str | Non
 
 
 def annotate(frame: Frame, scene: Scene, camera: Camera, keypoints: Any = None) -> list[dict[str, Any]]:
-    """One record per item of `scene` (``Scene.items`` order) of a frame rendered with
+    """One record per object of `scene` (``Scene.items`` order, then ``Scene.point_clouds``) of a frame rendered with
     ``buffers=("instance", "amodal")`` (conventions: the module docstring).
 
-    Each record: ``name`` (the node path), ``label`` (or None), ``class_id`` (1-based in ``Scene.labels``, 0 without
-    a label), ``bbox_visible`` and ``bbox_amodal`` (COCO ``[x, y, w, h]`` of the instance and amodal masks),
+    Each record: ``name`` (the node path), ``kind`` (``"mesh"``, ``"points"`` or ``"splats"``), ``label`` (or
+    None), ``class_id`` (1-based in ``Scene.labels``, 0 without a label), ``bbox_visible`` and ``bbox_amodal``
+    (COCO ``[x, y, w, h]`` of the instance and amodal masks),
     ``bbox_3d`` ((8, 2) pixel coordinates of the model's bounding-box corners, x fastest, NaN behind the camera) with
     ``bbox_3d_visible`` (8,) bool, ``pose`` (4×4 model-to-camera in OpenCV axes), ``visibility`` (visible / amodal
     pixels, NaN outside the view), ``px_count_visible`` and ``px_count_all`` (pixels of the two masks) and, where
@@ -111,8 +115,8 @@ def annotate(frame: Frame, scene: Scene, camera: Camera, keypoints: Any = None) 
     Parameters
     ----------
     keypoints : None, (M, 3) array_like, mapping or sequence
-        Model points: one array for every item, a mapping from label or node path to an array, or one array
-        (or None) per item.
+        Model points of the meshes: one array for every mesh item, a mapping from label or node path to an array,
+        or one array (or None) per item of ``Scene.items`` (point objects get none).
 
     Raises
     ------
@@ -136,14 +140,15 @@ def annotate(frame: Frame, scene: Scene, camera: Camera, keypoints: Any = None) 
             f"{where}: the frame is {frame.width} x {frame.height} but the camera {camera.width} x {camera.height}; "
             "give the camera the frame was rendered with"
         )
-    items = scene.items
+    items = objects(scene)
     if frame.amodal.shape[0] != len(items):
         raise FrustumError(
-            f"{where}: the frame has amodal masks of {frame.amodal.shape[0]} items but the scene has {len(items)}; "
+            f"{where}: the frame has amodal masks of {frame.amodal.shape[0]} objects but the scene has {len(items)}; "
             "give the scene the frame was rendered from"
         )
-    paths, labels = scene.item_paths(), scene.item_labels()
-    points = _keypoints_per_item(keypoints, paths, labels, where)
+    paths, labels = object_paths(scene), object_labels(scene)
+    points = _keypoints_per_item(keypoints, scene.item_paths(), scene.item_labels(), where)
+    points += [None] * (len(items) - len(points))
     classes = class_ids(scene)
     view_from_world = np.asarray(camera.view_matrix, dtype=np.float64)
     counts = np.bincount(instance[instance >= 0].ravel(), minlength=len(items))
@@ -157,6 +162,7 @@ def annotate(frame: Frame, scene: Scene, camera: Camera, keypoints: Any = None) 
         corners, corner_hidden = _project(camera, frame.depth, world_from_model, _box_corners(low, high))
         record: dict[str, Any] = {
             "name": paths[k],
+            "kind": _kind(item.mesh),
             "label": labels[k],
             "class_id": int(classes[k]),
             "bbox_visible": mask_box(visible_mask),
@@ -184,3 +190,10 @@ def _project(camera: Camera, depth: np.ndarray, world_from_model: np.ndarray,
     window, hidden = hidden_points(camera, depth, model, world_from_model)
     pixels = np.column_stack([window[:, 0] - 0.5, camera.height - window[:, 1] - 0.5])
     return pixels, hidden
+
+
+def _kind(geometry: object) -> str:
+    """``"mesh"``, ``"points"`` (a PointCloud) or ``"splats"`` (GaussianSplats)."""
+    if isinstance(geometry, Mesh):
+        return "mesh"
+    return "splats" if hasattr(geometry, "opacities") else "points"

@@ -18,7 +18,9 @@
    pixel centre (d from the projected centre), skipped below 1/255; $C += c·α·T$, $T ← T·(1 − α)$, stopping
    before T would fall below 1e-4 (that splat not drawn); a splat at or behind the depth already in the depth
    buffer (an opaque surface) ends the pixel. The expected depth $Σ wᵢ zᵢ / Σ wᵢ$ ($wᵢ = αᵢ·Tᵢ$, z window depth
-   of the centre) is written where $Σ wᵢ > 0$.
+   of the centre) is written where $Σ wᵢ > 0$, and the item of the median splat: the one whose compositing brings
+   the accumulated alpha $1 − T$ to ½ or more (T from above ½ to at most ½; −1 where it stays below ½), as 3DGS's
+   median depth picks its splat; item i holds records ``item_starts[i]`` to ``item_starts[i + 1] − 1``.
 
 Records (``SPLAT_FIELDS`` float64): window x, y (y up), window depth z of the centre, bound half side r (pixels,
 0: culled), conic (A, B, C) of $Σ'⁻¹$ in window axes, opacity o, colour (3), Σ' in image axes (x right,
@@ -42,13 +44,15 @@ import numpy as np
 from frustum.raster._jit import kernel, parallel_kernel, prefetch
 
 __all__ = [
-    "SPLAT_FIELDS", "TILE", "blend_tiles", "count_tiles", "fill_tiles", "project_splats", "sh_color",
+    "LAYER_CHANNELS", "SPLAT_FIELDS", "TILE", "blend_tiles", "count_tiles", "fill_tiles", "project_splats", "sh_color",
 ]  # fmt: skip
 
 SPLAT_FIELDS = 16
 TILE = 16
 """Tile side in pixels."""
 F_X, F_Y, F_Z, F_RADIUS, F_CONIC, F_OPACITY, F_COLOR, F_COV, F_EXTENT = 0, 1, 2, 3, 4, 7, 8, 11, 14
+LAYER_CHANNELS = 7
+"""``blend_tiles``' per-pixel outputs: colour (3), transmittance, $Σ wᵢ$, $Σ wᵢ zᵢ$, the median splat's item."""
 PREFETCH_AHEAD = 8
 """Tile entries ahead whose records ``blend_tiles`` prefetches."""
 DILATION = 0.3
@@ -218,14 +222,16 @@ def fill_tiles(records: np.ndarray, order: np.ndarray, height: int, tiles_x: int
 # many small pieces: tiles differ in cost by orders of magnitude (empty sky, dense surfaces), so threads balance
 @parallel_kernel(lambda records, starts, *_: starts.size - 1, pieces_per_thread=32)
 def blend_tiles(records: np.ndarray, starts: np.ndarray, entries: np.ndarray, tiles_x: int, depth: np.ndarray,
-                layer: np.ndarray, start: int, stop: int) -> None:  # fmt: skip
-    """Tiles [start, stop): ``layer`` (H, W, 6) float32 ← premultiplied colour $Σ cᵢ·αᵢ·Tᵢ$ (3), the final
-    transmittance T, $Σ wᵢ$ and $Σ wᵢ·zᵢ$ per pixel (module docstring, step 3); `depth` (H, W) is only read."""
+                item_starts: np.ndarray, layer: np.ndarray, start: int, stop: int) -> None:  # fmt: skip
+    """Tiles [start, stop): ``layer`` (H, W, ``LAYER_CHANNELS``) float32 ← premultiplied colour $Σ cᵢ·αᵢ·Tᵢ$ (3),
+    the final transmittance T, $Σ wᵢ$, $Σ wᵢ·zᵢ$ and the median splat's item (−1: none) per pixel (module
+    docstring, step 3); `depth` (H, W) is only read."""
     height, width = depth.shape
     color = np.empty((TILE, TILE, 3))
     transmittance = np.empty((TILE, TILE))
     weight = np.empty((TILE, TILE))
     weighted_z = np.empty((TILE, TILE))
+    median = np.empty((TILE, TILE))
     opaque = np.empty((TILE, TILE), dtype=np.float32)
     for tile in range(start, stop):
         row0, col0 = (tile // tiles_x) * TILE, (tile % tiles_x) * TILE
@@ -234,6 +240,7 @@ def blend_tiles(records: np.ndarray, starts: np.ndarray, entries: np.ndarray, ti
         transmittance[:] = 1.0
         weight[:] = 0.0
         weighted_z[:] = 0.0
+        median[:] = -1.0
         for i in range(rows):
             for j in range(cols):
                 opaque[i, j] = depth[row0 + i, col0 + j]
@@ -284,9 +291,15 @@ def blend_tiles(records: np.ndarray, starts: np.ndarray, entries: np.ndarray, ti
                     color[i, j, 2] += records[k, F_COLOR + 2] * w
                     weight[i, j] += w
                     weighted_z[i, j] += w * z
+                    if t > 0.5 >= after:  # the median splat: its item (once per pixel)
+                        item = 0
+                        while k >= item_starts[item + 1]:
+                            item += 1
+                        median[i, j] = item
                     transmittance[i, j] = after
         for i in range(rows):
             for j in range(cols):
                 r, c = row0 + i, col0 + j
                 layer[r, c, 0], layer[r, c, 1], layer[r, c, 2] = color[i, j, 0], color[i, j, 1], color[i, j, 2]
                 layer[r, c, 3], layer[r, c, 4], layer[r, c, 5] = transmittance[i, j], weight[i, j], weighted_z[i, j]
+                layer[r, c, 6] = median[i, j]

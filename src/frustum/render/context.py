@@ -43,7 +43,7 @@ from frustum.frame import Frame
 from frustum.render.buffers import Scratch, block_min, downsample, give_back, resolve_color
 from frustum.render.options import GROUND_TRUTH_BUFFERS, RenderOptions
 
-__all__ = ["FrameContext", "middle_samples"]
+__all__ = ["FrameContext", "middle_samples", "pixel_points"]
 
 
 @dataclasses.dataclass
@@ -82,6 +82,14 @@ class FrameContext:
             np.zeros((1, 1, 3), dtype=np.float32) if self.normals is None else self.normals,
             np.zeros((1, 1), dtype=np.int32) if self.object_id is None else self.object_id,
         )
+
+    def place_drawn(self, camera: Camera, drawn: np.ndarray) -> None:
+        """The world points of the pixels a pass after the surfaces took (`drawn`, (H, W) bool: points, splats) into
+        ``outputs["position"]`` where it is kept: their window depth unprojected at the pixel centres
+        (``Camera.unproject``)."""
+        points = self.outputs.get("position")
+        if points is not None and drawn.any():
+            points[drawn] = pixel_points(camera, self.depth, drawn)
 
     def counter(self) -> dict[str, Any]:
         """The dict a pass adds its counts to: ``counts``, or a throwaway one where the frame is not counted."""
@@ -133,6 +141,13 @@ class FrameContext:
             shadow = np.where(np.isnan(points[..., :1]), np.float32(np.nan), seen).astype(np.float32)
         give_back(points)  # copied out above: the next frame may have it
         return {"position": position, "shadow": shadow}
+
+
+def pixel_points(camera: Camera, depth: np.ndarray, mask: np.ndarray) -> np.ndarray:
+    """(N, 3) world points of the `mask` pixels (row-major order) at their window depth: ``Camera.unproject`` of
+    the pixel centres $(c + ½, H − r − ½, depth)$."""
+    rows, columns = np.nonzero(mask)
+    return camera.unproject(np.column_stack([columns + 0.5, camera.height - rows - 0.5, depth[rows, columns]]))
 
 
 def middle_samples(array: np.ndarray, factor: int) -> np.ndarray:

@@ -7,12 +7,20 @@ supersampling, the middle sample of each pixel's block, ``render.context.middle_
 sample ``Frame.depth`` reports), so a pixel never carries a blend of two objects and every id in a mask is an item
 of the scene. The pass writes the Frame's fields at the output size into ``context.fields``.
 
-- ``instance``: ``object_id`` under its dataset name, the index of the item in ``Scene.items`` (−1 background).
-- ``semantic``: the class id of each pixel's item, $c = 1 + $ the position of its label in ``Scene.labels``
-  (0 for the background and for items without a label).
-- ``amodal`` (K, H, W) bool: each item's silhouette alone, occluders ignored, still clipped by the view volume:
-  one depth-only fill of the item (``raster.shadow.fill_depth_tiles``, the same coverage rule as the surface
-  pass) per item. ``visibility`` (K,): $visible / amodal$ pixels, NaN where the amodal mask is empty.
+- The objects (``objects``): the meshes of ``Scene.items`` (ids 0 … K − 1), then the point clouds and splat sets
+  of ``Scene.point_clouds`` (ids K … K + P − 1, as the point and splat passes write them: ``render.points``,
+  ``render.splats``; a splat pixel is its set's where the accumulated alpha reaches ½).
+- ``instance``: ``object_id`` under its dataset name, the object's index (−1 background).
+- ``semantic``: the class id of each pixel's object, $c = 1 + $ the position of its label in ``Scene.labels``
+  (0 for the background and for objects without a label).
+- ``amodal`` (K + P, H, W) bool: each object's silhouette alone, occluders ignored, still clipped by the view
+  volume: one depth-only fill of each mesh (``raster.shadow.fill_depth_tiles``, the same coverage rule as the
+  surface pass), each cloud or splat set drawn alone (``point_masks``). ``visibility`` (K + P,):
+  $visible / amodal$ pixels, NaN where the amodal mask is empty.
+- Point objects have no surface between their points: their pixels' world points (for ``object_coords``, ``nocs``
+  and ``flow``; the passes write them, ``FrameContext.place_drawn``, or ``point_positions`` where the frame has
+  none) are the window depth unprojected (``Camera.unproject``; a splat pixel's is its expected depth),
+  their NOCS box the box of their points; the next frame's depth buffer of ``flow_occluded`` holds the meshes.
 - ``object_coords`` (H, W, 3) float32: the visible point in its item's model coordinates,
   $X = (world\\_from\\_model)^{-1} · P_{world}$, NaN on the background.
 - ``nocs``: Normalized Object Coordinate Space (Wang et al. 2019), $(X − c)/‖b_{max} − b_{min}‖ + ½$ with c the
@@ -33,13 +41,13 @@ import numpy as np
 
 from frustum.camera import Camera
 from frustum.errors import FrustumError
-from frustum.render.context import FrameContext, middle_samples
+from frustum.render.context import FrameContext, middle_samples, pixel_points
 from frustum.render.options import GROUND_TRUTH_BUFFERS, RenderOptions
 from frustum.scene import Scene, SceneItem
 
 __all__ = [
     "DEPTH_TOLERANCE", "amodal_masks", "class_ids", "draw", "flow_setup", "model_from_world", "nocs_boxes",
-    "point_buffers", "visibility",
+    "object_labels", "object_paths", "objects", "point_buffers", "point_masks", "point_positions", "visibility",
 ]  # fmt: skip
 
 DEPTH_TOLERANCE = 1e-2
@@ -49,10 +57,38 @@ the surface at the pixel's centre, not at the point, so a relative margin keeps 
 themselves."""
 
 
+def objects(scene: Scene) -> list[SceneItem]:
+    """The objects the ids count (module docstring): ``Scene.items``, then each entry of ``Scene.point_clouds`` as a
+    ``SceneItem`` whose ``mesh`` holds the PointCloud or GaussianSplats."""
+    return [*scene.items, *(SceneItem(p.geometry, p.material, p.world_from_model) for p in scene.point_clouds)]
+
+
+def object_labels(scene: Scene) -> list[str | None]:
+    """Each object's label (``objects`` order)."""
+    return [*scene.item_labels(), *scene.point_labels()]
+
+
+def object_paths(scene: Scene) -> list[str]:
+    """Each object's node path (``objects`` order)."""
+    return [*scene.item_paths(), *scene.point_paths()]
+
+
 def class_ids(scene: Scene) -> np.ndarray:
-    """(K,) int32: each item's class id, 1-based in ``Scene.labels`` (0: no label)."""
+    """(K + P,) int32: each object's class id, 1-based in ``Scene.labels`` (0: no label)."""
     number = {label: i + 1 for i, label in enumerate(scene.labels)}
-    return np.array([0 if label is None else number[label] for label in scene.item_labels()], dtype=np.int32)
+    return np.array([0 if label is None else number[label] for label in object_labels(scene)], dtype=np.int32)
+
+
+def point_positions(camera: Camera, depth: np.ndarray, instance: np.ndarray, first: int,
+                    position: np.ndarray) -> np.ndarray:  # fmt: skip
+    """`position` with the world points of the point objects' pixels (ids >= `first`) replaced by their window
+    depth unprojected (``Camera.unproject`` at the pixel centre)."""
+    mask = instance >= first
+    if not mask.any():
+        return position
+    result = np.array(position, dtype=np.float32)
+    result[mask] = pixel_points(camera, depth, mask)
+    return result
 
 
 def amodal_masks(items: list[SceneItem], camera: Camera, cull: bool, factor: int) -> np.ndarray:
@@ -76,6 +112,22 @@ def amodal_masks(items: list[SceneItem], camera: Camera, cull: bool, factor: int
             binned.tile_entries, tiling, depth, True,
         )  # fmt: skip
         np.less(depth[middle::factor, middle::factor], 1.0, out=masks[k])
+    return masks
+
+
+def point_masks(scene: Scene, camera: Camera, options: RenderOptions) -> np.ndarray:
+    """(P, H, W) bool: each entry of ``Scene.point_clouds`` drawn alone at ``options.factor`` times the camera's size,
+    the middle sample of each block kept (the sample ``object_id`` keeps): a cloud where it writes depth
+    (``render.points.silhouette``), a splat set where its accumulated alpha reaches ½ (``render.splats.silhouette``)."""
+    from frustum.render import points, splats
+
+    placed = scene.point_clouds
+    factor, middle = options.factor, options.factor // 2
+    big = dataclasses.replace(camera, width=camera.width * factor, height=camera.height * factor)
+    masks = np.zeros((len(placed), camera.height, camera.width), dtype=bool)
+    for k, item in enumerate(placed):
+        drawn = splats.silhouette(item, big) if item.style.style == "splats" else points.silhouette(item, big, options)
+        masks[k] = drawn[middle::factor, middle::factor]
     return masks
 
 
@@ -178,7 +230,7 @@ def matched_items(scene: Scene, next_scene: Scene, where: str) -> list[int]:
 
     Raises FrustumError naming the node when a path is not unique in either scene (an unmatched item would be
     ambiguous), or when no item of `scene` is in `next_scene` at all."""
-    paths, next_paths = scene.item_paths(), next_scene.item_paths()
+    paths, next_paths = object_paths(scene), object_paths(next_scene)
     for label, listed in (("scene", paths), ("next scene", next_paths)):
         seen: set[str] = set()
         for path in listed:
@@ -205,7 +257,7 @@ def flow_setup(scene: Scene, camera: Camera, next_scene: Scene, next_camera: Cam
     now and in the next frame, the matched items (``matched_items``), the next frame's depth buffer and the image
     sizes and next projection."""
     matched = matched_items(scene, next_scene, where)
-    items, next_items = scene.items, next_scene.items
+    items, next_items = objects(scene), objects(next_scene)
     clip_from_world = np.asarray(camera.projection_matrix) @ np.asarray(camera.view_matrix)
     next_clip_from_world = np.asarray(next_camera.projection_matrix) @ np.asarray(next_camera.view_matrix)
     now, later = np.zeros((max(1, len(items)), 16)), np.zeros((max(1, len(items)), 16))
@@ -244,7 +296,8 @@ def point_buffers(scene: Scene, camera: Camera, instance: np.ndarray, position: 
     flags = 1 * ("object_coords" in names) + 2 * ("nocs" in names) + 4 * ("flow" in names)
     ground_truth.point_truth(
         np.ascontiguousarray(instance, dtype=np.int32), np.ascontiguousarray(position, dtype=np.float64),
-        model_from_world(scene.items), nocs_boxes(scene.items), *terms, DEPTH_TOLERANCE, flags, *outputs.values(),
+        model_from_world(objects(scene)), nocs_boxes(objects(scene)), *terms, DEPTH_TOLERANCE, flags,
+        *outputs.values(),
     )  # fmt: skip
     return {name: outputs[name] for name in names}
 
@@ -277,7 +330,7 @@ def draw(scene: Scene, camera: Camera, options: RenderOptions, context: FrameCon
         camera = dataclasses.replace(camera, width=camera.width // factor, height=camera.height // factor)
     assert context.object_id is not None  # implied by every ground-truth buffer (render.options.with_implied)
     instance = middle_samples(context.object_id, factor)
-    items = scene.items
+    items = objects(scene)
     fields = context.fields
     if "instance" in wanted:
         fields["instance"] = instance
@@ -289,11 +342,16 @@ def draw(scene: Scene, camera: Camera, options: RenderOptions, context: FrameCon
 
         cause = f"amodal masks of {len(items)} items at {camera.width} x {camera.height}"
         check_memory(len(items) * camera.width * camera.height, where=where, cause=cause)
-        masks = amodal_masks(items, camera, options.cull, factor)
+        masks = amodal_masks(scene.items, camera, options.cull, factor)
+        if scene.point_clouds:
+            masks = np.concatenate([masks, point_masks(scene, camera, options)])
         fields["amodal"] = masks
         fields["visibility"] = visibility(instance, masks)
     if any(name in wanted for name in ("object_coords", "nocs", "flow")):
-        drawn = context.outputs.get("position")
-        position = (cast_positions(scene, camera, instance, factor) if drawn is None
-                    else middle_samples(drawn, factor))  # fmt: skip
+        drawn = context.outputs.get("position")  # the passes' world points (points and splats: depth unprojected)
+        if drawn is not None:
+            position = middle_samples(drawn, factor)
+        else:
+            position = point_positions(camera, middle_samples(context.depth, factor), instance, len(scene.items),
+                                       cast_positions(scene, camera, instance, factor))  # fmt: skip
         fields.update(point_buffers(scene, camera, instance, position, wanted, options, where))

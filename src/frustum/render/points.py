@@ -15,7 +15,9 @@ light. Squares and disks are lit by the scene's lights (the one model of
 colors (a scan: see ``render(..., eye_dome=True)``); spheres with the true normal of the hit point, surfels with
 their disk normal turned toward the viewer (``shading="none"``: colors only). Sizes in pixels are multiplied by
 √samples when supersampling. Object ids (``buffers=("object_id",)``) of clouds follow the meshes':
-$len(scene.items) + i$ for the i-th placed cloud or splat set.
+$len(scene.items) + i$ for the i-th placed cloud or splat set (``Scene.point_clouds``), so ``instance``,
+``semantic`` and the datasets hold them (``render.ground_truth``); a cloud's amodal mask is the cloud drawn alone
+(``silhouette``).
 
 References
 ----------
@@ -25,16 +27,20 @@ rasterization: the square of side ``gl_PointSize`` centred on the point).
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from frustum.camera import Camera
+from frustum.render.buffers import Scratch
 from frustum.render.context import FrameContext
 from frustum.render.options import RenderOptions
 from frustum.render.stages import Lighting, shading_parameters
 from frustum.scene import PointItem, Scene, SceneItem
+from frustum.shading import pack_lights
 from frustum.transforms import apply, apply_to_normals
 
-__all__ = ["draw_point_clouds", "draw_points"]
+__all__ = ["draw_point_clouds", "draw_points", "silhouette"]
 
 
 def draw_point_clouds(scene: Scene, camera: Camera, options: RenderOptions, buffers: FrameContext) -> None:
@@ -45,8 +51,25 @@ def draw_point_clouds(scene: Scene, camera: Camera, options: RenderOptions, buff
         return
     lighting = Lighting.of(scene)
     first_id = len(scene.items)
+    before = buffers.depth.copy() if "position" in buffers.outputs else None
     for index, item in clouds:
         draw_points(item, first_id + index, camera, options, lighting, buffers)
+    if before is not None:  # the "position" buffer: the points' pixels hold their own world points
+        buffers.place_drawn(camera, buffers.depth != before)
+
+
+def silhouette(item: PointItem, camera: Camera, options: RenderOptions) -> np.ndarray:
+    """(H, W) bool at the camera's size: where the cloud `item` drawn alone writes depth (its amodal mask; sizes in
+    pixels times ``options.factor``, as when drawn with the scene)."""
+    from frustum.raster import shade
+
+    unlit = dataclasses.replace(options, shade_mode=shade.SHADE_NONE)  # coverage only: no lighting needed
+    lighting = Lighting(*pack_lights([]))
+    context = FrameContext(None, None, Scratch())
+    context.depth = np.ones((camera.height, camera.width), dtype=np.float32)
+    context.color = np.zeros((camera.height, camera.width, 4), dtype=np.uint8)
+    draw_points(item, 0, camera, unlit, lighting, context)
+    return context.depth < 1.0
 
 
 def _bands(rows: np.ndarray, height: int) -> tuple[np.ndarray, np.ndarray, int]:

@@ -11,8 +11,15 @@ $$C = Σ cᵢ·αᵢ·Tᵢ + T·C_under,   A = (1 − T) + T·A_under$$
 with C_under, A_under what the surfaces (or the background) left there. Splat colours are display values, as 3DGS
 files store them: written as they are (no lighting, no tone map; ``color_space="srgb"`` still encodes the frame).
 ``Frame.depth`` where splats contribute is their expected window depth $Σ wᵢ zᵢ / Σ wᵢ$ ($wᵢ = αᵢ·Tᵢ$, zᵢ the
-window depth of splat i's centre), in front of whatever was there; elsewhere it is unchanged. Object ids and normals
-are not written for splats (they have no surface).
+window depth of splat i's centre), in front of whatever was there; elsewhere it is unchanged.
+
+Object ids (``buffers=("object_id",)``, and so ``instance``, ``semantic`` and the datasets): a pixel whose
+accumulated splat alpha $1 − T$ reaches ½ gets the id of the splat set of its median splat (the one whose
+compositing brings $1 − T$ to ½ or more, ``raster.splats``), $len(scene.items) + i$ for the i-th entry of
+``Scene.point_clouds`` as points have; its normal becomes (0, 0, 0) (splats have no surface). Below ½ the pixel
+keeps the id, normal and world point (``buffers=("position",)``) of what is under the splats (a surface, or −1 on
+the background); a pixel the splats own has the world point of its expected depth. A splat set's amodal mask
+(``silhouette``) is the same rule applied to the set drawn alone.
 
 References
 ----------
@@ -31,16 +38,18 @@ from frustum.render.context import FrameContext
 from frustum.render.options import RenderOptions
 from frustum.scene import PointItem, Scene
 
-__all__ = ["SplatLayer", "draw_splats", "project", "splat_layer"]
+__all__ = ["SplatLayer", "draw_splats", "project", "silhouette", "splat_layer"]
 
 
 class SplatLayer(NamedTuple):
     """What the splats of a frame add: premultiplied ``color`` (H, W, 3), ``transmittance`` (H, W) (1: nothing),
-    expected window ``depth`` (H, W) (NaN where no splat contributes), all float32, rows top first."""
+    expected window ``depth`` (H, W) (NaN where no splat contributes), all float32, and ``item`` (H, W) int32, the
+    index in the drawn items of the median splat's set (−1 where $1 − T < ½$), rows top first."""
 
     color: np.ndarray
     transmittance: np.ndarray
     depth: np.ndarray
+    item: np.ndarray
 
 
 def project(items: list[PointItem], camera: Camera, scratch: Scratch | None = None) -> np.ndarray:
@@ -88,19 +97,32 @@ def splat_layer(items: list[PointItem], camera: Camera, depth: np.ndarray | None
     np.cumsum(counts, out=starts[1:])
     entries = np.empty(int(starts[-1]), dtype=np.int64)
     kernels.fill_tiles(records, order, height, tiles_x, tiles_y, starts, entries)
-    layer = empty((height, width, 6), np.float32)
-    kernels.blend_tiles(records, starts, entries, tiles_x, np.ascontiguousarray(depth, dtype=np.float32), layer)
+    layer = empty((height, width, kernels.LAYER_CHANNELS), np.float32)
+    item_starts = np.cumsum([0] + [item.geometry.count for item in items], dtype=np.int64)  # items' records
+    kernels.blend_tiles(records, starts, entries, tiles_x, np.ascontiguousarray(depth, dtype=np.float32), item_starts,
+                        layer)  # fmt: skip
     with np.errstate(invalid="ignore", divide="ignore"):
         expected = np.where(layer[..., 4] > 0.0, layer[..., 5] / layer[..., 4], np.nan).astype(np.float32)
-    return SplatLayer(layer[..., :3], layer[..., 3], expected)
+    return SplatLayer(layer[..., :3], layer[..., 3], expected, layer[..., 6].astype(np.int32))
 
 
 def draw_splats(scene: Scene, camera: Camera, options: RenderOptions, buffers: FrameContext) -> None:
     """Composite every placed splat set of `scene` over `buffers` (the module docstring's equations)."""
-    items = [item for item in scene.point_clouds if item.style.style == "splats" and item.geometry.count]
-    if not items:
+    placed = [(i, item) for i, item in enumerate(scene.point_clouds)
+              if item.style.style == "splats" and item.geometry.count]  # fmt: skip
+    if not placed:
         return
+    items = [item for _, item in placed]
     layer = splat_layer(items, camera, buffers.depth, buffers.scratch)
+    covered = layer.item >= 0
+    if buffers.object_id is not None:
+        ids = len(scene.items) + np.array([i for i, _ in placed], dtype=np.int32)
+        buffers.object_id[covered] = ids[layer.item[covered]]
+    if buffers.normals is not None:
+        buffers.normals[covered] = 0.0
+    seen = ~np.isnan(layer.depth)
+    buffers.depth[seen] = layer.depth[seen]
+    buffers.place_drawn(camera, covered)
     color = buffers.color
     under = color.astype(np.float32) / 255.0
     t = layer.transmittance[..., None]
@@ -108,5 +130,9 @@ def draw_splats(scene: Scene, camera: Camera, options: RenderOptions, buffers: F
     alpha = (1.0 - layer.transmittance) + layer.transmittance * under[..., 3]
     color[..., :3] = np.floor(np.clip(rgb, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
     color[..., 3] = np.floor(np.clip(alpha, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
-    seen = ~np.isnan(layer.depth)
-    buffers.depth[seen] = layer.depth[seen]
+
+
+def silhouette(item: PointItem, camera: Camera) -> np.ndarray:
+    """(H, W) bool: where the splat set `item` drawn alone reaches an accumulated alpha of ½ (its amodal mask, the
+    module docstring's rule)."""
+    return splat_layer([item], camera).item >= 0

@@ -171,8 +171,8 @@ class Node:
     ``transform`` (4x4 affine, default identity) maps this node's coordinates into its parent's;
     ``geometry`` is a ``Mesh`` or a ``Polyline`` (or None for a pure group); ``material`` None inherits the
     nearest ancestor's (``Material()`` at the top); ``lights`` ride the node (they move with its world transform);
-    ``label`` (a non-empty string, or None to inherit the nearest ancestor's) is the semantic class of the meshes
-    at and below the node (``Scene.labels``, ``render(..., buffers=("semantic",))``).
+    ``label`` (a non-empty string, or None to inherit the nearest ancestor's) is the semantic class of the meshes,
+    point clouds and splat sets at and below the node (``Scene.labels``, ``render(..., buffers=("semantic",))``).
     """
 
     def __init__(
@@ -500,10 +500,11 @@ class Scene:
     @property
     def labels(self) -> list[str]:
         """The semantic classes of the placed meshes in first-seen order (``items`` order; a node without a label
-        inherits its nearest ancestor's). Class id $c$ of a label is its 1-based position here; 0 is the
-        background (``render(..., buffers=("semantic",))``)."""
+        inherits its nearest ancestor's), then those of the point clouds and splat sets (``point_clouds`` order)
+        not seen among the meshes. Class id $c$ of a label is its 1-based position here; 0 is the background
+        (``render(..., buffers=("semantic",))``)."""
         seen: dict[str, None] = {}
-        for label in self.item_labels():
+        for label in (*self.item_labels(), *self.point_labels()):
             if label is not None:
                 seen.setdefault(label)
         return list(seen)
@@ -518,13 +519,22 @@ class Scene:
         ``render(..., buffers=("flow",), next=...)`` and datasets match items across scenes."""
         return [path for path, _ in self._item_nodes()]
 
-    def _item_nodes(self) -> list[tuple[str, str | None]]:
-        """(path, label) of each placed mesh, in ``_placed(Mesh)``'s order."""
+    def point_labels(self) -> list[str | None]:
+        """Each placed point cloud's or splat set's label (``point_clouds`` order), inherited as ``item_labels``."""
+        return [label for _, label in self._item_nodes(points=True)]
+
+    def point_paths(self) -> list[str]:
+        """Each placed point cloud's or splat set's node path (``point_clouds`` order), written as ``item_paths``."""
+        return [path for path, _ in self._item_nodes(points=True)]
+
+    def _item_nodes(self, points: bool = False) -> list[tuple[str, str | None]]:
+        """(path, label) of each placed mesh, in ``_placed(Mesh)``'s order (`points`: of each point cloud or splat
+        set, in ``point_clouds``' order)."""
         result: list[tuple[str, str | None]] = []
 
         def visit(node: Node, path: str, inherited: str | None) -> None:
             label = node.label if node.label is not None else inherited
-            if isinstance(node.geometry, Mesh) or is_octree(node.geometry):
+            if _is_points(node.geometry) if points else (isinstance(node.geometry, Mesh) or is_octree(node.geometry)):
                 result.append((path, label))
             for i, child in enumerate(node.children):
                 visit(child, f"{path}/{child.name or f'#{i}'}".lstrip("/"), label)
