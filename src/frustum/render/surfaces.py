@@ -43,8 +43,8 @@ def draw_opaque(scene: Scene, items: list[SceneItem], camera: Camera, options: R
     scratch = context.scratch
     if len(items) == 1 and opaque and face_total and directional(items[0], options, lighting.lights):
         draw_tiled(items[0], camera, options, lighting, context)
-    elif len(items) == 1 and opaque and face_total and shadows.tiled(scene, items[0], options, lighting.lights):
-        shadows.draw_tiled(scene, items[0], camera, options, lighting, context)
+    elif len(opaque) == len(items) and face_total and shadows.tiled(scene, items, options, lighting.lights):
+        shadows.draw_tiled(scene, items, camera, options, lighting, context)
     else:
         offsets = face_offsets(items)
         codes = scratch.empty((height, width), code_type(items))
