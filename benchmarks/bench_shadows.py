@@ -19,11 +19,12 @@ own block of frames:
   twice), frames with shadows off and with maps reused; ratio and how many of the frames drew their map;
 - the scene with one point light (shadows off and on: a cube of six maps drawn every frame, the stage-by-stage
   path);
-- llvmpipe (``benchmarks/anchor_moderngl_shadows.py``, a child process): the same scene (one draw call per item)
-  without and with a 2048² depth-texture shadow map drawn every frame, ``sampler2DShadow`` with 2×2 PCF taps; ratio frustum
-  shadowed (map redrawn: like for like) / llvmpipe shadowed (target: <= 0.6);
-- the first scene only (``--scenes`` order): the shadow-ray pass alone, the rays from every drawn pixel toward the light through
-  frustum's any-hit query (``shadow_pass.occluded``) and through Embree (``embreex`` OCCLUDED query, same
+- llvmpipe (``benchmarks/anchor_moderngl_shadows.py``, a child process): the same scene (one draw call per
+  item) without and with a 2048² depth-texture shadow map drawn every frame, ``sampler2DShadow`` with 2×2 PCF
+  taps; ratio frustum shadowed (map redrawn: like for like) / llvmpipe shadowed (target: <= 0.6);
+- the first scene only (``--scenes`` order): the shadow-ray pass alone, the rays from every drawn pixel toward
+  the light through frustum's any-hit query (``shadow_pass.occluded``) and through Embree (``embreex`` OCCLUDED
+  query, same
   origins, directions and distances); ratio frustum / Embree (target: <= 3). Index builds are reported apart.
 
 Timings on a shared machine are noisy: read the ratios, measured in the same run.
