@@ -33,7 +33,7 @@ def draw_opaque(scene: Scene, items: list[SceneItem], camera: Camera, options: R
                 context: FrameContext) -> None:  # fmt: skip
     """Stages 1–5 for the opaque items of `items` into ``context.depth`` and ``context.color`` (recycled
     ``FrameBuffers``): every item binned and filled, the shadow pass, then every item shaded (or, for a frame of
-    one opaque mesh, tile by tile)."""
+    one opaque mesh, or of opaque meshes with shadow maps, ``shadows.tiled``, tile by tile)."""
     height, width = camera.height, camera.width
     opaque = [i for i, item in enumerate(items) if item.material.opacity >= 1.0]
     context.depth = depth = FrameBuffers.take((height, width), np.float32)

@@ -8,9 +8,10 @@ shadow-casting light in one of two ways.
   tile set-up, ``render.bin_item`` + ``raster.shadow.fill_depth_tiles``, depth alone, into a float32 depth map of
   ``shadow_map_size``² texels; both sides of an open surface, the front faces of a closed one). A directional
   light gets an orthographic map fitted to what the camera sees (the light-space box of the drawn points, widened
-  by the filter's reach; a frame of one mesh drawn tile by tile, ``render.shadows.draw_tiled``, fits it before
-  drawing: ``view_map``, and reuses the map of an earlier frame when the casters' bytes, their transform, the
-  light camera and the size are the same: ``kept_maps``, ``set_map_reuse``) and
+  by the filter's reach; a frame drawn tile by tile, ``render.shadows.draw_tiled``, fits it before drawing:
+  ``view_map``, and reuses the map of an earlier frame when the casters' bytes, their transforms, the light
+  camera and the size are the same: ``kept_maps``, ``set_map_reuse``; all casters are filled in one pass per
+  culling, ``caster_groups``) and
   deep enough toward the light to hold every caster (the scene's box); a spot light a perspective map over its
   cone; a point light a cube of six perspective maps (each a little wider than 90° so filter taps near a cube
   edge stay on their face). A point is lit where its distance along the light's axis, less a bias, is not beyond
