@@ -200,7 +200,7 @@ def draw_tiled(
             for number, (caster, cull) in enumerate(groups):
                 fractions.draw_depth(caster, light_camera, maps[m], number == 0, cull)
     tiling = np.array([1 << TILED_BITS, binned.tiles_x, 0, camera.width, camera.height], dtype=np.int64)
-    params = np.array([shading_parameters(one, camera, options, lighting.ambient) for one in items])
+    params = np.array([shading_parameters(placed, camera, options, lighting.ambient) for placed in items])
     flags = item_flags(0, 0, options, False, False, False)
     shadow_tiled.draw_tiles_shadowed(
         binned.faces, binned.win_int, binned.win_float, binned.tri_int, binned.tri_float, binned.tri_weights,
