@@ -10,7 +10,8 @@ multiplied by the lit fraction from a ``sampler2DShadow`` (compare mode LEQUAL, 
 (percentage-closer filtering), then glFinish and the readback of color (RGBA8) and depth (float32). The same
 frame without shadows (no depth pass, no lookup) is timed too. Prints one JSON object: medians in milliseconds
 (``frame_ms``, ``frame_shadowed_ms``, ``depth_pass_ms``), the GL renderer, and the shadowed fraction of covered
-pixels.
+pixels. A scene file of several items (``item_face_starts``, ``item_colors``: ``bench_shadows.py``'s ``items_8``)
+is drawn one call per item in both passes, each item with its own color.
 
 Needs Mesa's EGL/llvmpipe (Debian: libegl1 libgl1 libegl-mesa0 libgl1-mesa-dri libglx-mesa0 libgbm1) and
 ``pip install moderngl==5.13.0 glcontext==3.1.0``.
@@ -170,12 +171,18 @@ def main(argv: list[str] | None = None) -> int:
     color = np.empty((h, w, 4), np.uint8)
     depth = np.empty((h, w), np.float32)
 
+    # several items (a scene file with item_face_starts): one draw call per item, each with its own color
+    starts = [int(x) for x in sc.get("item_face_starts", [0, sc["faces"].shape[0]])]
+    colors = sc.get("item_colors", np.array([sc["base_color"]] * (len(starts) - 1)))
+    ranges = [(3 * starts[k], 3 * (starts[k + 1] - starts[k])) for k in range(len(starts) - 1)]
+
     def depth_pass() -> None:
         shadow_fbo.use()
         shadow_fbo.clear(depth=1.0)
         ctx.cull_face = "front"  # the back sides go into the map: no acne on the lit sides
         ctx.polygon_offset = (1.1, 4.0)
-        depth_vao.render(moderngl.TRIANGLES)
+        for first, count in ranges:
+            depth_vao.render(moderngl.TRIANGLES, vertices=count, first=first)
         ctx.polygon_offset = (0.0, 0.0)
         ctx.cull_face = "back"
 
@@ -187,7 +194,9 @@ def main(argv: list[str] | None = None) -> int:
         prog["u_shadows"].value = int(shadows)
         fbo.use()
         fbo.clear(*background, depth=1.0)
-        vao.render(moderngl.TRIANGLES)
+        for (first, count), item_color in zip(ranges, colors, strict=True):
+            prog["u_base_color"].value = tuple(float(x) for x in item_color)
+            vao.render(moderngl.TRIANGLES, vertices=count, first=first)
         ctx.finish()
         fbo.read_into(color, components=4, dtype="f1")
         fbo.read_into(depth, attachment=-1, dtype="f4")

@@ -623,6 +623,7 @@ def _cast_on_face(faces: _Faces, f: int, light: Any, eps: float, candidates: NDA
     return [origin[None, :] + p[:, :1] * e1[None, :] + p[:, 1:] * e2[None, :] for p in disjoint]
 
 
+# the same as output.svg._number, kept apart on purpose: svg imports this module (no import circle)
 def _number(value: float) -> str:
     value = float(value)
     if value == 0.0:

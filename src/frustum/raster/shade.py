@@ -314,6 +314,7 @@ def _shade_row(
             f, code % 2 == 1, u0, u1, u2, faces, world, normals, lit, vertex_colors, uvs, texture, params,
             lights, item,
         )  # fmt: skip
+        # kernel specialisation kept on purpose: cue, blend and store repeated in shadow.shade_pixels_shadowed
         if params[P_CUE_ON] != 0.0:
             a, bb, c = faces[f, 0], faces[f, 1], faces[f, 2]
             d = 0.0
@@ -469,6 +470,7 @@ def _gather_chunk(
 
 # Kernel specialization kept on purpose: ``raster.light.light_terms`` for directional lights (falloff 1), as passes
 # over a chunk of pixels that the compiler vectorizes; the same operations in the same order, so the same bytes.
+# kernel specialisation kept on purpose: raster.shadow_tiled._shade_chunk_shadowed repeats it with fractions
 @kernel
 def _shade_chunk(
     n: int, s: np.ndarray, where: np.ndarray, params: np.ndarray, lights: np.ndarray, words: np.ndarray

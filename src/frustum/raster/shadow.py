@@ -90,6 +90,7 @@ SLOPE_LIMIT = 8.0
 are barely lit, and a larger bias would detach shadows from their casters."""
 
 
+# kernel specialisation kept on purpose: the pixel loop and face decoding of shade_pixels_shadowed below
 @parallel_kernel(lambda depth, *_: depth.shape[0], work=lambda depth, *_: depth.size, grain=16384)
 def surface_points(
     depth: np.ndarray, codes: np.ndarray, bary: np.ndarray, faces: np.ndarray, world: np.ndarray,
@@ -260,6 +261,7 @@ def map_visibility(
             visibility[row, col, channel] = 1.0 if found < 0.0 else found
 
 
+# kernel specialisation kept on purpose: the light loop of raster.volume's gradient shading, with fractions
 @kernel
 def _illuminate_visible(
     params: np.ndarray, lights: np.ndarray, specular_model: int, seen: np.ndarray, row: int, col: int,
@@ -377,6 +379,7 @@ def shade_pixels_shadowed(
                 r = (base_r * dr + sr) + params[P_EMISSIVE]
                 g = (base_g * dg + sg) + params[P_EMISSIVE + 1]
                 b = (base_b * db + sb) + params[P_EMISSIVE + 2]
+            # kernel specialisation kept on purpose: raster.shade._shade_row's cue, blend and store, per pixel here
             if params[P_CUE_ON] != 0.0:
                 d = 0.0
                 d += (params[P_EYE] - px) * params[P_VIEW_AXIS]
@@ -479,6 +482,7 @@ def _fill_depth_tile(
                         depth[at_row, at] = z
                 continue
             i_max, j_max = block[u + _IMAX], block[u + _JMAX]
+            # kernel specialisation kept on purpose: raster.window.edge_setup's edges and top-left biases
             dx0, dy0 = x2 - x1, y2 - y1
             dx1, dy1 = x0 - x2, y0 - y2
             dx2, dy2 = x1 - x0, y1 - y0

@@ -68,12 +68,14 @@ def draw_tiles_shadowed(
     tri_weights: np.ndarray, tile_starts: np.ndarray, tile_entries: np.ndarray, tiling: np.ndarray,
     depth: np.ndarray, world: np.ndarray, normals: np.ndarray, params: np.ndarray, lights: np.ndarray,
     item: np.ndarray, background: np.ndarray, color: np.ndarray, maps: np.ndarray, views: np.ndarray,
-    map_of: np.ndarray, softness: float,
+    map_of: np.ndarray, softness: float, owner: np.ndarray,
     start: int, stop: int,
 ) -> None:  # fmt: skip
     """``raster.tiled.draw_tiles_directional`` with shadows: maps (M, S, S) float32 and their records views
     (M, MAP_FIELDS) (``raster.shadow``), map_of (K,) int64 the map of each light (row of `lights`), −1 for a light
-    casting no shadow; softness the PCF radius in texels (``raster.shadow._lookup``)."""
+    casting no shadow; softness the PCF radius in texels (``raster.shadow._lookup``). Several items drawn as one
+    mesh: `params` (I, P) one row of shading parameters per item and `owner` (F,) the row of each face (a chunk of
+    pixels is shaded with one row: it is finished where the row changes); one item: `owner` empty, row 0."""
     size, tiles_x = tiling[0], tiling[1]
     height, width = depth.shape[0], depth.shape[1]
     near = np.empty((size, size), dtype=np.float32)
@@ -94,7 +96,7 @@ def draw_tiles_shadowed(
         top = max(height - (band + 1) * size, 0)
         bottom = height - band * size
         left, right = first * size, min((first + per_segment) * size, width)
-        n = 0
+        n, current = 0, 0
         for t in range(band * tiles_x + first, band * tiles_x + min(first + per_segment, tiles_x)):
             col0 = (t % tiles_x) * size
             col1 = min(col0 + size, width)
@@ -109,14 +111,14 @@ def draw_tiles_shadowed(
                 t, faces, win_int, win_float, tri_int, tri_float, tri_weights, tile_starts, tile_entries, tiling,
                 near, codes, bary, top, col0,
             )  # fmt: skip
-            n = _shade_tile(n, bottom - top, col1 - col0, col0 - left, near, codes, bary, faces, world, normals,
-                            params, lights, item, word, band_words, scratch, where, corners, maps, views, map_of,
-                            softness)  # fmt: skip
+            n, current = _shade_tile(n, current, bottom - top, col1 - col0, col0 - left, near, codes, bary, faces,
+                                     world, normals, params, lights, item, word, band_words, scratch, where, corners,
+                                     maps, views, map_of, softness, owner)  # fmt: skip
             for row in range(bottom - top):
                 for col in range(col1 - col0):
                     band_depth[np.uint64(row), np.uint64(col0 - left + col)] = near[np.uint64(row), np.uint64(col)]
-        _finish_chunk(n, scratch, where, corners, faces, world, normals, params, lights, band_words, maps, views,
-                      map_of, softness)  # fmt: skip
+        _finish_chunk(n, scratch, where, corners, faces, world, normals, params[np.uint64(current)], lights,
+                      band_words, maps, views, map_of, softness)  # fmt: skip
         for row in range(bottom - top):
             at_row = np.uint64(row)
             for col in range(right - left):
@@ -128,13 +130,16 @@ def draw_tiles_shadowed(
 
 @kernel
 def _shade_tile(
-    n: int, rows: int, cols: int, offset: int, depth: np.ndarray, codes: np.ndarray, bary: np.ndarray,
-    faces: np.ndarray, world: np.ndarray, normals: np.ndarray, params: np.ndarray, lights: np.ndarray,
-    item: np.ndarray, word: np.uint32, words: np.ndarray, scratch: np.ndarray, where: np.ndarray,
-    corners: np.ndarray, maps: np.ndarray, views: np.ndarray, map_of: np.ndarray, softness: float,
-) -> int:  # fmt: skip
-    """``raster.tiled._shade_tile`` whose full chunks are finished by ``_finish_chunk``."""
+    n: int, current: int, rows: int, cols: int, offset: int, depth: np.ndarray, codes: np.ndarray,
+    bary: np.ndarray, faces: np.ndarray, world: np.ndarray, normals: np.ndarray, params: np.ndarray,
+    lights: np.ndarray, item: np.ndarray, word: np.uint32, words: np.ndarray, scratch: np.ndarray,
+    where: np.ndarray, corners: np.ndarray, maps: np.ndarray, views: np.ndarray, map_of: np.ndarray,
+    softness: float, owner: np.ndarray,
+) -> tuple[int, int]:  # fmt: skip
+    """``raster.tiled._shade_tile`` whose full chunks (and chunks whose item row `current` changes, ``owner``)
+    are finished by ``_finish_chunk``; the pixels listed and the row they are shaded with."""
     face_offset = item[I_FACE_OFFSET]
+    several = owner.shape[0] > 0
     for row in range(rows):
         at_row = np.uint64(row)
         for col in range(cols):
@@ -143,15 +148,24 @@ def _shade_tile(
                 words[at_row, np.uint64(offset + col), 0] = word
                 continue
             code = codes[at_row, at]
+            face = (code >> 1) - face_offset
+            if several:
+                found = owner[np.uint64(face)]
+                if found != current:
+                    if n > 0:
+                        _finish_chunk(n, scratch, where, corners, faces, world, normals, params[np.uint64(current)],
+                                      lights, words, maps, views, map_of, softness)  # fmt: skip
+                        n = 0
+                    current = found
             scratch[_X + n], scratch[_NDL + n] = float(bary[at_row, at, 0]), float(bary[at_row, at, 1])
             scratch[_SIGN + n] = -1.0 if code & 1 else 1.0
-            where[n], where[_CHUNK + n], where[2 * _CHUNK + n] = row, offset + col, (code >> 1) - face_offset
+            where[n], where[_CHUNK + n], where[2 * _CHUNK + n] = row, offset + col, face
             n += 1
             if n == _CHUNK:
-                _finish_chunk(n, scratch, where, corners, faces, world, normals, params, lights, words, maps, views,
-                              map_of, softness)  # fmt: skip
+                _finish_chunk(n, scratch, where, corners, faces, world, normals, params[np.uint64(current)], lights,
+                              words, maps, views, map_of, softness)  # fmt: skip
                 n = 0
-    return n
+    return n, current
 
 
 @kernel

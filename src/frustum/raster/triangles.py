@@ -436,6 +436,7 @@ def _setup_entries(
         block[u + _IMIN], block[u + _IMAX], block[u + _JMIN], block[u + _JMAX] = i_min, i_max, j_min, j_max
 
 
+# kernel specialisation kept on purpose: raster.shadow._fill_depth_tile repeats its set-up for depth alone
 @kernel
 def _fill_tile(
     tile: int, faces: np.ndarray, win_int: np.ndarray, win_float: np.ndarray, tri_int: np.ndarray,

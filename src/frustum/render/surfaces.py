@@ -33,7 +33,7 @@ def draw_opaque(scene: Scene, items: list[SceneItem], camera: Camera, options: R
                 context: FrameContext) -> None:  # fmt: skip
     """Stages 1–5 for the opaque items of `items` into ``context.depth`` and ``context.color`` (recycled
     ``FrameBuffers``): every item binned and filled, the shadow pass, then every item shaded (or, for a frame of
-    one opaque mesh, tile by tile)."""
+    one opaque mesh, or of opaque meshes with shadow maps, ``shadows.tiled``, tile by tile)."""
     height, width = camera.height, camera.width
     opaque = [i for i, item in enumerate(items) if item.material.opacity >= 1.0]
     context.depth = depth = FrameBuffers.take((height, width), np.float32)
@@ -43,8 +43,8 @@ def draw_opaque(scene: Scene, items: list[SceneItem], camera: Camera, options: R
     scratch = context.scratch
     if len(items) == 1 and opaque and face_total and directional(items[0], options, lighting.lights):
         draw_tiled(items[0], camera, options, lighting, context)
-    elif len(items) == 1 and opaque and face_total and shadows.tiled(scene, items[0], options, lighting.lights):
-        shadows.draw_tiled(scene, items[0], camera, options, lighting, context)
+    elif len(opaque) == len(items) and face_total and shadows.tiled(scene, items, options, lighting.lights):
+        shadows.draw_tiled(scene, items, camera, options, lighting, context)
     else:
         offsets = face_offsets(items)
         codes = scratch.empty((height, width), code_type(items))

@@ -2,5 +2,6 @@
 
 ``fractions``: the shadow pass (shadow maps drawn from each light, or shadow rays through the scene's BVH); ``passes``:
 its place among the surface passes (world points of the drawn pixels, fractions, shading with them, and the
-one-mesh tile pipeline with shadow maps). The kernels are ``raster.shadow`` and ``raster.shadow_tiled``.
+tile pipeline with shadow maps); ``merged``: several placed meshes as one world-space mesh, for the one-pass map
+fill and the tile pipeline of several items. The kernels are ``raster.shadow`` and ``raster.shadow_tiled``.
 """

@@ -8,9 +8,10 @@ shadow-casting light in one of two ways.
   tile set-up, ``render.bin_item`` + ``raster.shadow.fill_depth_tiles``, depth alone, into a float32 depth map of
   ``shadow_map_size``² texels; both sides of an open surface, the front faces of a closed one). A directional
   light gets an orthographic map fitted to what the camera sees (the light-space box of the drawn points, widened
-  by the filter's reach; a frame of one mesh drawn tile by tile, ``render.shadows.draw_tiled``, fits it before
-  drawing: ``view_map``, and reuses the map of an earlier frame when the casters' bytes, their transform, the
-  light camera and the size are the same: ``kept_maps``, ``set_map_reuse``) and
+  by the filter's reach; a frame drawn tile by tile, ``render.shadows.draw_tiled``, fits it before drawing:
+  ``view_map``, and reuses the map of an earlier frame when the casters' bytes, their transforms, the light
+  camera and the size are the same: ``kept_maps``, ``set_map_reuse``; all casters are filled in one pass per
+  culling, ``caster_groups``) and
   deep enough toward the light to hold every caster (the scene's box); a spot light a perspective map over its
   cone; a point light a cube of six perspective maps (each a little wider than 90° so filter taps near a cube
   edge stay on their face). A point is lit where its distance along the light's axis, less a bias, is not beyond
@@ -53,6 +54,7 @@ from frustum.camera import Camera, ViewFrame
 from frustum.projection import Orthographic, Perspective
 from frustum.render.buffers import give_back, keeps_memory, release_work_arrays, take_array
 from frustum.render.options import SHADOW_METHODS, ShadowOptions, check_shadows
+from frustum.render.shadows import merged
 from frustum.render.stages import TILED_BITS, bin_item
 from frustum.scene import Scene, SceneItem
 from frustum.shading import AmbientLight, DirectionalLight, PointLight, SpotLight
@@ -79,7 +81,7 @@ def release_memory() -> int:
         released += sum(maps.nbytes for _, maps in _KEPT)
         _KEPT.clear()
         _MEMO.clear()
-    return released
+    return released + merged.release()
 
 
 _MEMO: dict[tuple, Any] = {}
@@ -233,19 +235,38 @@ def _world_faces(item: SceneItem) -> np.ndarray:
     return faces
 
 
-def draw_depth(item: SceneItem, camera: Camera, depth: np.ndarray, fresh: bool) -> None:
+def draw_depth(item: SceneItem, camera: Camera, depth: np.ndarray, fresh: bool, cull: bool | None = None) -> None:
     """Stages 1–4 of one item into `depth` alone (``raster.shadow.fill_depth_tiles``: no face codes or weights,
     64-pixel tiles): a shadow map, cleared first where `fresh`. Both sides of an open surface; the front faces alone
     of a closed one (``Mesh.is_watertight``: along any ray from outside the first surface met is a front face, so
-    the map is the same, for half the fill)."""
+    the map is the same, for half the fill). `cull`: whether to skip back faces, where the caller knows (items
+    merged into one, ``caster_groups``)."""
     from frustum.raster import shadow
 
-    binned = bin_item(item, camera, bool(item.mesh.is_watertight), tile_bits=TILED_BITS)
+    if cull is None:
+        cull = bool(item.mesh.is_watertight)
+    binned = bin_item(item, camera, cull, tile_bits=TILED_BITS)
     tiling = np.array([1 << TILED_BITS, binned.tiles_x, 0, depth.shape[1], depth.shape[0]], dtype=np.int64)
     shadow.fill_depth_tiles(
         binned.faces, binned.win_int, binned.win_float, binned.tri_int, binned.tri_float, binned.tile_starts,
         binned.tile_entries, tiling, depth, fresh,
     )  # fmt: skip
+
+
+def caster_groups(casters: list[SceneItem], keys: list[tuple | None]) -> list[tuple[SceneItem, bool]]:
+    """The casters as at most two items to fill a map with in one pass each (``merged.merge``): the closed meshes
+    (back faces skipped) and the open ones (both sides), each with its culling; a group of one item is that item.
+    `keys`: each caster's ``casters_key`` (the merged groups are kept under them)."""
+    groups = []
+    for cull in (True, False):
+        chosen = [(item, key) for item, key in zip(casters, keys, strict=True) if bool(item.mesh.is_watertight) == cull]
+        if len(chosen) == 1:
+            groups.append((chosen[0][0], cull))
+        elif chosen:
+            parts = [key for _, key in chosen]
+            key = None if any(part is None for part in parts) else ("group", cull, *parts)
+            groups.append((merged.merge([item for item, _ in chosen], key).item, cull))
+    return groups
 
 
 def light_fractions(
@@ -301,11 +322,12 @@ def light_fractions(
             views[face] = map_record(light_camera, texel, light)
         key = map_key(every, [light_camera for light_camera, _ in cameras], views)
         maps = kept_maps(key, (len(cameras), size, size))
-        if maps is None:
+        if maps is None:  # all casters in one pass per culling (caster_groups)
             maps = take_array((len(cameras), size, size), np.float32)
+            groups = caster_groups(casters, keys)
             for face, (light_camera, _) in enumerate(cameras):
-                for number, item in enumerate(casters):
-                    draw_depth(item, light_camera, maps[face], number == 0)
+                for number, (item, cull) in enumerate(groups):
+                    draw_depth(item, light_camera, maps[face], number == 0, cull)
         shadow.map_visibility(depth, points, facing, maps, views, np.ascontiguousarray(lights[channel]),
                               float(options.softness), seen, channel)  # fmt: skip
         keep_maps(key, maps)

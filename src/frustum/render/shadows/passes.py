@@ -140,39 +140,49 @@ def lit_per_light(
     return lit
 
 
-def tiled(scene: Scene, item: SceneItem, options: RenderOptions, lights: np.ndarray) -> bool:
-    """Whether a frame of this one opaque mesh with shadow maps goes through the one-mesh tile pipeline with
-    shadows (``draw_tiled``): shading that is the directional fast path's without shadows (``stages.directional``)
-    and no buffer to read back."""
-    if options.shadow is None or options.shadow.method != "map" or options.buffers:
+def tiled(scene: Scene, items: list[SceneItem], options: RenderOptions, lights: np.ndarray) -> bool:
+    """Whether a frame of these opaque meshes with shadow maps goes through the tile pipeline with shadows
+    (``draw_tiled``): every item with faces, shading that is the directional fast path's without shadows
+    (``stages.directional``) and no buffer to read back."""
+    if options.shadow is None or options.shadow.method != "map" or options.buffers or not items:
         return False
-    return directional(item, dataclasses.replace(options, shadow=None), lights)
+    plain = dataclasses.replace(options, shadow=None)
+    return all(item.mesh.face_count > 0 and directional(item, plain, lights) for item in items)
 
 
 def draw_tiled(
-    scene: Scene, item: SceneItem, camera: Camera, options: RenderOptions, lighting: Lighting, context: FrameContext
+    scene: Scene, items: list[SceneItem], camera: Camera, options: RenderOptions, lighting: Lighting,
+    context: FrameContext,
 ) -> None:  # fmt: skip
-    """Stages 1–5 of a frame of one opaque mesh with shadow maps, tile by tile (``raster.shadow_tiled``): each
-    shadow-casting (directional) light's map is fitted to what the camera can see of the mesh before anything is
-    drawn (``fractions.view_map``) and filled, or taken as it is from an earlier frame where nothing it depends
-    on changed (``fractions.kept_maps``: the same vertex and face bytes, modeling transform, light camera and
-    size, as in a turntable of a model the camera sees whole under a fixed sun); then each tile is filled and
-    shaded, the map lookups made per pixel inside the shading (no image-sized world points, normals or
-    fractions)."""
+    """Stages 1–5 of a frame of opaque meshes with shadow maps, tile by tile (``raster.shadow_tiled``): several
+    items are drawn as one world-space mesh (``merged.merge``, each face shaded with its item's parameters), each
+    shadow-casting (directional) light's map is fitted to what the camera can see of the meshes before anything is
+    drawn (``fractions.view_map``) and filled in one pass per culling (``fractions.caster_groups``), or taken as
+    it is from an earlier frame where nothing it depends on changed (``fractions.kept_maps``: the same vertex and
+    face bytes and modeling transform of every item, light camera and size, as in a turntable of a model the
+    camera sees whole under a fixed sun); then each tile is filled and shaded, the map lookups made per pixel
+    inside the shading (no image-sized world points, normals or fractions)."""
     from frustum.raster import shadow, shadow_tiled
-    from frustum.render.shadows import fractions
+    from frustum.render.shadows import fractions, merged
 
-    binned = bin_item(item, camera, options.cull, 0, context.scratch, tile_bits=TILED_BITS)
-    world, normals = world_attributes(item, context.scratch)
-    lights = lighting.lights
     size, softness = options.shadow.map_size, float(options.shadow.softness)
     rows, casting = fractions.shadow_lights(scene)
-    cull = bool(item.mesh.is_watertight)
-    casters = fractions.casters_key(item, cull) if casting else None
+    keys = [fractions.casters_key(item, bool(item.mesh.is_watertight)) for item in items] if casting else []
+    casters = None if not keys or any(key is None for key in keys) else tuple(keys)
+    if len(items) == 1:
+        item, owner = items[0], np.empty(0, dtype=np.int32)
+        world, normals = world_attributes(item, context.scratch)
+        casters = casters[0] if casters else None
+    else:
+        kept = None if not keys or any(key is None for key in keys) else ("frame", *keys)
+        one = merged.merge(items, kept)
+        item, owner, world, normals = one.item, one.owner, one.item.mesh.vertices, one.normals
+    binned = bin_item(item, camera, options.cull, 0, context.scratch, tile_bits=TILED_BITS)
     fitted = [fractions.view_map(light, world, camera, size, softness, casters) for light in casting]
     records = [(row, found) for row, found in zip(rows, fitted, strict=True) if found is not None]
     check_memory(len(records) * size * size * 4, where="render",
                  cause=f"shadow_map_size = {size} with {len(records)} shadow-casting light(s)")  # fmt: skip
+    lights = lighting.lights
     shape = (max(len(records), 1), size, size)
     views = np.zeros((shape[0], shadow.MAP_FIELDS))
     map_of = np.full(lights.shape[0], -1, dtype=np.int64)
@@ -185,14 +195,16 @@ def draw_tiled(
     maps = fractions.kept_maps(key, shape)
     if maps is None:
         maps = take_array(shape, np.float32)
+        groups = fractions.caster_groups(items, keys) if records and len(items) > 1 else [(item, None)]
         for m, (_, (light_camera, _)) in enumerate(records):
-            fractions.draw_depth(item, light_camera, maps[m], True)
+            for number, (caster, cull) in enumerate(groups):
+                fractions.draw_depth(caster, light_camera, maps[m], number == 0, cull)
     tiling = np.array([1 << TILED_BITS, binned.tiles_x, 0, camera.width, camera.height], dtype=np.int64)
-    params = shading_parameters(item, camera, options, lighting.ambient)
+    params = np.array([shading_parameters(placed, camera, options, lighting.ambient) for placed in items])
     flags = item_flags(0, 0, options, False, False, False)
     shadow_tiled.draw_tiles_shadowed(
         binned.faces, binned.win_int, binned.win_float, binned.tri_int, binned.tri_float, binned.tri_weights,
         binned.tile_starts, binned.tile_entries, tiling, context.depth, world, normals, params, lights,
-        flags, options.background, context.color, maps, views, map_of, softness,
+        flags, options.background, context.color, maps, views, map_of, softness, owner,
     )  # fmt: skip
     fractions.keep_maps(key, maps)
