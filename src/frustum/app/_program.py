@@ -87,12 +87,18 @@ def main(arguments: Sequence[str] | None = None) -> None:
     if arguments is not None:
         status = run_render(request)
     else:
-        from frustum.app import resident
+        from frustum.app import resident_identity
 
-        status = resident.handed(request)
+        status = None
+        if resident_identity.maybe_running():  # the client (sockets, JSON) is imported only then
+            from frustum.app import resident
+
+            status = resident.handed(request)
         if status is None:
             status = as_program(lambda: run_render(request))
-            if status == 0 and resident.wanted():
+            if status == 0 and resident_identity.wanted():
+                from frustum.app import resident
+
                 resident.start()
     if status:
         raise SystemExit(status)

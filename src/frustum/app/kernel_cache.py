@@ -1,0 +1,51 @@
+"""A command's kernels loaded from Numba's on-disk cache without Numba's whole-target refresh first.
+
+Numba's ``Cache.load_overload`` calls ``target_context.refresh()`` before it loads a cached kernel: the refresh
+imports and installs every implementation registry of the CPU target (about 60 modules: typed containers, the
+random generators, jitclass, datetime, the CFFI parser, the third-party entry points) and initialises Numba's
+runtime (NRT). Loading machine code from the cache needs only the runtime; the registries are for compiling. On a
+warm command that refresh was most of the "kernel loading" stage (about 0.08 s of the 0.11 s of four kernels).
+
+``load_kernels_lean`` makes the cache load initialise the runtime alone. Nothing else changes: a kernel missing
+from the cache still compiles, and Numba's compiler refreshes the whole target before it compiles
+(``CompilerBase.__init__``), so a compile sees every registry as before. The machine code loaded is the same
+bytes, so every output is the same. It is the program's choice (``frustum.app.work.render_files``): a library
+user's process keeps Numba's own order.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+__all__ = ["load_kernels_lean"]
+
+_STATE = {"installed": False}
+
+
+def load_kernels_lean() -> None:
+    """Load cached kernels with Numba's runtime initialised instead of the whole target refreshed (once per
+    process; nothing under ``NUMBA_DISABLE_JIT=1`` or on a Numba without these names)."""
+    if _STATE["installed"]:
+        return
+    _STATE["installed"] = True
+    import numba
+
+    if numba.config.DISABLE_JIT:
+        return
+    try:
+        from numba.core import caching
+        from numba.core.runtime import nrt
+    except ImportError:  # pragma: no cover - a Numba laid out differently: keep its own order
+        return
+    cache_class = getattr(caching, "Cache", None)
+    if cache_class is None or not hasattr(cache_class, "_load_overload") or not hasattr(nrt, "rtsys"):
+        return  # pragma: no cover
+
+    def load_overload(cache: Any, signature: Any, target_context: Any) -> Any:
+        nrt.rtsys.initialize(target_context)  # what the loaded machine code calls (NRT_* symbols)
+        with cache._guard_against_spurious_io_errors():
+            return cache._load_overload(signature, target_context)
+        return None  # pragma: no cover - the guard swallowed an I/O error: compile instead, as Numba does
+
+    load_overload.__doc__ = cache_class.load_overload.__doc__
+    cache_class.load_overload = load_overload
