@@ -15,7 +15,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from frustum.app.runtime import as_program
+from frustum.app.runtime import as_program, end_program
 
 __all__ = ["main", "plain_render"]
 
@@ -74,7 +74,7 @@ def main(arguments: Sequence[str] | None = None) -> None:
     purpose and takes it (``frustum.app.resident``: the same work without the start-up); otherwise it runs here as
     a short-lived program (``runtime.as_program``). Only with ``FRUSTUM_RESIDENT=1`` and only after a successful
     render does it start a resident process for the next command (and says so); by default nothing is left
-    behind."""
+    behind. As the program it ends with ``runtime.end_program`` (no tear-down of the modules)."""
     from frustum.app.work import run_render
 
     argv = list(sys.argv[1:] if arguments is None else arguments)
@@ -100,5 +100,6 @@ def main(arguments: Sequence[str] | None = None) -> None:
                 from frustum.app import resident
 
                 resident.start()
+        end_program(status)
     if status:
         raise SystemExit(status)

@@ -6,18 +6,19 @@ The bottom of the program's package (``frustum.app``): it imports nothing of the
 
 from __future__ import annotations
 
+import contextlib
 import gc
 import os
 import sys
 import threading
 import time
 from collections.abc import Callable
-from typing import Any
+from typing import Any, NoReturn
 
 from frustum.errors import FrustumError
 
-__all__ = ["GC_PAUSE_S", "INTERRUPTED_STATUS", "REPORTED", "UsageError", "as_program", "fail", "failure",
-           "install_compile_notice", "run_interruptible", "say"]  # fmt: skip
+__all__ = ["GC_PAUSE_S", "INTERRUPTED_STATUS", "REPORTED", "UsageError", "as_program", "end_program", "fail",
+           "failure", "install_compile_notice", "run_interruptible", "say"]  # fmt: skip
 
 
 class UsageError(FrustumError):
@@ -94,6 +95,24 @@ def as_program(work: Callable[[], Any]) -> Any:
         return work()
     finally:
         gc.freeze()
+
+
+def end_program(code: int | str | None) -> NoReturn:
+    """End the program now with ``SystemExit``'s `code` (None: 0; a text: printed on stderr, status 1): standard
+    streams flushed and exit handlers run (``atexit``: a background compiler child is stopped, coverage saved),
+    then ``os._exit``, without Python's tear-down of its modules one by one (Numba's ~800 with NumPy's: about
+    0.03 s of CPU of a warm render even with every object frozen). Only for the program's own process (``main``
+    with no arguments): called from Python the commands return or raise as usual."""
+    import atexit
+
+    if isinstance(code, str):
+        say(code, sys.stderr)
+        code = 1
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(OSError, ValueError):  # a closed pipe (``| head``): nothing more can be said there
+            stream.flush()
+    atexit._run_exitfuncs()
+    os._exit(int(code or 0) & 0xFF)
 
 
 def run_interruptible(work: Callable[[], Any]) -> Any:
