@@ -60,11 +60,12 @@ def render_files(scene: Path, output: Sequence[Path] | None, size: str | None, u
                  shadows: str | None) -> list[Path]:  # fmt: skip
     """``frustum render``: render the scene or mesh file `scene` to `output` (None: the file's outputs) and
     return the files written."""
-    from frustum.app.kernel_cache import load_kernels_lean
+    from frustum.app.numba_start import load_kernels_lean
+
+    load_kernels_lean()  # first: Numba imported and set to load kernels the program's way (``numba_start``)
     from frustum.app.warmup import compile_in_background
     from frustum.scenefile import render_scene_file
 
-    load_kernels_lean()
     compile_in_background()  # a cold cache: a second process compiles part of the kernels meanwhile
 
     written = render_scene_file(scene, list(output) if output else None, size=image_size(size) if size else None,
