@@ -18,7 +18,7 @@ from typing import Any, NoReturn
 from frustum.errors import FrustumError
 
 __all__ = ["GC_PAUSE_S", "INTERRUPTED_STATUS", "REPORTED", "UsageError", "as_program", "end_program", "fail",
-           "failure", "install_compile_notice", "run_interruptible", "say"]  # fmt: skip
+           "failure", "install_compile_notice", "report_failure", "run_interruptible", "say"]  # fmt: skip
 
 
 class UsageError(FrustumError):
@@ -63,6 +63,13 @@ def error_line(message: str) -> str:
     from frustum._arrays import escape_control
 
     return f"error: {escape_control(message, keep_newlines=True)}"
+
+
+def report_failure(error: BaseException) -> int:
+    """Print `error` as the program's one ``error:`` line on stderr (``failure``); its exit status."""
+    text, status = failure(error)
+    say(error_line(text), sys.stderr)
+    return status
 
 
 def fail(message: str, status: int) -> None:
