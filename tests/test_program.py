@@ -197,3 +197,28 @@ def test_the_program_ends_at_once_but_runs_its_exit_handlers(tmp_path):
                                 text=True, timeout=300, check=False)  # fmt: skip
         assert result.returncode == status, result.stderr
         assert result.stdout.endswith("exit handler ran\n") and "not reached" not in result.stdout
+
+
+def test_numbas_runtime_is_kept_compiled_beside_the_kernels_and_serves_a_later_compile(tmp_path):
+    """``numba_start._initialize_runtime``: the runtime's object code left in the kernels' cache folder by one
+    command is loaded by the next (a damaged file is compiled anew), and a kernel compiled afterwards links it."""
+    code = (
+        "import glob, os\nfrom pathlib import Path\nimport numpy as np\nfrom frustum.app.work import render_files\n"
+        f"render_files(Path({str(BUNNY)!r}), [Path('out.png')], '32x24', 'y', None)\n"
+        "from frustum.raster.tiles import fill_tiles\nimport numba\n"
+        "print(len(glob.glob(os.path.join(fill_tiles.kernel._cache._cache_path, 'numba-runtime-*.nrt'))))\n"
+        "allocating = numba.njit(lambda n: np.ones(n) * 2)\nprint(allocating(3).tolist())\n"
+    )  # fmt: skip
+    outputs = []
+    for damage in (False, False, True, False):
+        if damage:
+            script = "from frustum.raster.tiles import fill_tiles as k; print(k.kernel._cache._cache_path)"
+            folder = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True)
+            for path in Path(folder.stdout.strip()).glob("numba-runtime-*.nrt"):
+                path.write_bytes(b"not a pickle")
+            continue
+        result = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True,
+                                timeout=300, check=False)  # fmt: skip
+        assert result.returncode == 0, result.stderr
+        outputs.append(((tmp_path / "out.png").read_bytes(), result.stdout.splitlines()))
+    assert all(output == (outputs[0][0], ["1", "[2.0, 2.0, 2.0]"]) for output in outputs)

@@ -24,6 +24,7 @@ from frustum.app.runtime import (
     install_compile_notice,
     report_failure,
     run_interruptible,
+    run_program,
 )
 
 __all__ = ["main", "plain_render", "render_words"]
@@ -123,7 +124,7 @@ def main(arguments: Sequence[str] | None = None) -> None:
             typer_main(arguments)
             return
         if arguments is None:
-            end_program(as_program(lambda: _render_inputs(found)))
+            run_program(lambda: _render_inputs(found))
         status = _render_inputs(found)
     elif arguments is not None:
         status = run_render(request)

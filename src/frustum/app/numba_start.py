@@ -78,7 +78,7 @@ def load_kernels_lean() -> None:
         return  # pragma: no cover
 
     def load_overload(cache: Any, signature: Any, target_context: Any) -> Any:
-        nrt.rtsys.initialize(target_context)  # what the loaded machine code calls (NRT_* symbols)
+        _initialize_runtime(target_context, getattr(cache, "_cache_path", None))  # what the machine code calls
         with cache._guard_against_spurious_io_errors():
             return cache._load_overload(signature, target_context)
         return None  # pragma: no cover - the guard swallowed an I/O error: compile instead, as Numba does
@@ -96,3 +96,76 @@ def _extensions_with_the_refresh(dispatcher: Any) -> None:
     """A kernel's first call: Numba's third-party extensions (entry points ``numba_extensions``) are initialised by
     the target refresh before a compile (``numba.core.entrypoints.init_all`` in the CPU target's registries), not
     here before the arguments' typing: frustum passes NumPy arrays and numbers, which no extension types."""
+
+
+def _runtime_key(target_context: Any) -> tuple:
+    """What the runtime's machine code depends on: Numba, llvmlite, Python, and the codegen's target (triple, CPU
+    name and features: ``magic_tuple``, as Numba keys its cache)."""
+    import llvmlite
+    import numba
+
+    return (numba.__version__, llvmlite.__version__, sys.version, target_context.codegen().magic_tuple())
+
+
+def _initialize_runtime(target_context: Any, folder: str | None) -> None:
+    """Initialise Numba's runtime as ``nrt.rtsys.initialize`` does, with its machine code from `folder` (the loading
+    kernel's cache folder) where an earlier command left it, else compiled and left there.
+
+    ``rtsys.initialize`` registers the runtime's C helpers and compiles its LLVM module (reference counting, memory
+    information) on every start: about 0.02 s of CPU. Here the compiled object code is kept in
+    ``numba-runtime-<key>.nrt`` (keyed by ``_runtime_key``, written atomically) and loaded as Numba loads a cached
+    kernel (``unserialize_library``); a missing, unreadable or foreign file means compiling, as Numba does."""
+    import pickle
+    import zlib
+
+    from llvmlite import binding
+    from numba.core import config
+    from numba.core.compiler_lock import global_compiler_lock
+    from numba.core.runtime import _nrt_python, nrt, nrtdynmod
+
+    runtime = nrt.rtsys
+    with global_compiler_lock:
+        if runtime._init:
+            return
+        if folder is None or not hasattr(nrtdynmod, "create_nrt_module"):  # pragma: no cover - another Numba
+            runtime.initialize(target_context)
+            return
+        key = _runtime_key(target_context)
+        path = os.path.join(folder, f"numba-runtime-{zlib.crc32(repr(key).encode()):08x}.nrt")
+        try:
+            with open(path, "rb") as file:
+                stored_key, state = pickle.load(file)
+        except Exception:  # missing, unreadable, truncated: compiled below
+            stored_key, state = None, None
+        if config.NRT_STATS:
+            _nrt_python.memsys_enable_stats()
+        for name, address in _nrt_python.c_helpers.items():
+            binding.add_symbol(name if name.startswith("_") else f"NRT_{name}", address)
+        if stored_key == key:
+            runtime._library = target_context.codegen().unserialize_library(state)
+        else:
+            module, library = nrtdynmod.create_nrt_module(target_context)
+            library.add_ir_module(module)
+            library.enable_object_caching()
+            library.finalize()
+            _keep(path, (key, library.serialize_using_object_code()))
+            runtime._library = library
+        runtime._init = True
+
+
+def _keep(path: str, value: Any) -> None:
+    """Write `value` pickled to `path` atomically (a temporary renamed); nothing when the folder cannot be
+    written."""
+    import contextlib
+    import pickle
+    import tempfile
+
+    with contextlib.suppress(OSError):
+        handle, temporary = tempfile.mkstemp(dir=os.path.dirname(path), suffix=".part")
+        try:
+            with os.fdopen(handle, "wb") as file:
+                pickle.dump(value, file, protocol=pickle.HIGHEST_PROTOCOL)
+            os.replace(temporary, path)
+        finally:
+            with contextlib.suppress(OSError):
+                os.unlink(temporary)

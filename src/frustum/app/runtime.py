@@ -18,7 +18,8 @@ from typing import Any, NoReturn
 from frustum.errors import FrustumError
 
 __all__ = ["GC_PAUSE_S", "INTERRUPTED_STATUS", "REPORTED", "UsageError", "as_program", "end_program", "fail",
-           "failure", "install_compile_notice", "report_failure", "run_interruptible", "say"]  # fmt: skip
+           "failure", "install_compile_notice", "report_failure", "run_interruptible", "run_program",
+           "say"]  # fmt: skip
 
 
 class UsageError(FrustumError):
@@ -102,6 +103,16 @@ def as_program(work: Callable[[], Any]) -> Any:
         return work()
     finally:
         gc.freeze()
+
+
+def run_program(work: Callable[[], Any]) -> NoReturn:
+    """Run `work` as the program (``as_program``) and end the process with its exit status (``end_program``): the
+    value it returns when an int, else 0, or the code of the ``SystemExit`` it raises."""
+    try:
+        status = as_program(work)
+    except SystemExit as exit:
+        end_program(exit.code)
+    end_program(status if isinstance(status, int) else 0)
 
 
 def end_program(code: int | str | None) -> NoReturn:
