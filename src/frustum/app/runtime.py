@@ -116,23 +116,24 @@ def run_program(work: Callable[[], Any]) -> NoReturn:
 
 
 def end_program(code: int | str | None) -> NoReturn:
-    """End the program now with ``SystemExit``'s `code` (None: 0; a text: printed on stderr, status 1): standard
-    streams flushed, other threads' work waited for and exit handlers run (``atexit``: a background compiler child
-    is stopped, coverage saved), then ``os._exit``, without Python's tear-down of its modules one by one (Numba's
-    ~800 with NumPy's: about 0.03 s of CPU of a warm render even with every object frozen). Only for the program's
-    own process (``main`` with no arguments): called from Python the commands return or raise as usual."""
+    """End the program now with ``SystemExit``'s `code` (None: 0; a text: printed on stderr, status 1) as Python
+    ends, in its order: other threads' work waited for, exit handlers run (``atexit``: a background compiler child
+    is stopped, coverage saved), standard streams flushed; then ``os._exit``, without Python's tear-down of its
+    modules one by one (Numba's ~800 with NumPy's: about 0.03 s of CPU of a warm render even with every object
+    frozen). Only for the program's own process (``main`` with no arguments): called from Python the commands
+    return or raise as usual."""
     import atexit
 
     if isinstance(code, str):
         say(code, sys.stderr)
         code = 1
-    for stream in (sys.stdout, sys.stderr):
-        with contextlib.suppress(OSError, ValueError):  # a closed pipe (``| head``): nothing more can be said there
-            stream.flush()
     shutdown = getattr(threading, "_shutdown", None)  # what Python does first at its end: thread pools told to end,
     if shutdown is not None:  # work still running on other (not daemon) threads waited for
         shutdown()
     atexit._run_exitfuncs()
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(OSError, ValueError):  # a closed pipe (``| head``): nothing more can be said there
+            stream.flush()
     os._exit(int(code or 0) & 0xFF)
 
 
