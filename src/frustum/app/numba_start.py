@@ -1,5 +1,6 @@
 """Numba's start-up as a short-lived command needs it: imported without the optional packages its import only
-probes, and the kernels loaded from its on-disk cache without its whole-target refresh first.
+probes, the kernels loaded from its on-disk cache without its whole-target refresh first, and its runtime loaded
+compiled instead of compiled anew.
 
 **The import** (``import_numba``). ``import numba`` imports PyYAML (to read a ``.numba_config.yaml`` in the working
 folder), colorama (for coloured error messages under ``NUMBA_COLOR_SCHEME``) and SciPy (to check its version):
@@ -19,7 +20,10 @@ Nothing else changes: a kernel missing from the cache still compiles, and Numba'
 target, extensions included, before it compiles (``CompilerBase.__init__``), so a compile sees every registry as
 before. The machine code loaded is the same bytes, so every output is the same.
 
-Both are the program's choice (``frustum.app.work.render_files``, ``frustum.app.timing``): a library user's
+**The runtime** (``_initialize_runtime``): Numba compiles its runtime's LLVM module on every start; here its object
+code is kept beside the kernels and loaded, as a cached kernel is.
+
+All three are the program's choice (``frustum.app.work.render_files``, ``frustum.app.timing``): a library user's
 process keeps Numba's own order.
 """
 
@@ -53,6 +57,7 @@ def import_numba() -> None:
         for name in hidden:
             if name in sys.modules and sys.modules[name] is None:
                 del sys.modules[name]
+
 
 _STATE = {"installed": False}
 
