@@ -134,6 +134,7 @@ def main() -> None:
 def _compare(args: argparse.Namespace, frustum_cli: list[str], folder: Path, env: dict[str, str],
              own_env: dict[str, str], have_f3d: bool) -> None:  # fmt: skip
     files = make_files(folder)
+    print(f"load average at the start: {' '.join(f'{v:.2f}' for v in os.getloadavg())} ({os.cpu_count()} cores)")
     first_name, (first, up) = next(iter(files.items()))
     if not args.no_cold:
         cold_env = {**own_env, "NUMBA_CACHE_DIR": str(folder / "empty_cache")}
@@ -178,6 +179,7 @@ def _compare(args: argparse.Namespace, frustum_cli: list[str], folder: Path, env
     print(f"(b) six files in one command: {batch_wall:.2f} s ({batch_cpu:.2f} s CPU), per file {batch_wall / 6:.3f} s "
           f"= {batch_wall / 6 / f3d_wall:.2f}x F3D's median per file ({f3d_wall:.2f} s); CPU per file "
           f"{batch_cpu / 6:.3f} s = {batch_cpu / 6 / f3d_cpu:.2f}x F3D's ({f3d_cpu:.2f} s)")  # fmt: skip
+    print(f"load average at the end: {' '.join(f'{v:.2f}' for v in os.getloadavg())}")
 
 
 if __name__ == "__main__":

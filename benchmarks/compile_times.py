@@ -45,6 +45,26 @@ class Listener(event.Listener):
                         "signature": str(ev.data["args"])[:200]})
 
 event.register("numba:compile", Listener())
+
+
+def report():
+    wall = time.perf_counter() - start
+    import resource
+    try:
+        from frustum.raster import _background
+        helper = _background._started  # the second compiler (frustum.raster._background), if one was started
+    except ImportError:  # a frustum without one
+        helper = None
+    if helper is not None:
+        helper.process.wait()  # it has ended by now (its last kernel is one the render waited for), or ends at once
+    helper_cpu = resource.getrusage(resource.RUSAGE_CHILDREN)
+    print("@@" + json.dumps({"records": records, "wall": wall, "cpu": time.process_time(),
+                             "helper": helper is not None and {"reported": helper.reported, "waited": helper.waited,
+                                                               "cpu": helper_cpu.ru_utime + helper_cpu.ru_stime}}))
+
+
+import atexit
+atexit.register(report)  # the program ends its process itself, after the exit handlers (runtime.end_program)
 from frustum.app.cli import main
 sys.argv[0] = "frustum"
 try:
@@ -52,19 +72,6 @@ try:
 except SystemExit as stop:
     if stop.code:
         raise
-wall = time.perf_counter() - start
-import resource
-try:
-    from frustum.raster import _background
-    helper = _background._started  # the second compiler (frustum.raster._background), if one was started
-except ImportError:  # a frustum without one
-    helper = None
-if helper is not None:
-    helper.process.wait()  # it has ended by now (its last kernel is one the render waited for), or ends at once
-helper_cpu = resource.getrusage(resource.RUSAGE_CHILDREN)
-print("@@" + json.dumps({"records": records, "wall": wall, "cpu": time.process_time(),
-                         "helper": helper is not None and {"reported": helper.reported, "waited": helper.waited,
-                                                           "cpu": helper_cpu.ru_utime + helper_cpu.ru_stime}}))
 """
 
 

@@ -135,7 +135,8 @@ def test_turntable_view_and_info_take_several_files(tmp_path):
 
 
 APP = ROOT / "src" / "frustum" / "app"
-ORDER = ["_program", "cli", "resident", "resident_identity", "mesh_info", "many", "work", "warmup", "timing", "runtime"]
+ORDER = ["_program", "cli", "resident", "resident_identity", "mesh_info", "many", "work", "warmup", "timing",
+         "numba_start", "runtime"]
 
 
 def _imports(module: str) -> set[str]:

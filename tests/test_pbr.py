@@ -406,6 +406,18 @@ def test_a_base_color_texture_is_decoded_from_srgb():
     assert np.array_equal(material.with_(roughness=0.3).texture, material.texture)
 
 
+def test_an_8_bit_base_color_texture_is_decoded_to_the_bytes_of_its_float_form():
+    """Bytes go through a table of the curve at their 256 values: the same float32s as the curve at k/255."""
+    values = np.arange(256, dtype=np.uint8)
+    for encoded in (np.stack([values, values[::-1], values], axis=-1).reshape(16, 16, 3),
+                    np.stack([values, values, values[::-1], values], axis=-1).reshape(16, 16, 4),
+                    values.reshape(16, 16)):  # fmt: skip
+        as_floats = encoded.astype(np.float32) / np.float32(255.0)
+        table = fr.Material(base_color_texture=encoded, model="pbr").texture
+        curve = fr.Material(base_color_texture=as_floats, model="pbr").texture
+        assert table.dtype == curve.dtype == np.float32 and np.array_equal(table, curve)
+
+
 # --- ray tracing ----------------------------------------------------------------------------------------------------
 
 

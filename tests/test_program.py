@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from frustum.app._program import plain_render
+from frustum.app._program import plain_render, render_words
 from testdata import DATA
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -49,6 +49,21 @@ def test_other_command_lines_go_to_typer(argv):
     assert plain_render(argv) is None
 
 
+@pytest.mark.parametrize(
+    ("argv", "taken"),
+    [
+        (["render", "a.ply", "b.ply"], {"scenes": ["a.ply", "b.ply"], "jobs": None}),
+        (["render", "models/*.ply", "-o", "{stem}.png", "-j", "4"], {"scenes": ["models/*.ply"], "jobs": "4"}),
+        (["render", "a.ply", "--jobs=2", "--up", "z"], {"scenes": ["a.ply"], "jobs": "2", "up": "z"}),
+        (["render", "a.ply", "--jobs", "x"], None), (["render", "a.ply", "--jobs", "2", "-j", "3"], None),
+        (["render", "a.ply", "-j=2"], None), (["render", "-o", "x.png"], None), (["render", "a.ply", "--help"], None),
+    ],
+)  # fmt: skip
+def test_the_many_files_command_lines_run_without_typer(argv, taken):
+    found = render_words(argv)
+    assert (found if taken is None else {key: found[key] for key in taken}) == taken
+
+
 def _both(tmp_path: Path, *arguments: str) -> tuple[subprocess.CompletedProcess[str], ...]:
     """The command line run as the program (its own path) and through Typer, each writing into its own folder."""
     results = []
@@ -71,6 +86,7 @@ def _quiet(stderr: str) -> str:
         (str(BUNNY), "-o", "out.png", "--size", "64x48"),
         (str(DATA / "teapot_n10.obj"), "--output=a.png", "-o", "b.svg", "--up", "z", "--size=48x32"),
         (str(ROOT / "examples" / "teapot.toml"), "-o", "t.png", "--size", "40x30", "--shadows", "off"),
+        (str(BUNNY), str(DATA / "teapot_n10.obj"), "-o", "{index}-{stem}.png", "--size=40x30", "-j", "1"),
     ],
 )
 def test_the_program_writes_what_typer_writes(tmp_path, arguments):
@@ -92,6 +108,10 @@ def test_the_program_writes_what_typer_writes(tmp_path, arguments):
         ((str(BUNNY), "-o", "x.png", "--shadows", "maybe"), 1, "--shadows 'maybe' is unknown"),
         ((str(BUNNY), "-o", "x.png", "--up", "x"), 1, "up = 'x' is not an axis"),
         ((str(BUNNY), "-o", "x.bmp"), 1, "has suffix '.bmp'"),
+        ((str(BUNNY), str(BUNNY), "-o", "{stem}.png"), 2, "would both write"),
+        ((str(BUNNY), str(DATA / "teapot_n10.obj"), "-o", "x.png"), 2, "names one file for 2 inputs"),
+        ((str(BUNNY), str(DATA / "teapot_n10.obj"), "-o", "{stem}.png", "--jobs", "0"), 2, "--jobs = 0"),
+        (("no-such-folder/*.ply", "-o", "{stem}.png"), 2, "matches no file"),
     ],
 )
 def test_the_program_fails_as_typer_does(tmp_path, arguments, status, fragment):
@@ -103,16 +123,19 @@ def test_the_program_fails_as_typer_does(tmp_path, arguments, status, fragment):
 
 def test_a_plain_render_imports_no_command_line_library_nor_what_it_does_not_use(tmp_path):
     code = (
-        "import sys\nfrom frustum.app._program import main\n"
-        f"sys.argv = ['frustum', 'render', {str(BUNNY)!r}, '-o', 'out.png', '--size', '32x24']\nmain()\n"
-        "print(sorted({m.split('.')[0] for m in sys.modules} & {'typer', 'click', 'rich', 'pydantic', 'trimesh',\n"
-        "     'skimage', 'imageio', 'cairosvg', 'manifold3d', 'multiprocessing'}))\n"
+        "import atexit, sys\nfrom frustum.app._program import main\nsys.argv = ['frustum', *sys.argv[1:]]\n"
+        "atexit.register(lambda: print(sorted({m.split('.')[0] for m in sys.modules} & {'typer', 'click', 'rich',\n"
+        "     'pydantic', 'trimesh', 'skimage', 'imageio', 'cairosvg', 'manifold3d', 'multiprocessing'})))\n"
+        "main()  # the program's end runs the exit handlers\n"
     )
-    result = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True, timeout=300,
-                            check=False)  # fmt: skip
-    assert result.returncode == 0, result.stderr
-    assert result.stdout.splitlines() == ["wrote out.png", "[]"]
-    assert (tmp_path / "out.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    for arguments, written in ((["-o", "out.png"], ["out.png"]),  # one file, and two (a batch, not on a terminal)
+                               ([str(DATA / "teapot_n10.obj"), "-o", "{stem}.png"], ["bun_zipper_res4.png",
+                                                                                      "teapot_n10.png"])):  # fmt: skip
+        result = subprocess.run([sys.executable, "-c", code, "render", str(BUNNY), *arguments, "--size", "32x24"],
+                                cwd=tmp_path, capture_output=True, text=True, timeout=300, check=False)  # fmt: skip
+        assert result.returncode == 0, result.stderr
+        assert result.stdout.splitlines() == [*(f"wrote {name}" for name in written), "[]"]
+        assert all((tmp_path / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" for name in written)
 
 
 def test_frustum_profile_times_each_stage_and_changes_nothing(tmp_path):
@@ -132,3 +155,70 @@ def test_frustum_profile_times_each_stage_and_changes_nothing(tmp_path):
     total = float(line.split("; total ")[1].removesuffix(" s"))
     assert all(value >= 0 for value in seconds) and sum(seconds) <= total * 1.05 + 0.01
     assert (tmp_path / "plain.png").read_bytes() == (tmp_path / "timed.png").read_bytes()
+
+
+def test_a_warm_plain_render_imports_neither_what_numba_only_probes_nor_its_compiler_registries(tmp_path):
+    """``frustum.app.numba_start``: PyYAML, colorama and SciPy hidden while Numba imports, and cached kernels loaded
+    without the CPU target's refresh (its registries: CFFI, the random generators) nor the extensions' entry points.
+    The first run fills the cache (a cold one compiles, and a compile refreshes the target as Numba does)."""
+    code = (
+        "import sys\nfrom frustum.app._program import main\n"
+        f"sys.argv = ['frustum', 'render', {str(BUNNY)!r}, '-o', 'out.png', '--size', '32x24']\nmain([*sys.argv[1:]])\n"
+        "import numba.core.entrypoints as e\n"
+        "print(sorted(m for m in sys.modules if m.split('.')[0] in ('yaml', 'colorama', 'scipy', 'cffi') or m in\n"
+        "     ('numba.core.typing.cffi_utils', 'numba.np.random.generator_methods')), e._already_initialized)\n"
+    )
+    for _ in range(2):
+        result = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True,
+                                timeout=300, check=False)  # fmt: skip
+        assert result.returncode == 0, result.stderr
+    assert result.stdout.splitlines() == ["wrote out.png", "[] False"]
+
+
+def test_numba_is_imported_with_the_probed_packages_hidden_meanwhile_only(tmp_path):
+    code = ("import sys\nfrom frustum.app.numba_start import PROBED, import_numba\nimport_numba()\n"
+            "print([name in sys.modules for name in PROBED])\nimport yaml, colorama, scipy\nprint('imported')\n")
+    plain = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True, timeout=300,
+                           check=False)  # fmt: skip
+    assert plain.stdout.splitlines() == ["[False, False, False]", "imported"], plain.stderr
+    (tmp_path / ".numba_config.yaml").write_text("# read by Numba: PyYAML is imported for it\n")
+    configured = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True,
+                                timeout=300, check=False, env={**os.environ, "NUMBA_COLOR_SCHEME": "dark_bg"})
+    assert configured.stdout.splitlines() == ["[True, True, False]", "imported"], configured.stderr
+
+
+def test_the_program_ends_at_once_but_runs_its_exit_handlers(tmp_path):
+    code = ("import atexit, sys\natexit.register(lambda: print('exit handler ran'))\n"
+            "from frustum.app._program import main\nsys.argv = ['frustum'] + sys.argv[1:]\nmain()\n"
+            "print('not reached: main ends the process')\n")  # fmt: skip
+    for arguments, status in ((["render", "missing.ply", "-o", "x.png"], 1), (["render", str(BUNNY), "-o",
+                              "x.png", "--size", "32x24"], 0), (["info", str(BUNNY)], 0)):  # fmt: skip
+        result = subprocess.run([sys.executable, "-c", code, *arguments], cwd=tmp_path, capture_output=True,
+                                text=True, timeout=300, check=False)  # fmt: skip
+        assert result.returncode == status, result.stderr
+        assert result.stdout.endswith("exit handler ran\n") and "not reached" not in result.stdout
+
+
+def test_numbas_runtime_is_kept_compiled_beside_the_kernels_and_serves_a_later_compile(tmp_path):
+    """``numba_start._initialize_runtime``: the runtime's object code left in the kernels' cache folder by one
+    command is loaded by the next (a damaged file is compiled anew), and a kernel compiled afterwards links it."""
+    code = (
+        "import glob, os\nfrom pathlib import Path\nimport numpy as np\nfrom frustum.app.work import render_files\n"
+        f"render_files(Path({str(BUNNY)!r}), [Path('out.png')], '32x24', 'y', None)\n"
+        "from frustum.raster.tiles import fill_tiles\nimport numba\n"
+        "print(len(glob.glob(os.path.join(fill_tiles.kernel._cache._cache_path, 'numba-runtime-*.nrt'))))\n"
+        "allocating = numba.njit(lambda n: np.ones(n) * 2)\nprint(allocating(3).tolist())\n"
+    )  # fmt: skip
+    outputs = []
+    for damage in (False, False, True, False):
+        if damage:
+            script = "from frustum.raster.tiles import fill_tiles as k; print(k.kernel._cache._cache_path)"
+            folder = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True)
+            for path in Path(folder.stdout.strip()).glob("numba-runtime-*.nrt"):
+                path.write_bytes(b"not a pickle")
+            continue
+        result = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True,
+                                timeout=300, check=False)  # fmt: skip
+        assert result.returncode == 0, result.stderr
+        outputs.append(((tmp_path / "out.png").read_bytes(), result.stdout.splitlines()))
+    assert all(output == (outputs[0][0], ["1", "[2.0, 2.0, 2.0]"]) for output in outputs)

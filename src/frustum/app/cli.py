@@ -31,12 +31,12 @@ from frustum.app.runtime import (
     _STATE,
     REPORTED,
     UsageError,
-    as_program,
     error_line,
     fail,
     failure,
     install_compile_notice,
     run_interruptible,
+    run_program,
     say,
 )
 from frustum.app.work import image_size as _image_size
@@ -766,12 +766,12 @@ def main(arguments: Sequence[str] | None = None) -> None:
 
     The command runs on a worker thread (``runtime.run_interruptible``): Ctrl-C exits with status 130 within a
     fraction of a second, leaving no partial output file. Run as the program (`arguments` None), it runs as a
-    short-lived program (``runtime.as_program``); called from Python the garbage collector is left alone.
+    short-lived program (``runtime.run_program``); called from Python the garbage collector is left alone.
     """
     if arguments is not None:
         _main(list(arguments))
         return
-    as_program(lambda: _main(sys.argv[1:]))
+    run_program(lambda: _main(sys.argv[1:]))
 
 
 def _main(argv: list[str]) -> None:

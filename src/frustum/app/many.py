@@ -152,23 +152,50 @@ def _watch_parent(parent: int) -> None:
     os._exit(1)
 
 
+def _bar_may_show(count: int) -> bool:
+    """Whether Rich could show a progress bar on stderr for `count` inputs: several, and stderr a terminal or taken
+    for one (``TTY_COMPATIBLE``, ``FORCE_COLOR``). When not, Rich is not even imported (a batch in a script)."""
+    if count <= 1:
+        return False
+    if os.environ.get("TTY_COMPATIBLE") or os.environ.get("FORCE_COLOR") is not None:
+        return True
+    try:
+        return sys.stderr.isatty()
+    except ValueError:  # a closed stream
+        return False
+
+
+def _progress(label: str, count: int) -> Any:
+    """The Rich progress bar of `count` inputs on stderr (shown on a terminal only), or None (``_bar_may_show``)."""
+    if not _bar_may_show(count):
+        return None
+    from rich.console import Console
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    console = Console(stderr=True, highlight=False, soft_wrap=True)
+    columns = (TextColumn(label), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
+               TextColumn("{task.description}"))  # fmt: skip
+    return Progress(*columns, console=console, transient=True, disable=not console.is_terminal, redirect_stdout=False,
+                    redirect_stderr=False)  # fmt: skip
+
+
 def run_each(task: Task, inputs: Sequence[Path], outputs: Sequence[list[Path] | None], options: dict[str, Any],
              jobs: int = 1, label: str = "render") -> int:  # fmt: skip
     """Do `task` for every input (on `jobs` worker processes when > 1), print each one's lines (stdout) or its error
     line (stderr) as it ends, with a progress bar while there are several; the exit status (1 when any failed)."""
     if jobs < 1:
         raise UsageError(f"--jobs = {jobs} is not a number of processes; give 1 or more")
-    from rich.console import Console
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+    import contextlib
 
-    bar_console = Console(stderr=True, highlight=False, soft_wrap=True)
-    shown = bar_console.is_terminal and len(inputs) > 1
+    progress = _progress(label, len(inputs))
+    shown = progress is not None and not progress.disable
     failed = 0
-    columns = (TextColumn(label), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
-               TextColumn("{task.description}"))  # fmt: skip
-    with Progress(*columns, console=bar_console, transient=True, disable=not shown, redirect_stdout=False,
-                  redirect_stderr=False) as progress:  # fmt: skip
-        bar = progress.add_task("", total=len(inputs))
+    with progress if progress is not None else contextlib.nullcontext():
+        bar = progress.add_task("", total=len(inputs)) if progress is not None else None
+
+        def advance(description: str, steps: int = 0) -> None:
+            if progress is not None:
+                progress.update(bar, advance=steps, description=description)
 
         def report(source: Path, ok: bool, result: Any) -> None:
             nonlocal failed
@@ -180,11 +207,11 @@ def run_each(task: Task, inputs: Sequence[Path], outputs: Sequence[list[Path] | 
                 else:
                     say(line, stream)
             failed += not ok
-            progress.update(bar, advance=1, description=source.name)
+            advance(source.name, 1)
 
         if jobs == 1 or len(inputs) == 1:
             for source, paths in zip(inputs, outputs, strict=True):
-                progress.update(bar, description=source.name)
+                advance(source.name)
                 report(source, *_attempt(task, source, paths, options))
         else:
             _pool(task, inputs, outputs, options, min(jobs, len(inputs)), report)

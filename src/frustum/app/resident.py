@@ -46,7 +46,6 @@ import json
 import os
 import signal
 import socket
-import stat
 import struct
 import sys
 import time
@@ -58,6 +57,8 @@ from frustum.app.resident_identity import (  # noqa: F401 - the resident's ident
     APPLIED_PREFIXES,
     _installation,
     _package_dir,
+    _paths,
+    _private_folder,
     conditions,
     difference,
     enabled,
@@ -83,40 +84,6 @@ ACCEPT_TIMEOUT_S = 2.0
 
 MAX_LOG_BYTES = 1 << 20
 """A resident's log (beside its socket) is emptied at start only when it has grown past this size."""
-
-def _private_folder(create: bool) -> Path | None:
-    """The user's folder for resident sockets, made (mode 0700) when `create`; None when it is missing or unsafe
-    (someone else's, a link, or open to other users)."""
-    runtime = os.environ.get("XDG_RUNTIME_DIR")
-    if runtime and os.path.isabs(runtime):
-        base = Path(runtime)
-    else:
-        import tempfile
-
-        base = Path(tempfile.gettempdir())
-    folder = base / ("frustum" if runtime else f"frustum-{os.getuid()}")
-    if create:
-        with contextlib.suppress(FileExistsError, OSError):
-            folder.mkdir(mode=0o700)
-    try:
-        info = os.lstat(folder)
-    except OSError:
-        return None
-    private = stat.S_ISDIR(info.st_mode) and info.st_uid == os.getuid() and not info.st_mode & 0o077
-    return folder if private else None
-
-
-def _paths(create: bool = False) -> tuple[Path, Path] | None:
-    """The socket and lock file of this installation's resident process, or None (unsafe folder, long path)."""
-    folder = _private_folder(create)
-    if folder is None:
-        return None
-    name = f"render-{_installation()}"
-    path = folder / f"{name}.sock"
-    if len(os.fsencode(path)) >= 100:  # sockaddr_un holds 108 bytes
-        return None
-    return path, folder / f"{name}.lock"
-
 
 def _send(connection: socket.socket, message: dict[str, Any]) -> None:
     connection.sendall(json.dumps(message).encode() + b"\n")

@@ -1,11 +1,12 @@
-"""Who a resident render process is and whom it may serve: the installation's name and fingerprint, the
-``FRUSTUM_RESIDENT`` setting, and the conditions (environment, limits, affinity, cgroup) a request must share with
-the resident (``frustum.app.resident``)."""
+"""Who a resident render process is, where it listens and whom it may serve: the installation's name and
+fingerprint, its socket's private folder, the ``FRUSTUM_RESIDENT`` setting, and the conditions (environment,
+limits, affinity, cgroup) a request must share with the resident (``frustum.app.resident``)."""
 
 from __future__ import annotations
 
+import contextlib
 import os
-import socket
+import stat
 import sys
 from pathlib import Path
 from typing import Any
@@ -33,6 +34,8 @@ def setting() -> str:
 
 def enabled() -> bool:
     """Whether this system supports resident processes (Linux: ``SO_PEERCRED`` and ``fork``)."""
+    import socket  # here: a plain render without a resident imports no socket module (``maybe_running``)
+
     return sys.platform == "linux" and hasattr(socket, "SO_PEERCRED") and hasattr(os, "fork")
 
 
@@ -87,6 +90,49 @@ def fingerprint(package: Path | None = None) -> str:
         if os.path.basename(entry) in ("site-packages", "dist-packages") and os.path.isdir(entry):
             digest.update(f"{entry}\0{os.stat(entry).st_mtime_ns}\0".encode())
     return digest.hexdigest()
+
+
+def _private_folder(create: bool) -> Path | None:
+    """The user's folder for resident sockets, made (mode 0700) when `create`; None when it is missing or unsafe
+    (someone else's, a link, or open to other users)."""
+    runtime = os.environ.get("XDG_RUNTIME_DIR")
+    if runtime and os.path.isabs(runtime):
+        base = Path(runtime)
+    else:
+        import tempfile
+
+        base = Path(tempfile.gettempdir())
+    folder = base / ("frustum" if runtime else f"frustum-{os.getuid()}")
+    if create:
+        with contextlib.suppress(FileExistsError, OSError):
+            folder.mkdir(mode=0o700)
+    try:
+        info = os.lstat(folder)
+    except OSError:
+        return None
+    private = stat.S_ISDIR(info.st_mode) and info.st_uid == os.getuid() and not info.st_mode & 0o077
+    return folder if private else None
+
+
+def _paths(create: bool = False) -> tuple[Path, Path] | None:
+    """The socket and lock file of this installation's resident process, or None (unsafe folder, long path)."""
+    folder = _private_folder(create)
+    if folder is None:
+        return None
+    name = f"render-{_installation()}"
+    path = folder / f"{name}.sock"
+    if len(os.fsencode(path)) >= 100:  # sockaddr_un holds 108 bytes
+        return None
+    return path, folder / f"{name}.lock"
+
+
+def maybe_running() -> bool:
+    """Whether a resident render process of this installation may be listening: its socket exists (a cheap check
+    before the client, ``frustum.app.resident``, is imported; ``FRUSTUM_RESIDENT=0`` says no)."""
+    if setting() == "off":
+        return False
+    paths = _paths()
+    return paths is not None and paths[0].exists()
 
 
 def conditions() -> dict[str, Any]:

@@ -74,6 +74,9 @@ class Profile:
         ("kernel compiling": a first run in a new environment)."""
         from numba.core import caching, event
 
+        from frustum.app.numba_start import load_kernels_lean
+
+        load_kernels_lean()  # the program's way of loading, timed (not replaced by it afterwards)
         profile = self
         load = caching.Cache.load_overload
 
@@ -114,7 +117,9 @@ class Profile:
 def profiled(work: Callable[[], Any], profile: Profile) -> Any:
     """Run a plain render's `work` with its stages timed (``frustum.app.work.run_render``)."""
     with profile.stage("import numpy and numba"):
-        import numba  # noqa: F401 - its import is a stage of its own
+        from frustum.app.numba_start import import_numba
+
+        import_numba()  # as the render imports it (``numba_start``): a stage of its own
     with profile.stage("numba target setup"):
         from numba.core.registry import cpu_target
 

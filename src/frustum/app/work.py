@@ -4,20 +4,11 @@
 
 from __future__ import annotations
 
-import sys
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from frustum.app.runtime import (
-    REPORTED,
-    UsageError,
-    error_line,
-    failure,
-    install_compile_notice,
-    run_interruptible,
-    say,
-)
+from frustum.app.runtime import REPORTED, UsageError, install_compile_notice, report_failure, run_interruptible, say
 from frustum.errors import FrustumError
 
 __all__ = ["MAX_SIZE", "image_size", "render_files", "render_task", "run_render", "shadow_choice"]
@@ -60,6 +51,9 @@ def render_files(scene: Path, output: Sequence[Path] | None, size: str | None, u
                  shadows: str | None) -> list[Path]:  # fmt: skip
     """``frustum render``: render the scene or mesh file `scene` to `output` (None: the file's outputs) and
     return the files written."""
+    from frustum.app.numba_start import load_kernels_lean
+
+    load_kernels_lean()  # first: Numba imported and set to load kernels the program's way (``numba_start``)
     from frustum.app.warmup import compile_in_background
     from frustum.scenefile import render_scene_file
 
@@ -85,9 +79,7 @@ def run_render(request: dict[str, Any]) -> int:
     try:
         written = run_interruptible(work if profile is None else lambda: timing.profiled(work, profile))
     except REPORTED as error:
-        text, status = failure(error)
-        say(error_line(text), sys.stderr)
-        return status
+        return report_failure(error)
     for path in written:
         say(f"wrote {path}")
     return 0

@@ -204,9 +204,14 @@ class Material:
                     f"{where}: both texture and base_color_texture are given; give one (texture: linear values, "
                     "base_color_texture: an sRGB-encoded image as glTF stores it)"
                 )
-            texels = _texture(self.base_color_texture, f"{where} base_color_texture")
+            encoded = np.asarray(self.base_color_texture)
+            texels = _texture(encoded, f"{where} base_color_texture")
             linear = np.array(texels)
-            linear[..., :3] = srgb_to_linear(linear[..., :3])
+            if encoded.dtype == np.uint8:  # 8-bit values (a PNG's, a JPEG's): the curve at the 256 of them, looked up
+                channels = np.repeat(encoded[:, :, None], 3, axis=2) if encoded.ndim == 2 else encoded[..., :3]
+                linear[..., :3] = srgb_to_linear(np.arange(256, dtype=np.float32) / np.float32(255.0))[channels]
+            else:
+                linear[..., :3] = srgb_to_linear(linear[..., :3])
             object.__setattr__(self, "texture", read_only(linear))
             object.__setattr__(self, "base_color_texture", None)
         for name in ("metallic_roughness_texture", "occlusion_texture"):
