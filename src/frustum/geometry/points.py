@@ -25,7 +25,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
-from typing import Any, NamedTuple
+from typing import Any, ClassVar, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -70,6 +70,9 @@ class PointCloud:
     GeometryError
         Wrong shapes, non-finite values, colours outside [0, 1], zero normals, radii <= 0.
     """
+
+    scene_geometry: ClassVar[str] = "points"
+    """What a scene places (``scene.graph`` checks this mark and need not import this module)."""
 
     points: Points
     colors: NDArray[np.float64] | None = None
