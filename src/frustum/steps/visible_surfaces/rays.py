@@ -12,11 +12,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from frustum.camera import Camera
-from frustum.errors import FrustumError, GeometryError, OutputError
+from frustum.errors import GeometryError, OutputError
 from frustum.scene import Scene
 from frustum.steps._record import Step, Steps, _Canvas
-from frustum.steps.viewing import _camera
-from frustum.steps.visible_surfaces.image_space import default_scene
+from frustum.steps.visible_surfaces.image_space import scene_and_camera
 
 __all__ = ["ray_casting", "traced_closest"]
 
@@ -102,12 +101,7 @@ def ray_casting(
     from frustum.render import render
 
     where = "steps.ray_casting"
-    if scene is None:
-        scene, default_camera = default_scene()
-        camera = default_camera if camera is None else camera
-    if not isinstance(scene, Scene):
-        raise FrustumError(f"{where}: scene = {scene!r} is not a Scene")
-    cam = _camera(camera, where)
+    scene, cam = scene_and_camera(scene, camera, where)
     width, height = cam.width, cam.height
     x, y = (width // 2, height // 2) if pixel is None else (int(v) for v in pixel)
     if not (0 <= x < width and 0 <= y < height):
