@@ -638,19 +638,24 @@ def _one_mesh(scene: fr.Scene) -> fr.Scene:
     return merged
 
 
+def _spy(monkeypatch, module, name: str, argument: int) -> list:
+    """Record the shape of argument `argument` of each call of the kernel `module.name` (and call it)."""
+    calls = []
+    kernel = getattr(module, name)
+
+    def spy(*args):
+        calls.append(args[argument].shape)
+        return kernel(*args)
+
+    monkeypatch.setattr(module, name, spy)
+    return calls
+
+
 def _spy_tiled(monkeypatch) -> list:
     """Record each call of the shadowed tile kernel (so a test knows the one-mesh path drew its frame)."""
     from frustum.raster import shadow_tiled
 
-    calls = []
-    kernel = shadow_tiled.draw_tiles_shadowed
-
-    def spy(*args):
-        calls.append(args[17].shape)
-        return kernel(*args)
-
-    monkeypatch.setattr(shadow_tiled, "draw_tiles_shadowed", spy)
-    return calls
+    return _spy(monkeypatch, shadow_tiled, "draw_tiles_shadowed", 17)
 
 
 def _fraction_from_colors(scene: fr.Scene, camera: fr.Camera, light, **options) -> tuple[np.ndarray, np.ndarray]:
@@ -828,15 +833,7 @@ def _spy_fills(monkeypatch) -> list:
     """Record each depth-only map fill (a shadow map drawn, not reused)."""
     from frustum.raster import shadow
 
-    fills = []
-    fill = shadow.fill_depth_tiles
-
-    def spy(*args):
-        fills.append(args[8].shape)
-        return fill(*args)
-
-    monkeypatch.setattr(shadow, "fill_depth_tiles", spy)
-    return fills
+    return _spy(monkeypatch, shadow, "fill_depth_tiles", 8)
 
 
 def _redrawn(scene: fr.Scene, camera: fr.Camera, **options) -> fr.Frame:
