@@ -836,6 +836,16 @@ def _spy_fills(monkeypatch) -> list:
     return _spy(monkeypatch, shadow, "fill_depth_tiles", 8)
 
 
+def _checked_frame(fills: list, scene: fr.Scene, camera: fr.Camera, **options) -> tuple[fr.Frame, int]:
+    """A shadowed frame (kept maps reused where they still hold) and how many maps it drew (`fills` from
+    ``_spy_fills``); its bytes are those of the same frame with every map drawn for it."""
+    count = len(fills)
+    frame = fr.render(scene, camera, shadows=True, **options)
+    drawn = len(fills) - count
+    assert np.array_equal(frame.color, _redrawn(scene, camera, **options).color)
+    return frame, drawn
+
+
 def _redrawn(scene: fr.Scene, camera: fr.Camera, **options) -> fr.Frame:
     """The frame with every shadow map drawn for it (reuse off)."""
     from frustum.render.shadows import fractions as shadow_pass
@@ -873,11 +883,8 @@ def test_a_reused_shadow_map_gives_the_bytes_of_a_redrawn_one(monkeypatch):
     calls = _spy_tiled(monkeypatch)
     drawn = []
     for angle in np.linspace(0.0, 2.0 * math.pi, 5, endpoint=False):
-        camera = _orbit(angle)
-        count = len(fills)
-        frame = fr.render(scene, camera, shadows=True, cull_back_faces=False)
-        drawn.append(len(fills) - count)
-        assert np.array_equal(frame.color, _redrawn(scene, camera, cull_back_faces=False).color), angle
+        frame, count = _checked_frame(fills, scene, _orbit(angle), cull_back_faces=False)
+        drawn.append(count)
     assert drawn == [1, 0, 0, 0, 0]  # drawn for the first view only
     assert len(fills) == 6 and len(calls) == 10  # the five reference frames drew their own maps
     plain = fr.render(scene, _orbit(0.0), cull_back_faces=False).color
@@ -907,10 +914,8 @@ def test_a_changed_mesh_light_or_map_size_draws_the_map_again(monkeypatch):
     steps = []
 
     def frame(scene, **options):
-        count = len(fills)
-        picture = fr.render(scene, camera, shadows=True, cull_back_faces=False, **options)
-        steps.append(len(fills) - count)
-        assert np.array_equal(picture.color, _redrawn(scene, camera, cull_back_faces=False, **options).color)
+        picture, count = _checked_frame(fills, scene, camera, cull_back_faces=False, **options)
+        steps.append(count)
         return picture
 
     first = frame(scene_of(mesh, light))
@@ -1053,11 +1058,8 @@ def test_maps_of_a_scene_of_several_items_are_reused_across_views(monkeypatch, l
     fills = _spy_fills(monkeypatch)
     drawn = []
     for angle in np.linspace(0.0, 2.0 * math.pi, 4, endpoint=False):
-        camera = _orbit(angle)
-        count = len(fills)
-        frame = fr.render(scene, camera, shadows=True)
-        drawn.append(len(fills) - count)
-        assert np.array_equal(frame.color, _redrawn(scene, camera).color), angle
+        frame, count = _checked_frame(fills, scene, _orbit(angle))
+        drawn.append(count)
     per_set = (6 if light_name == "point" else 1) * len(scene.items)
     assert drawn == [per_set, 0, 0, 0]
     assert not np.array_equal(frame.color, fr.render(scene, _orbit(0.0)).color)  # there are shadows

@@ -261,20 +261,17 @@ class MeshCollider(_Collider):
 
 
 def check_forces(forces: Any, where: str) -> tuple[Force, ...]:
-    items = tuple(forces) if isinstance(forces, list | tuple) else None
-    if items is None or not all(isinstance(f, Force) for f in items):
-        raise SimulationError(
-            f"{where}: forces = {describe(forces)} is not a list of forces; give e.g. [Gravity(), Drag(0.1)] "
-            "(Gravity, Drag, Wind, Vortex, Attractor)"
-        )
-    return items
+    return _items_of(forces, Force, "forces", where, "[Gravity(), Drag(0.1)] (Gravity, Drag, Wind, Vortex, Attractor)")
 
 
 def check_colliders(colliders: Any, where: str) -> tuple[_Collider, ...]:
-    items = tuple(colliders) if isinstance(colliders, list | tuple) else None
-    if items is None or not all(isinstance(c, _Collider) for c in items):
-        raise SimulationError(
-            f"{where}: colliders = {describe(colliders)} is not a list of colliders; give e.g. "
-            "[PlaneCollider((0, 0, 0), (0, 1, 0))] (PlaneCollider, SphereCollider, MeshCollider)"
-        )
+    return _items_of(colliders, _Collider, "colliders", where,
+                     "[PlaneCollider((0, 0, 0), (0, 1, 0))] (PlaneCollider, SphereCollider, MeshCollider)")  # fmt: skip
+
+
+def _items_of(value: Any, kind: type, name: str, where: str, example: str) -> tuple[Any, ...]:
+    """`value` (a list or tuple of `kind` instances) as a tuple, or SimulationError naming it with `example`."""
+    items = tuple(value) if isinstance(value, list | tuple) else None
+    if items is None or not all(isinstance(item, kind) for item in items):
+        raise SimulationError(f"{where}: {name} = {describe(value)} is not a list of {name}; give e.g. {example}")
     return items
