@@ -23,6 +23,7 @@ __all__ = ["ray_casting", "traced_closest"]
 def _pixel_ray(camera: Camera, x: int, y: int) -> tuple[float, ...]:
     """The ray of window pixel (x, y), with ``raster.rays.cast_pixels``' arithmetic: origin on the near plane,
     direction to the far plane (t in [0, 1))."""
+    # kept twice on purpose: the arithmetic of raster/rays.py:cast_pixels (a kernel's inner loop), for one pixel
     m = np.ascontiguousarray(camera.world_from_window, dtype=np.float64)
     px, py = x + 0.5, y + 0.5
     nw = m[3, 0] * px + m[3, 1] * py + m[3, 3]
