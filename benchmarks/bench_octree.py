@@ -30,30 +30,12 @@ import trimesh
 
 from frustum import Camera, Mesh, Octree, Perspective, Scene, render_octree
 
-DATA = Path(__file__).resolve().parents[1] / "tests" / "data"  # the bunny: in the repository
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))  # the closed bunny: tests/testdata.py
+from testdata import closed_bunny
+
 BENCH_DIR = Path(__file__).resolve().parents[1].parent / "shared" / "bench"  # the shared standard scenes
 if not BENCH_DIR.exists():
     BENCH_DIR = Path("/work/shared/bench")
-
-
-def closed_bunny() -> Mesh:
-    """The full-resolution bunny with each boundary loop closed by a fan from its centroid."""
-    data = trimesh.load(DATA / "bunny" / "bun_zipper.ply", process=False, force="mesh")
-    mesh = Mesh(np.asarray(data.vertices), np.asarray(data.faces)).welded()
-    faces = mesh.faces
-    directed = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]).tolist()
-    present = set(map(tuple, directed))
-    following = {a: b for a, b in directed if (b, a) not in present}
-    vertices, extra, count = [mesh.vertices], [], mesh.vertex_count
-    while following:
-        loop, a = [], next(iter(following))
-        while a in following:
-            loop.append(a)
-            a = following.pop(a)
-        vertices.append(mesh.vertices[loop].mean(axis=0)[None])
-        extra += [(loop[(i + 1) % len(loop)], loop[i], count) for i in range(len(loop))]
-        count += 1
-    return Mesh(np.concatenate(vertices), np.concatenate([faces, np.array(extra)]))
 
 
 def timed(fn, repeat: int = 1):

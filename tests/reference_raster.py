@@ -161,6 +161,8 @@ def _byte(value: float) -> int:
 
 def _power(x, n):
     """x**n as the renderer takes it: integral n in [0, 1024] by repeated squaring (lowest bit first)."""
+    # kept twice on purpose: the same loop as src/frustum/raster/power.py:textbook_power (this reference shares no
+    # code with the renderer)
     if n != math.floor(n) or not 0 <= n <= 1024:
         return x**n
     e, r = int(n), 1.0

@@ -33,28 +33,9 @@ from frustum.batch.cameras import colmap_pose, intrinsics, metric_depth
 from frustum.batch.jobs import TEMPORARY_MARK, write_atomically
 from frustum.scene import Scene
 from frustum.scenefile import load_scene_file
+from scene_texts import ball_scene
 
-SCENE = """
-title = "batch test"
-[render]
-size = [64, 48]
-[camera]
-eye = [0.3, 1.0, 4.0]
-target = [0.0, 0.0, 0.0]
-fovy_deg = 45
-near = 1.0
-far = 10.0
-[[lights]]
-type = "directional"
-direction = [-0.5, -1.0, -0.6]
-[[nodes]]
-name = "ball"
-geometry = { type = "icosphere", subdivisions = 2 }
-[[nodes]]
-name = "cube"
-geometry = { type = "box" }
-transform = [{ scale = 0.5 }, { translate = [0.9, 0.0, 0.3] }]
-"""
+SCENE = ball_scene("batch test")
 SRC = Path(frustum.__file__).resolve().parents[1]
 
 

@@ -31,30 +31,11 @@ from frustum.batch import render_dataset
 psutil = pytest.importorskip("psutil")
 pytest.importorskip("ray")
 from ray_local_cluster import Cluster, free_port, skip_reason, stop_groups  # noqa: E402
+from scene_texts import ball_scene  # noqa: E402
 
 pytestmark = pytest.mark.skipif(skip_reason() is not None, reason=str(skip_reason()))
 
-SCENE = """
-title = "batch cluster test"
-[render]
-size = [64, 48]
-[camera]
-eye = [0.3, 1.0, 4.0]
-target = [0.0, 0.0, 0.0]
-fovy_deg = 45
-near = 1.0
-far = 10.0
-[[lights]]
-type = "directional"
-direction = [-0.5, -1.0, -0.6]
-[[nodes]]
-name = "ball"
-geometry = { type = "icosphere", subdivisions = 2 }
-[[nodes]]
-name = "cube"
-geometry = { type = "box" }
-transform = [{ scale = 0.5 }, { translate = [0.9, 0.0, 0.3] }]
-"""
+SCENE = ball_scene("batch cluster test")
 
 
 @pytest.fixture(scope="module")

@@ -338,17 +338,9 @@ def _area(polygon: np.ndarray) -> float:
     return float(np.linalg.norm(0.5 * np.cross(polygon, np.roll(polygon, -1, axis=0)).sum(axis=0)))
 
 
-@settings(max_examples=60)
-@given(soups)
-def test_bsp_fragments_tile_their_source_polygon(soup):
-    triangles = np.array(soup, dtype=float)
-    # the skip rule of BSPTree: area <= (1e-9 · diagonal)²
-    diagonal = float(np.linalg.norm(triangles.reshape(-1, 3).max(axis=0) - triangles.reshape(-1, 3).min(axis=0)))
-    expected_skips = sum(_area(t) <= (1e-9 * diagonal) ** 2 for t in triangles)
-    tree = BSPTree(list(triangles))
-    fragments = tree.back_to_front(eye=(0.1, 0.2, 5.0))
-    assert tree.degenerate_count == expected_skips
-    assert len(fragments) == tree.fragment_count
+def _assert_fragments_tile(triangles: np.ndarray, fragments: list, diagonal: float) -> np.ndarray:
+    """Each (polygon, label) fragment lies in its source triangle's plane, and the fragments of each triangle add
+    up to its area; returns which triangles are kept (area above (1e-9 · diagonal)²)."""
     areas = np.zeros(len(triangles))
     for polygon, label in fragments:
         areas[label] += _area(polygon)
@@ -360,7 +352,22 @@ def test_bsp_fragments_tile_their_source_polygon(soup):
     expected = np.array([_area(t) for t in triangles])
     kept = expected > (1e-9 * diagonal) ** 2
     # slivers below (1e-9 · diagonal)² are dropped when cut off: areas agree to that, times the splits
-    np.testing.assert_allclose(areas[kept], expected[kept], rtol=1e-9, atol=1e-15 + tree.fragment_count * 1e-17)
+    np.testing.assert_allclose(areas[kept], expected[kept], rtol=1e-9, atol=1e-15 + len(fragments) * 1e-17)
+    return kept
+
+
+@settings(max_examples=60)
+@given(soups)
+def test_bsp_fragments_tile_their_source_polygon(soup):
+    triangles = np.array(soup, dtype=float)
+    # the skip rule of BSPTree: area <= (1e-9 · diagonal)²
+    diagonal = float(np.linalg.norm(triangles.reshape(-1, 3).max(axis=0) - triangles.reshape(-1, 3).min(axis=0)))
+    expected_skips = sum(_area(t) <= (1e-9 * diagonal) ** 2 for t in triangles)
+    tree = BSPTree(list(triangles))
+    fragments = tree.back_to_front(eye=(0.1, 0.2, 5.0))
+    assert tree.degenerate_count == expected_skips
+    assert len(fragments) == tree.fragment_count
+    _assert_fragments_tile(triangles, fragments, diagonal)
 
 
 @settings(max_examples=40)
@@ -370,17 +377,8 @@ def test_depth_sort_fragments_tile_their_source_polygon(soup):
     diagonal = float(np.linalg.norm(triangles.reshape(-1, 3).max(axis=0) - triangles.reshape(-1, 3).min(axis=0)))
     result = depth_sort(list(triangles), perspective_camera())
     assert result.clipped_count == 0 and result.unresolved_count == 0
-    areas = np.zeros(len(triangles))
-    for polygon, label in result.fragments:
-        areas[label] += _area(polygon)
-        triangle = triangles[label]
-        normal = np.cross(triangle[1] - triangle[0], triangle[2] - triangle[0])
-        normal /= np.linalg.norm(normal)
-        assert np.abs((polygon - triangle[0]) @ normal).max() <= 1e-9 * max(1.0, diagonal / (2 * _area(triangle)))
-    expected = np.array([_area(t) for t in triangles])
-    kept = expected > (1e-9 * diagonal) ** 2
+    kept = _assert_fragments_tile(triangles, result.fragments, diagonal)
     assert result.degenerate_count == int((~kept).sum())
-    np.testing.assert_allclose(areas[kept], expected[kept], rtol=1e-9, atol=1e-15 + len(result.fragments) * 1e-17)
 
 
 # --- bad input -------------------------------------------------------------------------------------------

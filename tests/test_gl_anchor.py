@@ -18,6 +18,7 @@ from frustum.geometry import Mesh
 from frustum.render import render
 from frustum.scene import Scene
 from frustum.shading import AmbientLight, DirectionalLight, Material, PointLight, SpotLight
+from gl_frames import draw_and_read, gl_context
 
 moderngl = pytest.importorskip("moderngl")
 
@@ -110,10 +111,7 @@ def scene_and_camera():
 
 
 def gl_render(mesh: Mesh, camera: Camera, phong: bool) -> np.ndarray:
-    try:
-        ctx = moderngl.create_standalone_context(require=330, backend="egl")
-    except Exception as error:  # no EGL / Mesa on this machine
-        pytest.skip(f"no OpenGL 3.3 context: {error}")
+    ctx = gl_context()
     program = ctx.program(vertex_shader=VERTEX, fragment_shader=FRAGMENT)
     program["u_clip_from_world"].write(np.asarray(camera.clip_from_world, dtype="f4").T.tobytes())
     program["u_eye"].value = tuple(float(c) for c in camera.frame.eye)
@@ -154,15 +152,7 @@ def gl_render(mesh: Mesh, camera: Camera, phong: bool) -> np.ndarray:
          (ctx.buffer(mesh.vertex_normals.astype("f4")), "3f", "in_normal")],
         index_buffer=ctx.buffer(mesh.faces.astype("i4")), index_element_size=4,
     )  # fmt: skip
-    fbo = ctx.framebuffer(color_attachments=[ctx.renderbuffer((WIDTH, HEIGHT), 4, dtype="f1")],
-                          depth_attachment=ctx.depth_renderbuffer((WIDTH, HEIGHT)))  # fmt: skip
-    fbo.use()
-    ctx.enable(moderngl.DEPTH_TEST | moderngl.CULL_FACE)
-    fbo.clear(0.0, 0.0, 0.0, 1.0, depth=1.0)
-    vao.render(moderngl.TRIANGLES)
-    pixels = np.frombuffer(fbo.read(components=4, dtype="f1"), dtype=np.uint8).reshape(HEIGHT, WIDTH, 4)
-    ctx.release()
-    return pixels[::-1]  # OpenGL reads the bottom row first
+    return draw_and_read(ctx, vao, moderngl.TRIANGLES, moderngl.DEPTH_TEST | moderngl.CULL_FACE, WIDTH, HEIGHT)
 
 
 @pytest.mark.parametrize("specular", ["blinn-phong", "phong"])

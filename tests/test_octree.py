@@ -36,7 +36,7 @@ from frustum import (
 )
 from frustum.geometry.fractals.solids import _menger_cells
 from frustum.geometry.octree import TEXTBOOK_OCTANTS, morton_decode, morton_encode
-from testdata import DATA
+from testdata import DATA, closed_bunny
 
 UNIT = [[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]]
 CUBE = [[-1.0, -1.0, -1.0], [1.0, 1.0, 1.0]]
@@ -147,25 +147,8 @@ def test_from_mesh_region_inside_the_solid_is_one_full_node_whatever_the_winding
 
 
 def _closed_bunny() -> Mesh:
-    """The Stanford bunny with its 5 bottom holes closed by fans from each hole's centroid."""
-    data = trimesh.load(DATA / "bunny" / "bun_zipper.ply", process=False, force="mesh")
-    mesh = Mesh(np.asarray(data.vertices), np.asarray(data.faces)).welded()
-    faces = mesh.faces
-    directed = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
-    present = set(map(tuple, directed.tolist()))
-    following = {a: b for a, b in directed.tolist() if (b, a) not in present}
-    vertices, extra = [mesh.vertices], []
-    count = mesh.vertex_count
-    while following:
-        start, loop = next(iter(following)), []
-        a = start
-        while a in following:
-            loop.append(a)
-            a = following.pop(a)
-        vertices.append(mesh.vertices[loop].mean(axis=0)[None])
-        extra += [(loop[(i + 1) % len(loop)], loop[i], count) for i in range(len(loop))]
-        count += 1
-    closed = Mesh(np.concatenate(vertices), np.concatenate([faces, np.array(extra)]))
+    """The Stanford bunny with its 5 bottom holes closed by fans from each hole's centroid (``testdata``)."""
+    closed = closed_bunny()
     assert closed.is_watertight
     return closed
 

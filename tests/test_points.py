@@ -15,6 +15,7 @@ from frustum.geometry import Mesh
 from frustum.render import eye_dome
 from frustum.scene import Scene
 from frustum.shading import DirectionalLight, Material, illuminate
+from gl_frames import draw_and_read, gl_context
 
 WIDTH, HEIGHT = 160, 120
 
@@ -51,11 +52,8 @@ def expected_squares(points: np.ndarray, cam: Camera, size: float) -> np.ndarray
 
 
 def gl_points(points: np.ndarray, cam: Camera, size: float) -> np.ndarray:
+    ctx = gl_context()
     moderngl = pytest.importorskip("moderngl")
-    try:
-        ctx = moderngl.create_standalone_context(require=330, backend="egl")
-    except Exception as error:  # no EGL / Mesa on this machine
-        pytest.skip(f"no OpenGL 3.3 context: {error}")
     program = ctx.program(
         vertex_shader="""
         #version 330 core
@@ -69,15 +67,8 @@ def gl_points(points: np.ndarray, cam: Camera, size: float) -> np.ndarray:
     program["u_clip_from_world"].write(np.asarray(cam.clip_from_world, dtype="f4").T.tobytes())
     program["u_size"].value = float(size)
     vao = ctx.vertex_array(program, [(ctx.buffer(points.astype("f4")), "3f", "in_position")])
-    fbo = ctx.framebuffer(color_attachments=[ctx.renderbuffer((WIDTH, HEIGHT), 4, dtype="f1")],
-                          depth_attachment=ctx.depth_renderbuffer((WIDTH, HEIGHT)))  # fmt: skip
-    fbo.use()
-    ctx.enable(moderngl.DEPTH_TEST | moderngl.PROGRAM_POINT_SIZE)
-    fbo.clear(0.0, 0.0, 0.0, 1.0, depth=1.0)
-    vao.render(moderngl.POINTS)
-    pixels = np.frombuffer(fbo.read(components=4, dtype="f1"), dtype=np.uint8).reshape(HEIGHT, WIDTH, 4)
-    ctx.release()
-    return pixels[::-1, :, 0] > 0  # OpenGL reads the bottom row first
+    flags = moderngl.DEPTH_TEST | moderngl.PROGRAM_POINT_SIZE
+    return draw_and_read(ctx, vao, moderngl.POINTS, flags, WIDTH, HEIGHT)[:, :, 0] > 0
 
 
 def unambiguous(points: np.ndarray, cam: Camera, size: float) -> np.ndarray:

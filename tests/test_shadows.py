@@ -638,19 +638,24 @@ def _one_mesh(scene: fr.Scene) -> fr.Scene:
     return merged
 
 
+def _spy(monkeypatch, module, name: str, argument: int) -> list:
+    """Record the shape of argument `argument` of each call of the kernel `module.name` (and call it)."""
+    calls = []
+    kernel = getattr(module, name)
+
+    def spy(*args):
+        calls.append(args[argument].shape)
+        return kernel(*args)
+
+    monkeypatch.setattr(module, name, spy)
+    return calls
+
+
 def _spy_tiled(monkeypatch) -> list:
     """Record each call of the shadowed tile kernel (so a test knows the one-mesh path drew its frame)."""
     from frustum.raster import shadow_tiled
 
-    calls = []
-    kernel = shadow_tiled.draw_tiles_shadowed
-
-    def spy(*args):
-        calls.append(args[17].shape)
-        return kernel(*args)
-
-    monkeypatch.setattr(shadow_tiled, "draw_tiles_shadowed", spy)
-    return calls
+    return _spy(monkeypatch, shadow_tiled, "draw_tiles_shadowed", 17)
 
 
 def _fraction_from_colors(scene: fr.Scene, camera: fr.Camera, light, **options) -> tuple[np.ndarray, np.ndarray]:
@@ -880,15 +885,17 @@ def _spy_fills(monkeypatch) -> list:
     """Record each depth-only map fill (a shadow map drawn, not reused)."""
     from frustum.raster import shadow
 
-    fills = []
-    fill = shadow.fill_depth_tiles
+    return _spy(monkeypatch, shadow, "fill_depth_tiles", 8)
 
-    def spy(*args):
-        fills.append(args[8].shape)
-        return fill(*args)
 
-    monkeypatch.setattr(shadow, "fill_depth_tiles", spy)
-    return fills
+def _checked_frame(fills: list, scene: fr.Scene, camera: fr.Camera, **options) -> tuple[fr.Frame, int]:
+    """A shadowed frame (kept maps reused where they still hold) and how many maps it drew (`fills` from
+    ``_spy_fills``); its bytes are those of the same frame with every map drawn for it."""
+    count = len(fills)
+    frame = fr.render(scene, camera, shadows=True, **options)
+    drawn = len(fills) - count
+    assert np.array_equal(frame.color, _redrawn(scene, camera, **options).color)
+    return frame, drawn
 
 
 def _redrawn(scene: fr.Scene, camera: fr.Camera, **options) -> fr.Frame:
@@ -928,11 +935,8 @@ def test_a_reused_shadow_map_gives_the_bytes_of_a_redrawn_one(monkeypatch):
     calls = _spy_tiled(monkeypatch)
     drawn = []
     for angle in np.linspace(0.0, 2.0 * math.pi, 5, endpoint=False):
-        camera = _orbit(angle)
-        count = len(fills)
-        frame = fr.render(scene, camera, shadows=True, cull_back_faces=False)
-        drawn.append(len(fills) - count)
-        assert np.array_equal(frame.color, _redrawn(scene, camera, cull_back_faces=False).color), angle
+        frame, count = _checked_frame(fills, scene, _orbit(angle), cull_back_faces=False)
+        drawn.append(count)
     assert drawn == [1, 0, 0, 0, 0]  # drawn for the first view only
     assert len(fills) == 6 and len(calls) == 10  # the five reference frames drew their own maps
     plain = fr.render(scene, _orbit(0.0), cull_back_faces=False).color
@@ -962,10 +966,8 @@ def test_a_changed_mesh_light_or_map_size_draws_the_map_again(monkeypatch):
     steps = []
 
     def frame(scene, **options):
-        count = len(fills)
-        picture = fr.render(scene, camera, shadows=True, cull_back_faces=False, **options)
-        steps.append(len(fills) - count)
-        assert np.array_equal(picture.color, _redrawn(scene, camera, cull_back_faces=False, **options).color)
+        picture, count = _checked_frame(fills, scene, camera, cull_back_faces=False, **options)
+        steps.append(count)
         return picture
 
     first = frame(scene_of(mesh, light))
@@ -1108,11 +1110,8 @@ def test_maps_of_a_scene_of_several_items_are_reused_across_views(monkeypatch, l
     fills = _spy_fills(monkeypatch)
     drawn = []
     for angle in np.linspace(0.0, 2.0 * math.pi, 4, endpoint=False):
-        camera = _orbit(angle)
-        count = len(fills)
-        frame = fr.render(scene, camera, shadows=True)
-        drawn.append(len(fills) - count)
-        assert np.array_equal(frame.color, _redrawn(scene, camera).color), angle
+        frame, count = _checked_frame(fills, scene, _orbit(angle))
+        drawn.append(count)
     per_set = (6 if light_name == "point" else 1) * 2  # each map filled in one pass per culling: closed, open
     assert drawn == [per_set, 0, 0, 0]
     assert not np.array_equal(frame.color, fr.render(scene, _orbit(0.0)).color)  # there are shadows

@@ -8,7 +8,6 @@ pixel by pixel with cairosvg's rendering of the SVG's lines.
 from __future__ import annotations
 
 import io
-import math
 import re
 import xml.etree.ElementTree as ET
 from collections import Counter
@@ -21,9 +20,10 @@ from PIL import Image
 from scipy import ndimage
 
 from frustum import Scene, rotate_x, translate
-from frustum.geometry import box, cylinder, uv_sphere
+from frustum.geometry import box, cylinder
 from frustum.output.sheet import drawing_sheet
 from frustum.scenefile import load_scene_file
+from sheet_scenes import plate
 
 ezdxf = pytest.importorskip("ezdxf")
 
@@ -33,11 +33,7 @@ EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 
 def _scene() -> Scene:
-    scene = Scene()
-    scene.add(box((80.0, 6.0, 50.0)))
-    scene.add(cylinder(8.0, 30.0, 48), transform=translate(-20.0, 18.0, 5.0) @ rotate_x(-math.pi / 2))
-    scene.add(box((20.0, 12.0, 14.0)), transform=translate(22.0, 9.0, -10.0))
-    scene.add(uv_sphere(5.0, 32, 16), transform=translate(22.0, 20.0, -10.0))
+    scene = plate()
     scene.add(cylinder(6.0, 10.0, 40), transform=translate(0.0, -8.0, 0.0) @ rotate_x(0.6))  # ellipses
     return scene
 

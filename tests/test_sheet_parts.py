@@ -20,9 +20,10 @@ from shapely.geometry import LineString, Point, box
 
 from frustum import OutputError, Scene, rotate_x, translate
 from frustum.geometry import box as box_mesh
-from frustum.geometry import cylinder, uv_sphere
+from frustum.geometry import cylinder
 from frustum.output.sheet import dimension_text, drawing_sheet
 from frustum.scenefile import load_scene_file
+from sheet_scenes import plate
 
 SVG = "{http://www.w3.org/2000/svg}"
 NUMBER = re.compile(r"-?\d+(?:\.\d+)?(?:e-?\d+)?")
@@ -161,11 +162,7 @@ def test_exploded_assembly_parts_carry_their_own_sizes():
 
 def _plate_with_parts() -> Scene:
     """A plate with a post, a block, a ball and two pins: parts of many sizes, crowding the dimensions."""
-    scene = Scene()
-    scene.add(box_mesh((80.0, 6.0, 50.0)))
-    scene.add(cylinder(8.0, 30.0, 48), transform=translate(-20.0, 18.0, 5.0) @ rotate_x(-math.pi / 2))
-    scene.add(box_mesh((20.0, 12.0, 14.0)), transform=translate(22.0, 9.0, -10.0))
-    scene.add(uv_sphere(5.0, 32, 16), transform=translate(22.0, 20.0, -10.0))
+    scene = plate()
     for x in (-33.0, 33.0):
         scene.add(cylinder(2.0, 10.0, 24), transform=translate(x, 8.0, 18.0) @ rotate_x(-math.pi / 2))
     return scene

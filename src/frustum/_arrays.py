@@ -28,6 +28,7 @@ __all__ = [
     "as_vector3",
     "describe",
     "escape_control",
+    "is_numeric",
     "read_only",
 ]
 
@@ -112,6 +113,15 @@ def _as_float_array(
     if not share and isinstance(value, np.ndarray) and np.may_share_memory(array, value):
         array = array.copy()  # the checked array is ours: later read-only flags must not reach the caller's
     return array
+
+
+def is_numeric(value: object) -> bool:
+    """Whether `value` converts to a float64 array (``np.asarray(value, dtype=np.float64)`` does not raise)."""
+    try:
+        np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        return False
+    return True
 
 
 def as_scalar(value: Any, name: str, *, where: str, error: ErrorType = TransformError) -> float:

@@ -27,6 +27,7 @@ from frustum._arrays import (
     as_scalar,
     as_vector3,
     describe,
+    is_numeric,
 )
 from frustum.errors import GeometryError, TransformError
 
@@ -74,7 +75,7 @@ class Quaternion:
     @classmethod
     def from_array(cls, wxyz: ArrayLike) -> Quaternion:
         """Quaternion from a length-4 sequence in (w, x, y, z) order."""
-        values = np.asarray(wxyz, dtype=np.float64) if _is_numeric(wxyz) else None
+        values = np.asarray(wxyz, dtype=np.float64) if is_numeric(wxyz) else None
         if values is None or values.shape != (4,):
             raise TransformError(
                 f"Quaternion.from_array: wxyz = {describe(wxyz)} is not four numbers; expected (w, x, y, z)"
@@ -285,11 +286,3 @@ def _shepperd(m: NDArray[np.float64]) -> NDArray[np.float64]:
     if q[0] < 0:
         q = -q
     return q / np.linalg.norm(q)
-
-
-def _is_numeric(value: object) -> bool:
-    try:
-        np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError):
-        return False
-    return True

@@ -25,17 +25,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from frustum._arrays import Matrix4, Points, as_matrix, as_points, describe, read_only
 from frustum.camera import Camera
-from frustum.clipping import (
-    REGION_BOTTOM,
-    REGION_FAR,
-    REGION_LEFT,
-    REGION_NEAR,
-    REGION_RIGHT,
-    REGION_TOP,
-    clip_lines,
-    clip_triangles,
-    region_code,
-)
+from frustum.clipping import clip_lines, clip_triangles, region_code
+from frustum.clipping.codes import region_names
 from frustum.errors import FrustumError
 from frustum.geometry import Mesh
 from frustum.scene import Scene
@@ -67,14 +58,6 @@ _TITLES = {
     "perspective_divide": "Perspective divide (normalized device coordinates)",
     "viewport": "Viewport transformation (window coordinates: pixel x, y up, depth in [0, 1])",
 }
-_REGION_NAMES = (
-    (REGION_LEFT, "left"),
-    (REGION_RIGHT, "right"),
-    (REGION_BOTTOM, "bottom"),
-    (REGION_TOP, "top"),
-    (REGION_NEAR, "near"),
-    (REGION_FAR, "far"),
-)
 _FLIP_Z = np.diag([1.0, 1.0, -1.0, 1.0])
 _SHOWN_POINTS = 8  # points listed per stage in the text reports; the arrays hold them all
 
@@ -379,7 +362,7 @@ def _grid(matrix: Matrix4) -> list[str]:
 def _region_text(code: int, w: float) -> str:
     if code == 0:
         return "inside" if w > 0 else "outside (w <= 0)"
-    return "outside: " + ", ".join(name for bit, name in _REGION_NAMES if code & bit)
+    return "outside: " + ", ".join(region_names(code))
 
 
 def _axes(stage: Stage) -> tuple[str, ...]:

@@ -18,24 +18,9 @@ import pytest
 from frustum.batch import render_dataset
 from frustum.errors import OutputError, SceneFileError
 from frustum.scenefile import load_scene, load_scene_file
+from scene_texts import ball_scene
 
-SCENE = """
-title = "round three"
-[render]
-size = [32, 24]
-[camera]
-eye = [0.3, 1.0, 4.0]
-target = [0.0, 0.0, 0.0]
-fovy_deg = 45
-near = 1.0
-far = 10.0
-[[lights]]
-type = "directional"
-direction = [-0.5, -1.0, -0.6]
-[[nodes]]
-name = "ball"
-geometry = { type = "icosphere", subdivisions = 1 }
-"""
+SCENE = ball_scene("round three", size=(32, 24), subdivisions=1, cube=False)
 
 
 @pytest.fixture

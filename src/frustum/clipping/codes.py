@@ -33,6 +33,7 @@ __all__ = [
     "plane_from_point_normal",
     "point4",
     "region_code",
+    "region_names",
     "single_point",
     "transform_plane",
     "trivially_accepted",
@@ -71,6 +72,20 @@ REGION_NEAR = 16
 
 REGION_FAR = 32
 """Region-code bit 6: ``w − z < 0`` (behind the far plane)."""
+
+_REGION_NAMES = (
+    (REGION_LEFT, "left"),
+    (REGION_RIGHT, "right"),
+    (REGION_BOTTOM, "bottom"),
+    (REGION_TOP, "top"),
+    (REGION_NEAR, "near"),
+    (REGION_FAR, "far"),
+)
+
+
+def region_names(code: int) -> list[str]:
+    """The planes a region code says a point is outside of, in bit order: e.g. ``["left", "far"]`` for 33."""
+    return [name for bit, name in _REGION_NAMES if code & bit]
 
 
 # fmt: off

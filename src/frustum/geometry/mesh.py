@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from frustum._arrays import Points, as_faces, as_matrix, as_points, as_scalar, describe, read_only
+from frustum._arrays import Points, as_faces, as_matrix, as_points, as_scalar, describe, is_numeric, read_only
 from frustum.errors import GeometryError
 from frustum.transforms import apply, apply_to_normals, swaps_handedness
 
@@ -389,7 +389,7 @@ class Mesh:
         [seed] "Quadrilateral Mesh" ("for n by m array of vertices, (n − 1) by (m − 1) quadrilaterals").
         """
         where = "Mesh.from_grid"
-        grid = np.asarray(points, dtype=np.float64) if _is_numeric(points) else None
+        grid = np.asarray(points, dtype=np.float64) if is_numeric(points) else None
         if grid is None or grid.ndim != 3 or grid.shape[2] != 3:
             shape = None if grid is None else grid.shape
             raise GeometryError(f"{where}: points has shape {shape}; expected an (n, m, 3) grid of points")
@@ -398,7 +398,7 @@ class Mesh:
             raise GeometryError(f"{where}: points has shape {grid.shape}; a grid needs n >= 2 rows and m >= 2 columns")
         flat_uvs = None
         if uvs is not None:
-            uv = np.asarray(uvs, dtype=np.float64) if _is_numeric(uvs) else None
+            uv = np.asarray(uvs, dtype=np.float64) if is_numeric(uvs) else None
             if uv is None or uv.shape != (n, m, 2):
                 shape = None if uv is None else uv.shape
                 raise GeometryError(f"{where}: uvs has shape {shape}; expected ({n}, {m}, 2), one (u, v) per point")
@@ -519,14 +519,6 @@ def _grid_faces(n: int, m: int) -> NDArray[np.int64]:
     return np.stack([np.stack([a, b, c], axis=1), np.stack([a, c, d], axis=1)], axis=1).reshape(-1, 3)
 
 
-def _is_numeric(value: object) -> bool:
-    try:
-        np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError):
-        return False
-    return True
-
-
 def _check_rows(array: np.ndarray, count: int, name: str, where: str) -> None:
     if array.shape[0] != count:
         what = "normal" if name == "vertex_normals" else "row"
@@ -536,7 +528,7 @@ def _check_rows(array: np.ndarray, count: int, name: str, where: str) -> None:
 
 
 def _as_uvs(value: ArrayLike, count: int, where: str) -> NDArray[np.float64]:
-    uv = np.asarray(value, dtype=np.float64) if _is_numeric(value) else None
+    uv = np.asarray(value, dtype=np.float64) if is_numeric(value) else None
     if uv is None:
         raise GeometryError(f"{where}: uvs = {describe(value)} is not numeric; expected (N, 2) texture coordinates")
     if uv.size == 0 and count == 0:
@@ -552,7 +544,7 @@ def _as_uvs(value: ArrayLike, count: int, where: str) -> NDArray[np.float64]:
 
 
 def _as_vertex_colors(value: ArrayLike, count: int, where: str) -> NDArray[np.float64]:
-    raw = np.asarray(value) if _is_numeric(value) else None
+    raw = np.asarray(value) if is_numeric(value) else None
     if raw is None:
         raise GeometryError(f"{where}: vertex_colors = {describe(value)} is not numeric; expected (N, 3) or (N, 4)")
     colors = raw / 255.0 if raw.dtype == np.uint8 else raw.astype(np.float64)

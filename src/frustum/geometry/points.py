@@ -25,7 +25,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
-from typing import Any, NamedTuple
+from typing import Any, ClassVar, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -33,6 +33,7 @@ from numpy.typing import ArrayLike, NDArray
 from frustum._arrays import Points, as_matrix, as_points, describe, read_only
 from frustum.budgets import check_memory, format_bytes
 from frustum.errors import GeometryError
+from frustum.geometry.readers import ply_header
 from frustum.transforms import apply, apply_to_normals
 
 __all__ = [
@@ -70,6 +71,9 @@ class PointCloud:
     GeometryError
         Wrong shapes, non-finite values, colours outside [0, 1], zero normals, radii <= 0.
     """
+
+    scene_geometry: ClassVar[str] = "points"
+    """What a scene places (``scene.graph`` checks this mark and need not import this module)."""
 
     points: Points
     colors: NDArray[np.float64] | None = None
@@ -411,21 +415,10 @@ def read_ply_header(file: Path, where: str) -> PlyHeader:
         raise GeometryError(f"{where}: path = {str(file)!r} is not a PLY file (no 'ply' … 'end_header' header)")
     newline = head.find(b"\n", end)
     body = newline + 1 if newline >= 0 else len(head)
-    fmt = ""
-    elements: list[tuple[str, int, list[tuple[str, ...]]]] = []
-    for line in head[:end].decode("ascii", errors="replace").splitlines()[1:]:
-        words = line.split()
-        if not words or words[0] in ("comment", "obj_info"):
-            continue
-        try:
-            if words[0] == "format":
-                fmt = words[1]
-            elif words[0] == "element":
-                elements.append((words[1], int(words[2]), []))
-            elif words[0] == "property":
-                elements[-1][2].append(tuple(words[1:]))
-        except (IndexError, ValueError):
-            raise GeometryError(f"{where}: path = {str(file)!r} has a malformed header line {line!r}") from None
+    try:  # comments and unknown keywords are passed over
+        fmt, elements, _ = ply_header(head[:end].decode("ascii", errors="replace").splitlines()[1:])
+    except ValueError as error:
+        raise GeometryError(f"{where}: path = {str(file)!r} has a malformed header line {error.args[0]!r}") from None
     if fmt not in ("ascii", "binary_little_endian", "binary_big_endian"):
         raise GeometryError(f"{where}: path = {str(file)!r} has format {fmt!r}; expected ascii, "
                             "binary_little_endian or binary_big_endian")  # fmt: skip

@@ -31,7 +31,7 @@ from numpy.typing import ArrayLike, NDArray
 from frustum._arrays import Points, as_count, as_points, as_scalar, as_vector3, describe
 from frustum.errors import GeometryError
 from frustum.geometry.mesh import Mesh, _area_weighted_normals, _grid_faces
-from frustum.geometry.primitives import _check_grid_memory
+from frustum.geometry.primitives import _check_grid_memory, _positive
 
 __all__ = [
     "ellipsoid",
@@ -292,13 +292,6 @@ def _grid_mesh(points: NDArray, normals: NDArray, uv: NDArray) -> Mesh:
         # where ∇F is undefined (s >= 2: edges and cusps), use the area-weighted normal of the faces around
         normal[bad] = _area_weighted_normals(vertices, faces)[bad]
     return Mesh(vertices, faces, normal, uvs)
-
-
-def _positive(value: Any, name: str, where: str) -> float:
-    number = as_scalar(value, name, where=where, error=GeometryError)
-    if number <= 0.0:
-        raise GeometryError(f"{where}: {name} = {number!r} is not positive; give a value > 0")
-    return number
 
 
 def _exponent(value: Any, name: str, where: str) -> float:

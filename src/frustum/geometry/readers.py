@@ -128,30 +128,39 @@ _PLY_INDEX_NAMES = ("vertex_indices", "vertex_index")
 _PLY_VERTEX_NAMES = {"x", "y", "z", "nx", "ny", "nz", "confidence", "intensity", "quality"}
 
 
+def ply_header(lines: list[str]) -> tuple[str, list[tuple[str, int, list[tuple[str, ...]]]], list[str]]:
+    """(format, elements as (name, count, property words), the other lines: comments and unknown keywords) of a
+    PLY header's lines after ``ply`` (``obj_info`` lines skipped); a malformed line raises ValueError(line)."""
+    fmt = ""
+    elements: list[tuple[str, int, list[tuple[str, ...]]]] = []
+    others: list[str] = []
+    for line in lines:
+        words = line.split()
+        if not words or words[0] == "obj_info":
+            continue
+        try:
+            if words[0] == "format":
+                fmt = words[1]
+            elif words[0] == "element":
+                elements.append((words[1], int(words[2]), []))
+            elif words[0] == "property":
+                elements[-1][2].append(tuple(words[1:]))
+            else:
+                others.append(line)
+        except (IndexError, ValueError):
+            raise ValueError(line) from None
+    return fmt, elements, others
+
+
 def _read_ply(file: Path, data: bytes) -> list[RawPart]:
     end = data.find(b"end_header")
     if end < 0 or not data.startswith(b"ply"):
         raise UnsupportedError("no header")
     body = data.index(b"\n", end) + 1
     lines = data[:end].decode("utf-8").splitlines()[1:]
-    fmt = None
-    elements: list[tuple[str, int, list[tuple[str, ...]]]] = []
-    for line in lines:
-        words = line.split()
-        if not words or words[0] == "obj_info":
-            continue
-        if words[0] == "comment":
-            if "texturefile" in line.lower():
-                raise UnsupportedError("texture file")
-            continue
-        if words[0] == "format":
-            fmt = words[1]
-        elif words[0] == "element":
-            elements.append((words[1], int(words[2]), []))
-        elif words[0] == "property":
-            elements[-1][2].append(tuple(words[1:]))
-        else:
-            raise UnsupportedError(line)
+    fmt, elements, others = ply_header(lines)
+    if any(line.split()[0] != "comment" or "texturefile" in line.lower() for line in others):
+        raise UnsupportedError("header line")  # a texture file, or a keyword trimesh knows
     if [e[0] for e in elements] != ["vertex", "face"]:
         raise UnsupportedError("elements")
     (_, vertex_count, vertex_props), (_, face_count, face_props) = elements

@@ -22,7 +22,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -64,6 +64,9 @@ class GaussianSplats:
     GeometryError
         Wrong shapes, non-finite values, scales <= 0, zero quaternions, opacities outside [0, 1].
     """
+
+    scene_geometry: ClassVar[str] = "splats"
+    """What a scene places (``scene.graph`` checks this mark and need not import this module)."""
 
     positions: Points
     scales: NDArray[np.float64]

@@ -214,6 +214,16 @@ def _segments_path(segments: NDArray, transform: Any) -> str:
     return " ".join(f"M{_point(*a)} L{_point(*b)}" for a, b in paper)
 
 
+def hidden_style(hidden: str, stroke_width: float, stroke: str = "#000000") -> str:
+    """The SVG stroke attributes of hidden lines: thinner (0.7 of `stroke_width`), and dashed (4 on, 2.5 off, in
+    stroke widths) in `stroke` or solid gray."""
+    thin = _number(0.7 * stroke_width)
+    if hidden == "dashed":
+        dash = f"{_number(4 * stroke_width)} {_number(2.5 * stroke_width)}"
+        return f'stroke="{stroke}" stroke-width="{thin}" stroke-dasharray="{dash}"'
+    return f'stroke="{_HIDDEN_GRAY}" stroke-width="{thin}"'
+
+
 def _line_groups(
     lines: HiddenLines | _Pieces, transform: Any, stroke_width: float, hidden: str | None, depth_cue: bool,
     stroke: str = "#000000",
@@ -223,12 +233,7 @@ def _line_groups(
     groups = []
     width = _number(stroke_width)
     if hidden is not None and lines.hidden.shape[0]:
-        thin = _number(0.7 * stroke_width)
-        if hidden == "dashed":
-            dash = f"{_number(4 * stroke_width)} {_number(2.5 * stroke_width)}"
-            style = f'stroke="{stroke}" stroke-width="{thin}" stroke-dasharray="{dash}"'
-        else:
-            style = f'stroke="{_HIDDEN_GRAY}" stroke-width="{thin}"'
+        style = hidden_style(hidden, stroke_width, stroke)
         groups.append(
             f'<g id="{prefix}hidden" fill="none" {style} stroke-linecap="butt">'
             f'<path d="{_segments_path(lines.hidden, transform)}"/></g>'

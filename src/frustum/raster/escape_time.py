@@ -16,7 +16,7 @@ from frustum.raster._jit import kernel, parallel_kernel
 @kernel
 def _escape(zx, zy, cx, cy, max_iter, radius2, log_radius, smooth):  # pragma: no cover - compiled
     """Iterate z ← z² + c from z; return the (smooth) escape time or inf."""
-    for n in range(max_iter):
+    for n in range(max_iter + 1):  # the test after the last step too (the step after it is never used)
         x2 = zx * zx
         y2 = zy * zy
         if x2 + y2 > radius2:
@@ -25,12 +25,6 @@ def _escape(zx, zy, cx, cy, max_iter, radius2, log_radius, smooth):  # pragma: n
             return float(n)
         zy = 2.0 * zx * zy + cy
         zx = x2 - y2 + cx
-    x2 = zx * zx
-    y2 = zy * zy
-    if x2 + y2 > radius2:
-        if smooth:
-            return max_iter + 1.0 - math.log2(0.5 * math.log(x2 + y2) / log_radius)
-        return float(max_iter)
     return np.inf
 
 

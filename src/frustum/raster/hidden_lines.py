@@ -69,6 +69,8 @@ def _triangle_interval(a, b, tri, depth_tolerance):  # pragma: no cover - compil
         xi, yi, xj, yj = tri[i, 0], tri[i, 1], tri[j, 0], tri[j, 1]
         e_a[k] = (xj - xi) * (a[1] - yi) - (yj - yi) * (a[0] - xi)
         e_b[k] = (xj - xi) * (b[1] - yi) - (yj - yi) * (b[0] - xi)
+    # kernel specialisation kept on purpose: the same parameter clipping (Cyrus–Beck, u in [lo, hi] against
+    # half-planes) as the ray's half-spaces in raster/volume.py, here on 2-D edge functions
     for k in range(3):
         c0 = sigma * e_a[k]
         c = sigma * (e_b[k] - e_a[k])

@@ -185,6 +185,8 @@ def draw_sprites(sprites: np.ndarray, starts: np.ndarray, entries: np.ndarray, b
     Pixel (row, col) has its centre at window $(col + ½, H − 1 − row + ½)$.
     """
     height, width = depth.shape
+    # kernel specialisation kept on purpose: the same band loop as draw_streaks below and raster/points.py
+    # (one band of rows per thread), inlined with each primitive's own coverage loop
     for band in range(start, stop):
         first_row = band * band_rows
         last_row = min(first_row + band_rows, height) - 1
@@ -226,6 +228,7 @@ def draw_streaks(streaks: np.ndarray, starts: np.ndarray, entries: np.ndarray, b
     lands in the pixel containing it ($⌊x⌋, ⌊y⌋$) and blends with α once per sample.
     """
     height, width = depth.shape
+    # kernel specialisation kept on purpose: the same band loop as draw_sprites above, with a DDA line inside
     for band in range(start, stop):
         first_row = band * band_rows
         last_row = min(first_row + band_rows, height) - 1

@@ -15,6 +15,8 @@ def textbook_power(x: float, n: float) -> float:
 
     Squaring: r = 1; per bit of n from the lowest, r·x if the bit is set, then x·x. Other n: libm ``x ** n``.
     """
+    # kept twice on purpose: tests/reference_raster.py:_power is the same loop, as the byte-exact tests' reference
+    # shares no code with the renderer
     if not (n == math.floor(n) and 0.0 <= n <= SQUARING_MAX):
         return x**n
     e, r = int(n), 1.0

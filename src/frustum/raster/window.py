@@ -79,6 +79,8 @@ def gather_faces(
 def edge_setup(xy: np.ndarray, t: int) -> tuple[int, int, int, int, int, int, int, int, int, float]:
     """$(dx0, dy0, dx1, dy1, dx2, dy2, bias0, bias1, bias2, 2·area)$ of triangle t (edge k opposite corner k)."""
     x0, y0, x1, y1, x2, y2 = xy[t, 0], xy[t, 1], xy[t, 2], xy[t, 3], xy[t, 4], xy[t, 5]
+    # the same edge deltas and top-left biases stand inline in raster/triangles.py:covers_centre and the depth fill
+    # of raster/shadow.py (kernel specialisations: they take corners, not a row of xy)
     dx0, dy0 = x2 - x1, y2 - y1
     dx1, dy1 = x0 - x2, y0 - y2
     dx2, dy2 = x1 - x0, y1 - y0

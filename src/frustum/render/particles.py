@@ -32,7 +32,7 @@ import numpy as np
 from frustum.camera import Camera
 from frustum.scene import ParticleLayer
 
-__all__ = ["draw_particles", "project_particles", "project_streaks"]
+__all__ = ["bands", "draw_particles", "project_particles", "project_streaks"]
 
 
 def _frame(camera: Camera, minimum: float) -> np.ndarray:
@@ -82,7 +82,9 @@ def project_streaks(system: Any, camera: Camera, blending: str) -> tuple[np.ndar
     return _back_to_front(streaks, rows, 5) if blending == "alpha" else (streaks, rows)
 
 
-def _bands(rows: np.ndarray, height: int) -> tuple[np.ndarray, np.ndarray, int]:
+def bands(rows: np.ndarray, height: int) -> tuple[np.ndarray, np.ndarray, int]:
+    """(starts, entries, band_rows): the primitives of each band of ``BAND_ROWS`` rows, by first `rows` (count,
+    prefix sum, fill; order kept), for the banded kernels of particles and point clouds."""
     from frustum.raster import particles as kernels
 
     band_rows = kernels.BAND_ROWS
@@ -142,7 +144,7 @@ def draw_particles(layers: list[ParticleLayer], camera: Camera, depth: np.ndarra
         if mode == kernels.BLEND_ADDITIVE:  # draw in screen order (records gathered, read sequentially)
             order = _spatial_order(primitives, rows, depth.shape[1])
             primitives, rows = np.take(primitives, order, axis=0), np.take(rows, order, axis=0)
-        starts, entries, band_rows = _bands(rows, height)
+        starts, entries, band_rows = bands(rows, height)
         if layer.style == "streaks":
             kernels.draw_streaks(primitives, starts, entries, band_rows, mode, depth, accumulator)
         else:

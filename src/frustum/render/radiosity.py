@@ -71,6 +71,7 @@ from frustum.geometry.mesh import Mesh
 from frustum.projection import Frustum, Orthographic
 from frustum.scene import Scene, SceneItem
 from frustum.shading import DirectionalLight, Material, PointLight, SpotLight
+from frustum.shading.light import toward_light
 
 __all__ = [
     "Patches",
@@ -512,25 +513,11 @@ def _visible_fraction(light: Any, patches: Patches, raster: _Rasterizer, resolut
 
 
 def _direct_light(light: Any, patches: Patches) -> np.ndarray:
-    """(P, 3) f_l · I_l · max(N·L, 0) at each patch centre: the depth buffer's diffuse factor, unshadowed."""
+    """(P, 3) f_l · I_l · max(N·L, 0) at each patch centre: the depth buffer's diffuse factor, unshadowed (L and
+    the falloff f_l by the one light model, ``shading.light.toward_light``)."""
     intensity = np.asarray(light.color, dtype=np.float64) * light.intensity
-    if isinstance(light, DirectionalLight):
-        to_light = np.broadcast_to(-np.asarray(light.direction, dtype=np.float64), patches.centre.shape)
-        falloff = np.ones(patches.count)
-    else:
-        offset = np.asarray(light.position) - patches.centre
-        distance = np.linalg.norm(offset, axis=1)
-        to_light = offset / distance[:, None]
-        a0, a1, a2 = light.attenuation
-        falloff = 1.0 / (a0 + a1 * distance + a2 * distance * distance)
-        if isinstance(light, SpotLight):
-            cos_inner, cos_outer = math.cos(light.inner_angle), math.cos(light.outer_angle)
-            cos_alpha = -(to_light @ np.asarray(light.direction))
-            if cos_inner > cos_outer:
-                falloff = falloff * np.clip((cos_alpha - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0)
-            else:
-                falloff = falloff * (cos_alpha >= cos_outer)
-    ndl = np.maximum((patches.normal * to_light).sum(axis=1), 0.0)
+    to_light, falloff = toward_light(light, patches.centre)
+    ndl = np.maximum(np.einsum("ij,ij->i", patches.normal, to_light), 0.0)
     return (falloff * ndl)[:, None] * intensity
 
 

@@ -21,6 +21,7 @@ from frustum.render.context import FrameContext
 from frustum.render.options import GROUND_TRUTH_BUFFERS, RenderOptions
 from frustum.scene import Scene, SceneItem
 from frustum.shading import pack_lights
+from frustum.visibility.window import clip_crossing
 
 TILE_BITS = 5
 TILE_SIZE = 1 << TILE_BITS
@@ -195,13 +196,7 @@ def bin_item(
             tri_int, tri_float, tri_weights = tri_int[kept], tri_float[kept], tri_weights[kept]
             record_starts[1:] = np.cumsum(made)
         else:  # count, prefix sum, write (no slots to spare for a mesh crossing the view volume everywhere)
-            triangles.clip_faces(*arguments, record_starts[1:], tri_int, tri_float, tri_weights)
-            record_starts = np.cumsum(record_starts)
-            total = int(record_starts[-1])
-            tri_int = np.empty((total, triangles.RECORD_FIELDS), dtype=np.int64)
-            tri_float, tri_weights = np.empty((total, 3, 4)), np.empty((total, 3, 2))
-            clip_options[4] = 1
-            triangles.clip_faces(*arguments, record_starts[:-1], tri_int, tri_float, tri_weights)
+            record_starts, tri_int, tri_float, tri_weights = clip_crossing(arguments)
         tiles.add_record_tiles(tri_int, options, counts)
     offsets, tile_starts = tile_offsets(counts)
     entry_type = np.int32 if max(faces.shape[0], tri_int.shape[0] + 1) < 2**31 else np.int64

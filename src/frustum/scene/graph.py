@@ -11,7 +11,6 @@ Why one module: the Scene and what it places (nodes, items, volumes, particles, 
 from __future__ import annotations
 
 import importlib
-import sys
 from collections.abc import Iterable, Iterator
 from typing import TYPE_CHECKING, Any, NamedTuple
 
@@ -46,17 +45,15 @@ __all__ = [
 
 
 def is_octree(value: Any) -> bool:
-    """``isinstance(value, Octree)`` without importing ``frustum.geometry.octree``: no Octree exists before it is."""
-    module = sys.modules.get("frustum.geometry.octree")
-    return module is not None and isinstance(value, module.Octree)
+    """``isinstance(value, Octree)`` by the class's own mark (``Octree.scene_geometry``), so that a scene of meshes
+    never imports ``frustum.geometry.octree``."""
+    return getattr(type(value), "scene_geometry", None) == "octree"
 
 
 def _is_points(value: Any) -> bool:
-    """A ``PointCloud`` or ``GaussianSplats`` (without importing their modules: none exists before they are)."""
-    points, splats = sys.modules.get("frustum.geometry.points"), sys.modules.get("frustum.geometry.splats")
-    return (points is not None and isinstance(value, points.PointCloud)) or (
-        splats is not None and isinstance(value, splats.GaussianSplats)
-    )
+    """A ``PointCloud`` or ``GaussianSplats``, by the class's own mark (``scene_geometry``), without importing
+    their modules."""
+    return getattr(type(value), "scene_geometry", None) in ("points", "splats")
 
 
 PARTICLE_STYLES = ("sprites", "points", "streaks")

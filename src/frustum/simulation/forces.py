@@ -130,23 +130,31 @@ class _Collider:
 
     def resolve(self, positions: NDArray[np.float64], velocities: NDArray[np.float64]) -> None:
         """Move particles inside the collider out and respond their velocities, in place."""
-        if positions.shape[0] == 0:
-            return
-        distance = self._signed_distance(positions)
-        inside = np.flatnonzero(distance < 0.0)
+        inside, depth = self._inside(positions)
         if inside.size == 0:
             return
-        depth = distance[inside]
         normals = self._normals(positions[inside])
+        positions[inside] -= ((1.0 + self.restitution) * depth)[:, None] * normals
+        self._respond(velocities, inside, normals)
+
+    def _inside(self, positions: NDArray[np.float64]) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
+        """The indices of the particles inside the collider and their signed distances (< 0)."""
+        if positions.shape[0] == 0:
+            return np.empty(0, dtype=np.int64), np.empty(0)
+        distance = self._signed_distance(positions)
+        inside = np.flatnonzero(distance < 0.0)
+        return inside, distance[inside]
+
+    def _respond(
+        self, velocities: NDArray[np.float64], inside: NDArray[np.int64], normals: NDArray[np.float64]
+    ) -> None:
+        """$v ← (1 − μ)·v_t − e·v_n$ for the particles `inside` that approach the surface (module docstring)."""
         e, mu = self.restitution, self.friction
-        positions[inside] -= ((1.0 + e) * depth)[:, None] * normals
         v = velocities[inside]
         normal_speed = (v * normals).sum(axis=1)
-        approaching = normal_speed < 0.0
         normal_part = normal_speed[:, None] * normals
-        tangential = v - normal_part
-        response = (1.0 - mu) * tangential - e * normal_part
-        velocities[inside] = np.where(approaching[:, None], response, v)
+        response = (1.0 - mu) * (v - normal_part) - e * normal_part
+        velocities[inside] = np.where((normal_speed < 0.0)[:, None], response, v)
 
 
 class PlaneCollider(_Collider):
@@ -241,40 +249,29 @@ class MeshCollider(_Collider):
         return np.zeros_like(positions)  # unused: resolve below moves to the surface point directly
 
     def resolve(self, positions: NDArray[np.float64], velocities: NDArray[np.float64]) -> None:
-        if positions.shape[0] == 0:
-            return
-        distance = self._signed_distance(positions)
-        inside = np.flatnonzero(distance < 0.0)
+        inside, _ = self._inside(positions)
         if inside.size == 0:
             return
         closest = self._closest[inside]
         offset = closest - positions[inside]
         depth = np.linalg.norm(offset, axis=1)
         normals = offset / np.where(depth > 0.0, depth, 1.0)[:, None]
-        e, mu = self.restitution, self.friction
-        positions[inside] = closest + (e * depth)[:, None] * normals
-        v = velocities[inside]
-        normal_speed = (v * normals).sum(axis=1)
-        normal_part = normal_speed[:, None] * normals
-        response = (1.0 - mu) * (v - normal_part) - e * normal_part
-        velocities[inside] = np.where((normal_speed < 0.0)[:, None], response, v)
+        positions[inside] = closest + (self.restitution * depth)[:, None] * normals
+        self._respond(velocities, inside, normals)
 
 
 def check_forces(forces: Any, where: str) -> tuple[Force, ...]:
-    items = tuple(forces) if isinstance(forces, list | tuple) else None
-    if items is None or not all(isinstance(f, Force) for f in items):
-        raise SimulationError(
-            f"{where}: forces = {describe(forces)} is not a list of forces; give e.g. [Gravity(), Drag(0.1)] "
-            "(Gravity, Drag, Wind, Vortex, Attractor)"
-        )
-    return items
+    return _items_of(forces, Force, "forces", where, "[Gravity(), Drag(0.1)] (Gravity, Drag, Wind, Vortex, Attractor)")
 
 
 def check_colliders(colliders: Any, where: str) -> tuple[_Collider, ...]:
-    items = tuple(colliders) if isinstance(colliders, list | tuple) else None
-    if items is None or not all(isinstance(c, _Collider) for c in items):
-        raise SimulationError(
-            f"{where}: colliders = {describe(colliders)} is not a list of colliders; give e.g. "
-            "[PlaneCollider((0, 0, 0), (0, 1, 0))] (PlaneCollider, SphereCollider, MeshCollider)"
-        )
+    return _items_of(colliders, _Collider, "colliders", where,
+                     "[PlaneCollider((0, 0, 0), (0, 1, 0))] (PlaneCollider, SphereCollider, MeshCollider)")  # fmt: skip
+
+
+def _items_of(value: Any, kind: type, name: str, where: str, example: str) -> tuple[Any, ...]:
+    """`value` (a list or tuple of `kind` instances) as a tuple, or SimulationError naming it with `example`."""
+    items = tuple(value) if isinstance(value, list | tuple) else None
+    if items is None or not all(isinstance(item, kind) for item in items):
+        raise SimulationError(f"{where}: {name} = {describe(value)} is not a list of {name}; give e.g. {example}")
     return items

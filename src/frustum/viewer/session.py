@@ -47,7 +47,7 @@ import numpy as np
 
 from frustum._arrays import describe, escape_control
 from frustum.camera import Camera
-from frustum.clipping import REGION_BOTTOM, REGION_FAR, REGION_LEFT, REGION_NEAR, REGION_RIGHT, REGION_TOP
+from frustum.clipping.codes import region_names
 from frustum.errors import FrustumError
 from frustum.frame import Frame
 from frustum.scene import Scene
@@ -81,6 +81,7 @@ CONTROLS: dict[str, tuple[Any, ...]] = {
 }
 """Each control's allowed values."""
 _SWITCHES = ("depth_cue", "shadows")
+"""Controls that are checkboxes (bool values)."""
 STEPS_METHODS = ("depth-buffer", "scan-line", "warnock", "a-buffer", "ray-casting")
 """Visible-surface methods the steps panel records on the current view (``frustum steps`` names)."""
 STEPS_SIZE = 64
@@ -89,15 +90,6 @@ of the record is drawn in the figures (the notes' examples are this size)."""
 _STEPS_OPTIONS = ("specular", "background", "cull_back_faces", "color_space")
 """The scene file's ``render`` keywords a recording keeps (beside the shading control); others (samples, mode,
 shadows, depth cue) do not apply to one method's record."""
-"""Controls that are checkboxes (bool values)."""
-_REGIONS = (
-    (REGION_LEFT, "left"),
-    (REGION_RIGHT, "right"),
-    (REGION_BOTTOM, "bottom"),
-    (REGION_TOP, "top"),
-    (REGION_NEAR, "near"),
-    (REGION_FAR, "far"),
-)
 
 
 def scene_bounds(scene: Scene) -> tuple[np.ndarray, float]:
@@ -496,7 +488,7 @@ class ViewerSession:
             if stage.codes is not None:
                 code = int(stage.codes[0])
                 entry["code"] = code
-                entry["regions"] = [name for bit, name in _REGIONS if code & bit]
+                entry["regions"] = region_names(code)
             stages.append(entry)
         result.update(
             hit=True,

@@ -25,12 +25,12 @@ from __future__ import annotations
 import contextlib
 import contextvars
 import dataclasses
-from collections.abc import Iterator
 
 import numpy as np
 
 from frustum.budgets import check_memory
 from frustum.errors import GeometryError
+from frustum.visibility.recording import recording_into
 from frustum.visibility.window import WindowTriangles
 
 __all__ = ["FRAGMENT_BYTES", "Fragments", "build_fragments", "recording", "resolve_fragments"]
@@ -38,16 +38,10 @@ __all__ = ["FRAGMENT_BYTES", "Fragments", "build_fragments", "recording", "resol
 _RECORDING: contextvars.ContextVar[list[dict] | None] = contextvars.ContextVar("a_buffer_log", default=None)
 
 
-@contextlib.contextmanager
-def recording() -> Iterator[list[dict]]:
+def recording() -> contextlib.AbstractContextManager[list[dict]]:
     """Recording mode (``frustum.steps``): every ``resolve_fragments`` inside the block appends to the list the
     ``fragments`` it resolves and their ``premultiplied`` colors (the A-buffer's per-pixel lists as composited)."""
-    logs: list[dict] = []
-    token = _RECORDING.set(logs)
-    try:
-        yield logs
-    finally:
-        _RECORDING.reset(token)
+    return recording_into(_RECORDING)
 
 
 FRAGMENT_BYTES = 8 + 2 + 4 + 8 + 8 + 4

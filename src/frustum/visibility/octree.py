@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
-from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
@@ -27,23 +26,18 @@ from frustum.errors import FrustumError
 from frustum.frame import Frame, background_bytes
 from frustum.geometry.octree import Octree
 from frustum.shading import LIGHT_TYPES, DirectionalLight, Light, Material, illuminate
+from frustum.visibility.recording import recording_into
 
 __all__ = ["draw_octree_into", "octree_face_colors", "recording", "render_octree"]
 
 _RECORDING: contextvars.ContextVar[list[np.ndarray] | None] = contextvars.ContextVar("octree_log", default=None)
 
 
-@contextlib.contextmanager
-def recording() -> Iterator[list[np.ndarray]]:
+def recording() -> contextlib.AbstractContextManager[list[np.ndarray]]:
     """Recording mode (``frustum.steps``): every ``draw_octree_into`` inside the block appends its traversal log,
     an (N, 4) int64 array of ``(level, Morton code, outcome, pixels drawn)`` per node visited in order
     (``raster.octree.draw_octree``)."""
-    logs: list[np.ndarray] = []
-    token = _RECORDING.set(logs)
-    try:
-        yield logs
-    finally:
-        _RECORDING.reset(token)
+    return recording_into(_RECORDING)
 
 _AXES = np.array([[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]], dtype=np.float64)
 _DEFAULT_LIGHTS: tuple[Light, ...] = (DirectionalLight((-0.4, -0.6, -1.0)),)

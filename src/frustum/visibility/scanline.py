@@ -17,10 +17,10 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
-from collections.abc import Iterator
 
 import numpy as np
 
+from frustum.visibility.recording import recording_into
 from frustum.visibility.window import WindowTriangles
 
 __all__ = ["recording", "scan_line"]
@@ -28,17 +28,11 @@ __all__ = ["recording", "scan_line"]
 _RECORDING: contextvars.ContextVar[list[dict] | None] = contextvars.ContextVar("scan_line_log", default=None)
 
 
-@contextlib.contextmanager
-def recording() -> Iterator[list[dict]]:
+def recording() -> contextlib.AbstractContextManager[list[dict]]:
     """Recording mode (``frustum.steps``): every ``scan_line`` run inside the block appends a dict to the list:
     ``order``, ``bucket`` (the edge table), ``active`` (H, capacity, 3) and ``spans`` (H, 2·capacity + 1, 4)
     (``raster.scanline``'s logs, −1 where unused), ``box`` (T, 4) and ``code`` (T,) of the triangles."""
-    logs: list[dict] = []
-    token = _RECORDING.set(logs)
-    try:
-        yield logs
-    finally:
-        _RECORDING.reset(token)
+    return recording_into(_RECORDING)
 
 
 def scan_line(triangles: WindowTriangles, depth: np.ndarray, codes: np.ndarray, bary: np.ndarray) -> dict:

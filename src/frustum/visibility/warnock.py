@@ -15,12 +15,12 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
-from collections.abc import Iterator
 
 import numpy as np
 
 from frustum.budgets import check_memory
 from frustum.errors import GeometryError
+from frustum.visibility.recording import recording_into
 from frustum.visibility.window import WindowTriangles
 
 __all__ = ["area_subdivision", "recording"]
@@ -28,16 +28,10 @@ __all__ = ["area_subdivision", "recording"]
 _RECORDING: contextvars.ContextVar[list[np.ndarray] | None] = contextvars.ContextVar("warnock_log", default=None)
 
 
-@contextlib.contextmanager
-def recording() -> Iterator[list[np.ndarray]]:
+def recording() -> contextlib.AbstractContextManager[list[np.ndarray]]:
     """Recording mode (``frustum.steps``): every ``area_subdivision`` run inside the block appends its area log,
     an (A, 9) int64 array (``raster.warnock.LOG_COLUMNS``: one row per area visited, in order), to the list."""
-    logs: list[np.ndarray] = []
-    token = _RECORDING.set(logs)
-    try:
-        yield logs
-    finally:
-        _RECORDING.reset(token)
+    return recording_into(_RECORDING)
 
 
 def area_subdivision(triangles: WindowTriangles, depth: np.ndarray, codes: np.ndarray, bary: np.ndarray) -> dict:

@@ -120,18 +120,9 @@ def window_triangles(
         crossing = np.flatnonzero(((c[:, 0] & c[:, 1] & c[:, 2]) == 0) & ((c[:, 0] | c[:, 1] | c[:, 2]) != 0))
         if crossing.shape[0]:
             clip_options = np.array([width, height, int(cull), face_offsets[k], 0], dtype=np.int64)
-            record_starts = np.zeros(crossing.shape[0] + 1, dtype=np.int64)
-            tri_int = np.empty((0, triangles.RECORD_FIELDS), dtype=np.int64)
-            tri_float, tri_weights = np.empty((0, 3, 4)), np.empty((0, 3, 2))
             arguments = (crossing, faces, mesh.vertices, clip_from_model, VIEW_VOLUME_PLANES, view, clip_options)
-            triangles.clip_faces(*arguments, record_starts[1:], tri_int, tri_float, tri_weights)
-            counts = record_starts[1:].copy()
-            record_starts = np.cumsum(record_starts)
-            total = int(record_starts[-1])
-            tri_int = np.empty((total, triangles.RECORD_FIELDS), dtype=np.int64)
-            tri_float, tri_weights = np.empty((total, 3, 4)), np.empty((total, 3, 2))
-            clip_options[4] = 1
-            triangles.clip_faces(*arguments, record_starts[:-1], tri_int, tri_float, tri_weights)
+            record_starts, tri_int, tri_float, tri_weights = clip_crossing(arguments)
+            counts = np.diff(record_starts)
             records = (
                 np.ascontiguousarray(tri_int[:, :6]), tri_float, tri_weights, tri_int[:, 6].copy(),
                 np.ascontiguousarray(tri_int[:, 7:11]),
@@ -143,6 +134,28 @@ def window_triangles(
     if not parts:
         return WindowTriangles(*_allocate(0), np.empty(0, dtype=np.int64), width, height)
     return WindowTriangles(*(np.concatenate(column) for column in zip(*parts, strict=True)), width, height)
+
+
+def clip_crossing(arguments: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The faces crossing the view volume clipped into window-triangle records by ``raster.triangles.clip_faces``
+    (`arguments`: its leading arguments, the crossing faces first and the options last), in two passes: count,
+    prefix sum, write. Returns (record_starts (C + 1,), tri_int, tri_float, tri_weights); ``render.bin_item``
+    clips this way too."""
+    from frustum.raster import triangles
+
+    clip_options = arguments[-1]
+    record_starts = np.zeros(arguments[0].shape[0] + 1, dtype=np.int64)
+    tri_int = np.empty((0, triangles.RECORD_FIELDS), dtype=np.int64)
+    tri_float, tri_weights = np.empty((0, 3, 4)), np.empty((0, 3, 2))  # z_w, 1/w, the snap residuals
+    clip_options[4] = 0
+    triangles.clip_faces(*arguments, record_starts[1:], tri_int, tri_float, tri_weights)
+    record_starts = np.cumsum(record_starts)
+    total = int(record_starts[-1])
+    tri_int = np.empty((total, triangles.RECORD_FIELDS), dtype=np.int64)
+    tri_float, tri_weights = np.empty((total, 3, 4)), np.empty((total, 3, 2))
+    clip_options[4] = 1
+    triangles.clip_faces(*arguments, record_starts[:-1], tri_int, tri_float, tri_weights)
+    return record_starts, tri_int, tri_float, tri_weights
 
 
 def _allocate(count: int) -> tuple[np.ndarray, ...]:

@@ -6,7 +6,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -53,6 +53,9 @@ class Octree:
     boundary : uint64 array, optional
         Finest-level codes of cells the sampled surface crossed (``volume_bounds``).
     """
+
+    scene_geometry: ClassVar[str] = "octree"
+    """What a scene places (``scene.graph`` checks this mark and need not import this module)."""
 
     bounds: NDArray[np.float64]
     depth: int

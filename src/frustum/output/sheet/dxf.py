@@ -183,41 +183,24 @@ def _add_mark(space: Any, mark: Any, dx: float, dy: float, to_dxf: Any, scale: f
         )  # fmt: skip
         dimension.render()
         return
-    if mark.kind == "diameter" and definition is not None:
-        _, centre, radius, tip = definition
-        centre_dxf = to_dxf(np.array([[centre[0] + dx, centre[1] + dy]]))[0]
-        direction = np.array([tip[0] - centre[0], -(tip[1] - centre[1])])
-        angle = math.degrees(math.atan2(direction[1], direction[0]))
-        knee = mark.lines[0][2:]
-        location = to_dxf(np.array([[knee[0] + dx, knee[1] + dy]]))[0]
-        dimension = space.add_diameter_dim(
-            center=tuple(centre_dxf),
-            radius=radius / scale,
-            angle=angle,
-            location=tuple(location),
-            text=f"{_prefix(mark.texts[0][2]).removesuffix('%%c')}<>",
-            dimstyle="FRUSTUM",
-            override={"dimdec": _decimals(mark.value), "dimtmove": 0, "dimtih": 1, "dimtoh": 1},
-            dxfattribs=attributes,
-        )  # fmt: skip  (a diameter dimension writes its own ⌀ before the measurement)
-        dimension.render()
-        return
-    if mark.kind == "radius" and definition is not None:
+    if mark.kind in ("diameter", "radius") and definition is not None:
+        # a diameter (radius) dimension writes its own ⌀ (R) before the measurement: the mark's text drops it
+        add, symbol = (space.add_diameter_dim, "%%c") if mark.kind == "diameter" else (space.add_radius_dim, "R")
         _, centre, radius, tip = definition
         centre_dxf = to_dxf(np.array([[centre[0] + dx, centre[1] + dy]]))[0]
         angle = math.degrees(math.atan2(-(tip[1] - centre[1]), tip[0] - centre[0]))
         knee = mark.lines[0][2:]
         location = to_dxf(np.array([[knee[0] + dx, knee[1] + dy]]))[0]
-        dimension = space.add_radius_dim(
+        dimension = add(
             center=tuple(centre_dxf),
             radius=radius / scale,
             angle=angle,
             location=tuple(location),
-            text=f"{_prefix(mark.texts[0][2]).removesuffix('R')}<>",
+            text=f"{_prefix(mark.texts[0][2]).removesuffix(symbol)}<>",
             dimstyle="FRUSTUM",
             override={"dimdec": _decimals(mark.value), "dimtmove": 0, "dimtih": 1, "dimtoh": 1},
             dxfattribs=attributes,
-        )  # fmt: skip  (a radius dimension writes its own R before the measurement)
+        )
         dimension.render()
         return
     weight = {"lineweight": round(mark.line_width * 100)} if layer == "TITLE" else {}

@@ -37,12 +37,12 @@ from frustum.output.sheet.model import (
 from frustum.output.sheet.title_block import draw_title_block, scale_bar, scale_label, title_fields
 from frustum.output.sheet.views import make_views
 from frustum.output.svg import (
-    _HIDDEN_GRAY,
     _check_common,
     _drawing_groups,
     _escape,
     _number,
     _placed_meshes,
+    hidden_style,
     save_svg,
     svg_document,
 )
@@ -393,12 +393,7 @@ def _curve_groups(view: SheetView, to_paper: Any, stroke_width: float, hidden: s
     ``<view>-visible-curves`` of ``<circle>``, ``<ellipse>`` and elliptical-arc ``<path>`` elements."""
     groups = []
     if hidden is not None and view.hidden_arcs:
-        thin = _number(0.7 * stroke_width)
-        if hidden == "dashed":
-            dash = f"{_number(4 * stroke_width)} {_number(2.5 * stroke_width)}"
-            style = f'stroke="#000000" stroke-width="{thin}" stroke-dasharray="{dash}"'
-        else:
-            style = f'stroke="{_HIDDEN_GRAY}" stroke-width="{thin}"'
+        style = hidden_style(hidden, stroke_width)
         elements = svg_arc_elements([arc.mapped(to_paper) for arc in view.hidden_arcs])
         groups.append(
             f'<g id="{view.name}-hidden-curves" fill="none" {style} stroke-linecap="butt">{"".join(elements)}</g>'

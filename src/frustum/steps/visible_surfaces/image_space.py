@@ -8,6 +8,7 @@ References: [HB 16] "Depth-Buffer Method", "Area-Subdivision Method", "Scan-Line
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -53,6 +54,18 @@ def default_scene() -> tuple[Scene, Camera]:
     return scene, camera
 
 
+def scene_and_camera(scene: Scene | None, camera: Camera | None, where: str,
+                     default: Callable[[], tuple[Scene, Camera]] = default_scene) -> tuple[Scene, Camera]:  # fmt: skip
+    """The scene and checked camera a visible-surface step works on: `default`'s scene and camera where none is
+    given (a given camera wins over the default's)."""
+    if scene is None:
+        scene, default_camera = default()
+        camera = default_camera if camera is None else camera
+    if not isinstance(scene, Scene):
+        raise FrustumError(f"{where}: scene = {scene!r} is not a Scene")
+    return scene, _camera(camera, where)
+
+
 def depth_buffer(scene: Scene | None = None, camera: Camera | None = None, **options: Any) -> Steps:
     """The depth-buffer method surface by surface: the depth and frame buffers after each of the scene's top
     nodes (in order) has been drawn.
@@ -69,12 +82,7 @@ def depth_buffer(scene: Scene | None = None, camera: Camera | None = None, **opt
     from frustum.render import render
 
     where = "steps.depth_buffer"
-    if scene is None:
-        scene, default_camera = default_scene()
-        camera = default_camera if camera is None else camera
-    if not isinstance(scene, Scene):
-        raise FrustumError(f"{where}: scene = {scene!r} is not a Scene")
-    cam = _camera(camera, where)
+    scene, cam = scene_and_camera(scene, camera, where)
     surfaces = list(scene.root.children)
     if not surfaces:
         raise GeometryError(f"{where}: the scene has no surfaces; add a mesh with Scene.add")
@@ -158,12 +166,7 @@ def area_subdivision(scene: Scene | None = None, camera: Camera | None = None, *
     from frustum.visibility.warnock import recording
 
     where = "steps.area_subdivision"
-    if scene is None:
-        scene, default_camera = default_scene()
-        camera = default_camera if camera is None else camera
-    if not isinstance(scene, Scene):
-        raise FrustumError(f"{where}: scene = {scene!r} is not a Scene")
-    cam = _camera(camera, where)
+    scene, cam = scene_and_camera(scene, camera, where)
     areas_bound = 2 * cam.width * cam.height + 1
     levels_bound = 2 * max(1, math.ceil(math.log2(max(cam.width, cam.height, 2)))) + 2
     check_memory(areas_bound * (_BYTES_PER_AREA_ROW + _BYTES_PER_AREA_RECT * levels_bound), where=where,
@@ -241,12 +244,7 @@ def scan_line(scene: Scene | None = None, camera: Camera | None = None, **option
     from frustum.visibility.scanline import recording
 
     where = "steps.scan_line"
-    if scene is None:
-        scene, default_camera = default_scene()
-        camera = default_camera if camera is None else camera
-    if not isinstance(scene, Scene):
-        raise FrustumError(f"{where}: scene = {scene!r} is not a Scene")
-    cam = _camera(camera, where)
+    scene, cam = scene_and_camera(scene, camera, where)
     zoom = max(1, 256 // max(cam.width, 1))
     check_memory(cam.height * cam.width * cam.height * zoom * zoom * _BYTES_PER_PIXEL_PER_FIGURE, where=where,
                  cause=f"a recording of {cam.height} scan lines at {cam.width}x{cam.height}",
@@ -340,12 +338,7 @@ def a_buffer(
     from frustum.visibility.abuffer import recording
 
     where = "steps.a_buffer"
-    if scene is None:
-        scene, default_camera = default_transparent_scene()
-        camera = default_camera if camera is None else camera
-    if not isinstance(scene, Scene):
-        raise FrustumError(f"{where}: scene = {scene!r} is not a Scene")
-    cam = _camera(camera, where)
+    scene, cam = scene_and_camera(scene, camera, where, default_transparent_scene)
     with recording() as logs:
         frame = render(scene, cam, method="a-buffer", **options)
     result = frame

@@ -12,11 +12,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from frustum.camera import Camera
-from frustum.errors import FrustumError, GeometryError, OutputError
+from frustum.errors import GeometryError, OutputError
 from frustum.scene import Scene
 from frustum.steps._record import Step, Steps, _Canvas
-from frustum.steps.viewing import _camera
-from frustum.steps.visible_surfaces.image_space import default_scene
+from frustum.steps.visible_surfaces.image_space import scene_and_camera
 
 __all__ = ["ray_casting", "traced_closest"]
 
@@ -24,6 +23,7 @@ __all__ = ["ray_casting", "traced_closest"]
 def _pixel_ray(camera: Camera, x: int, y: int) -> tuple[float, ...]:
     """The ray of window pixel (x, y), with ``raster.rays.cast_pixels``' arithmetic: origin on the near plane,
     direction to the far plane (t in [0, 1))."""
+    # kept twice on purpose: the arithmetic of raster/rays.py:cast_pixels (a kernel's inner loop), for one pixel
     m = np.ascontiguousarray(camera.world_from_window, dtype=np.float64)
     px, py = x + 0.5, y + 0.5
     nw = m[3, 0] * px + m[3, 1] * py + m[3, 3]
@@ -102,12 +102,7 @@ def ray_casting(
     from frustum.render import render
 
     where = "steps.ray_casting"
-    if scene is None:
-        scene, default_camera = default_scene()
-        camera = default_camera if camera is None else camera
-    if not isinstance(scene, Scene):
-        raise FrustumError(f"{where}: scene = {scene!r} is not a Scene")
-    cam = _camera(camera, where)
+    scene, cam = scene_and_camera(scene, camera, where)
     width, height = cam.width, cam.height
     x, y = (width // 2, height // 2) if pixel is None else (int(v) for v in pixel)
     if not (0 <= x < width and 0 <= y < height):
