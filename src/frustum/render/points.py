@@ -35,7 +35,7 @@ from frustum.camera import Camera
 from frustum.render.buffers import Scratch
 from frustum.render.context import FrameContext
 from frustum.render.options import RenderOptions
-from frustum.render.stages import Lighting, shading_parameters
+from frustum.render.stages import Lighting, bands, shading_parameters
 from frustum.scene import PointItem, Scene, SceneItem
 from frustum.shading import pack_lights
 from frustum.transforms import apply, apply_to_normals
@@ -72,18 +72,6 @@ def silhouette(item: PointItem, camera: Camera, options: RenderOptions) -> np.nd
     return context.depth < 1.0
 
 
-def _bands(rows: np.ndarray, height: int) -> tuple[np.ndarray, np.ndarray, int]:
-    from frustum.raster import particles
-
-    band_rows = particles.BAND_ROWS
-    bands = (height + band_rows - 1) // band_rows
-    counts = np.zeros(bands, dtype=np.int64)
-    particles.count_bands(rows, band_rows, counts)
-    starts = np.zeros(bands + 1, dtype=np.int64)
-    np.cumsum(counts, out=starts[1:])
-    entries = np.empty(int(starts[-1]), dtype=np.int64)
-    particles.fill_bands(rows, band_rows, starts, entries)
-    return starts, entries, band_rows
 
 
 def draw_points(item: PointItem, object_id: int, camera: Camera, options: RenderOptions, lighting: Lighting,
@@ -121,7 +109,7 @@ def draw_points(item: PointItem, object_id: int, camera: Camera, options: Render
         frame = np.array([width, height], dtype=np.float64)
         kernels.project_impostors(model, np.ascontiguousarray(radii * scale_3d), normals, view_from_model,
                                   clip_from_view, frame, records, rows)  # fmt: skip
-        starts, entries, band_rows = _bands(rows, height)
+        starts, entries, band_rows = bands(rows, height)
         matrices = np.ascontiguousarray(np.stack([np.linalg.inv(clip_from_view), clip_from_view,
                                                   np.linalg.inv(camera.view_matrix)]))  # fmt: skip
         kernels.draw_impostors(records, starts, entries, band_rows, matrices, colors, params, lighting.lights,
@@ -137,7 +125,7 @@ def draw_points(item: PointItem, object_id: int, camera: Camera, options: Render
         sizes = 2.0 * scale_3d * np.ascontiguousarray(radii, dtype=np.float64)
         frame = np.array([width, height, abs(float(camera.projection_matrix[1, 1])) * height / 2.0])
     kernels.project_points(model, sizes, clip_from_model, frame, records, rows)
-    starts, entries, band_rows = _bands(rows, height)
+    starts, entries, band_rows = bands(rows, height)
     world = normals = np.zeros((0, 3))
     if lit or buffers.normals is not None:
         if cloud.normals is not None:
