@@ -531,6 +531,56 @@ def memory_bytes(count: int) -> int:
 
 
 @kernel
+def _reciprocal(dx, dy, dz):
+    """A ray's reciprocal direction (inf for a zero component) and the rows of the bounds it enters first
+    (0/3, 1/4, 2/5 by its signs): ``(ix, iy, iz, nx, ny, nz)``, what every traversal's slab tests read."""
+    ix = 1.0 / dx if dx != 0.0 else np.inf
+    iy = 1.0 / dy if dy != 0.0 else np.inf
+    iz = 1.0 / dz if dz != 0.0 else np.inf
+    return ix, iy, iz, 0 if ix >= 0.0 else 3, 1 if iy >= 0.0 else 4, 2 if iz >= 0.0 else 5
+
+
+@kernel
+def _slab(x0, y0, z0, x1, y1, z1, ox, oy, oz, ix, iy, iz, t_min, reach):
+    """Where the ray enters the box within [t_min, reach] (inf: it misses), from the bounds it enters first
+    (x0, y0, z0) and last (x1 …): the slab test $t = (b − o)·(1/d)$, the far distances widened by
+    $1 + 2γ₃$ (``_ROBUST``, PBRT 3.9.2) so that rounding never loses a box."""
+    t0, t1 = t_min, reach
+    a0, b0, g0 = (x0 - ox) * ix, (y0 - oy) * iy, (z0 - oz) * iz
+    t0 = a0 if a0 > t0 else t0
+    t0 = b0 if b0 > t0 else t0
+    t0 = g0 if g0 > t0 else t0
+    a1, b1, g1 = (x1 - ox) * ix * _ROBUST, (y1 - oy) * iy * _ROBUST, (z1 - oz) * iz * _ROBUST
+    t1 = a1 if a1 < t1 else t1
+    t1 = b1 if b1 < t1 else t1
+    t1 = g1 if g1 < t1 else t1
+    return t0 if t0 <= t1 else np.inf
+
+
+@kernel
+def _triangle(triangles, row, ox, oy, oz, dx, dy, dz):
+    """Möller–Trumbore of one ray and triangle ``triangles[row]``: ``(t, u, v, det)`` (det = 0: no hit; the one
+    ray–triangle arithmetic of every traversal here, which ``tests/test_rays.py``'s brute force repeats)."""
+    ax, ay, az = triangles[row, 0, 0], triangles[row, 0, 1], triangles[row, 0, 2]
+    e1x, e1y, e1z = triangles[row, 1, 0] - ax, triangles[row, 1, 1] - ay, triangles[row, 1, 2] - az
+    e2x, e2y, e2z = triangles[row, 2, 0] - ax, triangles[row, 2, 1] - ay, triangles[row, 2, 2] - az
+    px, py, pz = dy * e2z - dz * e2y, dz * e2x - dx * e2z, dx * e2y - dy * e2x
+    det = e1x * px + e1y * py + e1z * pz
+    if det == 0.0:
+        return 0.0, 0.0, 0.0, 0.0
+    inv = 1.0 / det
+    sx, sy, sz = ox - ax, oy - ay, oz - az
+    u = (sx * px + sy * py + sz * pz) * inv
+    if u < 0.0 or u > 1.0:
+        return 0.0, 0.0, 0.0, 0.0
+    qx, qy, qz = sy * e1z - sz * e1y, sz * e1x - sx * e1z, sx * e1y - sy * e1x
+    v = (dx * qx + dy * qy + dz * qz) * inv
+    if v < 0.0 or u + v > 1.0:
+        return 0.0, 0.0, 0.0, 0.0
+    return (e2x * qx + e2y * qy + e2z * qz) * inv, u, v, det
+
+
+@kernel
 def _closest(boxes, links, triangles, order, skip, ox, oy, oz, dx, dy, dz, t_min, t_max, cull, stack, entry):
     """The first hit of one ray: ``(t, row, u, v, back, box_tests, nodes, tests)``.
 
@@ -540,12 +590,7 @@ def _closest(boxes, links, triangles, order, skip, ox, oy, oz, dx, dy, dz, t_min
     is (inf, −1, …). Counts: box (slab) tests, nodes visited (inner nodes and leaves entered), ray–triangle
     tests. `stack`, `entry`: scratch of at least the index's depth + 1.
     """
-    ix = 1.0 / dx if dx != 0.0 else np.inf
-    iy = 1.0 / dy if dy != 0.0 else np.inf
-    iz = 1.0 / dz if dz != 0.0 else np.inf
-    nx = 0 if ix >= 0.0 else 3
-    ny = 1 if iy >= 0.0 else 4
-    nz = 2 if iz >= 0.0 else 5
+    ix, iy, iz, nx, ny, nz = _reciprocal(dx, dy, dz)
     masked = skip.shape[0] > 0
     best = t_max
     reach = t_max
@@ -559,37 +604,12 @@ def _closest(boxes, links, triangles, order, skip, ox, oy, oz, dx, dy, dz, t_min
         nodes += 1
         if node >= 0:
             box_tests += 2
-            t_near0, t_near1 = np.inf, np.inf
-            for side in range(2):
-                c = 6 * side
-                a0 = (boxes[node, c + nx] - ox) * ix
-                a1 = (boxes[node, c + 3 - nx] - ox) * ix
-                b0 = (boxes[node, c + ny] - oy) * iy
-                b1 = (boxes[node, c + 5 - ny] - oy) * iy
-                g0 = (boxes[node, c + nz] - oz) * iz
-                g1 = (boxes[node, c + 7 - nz] - oz) * iz
-                t0 = t_min
-                t1 = reach
-                if a0 > t0:
-                    t0 = a0
-                if b0 > t0:
-                    t0 = b0
-                if g0 > t0:
-                    t0 = g0
-                a1 *= _ROBUST
-                b1 *= _ROBUST
-                g1 *= _ROBUST
-                if a1 < t1:
-                    t1 = a1
-                if b1 < t1:
-                    t1 = b1
-                if g1 < t1:
-                    t1 = g1
-                if t0 <= t1:
-                    if side == 0:
-                        t_near0 = t0
-                    else:
-                        t_near1 = t0
+            t_near0 = _slab(boxes[node, nx], boxes[node, ny], boxes[node, nz], boxes[node, 3 - nx],
+                            boxes[node, 5 - ny], boxes[node, 7 - nz], ox, oy, oz, ix, iy, iz, t_min,
+                            reach)  # fmt: skip
+            t_near1 = _slab(boxes[node, 6 + nx], boxes[node, 6 + ny], boxes[node, 6 + nz], boxes[node, 9 - nx],
+                            boxes[node, 11 - ny], boxes[node, 13 - nz], ox, oy, oz, ix, iy, iz, t_min,
+                            reach)  # fmt: skip
             left, right = links[node, 0], links[node, 1]
             swap = t_near1 < t_near0  # selects, not branches: the order is a coin toss for the predictor
             if (t_near1 if swap else t_near0) < np.inf:  # the nearer child now, the other one pushed if met
@@ -607,23 +627,9 @@ def _closest(boxes, links, triangles, order, skip, ox, oy, oz, dx, dy, dz, t_min
                 if masked and skip[face] != 0:
                     continue
                 tests += 1
-                ax, ay, az = triangles[row, 0, 0], triangles[row, 0, 1], triangles[row, 0, 2]
-                e1x, e1y, e1z = triangles[row, 1, 0] - ax, triangles[row, 1, 1] - ay, triangles[row, 1, 2] - az
-                e2x, e2y, e2z = triangles[row, 2, 0] - ax, triangles[row, 2, 1] - ay, triangles[row, 2, 2] - az
-                px, py, pz = dy * e2z - dz * e2y, dz * e2x - dx * e2z, dx * e2y - dy * e2x
-                det = e1x * px + e1y * py + e1z * pz
+                t, u, v, det = _triangle(triangles, row, ox, oy, oz, dx, dy, dz)
                 if det == 0.0 or (cull != 0 and det < 0.0):
                     continue
-                inv = 1.0 / det
-                sx, sy, sz = ox - ax, oy - ay, oz - az
-                u = (sx * px + sy * py + sz * pz) * inv
-                if u < 0.0 or u > 1.0:
-                    continue
-                qx, qy, qz = sy * e1z - sz * e1y, sz * e1x - sx * e1z, sx * e1y - sy * e1x
-                v = (dx * qx + dy * qy + dz * qz) * inv
-                if v < 0.0 or u + v > 1.0:
-                    continue
-                t = (e2x * qx + e2y * qy + e2z * qz) * inv
                 if t >= t_min and (t < best or (t == best and face < best_face)):
                     best, best_row, best_face, best_u, best_v = t, row, face, u, v
                     best_back = 1 if det < 0.0 else 0
@@ -646,44 +652,15 @@ def _closest(boxes, links, triangles, order, skip, ox, oy, oz, dx, dy, dz, t_min
 def _any(boxes, links, triangles, ox, oy, oz, dx, dy, dz, t_min, t_max, stack):
     """Whether one ray meets any triangle at t in [t_min, t_max) (Möller–Trumbore as in ``_closest``; back faces
     count): the traversal stops at the first such triangle."""
-    ix = 1.0 / dx if dx != 0.0 else np.inf
-    iy = 1.0 / dy if dy != 0.0 else np.inf
-    iz = 1.0 / dz if dz != 0.0 else np.inf
-    nx = 0 if ix >= 0.0 else 3
-    ny = 1 if iy >= 0.0 else 4
-    nz = 2 if iz >= 0.0 else 5
+    ix, iy, iz, nx, ny, nz = _reciprocal(dx, dy, dz)
     node = 0
     top = 0
     while True:
         if node >= 0:
-            near0, near1 = np.inf, np.inf
-            for side in range(2):
-                c = 6 * side
-                t0 = t_min
-                t1 = t_max
-                a0 = (boxes[node, c + nx] - ox) * ix
-                b0 = (boxes[node, c + ny] - oy) * iy
-                g0 = (boxes[node, c + nz] - oz) * iz
-                a1 = (boxes[node, c + 3 - nx] - ox) * ix * _ROBUST
-                b1 = (boxes[node, c + 5 - ny] - oy) * iy * _ROBUST
-                g1 = (boxes[node, c + 7 - nz] - oz) * iz * _ROBUST
-                if a0 > t0:
-                    t0 = a0
-                if b0 > t0:
-                    t0 = b0
-                if g0 > t0:
-                    t0 = g0
-                if a1 < t1:
-                    t1 = a1
-                if b1 < t1:
-                    t1 = b1
-                if g1 < t1:
-                    t1 = g1
-                if t0 <= t1:
-                    if side == 0:
-                        near0 = t0
-                    else:
-                        near1 = t0
+            near0 = _slab(boxes[node, nx], boxes[node, ny], boxes[node, nz], boxes[node, 3 - nx], boxes[node, 5 - ny],
+                          boxes[node, 7 - nz], ox, oy, oz, ix, iy, iz, t_min, t_max)  # fmt: skip
+            near1 = _slab(boxes[node, 6 + nx], boxes[node, 6 + ny], boxes[node, 6 + nz], boxes[node, 9 - nx],
+                          boxes[node, 11 - ny], boxes[node, 13 - nz], ox, oy, oz, ix, iy, iz, t_min, t_max)  # fmt: skip
             left, right = links[node, 0], links[node, 1]
             swap = near1 < near0
             if (near1 if swap else near0) < np.inf:
@@ -695,23 +672,9 @@ def _any(boxes, links, triangles, ox, oy, oz, dx, dy, dz, t_min, t_max, stack):
             code = ~node
             first = code >> 3
             for row in range(first, first + (code & 7)):
-                ax, ay, az = triangles[row, 0, 0], triangles[row, 0, 1], triangles[row, 0, 2]
-                e1x, e1y, e1z = triangles[row, 1, 0] - ax, triangles[row, 1, 1] - ay, triangles[row, 1, 2] - az
-                e2x, e2y, e2z = triangles[row, 2, 0] - ax, triangles[row, 2, 1] - ay, triangles[row, 2, 2] - az
-                px, py, pz = dy * e2z - dz * e2y, dz * e2x - dx * e2z, dx * e2y - dy * e2x
-                det = e1x * px + e1y * py + e1z * pz
+                t, _, _, det = _triangle(triangles, row, ox, oy, oz, dx, dy, dz)
                 if det == 0.0:
                     continue
-                inv = 1.0 / det
-                sx, sy, sz = ox - ax, oy - ay, oz - az
-                u = (sx * px + sy * py + sz * pz) * inv
-                if u < 0.0 or u > 1.0:
-                    continue
-                qx, qy, qz = sy * e1z - sz * e1y, sz * e1x - sx * e1z, sx * e1y - sy * e1x
-                v = (dx * qx + dy * qy + dz * qz) * inv
-                if v < 0.0 or u + v > 1.0:
-                    continue
-                t = (e2x * qx + e2y * qy + e2z * qz) * inv
                 if t >= t_min and t < t_max:
                     return True
         if top == 0:
@@ -771,51 +734,17 @@ def _slab4_vector(typingctx, boxes, node, nx, ny, nz, ox, oy, oz, ix, iy, iz, t_
 
 def _slab4_scalar(boxes, node, nx, ny, nz, ox, oy, oz, ix, iy, iz, t_min, reach, near):
     """``near[c]`` = where the ray enters child c's box of wide node `node` within [t_min, reach] (inf: it
-    misses): the slab test of ``_closest`` (far bounds widened by ``_ROBUST``), one child after another."""
+    misses): ``_slab`` on one child after another."""
     for c in range(WIDTH):
-        t0, t1 = t_min, reach
-        a0 = (np.float64(boxes[node, nx, c]) - ox) * ix
-        b0 = (np.float64(boxes[node, ny, c]) - oy) * iy
-        g0 = (np.float64(boxes[node, nz, c]) - oz) * iz
-        t0 = a0 if a0 > t0 else t0
-        t0 = b0 if b0 > t0 else t0
-        t0 = g0 if g0 > t0 else t0
-        a1 = (np.float64(boxes[node, 3 - nx, c]) - ox) * ix * _ROBUST
-        b1 = (np.float64(boxes[node, 5 - ny, c]) - oy) * iy * _ROBUST
-        g1 = (np.float64(boxes[node, 7 - nz, c]) - oz) * iz * _ROBUST
-        t1 = a1 if a1 < t1 else t1
-        t1 = b1 if b1 < t1 else t1
-        t1 = g1 if g1 < t1 else t1
-        near[c] = t0 if t0 <= t1 else np.inf
+        near[c] = _slab(np.float64(boxes[node, nx, c]), np.float64(boxes[node, ny, c]), np.float64(boxes[node, nz, c]),
+                        np.float64(boxes[node, 3 - nx, c]), np.float64(boxes[node, 5 - ny, c]),
+                        np.float64(boxes[node, 7 - nz, c]), ox, oy, oz, ix, iy, iz, t_min, reach)  # fmt: skip
 
 
 _slab4 = _slab4_scalar if numba.config.DISABLE_JIT else _slab4_vector
 """``_slab4(wide_boxes, node, nx, ny, nz, ox, oy, oz, ix, iy, iz, t_min, reach, near)`` in a kernel: the entry
 distances of a wide node's ``WIDTH`` children into ``near`` (inf where missed); ``nx`` … the rows of the
 bounds the ray enters first (0/3, 1/4, 2/5 by the signs of its direction)."""
-
-
-@kernel
-def _triangle(triangles, row, ox, oy, oz, dx, dy, dz):
-    """Möller–Trumbore of one ray and triangle ``triangles[row]``: ``(t, u, v, det)`` (det = 0: no hit; the
-    arithmetic of ``_closest``, which ``tests/test_rays.py``'s brute force repeats)."""
-    ax, ay, az = triangles[row, 0, 0], triangles[row, 0, 1], triangles[row, 0, 2]
-    e1x, e1y, e1z = triangles[row, 1, 0] - ax, triangles[row, 1, 1] - ay, triangles[row, 1, 2] - az
-    e2x, e2y, e2z = triangles[row, 2, 0] - ax, triangles[row, 2, 1] - ay, triangles[row, 2, 2] - az
-    px, py, pz = dy * e2z - dz * e2y, dz * e2x - dx * e2z, dx * e2y - dy * e2x
-    det = e1x * px + e1y * py + e1z * pz
-    if det == 0.0:
-        return 0.0, 0.0, 0.0, 0.0
-    inv = 1.0 / det
-    sx, sy, sz = ox - ax, oy - ay, oz - az
-    u = (sx * px + sy * py + sz * pz) * inv
-    if u < 0.0 or u > 1.0:
-        return 0.0, 0.0, 0.0, 0.0
-    qx, qy, qz = sy * e1z - sz * e1y, sz * e1x - sx * e1z, sx * e1y - sy * e1x
-    v = (dx * qx + dy * qy + dz * qz) * inv
-    if v < 0.0 or u + v > 1.0:
-        return 0.0, 0.0, 0.0, 0.0
-    return (e2x * qx + e2y * qy + e2z * qz) * inv, u, v, det
 
 
 @kernel
@@ -826,12 +755,7 @@ def _closest4(wide_boxes, wide_links, triangles, order, skip, ox, oy, oz, dx, dy
     ``WIDTH`` boxes are tested at once (``_slab4``) and the children met are pushed sorted by entry distance,
     the nearest on top (popped next); a popped entry beyond the best hit so far is skipped. `stack`, `entry`:
     scratch of at least 3·depth + 2, `near` of ``WIDTH``."""
-    ix = 1.0 / dx if dx != 0.0 else np.inf
-    iy = 1.0 / dy if dy != 0.0 else np.inf
-    iz = 1.0 / dz if dz != 0.0 else np.inf
-    nx = 0 if ix >= 0.0 else 3
-    ny = 1 if iy >= 0.0 else 4
-    nz = 2 if iz >= 0.0 else 5
+    ix, iy, iz, nx, ny, nz = _reciprocal(dx, dy, dz)
     masked = skip.shape[0] > 0
     best = t_max
     reach = t_max
@@ -892,12 +816,7 @@ def _any4(wide_boxes, wide_links, triangles, ox, oy, oz, dx, dy, dz, t_min, t_ma
     """``_any`` on the wide tree: whether one ray meets a triangle at t in [t_min, t_max): the inner children
     met are pushed in their order, the leaves met tested at once; the traversal stops at the first triangle
     found."""
-    ix = 1.0 / dx if dx != 0.0 else np.inf
-    iy = 1.0 / dy if dy != 0.0 else np.inf
-    iz = 1.0 / dz if dz != 0.0 else np.inf
-    nx = 0 if ix >= 0.0 else 3
-    ny = 1 if iy >= 0.0 else 4
-    nz = 2 if iz >= 0.0 else 5
+    ix, iy, iz, nx, ny, nz = _reciprocal(dx, dy, dz)
     node = 0
     top = 0
     while True:
