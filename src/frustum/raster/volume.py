@@ -137,12 +137,28 @@ def _table_index(table, params, value):  # pragma: no cover - compiled
 @kernel
 def _lookup(table, params, value, channel):  # pragma: no cover - compiled
     """One channel of the transfer-function table at `value` (linear between entries, clamped at the ends)."""
-    size = table.shape[1]
-    f = (value - params[P_TABLE_LOW]) * params[P_TABLE_SCALE]
-    f = min(max(f, 0.0), size - 1.0)
-    i = min(int(f), size - 2)
-    t = f - i
+    i, t = _table_index(table, params, value)
+    return _entry(table, channel, i, t)
+
+
+@kernel
+def _entry(table, channel, i, t):  # pragma: no cover - compiled
+    """One channel of the table between entries i and i + 1 at fraction t: $(1 − t)·T[i] + t·T[i + 1]$."""
     return table[channel, i] * (1.0 - t) + table[channel, i + 1] * t
+
+
+@kernel
+def _over(data, matrices, params, lights, u, view_dir, table, i, t, alpha, shade, u0, u1, u2, cr, cg, cb,
+          acc):  # pragma: no cover - compiled  # fmt: skip
+    """One sample composited front to back: $C + (1 − A)·α·c$, $A + (1 − A)·α$ as ``(cr, cg, cb, acc)``, c the
+    table's colour at entry i, fraction t (``_entry``), shaded at grid position (u0, u1, u2) when `shade`
+    (``_shade``; `u`: scratch of 3)."""
+    r, g, b = _entry(table, 0, i, t), _entry(table, 1, i, t), _entry(table, 2, i, t)
+    if shade:
+        u[0], u[1], u[2] = u0, u1, u2
+        r, g, b = _shade(data, matrices, params, lights, u, view_dir, r, g, b)
+    weight = (1.0 - acc) * alpha
+    return cr + weight * r, cg + weight * g, cb + weight * b, acc + weight
 
 
 @kernel
@@ -459,19 +475,10 @@ def cast_composite(data, blocks, table, matrices, planes, params, lights, depth,
                             if value <= clear_below:  # opacity 0: no lookup
                                 continue
                             t_index, t = _table_index(table, params, value)
-                            alpha = table[4, t_index] * (1.0 - t) + table[4, t_index + 1] * t  # corrected for Δ
+                            alpha = _entry(table, 4, t_index, t)  # corrected for Δ
                             if alpha > 0.0 or not shade:  # (unshaded, α = 0 adds 0: no branch on α)
-                                r = table[0, t_index] * (1.0 - t) + table[0, t_index + 1] * t
-                                g = table[1, t_index] * (1.0 - t) + table[1, t_index + 1] * t
-                                b = table[2, t_index] * (1.0 - t) + table[2, t_index + 1] * t
-                                if shade:
-                                    u[0], u[1], u[2] = u0, u1, u2
-                                    r, g, b = _shade(data, matrices, params, lights, u, view_dir, r, g, b)
-                                weight = (1.0 - acc) * alpha
-                                cr += weight * r
-                                cg += weight * g
-                                cb += weight * b
-                                acc += weight
+                                cr, cg, cb, acc = _over(data, matrices, params, lights, u, view_dir, table, t_index,
+                                                        t, alpha, shade, u0, u1, u2, cr, cg, cb, acc)  # fmt: skip
                                 if acc >= threshold:  # early ray termination
                                     done = True
                                     break
@@ -493,20 +500,11 @@ def cast_composite(data, blocks, table, matrices, planes, params, lights, depth,
                 u0, u1, u2 = (origin[0] + tail_s * direction[0], origin[1] + tail_s * direction[1],
                               origin[2] + tail_s * direction[2])  # fmt: skip
                 t_index, t = _table_index(table, params, _value(data, u0, u1, u2))
-                alpha = table[3, t_index] * (1.0 - t) + table[3, t_index + 1] * t
+                alpha = _entry(table, 3, t_index, t)
                 if alpha > 0.0:
                     alpha = 1.0 - (1.0 - alpha) ** (tail * model_length / params[P_UNIT])
-                    r = table[0, t_index] * (1.0 - t) + table[0, t_index + 1] * t
-                    g = table[1, t_index] * (1.0 - t) + table[1, t_index + 1] * t
-                    b = table[2, t_index] * (1.0 - t) + table[2, t_index + 1] * t
-                    if shade:
-                        u[0], u[1], u[2] = u0, u1, u2
-                        r, g, b = _shade(data, matrices, params, lights, u, view_dir, r, g, b)
-                    weight = (1.0 - acc) * alpha
-                    cr += weight * r
-                    cg += weight * g
-                    cb += weight * b
-                    acc += weight
+                    cr, cg, cb, acc = _over(data, matrices, params, lights, u, view_dir, table, t_index, t, alpha,
+                                            shade, u0, u1, u2, cr, cg, cb, acc)  # fmt: skip
             out[0], out[1], out[2], out[3] = cr, cg, cb, acc
             _blend(color, row, column, out)
 
@@ -686,23 +684,14 @@ def cast_composite_merged(datas, blocks, tables, matrices, planes, params, light
                 table, p = tables[v], params[v]
                 t_index, t = _table_index(table, p, _value(data, u0, u1, u2))
                 if full:
-                    alpha = table[4, t_index] * (1.0 - t) + table[4, t_index + 1] * t
+                    alpha = _entry(table, 4, t_index, t)
                 else:
-                    alpha = table[3, t_index] * (1.0 - t) + table[3, t_index + 1] * t
+                    alpha = _entry(table, 3, t_index, t)
                     if alpha > 0.0:
                         alpha = 1.0 - (1.0 - alpha) ** (tail[v] * model_length[v] / p[P_UNIT])
                 if alpha > 0.0:
-                    r = table[0, t_index] * (1.0 - t) + table[0, t_index + 1] * t
-                    g = table[1, t_index] * (1.0 - t) + table[1, t_index + 1] * t
-                    b = table[2, t_index] * (1.0 - t) + table[2, t_index + 1] * t
-                    if p[P_SHADE] != 0.0:
-                        u[0], u[1], u[2] = u0, u1, u2
-                        r, g, b = _shade(data, matrices[v], p, lights, u, view_dirs[v], r, g, b)
-                    weight = (1.0 - acc) * alpha
-                    cr += weight * r
-                    cg += weight * g
-                    cb += weight * b
-                    acc += weight
+                    cr, cg, cb, acc = _over(data, matrices[v], p, lights, u, view_dirs[v], table, t_index, t, alpha,
+                                            p[P_SHADE] != 0.0, u0, u1, u2, cr, cg, cb, acc)  # fmt: skip
             out[0], out[1], out[2], out[3] = cr, cg, cb, acc
             _blend(color, row, column, out)
 
