@@ -18,15 +18,16 @@ range of node numbers: the top of the tree is built on one thread, the subtrees 
 (or a sixteenth of them all) in parallel (``_jit.parallel_kernel``), and the result is the same bytes on any number
 of threads.
 
-Traversal (``closest_hits``, ``any_hits``, ``intersect``): the binary tree is collapsed into nodes of ``WIDTH``
-= 4 children (``_collapse``: from a node's two children, the inner child of the largest surface area is replaced
-by its own two until four are held; Embree's BVH4 [Wald et al. 2008]), whose bounds are stored as rows of four
-float32 (``wide_boxes`` (M, 6, 4): lo x, y, z, hi x, y, z, one value per child; the float32-rounded values of
-the binary boxes, so no box changes). Per ray, the four boxes of a node are tested at once (``_slab4``: LLVM
-vector code, each bound row one load of four float32 widened to ``<4 x double>``, the slab test in float64 with
+Traversal (``closest_hits``, ``any_hits``, ``intersect``): the binary tree is collapsed into nodes of ``WIDTH`` = 4
+children (``_collapse``: from a node's two children, the inner child of the largest surface area is replaced by its
+own two until four are held; Embree's BVH4 [Wald et al. 2008]; a subtree of at most ``LEAF_WIDE`` = 4 triangles
+becomes one leaf of the wide tree, its rows consecutive, as Embree's four-triangle leaves), whose bounds are stored
+as rows of four float32 (``wide_boxes`` (M, 6, 4): lo x, y, z, hi x, y, z, one value per child; the float32-rounded
+values of the binary boxes, so no box changes). Per ray, the four boxes of a node are tested at once (``_slab4``:
+LLVM vector code, each bound row one load of four float32 widened to ``<4 x double>``, the slab test in float64 with
 the far bound widened by $1 + 2γ₃$ so that rounding never loses a hit, PBRT 3.9.2, operation for operation the
-scalar test); the children met are pushed sorted by their entry distance, the nearest on top, and an entry
-popped beyond the best hit so far is skipped. Leaves are tested with the Möller–Trumbore ray–triangle test in
+scalar test); the children met are pushed sorted by their entry distance, the nearest on top, and an entry popped
+beyond the best hit so far is skipped. Leaves are tested with the Möller–Trumbore ray–triangle test in
 float64 (``_triangle``; the arithmetic ``tests/test_rays.py``'s brute force repeats). Closest hit: the least t in
 ``[t_min, t_max)``, ties to the lower triangle index (boxes are searched up to $best·(1 + 2⁻⁴⁰)$, so a triangle
 whose t rounds a few ulps below its box's entry, or ties, is still found): one triangle whatever order the boxes
@@ -46,7 +47,13 @@ once instead of pushing it in the any-hit path: within noise (0.055 against 0.05
 Tried and dropped: the hit mask of the four tests (``movmskpd``) with one met child entered and two ordered by a
 single compare (no stack sort): first hits within noise, occlusion 5–25 % slower; links as int32: no change.
 The sphere's rays are memory-bound (18 wide nodes and 5 triangles per shadow ray from the camera's hits at
-about 35 ns a node); the bunny's cost some 20 ns a node.
+about 35 ns a node); the bunny's cost some 20 ns a node. Leaves of up to four triangles in the wide tree
+(``LEAF_WIDE``; 3.4× fewer wide nodes: bunny 34,801 → 10,281, sphere 634,069 → 189,478), against one triangle
+a leaf, both trees in one process (load 15, medians of 5, first hit / occlusion, camera then random rays):
+bunny 0.060 / 0.053 → 0.060 / 0.049 and 0.061 / 0.042 → 0.054 / 0.041 s, sphere 0.153 / 0.172 → 0.137 / 0.150
+and 0.109 / 0.123 → 0.102 / 0.104 s; up to seven (``leaf_wide=7``, scalar tests) against four: 0–5 % slower on
+three rows of four, kept at four. Packing a wide node's bounds and links into one 128-byte-aligned record
+(as Embree's nodes) against the two arrays: within noise (−3 … +11 %), not kept.
 
 ``cast_pixels`` casts one ray per pixel through the view volume and writes what the depth buffer writes
 (``render(..., method="ray-casting")``).
@@ -73,8 +80,8 @@ from numba.extending import intrinsic
 from frustum.raster._jit import kernel, parallel_kernel
 
 __all__ = [
-    "BINS", "CAST_STATS", "FIELDS", "LEAF_SIZE", "WIDTH", "Index", "any_hits", "build", "cast_pixels", "closest_hits",
-    "intersect",
+    "BINS", "CAST_STATS", "FIELDS", "LEAF_SIZE", "LEAF_WIDE", "WIDTH", "Index", "any_hits", "build", "cast_pixels",
+    "closest_hits", "intersect",
 ]
 
 LEAF_SIZE = 1
@@ -94,6 +101,9 @@ _TASKS = 4096
 WIDTH = 4
 """Children of a node of the traversal tree (``Index.wide_boxes``): the binary tree collapsed, four boxes tested at
 once (one AVX2 register of float64 per bound)."""
+LEAF_WIDE = 4
+"""Most triangles in a leaf of the wide tree: a subtree of at most this many becomes one leaf whose triangles are
+tested one after another, instead of a wide node whose boxes are tested first (``_collapse``)."""
 SMALL = 8
 """Ranges of at most this many triangles are split by the exact SAH (every cut on every axis) instead of bins."""
 
@@ -107,7 +117,8 @@ class Index(NamedTuple):
     ``wide_boxes`` (M, 6, WIDTH) float32: the same tree collapsed to ``WIDTH`` children a node, the children's
     bounds as rows (lo x y z, hi x y z) of one value per child (an empty slot: lo +inf, hi −inf), and
     ``wide_links`` (M, WIDTH) int64: each child, a wide node number or a leaf code as in ``links``. ``boxes`` and
-    ``links`` serve ``cast_pixels`` (whose counts are the binary tree's) and the step-by-step traversal."""
+    ``links`` serve ``cast_pixels`` (whose counts are the binary tree's) and the step-by-step traversal. A leaf
+    code of the wide tree holds up to ``LEAF_WIDE`` consecutive rows."""
 
     boxes: np.ndarray
     links: np.ndarray
@@ -415,12 +426,46 @@ def _gather(triangles, index, out, start, stop):
 
 
 @kernel
-def _collapse(boxes, links, depth, wide_boxes, wide_links):
+def _subtrees(links, size, first):
+    """``size[k]``, ``first[k]``: the triangles under binary node k and the first of their rows (a subtree's
+    triangles are the rows ``[first, first + size)``; 0 for a number no node holds). Children are numbered above
+    their parent: marked reachable from the root going up, summed going down."""
+    size[:] = 0
+    size[0] = 1
+    for k in range(links.shape[0]):
+        if size[k] != 0:
+            for side in range(2):
+                if links[k, side] >= 0:
+                    size[links[k, side]] = 1
+    for k in range(links.shape[0] - 1, -1, -1):
+        if size[k] == 0:
+            continue
+        total = 0
+        for side in range(2):
+            link = links[k, side]
+            if link >= 0:
+                total += size[link]
+                start = first[link]
+            else:
+                total += ~link & 7
+                start = ~link >> 3
+            if side == 0:
+                first[k] = start
+        size[k] = total
+
+
+@kernel
+def _collapse(boxes, links, depth, leaf_wide, wide_boxes, wide_links):
     """The binary tree (``boxes``, ``links``) collapsed into ``WIDTH``-wide nodes: from each node's two children,
     the inner child of the largest surface area is replaced by its own two children while fewer than ``WIDTH``
     are held and an inner one is left (the order of the children kept); every inner child left becomes a wide node
-    of its own (numbered depth first). Fills ``wide_boxes``/``wide_links``; returns the wide nodes made. (A node
-    with fewer than ``WIDTH`` children has leaves only, so at most $(2F − 1)/3 + 1$ nodes for F triangles.)"""
+    of its own (numbered depth first), unless it holds at most `leaf_wide` triangles: then it becomes one leaf
+    of them all (tested one after another, no box of its own). Fills ``wide_boxes``/``wide_links``; returns the
+    wide nodes made. (A node with fewer than ``WIDTH`` children has leaves only, so at most $(2F − 1)/3 + 1$ nodes
+    for F triangles.)"""
+    size = np.empty(links.shape[0], dtype=np.int64)
+    first = np.empty(links.shape[0], dtype=np.int64)
+    _subtrees(links, size, first)
     child = np.empty(WIDTH, dtype=np.int64)
     box = np.empty((WIDTH, 6))
     stack = np.empty((3 * depth + 8, 2), dtype=np.int64)  # (binary node, its wide slot)
@@ -459,7 +504,9 @@ def _collapse(boxes, links, depth, wide_boxes, wide_links):
             if c < n:
                 for q in range(6):
                     wide_boxes[w, q, c] = box[c, q]
-                if child[c] >= 0:
+                if child[c] >= 0 and size[child[c]] <= leaf_wide:
+                    wide_links[w, c] = ~(first[child[c]] * 8 + size[child[c]])
+                elif child[c] >= 0:
                     wide_links[w, c] = made
                     stack[top, 0], stack[top, 1] = child[c], made
                     top += 1
@@ -479,8 +526,9 @@ def _wide_nodes(count: int) -> int:
     return (2 * count) // 3 + 2
 
 
-def build(triangles: np.ndarray) -> Index:
-    """The index of (F, 3, 3) float64 triangles (corner rows), F >= 1."""
+def build(triangles: np.ndarray, leaf_wide: int = LEAF_WIDE) -> Index:
+    """The index of (F, 3, 3) float64 triangles (corner rows), F >= 1; `leaf_wide` (1 … 7): the most triangles in
+    a leaf of the wide tree (``LEAF_WIDE``; the hits are the same for any)."""
     tri = np.ascontiguousarray(triangles, dtype=np.float64)
     count = tri.shape[0]
     data = np.empty((count, 6), dtype=np.float32)
@@ -516,8 +564,9 @@ def build(triangles: np.ndarray) -> Index:
     _gather(tri, index, ordered)
     wide_boxes = np.empty((_wide_nodes(count), 6, WIDTH), dtype=np.float32)
     wide_links = np.empty((wide_boxes.shape[0], WIDTH), dtype=np.int64)
-    made = _collapse(boxes, links, int(depth), wide_boxes, wide_links)
-    return Index(boxes, links, ordered, index, int(depth), int(nodes), wide_boxes[:made], wide_links[:made])
+    made = _collapse(boxes, links, int(depth), int(leaf_wide), wide_boxes, wide_links)
+    return Index(boxes, links, ordered, index, int(depth), int(nodes), wide_boxes[:made].copy(),
+                 wide_links[:made].copy())  # (copies: the unused rows' memory goes back)
 
 
 def memory_bytes(count: int) -> int:
@@ -578,6 +627,95 @@ def _triangle(triangles, row, ox, oy, oz, dx, dy, dz):
     if v < 0.0 or u + v > 1.0:
         return 0.0, 0.0, 0.0, 0.0
     return (e2x * qx + e2y * qy + e2z * qz) * inv, u, v, det
+
+
+@intrinsic
+def _triangles4_vector(typingctx, triangles, first, count, ox, oy, oz, dx, dy, dz, out):
+    """``_triangles4`` as LLVM vector code: the corners of rows ``first`` … ``first + 3`` loaded into
+    ``<4 x double>`` lanes (a lane past `count` repeats row `first` and is masked), then ``_triangle``'s
+    arithmetic operation for operation on the four at once (IEEE: the same bytes), its rejections as a mask."""
+
+    def codegen(context, builder, signature, args):
+        kind = signature.args[0]
+        data = context.make_array(kind)(context, builder, args[0])
+        result = context.make_array(signature.args[9])(context, builder, args[9])
+        double = ir.DoubleType()
+        vector = ir.VectorType(double, WIDTH)
+        shape = cgutils.unpack_tuple(builder, data.shape)
+        strides = cgutils.unpack_tuple(builder, data.strides)
+        start = context.cast(builder, args[1], signature.args[1], types.intp)
+        count = context.cast(builder, args[2], signature.args[2], types.intp)
+        index = ir.IntType(64)
+        rows = []
+        for lane in range(WIDTH):
+            there = builder.icmp_signed("<", ir.Constant(index, lane), count)
+            rows.append(builder.select(there, builder.add(start, ir.Constant(index, lane)), start))
+
+        def column(corner, axis):
+            value = ir.Constant(vector, ir.Undefined)
+            for lane in range(WIDTH):
+                pointer = cgutils.get_item_pointer2(context, builder, data.data, shape, strides, kind.layout,
+                                                    [rows[lane], ir.Constant(index, corner), ir.Constant(index, axis)],
+                                                    wraparound=False)  # fmt: skip
+                value = builder.insert_element(value, builder.load(pointer), ir.Constant(ir.IntType(32), lane))
+            return value
+
+        def splat(value):
+            one = builder.insert_element(ir.Constant(vector, ir.Undefined), value, ir.Constant(ir.IntType(32), 0))
+            mask = ir.Constant(ir.VectorType(ir.IntType(32), WIDTH), [0] * WIDTH)
+            return builder.shuffle_vector(one, ir.Constant(vector, ir.Undefined), mask)
+
+        mul, sub, add = builder.fmul, builder.fsub, builder.fadd
+        o = [splat(args[3 + a]) for a in range(3)]
+        d = [splat(args[6 + a]) for a in range(3)]
+        a = [column(0, q) for q in range(3)]
+        e1 = [sub(column(1, q), a[q]) for q in range(3)]
+        e2 = [sub(column(2, q), a[q]) for q in range(3)]
+        p = [sub(mul(d[1], e2[2]), mul(d[2], e2[1])), sub(mul(d[2], e2[0]), mul(d[0], e2[2])),
+             sub(mul(d[0], e2[1]), mul(d[1], e2[0]))]  # fmt: skip
+        det = add(add(mul(e1[0], p[0]), mul(e1[1], p[1])), mul(e1[2], p[2]))
+        zero, one = splat(ir.Constant(double, 0.0)), splat(ir.Constant(double, 1.0))
+        inv = builder.fdiv(one, det)
+        sv = [sub(o[q], a[q]) for q in range(3)]
+        u = mul(add(add(mul(sv[0], p[0]), mul(sv[1], p[1])), mul(sv[2], p[2])), inv)
+        qv = [sub(mul(sv[1], e1[2]), mul(sv[2], e1[1])), sub(mul(sv[2], e1[0]), mul(sv[0], e1[2])),
+              sub(mul(sv[0], e1[1]), mul(sv[1], e1[0]))]  # fmt: skip
+        v = mul(add(add(mul(d[0], qv[0]), mul(d[1], qv[1])), mul(d[2], qv[2])), inv)
+        t = mul(add(add(mul(e2[0], qv[0]), mul(e2[1], qv[1])), mul(e2[2], qv[2])), inv)
+        lanes = ir.Constant(ir.VectorType(index, WIDTH), list(range(WIDTH)))
+        counts = builder.insert_element(ir.Constant(ir.VectorType(index, WIDTH), ir.Undefined), count,
+                                        ir.Constant(ir.IntType(32), 0))  # fmt: skip
+        counts = builder.shuffle_vector(counts, ir.Constant(ir.VectorType(index, WIDTH), ir.Undefined),
+                                        ir.Constant(ir.VectorType(ir.IntType(32), WIDTH), [0] * WIDTH))  # fmt: skip
+        miss = builder.icmp_signed(">=", lanes, counts)
+        for test in (builder.fcmp_ordered("==", det, zero), builder.fcmp_ordered("<", u, zero),
+                     builder.fcmp_ordered(">", u, one), builder.fcmp_ordered("<", v, zero),
+                     builder.fcmp_ordered(">", add(u, v), one)):  # fmt: skip
+            miss = builder.or_(miss, test)
+        for row, value in enumerate((t, u, v, det)):
+            pointer = cgutils.get_item_pointer2(context, builder, result.data,
+                                                cgutils.unpack_tuple(builder, result.shape),
+                                                cgutils.unpack_tuple(builder, result.strides), signature.args[9].layout,
+                                                [ir.Constant(index, row), ir.Constant(index, 0)],
+                                                wraparound=False)  # fmt: skip
+            builder.store(builder.select(miss, zero, value), builder.bitcast(pointer, vector.as_pointer()), align=8)
+        return context.get_dummy_value()
+
+    return types.void(triangles, first, count, ox, oy, oz, dx, dy, dz, out), codegen
+
+
+def _triangles4_scalar(triangles, first, count, ox, oy, oz, dx, dy, dz, out):
+    """``out[:, c]`` = ``_triangle`` of row ``first + c`` as (t, u, v, det) for c < `count` (<= ``WIDTH``),
+    zeros (det 0: no hit) past it."""
+    for c in range(WIDTH):
+        out[0, c], out[1, c], out[2, c], out[3, c] = 0.0, 0.0, 0.0, 0.0
+        if c < count:
+            out[0, c], out[1, c], out[2, c], out[3, c] = _triangle(triangles, first + c, ox, oy, oz, dx, dy, dz)
+
+
+_triangles4 = _triangles4_scalar if numba.config.DISABLE_JIT else _triangles4_vector
+"""``_triangles4(triangles, first, count, ox, oy, oz, dx, dy, dz, out)`` in a kernel: Möller–Trumbore of the ray
+and up to ``WIDTH`` consecutive rows at once into `out` (4, ``WIDTH``): rows t, u, v, det (det 0: no hit)."""
 
 
 @kernel
@@ -749,12 +887,13 @@ bounds the ray enters first (0/3, 1/4, 2/5 by the signs of its direction)."""
 
 @kernel
 def _closest4(wide_boxes, wide_links, triangles, order, skip, ox, oy, oz, dx, dy, dz, t_min, t_max, cull, stack, entry,
-              near):  # fmt: skip
+              near, found):  # fmt: skip
     """``_closest`` on the wide tree: ``(t, row, u, v, back)``, the same hit to the byte (the least t, ties to
     the lower original index, is one triangle whatever the order the boxes are searched in). At a node the
     ``WIDTH`` boxes are tested at once (``_slab4``) and the children met are pushed sorted by entry distance,
-    the nearest on top (popped next); a popped entry beyond the best hit so far is skipped. `stack`, `entry`:
-    scratch of at least 3·depth + 2, `near` of ``WIDTH``."""
+    the nearest on top (popped next); a popped entry beyond the best hit so far is skipped; a leaf's triangles are
+    tested four at once (``_triangles4``). `stack`, `entry`: scratch of at least 3·depth + 2, `near` of
+    ``WIDTH``, `found` (4, ``WIDTH``)."""
     ix, iy, iz, nx, ny, nz = _reciprocal(dx, dy, dz)
     masked = skip.shape[0] > 0
     best = t_max
@@ -785,18 +924,21 @@ def _closest4(wide_boxes, wide_links, triangles, order, skip, ox, oy, oz, dx, dy
                 continue
         else:
             code = ~node
-            first = code >> 3
-            for row in range(first, first + (code & 7)):
-                face = order[row]
-                if masked and skip[face] != 0:
-                    continue
-                t, u, v, det = _triangle(triangles, row, ox, oy, oz, dx, dy, dz)
-                if det == 0.0 or (cull != 0 and det < 0.0):
-                    continue
-                if t >= t_min and (t < best or (t == best and face < best_face)):
-                    best, best_row, best_face, best_u, best_v = t, row, face, u, v
-                    best_back = 1 if det < 0.0 else 0
-                    reach = best * _WIDE
+            for first in range(code >> 3, (code >> 3) + (code & 7), WIDTH):
+                _triangles4(triangles, first, (code >> 3) + (code & 7) - first, ox, oy, oz, dx, dy, dz, found)
+                for c in range(WIDTH):
+                    det = found[3, c]
+                    if det == 0.0 or (cull != 0 and det < 0.0):
+                        continue
+                    row = first + c
+                    face = order[row]
+                    if masked and skip[face] != 0:
+                        continue
+                    t, u, v = found[0, c], found[1, c], found[2, c]
+                    if t >= t_min and (t < best or (t == best and face < best_face)):
+                        best, best_row, best_face, best_u, best_v = t, row, face, u, v
+                        best_back = 1 if det < 0.0 else 0
+                        reach = best * _WIDE
         popped = False
         while top > 0:  # the next pushed node still nearer than the best hit
             top -= 1
@@ -812,7 +954,7 @@ def _closest4(wide_boxes, wide_links, triangles, order, skip, ox, oy, oz, dx, dy
 
 
 @kernel
-def _any4(wide_boxes, wide_links, triangles, ox, oy, oz, dx, dy, dz, t_min, t_max, stack, near):
+def _any4(wide_boxes, wide_links, triangles, ox, oy, oz, dx, dy, dz, t_min, t_max, stack, near, found):
     """``_any`` on the wide tree: whether one ray meets a triangle at t in [t_min, t_max): the inner children
     met are pushed in their order, the leaves met tested at once; the traversal stops at the first triangle
     found."""
@@ -830,11 +972,13 @@ def _any4(wide_boxes, wide_links, triangles, ox, oy, oz, dx, dy, dz, t_min, t_ma
                         top += 1
                         continue
                     code = ~child  # a leaf: its triangles now, not pushed
-                    first = code >> 3
-                    for row in range(first, first + (code & 7)):
-                        t, _, _, det = _triangle(triangles, row, ox, oy, oz, dx, dy, dz)
-                        if det != 0.0 and t >= t_min and t < t_max:
-                            return True
+                    for first in range(code >> 3, (code >> 3) + (code & 7), WIDTH):
+                        _triangles4(triangles, first, (code >> 3) + (code & 7) - first, ox, oy, oz, dx, dy, dz,
+                                    found)  # fmt: skip
+                        for k in range(WIDTH):
+                            t = found[0, k]
+                            if found[3, k] != 0.0 and t >= t_min and t < t_max:
+                                return True
         if top == 0:
             return False
         top -= 1
@@ -850,10 +994,11 @@ def _closest_rays(wide_boxes, wide_links, triangles, order, depth, skip, origins
     stack = np.empty(3 * depth + 8, dtype=np.int64)
     entry = np.empty(3 * depth + 8)
     near = np.empty(WIDTH)
+    found = np.empty((4, WIDTH))
     for r in range(start, stop):
         t, row, u, v, back = _closest4(
             wide_boxes, wide_links, triangles, order, skip, origins[r, 0], origins[r, 1], origins[r, 2],
-            directions[r, 0], directions[r, 1], directions[r, 2], t_min[r], t_max[r], cull, stack, entry, near,
+            directions[r, 0], directions[r, 1], directions[r, 2], t_min[r], t_max[r], cull, stack, entry, near, found,
         )  # fmt: skip
         t_out[r] = t
         row_out[r] = row
@@ -869,11 +1014,12 @@ def _any_rays(wide_boxes, wide_links, triangles, depth, origins, directions, t_m
     per ray."""
     stack = np.empty(3 * depth + 8, dtype=np.int64)
     near = np.empty(WIDTH)
+    found = np.empty((4, WIDTH))
     each_min, each_max = t_min.shape[0] > 1, t_max.shape[0] > 1
     for r in range(start, stop):
         out[r] = _any4(wide_boxes, wide_links, triangles, origins[r, 0], origins[r, 1], origins[r, 2],
                        directions[r, 0], directions[r, 1], directions[r, 2], t_min[r if each_min else 0],
-                       t_max[r if each_max else 0], stack, near)  # fmt: skip
+                       t_max[r if each_max else 0], stack, near, found)  # fmt: skip
 
 
 def _per_ray(value: float | np.ndarray, count: int) -> np.ndarray:
@@ -955,13 +1101,14 @@ def _intersect_rays(wide_boxes, wide_links, triangles, order, depth, origins, di
     stack = np.empty(3 * depth + 8, dtype=np.int64)
     entry = np.empty(3 * depth + 8)
     near = np.empty(WIDTH)
+    found = np.empty((4, WIDTH))
     skip = np.empty(0, dtype=np.uint8)
     last = starts.shape[0] - 1
     for r in range(start, stop):
         ox, oy, oz = origins[r, 0], origins[r, 1], origins[r, 2]
         dx, dy, dz = directions[r, 0], directions[r, 1], directions[r, 2]
         t, row, u, v, back = _closest4(wide_boxes, wide_links, triangles, order, skip, ox, oy, oz, dx, dy, dz, 0.0,
-                                       np.inf, 0, stack, entry, near)  # fmt: skip
+                                       np.inf, 0, stack, entry, near, found)  # fmt: skip
         if row < 0:
             if wanted & 1:
                 t_out[r] = np.inf
