@@ -28,7 +28,8 @@ LLVM vector code, each bound row one load of four float32 widened to ``<4 x doub
 the far bound widened by $1 + 2γ₃$ so that rounding never loses a hit, PBRT 3.9.2, operation for operation the
 scalar test); the children met are pushed sorted by their entry distance, the nearest on top, and an entry popped
 beyond the best hit so far is skipped. Leaves are tested with the Möller–Trumbore ray–triangle test in
-float64 (``_triangle``; the arithmetic ``tests/test_rays.py``'s brute force repeats). Closest hit: the least t in
+float64 (``_triangle``; the arithmetic ``tests/test_rays.py``'s brute force repeats; in the wide tree four
+triangles at once, ``_triangles4``, the same bytes lane by lane). Closest hit: the least t in
 ``[t_min, t_max)``, ties to the lower triangle index (boxes are searched up to $best·(1 + 2⁻⁴⁰)$, so a triangle
 whose t rounds a few ulps below its box's entry, or ties, is still found): one triangle whatever order the boxes
 are searched in, so the wide traversal gives the binary one's hits to the byte (``_closest``, kept for
@@ -39,21 +40,25 @@ in ``[t_min, t_max)`` (shadow rays). ``intersect`` computes, in the traversal's 
 parallel over pieces of the ray array.
 
 Chosen by measurement (one thread, process CPU seconds for 262,144 rays, medians of 3, the bunny and a
-1.31 M-triangle sphere, camera / random rays; the shared 2-core host at load 8–16, Embree 4 in the same
-conditions 0.041 / 0.031 and 0.088 / 0.059 s): binary tree 0.085 / 0.080 and 0.206 / 0.165 s; four-wide, scalar
-slab tests 0.078 / 0.066 and 0.191 / 0.167; four-wide, vector slab tests 0.060 / 0.054 and 0.180 / 0.151 (the
-bounds in float32 or float64: the same within noise, float32 kept for half the memory). Testing a met leaf at
-once instead of pushing it in the any-hit path: within noise (0.055 against 0.058 s on the bunny's shadow rays).
-Tried and dropped: the hit mask of the four tests (``movmskpd``) with one met child entered and two ordered by a
-single compare (no stack sort): first hits within noise, occlusion 5–25 % slower; links as int32: no change.
-The sphere's rays are memory-bound (18 wide nodes and 5 triangles per shadow ray from the camera's hits at
-about 35 ns a node); the bunny's cost some 20 ns a node. Leaves of up to four triangles in the wide tree
-(``LEAF_WIDE``; 3.4× fewer wide nodes: bunny 34,801 → 10,281, sphere 634,069 → 189,478), against one triangle
-a leaf, both trees in one process (load 15, medians of 5, first hit / occlusion, camera then random rays):
-bunny 0.060 / 0.053 → 0.060 / 0.049 and 0.061 / 0.042 → 0.054 / 0.041 s, sphere 0.153 / 0.172 → 0.137 / 0.150
-and 0.109 / 0.123 → 0.102 / 0.104 s; up to seven (``leaf_wide=7``, scalar tests) against four: 0–5 % slower on
-three rows of four, kept at four. Packing a wide node's bounds and links into one 128-byte-aligned record
-(as Embree's nodes) against the two arrays: within noise (−3 … +11 %), not kept.
+1.31 M-triangle sphere, camera / random rays; the shared 2-core host at load 8–16, Embree 4 in the same conditions
+0.041 / 0.031 and 0.088 / 0.059 s): binary tree 0.085 / 0.080 and 0.206 / 0.165 s; four-wide, scalar slab tests
+0.078 / 0.066 and 0.191 / 0.167; four-wide, vector slab tests 0.060 / 0.054 and 0.180 / 0.151 (the bounds in float32
+or float64: the same within noise, float32 kept for half the memory). Testing a met leaf at once instead of pushing
+it in the any-hit path: within noise (0.055 against 0.058 s on the bunny's shadow rays). Tried and dropped: the hit
+mask of the four tests (``movmskpd``) with one met child entered and two ordered by a single compare (no stack
+sort): first hits within noise, occlusion 5–25 % slower; links as int32: no change. The sphere's rays are
+memory-bound (18 wide nodes and 5 triangles per shadow ray from the camera's hits at about 35 ns a node); the
+bunny's cost some 20 ns a node. Leaves of up to four triangles in the wide tree (``LEAF_WIDE``; 3.4× fewer wide
+nodes: bunny 34,801 → 10,281, sphere 634,069 → 189,478), against one triangle a leaf, both trees in one process
+(load 15, medians of 5, first hit / occlusion, camera then random rays): bunny 0.060 / 0.053 → 0.060 / 0.049 and
+0.061 / 0.042 → 0.054 / 0.041 s, sphere 0.153 / 0.172 → 0.137 / 0.150 and 0.109 / 0.123 → 0.102 / 0.104 s; up to
+seven (``leaf_wide=7``, scalar tests) against four: 0–5 % slower on three rows of four, kept at four. Then a leaf's
+triangles tested four at once (``_triangles4``: each corner coordinate of the four rows gathered into a
+``<4 x double>``, Möller–Trumbore on the four lanes, the rejections a mask) against one after another
+(``_triangle``), one process (load 15, medians of 5): bunny 0.056 / 0.049 → 0.045 / 0.036 and 0.056 / 0.040 → 0.050
+/ 0.028 s, sphere 0.138 / 0.150 → 0.125 / 0.122 and 0.109 / 0.109 → 0.102 / 0.092 s (first hits 6–21 % and occlusion
+15–31 % faster). Packing a wide node's bounds and links into one 128-byte-aligned record (as Embree's nodes) against
+the two arrays: within noise (−3 … +11 %), not kept.
 
 ``cast_pixels`` casts one ray per pixel through the view volume and writes what the depth buffer writes
 (``render(..., method="ray-casting")``).
@@ -629,6 +634,14 @@ def _triangle(triangles, row, ox, oy, oz, dx, dy, dz):
     return (e2x * qx + e2y * qy + e2z * qz) * inv, u, v, det
 
 
+def _splat(builder, value):
+    """LLVM IR: a vector of ``WIDTH`` copies of scalar `value` (insert into lane 0, shuffle to all)."""
+    vector = ir.VectorType(value.type, WIDTH)
+    one = builder.insert_element(ir.Constant(vector, ir.Undefined), value, ir.Constant(ir.IntType(32), 0))
+    return builder.shuffle_vector(one, ir.Constant(vector, ir.Undefined),
+                                  ir.Constant(ir.VectorType(ir.IntType(32), WIDTH), [0] * WIDTH))  # fmt: skip
+
+
 @intrinsic
 def _triangles4_vector(typingctx, triangles, first, count, ox, oy, oz, dx, dy, dz, out):
     """``_triangles4`` as LLVM vector code: the corners of rows ``first`` … ``first + 3`` loaded into
@@ -661,9 +674,7 @@ def _triangles4_vector(typingctx, triangles, first, count, ox, oy, oz, dx, dy, d
             return value
 
         def splat(value):
-            one = builder.insert_element(ir.Constant(vector, ir.Undefined), value, ir.Constant(ir.IntType(32), 0))
-            mask = ir.Constant(ir.VectorType(ir.IntType(32), WIDTH), [0] * WIDTH)
-            return builder.shuffle_vector(one, ir.Constant(vector, ir.Undefined), mask)
+            return _splat(builder, value)
 
         mul, sub, add = builder.fmul, builder.fsub, builder.fadd
         o = [splat(args[3 + a]) for a in range(3)]
@@ -683,11 +694,7 @@ def _triangles4_vector(typingctx, triangles, first, count, ox, oy, oz, dx, dy, d
         v = mul(add(add(mul(d[0], qv[0]), mul(d[1], qv[1])), mul(d[2], qv[2])), inv)
         t = mul(add(add(mul(e2[0], qv[0]), mul(e2[1], qv[1])), mul(e2[2], qv[2])), inv)
         lanes = ir.Constant(ir.VectorType(index, WIDTH), list(range(WIDTH)))
-        counts = builder.insert_element(ir.Constant(ir.VectorType(index, WIDTH), ir.Undefined), count,
-                                        ir.Constant(ir.IntType(32), 0))  # fmt: skip
-        counts = builder.shuffle_vector(counts, ir.Constant(ir.VectorType(index, WIDTH), ir.Undefined),
-                                        ir.Constant(ir.VectorType(ir.IntType(32), WIDTH), [0] * WIDTH))  # fmt: skip
-        miss = builder.icmp_signed(">=", lanes, counts)
+        miss = builder.icmp_signed(">=", lanes, splat(count))
         for test in (builder.fcmp_ordered("==", det, zero), builder.fcmp_ordered("<", u, zero),
                      builder.fcmp_ordered(">", u, one), builder.fcmp_ordered("<", v, zero),
                      builder.fcmp_ordered(">", add(u, v), one)):  # fmt: skip
@@ -846,9 +853,7 @@ def _slab4_vector(typingctx, boxes, node, nx, ny, nz, ox, oy, oz, ix, iy, iz, t_
             return value if lanes is vector or kind.dtype != types.float32 else builder.fpext(value, vector)
 
         def splat(value):
-            one = builder.insert_element(ir.Constant(vector, ir.Undefined), value, ir.Constant(ir.IntType(32), 0))
-            mask = ir.Constant(ir.VectorType(ir.IntType(32), WIDTH), [0] * WIDTH)
-            return builder.shuffle_vector(one, ir.Constant(vector, ir.Undefined), mask)
+            return _splat(builder, value)
 
         near_rows = [context.cast(builder, args[2 + a], signature.args[2 + a], types.intp) for a in range(3)]
         far_rows = [builder.sub(ir.Constant(ir.IntType(64), 3 + 2 * a), near_rows[a]) for a in range(3)]
