@@ -726,6 +726,23 @@ and up to ``WIDTH`` consecutive rows at once into `out` (4, ``WIDTH``): rows t, 
 
 
 @kernel
+def _nearer(t, face, t_min, best, best_face):
+    """Whether a hit at t on `face` replaces the best so far: t >= t_min and nearer, a tie to the lower face."""
+    return t >= t_min and (t < best or (t == best and face < best_face))
+
+
+@kernel
+def _pop(stack, entry, top, reach, node):
+    """The next pushed node whose box entry is still within `reach` (the best hit so far, widened):
+    ``(found, node, top)``; not found: the stack is spent (`node` returned as given)."""
+    while top > 0:
+        top -= 1
+        if entry[top] <= reach:
+            return True, stack[top], top
+    return False, node, top
+
+
+@kernel
 def _closest(boxes, links, triangles, order, skip, ox, oy, oz, dx, dy, dz, t_min, t_max, cull, stack, entry):
     """The first hit of one ray: ``(t, row, u, v, back, box_tests, nodes, tests)``.
 
@@ -775,17 +792,11 @@ def _closest(boxes, links, triangles, order, skip, ox, oy, oz, dx, dy, dz, t_min
                 t, u, v, det = _triangle(triangles, row, ox, oy, oz, dx, dy, dz)
                 if det == 0.0 or (cull != 0 and det < 0.0):
                     continue
-                if t >= t_min and (t < best or (t == best and face < best_face)):
+                if _nearer(t, face, t_min, best, best_face):
                     best, best_row, best_face, best_u, best_v = t, row, face, u, v
                     best_back = 1 if det < 0.0 else 0
                     reach = best * _WIDE
-        popped = False
-        while top > 0:  # the next pushed node still nearer than the best hit
-            top -= 1
-            if entry[top] <= reach:
-                node = stack[top]
-                popped = True
-                break
+        popped, node, top = _pop(stack, entry, top, reach, node)
         if not popped:
             break
     if best_row < 0:
@@ -940,17 +951,11 @@ def _closest4(wide_boxes, wide_links, triangles, order, skip, ox, oy, oz, dx, dy
                     if masked and skip[face] != 0:
                         continue
                     t, u, v = found[0, c], found[1, c], found[2, c]
-                    if t >= t_min and (t < best or (t == best and face < best_face)):
+                    if _nearer(t, face, t_min, best, best_face):
                         best, best_row, best_face, best_u, best_v = t, row, face, u, v
                         best_back = 1 if det < 0.0 else 0
                         reach = best * _WIDE
-        popped = False
-        while top > 0:  # the next pushed node still nearer than the best hit
-            top -= 1
-            if entry[top] <= reach:
-                node = stack[top]
-                popped = True
-                break
+        popped, node, top = _pop(stack, entry, top, reach, node)
         if not popped:
             break
     if best_row < 0:
