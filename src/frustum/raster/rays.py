@@ -59,8 +59,9 @@ triangles tested four at once (``_triangles4``: each corner coordinate of the fo
 / 0.028 s, sphere 0.138 / 0.150 → 0.125 / 0.122 and 0.109 / 0.109 → 0.102 / 0.092 s (first hits 6–21 % and occlusion
 15–31 % faster). Packing a wide node's bounds and links into one 128-byte-aligned record (as Embree's nodes) against
 the two arrays: within noise (−3 … +11 %), not kept.
-The default fields of ``Scene.intersect`` cost more than (t, item, face) mostly for their size: the eight
-columns of 262,144 rays are 30 MB, whose first writes (page faults) take some 7 ms of CPU alone.
+The default fields of ``Scene.intersect`` add 15–25 ms of CPU to (t, item, face) for 262,144 bunny rays, a part
+of it their size alone: the eight columns are 30 MB, whose allocation and first writes (page faults) take some
+7 ms (NumPy, no kernel).
 
 ``cast_pixels`` casts one ray per pixel through the view volume and writes what the depth buffer writes
 (``render(..., method="ray-casting")``).
