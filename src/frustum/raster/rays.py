@@ -537,6 +537,8 @@ def _wide_nodes(count: int) -> int:
 def build(triangles: np.ndarray, leaf_wide: int = LEAF_WIDE) -> Index:
     """The index of (F, 3, 3) float64 triangles (corner rows), F >= 1; `leaf_wide` (1 … 7): the most triangles in
     a leaf of the wide tree (``LEAF_WIDE``; the hits are the same for any)."""
+    if not 1 <= leaf_wide <= 7:  # a leaf code holds its count in three bits
+        raise ValueError(f"build: leaf_wide = {leaf_wide!r}; expected 1 … 7")
     tri = np.ascontiguousarray(triangles, dtype=np.float64)
     count = tri.shape[0]
     data = np.empty((count, 6), dtype=np.float32)
