@@ -62,6 +62,10 @@ the two arrays: within noise (−3 … +11 %), not kept.
 The default fields of ``Scene.intersect`` add 15–25 ms of CPU to (t, item, face) for 262,144 bunny rays, a part
 of it their size alone: the eight columns are 30 MB, whose allocation and first writes (page faults) take some
 7 ms (NumPy, no kernel).
+Through the public API (``benchmarks/bench_rays.py``, CPU with one thread / Embree's one thread, load 9–10,
+alternate runs; rows bunny camera, random, sphere camera, random), before these leaves → after: first hit, every
+field 2.01 / 3.42 / 2.45 / 2.78 → 1.59 / 2.56 / 2.08 / 2.10, (t, item, face) 1.66 / 2.50 / 2.01 / 2.44 →
+1.15 / 1.88 / 1.51 / 1.61; occlusion 1.90 / 2.26 / 2.37 / 2.15 → 1.42 / 1.50 / 1.46 / 1.54.
 
 ``cast_pixels`` casts one ray per pixel through the view volume and writes what the depth buffer writes
 (``render(..., method="ray-casting")``).
