@@ -657,7 +657,7 @@ def _triangles4_vector(typingctx, triangles, first, count, ox, oy, oz, dx, dy, d
     ``<4 x double>`` lanes (a lane past `count` repeats row `first` and is masked), then ``_triangle``'s
     arithmetic operation for operation on the four at once (IEEE: the same bytes), its rejections as a mask."""
 
-    def codegen(context, builder, signature, args):
+    def codegen(context, builder, signature, args):  # (its preamble as _slab4_vector's: kept on purpose, per intrinsic)
         kind = signature.args[0]
         data = context.make_array(kind)(context, builder, args[0])
         result = context.make_array(signature.args[9])(context, builder, args[9])
@@ -854,7 +854,7 @@ def _slab4_vector(typingctx, boxes, node, nx, ny, nz, ox, oy, oz, ix, iy, iz, t_
     (``<4 x double>``, one AVX2 register), and the arithmetic, compares and selects are ``_slab4_scalar``'s
     operation for operation (IEEE: the same bytes), on all four children at once."""
 
-    def codegen(context, builder, signature, args):
+    def codegen(context, builder, signature, args):  # (its preamble as _triangles4_vector's: kept on purpose)
         kind = signature.args[0]
         data = context.make_array(kind)(context, builder, args[0])
         out = context.make_array(signature.args[13])(context, builder, args[13])
