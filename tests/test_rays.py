@@ -485,6 +485,7 @@ def test_wide_traversal_gives_the_binary_traversals_hits_to_the_byte() -> None:
     codes = ~leaves
     assert np.sort(np.concatenate([np.arange(c >> 3, (c >> 3) + (c & 7)) for c in codes])).tolist() == list(
         range(tri.shape[0]))
+    assert ((codes & 7) <= rays.LEAF_WIDE).all()
     for node in range(links.shape[0]):  # children inside their parent's slot of the node above
         for c in range(rays.WIDTH):
             child = links[node, c]
@@ -505,6 +506,11 @@ def test_wide_traversal_equals_binary_on_soups(seed: int, count: int, spread: fl
     origins, directions = f32(rng.uniform(-3.0, 3.0, (300, 3))), f32(rng.normal(size=(300, 3)))
     directions[::7, rng.integers(0, 3)] = 0.0  # axis-parallel rays: infinite inverse directions
     assert_wide_equals_binary(index, origins, directions)
+    single = rays.build(tri, leaf_wide=1)  # one triangle a leaf: the same hits to the byte
+    assert (single.wide_links < 0).sum() >= (index.wide_links < 0).sum()
+    for a, b in zip(rays.closest_hits(single, origins, directions), rays.closest_hits(index, origins, directions),
+                    strict=True):
+        assert a.tobytes() == b.tobytes()
     t_max = f32(rng.uniform(0.0, 4.0, 300))
     assert np.array_equal(rays.any_hits(index, origins, directions, 0.0, t_max),
                           rays.closest_hits(index, origins, directions).t < t_max)  # fmt: skip

@@ -18,16 +18,18 @@ range of node numbers: the top of the tree is built on one thread, the subtrees 
 (or a sixteenth of them all) in parallel (``_jit.parallel_kernel``), and the result is the same bytes on any number
 of threads.
 
-Traversal (``closest_hits``, ``any_hits``, ``intersect``): the binary tree is collapsed into nodes of ``WIDTH``
-= 4 children (``_collapse``: from a node's two children, the inner child of the largest surface area is replaced
-by its own two until four are held; Embree's BVH4 [Wald et al. 2008]), whose bounds are stored as rows of four
-float32 (``wide_boxes`` (M, 6, 4): lo x, y, z, hi x, y, z, one value per child; the float32-rounded values of
-the binary boxes, so no box changes). Per ray, the four boxes of a node are tested at once (``_slab4``: LLVM
-vector code, each bound row one load of four float32 widened to ``<4 x double>``, the slab test in float64 with
+Traversal (``closest_hits``, ``any_hits``, ``intersect``): the binary tree is collapsed into nodes of ``WIDTH`` = 4
+children (``_collapse``: from a node's two children, the inner child of the largest surface area is replaced by its
+own two until four are held; Embree's BVH4 [Wald et al. 2008]; a subtree of at most ``LEAF_WIDE`` = 4 triangles
+becomes one leaf of the wide tree, its rows consecutive, as Embree's four-triangle leaves), whose bounds are stored
+as rows of four float32 (``wide_boxes`` (M, 6, 4): lo x, y, z, hi x, y, z, one value per child; the float32-rounded
+values of the binary boxes, so no box changes). Per ray, the four boxes of a node are tested at once (``_slab4``:
+LLVM vector code, each bound row one load of four float32 widened to ``<4 x double>``, the slab test in float64 with
 the far bound widened by $1 + 2γ₃$ so that rounding never loses a hit, PBRT 3.9.2, operation for operation the
-scalar test); the children met are pushed sorted by their entry distance, the nearest on top, and an entry
-popped beyond the best hit so far is skipped. Leaves are tested with the Möller–Trumbore ray–triangle test in
-float64 (``_triangle``; the arithmetic ``tests/test_rays.py``'s brute force repeats). Closest hit: the least t in
+scalar test); the children met are pushed sorted by their entry distance, the nearest on top, and an entry popped
+beyond the best hit so far is skipped. Leaves are tested with the Möller–Trumbore ray–triangle test in
+float64 (``_triangle``; the arithmetic ``tests/test_rays.py``'s brute force repeats; in the wide tree four
+triangles at once, ``_triangles4``, the same bytes lane by lane). Closest hit: the least t in
 ``[t_min, t_max)``, ties to the lower triangle index (boxes are searched up to $best·(1 + 2⁻⁴⁰)$, so a triangle
 whose t rounds a few ulps below its box's entry, or ties, is still found): one triangle whatever order the boxes
 are searched in, so the wide traversal gives the binary one's hits to the byte (``_closest``, kept for
@@ -38,15 +40,32 @@ in ``[t_min, t_max)`` (shadow rays). ``intersect`` computes, in the traversal's 
 parallel over pieces of the ray array.
 
 Chosen by measurement (one thread, process CPU seconds for 262,144 rays, medians of 3, the bunny and a
-1.31 M-triangle sphere, camera / random rays; the shared 2-core host at load 8–16, Embree 4 in the same
-conditions 0.041 / 0.031 and 0.088 / 0.059 s): binary tree 0.085 / 0.080 and 0.206 / 0.165 s; four-wide, scalar
-slab tests 0.078 / 0.066 and 0.191 / 0.167; four-wide, vector slab tests 0.060 / 0.054 and 0.180 / 0.151 (the
-bounds in float32 or float64: the same within noise, float32 kept for half the memory). Testing a met leaf at
-once instead of pushing it in the any-hit path: within noise (0.055 against 0.058 s on the bunny's shadow rays).
-Tried and dropped: the hit mask of the four tests (``movmskpd``) with one met child entered and two ordered by a
-single compare (no stack sort): first hits within noise, occlusion 5–25 % slower; links as int32: no change.
-The sphere's rays are memory-bound (18 wide nodes and 5 triangles per shadow ray from the camera's hits at
-about 35 ns a node); the bunny's cost some 20 ns a node.
+1.31 M-triangle sphere, camera / random rays; the shared 2-core host at load 8–16, Embree 4 in the same conditions
+0.041 / 0.031 and 0.088 / 0.059 s): binary tree 0.085 / 0.080 and 0.206 / 0.165 s; four-wide, scalar slab tests
+0.078 / 0.066 and 0.191 / 0.167; four-wide, vector slab tests 0.060 / 0.054 and 0.180 / 0.151 (the bounds in float32
+or float64: the same within noise, float32 kept for half the memory). Testing a met leaf at once instead of pushing
+it in the any-hit path: within noise (0.055 against 0.058 s on the bunny's shadow rays). Tried and dropped: the hit
+mask of the four tests (``movmskpd``) with one met child entered and two ordered by a single compare (no stack
+sort): first hits within noise, occlusion 5–25 % slower; links as int32: no change. The sphere's rays are
+memory-bound (18 wide nodes and 5 triangles per shadow ray from the camera's hits at about 35 ns a node); the
+bunny's cost some 20 ns a node. Leaves of up to four triangles in the wide tree (``LEAF_WIDE``; 3.4× fewer wide
+nodes: bunny 34,801 → 10,281, sphere 634,069 → 189,478), against one triangle a leaf, both trees in one process
+(load 15, medians of 5, first hit / occlusion, camera then random rays): bunny 0.060 / 0.053 → 0.060 / 0.049 and
+0.061 / 0.042 → 0.054 / 0.041 s, sphere 0.153 / 0.172 → 0.137 / 0.150 and 0.109 / 0.123 → 0.102 / 0.104 s; up to
+seven (``leaf_wide=7``, scalar tests) against four: 0–5 % slower on three rows of four, kept at four. Then a leaf's
+triangles tested four at once (``_triangles4``: each corner coordinate of the four rows gathered into a
+``<4 x double>``, Möller–Trumbore on the four lanes, the rejections a mask) against one after another
+(``_triangle``), one process (load 15, medians of 5): bunny 0.056 / 0.049 → 0.045 / 0.036 and 0.056 / 0.040 → 0.050
+/ 0.028 s, sphere 0.138 / 0.150 → 0.125 / 0.122 and 0.109 / 0.109 → 0.102 / 0.092 s (first hits 6–21 % and occlusion
+15–31 % faster). Packing a wide node's bounds and links into one 128-byte-aligned record (as Embree's nodes) against
+the two arrays: within noise (−3 … +11 %), not kept.
+The default fields of ``Scene.intersect`` add 15–25 ms of CPU to (t, item, face) for 262,144 bunny rays, a part
+of it their size alone: the eight columns are 30 MB, whose allocation and first writes (page faults) take some
+7 ms (NumPy, no kernel).
+Through the public API (``benchmarks/bench_rays.py``, CPU with one thread / Embree's one thread, load 9–10,
+alternate runs; rows bunny camera, random, sphere camera, random), before these leaves → after: first hit, every
+field 2.01 / 3.42 / 2.45 / 2.78 → 1.59 / 2.56 / 2.08 / 2.10, (t, item, face) 1.66 / 2.50 / 2.01 / 2.44 →
+1.15 / 1.88 / 1.51 / 1.61; occlusion 1.90 / 2.26 / 2.37 / 2.15 → 1.42 / 1.50 / 1.46 / 1.54.
 
 ``cast_pixels`` casts one ray per pixel through the view volume and writes what the depth buffer writes
 (``render(..., method="ray-casting")``).
@@ -73,8 +92,8 @@ from numba.extending import intrinsic
 from frustum.raster._jit import kernel, parallel_kernel
 
 __all__ = [
-    "BINS", "CAST_STATS", "FIELDS", "LEAF_SIZE", "WIDTH", "Index", "any_hits", "build", "cast_pixels", "closest_hits",
-    "intersect",
+    "BINS", "CAST_STATS", "FIELDS", "LEAF_SIZE", "LEAF_WIDE", "WIDTH", "Index", "any_hits", "build", "cast_pixels",
+    "closest_hits", "intersect",
 ]
 
 LEAF_SIZE = 1
@@ -94,6 +113,9 @@ _TASKS = 4096
 WIDTH = 4
 """Children of a node of the traversal tree (``Index.wide_boxes``): the binary tree collapsed, four boxes tested at
 once (one AVX2 register of float64 per bound)."""
+LEAF_WIDE = 4
+"""Most triangles in a leaf of the wide tree: a subtree of at most this many becomes one leaf whose triangles are
+tested one after another, instead of a wide node whose boxes are tested first (``_collapse``)."""
 SMALL = 8
 """Ranges of at most this many triangles are split by the exact SAH (every cut on every axis) instead of bins."""
 
@@ -107,7 +129,8 @@ class Index(NamedTuple):
     ``wide_boxes`` (M, 6, WIDTH) float32: the same tree collapsed to ``WIDTH`` children a node, the children's
     bounds as rows (lo x y z, hi x y z) of one value per child (an empty slot: lo +inf, hi −inf), and
     ``wide_links`` (M, WIDTH) int64: each child, a wide node number or a leaf code as in ``links``. ``boxes`` and
-    ``links`` serve ``cast_pixels`` (whose counts are the binary tree's) and the step-by-step traversal."""
+    ``links`` serve ``cast_pixels`` (whose counts are the binary tree's) and the step-by-step traversal. A leaf
+    code of the wide tree holds up to ``LEAF_WIDE`` consecutive rows."""
 
     boxes: np.ndarray
     links: np.ndarray
@@ -415,12 +438,46 @@ def _gather(triangles, index, out, start, stop):
 
 
 @kernel
-def _collapse(boxes, links, depth, wide_boxes, wide_links):
+def _subtrees(links, size, first):
+    """``size[k]``, ``first[k]``: the triangles under binary node k and the first of their rows (a subtree's
+    triangles are the rows ``[first, first + size)``; 0 for a number no node holds). Children are numbered above
+    their parent: marked reachable from the root going up, summed going down."""
+    size[:] = 0
+    size[0] = 1
+    for k in range(links.shape[0]):
+        if size[k] != 0:
+            for side in range(2):
+                if links[k, side] >= 0:
+                    size[links[k, side]] = 1
+    for k in range(links.shape[0] - 1, -1, -1):
+        if size[k] == 0:
+            continue
+        total = 0
+        for side in range(2):
+            link = links[k, side]
+            if link >= 0:
+                total += size[link]
+                start = first[link]
+            else:
+                total += ~link & 7
+                start = ~link >> 3
+            if side == 0:
+                first[k] = start
+        size[k] = total
+
+
+@kernel
+def _collapse(boxes, links, depth, leaf_wide, wide_boxes, wide_links):
     """The binary tree (``boxes``, ``links``) collapsed into ``WIDTH``-wide nodes: from each node's two children,
     the inner child of the largest surface area is replaced by its own two children while fewer than ``WIDTH``
     are held and an inner one is left (the order of the children kept); every inner child left becomes a wide node
-    of its own (numbered depth first). Fills ``wide_boxes``/``wide_links``; returns the wide nodes made. (A node
-    with fewer than ``WIDTH`` children has leaves only, so at most $(2F − 1)/3 + 1$ nodes for F triangles.)"""
+    of its own (numbered depth first), unless it holds at most `leaf_wide` triangles: then it becomes one leaf
+    of them all (tested one after another, no box of its own). Fills ``wide_boxes``/``wide_links``; returns the
+    wide nodes made. (A node with fewer than ``WIDTH`` children has leaves only, so at most $(2F − 1)/3 + 1$ nodes
+    for F triangles.)"""
+    size = np.empty(links.shape[0], dtype=np.int64)
+    first = np.empty(links.shape[0], dtype=np.int64)
+    _subtrees(links, size, first)
     child = np.empty(WIDTH, dtype=np.int64)
     box = np.empty((WIDTH, 6))
     stack = np.empty((3 * depth + 8, 2), dtype=np.int64)  # (binary node, its wide slot)
@@ -459,7 +516,9 @@ def _collapse(boxes, links, depth, wide_boxes, wide_links):
             if c < n:
                 for q in range(6):
                     wide_boxes[w, q, c] = box[c, q]
-                if child[c] >= 0:
+                if child[c] >= 0 and size[child[c]] <= leaf_wide:
+                    wide_links[w, c] = ~(first[child[c]] * 8 + size[child[c]])
+                elif child[c] >= 0:
                     wide_links[w, c] = made
                     stack[top, 0], stack[top, 1] = child[c], made
                     top += 1
@@ -479,8 +538,11 @@ def _wide_nodes(count: int) -> int:
     return (2 * count) // 3 + 2
 
 
-def build(triangles: np.ndarray) -> Index:
-    """The index of (F, 3, 3) float64 triangles (corner rows), F >= 1."""
+def build(triangles: np.ndarray, leaf_wide: int = LEAF_WIDE) -> Index:
+    """The index of (F, 3, 3) float64 triangles (corner rows), F >= 1; `leaf_wide` (1 … 7): the most triangles in
+    a leaf of the wide tree (``LEAF_WIDE``; the hits are the same for any)."""
+    if not 1 <= leaf_wide <= 7:  # a leaf code holds its count in three bits
+        raise ValueError(f"build: leaf_wide = {leaf_wide!r}; expected 1 … 7")
     tri = np.ascontiguousarray(triangles, dtype=np.float64)
     count = tri.shape[0]
     data = np.empty((count, 6), dtype=np.float32)
@@ -516,8 +578,9 @@ def build(triangles: np.ndarray) -> Index:
     _gather(tri, index, ordered)
     wide_boxes = np.empty((_wide_nodes(count), 6, WIDTH), dtype=np.float32)
     wide_links = np.empty((wide_boxes.shape[0], WIDTH), dtype=np.int64)
-    made = _collapse(boxes, links, int(depth), wide_boxes, wide_links)
-    return Index(boxes, links, ordered, index, int(depth), int(nodes), wide_boxes[:made], wide_links[:made])
+    made = _collapse(boxes, links, int(depth), int(leaf_wide), wide_boxes, wide_links)
+    return Index(boxes, links, ordered, index, int(depth), int(nodes), wide_boxes[:made].copy(),
+                 wide_links[:made].copy())  # (copies: the unused rows' memory goes back)
 
 
 def memory_bytes(count: int) -> int:
@@ -531,6 +594,164 @@ def memory_bytes(count: int) -> int:
 
 
 @kernel
+def _reciprocal(dx, dy, dz):
+    """A ray's reciprocal direction (inf for a zero component) and the rows of the bounds it enters first
+    (0/3, 1/4, 2/5 by its signs): ``(ix, iy, iz, nx, ny, nz)``, what every traversal's slab tests read."""
+    ix = 1.0 / dx if dx != 0.0 else np.inf
+    iy = 1.0 / dy if dy != 0.0 else np.inf
+    iz = 1.0 / dz if dz != 0.0 else np.inf
+    return ix, iy, iz, 0 if ix >= 0.0 else 3, 1 if iy >= 0.0 else 4, 2 if iz >= 0.0 else 5
+
+
+@kernel
+def _slab(x0, y0, z0, x1, y1, z1, ox, oy, oz, ix, iy, iz, t_min, reach):
+    """Where the ray enters the box within [t_min, reach] (inf: it misses), from the bounds it enters first
+    (x0, y0, z0) and last (x1 …): the slab test $t = (b − o)·(1/d)$, the far distances widened by
+    $1 + 2γ₃$ (``_ROBUST``, PBRT 3.9.2) so that rounding never loses a box."""
+    t0, t1 = t_min, reach
+    a0, b0, g0 = (x0 - ox) * ix, (y0 - oy) * iy, (z0 - oz) * iz
+    t0 = a0 if a0 > t0 else t0
+    t0 = b0 if b0 > t0 else t0
+    t0 = g0 if g0 > t0 else t0
+    a1, b1, g1 = (x1 - ox) * ix * _ROBUST, (y1 - oy) * iy * _ROBUST, (z1 - oz) * iz * _ROBUST
+    t1 = a1 if a1 < t1 else t1
+    t1 = b1 if b1 < t1 else t1
+    t1 = g1 if g1 < t1 else t1
+    return t0 if t0 <= t1 else np.inf
+
+
+@kernel
+def _triangle(triangles, row, ox, oy, oz, dx, dy, dz):
+    """Möller–Trumbore of one ray and triangle ``triangles[row]``: ``(t, u, v, det)`` (det = 0: no hit; the one
+    ray–triangle arithmetic of every traversal here, which ``tests/test_rays.py``'s brute force repeats)."""
+    ax, ay, az = triangles[row, 0, 0], triangles[row, 0, 1], triangles[row, 0, 2]
+    e1x, e1y, e1z = triangles[row, 1, 0] - ax, triangles[row, 1, 1] - ay, triangles[row, 1, 2] - az
+    e2x, e2y, e2z = triangles[row, 2, 0] - ax, triangles[row, 2, 1] - ay, triangles[row, 2, 2] - az
+    px, py, pz = dy * e2z - dz * e2y, dz * e2x - dx * e2z, dx * e2y - dy * e2x
+    det = e1x * px + e1y * py + e1z * pz
+    if det == 0.0:
+        return 0.0, 0.0, 0.0, 0.0
+    inv = 1.0 / det
+    sx, sy, sz = ox - ax, oy - ay, oz - az
+    u = (sx * px + sy * py + sz * pz) * inv
+    if u < 0.0 or u > 1.0:
+        return 0.0, 0.0, 0.0, 0.0
+    qx, qy, qz = sy * e1z - sz * e1y, sz * e1x - sx * e1z, sx * e1y - sy * e1x
+    v = (dx * qx + dy * qy + dz * qz) * inv
+    if v < 0.0 or u + v > 1.0:
+        return 0.0, 0.0, 0.0, 0.0
+    return (e2x * qx + e2y * qy + e2z * qz) * inv, u, v, det
+
+
+def _splat(builder, value):
+    """LLVM IR: a vector of ``WIDTH`` copies of scalar `value` (insert into lane 0, shuffle to all)."""
+    vector = ir.VectorType(value.type, WIDTH)
+    one = builder.insert_element(ir.Constant(vector, ir.Undefined), value, ir.Constant(ir.IntType(32), 0))
+    return builder.shuffle_vector(one, ir.Constant(vector, ir.Undefined),
+                                  ir.Constant(ir.VectorType(ir.IntType(32), WIDTH), [0] * WIDTH))  # fmt: skip
+
+
+@intrinsic
+def _triangles4_vector(typingctx, triangles, first, count, ox, oy, oz, dx, dy, dz, out):
+    """``_triangles4`` as LLVM vector code: the corners of rows ``first`` … ``first + 3`` loaded into
+    ``<4 x double>`` lanes (a lane past `count` repeats row `first` and is masked), then ``_triangle``'s
+    arithmetic operation for operation on the four at once (IEEE: the same bytes), its rejections as a mask."""
+
+    def codegen(context, builder, signature, args):  # (its preamble as _slab4_vector's: kept on purpose, per intrinsic)
+        kind = signature.args[0]
+        data = context.make_array(kind)(context, builder, args[0])
+        result = context.make_array(signature.args[9])(context, builder, args[9])
+        double = ir.DoubleType()
+        vector = ir.VectorType(double, WIDTH)
+        shape = cgutils.unpack_tuple(builder, data.shape)
+        strides = cgutils.unpack_tuple(builder, data.strides)
+        start = context.cast(builder, args[1], signature.args[1], types.intp)
+        count = context.cast(builder, args[2], signature.args[2], types.intp)
+        index = ir.IntType(64)
+        rows = []
+        for lane in range(WIDTH):
+            there = builder.icmp_signed("<", ir.Constant(index, lane), count)
+            rows.append(builder.select(there, builder.add(start, ir.Constant(index, lane)), start))
+
+        def column(corner, axis):
+            value = ir.Constant(vector, ir.Undefined)
+            for lane in range(WIDTH):
+                pointer = cgutils.get_item_pointer2(context, builder, data.data, shape, strides, kind.layout,
+                                                    [rows[lane], ir.Constant(index, corner), ir.Constant(index, axis)],
+                                                    wraparound=False)  # fmt: skip
+                value = builder.insert_element(value, builder.load(pointer), ir.Constant(ir.IntType(32), lane))
+            return value
+
+        def splat(value):
+            return _splat(builder, value)
+
+        mul, sub, add = builder.fmul, builder.fsub, builder.fadd
+        o = [splat(args[3 + a]) for a in range(3)]
+        d = [splat(args[6 + a]) for a in range(3)]
+        a = [column(0, q) for q in range(3)]
+        e1 = [sub(column(1, q), a[q]) for q in range(3)]
+        e2 = [sub(column(2, q), a[q]) for q in range(3)]
+        p = [sub(mul(d[1], e2[2]), mul(d[2], e2[1])), sub(mul(d[2], e2[0]), mul(d[0], e2[2])),
+             sub(mul(d[0], e2[1]), mul(d[1], e2[0]))]  # fmt: skip
+        det = add(add(mul(e1[0], p[0]), mul(e1[1], p[1])), mul(e1[2], p[2]))
+        zero, one = splat(ir.Constant(double, 0.0)), splat(ir.Constant(double, 1.0))
+        inv = builder.fdiv(one, det)
+        sv = [sub(o[q], a[q]) for q in range(3)]
+        u = mul(add(add(mul(sv[0], p[0]), mul(sv[1], p[1])), mul(sv[2], p[2])), inv)
+        qv = [sub(mul(sv[1], e1[2]), mul(sv[2], e1[1])), sub(mul(sv[2], e1[0]), mul(sv[0], e1[2])),
+              sub(mul(sv[0], e1[1]), mul(sv[1], e1[0]))]  # fmt: skip
+        v = mul(add(add(mul(d[0], qv[0]), mul(d[1], qv[1])), mul(d[2], qv[2])), inv)
+        t = mul(add(add(mul(e2[0], qv[0]), mul(e2[1], qv[1])), mul(e2[2], qv[2])), inv)
+        lanes = ir.Constant(ir.VectorType(index, WIDTH), list(range(WIDTH)))
+        miss = builder.icmp_signed(">=", lanes, splat(count))
+        for test in (builder.fcmp_ordered("==", det, zero), builder.fcmp_ordered("<", u, zero),
+                     builder.fcmp_ordered(">", u, one), builder.fcmp_ordered("<", v, zero),
+                     builder.fcmp_ordered(">", add(u, v), one)):  # fmt: skip
+            miss = builder.or_(miss, test)
+        for row, value in enumerate((t, u, v, det)):
+            pointer = cgutils.get_item_pointer2(context, builder, result.data,
+                                                cgutils.unpack_tuple(builder, result.shape),
+                                                cgutils.unpack_tuple(builder, result.strides), signature.args[9].layout,
+                                                [ir.Constant(index, row), ir.Constant(index, 0)],
+                                                wraparound=False)  # fmt: skip
+            builder.store(builder.select(miss, zero, value), builder.bitcast(pointer, vector.as_pointer()), align=8)
+        return context.get_dummy_value()
+
+    return types.void(triangles, first, count, ox, oy, oz, dx, dy, dz, out), codegen
+
+
+def _triangles4_scalar(triangles, first, count, ox, oy, oz, dx, dy, dz, out):
+    """``out[:, c]`` = ``_triangle`` of row ``first + c`` as (t, u, v, det) for c < `count` (<= ``WIDTH``),
+    zeros (det 0: no hit) past it."""
+    for c in range(WIDTH):
+        out[0, c], out[1, c], out[2, c], out[3, c] = 0.0, 0.0, 0.0, 0.0
+        if c < count:
+            out[0, c], out[1, c], out[2, c], out[3, c] = _triangle(triangles, first + c, ox, oy, oz, dx, dy, dz)
+
+
+_triangles4 = _triangles4_scalar if numba.config.DISABLE_JIT else _triangles4_vector
+"""``_triangles4(triangles, first, count, ox, oy, oz, dx, dy, dz, out)`` in a kernel: Möller–Trumbore of the ray
+and up to ``WIDTH`` consecutive rows at once into `out` (4, ``WIDTH``): rows t, u, v, det (det 0: no hit)."""
+
+
+@kernel
+def _nearer(t, face, t_min, best, best_face):
+    """Whether a hit at t on `face` replaces the best so far: t >= t_min and nearer, a tie to the lower face."""
+    return t >= t_min and (t < best or (t == best and face < best_face))
+
+
+@kernel
+def _pop(stack, entry, top, reach, node):
+    """The next pushed node whose box entry is still within `reach` (the best hit so far, widened):
+    ``(found, node, top)``; not found: the stack is spent (`node` returned as given)."""
+    while top > 0:
+        top -= 1
+        if entry[top] <= reach:
+            return True, stack[top], top
+    return False, node, top
+
+
+@kernel
 def _closest(boxes, links, triangles, order, skip, ox, oy, oz, dx, dy, dz, t_min, t_max, cull, stack, entry):
     """The first hit of one ray: ``(t, row, u, v, back, box_tests, nodes, tests)``.
 
@@ -540,12 +761,7 @@ def _closest(boxes, links, triangles, order, skip, ox, oy, oz, dx, dy, dz, t_min
     is (inf, −1, …). Counts: box (slab) tests, nodes visited (inner nodes and leaves entered), ray–triangle
     tests. `stack`, `entry`: scratch of at least the index's depth + 1.
     """
-    ix = 1.0 / dx if dx != 0.0 else np.inf
-    iy = 1.0 / dy if dy != 0.0 else np.inf
-    iz = 1.0 / dz if dz != 0.0 else np.inf
-    nx = 0 if ix >= 0.0 else 3
-    ny = 1 if iy >= 0.0 else 4
-    nz = 2 if iz >= 0.0 else 5
+    ix, iy, iz, nx, ny, nz = _reciprocal(dx, dy, dz)
     masked = skip.shape[0] > 0
     best = t_max
     reach = t_max
@@ -559,37 +775,12 @@ def _closest(boxes, links, triangles, order, skip, ox, oy, oz, dx, dy, dz, t_min
         nodes += 1
         if node >= 0:
             box_tests += 2
-            t_near0, t_near1 = np.inf, np.inf
-            for side in range(2):
-                c = 6 * side
-                a0 = (boxes[node, c + nx] - ox) * ix
-                a1 = (boxes[node, c + 3 - nx] - ox) * ix
-                b0 = (boxes[node, c + ny] - oy) * iy
-                b1 = (boxes[node, c + 5 - ny] - oy) * iy
-                g0 = (boxes[node, c + nz] - oz) * iz
-                g1 = (boxes[node, c + 7 - nz] - oz) * iz
-                t0 = t_min
-                t1 = reach
-                if a0 > t0:
-                    t0 = a0
-                if b0 > t0:
-                    t0 = b0
-                if g0 > t0:
-                    t0 = g0
-                a1 *= _ROBUST
-                b1 *= _ROBUST
-                g1 *= _ROBUST
-                if a1 < t1:
-                    t1 = a1
-                if b1 < t1:
-                    t1 = b1
-                if g1 < t1:
-                    t1 = g1
-                if t0 <= t1:
-                    if side == 0:
-                        t_near0 = t0
-                    else:
-                        t_near1 = t0
+            t_near0 = _slab(boxes[node, nx], boxes[node, ny], boxes[node, nz], boxes[node, 3 - nx],
+                            boxes[node, 5 - ny], boxes[node, 7 - nz], ox, oy, oz, ix, iy, iz, t_min,
+                            reach)  # fmt: skip
+            t_near1 = _slab(boxes[node, 6 + nx], boxes[node, 6 + ny], boxes[node, 6 + nz], boxes[node, 9 - nx],
+                            boxes[node, 11 - ny], boxes[node, 13 - nz], ox, oy, oz, ix, iy, iz, t_min,
+                            reach)  # fmt: skip
             left, right = links[node, 0], links[node, 1]
             swap = t_near1 < t_near0  # selects, not branches: the order is a coin toss for the predictor
             if (t_near1 if swap else t_near0) < np.inf:  # the nearer child now, the other one pushed if met
@@ -607,34 +798,14 @@ def _closest(boxes, links, triangles, order, skip, ox, oy, oz, dx, dy, dz, t_min
                 if masked and skip[face] != 0:
                     continue
                 tests += 1
-                ax, ay, az = triangles[row, 0, 0], triangles[row, 0, 1], triangles[row, 0, 2]
-                e1x, e1y, e1z = triangles[row, 1, 0] - ax, triangles[row, 1, 1] - ay, triangles[row, 1, 2] - az
-                e2x, e2y, e2z = triangles[row, 2, 0] - ax, triangles[row, 2, 1] - ay, triangles[row, 2, 2] - az
-                px, py, pz = dy * e2z - dz * e2y, dz * e2x - dx * e2z, dx * e2y - dy * e2x
-                det = e1x * px + e1y * py + e1z * pz
+                t, u, v, det = _triangle(triangles, row, ox, oy, oz, dx, dy, dz)
                 if det == 0.0 or (cull != 0 and det < 0.0):
                     continue
-                inv = 1.0 / det
-                sx, sy, sz = ox - ax, oy - ay, oz - az
-                u = (sx * px + sy * py + sz * pz) * inv
-                if u < 0.0 or u > 1.0:
-                    continue
-                qx, qy, qz = sy * e1z - sz * e1y, sz * e1x - sx * e1z, sx * e1y - sy * e1x
-                v = (dx * qx + dy * qy + dz * qz) * inv
-                if v < 0.0 or u + v > 1.0:
-                    continue
-                t = (e2x * qx + e2y * qy + e2z * qz) * inv
-                if t >= t_min and (t < best or (t == best and face < best_face)):
+                if _nearer(t, face, t_min, best, best_face):
                     best, best_row, best_face, best_u, best_v = t, row, face, u, v
                     best_back = 1 if det < 0.0 else 0
                     reach = best * _WIDE
-        popped = False
-        while top > 0:  # the next pushed node still nearer than the best hit
-            top -= 1
-            if entry[top] <= reach:
-                node = stack[top]
-                popped = True
-                break
+        popped, node, top = _pop(stack, entry, top, reach, node)
         if not popped:
             break
     if best_row < 0:
@@ -646,44 +817,15 @@ def _closest(boxes, links, triangles, order, skip, ox, oy, oz, dx, dy, dz, t_min
 def _any(boxes, links, triangles, ox, oy, oz, dx, dy, dz, t_min, t_max, stack):
     """Whether one ray meets any triangle at t in [t_min, t_max) (Möller–Trumbore as in ``_closest``; back faces
     count): the traversal stops at the first such triangle."""
-    ix = 1.0 / dx if dx != 0.0 else np.inf
-    iy = 1.0 / dy if dy != 0.0 else np.inf
-    iz = 1.0 / dz if dz != 0.0 else np.inf
-    nx = 0 if ix >= 0.0 else 3
-    ny = 1 if iy >= 0.0 else 4
-    nz = 2 if iz >= 0.0 else 5
+    ix, iy, iz, nx, ny, nz = _reciprocal(dx, dy, dz)
     node = 0
     top = 0
     while True:
         if node >= 0:
-            near0, near1 = np.inf, np.inf
-            for side in range(2):
-                c = 6 * side
-                t0 = t_min
-                t1 = t_max
-                a0 = (boxes[node, c + nx] - ox) * ix
-                b0 = (boxes[node, c + ny] - oy) * iy
-                g0 = (boxes[node, c + nz] - oz) * iz
-                a1 = (boxes[node, c + 3 - nx] - ox) * ix * _ROBUST
-                b1 = (boxes[node, c + 5 - ny] - oy) * iy * _ROBUST
-                g1 = (boxes[node, c + 7 - nz] - oz) * iz * _ROBUST
-                if a0 > t0:
-                    t0 = a0
-                if b0 > t0:
-                    t0 = b0
-                if g0 > t0:
-                    t0 = g0
-                if a1 < t1:
-                    t1 = a1
-                if b1 < t1:
-                    t1 = b1
-                if g1 < t1:
-                    t1 = g1
-                if t0 <= t1:
-                    if side == 0:
-                        near0 = t0
-                    else:
-                        near1 = t0
+            near0 = _slab(boxes[node, nx], boxes[node, ny], boxes[node, nz], boxes[node, 3 - nx], boxes[node, 5 - ny],
+                          boxes[node, 7 - nz], ox, oy, oz, ix, iy, iz, t_min, t_max)  # fmt: skip
+            near1 = _slab(boxes[node, 6 + nx], boxes[node, 6 + ny], boxes[node, 6 + nz], boxes[node, 9 - nx],
+                          boxes[node, 11 - ny], boxes[node, 13 - nz], ox, oy, oz, ix, iy, iz, t_min, t_max)  # fmt: skip
             left, right = links[node, 0], links[node, 1]
             swap = near1 < near0
             if (near1 if swap else near0) < np.inf:
@@ -695,23 +837,9 @@ def _any(boxes, links, triangles, ox, oy, oz, dx, dy, dz, t_min, t_max, stack):
             code = ~node
             first = code >> 3
             for row in range(first, first + (code & 7)):
-                ax, ay, az = triangles[row, 0, 0], triangles[row, 0, 1], triangles[row, 0, 2]
-                e1x, e1y, e1z = triangles[row, 1, 0] - ax, triangles[row, 1, 1] - ay, triangles[row, 1, 2] - az
-                e2x, e2y, e2z = triangles[row, 2, 0] - ax, triangles[row, 2, 1] - ay, triangles[row, 2, 2] - az
-                px, py, pz = dy * e2z - dz * e2y, dz * e2x - dx * e2z, dx * e2y - dy * e2x
-                det = e1x * px + e1y * py + e1z * pz
+                t, _, _, det = _triangle(triangles, row, ox, oy, oz, dx, dy, dz)
                 if det == 0.0:
                     continue
-                inv = 1.0 / det
-                sx, sy, sz = ox - ax, oy - ay, oz - az
-                u = (sx * px + sy * py + sz * pz) * inv
-                if u < 0.0 or u > 1.0:
-                    continue
-                qx, qy, qz = sy * e1z - sz * e1y, sz * e1x - sx * e1z, sx * e1y - sy * e1x
-                v = (dx * qx + dy * qy + dz * qz) * inv
-                if v < 0.0 or u + v > 1.0:
-                    continue
-                t = (e2x * qx + e2y * qy + e2z * qz) * inv
                 if t >= t_min and t < t_max:
                     return True
         if top == 0:
@@ -726,7 +854,7 @@ def _slab4_vector(typingctx, boxes, node, nx, ny, nz, ox, oy, oz, ix, iy, iz, t_
     (``<4 x double>``, one AVX2 register), and the arithmetic, compares and selects are ``_slab4_scalar``'s
     operation for operation (IEEE: the same bytes), on all four children at once."""
 
-    def codegen(context, builder, signature, args):
+    def codegen(context, builder, signature, args):  # (its preamble as _triangles4_vector's: kept on purpose)
         kind = signature.args[0]
         data = context.make_array(kind)(context, builder, args[0])
         out = context.make_array(signature.args[13])(context, builder, args[13])
@@ -745,9 +873,7 @@ def _slab4_vector(typingctx, boxes, node, nx, ny, nz, ox, oy, oz, ix, iy, iz, t_
             return value if lanes is vector or kind.dtype != types.float32 else builder.fpext(value, vector)
 
         def splat(value):
-            one = builder.insert_element(ir.Constant(vector, ir.Undefined), value, ir.Constant(ir.IntType(32), 0))
-            mask = ir.Constant(ir.VectorType(ir.IntType(32), WIDTH), [0] * WIDTH)
-            return builder.shuffle_vector(one, ir.Constant(vector, ir.Undefined), mask)
+            return _splat(builder, value)
 
         near_rows = [context.cast(builder, args[2 + a], signature.args[2 + a], types.intp) for a in range(3)]
         far_rows = [builder.sub(ir.Constant(ir.IntType(64), 3 + 2 * a), near_rows[a]) for a in range(3)]
@@ -771,22 +897,11 @@ def _slab4_vector(typingctx, boxes, node, nx, ny, nz, ox, oy, oz, ix, iy, iz, t_
 
 def _slab4_scalar(boxes, node, nx, ny, nz, ox, oy, oz, ix, iy, iz, t_min, reach, near):
     """``near[c]`` = where the ray enters child c's box of wide node `node` within [t_min, reach] (inf: it
-    misses): the slab test of ``_closest`` (far bounds widened by ``_ROBUST``), one child after another."""
+    misses): ``_slab`` on one child after another."""
     for c in range(WIDTH):
-        t0, t1 = t_min, reach
-        a0 = (np.float64(boxes[node, nx, c]) - ox) * ix
-        b0 = (np.float64(boxes[node, ny, c]) - oy) * iy
-        g0 = (np.float64(boxes[node, nz, c]) - oz) * iz
-        t0 = a0 if a0 > t0 else t0
-        t0 = b0 if b0 > t0 else t0
-        t0 = g0 if g0 > t0 else t0
-        a1 = (np.float64(boxes[node, 3 - nx, c]) - ox) * ix * _ROBUST
-        b1 = (np.float64(boxes[node, 5 - ny, c]) - oy) * iy * _ROBUST
-        g1 = (np.float64(boxes[node, 7 - nz, c]) - oz) * iz * _ROBUST
-        t1 = a1 if a1 < t1 else t1
-        t1 = b1 if b1 < t1 else t1
-        t1 = g1 if g1 < t1 else t1
-        near[c] = t0 if t0 <= t1 else np.inf
+        near[c] = _slab(np.float64(boxes[node, nx, c]), np.float64(boxes[node, ny, c]), np.float64(boxes[node, nz, c]),
+                        np.float64(boxes[node, 3 - nx, c]), np.float64(boxes[node, 5 - ny, c]),
+                        np.float64(boxes[node, 7 - nz, c]), ox, oy, oz, ix, iy, iz, t_min, reach)  # fmt: skip
 
 
 _slab4 = _slab4_scalar if numba.config.DISABLE_JIT else _slab4_vector
@@ -796,42 +911,15 @@ bounds the ray enters first (0/3, 1/4, 2/5 by the signs of its direction)."""
 
 
 @kernel
-def _triangle(triangles, row, ox, oy, oz, dx, dy, dz):
-    """Möller–Trumbore of one ray and triangle ``triangles[row]``: ``(t, u, v, det)`` (det = 0: no hit; the
-    arithmetic of ``_closest``, which ``tests/test_rays.py``'s brute force repeats)."""
-    ax, ay, az = triangles[row, 0, 0], triangles[row, 0, 1], triangles[row, 0, 2]
-    e1x, e1y, e1z = triangles[row, 1, 0] - ax, triangles[row, 1, 1] - ay, triangles[row, 1, 2] - az
-    e2x, e2y, e2z = triangles[row, 2, 0] - ax, triangles[row, 2, 1] - ay, triangles[row, 2, 2] - az
-    px, py, pz = dy * e2z - dz * e2y, dz * e2x - dx * e2z, dx * e2y - dy * e2x
-    det = e1x * px + e1y * py + e1z * pz
-    if det == 0.0:
-        return 0.0, 0.0, 0.0, 0.0
-    inv = 1.0 / det
-    sx, sy, sz = ox - ax, oy - ay, oz - az
-    u = (sx * px + sy * py + sz * pz) * inv
-    if u < 0.0 or u > 1.0:
-        return 0.0, 0.0, 0.0, 0.0
-    qx, qy, qz = sy * e1z - sz * e1y, sz * e1x - sx * e1z, sx * e1y - sy * e1x
-    v = (dx * qx + dy * qy + dz * qz) * inv
-    if v < 0.0 or u + v > 1.0:
-        return 0.0, 0.0, 0.0, 0.0
-    return (e2x * qx + e2y * qy + e2z * qz) * inv, u, v, det
-
-
-@kernel
 def _closest4(wide_boxes, wide_links, triangles, order, skip, ox, oy, oz, dx, dy, dz, t_min, t_max, cull, stack, entry,
-              near):  # fmt: skip
+              near, found):  # fmt: skip
     """``_closest`` on the wide tree: ``(t, row, u, v, back)``, the same hit to the byte (the least t, ties to
     the lower original index, is one triangle whatever the order the boxes are searched in). At a node the
     ``WIDTH`` boxes are tested at once (``_slab4``) and the children met are pushed sorted by entry distance,
-    the nearest on top (popped next); a popped entry beyond the best hit so far is skipped. `stack`, `entry`:
-    scratch of at least 3·depth + 2, `near` of ``WIDTH``."""
-    ix = 1.0 / dx if dx != 0.0 else np.inf
-    iy = 1.0 / dy if dy != 0.0 else np.inf
-    iz = 1.0 / dz if dz != 0.0 else np.inf
-    nx = 0 if ix >= 0.0 else 3
-    ny = 1 if iy >= 0.0 else 4
-    nz = 2 if iz >= 0.0 else 5
+    the nearest on top (popped next); a popped entry beyond the best hit so far is skipped; a leaf's triangles are
+    tested four at once (``_triangles4``). `stack`, `entry`: scratch of at least 3·depth + 2, `near` of
+    ``WIDTH``, `found` (4, ``WIDTH``)."""
+    ix, iy, iz, nx, ny, nz = _reciprocal(dx, dy, dz)
     masked = skip.shape[0] > 0
     best = t_max
     reach = t_max
@@ -861,25 +949,22 @@ def _closest4(wide_boxes, wide_links, triangles, order, skip, ox, oy, oz, dx, dy
                 continue
         else:
             code = ~node
-            first = code >> 3
-            for row in range(first, first + (code & 7)):
-                face = order[row]
-                if masked and skip[face] != 0:
-                    continue
-                t, u, v, det = _triangle(triangles, row, ox, oy, oz, dx, dy, dz)
-                if det == 0.0 or (cull != 0 and det < 0.0):
-                    continue
-                if t >= t_min and (t < best or (t == best and face < best_face)):
-                    best, best_row, best_face, best_u, best_v = t, row, face, u, v
-                    best_back = 1 if det < 0.0 else 0
-                    reach = best * _WIDE
-        popped = False
-        while top > 0:  # the next pushed node still nearer than the best hit
-            top -= 1
-            if entry[top] <= reach:
-                node = stack[top]
-                popped = True
-                break
+            for first in range(code >> 3, (code >> 3) + (code & 7), WIDTH):
+                _triangles4(triangles, first, (code >> 3) + (code & 7) - first, ox, oy, oz, dx, dy, dz, found)
+                for c in range(WIDTH):
+                    det = found[3, c]
+                    if det == 0.0 or (cull != 0 and det < 0.0):
+                        continue
+                    row = first + c
+                    face = order[row]
+                    if masked and skip[face] != 0:
+                        continue
+                    t, u, v = found[0, c], found[1, c], found[2, c]
+                    if _nearer(t, face, t_min, best, best_face):
+                        best, best_row, best_face, best_u, best_v = t, row, face, u, v
+                        best_back = 1 if det < 0.0 else 0
+                        reach = best * _WIDE
+        popped, node, top = _pop(stack, entry, top, reach, node)
         if not popped:
             break
     if best_row < 0:
@@ -888,16 +973,11 @@ def _closest4(wide_boxes, wide_links, triangles, order, skip, ox, oy, oz, dx, dy
 
 
 @kernel
-def _any4(wide_boxes, wide_links, triangles, ox, oy, oz, dx, dy, dz, t_min, t_max, stack, near):
+def _any4(wide_boxes, wide_links, triangles, ox, oy, oz, dx, dy, dz, t_min, t_max, stack, near, found):
     """``_any`` on the wide tree: whether one ray meets a triangle at t in [t_min, t_max): the inner children
     met are pushed in their order, the leaves met tested at once; the traversal stops at the first triangle
     found."""
-    ix = 1.0 / dx if dx != 0.0 else np.inf
-    iy = 1.0 / dy if dy != 0.0 else np.inf
-    iz = 1.0 / dz if dz != 0.0 else np.inf
-    nx = 0 if ix >= 0.0 else 3
-    ny = 1 if iy >= 0.0 else 4
-    nz = 2 if iz >= 0.0 else 5
+    ix, iy, iz, nx, ny, nz = _reciprocal(dx, dy, dz)
     node = 0
     top = 0
     while True:
@@ -911,11 +991,13 @@ def _any4(wide_boxes, wide_links, triangles, ox, oy, oz, dx, dy, dz, t_min, t_ma
                         top += 1
                         continue
                     code = ~child  # a leaf: its triangles now, not pushed
-                    first = code >> 3
-                    for row in range(first, first + (code & 7)):
-                        t, _, _, det = _triangle(triangles, row, ox, oy, oz, dx, dy, dz)
-                        if det != 0.0 and t >= t_min and t < t_max:
-                            return True
+                    for first in range(code >> 3, (code >> 3) + (code & 7), WIDTH):
+                        _triangles4(triangles, first, (code >> 3) + (code & 7) - first, ox, oy, oz, dx, dy, dz,
+                                    found)  # fmt: skip
+                        for k in range(WIDTH):
+                            t = found[0, k]
+                            if found[3, k] != 0.0 and t >= t_min and t < t_max:
+                                return True
         if top == 0:
             return False
         top -= 1
@@ -931,10 +1013,11 @@ def _closest_rays(wide_boxes, wide_links, triangles, order, depth, skip, origins
     stack = np.empty(3 * depth + 8, dtype=np.int64)
     entry = np.empty(3 * depth + 8)
     near = np.empty(WIDTH)
+    found = np.empty((4, WIDTH))
     for r in range(start, stop):
         t, row, u, v, back = _closest4(
             wide_boxes, wide_links, triangles, order, skip, origins[r, 0], origins[r, 1], origins[r, 2],
-            directions[r, 0], directions[r, 1], directions[r, 2], t_min[r], t_max[r], cull, stack, entry, near,
+            directions[r, 0], directions[r, 1], directions[r, 2], t_min[r], t_max[r], cull, stack, entry, near, found,
         )  # fmt: skip
         t_out[r] = t
         row_out[r] = row
@@ -950,11 +1033,12 @@ def _any_rays(wide_boxes, wide_links, triangles, depth, origins, directions, t_m
     per ray."""
     stack = np.empty(3 * depth + 8, dtype=np.int64)
     near = np.empty(WIDTH)
+    found = np.empty((4, WIDTH))
     each_min, each_max = t_min.shape[0] > 1, t_max.shape[0] > 1
     for r in range(start, stop):
         out[r] = _any4(wide_boxes, wide_links, triangles, origins[r, 0], origins[r, 1], origins[r, 2],
                        directions[r, 0], directions[r, 1], directions[r, 2], t_min[r if each_min else 0],
-                       t_max[r if each_max else 0], stack, near)  # fmt: skip
+                       t_max[r if each_max else 0], stack, near, found)  # fmt: skip
 
 
 def _per_ray(value: float | np.ndarray, count: int) -> np.ndarray:
@@ -1036,13 +1120,14 @@ def _intersect_rays(wide_boxes, wide_links, triangles, order, depth, origins, di
     stack = np.empty(3 * depth + 8, dtype=np.int64)
     entry = np.empty(3 * depth + 8)
     near = np.empty(WIDTH)
+    found = np.empty((4, WIDTH))
     skip = np.empty(0, dtype=np.uint8)
     last = starts.shape[0] - 1
     for r in range(start, stop):
         ox, oy, oz = origins[r, 0], origins[r, 1], origins[r, 2]
         dx, dy, dz = directions[r, 0], directions[r, 1], directions[r, 2]
         t, row, u, v, back = _closest4(wide_boxes, wide_links, triangles, order, skip, ox, oy, oz, dx, dy, dz, 0.0,
-                                       np.inf, 0, stack, entry, near)  # fmt: skip
+                                       np.inf, 0, stack, entry, near, found)  # fmt: skip
         if row < 0:
             if wanted & 1:
                 t_out[r] = np.inf
