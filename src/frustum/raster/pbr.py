@@ -24,6 +24,21 @@ import numpy as np
 
 from frustum.raster._jit import kernel, parallel_kernel
 from frustum.raster.shade import (
+    _CHUNK,
+    _DB,
+    _DG,
+    _DR,
+    _NX,
+    _NY,
+    _NZ,
+    _POW,
+    _PX,
+    _PY,
+    _PZ,
+    _SIGN,
+    _VX,
+    _VY,
+    _VZ,
     I_BLEND,
     I_FACE_OFFSET,
     I_OBJECT_ID,
@@ -42,7 +57,7 @@ from frustum.raster.shade import (
     _to_byte,
 )
 
-__all__ = ["PBR", "SHADE_PBR", "shade_pixels_pbr"]
+__all__ = ["PBR", "SHADE_PBR", "shade_chunk_pbr", "shade_pixels_pbr"]
 
 SHADE_PBR = 6
 """``render(shading="pbr")``: the shading mode code beside ``raster.shade``'s SHADE_* (0–5)."""
@@ -51,6 +66,7 @@ Q_METALLIC, Q_ROUGHNESS, Q_OCCLUSION_STRENGTH, Q_EXPOSURE, Q_TONE_MAP, Q_ENVIRON
 PBR = 9
 DIELECTRIC_F0 = 0.04
 INV_PI = 1.0 / math.pi
+_NDV = _POW  # the chunk scratch row holding n·v (``shade_chunk_pbr``)
 
 
 @kernel
@@ -187,57 +203,91 @@ def radiance(
     params: np.ndarray, pbr: np.ndarray, lights: np.ndarray, sh: np.ndarray, maps: np.ndarray, table: np.ndarray,
     seen: np.ndarray, row: int, col: int,
 ) -> tuple[float, float, float]:  # fmt: skip
-    """Linear radiance toward the eye (module docstring's L without emission) at P with unit normal N."""
+    """Linear radiance toward the eye (module docstring's L without emission) at P with unit normal N: each
+    light's ``direct_light``, then ``image_light``."""
+    vx, vy, vz, n_dot_v = view(params, px, py, pz, nx, ny, nz)
+    alpha = roughness * roughness
+    r, g, b = 0.0, 0.0, 0.0
+    shadowed = seen.shape[0] > 0
+    for k in range(lights.shape[0]):
+        visible = seen[row, col, k] if shadowed else 1.0
+        dr, dg, db = direct_light(lights, k, visible, px, py, pz, nx, ny, nz, vx, vy, vz, n_dot_v, alpha,
+                                  base_r, base_g, base_b, metallic)  # fmt: skip
+        r, g, b = r + dr, g + dg, b + db
+    ir, ig, ib = image_light(pbr, sh, maps, table, nx, ny, nz, vx, vy, vz, n_dot_v, alpha, roughness,
+                             base_r, base_g, base_b, metallic, occlusion)  # fmt: skip
+    return r + ir, g + ig, b + ib
+
+
+@kernel
+def view(
+    params: np.ndarray, px: float, py: float, pz: float, nx: float, ny: float, nz: float
+) -> tuple[float, float, float, float]:  # fmt: skip
+    """(V, n·v): the unit direction from P to the eye and its cosine with the unit normal N."""
     vx, vy, vz = params[P_EYE] - px, params[P_EYE + 1] - py, params[P_EYE + 2] - pz
     length = math.sqrt((vx * vx + vy * vy) + vz * vz)
     if length > 0.0:
         vx, vy, vz = vx / length, vy / length, vz / length
-    n_dot_v = (nx * vx + ny * vy) + nz * vz
-    alpha = roughness * roughness
-    r, g, b = 0.0, 0.0, 0.0
+    return vx, vy, vz, (nx * vx + ny * vy) + nz * vz
+
+
+@kernel
+def direct_light(
+    lights: np.ndarray, k: int, visible: float, px: float, py: float, pz: float, nx: float, ny: float, nz: float,
+    vx: float, vy: float, vz: float, n_dot_v: float, alpha: float, base_r: float, base_g: float, base_b: float,
+    metallic: float,
+) -> tuple[float, float, float]:  # fmt: skip
+    """$f(l, v)·E·(n·l)·seen$ of light k (lux; candela over d² in the ``range`` window and the spot's cone), its
+    visible fraction `visible`; zero where n·l <= 0."""
+    kind = lights[k, 0]
+    illuminance = 1.0
+    if kind == 0.0:
+        lx, ly, lz = lights[k, 7], lights[k, 8], lights[k, 9]
+    else:
+        lx, ly, lz = lights[k, 4] - px, lights[k, 5] - py, lights[k, 6] - pz
+        d2 = (lx * lx + ly * ly) + lz * lz
+        distance = math.sqrt(d2)
+        if distance == 0.0:
+            return 0.0, 0.0, 0.0
+        lx, ly, lz = lx / distance, ly / distance, lz / distance
+        illuminance = 1.0 / d2
+        reach = lights[k, 15]
+        if reach > 0.0:
+            q = distance / reach
+            window = min(max(1.0 - q * q * q * q, 0.0), 1.0)
+            illuminance *= window * window
+        if kind == 2.0:
+            cos_alpha = -((lx * lights[k, 7] + ly * lights[k, 8]) + lz * lights[k, 9])
+            scale = 1.0 / max(1e-3, lights[k, 13] - lights[k, 14])
+            t = min(max((cos_alpha - lights[k, 14]) * scale, 0.0), 1.0)
+            illuminance *= t * t
+    n_dot_l = (nx * lx + ny * ly) + nz * lz
+    if n_dot_l <= 0.0 or illuminance == 0.0:
+        return 0.0, 0.0, 0.0
+    illuminance *= visible
+    hx, hy, hz = lx + vx, ly + vy, lz + vz
+    length = math.sqrt((hx * hx + hy * hy) + hz * hz)
+    if length > 0.0:
+        hx, hy, hz = hx / length, hy / length, hz / length
+    n_dot_h = (nx * hx + ny * hy) + nz * hz
+    v_dot_h = (vx * hx + vy * hy) + vz * hz
+    specular = visibility_smith_ggx(n_dot_l, n_dot_v, alpha) * distribution_ggx(n_dot_h, alpha)
+    w = schlick_weight(v_dot_h)
+    scale = illuminance * n_dot_l
     diffuse_r, diffuse_g, diffuse_b = base_r * INV_PI, base_g * INV_PI, base_b * INV_PI
-    shadowed = seen.shape[0] > 0
-    for k in range(lights.shape[0]):
-        kind = lights[k, 0]
-        illuminance = 1.0
-        if kind == 0.0:
-            lx, ly, lz = lights[k, 7], lights[k, 8], lights[k, 9]
-        else:
-            lx, ly, lz = lights[k, 4] - px, lights[k, 5] - py, lights[k, 6] - pz
-            d2 = (lx * lx + ly * ly) + lz * lz
-            distance = math.sqrt(d2)
-            if distance == 0.0:
-                continue
-            lx, ly, lz = lx / distance, ly / distance, lz / distance
-            illuminance = 1.0 / d2
-            reach = lights[k, 15]
-            if reach > 0.0:
-                q = distance / reach
-                window = min(max(1.0 - q * q * q * q, 0.0), 1.0)
-                illuminance *= window * window
-            if kind == 2.0:
-                cos_alpha = -((lx * lights[k, 7] + ly * lights[k, 8]) + lz * lights[k, 9])
-                scale = 1.0 / max(1e-3, lights[k, 13] - lights[k, 14])
-                t = min(max((cos_alpha - lights[k, 14]) * scale, 0.0), 1.0)
-                illuminance *= t * t
-        n_dot_l = (nx * lx + ny * ly) + nz * lz
-        if n_dot_l <= 0.0 or illuminance == 0.0:
-            continue
-        if shadowed:
-            illuminance *= seen[row, col, k]
-        hx, hy, hz = lx + vx, ly + vy, lz + vz
-        length = math.sqrt((hx * hx + hy * hy) + hz * hz)
-        if length > 0.0:
-            hx, hy, hz = hx / length, hy / length, hz / length
-        n_dot_h = (nx * hx + ny * hy) + nz * hz
-        v_dot_h = (vx * hx + vy * hy) + vz * hz
-        specular = visibility_smith_ggx(n_dot_l, n_dot_v, alpha) * distribution_ggx(n_dot_h, alpha)
-        w = schlick_weight(v_dot_h)
-        scale = illuminance * n_dot_l
-        r += _brdf_channel(base_r, metallic, diffuse_r, specular, w) * lights[k, 1] * scale
-        g += _brdf_channel(base_g, metallic, diffuse_g, specular, w) * lights[k, 2] * scale
-        b += _brdf_channel(base_b, metallic, diffuse_b, specular, w) * lights[k, 3] * scale
-    # image-based and ambient light (split sum; ibl's docstring)
+    return (_brdf_channel(base_r, metallic, diffuse_r, specular, w) * lights[k, 1] * scale,
+            _brdf_channel(base_g, metallic, diffuse_g, specular, w) * lights[k, 2] * scale,
+            _brdf_channel(base_b, metallic, diffuse_b, specular, w) * lights[k, 3] * scale)  # fmt: skip
+
+
+@kernel
+def image_light(
+    pbr: np.ndarray, sh: np.ndarray, maps: np.ndarray, table: np.ndarray, nx: float, ny: float, nz: float,
+    vx: float, vy: float, vz: float, n_dot_v: float, alpha: float, roughness: float,
+    base_r: float, base_g: float, base_b: float, metallic: float, occlusion: float,
+) -> tuple[float, float, float]:  # fmt: skip
+    """$ao·(S·(P(R) + I_a) + (1 − m)·(1 − S_0)·base·(E_sh(n)/π + I_a))$: image-based and ambient light by the split
+    sum (ibl's docstring), S = F0·A + B."""
     a, bias = split_sum(table, min(max(n_dot_v, 0.0), 1.0), roughness)
     s0 = DIELECTRIC_F0 * a + bias
     keep = (1.0 - metallic) * (1.0 - s0)
@@ -258,10 +308,9 @@ def radiance(
     f0_r = (1.0 - metallic) * DIELECTRIC_F0 + metallic * base_r
     f0_g = (1.0 - metallic) * DIELECTRIC_F0 + metallic * base_g
     f0_b = (1.0 - metallic) * DIELECTRIC_F0 + metallic * base_b
-    r += occlusion * ((f0_r * a + bias) * spec_r + keep * base_r * irr_r)
-    g += occlusion * ((f0_g * a + bias) * spec_g + keep * base_g * irr_g)
-    b += occlusion * ((f0_b * a + bias) * spec_b + keep * base_b * irr_b)
-    return r, g, b
+    return (occlusion * ((f0_r * a + bias) * spec_r + keep * base_r * irr_r),
+            occlusion * ((f0_g * a + bias) * spec_g + keep * base_g * irr_g),
+            occlusion * ((f0_b * a + bias) * spec_b + keep * base_b * irr_b))  # fmt: skip
 
 
 @parallel_kernel(lambda depth, codes, *_: codes.shape[0], work=lambda depth, *_: depth.size, grain=8192)
@@ -353,3 +402,50 @@ def _shade_row_pbr(
             normal_out[row, col, 0], normal_out[row, col, 1], normal_out[row, col, 2] = nx, ny, nz
         if item[I_WRITE_IDS] != 0:
             id_out[row, col] = item[I_OBJECT_ID]
+
+
+# Kernel specialisation kept on purpose: ``_shade_row_pbr``'s pixel for the tile path (``raster.pbr_tiled``), as
+# passes over a chunk of gathered pixels calling the same helpers in the same order, so the same bytes.
+@kernel
+def shade_chunk_pbr(
+    n: int, s: np.ndarray, where: np.ndarray, params: np.ndarray, pbr: np.ndarray, lights: np.ndarray,
+    sh: np.ndarray, maps: np.ndarray, table: np.ndarray, words: np.ndarray,
+) -> None:  # fmt: skip
+    """Shade the first n pixels gathered by ``shade._gather_chunk`` (an opaque item without textures, vertex
+    colours, depth cue or shadows): ``_surface``'s normal, ``view``, each light's ``direct_light`` (one pass per
+    light over the chunk), ``image_light``, emission and ``tone``; each pixel's bytes (r, g, b, 255) stored as
+    one little-endian word (words: color viewed as uint32)."""
+    metallic, roughness = pbr[Q_METALLIC], pbr[Q_ROUGHNESS]
+    alpha = roughness * roughness
+    base_r, base_g, base_b = params[P_COLOR], params[P_COLOR + 1], params[P_COLOR + 2]
+    for i in range(n):
+        nx, ny, nz = s[_NX + i], s[_NY + i], s[_NZ + i]
+        length = math.sqrt((nx * nx + ny * ny) + nz * nz)
+        zero = length == 0.0
+        nx = 0.0 if zero else nx
+        ny = 0.0 if zero else ny
+        nz = 1.0 if zero else nz
+        length = 1.0 if zero else length
+        sign = s[_SIGN + i]
+        nx, ny, nz = sign * nx / length, sign * ny / length, sign * nz / length
+        s[_NX + i], s[_NY + i], s[_NZ + i] = nx, ny, nz
+        s[_VX + i], s[_VY + i], s[_VZ + i], s[_NDV + i] = view(params, s[_PX + i], s[_PY + i], s[_PZ + i], nx, ny, nz)
+        s[_DR + i], s[_DG + i], s[_DB + i] = 0.0, 0.0, 0.0
+    for k in range(lights.shape[0]):
+        for i in range(n):
+            dr, dg, db = direct_light(
+                lights, k, 1.0, s[_PX + i], s[_PY + i], s[_PZ + i], s[_NX + i], s[_NY + i], s[_NZ + i],
+                s[_VX + i], s[_VY + i], s[_VZ + i], s[_NDV + i], alpha, base_r, base_g, base_b, metallic,
+            )  # fmt: skip
+            s[_DR + i], s[_DG + i], s[_DB + i] = s[_DR + i] + dr, s[_DG + i] + dg, s[_DB + i] + db
+    tone_code, exposure = int(pbr[Q_TONE_MAP]), pbr[Q_EXPOSURE]
+    er, eg, eb = params[P_EMISSIVE], params[P_EMISSIVE + 1], params[P_EMISSIVE + 2]
+    for i in range(n):
+        ir, ig, ib = image_light(pbr, sh, maps, table, s[_NX + i], s[_NY + i], s[_NZ + i], s[_VX + i], s[_VY + i],
+                                 s[_VZ + i], s[_NDV + i], alpha, roughness, base_r, base_g, base_b, metallic, 1.0)
+        r, g, b = tone(tone_code, exposure, (s[_DR + i] + ir) + er, (s[_DG + i] + ig) + eg, (s[_DB + i] + ib) + eb)
+        where[2 * _CHUNK + i] = (
+            int(_to_byte(r)) | int(_to_byte(g)) << 8 | int(_to_byte(b)) << 16 | 255 << 24
+        )
+    for i in range(n):
+        words[np.uint64(where[i]), np.uint64(where[_CHUNK + i]), 0] = where[2 * _CHUNK + i]

@@ -35,6 +35,20 @@ def applies(item: SceneItem, options: RenderOptions) -> bool:
     )
 
 
+def tiled(item: SceneItem, options: RenderOptions) -> bool:
+    """Whether a frame of this one item may be drawn tile by tile (``raster.pbr_tiled``): shaded by this model,
+    opaque, no vertex colours, textures or normal maps it can use, no depth cue, shadows or extra buffers."""
+    mesh, material = item.mesh, item.material
+    mapped = getattr(mesh, "uvs", None) is not None and any(
+        image is not None for image in (material.texture, material.metallic_roughness_texture,
+                                        material.occlusion_texture, material.normal_map, material.bump)
+    )  # fmt: skip
+    return (
+        applies(item, options) and material.opacity >= 1.0 and getattr(mesh, "vertex_colors", None) is None
+        and not mapped and options.depth_cue is None and options.shadow is None and not options.buffers
+    )  # fmt: skip
+
+
 def physical_parameters(material: Material, options: RenderOptions, lit_by_environment: bool) -> np.ndarray:
     """(raster.pbr.PBR,) float64: metallic, roughness (a ``"phong"`` material's from its shininess), occlusion
     strength, exposure, tone map code, whether an environment lights the item, the ambient radiance (3)."""
