@@ -125,8 +125,9 @@ def _texel(maps: np.ndarray, level: int, fx: float, fy: float) -> tuple[float, f
     height, width = maps.shape[1], maps.shape[2]
     x0, y0 = math.floor(fx), math.floor(fy)
     tx, ty = fx - x0, fy - y0
-    i0 = int(x0) % width
-    i1 = (i0 + 1) % width
+    i0 = int(x0)  # fx in [−0.5, width − 0.5]: x0 in [−1, width − 1], wrapped without a division
+    i0 = width - 1 if i0 < 0 else i0
+    i1 = 0 if i0 + 1 >= width else i0 + 1
     j0 = min(max(int(y0), 0), height - 1)
     j1 = min(max(int(y0) + 1, 0), height - 1)
     w00, w01, w10, w11 = (1.0 - tx) * (1.0 - ty), tx * (1.0 - ty), (1.0 - tx) * ty, tx * ty
@@ -140,15 +141,35 @@ def _texel(maps: np.ndarray, level: int, fx: float, fy: float) -> tuple[float, f
 
 
 @kernel
+def arctangent(y: float, x: float) -> float:
+    """atan2(y, x) to 2e-8 rad, branch-free arithmetic (no libm call): $atan t ≈ t·Σ_k a_{2k}·t^{2k}$ on
+    t = min(|x|, |y|)/max(|x|, |y|) in [0, 1] (Abramowitz & Stegun 4.4.49), then the octant's reflections."""
+    ax, ay = abs(x), abs(y)
+    big, small = max(ax, ay), min(ax, ay)
+    t = small / big if big > 0.0 else 0.0
+    t2 = t * t
+    p = ((((((0.0028662257 * t2 - 0.0161657367) * t2 + 0.0429096138) * t2 - 0.0752896400) * t2 + 0.1065626393) * t2
+          - 0.1420889944) * t2 + 0.1999355085) * t2 - 0.3333314528  # fmt: skip
+    r = t * (p * t2 + 1.0)
+    r = 0.5 * math.pi - r if ay > ax else r
+    r = math.pi - r if x < 0.0 else r
+    return -r if y < 0.0 else r
+
+
+@kernel
 def prefiltered(maps: np.ndarray, roughness: float, x: float, y: float, z: float) -> tuple[float, float, float]:
     """The prefiltered radiance along the unit direction (x, y, z) (``EnvironmentMap``'s equirect layout:
-    $u = 1/2 + atan2(x, −z)/2π$, $v = acos(y)/π$), linear between the two levels around $roughness·(levels − 1)$."""
+    $u = 1/2 + atan2(x, −z)/2π$, $v = acos(y)/π$, by ``arctangent``), linear between the two levels around $roughness·(levels − 1)$
+    (one map: that map, the two levels blended already, ``render.pbr.blended_level``)."""
     top = maps.shape[0] - 1
+    y = min(max(y, -1.0), 1.0)
+    fx = (0.5 + arctangent(x, -z) / (2.0 * math.pi)) * maps.shape[2] - 0.5
+    fy = arctangent(math.sqrt((1.0 - y) * (1.0 + y)), y) / math.pi * maps.shape[1] - 0.5  # acos(y)
+    if top == 0:
+        return _texel(maps, 0, fx, fy)
     level = min(max(roughness, 0.0), 1.0) * top
     low = min(math.floor(level), top - 1)
     t = level - low
-    fx = (0.5 + math.atan2(x, -z) / (2.0 * math.pi)) * maps.shape[2] - 0.5
-    fy = math.acos(min(max(y, -1.0), 1.0)) / math.pi * maps.shape[1] - 0.5
     r0, g0, b0 = _texel(maps, low, fx, fy)
     if t == 0.0:
         return r0, g0, b0

@@ -25,6 +25,7 @@ SHADE_PBR = kernel.SHADE_PBR
 
 _NO_MAPS = np.zeros((2, 1, 2, 3), dtype=np.float32)
 _NO_SH = np.zeros((9, 3))
+_BLENDED: dict[tuple[int, float], tuple[weakref.ref, np.ndarray]] = {}
 _SURFACE_MAPS: weakref.WeakKeyDictionary[Material, np.ndarray] = weakref.WeakKeyDictionary()
 
 
@@ -96,6 +97,25 @@ def image_light(options: RenderOptions) -> tuple[np.ndarray, np.ndarray, np.ndar
         return _NO_SH, _NO_MAPS, brdf_table(), False
     lighting = image_lighting(options.environment)
     return lighting.sh, lighting.prefiltered, lighting.table, True
+
+
+def blended_level(maps: np.ndarray, roughness: float) -> np.ndarray:
+    """(1, H, 2H, 3) float32: the two prefiltered maps around $roughness·(levels − 1)$ blended as
+    ``raster.pbr.prefiltered`` blends its two lookups (a lerp of bilinear lookups is the bilinear lookup of the
+    lerp, to rounding), for an item of one roughness: one lookup per pixel instead of two. Cached per map."""
+    key = (id(maps), float(roughness))
+    cached = _BLENDED.get(key)
+    if cached is not None and cached[0]() is maps:
+        return cached[1]
+    top = maps.shape[0] - 1
+    level = min(max(float(roughness), 0.0), 1.0) * top
+    low = min(int(np.floor(level)), top - 1)
+    t = level - low
+    blended = ((1.0 - t) * maps[low].astype(np.float64) + t * maps[low + 1]).astype(np.float32)[None]
+    if len(_BLENDED) > 16:
+        _BLENDED.clear()
+    _BLENDED[key] = (weakref.ref(maps), blended)
+    return blended
 
 
 def shade_item(

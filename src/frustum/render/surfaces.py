@@ -100,6 +100,8 @@ def draw_tiled_pbr(
     flags = item_flags(0, 0, options, False, False, False)
     sh, maps, table, lit = pbr.image_light(options)
     values = pbr.physical_parameters(item.material, options, lit)
+    if lit:  # one roughness: the two levels around it blended once (render.pbr.blended_level)
+        maps = pbr.blended_level(maps, values[pbr.kernel.Q_ROUGHNESS])
     pbr_tiled.draw_tiles_pbr(
         binned.faces, binned.win_int, binned.win_float, binned.tri_int, binned.tri_float, binned.tri_weights,
         binned.tile_starts, binned.tile_entries, tiling, context.depth, np.asarray(world, dtype=np.float64),
