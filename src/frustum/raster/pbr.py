@@ -7,13 +7,15 @@ buffer), with the same interpolated, renormalized normal (flipped for a back fac
 
     L = Σ_l f(l, v)·E_l·(n·l)·seen_l + ao·(S·(P(R) + I_a) + (1 − m)·(1 − S_0)·base·(E_sh(n)/π + I_a)) + emissive
 
+(emissive: the factor times the emissive texture, where there is one)
+
 then $T(exposure·L)$, clamped and stored as $floor(c·255 + 0.5)$. The terms are written as in the NumPy module
 (each helper names its formula); ``tests/test_pbr.py`` holds the two equal.
 
 Array contracts (kernels never validate): params (shade.PARAMS,) as ``raster.shade``; pbr (PBR,) float64 laid
 out by the ``Q_*`` indices; lights (K, 16) rows of ``pack_lights`` (column 15: a point or spot light's range, 0
-for none); sh (9, 3); maps (levels, H, 2H, 3) float32; table (n, n, 2); textures (Ht, Wt, 4) float32 or empty;
-seen (H, W, K) float32 light fractions or an empty (0, 0, 0) array.
+for none); sh (9, 3); maps (levels, H, 2H, 3) float32; table (n, n, 2); textures and emission (Ht, Wt, 4)
+float32 or empty; seen (H, W, K) float32 light fractions or an empty (0, 0, 0) array.
 """
 
 from __future__ import annotations
@@ -159,8 +161,8 @@ def arctangent(y: float, x: float) -> float:
 @kernel
 def prefiltered(maps: np.ndarray, roughness: float, x: float, y: float, z: float) -> tuple[float, float, float]:
     """The prefiltered radiance along the unit direction (x, y, z) (``EnvironmentMap``'s equirect layout:
-    $u = 1/2 + atan2(x, −z)/2π$, $v = acos(y)/π$, by ``arctangent``), linear between the two levels around $roughness·(levels − 1)$
-    (one map: that map, the two levels blended already, ``render.pbr.blended_level``)."""
+    $u = 1/2 + atan2(x, −z)/2π$, $v = acos(y)/π$, by ``arctangent``), linear between the two levels around
+    $roughness·(levels − 1)$ (one map: that map, the two levels blended already, ``render.pbr.blended_level``)."""
     top = maps.shape[0] - 1
     y = min(max(y, -1.0), 1.0)
     fx = (0.5 + arctangent(x, -z) / (2.0 * math.pi)) * maps.shape[2] - 0.5
@@ -337,7 +339,7 @@ def image_light(
 @parallel_kernel(lambda depth, codes, *_: codes.shape[0], work=lambda depth, *_: depth.size, grain=8192)
 def shade_pixels_pbr(
     depth: np.ndarray, codes: np.ndarray, bary: np.ndarray, faces: np.ndarray, world: np.ndarray, normals: np.ndarray,
-    vertex_colors: np.ndarray, uvs: np.ndarray, texture: np.ndarray, surface_maps: np.ndarray,
+    vertex_colors: np.ndarray, uvs: np.ndarray, texture: np.ndarray, surface_maps: np.ndarray, emission: np.ndarray,
     params: np.ndarray, pbr: np.ndarray, lights: np.ndarray, sh: np.ndarray, maps: np.ndarray, table: np.ndarray,
     seen: np.ndarray, item: np.ndarray, color: np.ndarray, normal_out: np.ndarray, id_out: np.ndarray,
     start: int, stop: int,
@@ -346,11 +348,12 @@ def shade_pixels_pbr(
     contract for depth, codes, bary, faces, world, normals, vertex_colors, uvs, texture, params, item, color and
     the extra outputs). ``surface_maps`` (Ht, Wt, 4) float32: glTF's metallic–roughness texture's G (roughness)
     and B (metallic) in channels 1 and 2 and the occlusion texture's R in channel 0, or empty; sampled at the
-    same UVs as the base colour texture."""
+    same UVs as the base colour texture; ``emission`` (He, We, 4) float32 the emissive texture (linear), times the
+    emissive factor, or empty."""
     for row in range(start, stop):
         _shade_row_pbr(
-            row, depth, codes, bary, faces, world, normals, vertex_colors, uvs, texture, surface_maps, params, pbr,
-            lights, sh, maps, table, seen, item, color, normal_out, id_out,
+            row, depth, codes, bary, faces, world, normals, vertex_colors, uvs, texture, surface_maps, emission,
+            params, pbr, lights, sh, maps, table, seen, item, color, normal_out, id_out,
         )  # fmt: skip
 
 
@@ -358,8 +361,9 @@ def shade_pixels_pbr(
 def _shade_row_pbr(
     row: int, depth: np.ndarray, codes: np.ndarray, bary: np.ndarray, faces: np.ndarray, world: np.ndarray,
     normals: np.ndarray, vertex_colors: np.ndarray, uvs: np.ndarray, texture: np.ndarray, surface_maps: np.ndarray,
-    params: np.ndarray, pbr: np.ndarray, lights: np.ndarray, sh: np.ndarray, maps: np.ndarray, table: np.ndarray,
-    seen: np.ndarray, item: np.ndarray, color: np.ndarray, normal_out: np.ndarray, id_out: np.ndarray,
+    emission: np.ndarray, params: np.ndarray, pbr: np.ndarray, lights: np.ndarray, sh: np.ndarray, maps: np.ndarray,
+    table: np.ndarray, seen: np.ndarray, item: np.ndarray, color: np.ndarray, normal_out: np.ndarray,
+    id_out: np.ndarray,
 ) -> None:  # fmt: skip
     """One image row of ``shade_pixels_pbr``."""
     face_offset = item[I_FACE_OFFSET]
@@ -380,11 +384,12 @@ def _shade_row_pbr(
         alpha = params[P_OPACITY]
         base_r, base_g, base_b = params[P_COLOR], params[P_COLOR + 1], params[P_COLOR + 2]
         metallic, roughness, occlusion = pbr[Q_METALLIC], pbr[Q_ROUGHNESS], 1.0
+        emissive_r, emissive_g, emissive_b = params[P_EMISSIVE], params[P_EMISSIVE + 1], params[P_EMISSIVE + 2]
         if vertex_colors.shape[0] > 0:
             base_r *= _interpolate(u0, u1, u2, vertex_colors[a, 0], vertex_colors[b_, 0], vertex_colors[c, 0])
             base_g *= _interpolate(u0, u1, u2, vertex_colors[a, 1], vertex_colors[b_, 1], vertex_colors[c, 1])
             base_b *= _interpolate(u0, u1, u2, vertex_colors[a, 2], vertex_colors[b_, 2], vertex_colors[c, 2])
-        if texture.shape[0] > 0 or surface_maps.shape[0] > 0:
+        if texture.shape[0] > 0 or surface_maps.shape[0] > 0 or emission.shape[0] > 0:
             tu = _interpolate(u0, u1, u2, uvs[a, 0], uvs[b_, 0], uvs[c, 0])
             tv = _interpolate(u0, u1, u2, uvs[a, 1], uvs[b_, 1], uvs[c, 1])
             if texture.shape[0] > 0:
@@ -395,10 +400,12 @@ def _shade_row_pbr(
                 roughness *= rough
                 metallic *= metal
                 occlusion = 1.0 + pbr[Q_OCCLUSION_STRENGTH] * (ao - 1.0)
+            if emission.shape[0] > 0:
+                glow_r, glow_g, glow_b, _ = _sample(emission, tu, tv)
+                emissive_r, emissive_g, emissive_b = emissive_r * glow_r, emissive_g * glow_g, emissive_b * glow_b
         r, g, b = radiance(nx, ny, nz, px, py, pz, base_r, base_g, base_b, metallic, roughness, occlusion, params,
                            pbr, lights, sh, maps, table, seen, row, col)  # fmt: skip
-        r, g, b = tone(tone_code, pbr[Q_EXPOSURE], r + params[P_EMISSIVE], g + params[P_EMISSIVE + 1],
-                       b + params[P_EMISSIVE + 2])  # fmt: skip
+        r, g, b = tone(tone_code, pbr[Q_EXPOSURE], r + emissive_r, g + emissive_g, b + emissive_b)
         # depth cue and store: the same lines as raster/shade.py's and raster/shadow.py's pixel loops, a kernel
         # specialised per mode on purpose (the Phong kernels stay byte-equal and never compile the PBR terms)
         if params[P_CUE_ON] != 0.0:
