@@ -446,7 +446,7 @@ def shade_chunk_pbr(
     metallic, roughness = pbr[Q_METALLIC], pbr[Q_ROUGHNESS]
     alpha = roughness * roughness
     base_r, base_g, base_b = params[P_COLOR], params[P_COLOR + 1], params[P_COLOR + 2]
-    for i in range(n):
+    for i in range(n):  # the normal as raster.shade._shade_chunk's: kernel specialisation kept on purpose
         nx, ny, nz = s[_NX + i], s[_NY + i], s[_NZ + i]
         length = math.sqrt((nx * nx + ny * ny) + nz * nz)
         zero = length == 0.0

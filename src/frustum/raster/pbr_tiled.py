@@ -21,8 +21,9 @@ from frustum.raster.triangles import _fill_tile
 __all__ = ["draw_tiles_pbr"]
 
 
-# Kernel specialisation kept on purpose: raster.tiled.draw_tiles_directional's segment loop with the PBR chunk
-# shader (a Numba kernel cannot take its shading step as an argument and stay cached; the Phong one stays as it is).
+# Kernel specialisation kept on purpose: raster.tiled.draw_tiles_directional's (and raster.shadow_tiled's) segment
+# loop with the PBR chunk shader (a cached Numba kernel cannot take its shading step as an argument; the Phong one
+# compiles no PBR term).
 @parallel_kernel(lambda *args: segments(args[6].shape[0] - 1, args[8][1], args[8][0]), work=lambda *args: args[9].size,
                  grain=65536, pieces_per_thread=8)  # fmt: skip
 def draw_tiles_pbr(
