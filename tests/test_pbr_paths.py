@@ -117,3 +117,22 @@ def test_a_normal_mapped_plane_under_pbr_equals_the_brdf_at_the_perturbed_normal
     unmapped.add(fr.plane((2.0, 2.0)), material.with_(normal_map=None))
     assert np.array_equal(fr.render(scene, camera, shading="pbr").color, frame.color)  # without the buffer too
     assert np.abs(fr.render(unmapped, camera, shading="pbr").color.astype(int) - frame.color).max() > 10
+
+
+def test_a_scene_file_names_the_emissive_texture(tmp_path):
+    from PIL import Image
+
+    from frustum.scenefile import load_scene_file
+
+    texels = np.zeros((4, 4, 3), dtype=np.uint8)
+    texels[:, :2] = (255, 128, 0)
+    Image.fromarray(texels).save(tmp_path / "glow.png")
+    (tmp_path / "scene.toml").write_text(
+        '[camera]\neye = [0.0, 0.0, 2.5]\ntarget = [0.0, 0.0, 0.0]\n\n'
+        '[materials.glow]\nmodel = "pbr"\ncolor = [0.0, 0.0, 0.0]\nemissive = [1.0, 1.0, 1.0]\n'
+        'emissive_texture = "glow.png"\n\n'
+        '[[nodes]]\nname = "quad"\nmaterial = "glow"\ngeometry = { type = "plane", size = [2.0, 2.0] }\n'
+    )  # fmt: skip
+    loaded = load_scene_file(tmp_path / "scene.toml")
+    material = loaded.scene.items[0].material
+    np.testing.assert_array_equal(np.round(material.emissive_texture[..., :3] * 255), texels)
