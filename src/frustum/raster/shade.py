@@ -314,7 +314,8 @@ def _shade_row(
             f, code % 2 == 1, u0, u1, u2, faces, world, normals, lit, vertex_colors, uvs, texture, params,
             lights, item,
         )  # fmt: skip
-        # kernel specialisation kept on purpose: cue, blend and store repeated in shadow.shade_pixels_shadowed
+        # kernel specialisation kept on purpose: cue, blend and store repeated in shadow.shade_pixels_shadowed and
+        # raster.pbr's pixel loop
         if params[P_CUE_ON] != 0.0:
             a, bb, c = faces[f, 0], faces[f, 1], faces[f, 2]
             d = 0.0
@@ -468,6 +469,7 @@ def _gather_chunk(
         s[_PZ + i] = _interpolate(u0, u1, u2, world[a, 2], world[b, 2], world[c, 2])
 
 
+# Its normal pass is repeated by ``raster.pbr.shade_chunk_pbr``: kernel specialisation kept on purpose (no shared call).
 # Kernel specialization kept on purpose: ``raster.light.light_terms`` for directional lights (falloff 1), as passes
 # over a chunk of pixels that the compiler vectorizes; the same operations in the same order, so the same bytes.
 # kernel specialisation kept on purpose: raster.shadow_tiled._shade_chunk_shadowed repeats it with fractions

@@ -28,7 +28,8 @@ threads take: 512 rather than 1024 pixels balances them better where the surface
 1024² bunny: 16 pieces → 32; 3–8 % less frame time on every standard scene)."""
 
 
-# kernel specialisation kept on purpose: raster.shadow_tiled.draw_tiles_shadowed repeats its tile loop
+# kernel specialisation kept on purpose: raster.shadow_tiled.draw_tiles_shadowed repeats its tile loop, and
+# raster.pbr_tiled.draw_tiles_pbr with the PBR chunk shader
 @parallel_kernel(lambda *args: segments(args[6].shape[0] - 1, args[8][1], args[8][0]), work=lambda *args: args[9].size,
                  grain=65536, pieces_per_thread=8)  # fmt: skip
 def draw_tiles_directional(
@@ -105,6 +106,7 @@ def segments(tiles: int, tiles_x: int, size: int) -> int:
     return tiles // tiles_x * -(-tiles_x // (SPAN // size))
 
 
+# Kernel specialisation kept on purpose: raster.pbr_tiled._shade_tile_pbr repeats this listing for the PBR shader.
 @kernel
 def _shade_tile(
     n: int, rows: int, cols: int, offset: int, depth: np.ndarray, codes: np.ndarray, bary: np.ndarray,

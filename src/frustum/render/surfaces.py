@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from frustum.camera import Camera
+from frustum.render import pbr
 from frustum.render.buffers import FrameBuffers, clear_buffers
 from frustum.render.context import FrameContext
 from frustum.render.options import RenderOptions
@@ -43,6 +44,8 @@ def draw_opaque(scene: Scene, items: list[SceneItem], camera: Camera, options: R
     scratch = context.scratch
     if len(items) == 1 and opaque and face_total and directional(items[0], options, lighting.lights):
         draw_tiled(items[0], camera, options, lighting, context)
+    elif len(items) == 1 and opaque and face_total and pbr.tiled(items[0], options):
+        draw_tiled_pbr(items[0], camera, options, lighting, context)
     elif len(opaque) == len(items) and face_total and shadows.tiled(scene, items, options, lighting.lights):
         shadows.draw_tiled(scene, items, camera, options, lighting, context)
     else:
@@ -80,4 +83,28 @@ def draw_tiled(
         binned.faces, binned.win_int, binned.win_float, binned.tri_int, binned.tri_float, binned.tri_weights,
         binned.tile_starts, binned.tile_entries, tiling, context.depth, world, normals, params, lighting.lights,
         flags, options.background, context.color,
+    )  # fmt: skip
+
+
+def draw_tiled_pbr(
+    item: SceneItem, camera: Camera, options: RenderOptions, lighting: Lighting, context: FrameContext
+) -> None:  # fmt: skip
+    """``draw_tiled`` for an item of the metallic–roughness model (``render.pbr.tiled``; ``raster.pbr_tiled``): the
+    same bytes as the stage-by-stage path's ``render.pbr.shade_item``."""
+    from frustum.raster import pbr_tiled
+
+    binned = bin_item(item, camera, options.cull, 0, context.scratch, tile_bits=TILED_BITS)
+    world, normals = world_attributes(item, context.scratch)
+    tiling = np.array([1 << TILED_BITS, binned.tiles_x, 0, camera.width, camera.height], dtype=np.int64)
+    params = shading_parameters(item, camera, options, lighting.ambient)
+    flags = item_flags(0, 0, options, False, False, False)
+    sh, maps, table, lit = pbr.image_light(options)
+    values = pbr.physical_parameters(item.material, options, lit)
+    if lit:  # one roughness: the two levels around it blended once (render.pbr.blended_level)
+        maps = pbr.blended_level(maps, values[pbr.kernel.Q_ROUGHNESS])
+    pbr_tiled.draw_tiles_pbr(
+        binned.faces, binned.win_int, binned.win_float, binned.tri_int, binned.tri_float, binned.tri_weights,
+        binned.tile_starts, binned.tile_entries, tiling, context.depth, np.asarray(world, dtype=np.float64),
+        np.asarray(normals, dtype=np.float64), params, lighting.lights, flags, options.background, context.color,
+        values, sh, maps, table,
     )  # fmt: skip

@@ -12,7 +12,8 @@ from frustum.scenefile.report import _BAD, _Report
 from frustum.shading import AmbientLight, DirectionalLight, Material, PointLight, SpotLight
 from frustum.shading.environment import ENVIRONMENT_KINDS, EnvironmentMap
 
-IMAGE_KEYS = ("texture", "bump", "normal_map", "base_color_texture", "metallic_roughness_texture", "occlusion_texture")
+IMAGE_KEYS = ("texture", "bump", "normal_map", "base_color_texture", "metallic_roughness_texture", "occlusion_texture",
+              "emissive_texture")
 """Material keys that name an image file (relative to the scene file's folder): PNG, JPEG, anything Pillow reads."""
 
 _LIGHT_TYPES = {"ambient": AmbientLight, "directional": DirectionalLight, "point": PointLight, "spot": SpotLight}

@@ -122,7 +122,9 @@ class Material:
     ``metallic`` and ``roughness`` in [0, 1] its factors, ``metallic_roughness_texture`` an image whose B channel
     scales metallic and G roughness, ``occlusion_texture`` one whose R channel r darkens image-based and ambient
     light by $1 + occlusion_strength·(r − 1)$; ``base_color_texture`` an sRGB-encoded image (as glTF stores it),
-    decoded to linear values into ``texture`` (give one of the two). ``render(shading="phong")`` shades a
+    decoded to linear values into ``texture`` (give one of the two); ``emissive_texture`` an sRGB-encoded image
+    (glTF's ``emissiveTexture``) sampled at the same UVs, decoded, times ``emissive``: the emission the model adds
+    to the linear radiance (the classical shading modes leave it unused). ``render(shading="phong")`` shades a
     ``"pbr"`` material per pixel by that model, ``shading="pbr"`` every material (a ``"phong"`` one with
     ``shading.pbr.phong_roughness(shininess)``); docs/materials.md.
     ``hatch`` (vector output only): the spacing of 45° section lines drawn over the faces in filled SVG/PDF,
@@ -156,6 +158,7 @@ class Material:
     metallic_roughness_texture: NDArray[np.float32] | None = None
     occlusion_texture: NDArray[np.float32] | None = None
     occlusion_strength: float = 1.0
+    emissive_texture: NDArray[np.float32] | None = None
 
     def __post_init__(self) -> None:
         where = "Material"
@@ -214,7 +217,7 @@ class Material:
                 linear[..., :3] = srgb_to_linear(linear[..., :3])
             object.__setattr__(self, "texture", read_only(linear))
             object.__setattr__(self, "base_color_texture", None)
-        for name in ("metallic_roughness_texture", "occlusion_texture"):
+        for name in ("metallic_roughness_texture", "occlusion_texture", "emissive_texture"):
             object.__setattr__(self, name, _texture(getattr(self, name), f"{where} {name}"))
 
     def with_(self, **changes: Any) -> Material:
