@@ -30,10 +30,25 @@ from typing import Any
 import numpy as np
 
 from frustum.camera import Camera
-from frustum.render.stages import bands
 from frustum.scene import ParticleLayer
 
-__all__ = ["draw_particles", "project_particles", "project_streaks"]
+__all__ = ["bands", "draw_particles", "project_particles", "project_streaks"]
+
+
+def bands(rows: np.ndarray, height: int) -> tuple[np.ndarray, np.ndarray, int]:
+    """(starts, entries, band_rows): the primitives of each band of ``BAND_ROWS`` rows, by first `rows` (count,
+    prefix sum, fill; order kept), for the banded kernels of particles and point clouds."""
+    from frustum.raster import particles as kernels
+
+    band_rows = kernels.BAND_ROWS
+    bands = (height + band_rows - 1) // band_rows
+    counts = np.zeros(bands, dtype=np.int64)
+    kernels.count_bands(rows, band_rows, counts)
+    starts = np.zeros(bands + 1, dtype=np.int64)
+    np.cumsum(counts, out=starts[1:])
+    entries = np.empty(int(starts[-1]), dtype=np.int64)
+    kernels.fill_bands(rows, band_rows, starts, entries)
+    return starts, entries, band_rows
 
 
 def _frame(camera: Camera, minimum: float) -> np.ndarray:
@@ -81,7 +96,6 @@ def project_streaks(system: Any, camera: Camera, blending: str) -> tuple[np.ndar
     )  # fmt: skip
     streaks, rows = streaks[:kept], rows[:kept]
     return _back_to_front(streaks, rows, 5) if blending == "alpha" else (streaks, rows)
-
 
 
 

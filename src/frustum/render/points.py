@@ -35,7 +35,8 @@ from frustum.camera import Camera
 from frustum.render.buffers import Scratch
 from frustum.render.context import FrameContext
 from frustum.render.options import RenderOptions
-from frustum.render.stages import Lighting, bands, shading_parameters
+from frustum.render.particles import bands
+from frustum.render.stages import Lighting, shading_parameters
 from frustum.scene import PointItem, Scene, SceneItem
 from frustum.shading import pack_lights
 from frustum.transforms import apply, apply_to_normals

@@ -462,19 +462,3 @@ def draw_transparent(scene: Scene, items: list[SceneItem], camera: Camera, optio
         world, normals, band = draw_item(item, camera, options.cull, offsets[index], layer, context.scratch)
         shade_item(item, index, offsets[index], camera, options, lighting, (world, normals), layer, band,
                    blend=True)  # fmt: skip
-
-
-def bands(rows: np.ndarray, height: int) -> tuple[np.ndarray, np.ndarray, int]:
-    """(starts, entries, band_rows): the primitives of each band of ``BAND_ROWS`` rows, by first `rows` (count,
-    prefix sum, fill; order kept), for the banded kernels of particles and point clouds."""
-    from frustum.raster import particles as kernels
-
-    band_rows = kernels.BAND_ROWS
-    bands = (height + band_rows - 1) // band_rows
-    counts = np.zeros(bands, dtype=np.int64)
-    kernels.count_bands(rows, band_rows, counts)
-    starts = np.zeros(bands + 1, dtype=np.int64)
-    np.cumsum(counts, out=starts[1:])
-    entries = np.empty(int(starts[-1]), dtype=np.int64)
-    kernels.fill_bands(rows, band_rows, starts, entries)
-    return starts, entries, band_rows
