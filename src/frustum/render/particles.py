@@ -98,7 +98,6 @@ def project_streaks(system: Any, camera: Camera, blending: str) -> tuple[np.ndar
     return _back_to_front(streaks, rows, 5) if blending == "alpha" else (streaks, rows)
 
 
-
 def _spatial_order(primitives: np.ndarray, rows: np.ndarray, width: int) -> np.ndarray:
     """The drawing order of additive primitives: by (band of their first row, 32-pixel column tile), a stable
     counting sort (``count_bands``/``fill_bands`` over one key per primitive). Neighbours in the order are
