@@ -20,7 +20,8 @@
    buffer (an opaque surface) ends the pixel. The expected depth $Σ wᵢ zᵢ / Σ wᵢ$ ($wᵢ = αᵢ·Tᵢ$, z window depth
    of the centre) is written where $Σ wᵢ > 0$, and the item of the median splat: the one whose compositing brings
    the accumulated alpha $1 − T$ to ½ or more (T from above ½ to at most ½; −1 where it stays below ½), as 3DGS's
-   median depth picks its splat; item i holds records ``item_starts[i]`` to ``item_starts[i + 1] − 1``.
+   median depth picks its splat; item i holds the records from ``item_starts[i]`` up to (not including)
+   ``item_starts[i + 1]``.
 
 Records (``SPLAT_FIELDS`` float64): window x, y (y up), window depth z of the centre, bound half side r (pixels,
 0: culled), conic (A, B, C) of $Σ'⁻¹$ in window axes, opacity o, colour (3), Σ' in image axes (x right,
