@@ -376,6 +376,37 @@ def test_a_glb_material_without_factors_gets_the_specifications_defaults(tmp_pat
     assert (material.model, material.metallic, material.roughness) == ("pbr", 1.0, 1.0)
 
 
+def test_a_glb_emissive_texture_loads_into_the_material_and_glows(tmp_path):
+    """glTF's ``emissiveTexture`` × ``emissiveFactor``, by frustum's own glTF reader and by trimesh's (a file the
+    own reader leaves to trimesh: a second UV set)."""
+    from frustum.geometry import io
+    from frustum.scenefile.models import part_material
+
+    glow = np.zeros((8, 8, 3), dtype=np.uint8)
+    glow[..., 0], glow[..., 1], glow[..., 2] = 200, 40, 90
+    box = trimesh.creation.box()
+    material = trimesh.visual.material.PBRMaterial(baseColorFactor=[0, 0, 0, 255], emissiveFactor=[1.0, 0.5, 1.0],
+                                                   emissiveTexture=Image.fromarray(glow))  # fmt: skip
+    box.visual = trimesh.visual.TextureVisuals(uv=np.full((len(box.vertices), 2), 0.5), material=material)
+    path = tmp_path / "glow.glb"
+    box.export(path)
+    parts = {"own reader": fr.load_parts(path)[0], "trimesh": io.scene_parts(trimesh.load(path, force="scene"),
+                                                                             path)[0]}  # fmt: skip
+    for reader, part in parts.items():
+        np.testing.assert_array_equal(part.emissive_texture, glow, err_msg=reader)
+        material = part_material(part)
+        assert np.allclose(material.emissive, (1.0, 0.5, 1.0)) and material.emissive_texture is not None, reader
+    scene = fr.Scene()  # unlit: the emission alone, factor × texture (linear after sRGB decoding), then sRGB
+    scene.add(parts["own reader"].mesh, part_material(parts["own reader"]))
+    frame = fr.render(scene, _camera(), shading="pbr", tone_map="none", color_space="srgb")
+    covered = frame.depth < 1.0
+    texel = np.array([200, 40, 90]) / 255.0
+    linear = np.where(texel <= 0.04045, texel / 12.92, ((texel + 0.055) / 1.055) ** 2.4) * (1.0, 0.5, 1.0)
+    encoded = np.where(linear <= 0.0031308, 12.92 * linear, 1.055 * linear ** (1 / 2.4) - 0.055) * 255.0
+    assert covered.sum() > 100
+    assert np.abs(frame.color[covered][:, :3].astype(float) - encoded).max() <= 2.0
+
+
 # --- bad input ------------------------------------------------------------------------------------------------------
 
 

@@ -85,6 +85,8 @@ class MeshPart(NamedTuple):
     physical: bool = False
     """Whether the file describes the material by glTF's metallic–roughness model (a glTF or GLB file, or an OBJ
     whose MTL material has PBR statements: ``frustum.geometry.mtl_pbr``)."""
+    emissive_texture: NDArray[np.uint8] | None = None
+    """A glTF material's ``emissiveTexture`` as (H, W, 3) sRGB bytes (emission = ``emissive`` × the texture)."""
 
     def __repr__(self) -> str:
         def image(array: Any) -> str:
@@ -92,7 +94,8 @@ class MeshPart(NamedTuple):
 
         physical = (f", metallic={self.metallic!r}, roughness={self.roughness!r}, metallic_roughness_texture="
                     f"{image(self.metallic_roughness_texture)}, occlusion_texture={image(self.occlusion_texture)}, "
-                    "physical=True") if self.physical else ""  # fmt: skip
+                    f"physical=True, emissive_texture={image(self.emissive_texture)}"
+                    ) if self.physical else ""  # fmt: skip
         return (f"MeshPart(name={self.name!r}, mesh={self.mesh!r}, texture={image(self.texture)}, "
                 f"color={self.color!r}, normal_map={image(self.normal_map)}, emissive={self.emissive!r}, "
                 f"alpha_mode={self.alpha_mode!r}{physical})")  # fmt: skip
@@ -209,7 +212,8 @@ def scene_parts(scene: Any, file: Path | None = None) -> list[MeshPart]:
         matrix = np.array(world_from_model, dtype=np.float64)
         emissive, alpha_mode = _emission_and_alpha(geometry)
         parts.append(MeshPart(str(node), mesh, matrix, image, color, _normal_texture(geometry), emissive,
-                              alpha_mode, *_metallic_roughness(geometry, file)))  # fmt: skip
+                              alpha_mode, *_metallic_roughness(geometry, file),
+                              _normal_texture(geometry, "emissiveTexture")))  # fmt: skip
     return parts
 
 
@@ -241,14 +245,15 @@ def _native_parts(file: Path, text: bytes | None) -> list[MeshPart] | None:
             normal_map = None
             if part.normal_image is not None and part.uvs is not None:
                 normal_map = np.asarray(part.normal_image.convert("RGB"), dtype=np.uint8)
-            physical = [None, None]
-            for k, texture_image in enumerate((part.metallic_roughness_image, part.occlusion_image)):
+            physical = [None, None, None]
+            textures = (part.metallic_roughness_image, part.occlusion_image, part.emissive_image)
+            for k, texture_image in enumerate(textures):
                 if texture_image is not None and part.uvs is not None:
                     physical[k] = np.asarray(texture_image.convert("RGB"), dtype=np.uint8)
             pbr = file.suffix.lower() in (".glb", ".gltf") or part.metallic is not None  # glTF, or an MTL's Pr/Pm
             parts.append(MeshPart(part.name, mesh, np.asarray(part.world_from_model, dtype=np.float64), image, color,
                                   normal_map, part.emissive, part.alpha_mode, part.metallic, part.roughness,
-                                  *physical, pbr))  # fmt: skip
+                                  physical[0], physical[1], pbr, physical[2]))  # fmt: skip
     except MemoryError:
         raise
     except Exception:  # invalid geometry or an unreadable image: trimesh's path says what is wrong
@@ -636,9 +641,10 @@ def _from_trimesh(geometry: Any) -> tuple[Mesh, NDArray[np.uint8] | None, tuple 
     return Mesh(vertices, faces, normals, uvs, colors), image, base
 
 
-def _normal_texture(geometry: Any) -> NDArray[np.uint8] | None:
-    """The glTF material's ``normalTexture`` as (H, W, 3) bytes, or None."""
-    image = getattr(getattr(geometry.visual, "material", None), "normalTexture", None)
+def _normal_texture(geometry: Any, name: str = "normalTexture") -> NDArray[np.uint8] | None:
+    """The glTF material's ``normalTexture`` (or the texture `name`: ``emissiveTexture``) as (H, W, 3) bytes, or
+    None (also without UVs)."""
+    image = getattr(getattr(geometry.visual, "material", None), name, None)
     if image is None or getattr(geometry.visual, "uv", None) is None:
         return None
     return np.asarray(image.convert("RGB"), dtype=np.uint8)

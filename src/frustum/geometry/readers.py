@@ -58,6 +58,7 @@ class RawPart(NamedTuple):
     roughness: float | None = None
     metallic_roughness_image: Any = None
     occlusion_image: Any = None
+    emissive_image: Any = None
 
 
 class UnsupportedError(Exception):
@@ -436,8 +437,8 @@ def _read_mtl(file: Path) -> dict[str, tuple[Any, tuple[float, float, float, flo
 # --- glTF ---------------------------------------------------------------------------------------------------
 
 _COMPONENTS = {5120: "i1", 5121: "u1", 5122: "i2", 5123: "u2", 5125: "u4", 5126: "f4"}
-_GLTF_MATERIAL_KEYS = {"name", "pbrMetallicRoughness", "normalTexture", "occlusionTexture", "emissiveFactor",
-                       "alphaMode", "doubleSided"}  # fmt: skip
+_GLTF_MATERIAL_KEYS = {"name", "pbrMetallicRoughness", "normalTexture", "occlusionTexture", "emissiveTexture",
+                       "emissiveFactor", "alphaMode", "doubleSided"}  # fmt: skip
 _GLTF_PBR_KEYS = {"baseColorFactor", "baseColorTexture", "metallicFactor", "roughnessFactor",
                   "metallicRoughnessTexture"}  # fmt: skip
 _WIDTHS = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT4": 16}
@@ -548,7 +549,7 @@ def _gltf_part(gltf: dict[str, Any], primitive: dict[str, Any], name: str, acces
         uvs[:, 1] = 1.0 - uvs[:, 1]  # glTF's v runs down the image (flipped in float32, as trimesh does)
         uvs = uvs.astype(np.float64)
     image = color = normal_image = emissive = alpha_mode = None
-    metallic = roughness = metallic_roughness_image = occlusion_image = None
+    metallic = roughness = metallic_roughness_image = occlusion_image = emissive_image = None
     if "material" in primitive:
         material = gltf["materials"][primitive["material"]]
         if material.get("extensions") or not set(material) <= _GLTF_MATERIAL_KEYS:
@@ -567,13 +568,15 @@ def _gltf_part(gltf: dict[str, Any], primitive: dict[str, Any], name: str, acces
             image = _gltf_image(gltf, pbr["baseColorTexture"], view_bytes)
         if "normalTexture" in material:
             normal_image = _gltf_image(gltf, material["normalTexture"], view_bytes)
+        if "emissiveTexture" in material:
+            emissive_image = _gltf_image(gltf, material["emissiveTexture"], view_bytes)
         rgb = np.asarray(material.get("emissiveFactor", [0.0, 0.0, 0.0]), dtype=np.float64)
         if rgb.size == 3 and np.isfinite(rgb).all() and rgb.max() > 0.0:
             emissive = tuple(float(c) for c in np.clip(rgb, 0.0, 1.0))
         alpha_mode = str(material["alphaMode"]).upper() if "alphaMode" in material else None
     return RawPart(name, vertices, faces, normals, uvs, _IDENTITY.copy(), image, color, normal_image,
                    emissive, alpha_mode, metallic, roughness, metallic_roughness_image,
-                   occlusion_image)  # type: ignore[arg-type]  # fmt: skip
+                   occlusion_image, emissive_image)  # type: ignore[arg-type]  # fmt: skip
 
 
 def _gltf_color(factor: Any) -> tuple[float, float, float, float]:

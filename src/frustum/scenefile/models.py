@@ -89,7 +89,8 @@ def part_material(part: Any) -> Material:
                         emissive=emissive, model="pbr", metallic=1.0 if part.metallic is None else part.metallic,
                         roughness=1.0 if part.roughness is None else part.roughness,
                         metallic_roughness_texture=part.metallic_roughness_texture,
-                        occlusion_texture=part.occlusion_texture)  # fmt: skip
+                        occlusion_texture=part.occlusion_texture,
+                        emissive_texture=getattr(part, "emissive_texture", None))  # fmt: skip
     return Material(color=rgb, texture=texture, normal_map=normal_map, opacity=opacity, specular=0.2,
                     emissive=emissive)  # fmt: skip
 
