@@ -94,8 +94,7 @@ class MeshPart(NamedTuple):
 
         physical = (f", metallic={self.metallic!r}, roughness={self.roughness!r}, metallic_roughness_texture="
                     f"{image(self.metallic_roughness_texture)}, occlusion_texture={image(self.occlusion_texture)}, "
-                    f"physical=True, emissive_texture={image(self.emissive_texture)}"
-                    ) if self.physical else ""  # fmt: skip
+                    f"physical=True, emissive_texture={image(self.emissive_texture)}") if self.physical else ""
         return (f"MeshPart(name={self.name!r}, mesh={self.mesh!r}, texture={image(self.texture)}, "
                 f"color={self.color!r}, normal_map={image(self.normal_map)}, emissive={self.emissive!r}, "
                 f"alpha_mode={self.alpha_mode!r}{physical})")  # fmt: skip
@@ -246,10 +245,9 @@ def _native_parts(file: Path, text: bytes | None) -> list[MeshPart] | None:
             if part.normal_image is not None and part.uvs is not None:
                 normal_map = np.asarray(part.normal_image.convert("RGB"), dtype=np.uint8)
             physical = [None, None, None]
-            textures = (part.metallic_roughness_image, part.occlusion_image, part.emissive_image)
-            for k, texture_image in enumerate(textures):
-                if texture_image is not None and part.uvs is not None:
-                    physical[k] = np.asarray(texture_image.convert("RGB"), dtype=np.uint8)
+            for k, image_k in enumerate((part.metallic_roughness_image, part.occlusion_image, part.emissive_image)):
+                if image_k is not None and part.uvs is not None:
+                    physical[k] = np.asarray(image_k.convert("RGB"), dtype=np.uint8)
             pbr = file.suffix.lower() in (".glb", ".gltf") or part.metallic is not None  # glTF, or an MTL's Pr/Pm
             parts.append(MeshPart(part.name, mesh, np.asarray(part.world_from_model, dtype=np.float64), image, color,
                                   normal_map, part.emissive, part.alpha_mode, part.metallic, part.roughness,
@@ -642,8 +640,7 @@ def _from_trimesh(geometry: Any) -> tuple[Mesh, NDArray[np.uint8] | None, tuple 
 
 
 def _normal_texture(geometry: Any, name: str = "normalTexture") -> NDArray[np.uint8] | None:
-    """The glTF material's ``normalTexture`` (or the texture `name`: ``emissiveTexture``) as (H, W, 3) bytes, or
-    None (also without UVs)."""
+    """The glTF material's texture `name` (``normalTexture``, ``emissiveTexture``) as (H, W, 3) bytes, or None."""
     image = getattr(getattr(geometry.visual, "material", None), name, None)
     if image is None or getattr(geometry.visual, "uv", None) is None:
         return None
