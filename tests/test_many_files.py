@@ -153,6 +153,58 @@ def _imports(module: str) -> set[str]:
     return found - {module}
 
 
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="SIGKILL and /proc: Linux")
+def test_a_worker_of_a_killed_command_ends_with_it(tmp_path):
+    """``runtime.exit_with_parent`` (the ``--jobs`` and ``frustum warmup`` pool workers): the command's process
+    killed outright (SIGKILL: no handler runs), its worker ends within a second or so instead of waiting on its
+    pool's queue for ever."""
+    import os
+    import signal
+    import time
+
+    pid_file = tmp_path / "worker.pid"
+    command = (
+        "import multiprocessing, os, sys, time\n"
+        "from frustum.app.runtime import exit_with_parent\n"
+        "def work(path):\n"
+        "    open(path, 'w').write(str(os.getpid()))\n"
+        "    time.sleep(600)\n"
+        "if __name__ == '__main__':\n"
+        "    context = multiprocessing.get_context('spawn')\n"
+        "    from concurrent.futures import ProcessPoolExecutor\n"
+        "    pool = ProcessPoolExecutor(1, mp_context=context, initializer=exit_with_parent, initargs=(os.getpid(),))\n"
+        f"    pool.submit(work, {str(pid_file)!r})\n"
+        "    time.sleep(600)\n"
+    )
+    script = tmp_path / "command.py"
+    script.write_text(command)
+    parent = subprocess.Popen([sys.executable, str(script)])
+    try:
+        deadline = time.monotonic() + 60
+        while not pid_file.exists() or not pid_file.read_text():
+            assert time.monotonic() < deadline, "the worker did not start"
+            time.sleep(0.1)
+        worker = int(pid_file.read_text())
+        parent.send_signal(signal.SIGKILL)
+        parent.wait()
+        deadline = time.monotonic() + 5
+        while True:
+            try:
+                os.kill(worker, 0)
+            except ProcessLookupError:
+                break
+            try:
+                with open(f"/proc/{worker}/stat") as stat:
+                    if stat.read().split(") ")[-1].startswith("Z"):  # ended, not yet reaped by its new parent
+                        break
+            except FileNotFoundError:
+                break
+            assert time.monotonic() < deadline, "the worker outlived its command by 5 s"
+            time.sleep(0.1)
+    finally:
+        parent.kill()
+
+
 def test_the_program_modules_import_one_way():
     modules = sorted(path.stem for path in APP.glob("*.py") if path.stem != "__init__")
     assert sorted(ORDER) == modules, "a module of frustum.app is missing from ORDER"

@@ -14,12 +14,11 @@ from __future__ import annotations
 
 import os
 import sys
-import threading
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
-from frustum.app.runtime import UsageError, error_line, failure, install_compile_notice, say
+from frustum.app.runtime import UsageError, error_line, exit_with_parent, failure, install_compile_notice, say
 
 __all__ = ["FIELDS", "expand_inputs", "output_paths", "render_inputs", "run_each"]
 
@@ -138,18 +137,7 @@ def _init_worker(parent: int, threads: int) -> None:
     set_threads(threads)
     install_compile_notice()
     _PARENT["pid"] = parent
-    threading.Thread(target=_watch_parent, args=(parent,), name="frustum-parent-watch", daemon=True).start()
-
-
-def _watch_parent(parent: int) -> None:
-    import time
-
-    from frustum._files import remove_partial_files
-
-    while os.getppid() == parent:
-        time.sleep(0.25)
-    remove_partial_files()
-    os._exit(1)
+    exit_with_parent(parent)
 
 
 def _bar_may_show(count: int) -> bool:

@@ -17,9 +17,9 @@ from typing import Any, NoReturn
 
 from frustum.errors import FrustumError
 
-__all__ = ["GC_PAUSE_S", "INTERRUPTED_STATUS", "REPORTED", "UsageError", "as_program", "end_program", "fail",
-           "failure", "install_compile_notice", "report_failure", "run_interruptible", "run_program",
-           "say"]  # fmt: skip
+__all__ = ["GC_PAUSE_S", "INTERRUPTED_STATUS", "REPORTED", "UsageError", "as_program", "end_program",
+           "exit_with_parent", "fail", "failure", "install_compile_notice", "report_failure", "run_interruptible",
+           "run_program", "say"]  # fmt: skip
 
 
 class UsageError(FrustumError):
@@ -187,3 +187,19 @@ def install_compile_notice() -> None:
     import frustum.raster
 
     frustum.raster.compile_notice = _compile_notice
+
+
+def exit_with_parent(parent: int) -> None:
+    """In a worker process of a command (``--jobs``, ``frustum warmup``): end it, its partial files removed, as soon
+    as `parent`, the command's process, is gone. A pool's worker of a killed command would otherwise wait on its
+    task queue for ever (it holds a writing end of that queue itself, so it never reads the end of it)."""
+    threading.Thread(target=_watch_parent, args=(parent,), name="frustum-parent-watch", daemon=True).start()
+
+
+def _watch_parent(parent: int) -> None:
+    from frustum._files import remove_partial_files
+
+    while os.getppid() == parent:
+        time.sleep(0.25)
+    remove_partial_files()
+    os._exit(1)

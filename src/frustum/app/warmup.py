@@ -20,6 +20,8 @@ from types import SimpleNamespace
 
 import numpy as np
 
+from frustum.app.runtime import exit_with_parent
+
 __all__ = ["WarmupReport", "warmup"]
 
 
@@ -336,6 +338,7 @@ def warmup(processes: int | None = None) -> WarmupReport:
     processes = max(1, min(processes or os.cpu_count() or 1, len(TASKS)))
     start = time.perf_counter()
     context = multiprocessing.get_context("spawn")  # fresh interpreters: no threads or half-loaded state copied
-    with concurrent.futures.ProcessPoolExecutor(processes, mp_context=context) as pool:
+    with concurrent.futures.ProcessPoolExecutor(processes, mp_context=context, initializer=exit_with_parent,
+                                                initargs=(os.getpid(),)) as pool:  # fmt: skip
         counts = list(pool.map(_run, TASKS))
     return WarmupReport(sum(counts), processes, time.perf_counter() - start)
