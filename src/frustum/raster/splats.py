@@ -203,6 +203,7 @@ def count_tiles(records: np.ndarray, order: np.ndarray, height: int, tiles_x: in
                 counts[ty * tiles_x + tx] += 1
 
 
+# kernel specialisation kept on purpose: the second pass of count-then-fill, the loop of count_tiles with a write
 @kernel
 def fill_tiles(records: np.ndarray, order: np.ndarray, height: int, tiles_x: int, tiles_y: int,
                starts: np.ndarray, entries: np.ndarray) -> None:  # fmt: skip

@@ -94,25 +94,30 @@ def point_positions(camera: Camera, depth: np.ndarray, instance: np.ndarray, fir
 def amodal_masks(items: list[SceneItem], camera: Camera, cull: bool, factor: int) -> np.ndarray:
     """(K, H, W) bool: each item drawn alone (depth only) at `factor` times the camera's size, the middle sample
     of each factor × factor block kept (the sample ``object_id`` keeps)."""
-    from frustum.raster import shadow
-    from frustum.render.stages import TILED_BITS, bin_item
-
     height, width = camera.height, camera.width
     big = dataclasses.replace(camera, width=width * factor, height=height * factor) if factor != 1 else camera
     masks = np.zeros((len(items), height, width), dtype=bool)
     depth = np.empty((big.height, big.width), dtype=np.float32)
     middle = factor // 2
     for k, item in enumerate(items):
-        if item.mesh.face_count == 0:
-            continue
-        binned = bin_item(item, big, cull, tile_bits=TILED_BITS)
-        tiling = np.array([1 << TILED_BITS, binned.tiles_x, 0, big.width, big.height], dtype=np.int64)
-        shadow.fill_depth_tiles(
-            binned.faces, binned.win_int, binned.win_float, binned.tri_int, binned.tri_float, binned.tile_starts,
-            binned.tile_entries, tiling, depth, True,
-        )  # fmt: skip
-        np.less(depth[middle::factor, middle::factor], 1.0, out=masks[k])
+        if item.mesh.face_count:
+            _fill_depth(item, big, cull, depth, True)
+            np.less(depth[middle::factor, middle::factor], 1.0, out=masks[k])
     return masks
+
+
+def _fill_depth(item: SceneItem, camera: Camera, cull: bool, depth: np.ndarray, fresh: bool) -> None:
+    """One item's depth-only fill into `depth` (cleared first where `fresh`): stages 1–3 (``render.stages.bin_item``)
+    and ``raster.shadow.fill_depth_tiles``, the surface pass's coverage rule."""
+    from frustum.raster import shadow
+    from frustum.render.stages import TILED_BITS, bin_item
+
+    binned = bin_item(item, camera, cull, tile_bits=TILED_BITS)
+    tiling = np.array([1 << TILED_BITS, binned.tiles_x, 0, camera.width, camera.height], dtype=np.int64)
+    shadow.fill_depth_tiles(
+        binned.faces, binned.win_int, binned.win_float, binned.tri_int, binned.tri_float, binned.tile_starts,
+        binned.tile_entries, tiling, depth, fresh,
+    )  # fmt: skip
 
 
 def point_masks(scene: Scene, camera: Camera, options: RenderOptions) -> np.ndarray:
@@ -209,19 +214,10 @@ def view_distance(camera: Camera, window_depth: np.ndarray) -> np.ndarray:
 
 def _depth_of(scene: Scene, camera: Camera, cull: bool) -> np.ndarray:
     """The window depth buffer of `scene`'s meshes seen by `camera` (depth-only fills, 1.0 where none)."""
-    from frustum.raster import shadow
-    from frustum.render.stages import TILED_BITS, bin_item
-
     depth = np.ones((camera.height, camera.width), dtype=np.float32)
     for item in scene.items:
-        if item.mesh.face_count == 0:
-            continue
-        binned = bin_item(item, camera, cull, tile_bits=TILED_BITS)
-        tiling = np.array([1 << TILED_BITS, binned.tiles_x, 0, camera.width, camera.height], dtype=np.int64)
-        shadow.fill_depth_tiles(
-            binned.faces, binned.win_int, binned.win_float, binned.tri_int, binned.tri_float, binned.tile_starts,
-            binned.tile_entries, tiling, depth, False,
-        )  # fmt: skip
+        if item.mesh.face_count:
+            _fill_depth(item, camera, cull, depth, False)
     return depth
 
 
