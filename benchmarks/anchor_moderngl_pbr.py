@@ -23,6 +23,7 @@ import sys
 import time
 
 import numpy as np
+from _anchor_camera import scene_camera
 
 PBR_MATERIAL = {"metallic": 0.6, "roughness": 0.45}
 LIGHT_LUX = 3.0
@@ -136,23 +137,8 @@ def main(argv: list[str] | None = None) -> int:
 
     from frustum.shading.ibl import ROUGHNESS_LEVELS, image_lighting
 
-    data = np.load(args.scene)
-    sc = {key: data[key] for key in data.files}
-    w, h = int(sc["width"]), int(sc["height"])
-    fovy = np.radians(float(sc["fovy_deg"]))
-    near, far = float(sc["near"]), float(sc["far"])
-    f = 1.0 / np.tan(fovy / 2.0)
-    proj = np.zeros((4, 4))
-    proj[0, 0], proj[1, 1] = f / (w / h), f
-    proj[2, 2], proj[2, 3], proj[3, 2] = -(far + near) / (far - near), -2.0 * far * near / (far - near), -1.0
-    eye, target, up = (sc[k].astype(float) for k in ("eye", "target", "up"))
-    forward = (target - eye) / np.linalg.norm(target - eye)
-    side = np.cross(forward, up)
-    side /= np.linalg.norm(side)
-    view = np.eye(4)
-    view[0, :3], view[1, :3], view[2, :3] = side, np.cross(side, forward), -forward
-    view[:3, 3] = -view[:3, :3] @ eye
-    mvp = (proj @ view).astype(np.float32)
+    sc, w, h, mvp = scene_camera(args.scene)
+    eye = sc["eye"].astype(float)
 
     lighting = image_lighting(bench_environment())
     level = PBR_MATERIAL["roughness"] * (len(ROUGHNESS_LEVELS) - 1)

@@ -26,6 +26,7 @@ import sys
 import time
 
 import numpy as np
+from _anchor_camera import look_at, scene_camera
 
 DEPTH_VERTEX = """
 #version 330 core
@@ -87,18 +88,6 @@ void main() {
 """
 
 
-def _look_at(eye: np.ndarray, target: np.ndarray, up: np.ndarray) -> np.ndarray:
-    f = target - eye
-    f = f / np.linalg.norm(f)
-    s = np.cross(f, up)
-    s = s / np.linalg.norm(s)
-    u = np.cross(s, f)
-    m = np.eye(4)
-    m[0, :3], m[1, :3], m[2, :3] = s, u, -f
-    m[:3, 3] = -m[:3, :3] @ eye
-    return m
-
-
 def _ortho(half: float, near: float, far: float) -> np.ndarray:
     m = np.eye(4)
     m[0, 0] = m[1, 1] = 1.0 / half
@@ -113,7 +102,7 @@ def light_matrix(vertices: np.ndarray, light_dir: np.ndarray) -> np.ndarray:
     radius = float(np.linalg.norm(vertices - centre, axis=1).max())
     eye = centre + light_dir * 2.0 * radius
     up = np.array([0.0, 1.0, 0.0]) if abs(light_dir[1]) < 0.9 else np.array([0.0, 0.0, 1.0])
-    return _ortho(radius * 1.01, radius, 3.0 * radius) @ _look_at(eye, centre, up)
+    return _ortho(radius * 1.01, radius, 3.0 * radius) @ look_at(eye, centre, up)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -126,17 +115,7 @@ def main(argv: list[str] | None = None) -> int:
 
     import moderngl
 
-    data = np.load(args.scene)
-    sc = {key: data[key] for key in data.files}
-    w, h = int(sc["width"]), int(sc["height"])
-    fovy = np.radians(float(sc["fovy_deg"]))
-    near, far = float(sc["near"]), float(sc["far"])
-    f = 1.0 / np.tan(fovy / 2.0)
-    proj = np.zeros((4, 4))
-    proj[0, 0], proj[1, 1] = f / (w / h), f
-    proj[2, 2], proj[2, 3], proj[3, 2] = -(far + near) / (far - near), -2.0 * far * near / (far - near), -1.0
-    view = _look_at(sc["eye"].astype(float), sc["target"].astype(float), sc["up"].astype(float))
-    mvp = (proj @ view).astype(np.float32)
+    sc, w, h, mvp = scene_camera(args.scene)
     light_dir = np.asarray(sc["light_dir"], dtype=np.float64)
     light_mvp = light_matrix(sc["vertices"].astype(np.float64), light_dir).astype(np.float32)
 
