@@ -94,14 +94,15 @@ are barely lit, and a larger bias would detach shadows from their casters."""
 @parallel_kernel(lambda depth, *_: depth.shape[0], work=lambda depth, *_: depth.size, grain=16384)
 def surface_points(
     depth: np.ndarray, codes: np.ndarray, bary: np.ndarray, faces: np.ndarray, world: np.ndarray,
-    face_offset: int, points: np.ndarray, facing: np.ndarray,
+    face_offset: int, points: np.ndarray, facing: np.ndarray, normals: bool,
     start: int, stop: int,
 ) -> None:  # fmt: skip
-    """World point $(u0·Pa + u1·Pb) + u2·Pc$ and unit face normal (turned toward the viewer: flipped for a back
-    face drawn two-sided) of every pixel of one item (face $code // 2 − face_offset$ in [0, M)).
+    """World point $(u0·Pa + u1·Pb) + u2·Pc$ and, where `normals`, unit face normal (turned toward the viewer:
+    flipped for a back face drawn two-sided) of every pixel of one item (face $code // 2 − face_offset$ in [0, M)).
 
     depth (H, W) float32, codes (H, W) int, bary (H, W, 2) float32, faces (M, 3) int64 counter-clockwise seen from
-    the front, world (N, 3) float; points and facing (H, W, 3) float64 written at those pixels only.
+    the front, world (N, 3) float; points and facing (H, W, 3) float64 written at those pixels only (facing not
+    read where not `normals`: any (1, 1, 3) array).
     """
     for row in range(start, stop):
         for col in range(depth.shape[1]):
@@ -118,6 +119,8 @@ def surface_points(
             a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
             for k in range(3):
                 points[row, col, k] = _interpolate(u0, u1, u2, world[a, k], world[b, k], world[c, k])
+            if not normals:
+                continue
             e1x, e1y, e1z = world[b, 0] - world[a, 0], world[b, 1] - world[a, 1], world[b, 2] - world[a, 2]
             e2x, e2y, e2z = world[c, 0] - world[a, 0], world[c, 1] - world[a, 1], world[c, 2] - world[a, 2]
             nx, ny, nz = e1y * e2z - e1z * e2y, e1z * e2x - e1x * e2z, e1x * e2y - e1y * e2x

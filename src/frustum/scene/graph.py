@@ -10,6 +10,7 @@ Why one module: the Scene and what it places (nodes, items, volumes, particles, 
 
 from __future__ import annotations
 
+import functools
 import importlib
 from collections.abc import Iterable, Iterator
 from typing import TYPE_CHECKING, Any, NamedTuple
@@ -42,6 +43,13 @@ __all__ = [
     "SceneItem",
     "VolumeItem",
 ]
+
+
+@functools.cache
+def _default_material() -> Material:
+    """``Material()``, the material of a node nothing above gives one, built once (it is frozen): the scene's item
+    lists are asked for several times a frame, and a Material checks its fields when built."""
+    return Material()
 
 
 def is_octree(value: Any) -> bool:
@@ -485,8 +493,8 @@ class Scene:
 
     def _walk_materials(self) -> Iterator[tuple[Node, Matrix4, Material]]:
         """Every node (root excluded) with its world transform and inherited material, depth-first."""
-        stack = [(child, IDENTITY, Material() if self.root.material is None else self.root.material)
-                 for child in reversed(self.root.children)]  # fmt: skip
+        top = _default_material() if self.root.material is None else self.root.material
+        stack = [(child, IDENTITY, top) for child in reversed(self.root.children)]
         while stack:
             node, parent, inherited = stack.pop()
             world = parent @ node.transform
@@ -641,7 +649,7 @@ class Scene:
             for child in node.children:
                 visit(child, world, material)
 
-        visit(self.root, IDENTITY, Material() if self.root.material is None else self.root.material)
+        visit(self.root, IDENTITY, _default_material() if self.root.material is None else self.root.material)
         return result
 
     def world_lights(self) -> list[Light]:

@@ -207,23 +207,24 @@ def shadow_lights(scene: Scene) -> tuple[list[int], list[Any]]:
 
 def surface_points(
     items: list[SceneItem], drawn: list[tuple[int, np.ndarray, int]], depth: np.ndarray, codes: np.ndarray,
-    bary: np.ndarray,
+    bary: np.ndarray, normals: bool = True,
 ) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
-    """(H, W, 3) float64 world points (NaN where nothing is drawn) and unit face normals turned toward the viewer,
-    from the depth buffer's codes and weights of the drawn items ``(index, world positions, face offset)``."""
+    """(H, W, 3) float64 world points (NaN where nothing is drawn) and, where `normals`, unit face normals turned
+    toward the viewer (else a (1, 1, 3) stand-in), from the depth buffer's codes and weights of the drawn items
+    ``(index, world positions, face offset)``."""
     from frustum.raster import shadow
 
     height, width = depth.shape
     points = take_array((height, width, 3), np.float64)
     points.fill(np.nan)
-    facing = take_array((height, width, 3), np.float64)
+    facing = take_array((height, width, 3) if normals else (1, 1, 3), np.float64)
     for index, world, offset in drawn:
         item = items[index]
         if item.mesh.face_count == 0:
             continue
         faces = _world_faces(item)
         shadow.surface_points(depth, codes, bary, faces, np.ascontiguousarray(world, dtype=np.float64), offset,
-                              points, facing)  # fmt: skip
+                              points, facing, normals)  # fmt: skip
     return points, facing
 
 

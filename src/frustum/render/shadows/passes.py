@@ -49,7 +49,8 @@ def prepare(
         return
     from frustum.render.shadows import fractions  # the shadow maps' module: loaded by the first frame that needs it
 
-    points, facing = fractions.surface_points(items, drawn, pixels.depth, pixels.codes, pixels.bary)
+    points, facing = fractions.surface_points(items, drawn, pixels.depth, pixels.codes, pixels.bary,
+                                              options.shadow is not None)  # fmt: skip
     context.outputs["position"] = points
     if options.shadow is not None:
         context.outputs["seen"] = fractions.light_fractions(
