@@ -1,7 +1,9 @@
 """Adapters to the independent oracle libraries (test-only): PyGLM, SciPy, trimesh.transformations.
 
 Each adapter returns plain float64 numpy arrays in frustum's conventions, so tests compare like with like.
-The convention traps they encode are listed in ../shared/ORACLES.md.
+The convention traps they encode are written beside each adapter: PyGLM builds float32 matrices unless given
+float64 vectors (``glm_vec``), ``np.array`` of a PyGLM matrix is already in mathematical layout (``glm_matrix``),
+its quaternions store (w, x, y, z) in that order (``glm_wxyz``), and q and −q are one rotation.
 """
 
 from __future__ import annotations
@@ -11,12 +13,12 @@ from pyglm import glm
 
 
 def glm_vec(v) -> glm.dvec3:
-    """A float64 PyGLM vector (dvec3), so builders return float64 dmat4 (ORACLES trap 2)."""
+    """A float64 PyGLM vector (dvec3), so builders return float64 dmat4."""
     return glm.dvec3(*map(float, v))
 
 
 def glm_matrix(m) -> np.ndarray:
-    """PyGLM matrix → numpy in mathematical layout: np.array(m) needs no transpose (ORACLES trap 1)."""
+    """PyGLM matrix → numpy in mathematical layout: np.array(m) needs no transpose."""
     return np.array(m, dtype=np.float64)
 
 
